@@ -1,0 +1,45 @@
+//! File readers: text -> model. Each reader stays faithful to its format and reports
+//! malformed input as a typed error naming the file, the line and what was expected.
+
+pub mod cube;
+mod error;
+mod text;
+
+pub use error::{LoadError, ParseError};
+
+use std::path::Path;
+
+use crate::model::Document;
+
+/// Largest grid a file may declare before anything is allocated: 2³⁰ values (4 GiB of f32)
+/// is beyond any GPU texture the viewer can use.
+pub const MAX_GRID_VALUES: u64 = 1 << 30;
+
+/// Reads a file from disk, picking the reader by extension (`.cube`, `.cub`, `.cube.gz`).
+pub fn load(path: &Path) -> Result<Document, LoadError> {
+    let name = path.file_name().map(|n| n.to_string_lossy().to_lowercase()).unwrap_or_default();
+    let base = name.strip_suffix(".gz").unwrap_or(&name);
+    if base.ends_with(".cube") || base.ends_with(".cub") {
+        cube::load(path)
+    } else {
+        Err(LoadError::UnknownFormat { path: path.display().to_string() })
+    }
+}
+
+/// Reads a whole file, transparently gunzipping `*.gz`.
+pub fn read_text(path: &Path) -> Result<String, LoadError> {
+    let io = |source| LoadError::Io { path: path.display().to_string(), source };
+    let bytes = std::fs::read(path).map_err(io)?;
+    let bytes = if bytes.starts_with(&[0x1f, 0x8b]) {
+        use std::io::Read;
+        let mut out = Vec::new();
+        flate2::read::MultiGzDecoder::new(&bytes[..]).read_to_end(&mut out).map_err(io)?;
+        out
+    } else {
+        bytes
+    };
+    String::from_utf8(bytes).map_err(|e| LoadError::NotText {
+        path: path.display().to_string(),
+        offset: e.utf8_error().valid_up_to(),
+    })
+}

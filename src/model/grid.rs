@@ -1,0 +1,201 @@
+//! Scalar values on a (possibly non-orthogonal) regular grid.
+
+use glam::{DMat3, DMat4, DVec3};
+
+/// Summary statistics of a grid, computed once when the grid is built.
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
+pub struct GridStats {
+    pub min: f64,
+    pub max: f64,
+    pub mean: f64,
+    /// Standard deviation of the values (population).
+    pub sigma: f64,
+    /// max(|min|, |max|): the scale the transfer function normalises by.
+    pub max_abs: f64,
+}
+
+impl GridStats {
+    pub fn of(values: &[f32]) -> Self {
+        if values.is_empty() {
+            return Self::default();
+        }
+        let (mut min, mut max, mut sum, mut sum2) = (f64::INFINITY, f64::NEG_INFINITY, 0.0, 0.0);
+        for &v in values {
+            let v = v as f64;
+            min = min.min(v);
+            max = max.max(v);
+            sum += v;
+            sum2 += v * v;
+        }
+        let n = values.len() as f64;
+        let mean = sum / n;
+        let sigma = (sum2 / n - mean * mean).max(0.0).sqrt();
+        Self { min, max, mean, sigma, max_abs: min.abs().max(max.abs()) }
+    }
+}
+
+/// What the values mean, which decides how they are coloured.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum ValueKind {
+    /// Signed (an orbital ψ): two colours by sign, opacity from ψ².
+    Signed,
+    /// Non-negative (a density ρ): one colour ramp.
+    Density,
+}
+
+/// Values on `dims` grid points. Index (i, j, k) maps to the world (bohr) through
+/// `world_from_grid`; storage is x slowest, z fastest, as in cube files.
+#[derive(Debug, Clone, PartialEq)]
+pub struct VolumeGrid {
+    pub label: String,
+    pub dims: [usize; 3],
+    pub world_from_grid: DMat4,
+    pub values: Vec<f32>,
+    pub stats: GridStats,
+    pub kind: ValueKind,
+}
+
+impl VolumeGrid {
+    /// Builds a grid; `values.len()` must equal the product of `dims`.
+    pub fn new(label: impl Into<String>, dims: [usize; 3], world_from_grid: DMat4, values: Vec<f32>) -> Self {
+        assert_eq!(values.len(), dims[0] * dims[1] * dims[2], "grid values do not match dims");
+        let stats = GridStats::of(&values);
+        // A grid with clearly negative values is an orbital (or a difference density).
+        let kind = if stats.min < -1e-3 * stats.max_abs { ValueKind::Signed } else { ValueKind::Density };
+        Self { label: label.into(), dims, world_from_grid, values, stats, kind }
+    }
+
+    /// `world_from_grid` from an origin and the three step vectors (columns), all bohr.
+    pub fn affine(origin: DVec3, steps: [DVec3; 3]) -> DMat4 {
+        DMat4::from_cols(steps[0].extend(0.0), steps[1].extend(0.0), steps[2].extend(0.0), origin.extend(1.0))
+    }
+
+    pub fn origin(&self) -> DVec3 {
+        self.world_from_grid.w_axis.truncate()
+    }
+
+    /// The step vector along grid axis `axis` (bohr).
+    pub fn step(&self, axis: usize) -> DVec3 {
+        self.world_from_grid.col(axis).truncate()
+    }
+
+    pub fn is_orthogonal(&self) -> bool {
+        let (a, b, c) = (self.step(0), self.step(1), self.step(2));
+        let tol = 1e-6 * a.length() * b.length().max(c.length());
+        a.dot(b).abs() < tol && a.dot(c).abs() < tol && b.dot(c).abs() < tol
+    }
+
+    pub fn index(&self, i: usize, j: usize, k: usize) -> usize {
+        (i * self.dims[1] + j) * self.dims[2] + k
+    }
+
+    pub fn value(&self, i: usize, j: usize, k: usize) -> f32 {
+        self.values[self.index(i, j, k)]
+    }
+
+    /// World position (bohr) of grid point (i, j, k).
+    pub fn point(&self, i: usize, j: usize, k: usize) -> DVec3 {
+        self.world_from_grid.transform_point3(DVec3::new(i as f64, j as f64, k as f64))
+    }
+
+    /// The parallelepiped spanned by the grid points: origin plus edges (n−1)·step.
+    pub fn box_edges(&self) -> DMat3 {
+        DMat3::from_cols(
+            self.step(0) * (self.dims[0].max(1) - 1) as f64,
+            self.step(1) * (self.dims[1].max(1) - 1) as f64,
+            self.step(2) * (self.dims[2].max(1) - 1) as f64,
+        )
+    }
+
+    /// The eight corners of the grid's box in world space.
+    pub fn corners(&self) -> [DVec3; 8] {
+        let e = self.box_edges();
+        let o = self.origin();
+        std::array::from_fn(|n| {
+            o + e.x_axis * (n & 1) as f64 + e.y_axis * ((n >> 1) & 1) as f64 + e.z_axis * ((n >> 2) & 1) as f64
+        })
+    }
+
+    /// Voxel volume in bohr³ (|det| of the step vectors).
+    pub fn voxel_volume(&self) -> f64 {
+        DMat3::from_cols(self.step(0), self.step(1), self.step(2)).determinant().abs()
+    }
+
+    /// Trilinear interpolation at fractional grid coordinates, clamped to the grid.
+    pub fn sample(&self, g: DVec3) -> f64 {
+        let clampi = |v: f64, n: usize| v.clamp(0.0, (n.max(1) - 1) as f64);
+        let (x, y, z) = (clampi(g.x, self.dims[0]), clampi(g.y, self.dims[1]), clampi(g.z, self.dims[2]));
+        let (i0, j0, k0) = (x.floor() as usize, y.floor() as usize, z.floor() as usize);
+        let (i1, j1, k1) =
+            ((i0 + 1).min(self.dims[0] - 1), (j0 + 1).min(self.dims[1] - 1), (k0 + 1).min(self.dims[2] - 1));
+        let (fx, fy, fz) = (x - i0 as f64, y - j0 as f64, z - k0 as f64);
+        let v = |i, j, k| self.value(i, j, k) as f64;
+        let lerp = |a: f64, b: f64, t: f64| a + (b - a) * t;
+        let c00 = lerp(v(i0, j0, k0), v(i1, j0, k0), fx);
+        let c10 = lerp(v(i0, j1, k0), v(i1, j1, k0), fx);
+        let c01 = lerp(v(i0, j0, k1), v(i1, j0, k1), fx);
+        let c11 = lerp(v(i0, j1, k1), v(i1, j1, k1), fx);
+        lerp(lerp(c00, c10, fy), lerp(c01, c11, fy), fz)
+    }
+
+    /// Trilinear value at a world position (bohr); `None` outside the grid box.
+    pub fn sample_world(&self, p: DVec3) -> Option<f64> {
+        let g = self.world_from_grid.inverse().transform_point3(p);
+        let inside = (0..3).all(|a| g[a] >= -1e-9 && g[a] <= (self.dims[a].max(1) - 1) as f64 + 1e-9);
+        inside.then(|| self.sample(g))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn linear_grid() -> VolumeGrid {
+        let dims = [4, 5, 6];
+        let w = VolumeGrid::affine(
+            DVec3::new(-1.0, 2.0, 0.5),
+            [DVec3::new(0.5, 0.1, 0.0), DVec3::new(0.0, 0.4, 0.0), DVec3::new(0.0, 0.0, 0.3)],
+        );
+        let mut values = Vec::new();
+        for i in 0..4 {
+            for j in 0..5 {
+                for k in 0..6 {
+                    values.push((i as f32) + 10.0 * j as f32 - 3.0 * k as f32);
+                }
+            }
+        }
+        VolumeGrid::new("lin", dims, w, values)
+    }
+
+    #[test]
+    fn geometry_follows_the_affine_map() {
+        let g = linear_grid();
+        assert_eq!(g.point(0, 0, 0), DVec3::new(-1.0, 2.0, 0.5));
+        assert!((g.point(2, 1, 3) - DVec3::new(0.0, 2.6, 1.4)).length() < 1e-12);
+        assert!(!g.is_orthogonal());
+        assert!((g.voxel_volume() - 0.06).abs() < 1e-12);
+        assert_eq!(g.corners()[7], g.point(3, 4, 5));
+    }
+
+    #[test]
+    fn trilinear_sampling_is_exact_for_linear_fields() {
+        let g = linear_grid();
+        let v = g.sample(DVec3::new(1.5, 2.25, 4.5));
+        assert!((v - (1.5 + 22.5 - 13.5)).abs() < 1e-9);
+        let p = g.world_from_grid.transform_point3(DVec3::new(1.5, 2.25, 4.5));
+        assert!((g.sample_world(p).unwrap() - v).abs() < 1e-9);
+        assert!(g.sample_world(DVec3::new(100.0, 0.0, 0.0)).is_none());
+    }
+
+    #[test]
+    fn stats_and_kind() {
+        let g = linear_grid();
+        assert_eq!(g.kind, ValueKind::Signed);
+        assert_eq!(g.stats.min, -15.0);
+        assert_eq!(g.stats.max, 43.0);
+        assert_eq!(g.stats.max_abs, 43.0);
+        let d = VolumeGrid::new("d", [1, 1, 2], DMat4::IDENTITY, vec![1.0, 3.0]);
+        assert_eq!(d.kind, ValueKind::Density);
+        assert_eq!((d.stats.mean, d.stats.sigma), (2.0, 1.0));
+    }
+}

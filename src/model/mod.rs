@@ -1,0 +1,15 @@
+//! The in-memory model: molecules, elements, bonds and volume grids.
+//!
+//! Everything here is in bohr and knows nothing of files, the GPU or the UI.
+
+pub mod bonds;
+pub mod document;
+pub mod elements;
+mod element_table;
+pub mod grid;
+pub mod molecule;
+pub mod units;
+
+pub use document::Document;
+pub use grid::{GridStats, VolumeGrid};
+pub use molecule::{Atom, Bond, Molecule};
