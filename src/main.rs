@@ -1,1 +1,248 @@
-fn main() {}
+//! The orbcloud command line: the viewer, headless rendering, file information, benchmarks.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use orbcloud::gpu::{AdapterPreference, GpuContext};
+use orbcloud::headless::{Headless, default_camera};
+use orbcloud::model::Document;
+use orbcloud::scene::{AtomStyle, Camera, RenderSettings, SliceMode};
+use orbcloud::{demo, formats, info};
+
+#[derive(Parser)]
+#[command(name = "orbcloud", version, about = "Molecular orbitals and densities as GPU-rendered clouds")]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+    /// Files to open in the viewer (cube, cube.gz); the bundled demo when none.
+    files: Vec<PathBuf>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Open the interactive viewer (the default).
+    Viewer { files: Vec<PathBuf> },
+    /// Render a file to a PNG without a window.
+    Render(RenderArgs),
+    /// Print atoms and grids of a file.
+    Info {
+        file: PathBuf,
+        /// Machine-readable JSON instead of text.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Print performance figures.
+    #[command(subcommand)]
+    Bench(BenchCommand),
+}
+
+#[derive(Subcommand)]
+enum BenchCommand {
+    /// ms per frame of the scene (atoms + volume slices) at a given size and slice count.
+    Render {
+        /// A cube file; the bundled demo when omitted.
+        file: Option<PathBuf>,
+        #[command(flatten)]
+        view: ViewArgs,
+        /// Frames to time (after two warm-up frames).
+        #[arg(long, default_value_t = 10)]
+        frames: u32,
+        /// Use the CPU Vulkan adapter (lavapipe) even when a GPU is present.
+        #[arg(long)]
+        lavapipe: bool,
+    },
+}
+
+#[derive(Args)]
+struct RenderArgs {
+    /// A cube file; the bundled demo when omitted.
+    file: Option<PathBuf>,
+    /// Output PNG.
+    #[arg(short, long)]
+    output: PathBuf,
+    #[command(flatten)]
+    view: ViewArgs,
+    /// Use the CPU Vulkan adapter (lavapipe) even when a GPU is present.
+    #[arg(long)]
+    lavapipe: bool,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum ModeArg {
+    /// Slices perpendicular to the view direction.
+    View,
+    /// Seed 000's three axis-aligned stacks.
+    Axis,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum AtomsArg {
+    BallAndStick,
+    SpaceFilling,
+    Hidden,
+}
+
+#[derive(Args)]
+struct ViewArgs {
+    /// Image size, WIDTHxHEIGHT.
+    #[arg(long, default_value = "800x600", value_parser = parse_size)]
+    size: [u32; 2],
+    /// Which volume of a multi-orbital cube (0-based, in file order; see `info`).
+    #[arg(long, default_value_t = 0)]
+    volume: usize,
+    /// Camera rotation about the vertical axis, degrees.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    yaw: f32,
+    /// Camera elevation, degrees.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pitch: f32,
+    /// Zoom factor (> 1 comes closer).
+    #[arg(long, default_value_t = 1.0)]
+    zoom: f32,
+    #[arg(long, value_enum, default_value_t = ModeArg::View)]
+    mode: ModeArg,
+    /// Number of slices.
+    #[arg(long)]
+    slices: Option<u32>,
+    /// Opacity scale k1 in α = k1·ρ^k2.
+    #[arg(long)]
+    k1: Option<f32>,
+    /// Opacity exponent k2 in α = k1·ρ^k2.
+    #[arg(long)]
+    k2: Option<f32>,
+    #[arg(long, value_enum, default_value_t = AtomsArg::BallAndStick)]
+    atoms: AtomsArg,
+    /// Hide the volume (atoms only).
+    #[arg(long)]
+    no_volume: bool,
+}
+
+fn parse_size(s: &str) -> Result<[u32; 2], String> {
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("expected WIDTHxHEIGHT, got {s:?}"))?;
+    let parse = |v: &str| v.trim().parse::<u32>().ok().filter(|&n| (1..=16384).contains(&n));
+    match (parse(w), parse(h)) {
+        (Some(w), Some(h)) => Ok([w, h]),
+        _ => Err(format!("expected WIDTHxHEIGHT with sides 1..16384, got {s:?}")),
+    }
+}
+
+impl ViewArgs {
+    fn settings(&self) -> RenderSettings {
+        let mut s = RenderSettings::default();
+        s.volume.mode = match self.mode {
+            ModeArg::View => SliceMode::ViewAligned,
+            ModeArg::Axis => SliceMode::AxisAligned,
+        };
+        s.volume.visible = !self.no_volume;
+        if let Some(n) = self.slices {
+            s.volume.slices = n.clamp(1, 4096);
+        }
+        if let Some(k1) = self.k1 {
+            s.volume.k1 = k1;
+        }
+        if let Some(k2) = self.k2 {
+            s.volume.k2 = k2;
+        }
+        s.atoms = match self.atoms {
+            AtomsArg::BallAndStick => AtomStyle::BallAndStick,
+            AtomsArg::SpaceFilling => AtomStyle::SpaceFilling,
+            AtomsArg::Hidden => AtomStyle::Hidden,
+        };
+        s
+    }
+
+    fn camera(&self, doc: &Document) -> Camera {
+        let mut cam = default_camera(doc);
+        cam.orbit(self.yaw.to_radians(), self.pitch.to_radians());
+        cam.zoom(1.0 / self.zoom.max(1e-3));
+        cam
+    }
+
+    fn volume_index(&self, doc: &Document) -> Result<Option<usize>> {
+        if doc.volumes.is_empty() {
+            return Ok(None);
+        }
+        if self.volume >= doc.volumes.len() {
+            bail!("--volume {} is out of range: the file has {} volume(s)", self.volume, doc.volumes.len());
+        }
+        Ok(Some(self.volume))
+    }
+}
+
+fn load(file: Option<&Path>) -> Result<Document> {
+    match file {
+        Some(p) => formats::load(p).map_err(anyhow::Error::from),
+        None => demo::document().context("the bundled demo did not load"),
+    }
+}
+
+fn gpu(lavapipe: bool) -> Result<GpuContext> {
+    let pref = if lavapipe { AdapterPreference::LavapipeOnly } else { AdapterPreference::HighPerformance };
+    Ok(GpuContext::headless(pref)?)
+}
+
+fn main() -> Result<()> {
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
+    let cli = Cli::parse();
+    match cli.command {
+        None => Ok(orbcloud::app::run(cli.files)?),
+        Some(Command::Viewer { files }) => Ok(orbcloud::app::run(files)?),
+        Some(Command::Render(args)) => {
+            let doc = load(args.file.as_deref())?;
+            let ctx = gpu(args.lavapipe)?;
+            let settings = args.view.settings();
+            let mut h = Headless::new(&ctx, &doc, args.view.volume_index(&doc)?, &settings, args.view.size)?;
+            let img = h.render(&ctx, &args.view.camera(&doc), &settings)?;
+            img.save(&args.output).with_context(|| format!("writing {}", args.output.display()))?;
+            eprintln!("wrote {} ({}x{}, {})", args.output.display(), img.width(), img.height(), ctx.describe());
+            Ok(())
+        }
+        Some(Command::Info { file, json }) => {
+            let doc = formats::load(&file)?;
+            if json {
+                println!("{}", serde_json::to_string_pretty(&info::describe(&doc))?);
+            } else {
+                print!("{}", info::text(&doc));
+            }
+            Ok(())
+        }
+        Some(Command::Bench(BenchCommand::Render { file, view, frames, lavapipe })) => {
+            let doc = load(file.as_deref())?;
+            let ctx = gpu(lavapipe)?;
+            let settings = view.settings();
+            let camera = view.camera(&doc);
+            let mut h = Headless::new(&ctx, &doc, view.volume_index(&doc)?, &settings, view.size)?;
+            let wait = |ctx: &GpuContext| ctx.device.poll(wgpu::PollType::wait_indefinitely()).map(|_| ());
+            for _ in 0..2 {
+                h.draw(&ctx, &camera, &settings);
+                wait(&ctx)?;
+            }
+            let mut times = Vec::new();
+            for f in 0..frames.max(1) {
+                // Turn the camera a little each frame so the slices are cut anew, as in the viewer.
+                let mut cam = camera;
+                cam.orbit(0.01 * f as f32, 0.0);
+                let t = Instant::now();
+                h.draw(&ctx, &cam, &settings);
+                wait(&ctx)?;
+                times.push(t.elapsed().as_secs_f64() * 1e3);
+            }
+            times.sort_by(f64::total_cmp);
+            let median = times[times.len() / 2];
+            let grid = doc.volumes.get(view.volume).map(|g| format!("{:?}", g.dims)).unwrap_or("none".into());
+            println!("adapter: {}", ctx.describe());
+            println!(
+                "scene: {} atoms, grid {grid}, {}x{}, {:?}, {} slices",
+                doc.molecule.atoms.len(),
+                view.size[0],
+                view.size[1],
+                settings.volume.mode,
+                settings.volume.slices
+            );
+            println!("ms_per_frame_median={median:.1} min={:.1} max={:.1} frames={}", times[0], times[times.len() - 1], times.len());
+            Ok(())
+        }
+    }
+}

@@ -28,18 +28,22 @@ pub fn load(path: &Path) -> Result<Document, LoadError> {
 
 /// Reads a whole file, transparently gunzipping `*.gz`.
 pub fn read_text(path: &Path) -> Result<String, LoadError> {
-    let io = |source| LoadError::Io { path: path.display().to_string(), source };
-    let bytes = std::fs::read(path).map_err(io)?;
+    let bytes = std::fs::read(path).map_err(|source| LoadError::Io { path: path.display().to_string(), source })?;
+    gunzip_text(&path.display().to_string(), &bytes)
+}
+
+/// Bytes as text, gunzipped first when they start with the gzip magic number.
+pub fn gunzip_text(name: &str, bytes: &[u8]) -> Result<String, LoadError> {
     let bytes = if bytes.starts_with(&[0x1f, 0x8b]) {
         use std::io::Read;
         let mut out = Vec::new();
-        flate2::read::MultiGzDecoder::new(&bytes[..]).read_to_end(&mut out).map_err(io)?;
+        flate2::read::MultiGzDecoder::new(bytes)
+            .read_to_end(&mut out)
+            .map_err(|source| LoadError::Io { path: name.to_string(), source })?;
         out
     } else {
-        bytes
+        bytes.to_vec()
     };
-    String::from_utf8(bytes).map_err(|e| LoadError::NotText {
-        path: path.display().to_string(),
-        offset: e.utf8_error().valid_up_to(),
-    })
+    String::from_utf8(bytes)
+        .map_err(|e| LoadError::NotText { path: name.to_string(), offset: e.utf8_error().valid_up_to() })
 }

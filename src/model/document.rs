@@ -11,3 +11,19 @@ pub struct Document {
     /// One volume per data set (a multi-orbital cube gives several).
     pub volumes: Vec<VolumeGrid>,
 }
+
+impl Document {
+    /// Bounds (bohr) of the atoms (as spheres of their covalent radius) and every volume's box; `None` for
+    /// an empty document.
+    pub fn bounds(&self) -> Option<(glam::DVec3, glam::DVec3)> {
+        let atoms = self.molecule.atoms.iter().flat_map(|a| {
+            let r = glam::DVec3::splat(a.element().covalent_radius as f64 * super::units::BOHR_PER_ANGSTROM);
+            [a.position - r, a.position + r]
+        });
+        let points = atoms.chain(self.volumes.iter().flat_map(|v| v.corners()));
+        points.fold(None, |acc, p| match acc {
+            None => Some((p, p)),
+            Some((lo, hi)) => Some((lo.min(p), hi.max(p))),
+        })
+    }
+}

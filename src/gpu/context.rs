@@ -1,0 +1,119 @@
+//! Adapter, device and queue: which GPU, which features, and what it cannot do.
+
+use thiserror::Error;
+
+#[derive(Debug, Error)]
+pub enum GpuError {
+    #[error("no GPU adapter found ({0}); install a Vulkan driver (on Debian/Ubuntu: apt-get install mesa-vulkan-drivers libvulkan1)")]
+    NoAdapter(String),
+    #[error(
+        "the adapter is {found}, but a {wanted} adapter was required (install mesa-vulkan-drivers libvulkan1 for lavapipe)"
+    )]
+    WrongAdapter { wanted: String, found: String },
+    #[error("could not open the GPU device: {0}")]
+    Device(String),
+    #[error("the volume is {dims:?} points, but this GPU holds 3D textures of at most {max} per side")]
+    VolumeTooLarge { dims: [usize; 3], max: u32 },
+    #[error("reading back the frame failed: {0}")]
+    Readback(String),
+}
+
+/// Which adapter to open.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum AdapterPreference {
+    /// The fastest adapter there is (the viewer).
+    #[default]
+    HighPerformance,
+    /// A Vulkan CPU adapter (Mesa lavapipe): reproducible output for tests and golden images.
+    LavapipeOnly,
+}
+
+pub struct GpuContext {
+    pub adapter: wgpu::Adapter,
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    pub info: wgpu::AdapterInfo,
+    /// Format of volume textures: R32Float when it can be filtered, else R16Float.
+    pub volume_format: wgpu::TextureFormat,
+}
+
+/// Features the renderer uses when the adapter has them.
+pub fn wanted_features(adapter: &wgpu::Adapter) -> wgpu::Features {
+    adapter.features() & wgpu::Features::FLOAT32_FILTERABLE
+}
+
+/// Device descriptor with the features the renderer uses and the adapter's own limits
+/// (volumes need big 3D textures and storage buffers; WebGPU defaults are too small).
+pub fn device_descriptor(adapter: &wgpu::Adapter) -> wgpu::DeviceDescriptor<'static> {
+    wgpu::DeviceDescriptor {
+        label: Some("orbcloud device"),
+        required_features: wanted_features(adapter),
+        required_limits: adapter.limits(),
+        ..Default::default()
+    }
+}
+
+/// The volume texture format a device opened with `features` can filter.
+pub fn volume_format_for(features: wgpu::Features) -> wgpu::TextureFormat {
+    if features.contains(wgpu::Features::FLOAT32_FILTERABLE) {
+        wgpu::TextureFormat::R32Float
+    } else {
+        wgpu::TextureFormat::R16Float
+    }
+}
+
+fn describe(info: &wgpu::AdapterInfo) -> String {
+    format!("{} ({:?}, {:?}, driver {})", info.name, info.backend, info.device_type, info.driver_info)
+}
+
+impl GpuContext {
+    /// Opens a device without a window.
+    pub fn headless(pref: AdapterPreference) -> Result<Self, GpuError> {
+        let backends = match pref {
+            AdapterPreference::LavapipeOnly => wgpu::Backends::VULKAN,
+            AdapterPreference::HighPerformance => wgpu::Backends::all(),
+        };
+        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+        desc.backends = backends;
+        let instance = wgpu::Instance::new(desc);
+        let adapter = match pref {
+            AdapterPreference::LavapipeOnly => {
+                let adapters = pollster::block_on(instance.enumerate_adapters(backends));
+                let found: Vec<String> = adapters.iter().map(|a| describe(&a.get_info())).collect();
+                adapters
+                    .into_iter()
+                    .find(|a| {
+                        let i = a.get_info();
+                        i.backend == wgpu::Backend::Vulkan && i.device_type == wgpu::DeviceType::Cpu
+                    })
+                    .ok_or_else(|| GpuError::WrongAdapter {
+                        wanted: "Vulkan CPU (lavapipe)".into(),
+                        found: if found.is_empty() { "none".into() } else { found.join("; ") },
+                    })?
+            }
+            AdapterPreference::HighPerformance => pollster::block_on(instance.request_adapter(
+                &wgpu::RequestAdapterOptions {
+                    power_preference: wgpu::PowerPreference::HighPerformance,
+                    ..Default::default()
+                },
+            ))
+            .map_err(|e| GpuError::NoAdapter(e.to_string()))?,
+        };
+        let (device, queue) = pollster::block_on(adapter.request_device(&device_descriptor(&adapter)))
+            .map_err(|e| GpuError::Device(e.to_string()))?;
+        Ok(Self::from_parts(adapter, device, queue))
+    }
+
+    /// Wraps a device someone else opened (the window's), reading back what it can do.
+    pub fn from_parts(adapter: wgpu::Adapter, device: wgpu::Device, queue: wgpu::Queue) -> Self {
+        let info = adapter.get_info();
+        let volume_format = volume_format_for(device.features());
+        log::info!("GPU: {}; volume textures {volume_format:?}", describe(&info));
+        Self { adapter, device, queue, info, volume_format }
+    }
+
+    /// One line naming the adapter, for logs and `bench` output.
+    pub fn describe(&self) -> String {
+        describe(&self.info)
+    }
+}

@@ -1,0 +1,38 @@
+//! The GPU layer: adapter and device selection, offscreen targets, and the render passes.
+//!
+//! Passes draw into views they do not own; the window, the CLI and the tests all call
+//! [`Renderer::render`]. Nothing here reads files or knows about the UI.
+
+pub mod atoms;
+pub mod context;
+pub mod renderer;
+pub mod resolve;
+pub mod target;
+pub mod volume;
+
+pub use context::{AdapterPreference, GpuContext, GpuError};
+pub use renderer::{FrameInput, Renderer};
+pub use target::OffscreenTarget;
+
+/// The format of the final image (sRGB storage).
+pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
+/// The scene is drawn into this first: blending hundreds of faint slices in 8 bits would round
+/// each slice's contribution away.
+pub const SCENE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+/// Depth buffer shared by the opaque impostors and the translucent slices.
+pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+/// Every WGSL shader, by file name, for validation and pipeline creation.
+pub const SHADERS: &[(&str, &str)] = &[
+    ("volume_slices.wgsl", include_str!("../../shaders/volume_slices.wgsl")),
+    ("atoms.wgsl", include_str!("../../shaders/atoms.wgsl")),
+    ("resolve.wgsl", include_str!("../../shaders/resolve.wgsl")),
+];
+
+pub(crate) fn shader_source(name: &str) -> &'static str {
+    SHADERS
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(_, s)| *s)
+        .unwrap_or_else(|| panic!("shader {name} is not in gpu::SHADERS"))
+}

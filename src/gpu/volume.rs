@@ -1,0 +1,287 @@
+//! The volume pass: a grid as a 3D texture, drawn as translucent slices back to front.
+
+use bytemuck::{Pod, Zeroable};
+use glam::{DMat4, DVec3, Mat4, Vec3, Vec4};
+use wgpu::util::DeviceExt;
+
+use super::{DEPTH_FORMAT, SCENE_FORMAT, GpuContext, GpuError};
+use crate::model::{VolumeGrid, grid::ValueKind};
+use crate::scene::VolumeSettings;
+use crate::scene::slicing::{GridBox, Slices};
+
+/// Mirror of `VolumeUniforms` in volume_slices.wgsl.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+pub struct VolumeUniforms {
+    pub clip_from_world: [[f32; 4]; 4],
+    pub tex_from_world: [[f32; 4]; 4],
+    pub eye: [f32; 4],
+    pub plane: [f32; 4],
+    pub positive_color: [f32; 4],
+    pub negative_color: [f32; 4],
+    pub params: [f32; 4],
+    pub flags: [u32; 4],
+}
+const _: () = assert!(std::mem::size_of::<VolumeUniforms>() == 224);
+
+/// A grid uploaded to the GPU, with what the shader needs to place and scale it.
+pub struct VolumeTexture {
+    pub texture: wgpu::Texture,
+    pub view: wgpu::TextureView,
+    pub dims: [usize; 3],
+    /// Texture coordinates (0..1, texel centres at grid points) from world (bohr).
+    pub tex_from_world: Mat4,
+    pub grid_box: GridBox,
+    pub kind: ValueKind,
+    pub max_abs: f32,
+    /// Mean grid spacing (bohr): the step k1 refers to.
+    pub step: f32,
+}
+
+impl VolumeTexture {
+    /// Uploads a grid. The texture's x (fastest) axis is the grid's k (cube files' fastest), so
+    /// no transposition is needed; `tex_from_world` swaps the axes instead.
+    pub fn upload(ctx: &GpuContext, grid: &VolumeGrid) -> Result<Self, GpuError> {
+        let [nx, ny, nz] = grid.dims;
+        let max = ctx.device.limits().max_texture_dimension_3d;
+        if grid.dims.iter().any(|&d| d == 0 || d > max as usize) {
+            return Err(GpuError::VolumeTooLarge { dims: grid.dims, max });
+        }
+        let format = ctx.volume_format;
+        let bytes: Vec<u8> = match format {
+            wgpu::TextureFormat::R32Float => bytemuck::cast_slice(&grid.values).to_vec(),
+            _ => {
+                let halves: Vec<half::f16> = grid.values.iter().map(|&v| half::f16::from_f32(v)).collect();
+                bytemuck::cast_slice(&halves).to_vec()
+            }
+        };
+        let texture = ctx.device.create_texture_with_data(
+            &ctx.queue,
+            &wgpu::TextureDescriptor {
+                label: Some(&format!("volume {}", grid.label)),
+                size: wgpu::Extent3d { width: nz as u32, height: ny as u32, depth_or_array_layers: nx as u32 },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D3,
+                format,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+                view_formats: &[],
+            },
+            wgpu::util::TextureDataOrder::LayerMajor,
+            &bytes,
+        );
+        let view = texture.create_view(&Default::default());
+        // tex = ((k + ½)/nz, (j + ½)/ny, (i + ½)/nx) for grid point (i, j, k).
+        let tex_from_grid = DMat4::from_cols(
+            DVec3::new(0.0, 0.0, 1.0 / nx as f64).extend(0.0),
+            DVec3::new(0.0, 1.0 / ny as f64, 0.0).extend(0.0),
+            DVec3::new(1.0 / nz as f64, 0.0, 0.0).extend(0.0),
+            DVec3::new(0.5 / nz as f64, 0.5 / ny as f64, 0.5 / nx as f64).extend(1.0),
+        );
+        let tex_from_world = (tex_from_grid * grid.world_from_grid.inverse()).as_mat4();
+        let e = grid.box_edges();
+        let grid_box = GridBox {
+            origin: grid.origin().as_vec3(),
+            edges: [e.x_axis.as_vec3(), e.y_axis.as_vec3(), e.z_axis.as_vec3()],
+        };
+        Ok(Self {
+            texture,
+            view,
+            dims: grid.dims,
+            tex_from_world,
+            grid_box,
+            kind: grid.kind,
+            max_abs: grid.stats.max_abs.max(1e-30) as f32,
+            step: grid.voxel_volume().cbrt().max(1e-6) as f32,
+        })
+    }
+}
+
+pub struct VolumePass {
+    pipeline: wgpu::RenderPipeline,
+    layout: wgpu::BindGroupLayout,
+    sampler: wgpu::Sampler,
+    uniforms: wgpu::Buffer,
+    vertices: wgpu::Buffer,
+    vertex_count: u32,
+    bind_group: Option<wgpu::BindGroup>,
+    volume: Option<VolumeTexture>,
+}
+
+impl VolumePass {
+    pub fn new(ctx: &GpuContext) -> Self {
+        let device = &ctx.device;
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("volume_slices.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(super::shader_source("volume_slices.wgsl").into()),
+        });
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("volume bind group layout"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                        view_dimension: wgpu::TextureViewDimension::D3,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 2,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                    count: None,
+                },
+            ],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("volume pipeline layout"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("volume slices"),
+            layout: Some(&pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[Some(wgpu::VertexBufferLayout {
+                    array_stride: 12,
+                    step_mode: wgpu::VertexStepMode::Vertex,
+                    attributes: &wgpu::vertex_attr_array![0 => Float32x3],
+                })],
+            },
+            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+            // Test against the atoms' depth so they hide the cloud behind them; never write.
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: DEPTH_FORMAT,
+                depth_write_enabled: Some(false),
+                depth_compare: Some(wgpu::CompareFunction::Less),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets: &[Some(wgpu::ColorTargetState {
+                    format: SCENE_FORMAT,
+                    blend: Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING),
+                    write_mask: wgpu::ColorWrites::ALL,
+                })],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("volume sampler"),
+            address_mode_u: wgpu::AddressMode::ClampToEdge,
+            address_mode_v: wgpu::AddressMode::ClampToEdge,
+            address_mode_w: wgpu::AddressMode::ClampToEdge,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        });
+        let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("volume uniforms"),
+            size: std::mem::size_of::<VolumeUniforms>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let vertices = Self::vertex_buffer(device, 1024);
+        Self { pipeline, layout, sampler, uniforms, vertices, vertex_count: 0, bind_group: None, volume: None }
+    }
+
+    fn vertex_buffer(device: &wgpu::Device, count: usize) -> wgpu::Buffer {
+        device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("volume slice vertices"),
+            size: (count * 12) as u64,
+            usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        })
+    }
+
+    /// Replaces the volume shown (None shows none).
+    pub fn set_volume(&mut self, ctx: &GpuContext, grid: Option<&VolumeGrid>) -> Result<(), GpuError> {
+        self.volume = grid.map(|g| VolumeTexture::upload(ctx, g)).transpose()?;
+        self.bind_group = self.volume.as_ref().map(|v| {
+            ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("volume bind group"),
+                layout: &self.layout,
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: self.uniforms.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&v.view) },
+                    wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&self.sampler) },
+                ],
+            })
+        });
+        Ok(())
+    }
+
+    pub fn volume(&self) -> Option<&VolumeTexture> {
+        self.volume.as_ref()
+    }
+
+    /// Cuts this frame's slices and uploads them with the uniforms.
+    pub fn prepare(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        clip_from_world: Mat4,
+        eye: Vec3,
+        view_dir: Vec3,
+        settings: &VolumeSettings,
+    ) {
+        self.vertex_count = 0;
+        let Some(vol) = &self.volume else { return };
+        if !settings.visible {
+            return;
+        }
+        let Slices { vertices, normal, spacing } = vol.grid_box.slices(settings.mode, settings.slices, eye, view_dir);
+        if vertices.is_empty() {
+            return;
+        }
+        if (self.vertices.size() as usize) < vertices.len() * 12 {
+            self.vertices = Self::vertex_buffer(device, vertices.len().next_power_of_two());
+        }
+        queue.write_buffer(&self.vertices, 0, bytemuck::cast_slice(&vertices));
+        self.vertex_count = vertices.len() as u32;
+        let rgb = |c: [f32; 3]| Vec4::new(c[0], c[1], c[2], 1.0).to_array();
+        let u = VolumeUniforms {
+            clip_from_world: clip_from_world.to_cols_array_2d(),
+            tex_from_world: vol.tex_from_world.to_cols_array_2d(),
+            eye: eye.extend(1.0).to_array(),
+            plane: normal.extend(spacing).to_array(),
+            positive_color: rgb(settings.positive_color),
+            negative_color: rgb(settings.negative_color),
+            params: [settings.k1, settings.k2, 1.0 / vol.max_abs, vol.step],
+            flags: [u32::from(vol.kind == ValueKind::Signed), 0, 0, 0],
+        };
+        queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
+    }
+
+    pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>) {
+        let Some(bind_group) = &self.bind_group else { return };
+        if self.vertex_count == 0 {
+            return;
+        }
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, bind_group, &[]);
+        pass.set_vertex_buffer(0, self.vertices.slice(..self.vertex_count as u64 * 12));
+        pass.draw(0..self.vertex_count, 0..1);
+    }
+}

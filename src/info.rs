@@ -1,0 +1,125 @@
+//! `orbcloud info`: what a file holds, as text or as JSON for scripts.
+
+use serde::Serialize;
+
+use crate::model::{Document, GridStats, grid::ValueKind, units::ANGSTROM_PER_BOHR};
+
+#[derive(Serialize)]
+pub struct AtomInfo {
+    pub index: usize,
+    pub symbol: &'static str,
+    pub z: u32,
+    pub ghost: bool,
+    pub charge: f64,
+    pub position_bohr: [f64; 3],
+}
+
+#[derive(Serialize)]
+pub struct GridInfo {
+    pub index: usize,
+    pub label: String,
+    pub dims: [usize; 3],
+    /// Row-major 4×4 affine map from grid indices (i, j, k, 1) to bohr.
+    pub world_from_grid: [[f64; 4]; 4],
+    pub orthogonal: bool,
+    pub voxel_volume_bohr3: f64,
+    pub kind: ValueKind,
+    pub stats: GridStats,
+}
+
+#[derive(Serialize)]
+pub struct DocumentInfo {
+    pub source: String,
+    pub title: String,
+    pub formula: String,
+    pub atoms: Vec<AtomInfo>,
+    pub bonds: usize,
+    pub grids: Vec<GridInfo>,
+}
+
+pub fn describe(doc: &Document) -> DocumentInfo {
+    DocumentInfo {
+        source: doc.source.clone(),
+        title: doc.title.clone(),
+        formula: doc.molecule.formula(),
+        atoms: doc
+            .molecule
+            .atoms
+            .iter()
+            .enumerate()
+            .map(|(index, a)| AtomInfo {
+                index,
+                symbol: a.element().symbol,
+                z: a.z,
+                ghost: a.ghost,
+                charge: a.charge,
+                position_bohr: a.position.to_array(),
+            })
+            .collect(),
+        bonds: doc.molecule.bonds.len(),
+        grids: doc
+            .volumes
+            .iter()
+            .enumerate()
+            .map(|(index, g)| GridInfo {
+                index,
+                label: g.label.clone(),
+                dims: g.dims,
+                world_from_grid: g.world_from_grid.transpose().to_cols_array_2d(),
+                orthogonal: g.is_orthogonal(),
+                voxel_volume_bohr3: g.voxel_volume(),
+                kind: g.kind,
+                stats: g.stats,
+            })
+            .collect(),
+    }
+}
+
+pub fn text(doc: &Document) -> String {
+    use std::fmt::Write;
+    let info = describe(doc);
+    let mut s = String::new();
+    let _ = writeln!(s, "{}: {}", info.source, info.title);
+    let _ = writeln!(s, "{} atoms ({}), {} bonds", info.atoms.len(), info.formula, info.bonds);
+    for a in &info.atoms {
+        let p = a.position_bohr;
+        let ang = p.map(|v| v * ANGSTROM_PER_BOHR);
+        let _ = writeln!(
+            s,
+            "  {:>4} {:<2}{} {:>12.6} {:>12.6} {:>12.6} bohr  ({:.4} {:.4} {:.4} Å)",
+            a.index + 1,
+            a.symbol,
+            if a.ghost { "*" } else { " " },
+            p[0],
+            p[1],
+            p[2],
+            ang[0],
+            ang[1],
+            ang[2]
+        );
+    }
+    for g in &info.grids {
+        let _ = writeln!(
+            s,
+            "grid {} \"{}\": {}×{}×{} {:?}, {}orthogonal, voxel {:.5} bohr³",
+            g.index,
+            g.label,
+            g.dims[0],
+            g.dims[1],
+            g.dims[2],
+            g.kind,
+            if g.orthogonal { "" } else { "non-" },
+            g.voxel_volume_bohr3
+        );
+        for row in &g.world_from_grid[..3] {
+            let _ = writeln!(s, "    [{:>11.6} {:>11.6} {:>11.6} | {:>11.6}]", row[0], row[1], row[2], row[3]);
+        }
+        let st = g.stats;
+        let _ = writeln!(
+            s,
+            "    min {:.6e}  max {:.6e}  mean {:.6e}  σ {:.6e}",
+            st.min, st.max, st.mean, st.sigma
+        );
+    }
+    s
+}

@@ -1,0 +1,120 @@
+//! An orbit camera around a target point. World units are bohr.
+
+use glam::{Mat4, Vec3};
+use serde::{Deserialize, Serialize};
+
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Camera {
+    /// The point the camera orbits and looks at.
+    pub target: Vec3,
+    /// Rotation about the world Y axis, radians.
+    pub yaw: f32,
+    /// Elevation above the XZ plane, radians, kept inside (−π/2, π/2).
+    pub pitch: f32,
+    /// Distance from the target, bohr.
+    pub distance: f32,
+    /// Vertical field of view, radians.
+    pub fov_y: f32,
+}
+
+impl Default for Camera {
+    fn default() -> Self {
+        Self { target: Vec3::ZERO, yaw: 0.0, pitch: 0.0, distance: 20.0, fov_y: 30f32.to_radians() }
+    }
+}
+
+const PITCH_LIMIT: f32 = std::f32::consts::FRAC_PI_2 - 1e-3;
+
+impl Camera {
+    /// A camera looking at the centre of the box `lo..hi` from far enough to see all of it.
+    pub fn framing(lo: Vec3, hi: Vec3) -> Self {
+        let mut cam = Self::default();
+        cam.frame(lo, hi);
+        cam
+    }
+
+    /// Re-targets the camera on the box `lo..hi`, keeping its direction.
+    pub fn frame(&mut self, lo: Vec3, hi: Vec3) {
+        self.target = 0.5 * (lo + hi);
+        let radius = (0.5 * (hi - lo).length()).max(1.0);
+        // The bounding sphere just fits the vertical field of view (it overestimates most boxes).
+        self.distance = radius / (0.5 * self.fov_y).sin();
+    }
+
+    /// Unit vector from the target towards the eye.
+    pub fn backward(&self) -> Vec3 {
+        let (sy, cy) = self.yaw.sin_cos();
+        let (sp, cp) = self.pitch.sin_cos();
+        Vec3::new(sy * cp, sp, cy * cp)
+    }
+
+    pub fn eye(&self) -> Vec3 {
+        self.target + self.backward() * self.distance
+    }
+
+    pub fn view_from_world(&self) -> Mat4 {
+        glam::camera::rh::view::look_at_mat4(self.eye(), self.target, Vec3::Y)
+    }
+
+    /// Near and far planes that bracket everything within `scene_radius` of the target.
+    fn depth_range(&self, scene_radius: f32) -> (f32, f32) {
+        let near = (self.distance - scene_radius).max(self.distance * 1e-3).max(1e-3);
+        let far = self.distance + scene_radius.max(1.0);
+        (near, far)
+    }
+
+    /// wgpu clip space (depth 0..1, y up) from world.
+    pub fn clip_from_world(&self, aspect: f32, scene_radius: f32) -> Mat4 {
+        let (near, far) = self.depth_range(scene_radius);
+        let proj = glam::camera::rh::proj::directx::perspective(self.fov_y, aspect.max(1e-3), near, far);
+        proj * self.view_from_world()
+    }
+
+    /// Orbits by the given angles (radians).
+    pub fn orbit(&mut self, d_yaw: f32, d_pitch: f32) {
+        self.yaw = (self.yaw + d_yaw).rem_euclid(std::f32::consts::TAU);
+        self.pitch = (self.pitch + d_pitch).clamp(-PITCH_LIMIT, PITCH_LIMIT);
+    }
+
+    /// Zooms by a factor (> 1 moves away).
+    pub fn zoom(&mut self, factor: f32) {
+        self.distance = (self.distance * factor).clamp(0.5, 1e5);
+    }
+
+    /// Moves the target in the view plane; `dx`, `dy` are fractions of the view height.
+    pub fn pan(&mut self, dx: f32, dy: f32) {
+        let back = self.backward();
+        let right = Vec3::Y.cross(back).normalize_or(Vec3::X);
+        let up = back.cross(right);
+        let height = 2.0 * self.distance * (0.5 * self.fov_y).tan();
+        self.target += (-dx * right + dy * up) * height;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn target_projects_to_centre_and_eye_sees_it_in_front() {
+        let mut cam = Camera::framing(Vec3::splat(-3.0), Vec3::new(5.0, 3.0, 3.0));
+        cam.orbit(0.7, -0.4);
+        let m = cam.clip_from_world(4.0 / 3.0, 10.0);
+        let c = m * cam.target.extend(1.0);
+        let ndc = c.truncate() / c.w;
+        assert!(ndc.x.abs() < 1e-5 && ndc.y.abs() < 1e-5);
+        assert!(ndc.z > 0.0 && ndc.z < 1.0);
+        assert!((cam.eye() - cam.target).length() - cam.distance < 1e-4);
+    }
+
+    #[test]
+    fn pitch_is_clamped_and_pan_moves_target() {
+        let mut cam = Camera::default();
+        cam.orbit(0.0, 10.0);
+        assert!(cam.pitch < std::f32::consts::FRAC_PI_2);
+        let before = cam.target;
+        cam.pan(0.1, 0.0);
+        assert!((cam.target - before).length() > 0.0);
+        assert!((cam.target - before).dot(cam.backward()).abs() < 1e-5);
+    }
+}

@@ -1,0 +1,8 @@
+//! What to draw and how: camera and render settings. Plain, serialisable data; no wgpu.
+
+pub mod camera;
+pub mod settings;
+pub mod slicing;
+
+pub use camera::Camera;
+pub use settings::{AtomStyle, RenderSettings, SliceMode, VolumeSettings};

@@ -1,0 +1,65 @@
+//! Render settings the UI edits and the CLI parses: plain data.
+
+use serde::{Deserialize, Serialize};
+
+/// How the volume is cut into slices.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub enum SliceMode {
+    /// Planes perpendicular to the view direction, cut from the grid box each frame.
+    #[default]
+    ViewAligned,
+    /// Seed 000: three stacks along the grid axes; the one facing the viewer is drawn.
+    AxisAligned,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct VolumeSettings {
+    pub visible: bool,
+    pub mode: SliceMode,
+    /// Number of slices through the volume.
+    pub slices: u32,
+    /// Opacity scale k1 in α = k1·ρ^k2 (per grid spacing of travel).
+    pub k1: f32,
+    /// Opacity shape k2; ρ is ψ² (orbitals) or the density, normalised to its maximum.
+    pub k2: f32,
+    /// Linear RGB for positive ψ (or the dense end of a density ramp).
+    pub positive_color: [f32; 3],
+    /// Linear RGB for negative ψ (or the thin end of a density ramp).
+    pub negative_color: [f32; 3],
+}
+
+impl Default for VolumeSettings {
+    fn default() -> Self {
+        Self {
+            visible: true,
+            mode: SliceMode::ViewAligned,
+            slices: 192,
+            k1: 0.12,
+            k2: 0.5,
+            positive_color: [0.90, 0.12, 0.10],
+            negative_color: [0.10, 0.30, 0.95],
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub enum AtomStyle {
+    #[default]
+    BallAndStick,
+    SpaceFilling,
+    Hidden,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct RenderSettings {
+    pub volume: VolumeSettings,
+    pub atoms: AtomStyle,
+    /// Linear RGB background.
+    pub background: [f32; 3],
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        Self { volume: VolumeSettings::default(), atoms: AtomStyle::default(), background: [0.02, 0.02, 0.03] }
+    }
+}

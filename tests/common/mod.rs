@@ -1,0 +1,114 @@
+//! Shared by the GPU tests: the lavapipe context, synthetic scenes and golden-image checks.
+#![allow(dead_code)]
+
+use std::path::PathBuf;
+
+use glam::DVec3;
+use orbcloud::gpu::{AdapterPreference, GpuContext};
+use orbcloud::model::{Atom, Document, Molecule, VolumeGrid, units::BOHR_PER_ANGSTROM};
+
+/// The test adapter: Mesa lavapipe on Vulkan. Fails loudly (never skips) when it is missing.
+pub fn lavapipe() -> GpuContext {
+    let ctx = GpuContext::headless(AdapterPreference::LavapipeOnly).unwrap_or_else(|e| {
+        panic!("GPU tests need the Vulkan CPU adapter (lavapipe): {e}. Install: apt-get install -y mesa-vulkan-drivers libvulkan1")
+    });
+    assert_eq!(ctx.info.backend, wgpu::Backend::Vulkan, "tests must run on Vulkan, got {}", ctx.describe());
+    eprintln!("test adapter: {}", ctx.describe());
+    ctx
+}
+
+fn atom(z: u32, ang: [f64; 3]) -> Atom {
+    Atom { z, charge: z as f64, position: DVec3::from(ang) * BOHR_PER_ANGSTROM, ghost: false }
+}
+
+/// Formaldehyde-like skeleton in the xy plane, C=O along x, centred near the origin.
+pub fn formaldehyde() -> Molecule {
+    Molecule::new(vec![
+        atom(6, [-0.6, 0.0, 0.0]),
+        atom(8, [0.61, 0.0, 0.0]),
+        atom(1, [-1.15, 0.94, 0.0]),
+        atom(1, [-1.15, -0.94, 0.0]),
+    ])
+}
+
+/// A π-like orbital: ψ = z·exp(−r²/σ²) around the C=O midpoint, on an `n`³ grid, optionally
+/// sheared (non-orthogonal axes).
+pub fn p_orbital(n: usize, sheared: bool) -> VolumeGrid {
+    let half = 4.5;
+    let h = 2.0 * half / (n - 1) as f64;
+    let steps = if sheared {
+        [DVec3::new(h, 0.0, 0.0), DVec3::new(0.35 * h, h, 0.0), DVec3::new(0.0, 0.2 * h, h)]
+    } else {
+        [DVec3::new(h, 0.0, 0.0), DVec3::new(0.0, h, 0.0), DVec3::new(0.0, 0.0, h)]
+    };
+    let origin = DVec3::splat(-half) - if sheared { 0.5 * (n - 1) as f64 * (steps[1] - DVec3::new(0.0, h, 0.0)) } else { DVec3::ZERO };
+    let world = VolumeGrid::affine(origin, steps);
+    let mut values = Vec::with_capacity(n * n * n);
+    for i in 0..n {
+        for j in 0..n {
+            for k in 0..n {
+                let p = world.transform_point3(DVec3::new(i as f64, j as f64, k as f64));
+                let r2 = (p - DVec3::new(0.3, 0.0, 0.0)).length_squared();
+                values.push((p.z * (-r2 / 4.0).exp()) as f32);
+            }
+        }
+    }
+    VolumeGrid::new(if sheared { "sheared p" } else { "p" }, [n, n, n], world, values)
+}
+
+pub fn scene(with_volume: Option<VolumeGrid>) -> Document {
+    Document {
+        source: "synthetic".into(),
+        title: "formaldehyde-like test scene".into(),
+        molecule: formaldehyde(),
+        volumes: with_volume.into_iter().collect(),
+    }
+}
+
+/// Compares `actual` with tests/golden/NAME.png (lavapipe output). Writes NAME.actual.png and
+/// NAME.diff.png on failure; `ORBCLOUD_BLESS=1` rewrites the reference.
+///
+/// Tolerance: lavapipe is bit-identical run to run, so the check is tight but not exact (other
+/// Mesa versions round a few edge pixels differently): at most 0.5% of pixels may differ by more
+/// than 8/255 in any channel, and the mean absolute difference must stay below 1/255.
+pub fn assert_golden(name: &str, actual: &image::RgbaImage) {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/golden");
+    let reference = dir.join(format!("{name}.png"));
+    if std::env::var_os("ORBCLOUD_BLESS").is_some() {
+        actual.save(&reference).unwrap();
+        eprintln!("blessed {}", reference.display());
+        return;
+    }
+    let expected = image::open(&reference)
+        .unwrap_or_else(|e| panic!("{}: {e} (run with ORBCLOUD_BLESS=1 to create it)", reference.display()))
+        .to_rgba8();
+    assert_eq!(expected.dimensions(), actual.dimensions(), "{name}: size differs from the reference");
+    let mut diff = image::RgbaImage::new(actual.width(), actual.height());
+    let (mut bad, mut sum) = (0usize, 0u64);
+    for (x, y, a) in actual.enumerate_pixels() {
+        let e = expected.get_pixel(x, y);
+        let d = (0..4).map(|c| (a[c] as i32 - e[c] as i32).unsigned_abs()).max().unwrap_or(0);
+        sum += d as u64;
+        if d > 8 {
+            bad += 1;
+        }
+        let v = (d * 8).min(255) as u8;
+        diff.put_pixel(x, y, image::Rgba([v, v, v, 255]));
+    }
+    let n = (actual.width() * actual.height()) as usize;
+    let mean = sum as f64 / n as f64;
+    if bad * 200 > n || mean > 1.0 {
+        actual.save(dir.join(format!("{name}.actual.png"))).unwrap();
+        diff.save(dir.join(format!("{name}.diff.png"))).unwrap();
+        panic!("{name}: {bad} of {n} pixels differ by > 8/255, mean |diff| {mean:.3}/255; see tests/golden/{name}.actual.png and .diff.png");
+    }
+}
+
+/// Fraction of pixels that differ from the background colour by more than a few counts.
+pub fn coverage(img: &image::RgbaImage, background: [u8; 3]) -> f64 {
+    let covered = img
+        .pixels()
+        .filter(|p| (0..3).any(|c| (p[c] as i32 - background[c] as i32).abs() > 6))
+        .count();
+    covered as f64 / (img.width() * img.height()) as f64
+}

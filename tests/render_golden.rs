@@ -1,0 +1,93 @@
+//! Golden images on lavapipe: both slice modes, atoms only, atoms with a cloud, a sheared grid.
+//! References live in tests/golden; see `common::assert_golden` for the tolerance.
+
+mod common;
+
+use common::{assert_golden, coverage, lavapipe, p_orbital, scene};
+use orbcloud::headless::{default_camera, render_document};
+use orbcloud::scene::{AtomStyle, RenderSettings, SliceMode};
+
+const SIZE: [u32; 2] = [192, 144];
+
+fn settings(mode: SliceMode, atoms: AtomStyle) -> RenderSettings {
+    let mut s = RenderSettings::default();
+    s.volume.mode = mode;
+    s.volume.slices = 96;
+    s.atoms = atoms;
+    s
+}
+
+fn render(doc: &orbcloud::model::Document, s: &RenderSettings, yaw: f32, pitch: f32) -> image::RgbaImage {
+    let ctx = lavapipe();
+    let mut cam = default_camera(doc);
+    cam.orbit(yaw.to_radians(), pitch.to_radians());
+    let index = (!doc.volumes.is_empty()).then_some(0);
+    render_document(&ctx, doc, index, &cam, s, SIZE).expect("render")
+}
+
+fn background(s: &RenderSettings) -> [u8; 3] {
+    // sRGB encoding of the linear background colour.
+    s.background.map(|c| {
+        let v = if c <= 0.0031308 { 12.92 * c } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 };
+        (v * 255.0).round() as u8
+    })
+}
+
+#[test]
+fn atoms_only() {
+    let s = settings(SliceMode::ViewAligned, AtomStyle::BallAndStick);
+    let img = render(&scene(None), &s, 20.0, 25.0);
+    let c = coverage(&img, background(&s));
+    assert!(c > 0.02 && c < 0.5, "atoms cover {c}");
+    assert_golden("atoms_only", &img);
+}
+
+#[test]
+fn space_filling() {
+    let s = settings(SliceMode::ViewAligned, AtomStyle::SpaceFilling);
+    let img = render(&scene(None), &s, 20.0, 25.0);
+    let ball = render(&scene(None), &settings(SliceMode::ViewAligned, AtomStyle::BallAndStick), 20.0, 25.0);
+    assert!(coverage(&img, background(&s)) > 1.5 * coverage(&ball, background(&s)));
+    assert_golden("space_filling", &img);
+}
+
+#[test]
+fn cloud_view_aligned() {
+    let s = settings(SliceMode::ViewAligned, AtomStyle::Hidden);
+    let img = render(&scene(Some(p_orbital(40, false))), &s, 65.0, 20.0);
+    assert_two_coloured_lobes(&img);
+    assert_golden("cloud_view_aligned", &img);
+}
+
+#[test]
+fn cloud_axis_aligned() {
+    let s = settings(SliceMode::AxisAligned, AtomStyle::Hidden);
+    let img = render(&scene(Some(p_orbital(40, false))), &s, 65.0, 20.0);
+    assert_two_coloured_lobes(&img);
+    assert_golden("cloud_axis_aligned", &img);
+}
+
+#[test]
+fn atoms_and_cloud() {
+    let s = settings(SliceMode::ViewAligned, AtomStyle::BallAndStick);
+    let img = render(&scene(Some(p_orbital(40, false))), &s, 65.0, 20.0);
+    assert_two_coloured_lobes(&img);
+    assert_golden("atoms_and_cloud", &img);
+}
+
+#[test]
+fn sheared_grid() {
+    let s = settings(SliceMode::ViewAligned, AtomStyle::BallAndStick);
+    let img = render(&scene(Some(p_orbital(40, true))), &s, -60.0, 15.0);
+    assert_two_coloured_lobes(&img);
+    assert_golden("sheared_grid", &img);
+}
+
+/// The p orbital is positive above the molecular plane (z > 0) and negative below: both the red
+/// and the blue colour must show.
+fn assert_two_coloured_lobes(img: &image::RgbaImage) {
+    let red = img.pixels().filter(|p| p[0] as i32 > p[2] as i32 + 30).count();
+    let blue = img.pixels().filter(|p| p[2] as i32 > p[0] as i32 + 30).count();
+    let n = (img.width() * img.height()) as usize;
+    assert!(red * 50 > n && blue * 50 > n, "red {red} blue {blue} of {n} pixels");
+}
