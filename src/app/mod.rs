@@ -1,7 +1,201 @@
-//! The eframe viewer.
+//! The eframe viewer: the only module that uses egui and rfd.
+
+mod loader;
+mod panels;
+pub mod state;
+mod viewport;
 
 use std::path::PathBuf;
+use std::sync::Arc;
 
-pub fn run(_files: Vec<PathBuf>) -> eframe::Result<()> {
-    Ok(())
+use crate::gpu::{GpuContext, context::device_descriptor};
+use crate::headless::default_camera;
+use crate::model::Document;
+use loader::LoadJob;
+pub use state::ViewState;
+use viewport::Viewport;
+
+/// Opens the window on `files` (the bundled demo when empty) and runs until it closes.
+pub fn run(files: Vec<PathBuf>) -> eframe::Result<()> {
+    let options = eframe::NativeOptions {
+        viewport: egui::ViewportBuilder::default()
+            .with_title("orbcloud")
+            .with_inner_size([1280.0, 800.0])
+            .with_drag_and_drop(true),
+        wgpu_options: egui_wgpu::WgpuConfiguration { wgpu_setup: wgpu_setup(false), ..Default::default() },
+        ..Default::default()
+    };
+    eframe::run_native("orbcloud", options, Box::new(|cc| Ok(Box::new(OrbApp::new(cc, files)))))
+}
+
+/// The window's device: the renderer's features and the adapter's limits. `lavapipe` picks
+/// the Vulkan CPU adapter (tests).
+pub fn wgpu_setup(lavapipe: bool) -> egui_wgpu::WgpuSetup {
+    let mut setup = egui_wgpu::WgpuSetupCreateNew::without_display_handle();
+    setup.device_descriptor = Arc::new(device_descriptor);
+    if lavapipe {
+        setup.instance_descriptor.backends = wgpu::Backends::VULKAN;
+        setup.native_adapter_selector = Some(Arc::new(|adapters, _surface| {
+            adapters
+                .iter()
+                .find(|a| a.get_info().device_type == wgpu::DeviceType::Cpu)
+                .cloned()
+                .ok_or_else(|| "no Vulkan CPU adapter (install mesa-vulkan-drivers libvulkan1)".to_owned())
+        }));
+    }
+    egui_wgpu::WgpuSetup::CreateNew(setup)
+}
+
+pub struct OrbApp {
+    pub doc: Document,
+    pub view: ViewState,
+    viewport: Option<Viewport>,
+    job: Option<LoadJob>,
+    /// Files given on the command line or dropped, waiting to be loaded one after another.
+    queue: Vec<PathBuf>,
+    pub error: Option<String>,
+    pub status: String,
+}
+
+impl OrbApp {
+    pub fn new(cc: &eframe::CreationContext<'_>, files: Vec<PathBuf>) -> Self {
+        let viewport = cc.wgpu_render_state.as_ref().map(|rs| {
+            Viewport::new(GpuContext::from_parts(rs.adapter.clone(), rs.device.clone(), rs.queue.clone()))
+        });
+        let mut app = Self {
+            doc: Document::default(),
+            view: ViewState::default(),
+            viewport,
+            job: None,
+            queue: files.into_iter().rev().collect(),
+            error: None,
+            status: String::new(),
+        };
+        if app.viewport.is_none() {
+            app.error = Some("no wgpu render state: the viewer needs eframe's wgpu backend".into());
+        }
+        if app.queue.is_empty() {
+            match crate::demo::document() {
+                Ok(doc) => app.show_document(doc),
+                Err(e) => app.error = Some(e.to_string()),
+            }
+        }
+        app
+    }
+
+    /// Starts loading a file in the background; what is shown stays until it has loaded.
+    pub fn open(&mut self, path: PathBuf, ctx: &egui::Context) {
+        let ctx = ctx.clone();
+        self.job = Some(LoadJob::start(path, move || ctx.request_repaint()));
+    }
+
+    pub fn is_loading(&self) -> bool {
+        self.job.is_some() || !self.queue.is_empty()
+    }
+
+    fn show_document(&mut self, doc: Document) {
+        let mut view = self.view;
+        view.camera = default_camera(&doc);
+        view.volume = 0;
+        if let Some(vp) = &mut self.viewport
+            && let Err(e) = vp.set_document(&doc, &view)
+        {
+            self.error = Some(format!("{}: {e}", doc.source));
+            return;
+        }
+        self.status = format!("opened {}", doc.source);
+        self.doc = doc;
+        self.view = view;
+    }
+
+    fn poll_job(&mut self, ctx: &egui::Context) {
+        if let Some(job) = &self.job
+            && let Some(result) = job.poll()
+        {
+            self.job = None;
+            match result {
+                Ok(doc) => self.show_document(doc),
+                Err(e) => self.error = Some(e.to_string()),
+            }
+        }
+        if self.job.is_none()
+            && let Some(next) = self.queue.pop()
+        {
+            self.open(next, ctx);
+        }
+        let dropped: Vec<PathBuf> = ctx.input(|i| i.raw.dropped_files.iter().map(|f| f.path().to_path_buf()).filter(|p| !p.as_os_str().is_empty()).collect());
+        for path in dropped.into_iter().rev() {
+            self.queue.push(path);
+        }
+    }
+
+    /// Applies a change of the shown volume or atom style made in the panels.
+    fn apply(&mut self, before: &ViewState) {
+        let Some(vp) = &mut self.viewport else { return };
+        if before.volume != self.view.volume
+            && let Err(e) = vp.set_volume(&self.doc, self.view.volume)
+        {
+            self.error = Some(e.to_string());
+        }
+        if before.settings.atoms != self.view.settings.atoms {
+            vp.set_atom_style(&self.doc, &self.view);
+        }
+    }
+
+    /// Saves the current view as a PNG: where the user chooses, or in the working directory
+    /// when no file dialog is available.
+    fn screenshot(&mut self) {
+        let Some(vp) = &mut self.viewport else { return };
+        let size = vp.size().unwrap_or([1280, 800]);
+        let default_name = format!(
+            "orbcloud-{}.png",
+            std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map(|d| d.as_secs()).unwrap_or(0)
+        );
+        let path = rfd::FileDialog::new()
+            .add_filter("PNG image", &["png"])
+            .set_file_name(&default_name)
+            .save_file()
+            .unwrap_or_else(|| PathBuf::from(&default_name));
+        match vp.snapshot(&self.view, size).map(|img| img.save(&path)) {
+            Ok(Ok(())) => self.status = format!("saved {}", path.display()),
+            Ok(Err(e)) => self.error = Some(format!("{}: {e}", path.display())),
+            Err(e) => self.error = Some(e.to_string()),
+        }
+    }
+}
+
+impl eframe::App for OrbApp {
+    fn ui(&mut self, ui: &mut egui::Ui, frame: &mut eframe::Frame) {
+        let ctx = ui.ctx().clone();
+        self.poll_job(&ctx);
+        let before = self.view;
+        let action = panels::top_bar(ui, self);
+        panels::status_bar(ui, self);
+        panels::side_panel(ui, self);
+        self.apply(&before);
+        match action {
+            panels::Action::Open => {
+                if let Some(path) = rfd::FileDialog::new()
+                    .add_filter("Gaussian cube", &["cube", "cub", "gz"])
+                    .pick_file()
+                {
+                    self.open(path, &ctx);
+                } else {
+                    self.status = "no file chosen (open files from the command line or drop them on the window)".into();
+                }
+            }
+            panels::Action::Screenshot => self.screenshot(),
+            panels::Action::ResetView => self.view.camera = default_camera(&self.doc),
+            panels::Action::None => {}
+        }
+        panels::error_window(ui, self);
+        egui::CentralPanel::no_frame().show(ui, |ui| {
+            if let (Some(vp), Some(rs)) = (&mut self.viewport, frame.wgpu_render_state()) {
+                vp.show(ui, rs, &mut self.view);
+            }
+        });
+        if self.is_loading() {
+            ctx.request_repaint_after(std::time::Duration::from_millis(100));
+        }
+    }
 }

@@ -17,10 +17,31 @@ pub const MAX_GRID_VALUES: u64 = 1 << 30;
 
 /// Reads a file from disk, picking the reader by extension (`.cube`, `.cub`, `.cube.gz`).
 pub fn load(path: &Path) -> Result<Document, LoadError> {
+    reader_for(path)?;
+    let bytes = std::fs::read(path).map_err(|source| LoadError::Io { path: path.display().to_string(), source })?;
+    load_bytes(path, &bytes)
+}
+
+/// Parses a file's bytes already in memory; `path` picks the reader and names the file in errors.
+pub fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Document, LoadError> {
+    let name = path.display().to_string();
+    let text = gunzip_text(&name, bytes)?;
+    let mut doc = match reader_for(path)? {
+        Reader::Cube => cube::parse(&name, &text)?,
+    };
+    doc.source = name;
+    Ok(doc)
+}
+
+enum Reader {
+    Cube,
+}
+
+fn reader_for(path: &Path) -> Result<Reader, LoadError> {
     let name = path.file_name().map(|n| n.to_string_lossy().to_lowercase()).unwrap_or_default();
     let base = name.strip_suffix(".gz").unwrap_or(&name);
     if base.ends_with(".cube") || base.ends_with(".cub") {
-        cube::load(path)
+        Ok(Reader::Cube)
     } else {
         Err(LoadError::UnknownFormat { path: path.display().to_string() })
     }

@@ -1,0 +1,61 @@
+//! Loading files on a background thread, with progress, so the window stays responsive and
+//! keeps what it shows until the new file has loaded.
+
+use std::io::Read;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::mpsc::{Receiver, channel};
+
+use crate::formats::{self, LoadError};
+use crate::model::Document;
+
+pub struct LoadJob {
+    pub path: PathBuf,
+    /// Bytes read so far and the file's size; parsing starts when they are equal.
+    read: Arc<AtomicU64>,
+    total: u64,
+    result: Receiver<Result<Document, LoadError>>,
+}
+
+impl LoadJob {
+    pub fn start(path: PathBuf, repaint: impl Fn() + Send + 'static) -> Self {
+        let total = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
+        let read = Arc::new(AtomicU64::new(0));
+        let (tx, result) = channel();
+        let (p, counter) = (path.clone(), read.clone());
+        std::thread::spawn(move || {
+            let _ = tx.send(load_with_progress(&p, &counter, &repaint));
+            repaint();
+        });
+        Self { path, read, total, result }
+    }
+
+    /// Fraction of the file read (0..1), and whether it is being parsed.
+    pub fn progress(&self) -> (f32, bool) {
+        let read = self.read.load(Ordering::Relaxed);
+        let f = if self.total == 0 { 0.0 } else { read as f32 / self.total as f32 };
+        (f.min(1.0), self.total > 0 && read >= self.total)
+    }
+
+    pub fn poll(&self) -> Option<Result<Document, LoadError>> {
+        self.result.try_recv().ok()
+    }
+}
+
+fn load_with_progress(path: &Path, counter: &AtomicU64, repaint: &dyn Fn()) -> Result<Document, LoadError> {
+    let io = |source| LoadError::Io { path: path.display().to_string(), source };
+    let mut file = std::fs::File::open(path).map_err(io)?;
+    let mut bytes = Vec::new();
+    let mut chunk = vec![0u8; 1 << 20];
+    loop {
+        let n = file.read(&mut chunk).map_err(io)?;
+        if n == 0 {
+            break;
+        }
+        bytes.extend_from_slice(&chunk[..n]);
+        counter.store(bytes.len() as u64, Ordering::Relaxed);
+        repaint();
+    }
+    formats::load_bytes(path, &bytes)
+}
