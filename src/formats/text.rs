@@ -61,3 +61,19 @@ pub(crate) fn excerpt(s: &str) -> String {
     let short: String = s.chars().take(60).collect();
     if short.len() < s.len() { format!("\"{short}…\"") } else { format!("\"{short}\"") }
 }
+
+/// A Fortran-style real number: also accepts `D`/`d` exponents (`1.0D-03`).
+/// `None` when the token is not a number or not finite.
+pub(crate) fn parse_real(token: &str) -> Option<f64> {
+    let v = match token.parse::<f64>() {
+        Ok(v) => v,
+        Err(_) if token.contains(['D', 'd']) => token.replace(['D', 'd'], "E").parse::<f64>().ok()?,
+        Err(_) => return None,
+    };
+    v.is_finite().then_some(v)
+}
+
+/// 1-based number of the line holding byte `offset` of `text`.
+pub(crate) fn line_at(text: &[u8], offset: usize) -> usize {
+    1 + text[..offset.min(text.len())].iter().filter(|&&b| b == b'\n').count()
+}
