@@ -4,8 +4,8 @@
     python3 scripts/make_assets.py [--out assets/demo.cube.gz]
 
 Formaldehyde (H2CO), B3LYP/6-31G* in PySCF, symmetry off so the input
-coordinates are kept: C at the origin, C=O along +z, the CH2 group in the xz
-plane. The HOMO (MO 8, the in-plane oxygen lone pair, 2b2 in the usual
+coordinates are kept: C at the origin, C=O along +x, the molecule in the xy
+plane (the viewer's default camera looks along -z, so it sees the molecule face on). The HOMO (MO 8, the in-plane oxygen lone pair, 2b2 in the usual
 yz-plane labelling: an O 2p_x lobe pair of opposite sign mixed with the
 antisymmetric combination of the C-H bonds) is written with
 pyscf.tools.cubegen.orbital on a 48x48x48 grid with a 3.5 bohr margin and
@@ -37,14 +37,14 @@ from pyscf.tools import cubegen
 HARTREE_EV = 27.211386245988
 
 # Formaldehyde, experimental-like geometry (Å): r(CO) 1.205, r(CH) 1.111,
-# angle HCH 116.1 degrees. C at the origin, O on +z, H atoms in the xz plane.
+# angle HCH 116.1 degrees. C at the origin, O on +x, H atoms in the xy plane.
 _HCH = np.deg2rad(116.1)
 _RCH = 1.111
 FORMALDEHYDE = [
     ("C", (0.0, 0.0, 0.0)),
-    ("O", (0.0, 0.0, 1.205)),
-    ("H", (_RCH * np.sin(_HCH / 2), 0.0, -_RCH * np.cos(_HCH / 2))),
-    ("H", (-_RCH * np.sin(_HCH / 2), 0.0, -_RCH * np.cos(_HCH / 2))),
+    ("O", (1.205, 0.0, 0.0)),
+    ("H", (-_RCH * np.cos(_HCH / 2), _RCH * np.sin(_HCH / 2), 0.0)),
+    ("H", (-_RCH * np.cos(_HCH / 2), -_RCH * np.sin(_HCH / 2), 0.0)),
 ]
 
 DEMO_GRID = 48

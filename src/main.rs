@@ -12,7 +12,11 @@ use orbcloud::scene::{AtomStyle, Camera, RenderSettings, SliceMode};
 use orbcloud::{demo, formats, info};
 
 #[derive(Parser)]
-#[command(name = "orbcloud", version, about = "Molecular orbitals and densities as GPU-rendered clouds")]
+#[command(
+    name = "orbcloud",
+    version,
+    about = "Molecular orbitals and densities as GPU-rendered clouds"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
@@ -120,11 +124,20 @@ struct ViewArgs {
 }
 
 fn parse_size(s: &str) -> Result<[u32; 2], String> {
-    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("expected WIDTHxHEIGHT, got {s:?}"))?;
-    let parse = |v: &str| v.trim().parse::<u32>().ok().filter(|&n| (1..=16384).contains(&n));
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("expected WIDTHxHEIGHT, got {s:?}"))?;
+    let parse = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .ok()
+            .filter(|&n| (1..=16384).contains(&n))
+    };
     match (parse(w), parse(h)) {
         (Some(w), Some(h)) => Ok([w, h]),
-        _ => Err(format!("expected WIDTHxHEIGHT with sides 1..16384, got {s:?}")),
+        _ => Err(format!(
+            "expected WIDTHxHEIGHT with sides 1..16384, got {s:?}"
+        )),
     }
 }
 
@@ -165,7 +178,11 @@ impl ViewArgs {
             return Ok(None);
         }
         if self.volume >= doc.volumes.len() {
-            bail!("--volume {} is out of range: the file has {} volume(s)", self.volume, doc.volumes.len());
+            bail!(
+                "--volume {} is out of range: the file has {} volume(s)",
+                self.volume,
+                doc.volumes.len()
+            );
         }
         Ok(Some(self.volume))
     }
@@ -179,7 +196,11 @@ fn load(file: Option<&Path>) -> Result<Document> {
 }
 
 fn gpu(lavapipe: bool) -> Result<GpuContext> {
-    let pref = if lavapipe { AdapterPreference::LavapipeOnly } else { AdapterPreference::HighPerformance };
+    let pref = if lavapipe {
+        AdapterPreference::LavapipeOnly
+    } else {
+        AdapterPreference::HighPerformance
+    };
     Ok(GpuContext::headless(pref)?)
 }
 
@@ -193,10 +214,23 @@ fn main() -> Result<()> {
             let doc = load(args.file.as_deref())?;
             let ctx = gpu(args.lavapipe)?;
             let settings = args.view.settings();
-            let mut h = Headless::new(&ctx, &doc, args.view.volume_index(&doc)?, &settings, args.view.size)?;
+            let mut h = Headless::new(
+                &ctx,
+                &doc,
+                args.view.volume_index(&doc)?,
+                &settings,
+                args.view.size,
+            )?;
             let img = h.render(&ctx, &args.view.camera(&doc), &settings)?;
-            img.save(&args.output).with_context(|| format!("writing {}", args.output.display()))?;
-            eprintln!("wrote {} ({}x{}, {})", args.output.display(), img.width(), img.height(), ctx.describe());
+            img.save(&args.output)
+                .with_context(|| format!("writing {}", args.output.display()))?;
+            eprintln!(
+                "wrote {} ({}x{}, {})",
+                args.output.display(),
+                img.width(),
+                img.height(),
+                ctx.describe()
+            );
             Ok(())
         }
         Some(Command::Info { file, json }) => {
@@ -208,13 +242,22 @@ fn main() -> Result<()> {
             }
             Ok(())
         }
-        Some(Command::Bench(BenchCommand::Render { file, view, frames, lavapipe })) => {
+        Some(Command::Bench(BenchCommand::Render {
+            file,
+            view,
+            frames,
+            lavapipe,
+        })) => {
             let doc = load(file.as_deref())?;
             let ctx = gpu(lavapipe)?;
             let settings = view.settings();
             let camera = view.camera(&doc);
             let mut h = Headless::new(&ctx, &doc, view.volume_index(&doc)?, &settings, view.size)?;
-            let wait = |ctx: &GpuContext| ctx.device.poll(wgpu::PollType::wait_indefinitely()).map(|_| ());
+            let wait = |ctx: &GpuContext| {
+                ctx.device
+                    .poll(wgpu::PollType::wait_indefinitely())
+                    .map(|_| ())
+            };
             for _ in 0..2 {
                 h.draw(&ctx, &camera, &settings);
                 wait(&ctx)?;
@@ -231,7 +274,11 @@ fn main() -> Result<()> {
             }
             times.sort_by(f64::total_cmp);
             let median = times[times.len() / 2];
-            let grid = doc.volumes.get(view.volume).map(|g| format!("{:?}", g.dims)).unwrap_or("none".into());
+            let grid = doc
+                .volumes
+                .get(view.volume)
+                .map(|g| format!("{:?}", g.dims))
+                .unwrap_or("none".into());
             println!("adapter: {}", ctx.describe());
             println!(
                 "scene: {} atoms, grid {grid}, {}x{}, {:?}, {} slices",
@@ -241,7 +288,12 @@ fn main() -> Result<()> {
                 settings.volume.mode,
                 settings.volume.slices
             );
-            println!("ms_per_frame_median={median:.1} min={:.1} max={:.1} frames={}", times[0], times[times.len() - 1], times.len());
+            println!(
+                "ms_per_frame_median={median:.1} min={:.1} max={:.1} frames={}",
+                times[0],
+                times[times.len() - 1],
+                times.len()
+            );
             Ok(())
         }
     }

@@ -17,7 +17,12 @@ fn settings(mode: SliceMode, atoms: AtomStyle) -> RenderSettings {
     s
 }
 
-fn render(doc: &orbcloud::model::Document, s: &RenderSettings, yaw: f32, pitch: f32) -> image::RgbaImage {
+fn render(
+    doc: &orbcloud::model::Document,
+    s: &RenderSettings,
+    yaw: f32,
+    pitch: f32,
+) -> image::RgbaImage {
     let ctx = lavapipe();
     let mut cam = default_camera(doc);
     cam.orbit(yaw.to_radians(), pitch.to_radians());
@@ -28,7 +33,11 @@ fn render(doc: &orbcloud::model::Document, s: &RenderSettings, yaw: f32, pitch: 
 fn background(s: &RenderSettings) -> [u8; 3] {
     // sRGB encoding of the linear background colour.
     s.background.map(|c| {
-        let v = if c <= 0.0031308 { 12.92 * c } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 };
+        let v = if c <= 0.0031308 {
+            12.92 * c
+        } else {
+            1.055 * c.powf(1.0 / 2.4) - 0.055
+        };
         (v * 255.0).round() as u8
     })
 }
@@ -46,7 +55,12 @@ fn atoms_only() {
 fn space_filling() {
     let s = settings(SliceMode::ViewAligned, AtomStyle::SpaceFilling);
     let img = render(&scene(None), &s, 20.0, 25.0);
-    let ball = render(&scene(None), &settings(SliceMode::ViewAligned, AtomStyle::BallAndStick), 20.0, 25.0);
+    let ball = render(
+        &scene(None),
+        &settings(SliceMode::ViewAligned, AtomStyle::BallAndStick),
+        20.0,
+        25.0,
+    );
     assert!(coverage(&img, background(&s)) > 1.5 * coverage(&ball, background(&s)));
     assert_golden("space_filling", &img);
 }
@@ -86,8 +100,17 @@ fn sheared_grid() {
 /// The p orbital is positive above the molecular plane (z > 0) and negative below: both the red
 /// and the blue colour must show.
 fn assert_two_coloured_lobes(img: &image::RgbaImage) {
-    let red = img.pixels().filter(|p| p[0] as i32 > p[2] as i32 + 30).count();
-    let blue = img.pixels().filter(|p| p[2] as i32 > p[0] as i32 + 30).count();
+    let red = img
+        .pixels()
+        .filter(|p| p[0] as i32 > p[2] as i32 + 30)
+        .count();
+    let blue = img
+        .pixels()
+        .filter(|p| p[2] as i32 > p[0] as i32 + 30)
+        .count();
     let n = (img.width() * img.height()) as usize;
-    assert!(red * 50 > n && blue * 50 > n, "red {red} blue {blue} of {n} pixels");
+    assert!(
+        red * 50 > n && blue * 50 > n,
+        "red {red} blue {blue} of {n} pixels"
+    );
 }

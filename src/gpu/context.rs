@@ -4,7 +4,9 @@ use thiserror::Error;
 
 #[derive(Debug, Error)]
 pub enum GpuError {
-    #[error("no GPU adapter found ({0}); install a Vulkan driver (on Debian/Ubuntu: apt-get install mesa-vulkan-drivers libvulkan1)")]
+    #[error(
+        "no GPU adapter found ({0}); install a Vulkan driver (on Debian/Ubuntu: apt-get install mesa-vulkan-drivers libvulkan1)"
+    )]
     NoAdapter(String),
     #[error(
         "the adapter is {found}, but a {wanted} adapter was required (install mesa-vulkan-drivers libvulkan1 for lavapipe)"
@@ -12,7 +14,9 @@ pub enum GpuError {
     WrongAdapter { wanted: String, found: String },
     #[error("could not open the GPU device: {0}")]
     Device(String),
-    #[error("the volume is {dims:?} points, but this GPU holds 3D textures of at most {max} per side")]
+    #[error(
+        "the volume is {dims:?} points, but this GPU holds 3D textures of at most {max} per side"
+    )]
     VolumeTooLarge { dims: [usize; 3], max: u32 },
     #[error("reading back the frame failed: {0}")]
     Readback(String),
@@ -63,7 +67,10 @@ pub fn volume_format_for(features: wgpu::Features) -> wgpu::TextureFormat {
 }
 
 fn describe(info: &wgpu::AdapterInfo) -> String {
-    format!("{} ({:?}, {:?}, driver {})", info.name, info.backend, info.device_type, info.driver_info)
+    format!(
+        "{} ({:?}, {:?}, driver {})",
+        info.name, info.backend, info.device_type, info.driver_info
+    )
 }
 
 impl GpuContext {
@@ -88,19 +95,24 @@ impl GpuContext {
                     })
                     .ok_or_else(|| GpuError::WrongAdapter {
                         wanted: "Vulkan CPU (lavapipe)".into(),
-                        found: if found.is_empty() { "none".into() } else { found.join("; ") },
+                        found: if found.is_empty() {
+                            "none".into()
+                        } else {
+                            found.join("; ")
+                        },
                     })?
             }
-            AdapterPreference::HighPerformance => pollster::block_on(instance.request_adapter(
-                &wgpu::RequestAdapterOptions {
+            AdapterPreference::HighPerformance => {
+                pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
                     power_preference: wgpu::PowerPreference::HighPerformance,
                     ..Default::default()
-                },
-            ))
-            .map_err(|e| GpuError::NoAdapter(e.to_string()))?,
+                }))
+                .map_err(|e| GpuError::NoAdapter(e.to_string()))?
+            }
         };
-        let (device, queue) = pollster::block_on(adapter.request_device(&device_descriptor(&adapter)))
-            .map_err(|e| GpuError::Device(e.to_string()))?;
+        let (device, queue) =
+            pollster::block_on(adapter.request_device(&device_descriptor(&adapter)))
+                .map_err(|e| GpuError::Device(e.to_string()))?;
         Ok(Self::from_parts(adapter, device, queue))
     }
 
@@ -108,8 +120,17 @@ impl GpuContext {
     pub fn from_parts(adapter: wgpu::Adapter, device: wgpu::Device, queue: wgpu::Queue) -> Self {
         let info = adapter.get_info();
         let volume_format = volume_format_for(device.features());
-        log::info!("GPU: {}; volume textures {volume_format:?}", describe(&info));
-        Self { adapter, device, queue, info, volume_format }
+        log::info!(
+            "GPU: {}; volume textures {volume_format:?}",
+            describe(&info)
+        );
+        Self {
+            adapter,
+            device,
+            queue,
+            info,
+            volume_format,
+        }
     }
 
     /// One line naming the adapter, for logs and `bench` output.

@@ -24,7 +24,10 @@ pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
 /// Every WGSL shader, by file name, for validation and pipeline creation.
 pub const SHADERS: &[(&str, &str)] = &[
-    ("volume_slices.wgsl", include_str!("../../shaders/volume_slices.wgsl")),
+    (
+        "volume_slices.wgsl",
+        include_str!("../../shaders/volume_slices.wgsl"),
+    ),
     ("atoms.wgsl", include_str!("../../shaders/atoms.wgsl")),
     ("resolve.wgsl", include_str!("../../shaders/resolve.wgsl")),
 ];

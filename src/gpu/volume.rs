@@ -4,7 +4,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::{DMat4, DVec3, Mat4, Vec3, Vec4};
 use wgpu::util::DeviceExt;
 
-use super::{DEPTH_FORMAT, SCENE_FORMAT, GpuContext, GpuError};
+use super::{DEPTH_FORMAT, GpuContext, GpuError, SCENE_FORMAT};
 use crate::model::{VolumeGrid, grid::ValueKind};
 use crate::scene::VolumeSettings;
 use crate::scene::slicing::{GridBox, Slices};
@@ -45,13 +45,20 @@ impl VolumeTexture {
         let [nx, ny, nz] = grid.dims;
         let max = ctx.device.limits().max_texture_dimension_3d;
         if grid.dims.iter().any(|&d| d == 0 || d > max as usize) {
-            return Err(GpuError::VolumeTooLarge { dims: grid.dims, max });
+            return Err(GpuError::VolumeTooLarge {
+                dims: grid.dims,
+                max,
+            });
         }
         let format = ctx.volume_format;
         let bytes: Vec<u8> = match format {
             wgpu::TextureFormat::R32Float => bytemuck::cast_slice(&grid.values).to_vec(),
             _ => {
-                let halves: Vec<half::f16> = grid.values.iter().map(|&v| half::f16::from_f32(v)).collect();
+                let halves: Vec<half::f16> = grid
+                    .values
+                    .iter()
+                    .map(|&v| half::f16::from_f32(v))
+                    .collect();
                 bytemuck::cast_slice(&halves).to_vec()
             }
         };
@@ -59,7 +66,11 @@ impl VolumeTexture {
             &ctx.queue,
             &wgpu::TextureDescriptor {
                 label: Some(&format!("volume {}", grid.label)),
-                size: wgpu::Extent3d { width: nz as u32, height: ny as u32, depth_or_array_layers: nx as u32 },
+                size: wgpu::Extent3d {
+                    width: nz as u32,
+                    height: ny as u32,
+                    depth_or_array_layers: nx as u32,
+                },
                 mip_level_count: 1,
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D3,
@@ -164,7 +175,10 @@ impl VolumePass {
                     attributes: &wgpu::vertex_attr_array![0 => Float32x3],
                 })],
             },
-            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+            primitive: wgpu::PrimitiveState {
+                cull_mode: None,
+                ..Default::default()
+            },
             // Test against the atoms' depth so they hide the cloud behind them; never write.
             depth_stencil: Some(wgpu::DepthStencilState {
                 format: DEPTH_FORMAT,
@@ -203,7 +217,16 @@ impl VolumePass {
             mapped_at_creation: false,
         });
         let vertices = Self::vertex_buffer(device, 1024);
-        Self { pipeline, layout, sampler, uniforms, vertices, vertex_count: 0, bind_group: None, volume: None }
+        Self {
+            pipeline,
+            layout,
+            sampler,
+            uniforms,
+            vertices,
+            vertex_count: 0,
+            bind_group: None,
+            volume: None,
+        }
     }
 
     fn vertex_buffer(device: &wgpu::Device, count: usize) -> wgpu::Buffer {
@@ -216,16 +239,29 @@ impl VolumePass {
     }
 
     /// Replaces the volume shown (None shows none).
-    pub fn set_volume(&mut self, ctx: &GpuContext, grid: Option<&VolumeGrid>) -> Result<(), GpuError> {
+    pub fn set_volume(
+        &mut self,
+        ctx: &GpuContext,
+        grid: Option<&VolumeGrid>,
+    ) -> Result<(), GpuError> {
         self.volume = grid.map(|g| VolumeTexture::upload(ctx, g)).transpose()?;
         self.bind_group = self.volume.as_ref().map(|v| {
             ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("volume bind group"),
                 layout: &self.layout,
                 entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: self.uniforms.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&v.view) },
-                    wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&self.sampler) },
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: self.uniforms.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: wgpu::BindingResource::TextureView(&v.view),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: wgpu::BindingResource::Sampler(&self.sampler),
+                    },
                 ],
             })
         });
@@ -251,7 +287,13 @@ impl VolumePass {
         if !settings.visible {
             return;
         }
-        let Slices { vertices, normal, spacing } = vol.grid_box.slices(settings.mode, settings.slices, eye, view_dir);
+        let Slices {
+            vertices,
+            normal,
+            spacing,
+        } = vol
+            .grid_box
+            .slices(settings.mode, settings.slices, eye, view_dir);
         if vertices.is_empty() {
             return;
         }
@@ -275,7 +317,9 @@ impl VolumePass {
     }
 
     pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>) {
-        let Some(bind_group) = &self.bind_group else { return };
+        let Some(bind_group) = &self.bind_group else {
+            return;
+        };
         if self.vertex_count == 0 {
             return;
         }

@@ -87,7 +87,11 @@ mod tests {
 
     #[test]
     fn ghosts_and_distant_atoms_do_not_bond() {
-        let mut atoms = vec![atom(6, 0.0, 0.0, 0.0), atom(6, 1.54, 0.0, 0.0), atom(6, 5.0, 0.0, 0.0)];
+        let mut atoms = vec![
+            atom(6, 0.0, 0.0, 0.0),
+            atom(6, 1.54, 0.0, 0.0),
+            atom(6, 5.0, 0.0, 0.0),
+        ];
         assert_eq!(infer_bonds(&atoms).len(), 1);
         atoms[1].ghost = true;
         assert!(infer_bonds(&atoms).is_empty());
@@ -98,7 +102,9 @@ mod tests {
         // A pseudo-random cloud of carbons: the spatial hash must find exactly the brute-force pairs.
         let mut s = 12345u64;
         let mut rnd = || {
-            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             (s >> 11) as f64 / (1u64 << 53) as f64
         };
         let atoms: Vec<Atom> = (0..400)
@@ -110,7 +116,10 @@ mod tests {
             for j in i + 1..atoms.len() {
                 let d = atoms[i].position.distance(atoms[j].position) / BOHR_PER_ANGSTROM;
                 if d > MIN_BOND_ANG && d < 0.76 * 2.0 + BOND_TOLERANCE_ANG {
-                    slow.push(Bond { a: i as u32, b: j as u32 });
+                    slow.push(Bond {
+                        a: i as u32,
+                        b: j as u32,
+                    });
                 }
             }
         }

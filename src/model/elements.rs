@@ -49,7 +49,10 @@ mod tests {
     #[test]
     fn radii_are_physical() {
         for (z, e) in ELEMENTS.iter().enumerate().skip(1) {
-            assert!(e.covalent_radius > 0.2 && e.covalent_radius < 2.6, "Z={z} {e:?}");
+            assert!(
+                e.covalent_radius > 0.2 && e.covalent_radius < 2.6,
+                "Z={z} {e:?}"
+            );
             assert!(e.vdw_radius >= e.covalent_radius, "Z={z} {e:?}");
         }
         // Carbon: 0.76 Å covalent (sp3), 1.70-1.77 Å vdW.

@@ -4,8 +4,8 @@
 
 pub mod bonds;
 pub mod document;
-pub mod elements;
 mod element_table;
+pub mod elements;
 pub mod grid;
 pub mod molecule;
 pub mod units;

@@ -34,8 +34,8 @@ impl Default for VolumeSettings {
             visible: true,
             mode: SliceMode::ViewAligned,
             slices: 192,
-            k1: 0.12,
-            k2: 0.5,
+            k1: 0.2,
+            k2: 0.6,
             positive_color: [0.90, 0.12, 0.10],
             negative_color: [0.10, 0.30, 0.95],
         }
@@ -60,6 +60,10 @@ pub struct RenderSettings {
 
 impl Default for RenderSettings {
     fn default() -> Self {
-        Self { volume: VolumeSettings::default(), atoms: AtomStyle::default(), background: [0.02, 0.02, 0.03] }
+        Self {
+            volume: VolumeSettings::default(),
+            atoms: AtomStyle::default(),
+            background: [0.02, 0.02, 0.03],
+        }
     }
 }

@@ -1,0 +1,87 @@
+//! The viewer in egui_kittest on lavapipe: starts on the demo, reacts to controls and the mouse,
+//! and keeps what it shows when a file fails to load.
+
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
+use orbcloud::app::{OrbApp, wgpu_setup};
+use orbcloud::scene::SliceMode;
+
+fn harness() -> Harness<'static, OrbApp> {
+    let h = Harness::builder()
+        .with_size([1000.0, 700.0])
+        .wgpu_setup(wgpu_setup(true))
+        .build_eframe(|cc| OrbApp::new(cc, Vec::new()));
+    assert!(
+        h.state().error.is_none(),
+        "viewer failed to start: {:?}",
+        h.state().error
+    );
+    h
+}
+
+#[test]
+fn starts_on_the_demo_and_changes_controls() {
+    let mut h = harness();
+    h.run_steps(2);
+    let app = h.state();
+    assert_eq!(app.doc.volumes.len(), 1, "the demo cube has one orbital");
+    assert_eq!(app.doc.molecule.atoms.len(), 4, "formaldehyde");
+    assert_eq!(app.view.settings.volume.mode, SliceMode::ViewAligned);
+
+    h.get_by_label("axis stacks").click();
+    h.run_steps(2);
+    assert_eq!(h.state().view.settings.volume.mode, SliceMode::AxisAligned);
+
+    h.get_by_label("show cloud").click();
+    h.run_steps(2);
+    assert!(!h.state().view.settings.volume.visible);
+}
+
+#[test]
+fn dragging_the_view_orbits_the_camera() {
+    let mut h = harness();
+    h.run_steps(2);
+    let yaw = h.state().view.camera.yaw;
+    let start = egui::pos2(650.0, 350.0);
+    h.hover_at(start);
+    h.drag_at(start);
+    h.run_steps(1);
+    for i in 1..=5 {
+        h.hover_at(start + egui::vec2(20.0 * i as f32, 0.0));
+        h.run_steps(1);
+    }
+    h.drop_at(start + egui::vec2(100.0, 0.0));
+    h.run_steps(1);
+    let moved = h.state().view.camera.yaw;
+    assert!((moved - yaw).abs() > 0.3, "yaw {yaw} -> {moved}");
+}
+
+#[test]
+fn a_bad_file_reports_an_error_and_keeps_the_open_document() {
+    let mut h = harness();
+    h.run_steps(1);
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("broken.cube");
+    std::fs::write(
+        &bad,
+        "title\ncomment\n    2 0.0 0.0 0.0\n    3 0.5 0.0 0.0\n",
+    )
+    .unwrap();
+    let ctx = h.ctx.clone();
+    h.state_mut().open(bad, &ctx);
+    for _ in 0..200 {
+        h.run_steps(1);
+        if !h.state().is_loading() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    h.run_steps(2);
+    let app = h.state();
+    let err = app.error.as_deref().expect("an error is shown");
+    assert!(err.contains("broken.cube") && err.contains(":4"), "{err}");
+    assert_eq!(app.doc.molecule.atoms.len(), 4, "the demo stays open");
+    h.get_by_label("Dismiss").click();
+    h.run_steps(2);
+    assert!(h.state().error.is_none());
+}
