@@ -89,7 +89,9 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
                 if app.doc.volumes.is_empty() {
                     ui.label("no volume in this file");
                 } else {
-                    ComboBox::from_label("data set")
+                    ui.label("data set");
+                    ComboBox::from_id_salt("data set")
+                        .width(220.0)
                         .selected_text(
                             app.doc
                                 .volumes

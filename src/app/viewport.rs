@@ -75,7 +75,7 @@ impl Viewport {
                 Some((_, id)) => {
                     egui_renderer.update_egui_texture_from_wgpu_texture(
                         &self.ctx.device,
-                        &target.color_view,
+                        &target.encoded_view,
                         wgpu::FilterMode::Linear,
                         id,
                     );
@@ -83,7 +83,7 @@ impl Viewport {
                 }
                 None => egui_renderer.register_native_texture(
                     &self.ctx.device,
-                    &target.color_view,
+                    &target.encoded_view,
                     wgpu::FilterMode::Linear,
                 ),
             };

@@ -5,6 +5,9 @@ use super::{COLOR_FORMAT, GpuError};
 pub struct OffscreenTarget {
     pub color: wgpu::Texture,
     pub color_view: wgpu::TextureView,
+    /// The same pixels viewed as plain `Rgba8Unorm`: sampling returns the sRGB-encoded bytes,
+    /// which is what egui expects of a user texture.
+    pub encoded_view: wgpu::TextureView,
     pub size: [u32; 2],
 }
 
@@ -26,12 +29,18 @@ impl OffscreenTarget {
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT
                 | wgpu::TextureUsages::COPY_SRC
                 | wgpu::TextureUsages::TEXTURE_BINDING,
-            view_formats: &[],
+            view_formats: &[wgpu::TextureFormat::Rgba8Unorm],
         });
         let color_view = color.create_view(&Default::default());
+        let encoded_view = color.create_view(&wgpu::TextureViewDescriptor {
+            label: Some("offscreen colour, encoded"),
+            format: Some(wgpu::TextureFormat::Rgba8Unorm),
+            ..Default::default()
+        });
         Self {
             color,
             color_view,
+            encoded_view,
             size,
         }
     }
