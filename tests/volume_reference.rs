@@ -94,8 +94,7 @@ fn reference(grid: &VolumeGrid, cam: &Camera, s: &RenderSettings) -> image::Rgba
 fn compare(mode: SliceMode) {
     let grid = p_orbital(24, true);
     let doc = scene(Some(grid.clone()));
-    let mut s = RenderSettings::default();
-    s.atoms = AtomStyle::Hidden;
+    let mut s = RenderSettings { atoms: AtomStyle::Hidden, ..Default::default() };
     s.volume.mode = mode;
     s.volume.slices = 40;
     s.volume.k1 = 0.35;
