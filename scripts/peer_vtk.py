@@ -156,6 +156,10 @@ def main(argv: list[str] | None = None) -> int:
                     help="initial camera elevation from the cube's +z axis, degrees (default 60)")
     ap.add_argument("--zoom", type=float, default=1.5,
                     help="camera zoom after fitting the volume's bounding sphere (default 1.5)")
+    ap.add_argument("--eye", default=None,
+                    help="camera position x,y,z in bohr (with --target and --fov: replaces --elevation/--zoom)")
+    ap.add_argument("--target", default=None, help="camera focal point x,y,z in bohr")
+    ap.add_argument("--fov", type=float, default=30.0, help="vertical view angle, degrees (with --eye)")
     ap.add_argument("--readback", action="store_true",
                     help="also read the RGBA pixels back after every frame")
     ap.add_argument("--save", default=None, help="write the last frame as PNG")
@@ -203,11 +207,18 @@ def main(argv: list[str] | None = None) -> int:
 
     ren.ResetCamera()
     cam = ren.GetActiveCamera()
-    cam.Elevation(args.elevation)
-    cam.OrthogonalizeViewUp()
-    cam.Azimuth(30.0)
-    ren.ResetCamera()
-    cam.Zoom(args.zoom)
+    if args.eye and args.target:
+        # The exact camera another renderer used (e.g. `orbcloud bench render` prints it).
+        cam.SetPosition(*[float(v) for v in args.eye.split(",")])
+        cam.SetFocalPoint(*[float(v) for v in args.target.split(",")])
+        cam.SetViewUp(0.0, 1.0, 0.0)
+        cam.SetViewAngle(args.fov)
+    else:
+        cam.Elevation(args.elevation)
+        cam.OrthogonalizeViewUp()
+        cam.Azimuth(30.0)
+        ren.ResetCamera()
+        cam.Zoom(args.zoom)
     ren.ResetCameraClippingRange()
 
     def finish():

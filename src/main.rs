@@ -288,6 +288,26 @@ fn main() -> Result<()> {
                 settings.volume.mode,
                 settings.volume.slices
             );
+            let eye = camera.eye();
+            println!(
+                "camera: eye={:.4},{:.4},{:.4} target={:.4},{:.4},{:.4} fov_deg={:.2}",
+                eye.x,
+                eye.y,
+                eye.z,
+                camera.target.x,
+                camera.target.y,
+                camera.target.z,
+                camera.fov_y.to_degrees()
+            );
+            if let Some(v) = h.renderer.volume.volume() {
+                let s = v.grid_box.slices(
+                    settings.volume.mode,
+                    settings.volume.slices,
+                    eye,
+                    -camera.backward(),
+                );
+                println!("slice_spacing_bohr={:.5}", s.spacing);
+            }
             println!(
                 "ms_per_frame_median={median:.1} min={:.1} max={:.1} frames={}",
                 times[0],

@@ -21,8 +21,39 @@ pub struct VolumeUniforms {
     pub negative_color: [f32; 4],
     pub params: [f32; 4],
     pub flags: [u32; 4],
+    pub flags_f: [f32; 4],
 }
-const _: () = assert!(std::mem::size_of::<VolumeUniforms>() == 224);
+const _: () = assert!(std::mem::size_of::<VolumeUniforms>() == 240);
+
+/// Extinction per reference step below which a sample cannot be seen.
+const INVISIBLE: f32 = 1e-4;
+
+/// The smallest scaled |value| whose opacity k1·ρ^k2 reaches [`INVISIBLE`]
+/// (ρ = value² for an orbital, value for a density).
+pub fn visibility_threshold(k1: f32, k2: f32, signed: bool) -> f32 {
+    if k1 <= 0.0 {
+        return f32::INFINITY;
+    }
+    let rho = (INVISIBLE / k1).powf(1.0 / k2.max(1e-3));
+    if signed { rho.sqrt() } else { rho }
+}
+
+/// Values below this fraction of the grid's largest |value| are invisible at any opacity
+/// setting the viewer offers (ψ² of 10⁻⁸ of the maximum).
+const ACTIVE_FRACTION: f64 = 1e-4;
+
+/// The part of the grid's box that holds visible values: slices are cut only there, which
+/// spares the fragments that cube files' generous margins would cost.
+fn active_box(grid: &VolumeGrid) -> GridBox {
+    let (lo, hi) = grid
+        .active_bounds((ACTIVE_FRACTION * grid.stats.max_abs) as f32)
+        .unwrap_or(([0; 3], grid.dims.map(|d| d.saturating_sub(1))));
+    let lo_f = DVec3::new(lo[0] as f64, lo[1] as f64, lo[2] as f64);
+    GridBox {
+        origin: grid.world_from_grid.transform_point3(lo_f).as_vec3(),
+        edges: std::array::from_fn(|a| (grid.step(a) * (hi[a] - lo[a]) as f64).as_vec3()),
+    }
+}
 
 /// A grid uploaded to the GPU, with what the shader needs to place and scale it.
 pub struct VolumeTexture {
@@ -90,11 +121,7 @@ impl VolumeTexture {
             DVec3::new(0.5 / nz as f64, 0.5 / ny as f64, 0.5 / nx as f64).extend(1.0),
         );
         let tex_from_world = (tex_from_grid * grid.world_from_grid.inverse()).as_mat4();
-        let e = grid.box_edges();
-        let grid_box = GridBox {
-            origin: grid.origin().as_vec3(),
-            edges: [e.x_axis.as_vec3(), e.y_axis.as_vec3(), e.z_axis.as_vec3()],
-        };
+        let grid_box = active_box(grid);
         Ok(Self {
             texture,
             view,
@@ -302,6 +329,7 @@ impl VolumePass {
         }
         queue.write_buffer(&self.vertices, 0, bytemuck::cast_slice(&vertices));
         self.vertex_count = vertices.len() as u32;
+        let signed = vol.kind == ValueKind::Signed;
         let rgb = |c: [f32; 3]| Vec4::new(c[0], c[1], c[2], 1.0).to_array();
         let u = VolumeUniforms {
             clip_from_world: clip_from_world.to_cols_array_2d(),
@@ -311,7 +339,13 @@ impl VolumePass {
             positive_color: rgb(settings.positive_color),
             negative_color: rgb(settings.negative_color),
             params: [settings.k1, settings.k2, 1.0 / vol.max_abs, vol.step],
-            flags: [u32::from(vol.kind == ValueKind::Signed), 0, 0, 0],
+            flags: [u32::from(signed), 0, 0, 0],
+            flags_f: [
+                visibility_threshold(settings.k1, settings.k2, signed),
+                0.0,
+                0.0,
+                0.0,
+            ],
         };
         queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
     }

@@ -150,6 +150,36 @@ impl VolumeGrid {
         })
     }
 
+    /// Index bounds (inclusive) of the points with |value| ≥ `threshold`, grown by one point on
+    /// each side and clamped to the grid; `None` when no point reaches the threshold.
+    pub fn active_bounds(&self, threshold: f32) -> Option<([usize; 3], [usize; 3])> {
+        let [nx, ny, nz] = self.dims;
+        let (mut lo, mut hi) = ([usize::MAX; 3], [0usize; 3]);
+        for i in 0..nx {
+            for j in 0..ny {
+                let row = &self.values[self.index(i, j, 0)..self.index(i, j, 0) + nz];
+                let first = row.iter().position(|v| v.abs() >= threshold);
+                let Some(first) = first else { continue };
+                let last = row
+                    .iter()
+                    .rposition(|v| v.abs() >= threshold)
+                    .unwrap_or(first);
+                for (a, v) in [i, j, first].into_iter().enumerate() {
+                    lo[a] = lo[a].min(v);
+                }
+                for (a, v) in [i, j, last].into_iter().enumerate() {
+                    hi[a] = hi[a].max(v);
+                }
+            }
+        }
+        (lo[0] != usize::MAX).then(|| {
+            (
+                lo.map(|v| v.saturating_sub(1)),
+                std::array::from_fn(|a| (hi[a] + 1).min(self.dims[a] - 1)),
+            )
+        })
+    }
+
     /// Voxel volume in bohr³ (|det| of the step vectors).
     pub fn voxel_volume(&self) -> f64 {
         DMat3::from_cols(self.step(0), self.step(1), self.step(2))
@@ -235,6 +265,17 @@ mod tests {
             .transform_point3(DVec3::new(1.5, 2.25, 4.5));
         assert!((g.sample_world(p).unwrap() - v).abs() < 1e-9);
         assert!(g.sample_world(DVec3::new(100.0, 0.0, 0.0)).is_none());
+    }
+
+    #[test]
+    fn active_bounds_enclose_the_significant_values() {
+        let mut values = vec![0.0f32; 6 * 5 * 4];
+        let g = VolumeGrid::new("a", [6, 5, 4], DMat4::IDENTITY, values.clone());
+        assert_eq!(g.active_bounds(0.5), None);
+        values[g.index(2, 1, 3)] = -1.0;
+        values[g.index(3, 3, 1)] = 1.0;
+        let g = VolumeGrid::new("a", [6, 5, 4], DMat4::IDENTITY, values);
+        assert_eq!(g.active_bounds(0.5), Some(([1, 0, 0], [4, 4, 3])));
     }
 
     #[test]
