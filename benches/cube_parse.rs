@@ -71,6 +71,14 @@ fn bench(c: &mut Criterion) {
                 .expect("parses")
         })
     });
+    // Baseline: the standard library's tokenizer and float parser, one thread, data section only.
+    let data = &text[text.match_indices('\n').nth(7).map_or(0, |(i, _)| i + 1)..];
+    group.throughput(Throughput::Bytes(data.len() as u64));
+    group.bench_function("std_split_parse_f32_128^3", |b| {
+        b.iter(|| {
+            black_box(data).split_ascii_whitespace().map(|t| t.parse::<f32>().expect("a number")).collect::<Vec<f32>>()
+        })
+    });
     group.finish();
 }
 
