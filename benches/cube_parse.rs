@@ -76,7 +76,10 @@ fn bench(c: &mut Criterion) {
     group.throughput(Throughput::Bytes(data.len() as u64));
     group.bench_function("std_split_parse_f32_128^3", |b| {
         b.iter(|| {
-            black_box(data).split_ascii_whitespace().map(|t| t.parse::<f32>().expect("a number")).collect::<Vec<f32>>()
+            black_box(data)
+                .split_ascii_whitespace()
+                .map(|t| t.parse::<f32>().expect("a number"))
+                .collect::<Vec<f32>>()
         })
     });
     group.finish();

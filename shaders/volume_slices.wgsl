@@ -24,21 +24,23 @@ struct VolumeUniforms {
 
 struct VertexOut {
     @builtin(position) clip: vec4<f32>,
-    @location(0) world: vec3<f32>,
+    // Both are affine in the world position, so interpolation gives them exactly per fragment.
+    @location(0) uvw: vec3<f32>,
+    @location(1) from_eye: vec3<f32>,
 };
 
 @vertex
 fn vs_main(@location(0) world: vec3<f32>) -> VertexOut {
     var out: VertexOut;
     out.clip = u.clip_from_world * vec4<f32>(world, 1.0);
-    out.world = world;
+    out.uvw = (u.tex_from_world * vec4<f32>(world, 1.0)).xyz;
+    out.from_eye = world - u.eye.xyz;
     return out;
 }
 
 @fragment
 fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
-    let uvw = (u.tex_from_world * vec4<f32>(in.world, 1.0)).xyz;
-    let value = textureSampleLevel(volume, volume_sampler, uvw, 0.0).r;
+    let value = textureSampleLevel(volume, volume_sampler, in.uvw, 0.0).r;
     let scaled = value * u.params.z;
     // Below this magnitude a sample is invisible (computed on the CPU from k1, k2): skip the
     // transcendental functions and the frame buffer's read-modify-write.
@@ -58,7 +60,7 @@ fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
     // k1 * rho^k2 is the opacity of one reference step (seed 000's alpha), taken as an extinction
     // so it composes exactly over the distance the ray travels between two slices:
     // alpha = 1 - exp(-k1 rho^k2 * path / step).
-    let ray = normalize(in.world - u.eye.xyz);
+    let ray = normalize(in.from_eye);
     let path = u.plane.w / max(abs(dot(ray, u.plane.xyz)), 0.05);
     let x = u.params.x * shaped * path / u.params.w;
     // 1 − e^−x loses its digits to cancellation for small x: use the series there.

@@ -12,6 +12,10 @@ use super::units::BOHR_PER_ANGSTROM;
 const BOND_TOLERANCE_ANG: f64 = 0.45;
 /// Closer than this (Å) is an overlap, not a bond.
 const MIN_BOND_ANG: f64 = 0.1;
+/// A cell as wide as the longest bond holds a few dozen real atoms; more means a degenerate
+/// structure (atoms piled on one spot), whose pairs are not searched so that a hostile file
+/// cannot make bond perception quadratic.
+const MAX_ATOMS_PER_CELL: usize = 256;
 
 /// Bonds between non-ghost atoms, each pair once with `a < b`, sorted.
 pub fn infer_bonds(atoms: &[Atom]) -> Vec<Bond> {
@@ -45,6 +49,9 @@ pub fn infer_bonds(atoms: &[Atom]) -> Vec<Bond> {
                     let Some(list) = cells.get(&(cx + dx, cy + dy, cz + dz)) else {
                         continue;
                     };
+                    if list.len() > MAX_ATOMS_PER_CELL {
+                        continue;
+                    }
                     for &j in list.iter().filter(|&&j| j as usize > i) {
                         let b = &atoms[j as usize];
                         let rb = b.element().covalent_radius as f64;
@@ -94,6 +101,12 @@ mod tests {
         ];
         assert_eq!(infer_bonds(&atoms).len(), 1);
         atoms[1].ghost = true;
+        assert!(infer_bonds(&atoms).is_empty());
+    }
+
+    #[test]
+    fn piled_up_atoms_stay_linear() {
+        let atoms: Vec<Atom> = (0..20_000).map(|_| atom(6, 1.0, 1.0, 1.0)).collect();
         assert!(infer_bonds(&atoms).is_empty());
     }
 
