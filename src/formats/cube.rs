@@ -409,6 +409,7 @@ impl CubeFile {
             title,
             molecule,
             volumes,
+            wavefunction: None,
         }
     }
 }

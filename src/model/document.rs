@@ -1,6 +1,6 @@
 //! What one opened file gives the viewer: a molecule and zero or more volumes.
 
-use super::{Molecule, VolumeGrid};
+use super::{Molecule, VolumeGrid, Wavefunction};
 
 #[derive(Debug, Clone, Default)]
 pub struct Document {
@@ -10,6 +10,8 @@ pub struct Document {
     pub molecule: Molecule,
     /// One volume per data set (a multi-orbital cube gives several).
     pub volumes: Vec<VolumeGrid>,
+    /// Basis set and orbitals (Molden, fchk); `None` for grid-only files.
+    pub wavefunction: Option<Wavefunction>,
 }
 
 impl Document {
