@@ -145,3 +145,34 @@ fn view_aligned_slices_match_the_cpu_compositor() {
 fn axis_aligned_stacks_match_the_cpu_compositor() {
     compare(SliceMode::AxisAligned);
 }
+
+#[test]
+fn r16float_fallback_matches_r32float() {
+    // Adapters without FLOAT32_FILTERABLE get R16Float volumes; the picture must not change
+    // beyond the rounding of 16-bit values.
+    let doc = scene(Some(p_orbital(24, false)));
+    let s = RenderSettings {
+        atoms: AtomStyle::Hidden,
+        ..Default::default()
+    };
+    let cam = default_camera(&doc);
+    let mut ctx = lavapipe();
+    assert_eq!(
+        ctx.volume_format,
+        wgpu::TextureFormat::R32Float,
+        "lavapipe filters R32Float"
+    );
+    let full = render_document(&ctx, &doc, Some(0), &cam, &s, SIZE).unwrap();
+    ctx.volume_format = wgpu::TextureFormat::R16Float;
+    let half = render_document(&ctx, &doc, Some(0), &cam, &s, SIZE).unwrap();
+    let worst = full
+        .pixels()
+        .zip(half.pixels())
+        .map(|(a, b)| (0..3).map(|c| a[c].abs_diff(b[c])).max().unwrap())
+        .max()
+        .unwrap();
+    assert!(
+        worst <= 3,
+        "R16Float differs from R32Float by up to {worst}/255"
+    );
+}
