@@ -1,6 +1,6 @@
 //! Every WGSL shader parses and validates with naga: no GPU needed.
 
-use orbcloud::gpu::SHADERS;
+use orbcloud::gpu::{SHADER_MODULES, SHADERS, module_source};
 
 #[test]
 fn every_shader_file_is_registered() {
@@ -16,20 +16,44 @@ fn every_shader_file_is_registered() {
     assert_eq!(on_disk, registered, "shaders/ and gpu::SHADERS disagree");
 }
 
+/// Files that only serve as prerequisites of other modules (they have no entry points).
+fn prerequisites() -> Vec<&'static str> {
+    SHADER_MODULES
+        .iter()
+        .flat_map(|(name, parts)| parts.iter().copied().filter(move |p| p != name))
+        .collect()
+}
+
 #[test]
-fn every_shader_validates() {
-    for (name, source) in SHADERS {
-        let module = naga::front::wgsl::parse_str(source)
-            .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(source)));
+fn every_shader_module_validates() {
+    let prereqs = prerequisites();
+    let mut validated = 0;
+    for (name, _) in SHADERS.iter().filter(|(n, _)| !prereqs.contains(n)) {
+        let source = module_source(name);
+        let module = naga::front::wgsl::parse_str(&source)
+            .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&source)));
         naga::valid::Validator::new(
             naga::valid::ValidationFlags::all(),
             naga::valid::Capabilities::default(),
         )
         .validate(&module)
-        .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(source)));
+        .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&source)));
         assert!(
             !module.entry_points.is_empty(),
             "{name} has no entry points"
+        );
+        validated += 1;
+    }
+    assert!(validated >= 4, "only {validated} shader modules found");
+}
+
+#[test]
+fn every_prerequisite_is_registered() {
+    let names: Vec<&str> = SHADERS.iter().map(|(n, _)| *n).collect();
+    for p in prerequisites() {
+        assert!(
+            names.contains(&p),
+            "{p} is a prerequisite but not in gpu::SHADERS"
         );
     }
 }

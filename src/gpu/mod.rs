@@ -5,6 +5,7 @@
 
 pub mod atoms;
 pub mod context;
+pub mod gto;
 pub mod renderer;
 pub mod resolve;
 pub mod target;
@@ -30,7 +31,29 @@ pub const SHADERS: &[(&str, &str)] = &[
     ),
     ("atoms.wgsl", include_str!("../../shaders/atoms.wgsl")),
     ("resolve.wgsl", include_str!("../../shaders/resolve.wgsl")),
+    (
+        "gto_common.wgsl",
+        include_str!("../../shaders/gto_common.wgsl"),
+    ),
+    ("gto_fill.wgsl", include_str!("../../shaders/gto_fill.wgsl")),
 ];
+
+/// Shaders that are only complete with others prepended (WGSL has no includes): the module
+/// for `name` is the concatenation of these files, in order.
+pub const SHADER_MODULES: &[(&str, &[&str])] =
+    &[("gto_fill.wgsl", &["gto_common.wgsl", "gto_fill.wgsl"])];
+
+/// The full source of a shader module: its prerequisites, then itself.
+pub fn module_source(name: &str) -> String {
+    match SHADER_MODULES.iter().find(|(n, _)| *n == name) {
+        Some((_, parts)) => parts
+            .iter()
+            .map(|p| shader_source(p))
+            .collect::<Vec<_>>()
+            .join("\n"),
+        None => shader_source(name).to_string(),
+    }
+}
 
 pub(crate) fn shader_source(name: &str) -> &'static str {
     SHADERS

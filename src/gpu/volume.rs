@@ -112,6 +112,26 @@ impl VolumeTexture {
             wgpu::util::TextureDataOrder::LayerMajor,
             &bytes,
         );
+        let mut volume = Self::from_texture(
+            texture,
+            grid.dims,
+            grid.world_from_grid,
+            grid.kind,
+            grid.stats.max_abs,
+        );
+        volume.grid_box = active_box(grid);
+        Ok(volume)
+    }
+
+    /// Wraps a texture already holding a grid's values (texel x = grid k, as [`Self::upload`]).
+    pub fn from_texture(
+        texture: wgpu::Texture,
+        dims: [usize; 3],
+        world_from_grid: DMat4,
+        kind: ValueKind,
+        max_abs: f64,
+    ) -> Self {
+        let [nx, ny, nz] = dims;
         let view = texture.create_view(&Default::default());
         // tex = ((k + ½)/nz, (j + ½)/ny, (i + ½)/nx) for grid point (i, j, k).
         let tex_from_grid = DMat4::from_cols(
@@ -120,18 +140,25 @@ impl VolumeTexture {
             DVec3::new(1.0 / nz as f64, 0.0, 0.0).extend(0.0),
             DVec3::new(0.5 / nz as f64, 0.5 / ny as f64, 0.5 / nx as f64).extend(1.0),
         );
-        let tex_from_world = (tex_from_grid * grid.world_from_grid.inverse()).as_mat4();
-        let grid_box = active_box(grid);
-        Ok(Self {
+        let tex_from_world = (tex_from_grid * world_from_grid.inverse()).as_mat4();
+        let step = |a: usize| world_from_grid.col(a).truncate();
+        let voxel = glam::DMat3::from_cols(step(0), step(1), step(2))
+            .determinant()
+            .abs();
+        let edges = |a: usize| (step(a) * (dims[a].max(1) - 1) as f64).as_vec3();
+        Self {
             texture,
             view,
-            dims: grid.dims,
+            dims,
             tex_from_world,
-            grid_box,
-            kind: grid.kind,
-            max_abs: grid.stats.max_abs.max(1e-30) as f32,
-            step: grid.voxel_volume().cbrt().max(1e-6) as f32,
-        })
+            grid_box: GridBox {
+                origin: world_from_grid.w_axis.truncate().as_vec3(),
+                edges: [edges(0), edges(1), edges(2)],
+            },
+            kind,
+            max_abs: max_abs.max(1e-30) as f32,
+            step: voxel.cbrt().max(1e-6) as f32,
+        }
     }
 }
 
@@ -271,7 +298,14 @@ impl VolumePass {
         ctx: &GpuContext,
         grid: Option<&VolumeGrid>,
     ) -> Result<(), GpuError> {
-        self.volume = grid.map(|g| VolumeTexture::upload(ctx, g)).transpose()?;
+        let volume = grid.map(|g| VolumeTexture::upload(ctx, g)).transpose()?;
+        self.set_texture(ctx, volume);
+        Ok(())
+    }
+
+    /// Shows a volume already on the GPU (None shows none).
+    pub fn set_texture(&mut self, ctx: &GpuContext, volume: Option<VolumeTexture>) {
+        self.volume = volume;
         self.bind_group = self.volume.as_ref().map(|v| {
             ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("volume bind group"),
@@ -292,7 +326,6 @@ impl VolumePass {
                 ],
             })
         });
-        Ok(())
     }
 
     pub fn volume(&self) -> Option<&VolumeTexture> {

@@ -4,6 +4,7 @@
 
 pub mod basis;
 pub mod bonds;
+pub mod cartesian;
 pub mod document;
 mod element_table;
 pub mod elements;

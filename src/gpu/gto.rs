@@ -1,0 +1,361 @@
+//! Orbitals evaluated from their basis functions on the GPU: a compute pass that fills a 3D
+//! texture for the slice renderer (seed 004's exact orbitals, switched without resampling files).
+
+use bytemuck::{Pod, Zeroable};
+use glam::{DMat4, DVec3};
+use wgpu::util::DeviceExt;
+
+use super::volume::VolumeTexture;
+use super::{GpuContext, GpuError};
+use crate::model::cartesian::CartesianExpansion;
+use crate::model::grid::ValueKind;
+
+/// Mirror of `GtoShell` in gto_common.wgsl.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuShell {
+    pub center: [f32; 3],
+    pub cutoff2: f32,
+    pub l: u32,
+    pub prim_offset: u32,
+    pub prim_count: u32,
+    pub weight_offset: u32,
+}
+const _: () = assert!(std::mem::size_of::<GpuShell>() == 32);
+
+/// Mirror of `FillParams` in gto_fill.wgsl.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+struct FillParams {
+    world_from_grid: [[f32; 4]; 4],
+    dims: [u32; 4],
+}
+const _: () = assert!(std::mem::size_of::<FillParams>() == 80);
+
+/// The flat arrays the kernels read.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct GtoArrays {
+    pub shells: Vec<GpuShell>,
+    pub prims: Vec<[f32; 2]>,
+    pub weights: Vec<f32>,
+}
+
+impl GtoArrays {
+    pub fn new(e: &CartesianExpansion) -> Self {
+        let mut out = Self::default();
+        for s in &e.shells {
+            out.shells.push(GpuShell {
+                center: s.center.as_vec3().to_array(),
+                cutoff2: (s.cutoff * s.cutoff).min(f32::MAX as f64) as f32,
+                l: s.l,
+                prim_offset: out.prims.len() as u32,
+                prim_count: s.primitives.len() as u32,
+                weight_offset: out.weights.len() as u32,
+            });
+            out.prims
+                .extend(s.primitives.iter().map(|[a, d]| [*a as f32, *d as f32]));
+            out.weights.extend(s.weights.iter().map(|&w| w as f32));
+        }
+        out
+    }
+}
+
+/// Storage buffers holding one expansion, bound as group 1 of the GTO kernels.
+pub struct GtoBuffers {
+    pub bind_group: wgpu::BindGroup,
+}
+
+pub fn gto_layout(device: &wgpu::Device, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayout {
+    let storage = |binding| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only: true },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    };
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("gto bind group layout"),
+        entries: &[storage(0), storage(1), storage(2)],
+    })
+}
+
+impl GtoBuffers {
+    pub fn new(device: &wgpu::Device, layout: &wgpu::BindGroupLayout, arrays: &GtoArrays) -> Self {
+        // Empty storage buffers are not allowed: pad each with one element.
+        let buffer = |label: &str, mut bytes: Vec<u8>| {
+            if bytes.is_empty() {
+                bytes.resize(32, 0);
+            }
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents: &bytes,
+                usage: wgpu::BufferUsages::STORAGE,
+            })
+        };
+        // An empty expansion must evaluate to zero: the padding shell has l = 0 and no primitives.
+        let shells = buffer("gto shells", bytemuck::cast_slice(&arrays.shells).to_vec());
+        let prims = buffer(
+            "gto primitives",
+            bytemuck::cast_slice(&arrays.prims).to_vec(),
+        );
+        let weights = buffer(
+            "gto weights",
+            bytemuck::cast_slice(&arrays.weights).to_vec(),
+        );
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("gto bind group"),
+            layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: shells.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: prims.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: weights.as_entire_binding(),
+                },
+            ],
+        });
+        Self { bind_group }
+    }
+}
+
+pub struct GtoFillPass {
+    pipeline: wgpu::ComputePipeline,
+    fill_layout: wgpu::BindGroupLayout,
+    gto_layout: wgpu::BindGroupLayout,
+}
+
+/// Where to evaluate: a grid's shape and placement, without values.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GridGeometry {
+    pub dims: [usize; 3],
+    pub world_from_grid: DMat4,
+}
+
+impl GridGeometry {
+    /// A grid of `n` points per axis over the box `lo..hi` (bohr).
+    pub fn cube(lo: DVec3, hi: DVec3, n: usize) -> Self {
+        let n = n.max(2);
+        let step = (hi - lo) / (n - 1) as f64;
+        let world_from_grid = crate::model::VolumeGrid::affine(
+            lo,
+            [
+                DVec3::new(step.x, 0.0, 0.0),
+                DVec3::new(0.0, step.y, 0.0),
+                DVec3::new(0.0, 0.0, step.z),
+            ],
+        );
+        Self {
+            dims: [n; 3],
+            world_from_grid,
+        }
+    }
+}
+
+impl GtoFillPass {
+    pub fn new(ctx: &GpuContext) -> Self {
+        let device = &ctx.device;
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("gto_fill.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(super::module_source("gto_fill.wgsl").into()),
+        });
+        let fill_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("gto fill layout"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::StorageTexture {
+                        access: wgpu::StorageTextureAccess::WriteOnly,
+                        format: wgpu::TextureFormat::R32Float,
+                        view_dimension: wgpu::TextureViewDimension::D3,
+                    },
+                    count: None,
+                },
+            ],
+        });
+        let gto_layout = gto_layout(device, wgpu::ShaderStages::COMPUTE);
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("gto fill pipeline layout"),
+            bind_group_layouts: &[Some(&fill_layout), Some(&gto_layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("gto fill"),
+            layout: Some(&layout),
+            module: &module,
+            entry_point: Some("cs_fill"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        Self {
+            pipeline,
+            fill_layout,
+            gto_layout,
+        }
+    }
+
+    /// Evaluates `expansion` on `grid` into a new R32Float 3D texture (texel x = grid k).
+    pub fn fill(
+        &self,
+        ctx: &GpuContext,
+        expansion: &CartesianExpansion,
+        grid: &GridGeometry,
+    ) -> Result<wgpu::Texture, GpuError> {
+        let device = &ctx.device;
+        let [nx, ny, nz] = grid.dims;
+        let max = device.limits().max_texture_dimension_3d;
+        if grid.dims.iter().any(|&d| d == 0 || d > max as usize) {
+            return Err(GpuError::VolumeTooLarge {
+                dims: grid.dims,
+                max,
+            });
+        }
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("gto volume"),
+            size: wgpu::Extent3d {
+                width: nz as u32,
+                height: ny as u32,
+                depth_or_array_layers: nx as u32,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D3,
+            format: wgpu::TextureFormat::R32Float,
+            usage: wgpu::TextureUsages::STORAGE_BINDING
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let params = FillParams {
+            world_from_grid: grid.world_from_grid.as_mat4().to_cols_array_2d(),
+            dims: [nx as u32, ny as u32, nz as u32, 0],
+        };
+        let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("gto fill params"),
+            contents: bytemuck::bytes_of(&params),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let view = texture.create_view(&Default::default());
+        let fill_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("gto fill bind group"),
+            layout: &self.fill_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: params.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(&view),
+                },
+            ],
+        });
+        let gto = GtoBuffers::new(device, &self.gto_layout, &GtoArrays::new(expansion));
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("gto fill"),
+        });
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("gto fill"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &fill_group, &[]);
+            pass.set_bind_group(1, &gto.bind_group, &[]);
+            pass.dispatch_workgroups(
+                (nz as u32).div_ceil(4),
+                (ny as u32).div_ceil(4),
+                (nx as u32).div_ceil(4),
+            );
+        }
+        ctx.queue.submit([encoder.finish()]);
+        Ok(texture)
+    }
+}
+
+/// A filled texture made ready for the slice renderer. `max_abs` scales the opacity (the CPU
+/// knows it from the evaluator or a coarse estimate).
+pub fn volume_from_texture(
+    texture: wgpu::Texture,
+    grid: &GridGeometry,
+    max_abs: f64,
+) -> VolumeTexture {
+    VolumeTexture::from_texture(
+        texture,
+        grid.dims,
+        grid.world_from_grid,
+        ValueKind::Signed,
+        max_abs,
+    )
+}
+
+/// Reads an R32Float 3D texture back into cube order (x slowest, z fastest) — for tests, export
+/// and checks against the CPU.
+pub fn read_volume(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Vec<f32>, GpuError> {
+    let size = texture.size();
+    let (w, h, d) = (size.width, size.height, size.depth_or_array_layers);
+    let unpadded = 4 * w;
+    let padded =
+        unpadded.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("volume readback"),
+        size: padded as u64 * h as u64 * d as u64,
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut encoder = ctx
+        .device
+        .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("volume readback"),
+        });
+    encoder.copy_texture_to_buffer(
+        texture.as_image_copy(),
+        wgpu::TexelCopyBufferInfo {
+            buffer: &buffer,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(padded),
+                rows_per_image: Some(h),
+            },
+        },
+        size,
+    );
+    ctx.queue.submit([encoder.finish()]);
+    let slice = buffer.slice(..);
+    let (tx, rx) = std::sync::mpsc::channel();
+    slice.map_async(wgpu::MapMode::Read, move |r| {
+        let _ = tx.send(r);
+    });
+    let fail = |e: String| GpuError::Readback(e);
+    ctx.device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map_err(|e| fail(e.to_string()))?;
+    rx.recv()
+        .map_err(|e| fail(e.to_string()))?
+        .map_err(|e| fail(e.to_string()))?;
+    let data = slice.get_mapped_range().map_err(|e| fail(e.to_string()))?;
+    let mut out = Vec::with_capacity((w * h * d) as usize);
+    for row in data.chunks(padded as usize) {
+        out.extend_from_slice(bytemuck::cast_slice(&row[..unpadded as usize]));
+    }
+    Ok(out)
+}

@@ -1,0 +1,99 @@
+//! The GPU's GTO kernel against its CPU reference (`CartesianExpansion::value`), on lavapipe.
+
+mod common;
+
+use glam::DVec3;
+use orbcloud::gpu::gto::{GridGeometry, GtoFillPass, read_volume};
+use orbcloud::model::VolumeGrid;
+use orbcloud::model::basis::n_cartesian;
+use orbcloud::model::cartesian::{CartesianExpansion, CartesianShell};
+
+fn expansion() -> CartesianExpansion {
+    // A deterministic mix of shells, l = 0..5, with contracted primitives and signed weights.
+    let mut seed = 7u64;
+    let mut rnd = move || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let shells = (0..12)
+        .map(|i| {
+            let l = (i % 6) as u32;
+            CartesianShell {
+                center: DVec3::new(rnd() * 4.0 - 2.0, rnd() * 4.0 - 2.0, rnd() * 3.0 - 1.5),
+                l,
+                cutoff: 9.0,
+                primitives: (0..1 + i % 3)
+                    .map(|_| [0.3 + 2.0 * rnd(), rnd() - 0.3])
+                    .collect(),
+                weights: (0..n_cartesian(l)).map(|_| rnd() * 2.0 - 1.0).collect(),
+            }
+        })
+        .collect();
+    CartesianExpansion { shells }
+}
+
+#[test]
+fn gpu_fill_matches_the_cpu_reference() {
+    let ctx = common::lavapipe();
+    let e = expansion();
+    // Odd, unequal dimensions and a sheared grid catch any mix-up of axes.
+    let dims = [21, 17, 13];
+    let world_from_grid = VolumeGrid::affine(
+        DVec3::new(-3.0, -2.5, -2.0),
+        [
+            DVec3::new(0.3, 0.0, 0.0),
+            DVec3::new(0.05, 0.31, 0.0),
+            DVec3::new(0.0, 0.02, 0.33),
+        ],
+    );
+    let grid = GridGeometry {
+        dims,
+        world_from_grid,
+    };
+    let texture = GtoFillPass::new(&ctx).fill(&ctx, &e, &grid).unwrap();
+    let gpu = read_volume(&ctx, &texture).unwrap();
+    assert_eq!(gpu.len(), dims.iter().product::<usize>());
+    let mut cpu = Vec::with_capacity(gpu.len());
+    for i in 0..dims[0] {
+        for j in 0..dims[1] {
+            for k in 0..dims[2] {
+                cpu.push(e.value(
+                    world_from_grid.transform_point3(DVec3::new(i as f64, j as f64, k as f64)),
+                ));
+            }
+        }
+    }
+    let max = cpu.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let worst = gpu
+        .iter()
+        .zip(&cpu)
+        .map(|(g, c)| (*g as f64 - c).abs())
+        .fold(0.0, f64::max);
+    eprintln!(
+        "max |ψ| {max:.4}, worst |gpu − cpu| {worst:.3e} ({:.2e} of max)",
+        worst / max
+    );
+    assert!(max > 0.1, "the test expansion is not trivial");
+    // f32 arithmetic: 1e-4 of the largest value.
+    assert!(
+        worst <= 1e-4 * max,
+        "GPU differs from CPU by {worst:e} (max {max})"
+    );
+}
+
+#[test]
+fn an_empty_expansion_fills_zeros() {
+    let ctx = common::lavapipe();
+    let grid = GridGeometry::cube(DVec3::splat(-1.0), DVec3::splat(1.0), 5);
+    let texture = GtoFillPass::new(&ctx)
+        .fill(&ctx, &CartesianExpansion::default(), &grid)
+        .unwrap();
+    assert!(
+        read_volume(&ctx, &texture)
+            .unwrap()
+            .iter()
+            .all(|&v| v == 0.0)
+    );
+}
