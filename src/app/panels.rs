@@ -89,7 +89,7 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
                 if app.doc.volumes.is_empty() {
                     ui.label("no volume in this file");
                 } else {
-                    ui.label("data set");
+                    let label = ui.label("data set");
                     ComboBox::from_id_salt("data set")
                         .width(220.0)
                         .selected_text(
@@ -103,7 +103,9 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
                             for (i, v) in app.doc.volumes.iter().enumerate() {
                                 ui.selectable_value(&mut view.volume, i, &v.label);
                             }
-                        });
+                        })
+                        .response
+                        .labelled_by(label.id);
                 }
                 let vs = &mut view.settings.volume;
                 ui.checkbox(&mut vs.visible, "show cloud");

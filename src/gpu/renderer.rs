@@ -3,9 +3,11 @@
 use glam::Vec3;
 
 use super::atoms::AtomsPass;
+use super::gto::GridGeometry;
 use super::resolve::{ResolvePass, SceneBuffers};
-use super::volume::VolumePass;
+use super::volume::{VolumePass, VolumeTexture};
 use super::{GpuContext, GpuError};
+use crate::model::cartesian::CartesianExpansion;
 use crate::model::{Molecule, VolumeGrid};
 use crate::scene::{AtomStyle, Camera, RenderSettings};
 
@@ -57,6 +59,24 @@ impl Renderer {
         self.volume.set_volume(ctx, grid)?;
         self.update_bounds();
         Ok(())
+    }
+
+    /// Shows a volume already on the GPU (a filled GTO grid).
+    pub fn set_volume_texture(&mut self, ctx: &GpuContext, volume: VolumeTexture) {
+        self.volume.set_texture(ctx, Some(volume));
+        self.update_bounds();
+    }
+
+    /// Shows an orbital evaluated per fragment from its basis functions (seed 004's direct mode).
+    pub fn set_direct(
+        &mut self,
+        ctx: &GpuContext,
+        expansion: &CartesianExpansion,
+        geometry: &GridGeometry,
+        max_abs: f64,
+    ) {
+        self.volume.set_direct(ctx, expansion, geometry, max_abs);
+        self.update_bounds();
     }
 
     fn update_bounds(&mut self) {

@@ -4,7 +4,9 @@ use bytemuck::{Pod, Zeroable};
 use glam::{DMat4, DVec3, Mat4, Vec3, Vec4};
 use wgpu::util::DeviceExt;
 
+use super::gto::{GridGeometry, GtoArrays, GtoBuffers, gto_layout};
 use super::{DEPTH_FORMAT, GpuContext, GpuError, SCENE_FORMAT};
+use crate::model::cartesian::CartesianExpansion;
 use crate::model::{VolumeGrid, grid::ValueKind};
 use crate::scene::VolumeSettings;
 use crate::scene::slicing::{GridBox, Slices};
@@ -171,15 +173,72 @@ pub struct VolumePass {
     vertex_count: u32,
     bind_group: Option<wgpu::BindGroup>,
     volume: Option<VolumeTexture>,
+    direct_pipeline: wgpu::RenderPipeline,
+    gto_layout: wgpu::BindGroupLayout,
+    /// Basis functions of the orbital shown in direct mode (then `volume` holds only its box).
+    direct: Option<GtoBuffers>,
+}
+
+/// The slice pipeline with a fragment shader from `module` (volume_slices or volume_direct).
+fn make_pipeline(
+    device: &wgpu::Device,
+    module: &str,
+    fragment_entry: &str,
+    groups: &[Option<&wgpu::BindGroupLayout>],
+) -> wgpu::RenderPipeline {
+    let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(module),
+        source: wgpu::ShaderSource::Wgsl(super::module_source(module).into()),
+    });
+    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(module),
+        bind_group_layouts: groups,
+        immediate_size: 0,
+    });
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(module),
+        layout: Some(&layout),
+        vertex: wgpu::VertexState {
+            module: &shader,
+            entry_point: Some("vs_main"),
+            compilation_options: Default::default(),
+            buffers: &[Some(wgpu::VertexBufferLayout {
+                array_stride: 12,
+                step_mode: wgpu::VertexStepMode::Vertex,
+                attributes: &wgpu::vertex_attr_array![0 => Float32x3],
+            })],
+        },
+        primitive: wgpu::PrimitiveState {
+            cull_mode: None,
+            ..Default::default()
+        },
+        // Test against the atoms' depth so they hide the cloud behind them; never write.
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: DEPTH_FORMAT,
+            depth_write_enabled: Some(false),
+            depth_compare: Some(wgpu::CompareFunction::Less),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module: &shader,
+            entry_point: Some(fragment_entry),
+            compilation_options: Default::default(),
+            targets: &[Some(wgpu::ColorTargetState {
+                format: SCENE_FORMAT,
+                blend: Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING),
+                write_mask: wgpu::ColorWrites::ALL,
+            })],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
 }
 
 impl VolumePass {
     pub fn new(ctx: &GpuContext) -> Self {
         let device = &ctx.device;
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("volume_slices.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(super::shader_source("volume_slices.wgsl").into()),
-        });
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("volume bind group layout"),
             entries: &[
@@ -211,50 +270,14 @@ impl VolumePass {
                 },
             ],
         });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("volume pipeline layout"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("volume slices"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[Some(wgpu::VertexBufferLayout {
-                    array_stride: 12,
-                    step_mode: wgpu::VertexStepMode::Vertex,
-                    attributes: &wgpu::vertex_attr_array![0 => Float32x3],
-                })],
-            },
-            primitive: wgpu::PrimitiveState {
-                cull_mode: None,
-                ..Default::default()
-            },
-            // Test against the atoms' depth so they hide the cloud behind them; never write.
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(false),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: SCENE_FORMAT,
-                    blend: Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING),
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let gto_layout = gto_layout(device, wgpu::ShaderStages::FRAGMENT);
+        let pipeline = make_pipeline(device, "volume_slices.wgsl", "fs_main", &[Some(&layout)]);
+        let direct_pipeline = make_pipeline(
+            device,
+            "volume_direct.wgsl",
+            "fs_direct",
+            &[Some(&layout), Some(&gto_layout)],
+        );
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("volume sampler"),
             address_mode_u: wgpu::AddressMode::ClampToEdge,
@@ -280,6 +303,9 @@ impl VolumePass {
             vertex_count: 0,
             bind_group: None,
             volume: None,
+            direct_pipeline,
+            gto_layout,
+            direct: None,
         }
     }
 
@@ -303,8 +329,49 @@ impl VolumePass {
         Ok(())
     }
 
+    /// Seed 004's direct mode: the slices through `geometry`'s box evaluate `expansion` per
+    /// fragment. `max_abs` scales the opacity like a grid's maximum; the grid spacing of
+    /// `geometry` is the reference step of k1.
+    pub fn set_direct(
+        &mut self,
+        ctx: &GpuContext,
+        expansion: &CartesianExpansion,
+        geometry: &GridGeometry,
+        max_abs: f64,
+    ) {
+        // The texture binding is unused by the direct shader but part of the shared layout.
+        let placeholder = ctx.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("direct-mode placeholder volume"),
+            size: wgpu::Extent3d {
+                width: 1,
+                height: 1,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D3,
+            format: ctx.volume_format,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        });
+        let shape = VolumeTexture::from_texture(
+            placeholder,
+            geometry.dims,
+            geometry.world_from_grid,
+            ValueKind::Signed,
+            max_abs,
+        );
+        self.set_texture(ctx, Some(shape));
+        self.direct = Some(GtoBuffers::new(
+            &ctx.device,
+            &self.gto_layout,
+            &GtoArrays::new(expansion),
+        ));
+    }
+
     /// Shows a volume already on the GPU (None shows none).
     pub fn set_texture(&mut self, ctx: &GpuContext, volume: Option<VolumeTexture>) {
+        self.direct = None;
         self.volume = volume;
         self.bind_group = self.volume.as_ref().map(|v| {
             ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -390,7 +457,13 @@ impl VolumePass {
         if self.vertex_count == 0 {
             return;
         }
-        pass.set_pipeline(&self.pipeline);
+        match &self.direct {
+            Some(gto) => {
+                pass.set_pipeline(&self.direct_pipeline);
+                pass.set_bind_group(1, &gto.bind_group, &[]);
+            }
+            None => pass.set_pipeline(&self.pipeline),
+        }
         pass.set_bind_group(0, bind_group, &[]);
         pass.set_vertex_buffer(0, self.vertices.slice(..self.vertex_count as u64 * 12));
         pass.draw(0..self.vertex_count, 0..1);
