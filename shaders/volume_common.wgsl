@@ -18,6 +18,18 @@ struct VolumeUniforms {
     flags: vec4<u32>,
     // x: the smallest |value| / max|value| that can be seen at these k1, k2
     flags_f: vec4<f32>,
+    // x: transfer kind (0 power law, 1 shaped), y/z: shape of the positive/negative lobe,
+    // w: bit 0 shading, bit 1 gradient needed, bit 2 clipping
+    tf: vec4<u32>,
+    // centre, width, peak opacity (fractions of max|value|), unused
+    tf_positive: vec4<f32>,
+    tf_negative: vec4<f32>,
+    // x: gradient power (2D transfer function), y: boundary enhancement, z: 1 / max|∇value|
+    tf_gradient: vec4<f32>,
+    // xyz: unit normal, w: offset; fragments with n·p > offset are cut away
+    clip: vec4<f32>,
+    // xyz: unit direction towards the light
+    light: vec4<f32>,
 };
 
 @group(0) @binding(0) var<uniform> u: VolumeUniforms;
@@ -42,32 +54,86 @@ fn vs_main(@location(0) world: vec3<f32>) -> VertexOut {
     return out;
 }
 
-// Premultiplied colour of one sample; alpha < 0 means invisible (the caller discards, which
-// skips the frame buffer's read-modify-write).
-fn shade(value: f32, from_eye: vec3<f32>) -> vec4<f32> {
+fn gaussian(x: f32) -> f32 {
+    return exp(-x * x);
+}
+
+// Seed 004's shapes of t = |value| / max|value|; see scene::transfer::Shape::factor.
+fn shape_factor(shape: u32, t: f32, c: f32, w_in: f32) -> f32 {
+    let w = max(w_in, 1e-4);
+    switch shape {
+        case 0u: { return select(0.0, 1.0, abs(t - c) <= 0.5 * w); }
+        case 1u: { return gaussian((t - c) / w); }
+        case 2u: { return select(gaussian((t - c) / w), 1.0, t >= c); }
+        case 3u: { return select(gaussian((t - c) / w), 1.0, t <= c); }
+        default: {
+            return select(pow(0.5 + 0.5 * cos(6.2831853 * (t - c) / w), 8.0), 0.0, t < c - 0.5 * w);
+        }
+    }
+}
+
+fn clipped(world: vec3<f32>) -> bool {
+    return (u.tf.w & 4u) != 0u && dot(u.clip.xyz, world) > u.clip.w;
+}
+
+fn needs_gradient() -> bool {
+    return (u.tf.w & 2u) != 0u;
+}
+
+// Premultiplied colour of one sample with gradient `grad` (world units; ignored unless the
+// transfer function needs it); alpha < 0 means invisible (the caller discards, which skips the
+// frame buffer's read-modify-write).
+fn shade(value: f32, grad: vec3<f32>, from_eye: vec3<f32>) -> vec4<f32> {
     let scaled = value * u.params.z;
-    // Below this magnitude a sample is invisible (computed on the CPU from k1, k2).
-    if (abs(scaled) < u.flags_f.x) {
-        return vec4<f32>(-1.0);
-    }
-    var shaped: f32;
+    var extinction: f32;
     var color: vec3<f32>;
-    if (u.flags.x == 1u) {
-        // rho = psi^2, so rho^k2 = |psi|^(2 k2).
-        shaped = pow(abs(scaled), 2.0 * u.params.y);
-        color = select(u.negative_color.rgb, u.positive_color.rgb, value >= 0.0);
+    if (u.tf.x == 0u) {
+        // Below this magnitude a sample is invisible (computed on the CPU from k1, k2).
+        if (abs(scaled) < u.flags_f.x) {
+            return vec4<f32>(-1.0);
+        }
+        if (u.flags.x == 1u) {
+            // rho = psi^2, so rho^k2 = |psi|^(2 k2).
+            extinction = u.params.x * pow(abs(scaled), 2.0 * u.params.y);
+            color = select(u.negative_color.rgb, u.positive_color.rgb, value >= 0.0);
+        } else {
+            extinction = u.params.x * pow(max(scaled, 0.0), u.params.y);
+            color = mix(u.negative_color.rgb, u.positive_color.rgb, sqrt(min(scaled, 1.0)));
+        }
     } else {
-        shaped = pow(scaled, u.params.y);
-        color = mix(u.negative_color.rgb, u.positive_color.rgb, sqrt(min(scaled, 1.0)));
+        let positive = value >= 0.0 || u.flags.x == 0u;
+        let lobe = select(u.tf_negative, u.tf_positive, positive);
+        let shape = select(u.tf.z, u.tf.y, positive);
+        extinction = lobe.z * shape_factor(shape, abs(scaled), lobe.x, lobe.y);
+        if (extinction < 1e-5) {
+            return vec4<f32>(-1.0);
+        }
+        color = select(u.negative_color.rgb, u.positive_color.rgb, positive);
     }
-    // k1 * rho^k2 is the opacity of one reference step (seed 000's alpha), taken as an extinction
-    // so it composes exactly over the distance the ray travels between two slices:
-    // alpha = 1 - exp(-k1 rho^k2 * path / step).
+    if (needs_gradient()) {
+        let g = min(length(grad) * u.tf_gradient.z, 1.0);
+        if (u.tf_gradient.x > 0.0) {
+            extinction *= pow(g, u.tf_gradient.x);
+        }
+        extinction *= 1.0 - u.tf_gradient.y + u.tf_gradient.y * sqrt(g);
+        if ((u.tf.w & 1u) != 0u && length(grad) > 0.0) {
+            // Two-sided lighting: a translucent shell is seen from both sides.
+            let n = normalize(grad);
+            let v = -normalize(from_eye);
+            let l = u.light.xyz;
+            let diffuse = abs(dot(n, l));
+            let h = normalize(l + v);
+            let specular = pow(abs(dot(n, h)), 32.0);
+            color = color * (0.3 + 0.7 * diffuse) + vec3<f32>(0.35 * specular);
+        }
+    }
+    // The extinction of one reference step (seed 000's alpha = k1 rho^k2 for the power law)
+    // composes exactly over the distance the ray travels between two slices:
+    // alpha = 1 - exp(-extinction * path / step).
     let ray = normalize(from_eye);
     let path = u.plane.w / max(abs(dot(ray, u.plane.xyz)), 0.05);
-    let x = u.params.x * shaped * path / u.params.w;
+    let x = extinction * path / u.params.w;
     // 1 − e^−x loses its digits to cancellation for small x: use the series there.
     let alpha = select(1.0 - exp2(-1.442695 * x), x * (1.0 - x * (0.5 - x / 6.0)), x < 0.03);
     return vec4<f32>(color * alpha, alpha);
 }
-

@@ -31,26 +31,14 @@ impl Headless {
         let mut renderer = Renderer::new(ctx);
         renderer.set_molecule(ctx, &doc.molecule, settings.atoms);
         renderer.set_volume(ctx, volume_index.and_then(|i| doc.volumes.get(i)))?;
-        Ok(Self {
-            renderer,
-            target: OffscreenTarget::new(&ctx.device, size),
-        })
+        Ok(Self { renderer, target: OffscreenTarget::new(&ctx.device, size) })
     }
 
     /// Records and submits one frame (does not wait for it).
     pub fn draw(&mut self, ctx: &GpuContext, camera: &Camera, settings: &RenderSettings) {
-        let mut encoder = ctx
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("frame"),
-            });
-        let frame = FrameInput {
-            camera,
-            settings,
-            size: self.target.size,
-        };
-        self.renderer
-            .render(ctx, &mut encoder, &self.target.color_view, &frame);
+        let mut encoder = ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
+        let frame = FrameInput { camera, settings, size: self.target.size };
+        self.renderer.render(ctx, &mut encoder, &self.target.color_view, &frame);
         ctx.queue.submit([encoder.finish()]);
     }
 

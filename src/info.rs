@@ -80,13 +80,7 @@ pub fn text(doc: &Document) -> String {
     let info = describe(doc);
     let mut s = String::new();
     let _ = writeln!(s, "{}: {}", info.source, info.title);
-    let _ = writeln!(
-        s,
-        "{} atoms ({}), {} bonds",
-        info.atoms.len(),
-        info.formula,
-        info.bonds
-    );
+    let _ = writeln!(s, "{} atoms ({}), {} bonds", info.atoms.len(), info.formula, info.bonds);
     for a in &info.atoms {
         let p = a.position_bohr;
         let ang = p.map(|v| v * ANGSTROM_PER_BOHR);
@@ -118,18 +112,10 @@ pub fn text(doc: &Document) -> String {
             g.voxel_volume_bohr3
         );
         for row in &g.world_from_grid[..3] {
-            let _ = writeln!(
-                s,
-                "    [{:>11.6} {:>11.6} {:>11.6} | {:>11.6}]",
-                row[0], row[1], row[2], row[3]
-            );
+            let _ = writeln!(s, "    [{:>11.6} {:>11.6} {:>11.6} | {:>11.6}]", row[0], row[1], row[2], row[3]);
         }
         let st = g.stats;
-        let _ = writeln!(
-            s,
-            "    min {:.6e}  max {:.6e}  mean {:.6e}  σ {:.6e}",
-            st.min, st.max, st.mean, st.sigma
-        );
+        let _ = writeln!(s, "    min {:.6e}  max {:.6e}  mean {:.6e}  σ {:.6e}", st.min, st.max, st.mean, st.sigma);
     }
     s
 }

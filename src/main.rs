@@ -8,15 +8,12 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 use orbcloud::gpu::{AdapterPreference, GpuContext};
 use orbcloud::headless::{Headless, default_camera};
 use orbcloud::model::Document;
-use orbcloud::scene::{AtomStyle, Camera, RenderSettings, SliceMode};
+use orbcloud::scene::transfer::PRESETS;
+use orbcloud::scene::{AtomStyle, Camera, ClipPlane, RenderSettings, Shape, SliceMode, TransferKind};
 use orbcloud::{demo, formats, info};
 
 #[derive(Parser)]
-#[command(
-    name = "orbcloud",
-    version,
-    about = "Molecular orbitals and densities as GPU-rendered clouds"
-)]
+#[command(name = "orbcloud", version, about = "Molecular orbitals and densities as GPU-rendered clouds")]
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
@@ -121,23 +118,72 @@ struct ViewArgs {
     /// Hide the volume (atoms only).
     #[arg(long)]
     no_volume: bool,
+    /// Transfer function: seed 000's power law, or one of seed 004's shapes (both signs).
+    #[arg(long, value_enum, default_value_t = TfArg::Power)]
+    tf: TfArg,
+    /// Shape centre (iso-value), a fraction of max|value|.
+    #[arg(long)]
+    tf_center: Option<f32>,
+    /// Shape width, a fraction of max|value| (the contour spacing for `sinusoidal`).
+    #[arg(long)]
+    tf_width: Option<f32>,
+    /// Shape peak opacity per grid step.
+    #[arg(long)]
+    tf_opacity: Option<f32>,
+    /// Light the cloud with the gradient as the normal.
+    #[arg(long)]
+    shading: bool,
+    /// Boundary enhancement 0..1 (opacity rises with the gradient magnitude).
+    #[arg(long)]
+    boundary: Option<f32>,
+    /// 2D transfer function: opacity × (|∇|/max|∇|)^P.
+    #[arg(long)]
+    gradient_power: Option<f32>,
+    /// Clipping plane NX,NY,NZ[,OFFSET]: cut away what lies beyond it (offset in bohr from the
+    /// grid's centre along the normal).
+    #[arg(long, value_parser = parse_clip, allow_hyphen_values = true)]
+    clip: Option<[f32; 4]>,
+    /// Colours for ψ > 0 and ψ < 0: red-blue, red-white, orange-teal, gold-purple or
+    /// green-magenta.
+    #[arg(long, value_parser = parse_preset)]
+    colors: Option<([f32; 3], [f32; 3])>,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum TfArg {
+    Power,
+    Uniform,
+    Gaussian,
+    LeftHalf,
+    RightHalf,
+    Sinusoidal,
+}
+
+fn parse_preset(s: &str) -> Result<([f32; 3], [f32; 3]), String> {
+    let key = |n: &str| n.chars().filter(|c| c.is_alphanumeric()).collect::<String>().to_lowercase();
+    PRESETS
+        .iter()
+        .find(|(n, _, _)| key(n).starts_with(&key(s)))
+        .map(|(_, pos, neg)| (*pos, *neg))
+        .ok_or_else(|| format!("unknown colour preset {s:?}"))
+}
+
+fn parse_clip(s: &str) -> Result<[f32; 4], String> {
+    let v: Vec<f32> =
+        s.split(',').map(|t| t.trim().parse::<f32>()).collect::<Result<_, _>>().map_err(|e| e.to_string())?;
+    match v[..] {
+        [x, y, z] => Ok([x, y, z, 0.0]),
+        [x, y, z, o] => Ok([x, y, z, o]),
+        _ => Err(format!("expected NX,NY,NZ[,OFFSET], got {s:?}")),
+    }
 }
 
 fn parse_size(s: &str) -> Result<[u32; 2], String> {
-    let (w, h) = s
-        .split_once(['x', 'X'])
-        .ok_or_else(|| format!("expected WIDTHxHEIGHT, got {s:?}"))?;
-    let parse = |v: &str| {
-        v.trim()
-            .parse::<u32>()
-            .ok()
-            .filter(|&n| (1..=16384).contains(&n))
-    };
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("expected WIDTHxHEIGHT, got {s:?}"))?;
+    let parse = |v: &str| v.trim().parse::<u32>().ok().filter(|&n| (1..=16384).contains(&n));
     match (parse(w), parse(h)) {
         (Some(w), Some(h)) => Ok([w, h]),
-        _ => Err(format!(
-            "expected WIDTHxHEIGHT with sides 1..16384, got {s:?}"
-        )),
+        _ => Err(format!("expected WIDTHxHEIGHT with sides 1..16384, got {s:?}")),
     }
 }
 
@@ -157,6 +203,34 @@ impl ViewArgs {
         }
         if let Some(k2) = self.k2 {
             s.volume.k2 = k2;
+        }
+        let t = &mut s.volume.transfer;
+        let shape = match self.tf {
+            TfArg::Power => None,
+            TfArg::Uniform => Some(Shape::Uniform),
+            TfArg::Gaussian => Some(Shape::Gaussian),
+            TfArg::LeftHalf => Some(Shape::LeftHalfGaussian),
+            TfArg::RightHalf => Some(Shape::RightHalfGaussian),
+            TfArg::Sinusoidal => Some(Shape::Sinusoidal),
+        };
+        if let Some(shape) = shape {
+            t.kind = TransferKind::Shaped;
+            for lobe in [&mut t.positive, &mut t.negative] {
+                lobe.shape = shape;
+                lobe.center = self.tf_center.unwrap_or(lobe.center);
+                lobe.width = self.tf_width.unwrap_or(lobe.width);
+                lobe.opacity = self.tf_opacity.unwrap_or(lobe.opacity);
+            }
+        }
+        t.shading = self.shading;
+        t.boundary = self.boundary.unwrap_or(0.0).clamp(0.0, 1.0);
+        t.gradient_power = self.gradient_power.unwrap_or(0.0).max(0.0);
+        if let Some([x, y, z, offset]) = self.clip {
+            s.volume.clip = ClipPlane { enabled: true, normal: [x, y, z], offset };
+        }
+        if let Some((pos, neg)) = self.colors {
+            s.volume.positive_color = pos;
+            s.volume.negative_color = neg;
         }
         s.atoms = match self.atoms {
             AtomsArg::BallAndStick => AtomStyle::BallAndStick,
@@ -178,11 +252,7 @@ impl ViewArgs {
             return Ok(None);
         }
         if self.volume >= doc.volumes.len() {
-            bail!(
-                "--volume {} is out of range: the file has {} volume(s)",
-                self.volume,
-                doc.volumes.len()
-            );
+            bail!("--volume {} is out of range: the file has {} volume(s)", self.volume, doc.volumes.len());
         }
         Ok(Some(self.volume))
     }
@@ -196,11 +266,7 @@ fn load(file: Option<&Path>) -> Result<Document> {
 }
 
 fn gpu(lavapipe: bool) -> Result<GpuContext> {
-    let pref = if lavapipe {
-        AdapterPreference::LavapipeOnly
-    } else {
-        AdapterPreference::HighPerformance
-    };
+    let pref = if lavapipe { AdapterPreference::LavapipeOnly } else { AdapterPreference::HighPerformance };
     Ok(GpuContext::headless(pref)?)
 }
 
@@ -214,23 +280,10 @@ fn main() -> Result<()> {
             let doc = load(args.file.as_deref())?;
             let ctx = gpu(args.lavapipe)?;
             let settings = args.view.settings();
-            let mut h = Headless::new(
-                &ctx,
-                &doc,
-                args.view.volume_index(&doc)?,
-                &settings,
-                args.view.size,
-            )?;
+            let mut h = Headless::new(&ctx, &doc, args.view.volume_index(&doc)?, &settings, args.view.size)?;
             let img = h.render(&ctx, &args.view.camera(&doc), &settings)?;
-            img.save(&args.output)
-                .with_context(|| format!("writing {}", args.output.display()))?;
-            eprintln!(
-                "wrote {} ({}x{}, {})",
-                args.output.display(),
-                img.width(),
-                img.height(),
-                ctx.describe()
-            );
+            img.save(&args.output).with_context(|| format!("writing {}", args.output.display()))?;
+            eprintln!("wrote {} ({}x{}, {})", args.output.display(), img.width(), img.height(), ctx.describe());
             Ok(())
         }
         Some(Command::Info { file, json }) => {
@@ -242,22 +295,13 @@ fn main() -> Result<()> {
             }
             Ok(())
         }
-        Some(Command::Bench(BenchCommand::Render {
-            file,
-            view,
-            frames,
-            lavapipe,
-        })) => {
+        Some(Command::Bench(BenchCommand::Render { file, view, frames, lavapipe })) => {
             let doc = load(file.as_deref())?;
             let ctx = gpu(lavapipe)?;
             let settings = view.settings();
             let camera = view.camera(&doc);
             let mut h = Headless::new(&ctx, &doc, view.volume_index(&doc)?, &settings, view.size)?;
-            let wait = |ctx: &GpuContext| {
-                ctx.device
-                    .poll(wgpu::PollType::wait_indefinitely())
-                    .map(|_| ())
-            };
+            let wait = |ctx: &GpuContext| ctx.device.poll(wgpu::PollType::wait_indefinitely()).map(|_| ());
             for _ in 0..2 {
                 h.draw(&ctx, &camera, &settings);
                 wait(&ctx)?;
@@ -274,11 +318,7 @@ fn main() -> Result<()> {
             }
             times.sort_by(f64::total_cmp);
             let median = times[times.len() / 2];
-            let grid = doc
-                .volumes
-                .get(view.volume)
-                .map(|g| format!("{:?}", g.dims))
-                .unwrap_or("none".into());
+            let grid = doc.volumes.get(view.volume).map(|g| format!("{:?}", g.dims)).unwrap_or("none".into());
             println!("adapter: {}", ctx.describe());
             println!(
                 "scene: {} atoms, grid {grid}, {}x{}, {:?}, {} slices",
@@ -300,12 +340,7 @@ fn main() -> Result<()> {
                 camera.fov_y.to_degrees()
             );
             if let Some(v) = h.renderer.volume.volume() {
-                let s = v.grid_box.slices(
-                    settings.volume.mode,
-                    settings.volume.slices,
-                    eye,
-                    -camera.backward(),
-                );
+                let s = v.grid_box.slices(settings.volume.mode, settings.volume.slices, eye, -camera.backward());
                 println!("slice_spacing_bohr={:.5}", s.spacing);
             }
             println!(

@@ -4,36 +4,12 @@ use std::path::Path;
 
 /// For each layer (a directory or file under src/), the crate modules it must not name.
 const RULES: &[(&str, &[&str])] = &[
-    (
-        "model",
-        &[
-            "formats", "scene", "gpu", "headless", "app", "demo", "info", "wgpu", "egui", "eframe",
-            "rfd",
-        ],
-    ),
-    (
-        "formats",
-        &[
-            "scene", "gpu", "headless", "app", "wgpu", "egui", "eframe", "rfd",
-        ],
-    ),
-    (
-        "scene",
-        &[
-            "formats", "gpu", "headless", "app", "wgpu", "egui", "eframe", "rfd",
-        ],
-    ),
-    (
-        "gpu",
-        &[
-            "formats", "headless", "app", "demo", "egui", "eframe", "rfd",
-        ],
-    ),
+    ("model", &["formats", "scene", "gpu", "headless", "app", "demo", "info", "wgpu", "egui", "eframe", "rfd"]),
+    ("formats", &["scene", "gpu", "headless", "app", "wgpu", "egui", "eframe", "rfd"]),
+    ("scene", &["formats", "gpu", "headless", "app", "wgpu", "egui", "eframe", "rfd"]),
+    ("gpu", &["formats", "headless", "app", "demo", "egui", "eframe", "rfd"]),
     ("headless.rs", &["formats", "app", "egui", "eframe", "rfd"]),
-    (
-        "info.rs",
-        &["gpu", "headless", "app", "wgpu", "egui", "eframe"],
-    ),
+    ("info.rs", &["gpu", "headless", "app", "wgpu", "egui", "eframe"]),
 ];
 
 fn rust_files(path: &Path, out: &mut Vec<std::path::PathBuf>) {
@@ -51,13 +27,7 @@ fn names(line: &str, module: &str) -> bool {
     if l.starts_with("//") {
         return false;
     }
-    [
-        format!("crate::{module}"),
-        format!("{module}::"),
-        format!("super::super::{module}"),
-    ]
-    .iter()
-    .any(|pat| {
+    [format!("crate::{module}"), format!("{module}::"), format!("super::super::{module}")].iter().any(|pat| {
         l.match_indices(pat.as_str()).any(|(i, _)| {
             // Only whole path segments: `crate::gpu` but not `my_gpu::`.
             i == 0 || !l.as_bytes()[i - 1].is_ascii_alphanumeric() && l.as_bytes()[i - 1] != b'_'
@@ -78,22 +48,13 @@ fn layers_import_only_downwards() {
             for (n, line) in text.lines().enumerate() {
                 for m in *forbidden {
                     if names(line, m) {
-                        violations.push(format!(
-                            "{}:{}: {layer} names {m}: {}",
-                            f.display(),
-                            n + 1,
-                            line.trim()
-                        ));
+                        violations.push(format!("{}:{}: {layer} names {m}: {}", f.display(), n + 1, line.trim()));
                     }
                 }
             }
         }
     }
-    assert!(
-        violations.is_empty(),
-        "layering violations:\n{}",
-        violations.join("\n")
-    );
+    assert!(violations.is_empty(), "layering violations:\n{}", violations.join("\n"));
 }
 
 #[test]
@@ -103,10 +64,6 @@ fn only_main_uses_anyhow() {
     rust_files(&src, &mut files);
     for f in files.iter().filter(|f| !f.ends_with("main.rs")) {
         let text = std::fs::read_to_string(f).unwrap();
-        assert!(
-            !text.contains("anyhow"),
-            "{} uses anyhow; library code returns typed errors",
-            f.display()
-        );
+        assert!(!text.contains("anyhow"), "{} uses anyhow; library code returns typed errors", f.display());
     }
 }

@@ -12,9 +12,7 @@ fn expansion() -> CartesianExpansion {
     // A deterministic mix of shells, l = 0..5, with contracted primitives and signed weights.
     let mut seed = 7u64;
     let mut rnd = move || {
-        seed = seed
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
+        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
         (seed >> 11) as f64 / (1u64 << 53) as f64
     };
     let shells = (0..12)
@@ -24,9 +22,7 @@ fn expansion() -> CartesianExpansion {
                 center: DVec3::new(rnd() * 4.0 - 2.0, rnd() * 4.0 - 2.0, rnd() * 3.0 - 1.5),
                 l,
                 cutoff: 9.0,
-                primitives: (0..1 + i % 3)
-                    .map(|_| [0.3 + 2.0 * rnd(), rnd() - 0.3])
-                    .collect(),
+                primitives: (0..1 + i % 3).map(|_| [0.3 + 2.0 * rnd(), rnd() - 0.3]).collect(),
                 weights: (0..n_cartesian(l)).map(|_| rnd() * 2.0 - 1.0).collect(),
             }
         })
@@ -42,16 +38,9 @@ fn gpu_fill_matches_the_cpu_reference() {
     let dims = [21, 17, 13];
     let world_from_grid = VolumeGrid::affine(
         DVec3::new(-3.0, -2.5, -2.0),
-        [
-            DVec3::new(0.3, 0.0, 0.0),
-            DVec3::new(0.05, 0.31, 0.0),
-            DVec3::new(0.0, 0.02, 0.33),
-        ],
+        [DVec3::new(0.3, 0.0, 0.0), DVec3::new(0.05, 0.31, 0.0), DVec3::new(0.0, 0.02, 0.33)],
     );
-    let grid = GridGeometry {
-        dims,
-        world_from_grid,
-    };
+    let grid = GridGeometry { dims, world_from_grid };
     let texture = GtoFillPass::new(&ctx).fill(&ctx, &e, &grid).unwrap();
     let gpu = read_volume(&ctx, &texture).unwrap();
     assert_eq!(gpu.len(), dims.iter().product::<usize>());
@@ -59,43 +48,24 @@ fn gpu_fill_matches_the_cpu_reference() {
     for i in 0..dims[0] {
         for j in 0..dims[1] {
             for k in 0..dims[2] {
-                cpu.push(e.value(
-                    world_from_grid.transform_point3(DVec3::new(i as f64, j as f64, k as f64)),
-                ));
+                cpu.push(e.value(world_from_grid.transform_point3(DVec3::new(i as f64, j as f64, k as f64))));
             }
         }
     }
     let max = cpu.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let worst = gpu
-        .iter()
-        .zip(&cpu)
-        .map(|(g, c)| (*g as f64 - c).abs())
-        .fold(0.0, f64::max);
-    eprintln!(
-        "max |ψ| {max:.4}, worst |gpu − cpu| {worst:.3e} ({:.2e} of max)",
-        worst / max
-    );
+    let worst = gpu.iter().zip(&cpu).map(|(g, c)| (*g as f64 - c).abs()).fold(0.0, f64::max);
+    eprintln!("max |ψ| {max:.4}, worst |gpu − cpu| {worst:.3e} ({:.2e} of max)", worst / max);
     assert!(max > 0.1, "the test expansion is not trivial");
     // f32 arithmetic: 1e-4 of the largest value.
-    assert!(
-        worst <= 1e-4 * max,
-        "GPU differs from CPU by {worst:e} (max {max})"
-    );
+    assert!(worst <= 1e-4 * max, "GPU differs from CPU by {worst:e} (max {max})");
 }
 
 #[test]
 fn an_empty_expansion_fills_zeros() {
     let ctx = common::lavapipe();
     let grid = GridGeometry::cube(DVec3::splat(-1.0), DVec3::splat(1.0), 5);
-    let texture = GtoFillPass::new(&ctx)
-        .fill(&ctx, &CartesianExpansion::default(), &grid)
-        .unwrap();
-    assert!(
-        read_volume(&ctx, &texture)
-            .unwrap()
-            .iter()
-            .all(|&v| v == 0.0)
-    );
+    let texture = GtoFillPass::new(&ctx).fill(&ctx, &CartesianExpansion::default(), &grid).unwrap();
+    assert!(read_volume(&ctx, &texture).unwrap().iter().all(|&v| v == 0.0));
 }
 
 #[test]
@@ -111,29 +81,19 @@ fn direct_mode_matches_slicing_the_filled_grid() {
     let texture = GtoFillPass::new(&ctx).fill(&ctx, &e, &grid).unwrap();
     let values = read_volume(&ctx, &texture).unwrap();
     let max_abs = values.iter().fold(0.0f64, |m, v| m.max(v.abs() as f64));
-    let settings = RenderSettings {
-        atoms: AtomStyle::Hidden,
-        ..Default::default()
-    };
-    let doc = Document {
-        molecule: Molecule::default(),
-        ..Default::default()
-    };
+    let settings = RenderSettings { atoms: AtomStyle::Hidden, ..Default::default() };
+    let doc = Document { molecule: Molecule::default(), ..Default::default() };
     let mut camera = Camera::framing(DVec3::splat(-4.0).as_vec3(), DVec3::splat(4.0).as_vec3());
     camera.orbit(0.6, 0.3);
     let mut h = Headless::new(&ctx, &doc, None, &settings, [96, 72]).unwrap();
 
-    h.renderer
-        .set_volume_texture(&ctx, volume_from_texture(texture, &grid, max_abs));
+    h.renderer.set_volume_texture(&ctx, volume_from_texture(texture, &grid, max_abs));
     let sliced = h.render(&ctx, &camera, &settings).unwrap();
     h.renderer.set_direct(&ctx, &e, &grid, max_abs);
     let direct = h.render(&ctx, &camera, &settings).unwrap();
 
     let covered = direct.pixels().filter(|p| p[0].abs_diff(p[2]) > 20).count();
-    assert!(
-        covered > 500,
-        "direct mode shows the orbital ({covered} pixels)"
-    );
+    assert!(covered > 500, "direct mode shows the orbital ({covered} pixels)");
     let (mut worst, mut sum) = (0u8, 0u64);
     for (a, b) in sliced.pixels().zip(direct.pixels()) {
         let d = (0..3).map(|c| a[c].abs_diff(b[c])).max().unwrap();

@@ -36,10 +36,7 @@ fn expected() -> Vec<Expected> {
             volumes: 1,
             atoms: 16,
             // N1 < 0: the origin and atoms are read as ångström too.
-            first_atom: (
-                29,
-                DVec3::new(2.317035, 3.509540, -0.795570) * BOHR_PER_ANGSTROM,
-            ),
+            first_atom: (29, DVec3::new(2.317035, 3.509540, -0.795570) * BOHR_PER_ANGSTROM),
             orthogonal: true,
         },
         Expected {
@@ -63,11 +60,7 @@ fn expected() -> Vec<Expected> {
 
 fn dir() -> PathBuf {
     let dir = PathBuf::from(DIR);
-    assert!(
-        dir.is_dir(),
-        "reference corpus missing: {} (it lives beside the project)",
-        dir.display()
-    );
+    assert!(dir.is_dir(), "reference corpus missing: {} (it lives beside the project)", dir.display());
     dir
 }
 
@@ -85,27 +78,15 @@ fn manifest_range(name: &str) -> (String, String) {
         .split("\n\n")
         .find(|b| b.starts_with(&format!("{name} ")))
         .unwrap_or_else(|| panic!("{name} not in MANIFEST.md"));
-    let range = block
-        .split("range=[")
-        .nth(1)
-        .and_then(|r| r.split(']').next())
-        .expect("range=[…]");
+    let range = block.split("range=[").nth(1).and_then(|r| r.split(']').next()).expect("range=[…]");
     let (lo, hi) = range.split_once(',').expect("range=[min,max]");
     (lo.trim().to_string(), hi.trim().to_string())
 }
 
 /// `value` agrees with `printed` to the significant digits `printed` shows.
 fn agrees_to_printed_digits(value: f64, printed: &str) -> bool {
-    let mantissa = printed
-        .trim_start_matches(['-', '+'])
-        .split(['e', 'E'])
-        .next()
-        .unwrap_or("");
-    let digits = mantissa
-        .replace('.', "")
-        .trim_start_matches('0')
-        .len()
-        .max(1);
+    let mantissa = printed.trim_start_matches(['-', '+']).split(['e', 'E']).next().unwrap_or("");
+    let digits = mantissa.replace('.', "").trim_start_matches('0').len().max(1);
     let want: f64 = printed.parse().expect("a number");
     format!("{:.*e}", digits - 1, value) == format!("{:.*e}", digits - 1, want)
 }
@@ -122,10 +103,7 @@ fn every_reference_cube_loads_as_the_manifest_says() {
     entries.sort();
     for path in entries {
         let name = path.file_name().unwrap().to_string_lossy().to_string();
-        let e = table
-            .iter()
-            .find(|e| e.name == name)
-            .unwrap_or_else(|| panic!("{name}: no expectations"));
+        let e = table.iter().find(|e| e.name == name).unwrap_or_else(|| panic!("{name}: no expectations"));
         let d = load(&path);
         assert_eq!(d.volumes.len(), e.volumes, "{name}: volumes");
         for g in &d.volumes {
@@ -135,31 +113,13 @@ fn every_reference_cube_loads_as_the_manifest_says() {
         assert_eq!(d.molecule.atoms.len(), e.atoms, "{name}: atoms");
         let a = &d.molecule.atoms[0];
         assert_eq!(a.z, e.first_atom.0, "{name}: first atom Z");
-        assert!(
-            (a.position - e.first_atom.1).length() < 1e-6,
-            "{name}: first atom at {}",
-            a.position
-        );
+        assert!((a.position - e.first_atom.1).length() < 1e-6, "{name}: first atom at {}", a.position);
 
-        let min = d
-            .volumes
-            .iter()
-            .map(|g| g.stats.min)
-            .fold(f64::INFINITY, f64::min);
-        let max = d
-            .volumes
-            .iter()
-            .map(|g| g.stats.max)
-            .fold(f64::NEG_INFINITY, f64::max);
+        let min = d.volumes.iter().map(|g| g.stats.min).fold(f64::INFINITY, f64::min);
+        let max = d.volumes.iter().map(|g| g.stats.max).fold(f64::NEG_INFINITY, f64::max);
         let (lo, hi) = manifest_range(&name);
-        assert!(
-            agrees_to_printed_digits(min, &lo),
-            "{name}: min {min} vs manifest {lo}"
-        );
-        assert!(
-            agrees_to_printed_digits(max, &hi),
-            "{name}: max {max} vs manifest {hi}"
-        );
+        assert!(agrees_to_printed_digits(min, &lo), "{name}: min {min} vs manifest {lo}");
+        assert!(agrees_to_printed_digits(max, &hi), "{name}: max {max} vs manifest {hi}");
         seen += 1;
     }
     assert_eq!(seen, table.len(), "every expected cube is in the corpus");
@@ -176,40 +136,18 @@ fn multi_orbital_cube_has_its_dataset_ids() {
     assert_eq!(labels, ["MO 6", "MO 7", "MO 8"]);
     // The first values of the file belong to point (0, 0, 0) of MO 6, 7, 8 in turn.
     let first = &file.values[..6];
-    assert_eq!(
-        [
-            d.volumes[0].values[0],
-            d.volumes[1].values[0],
-            d.volumes[2].values[0]
-        ],
-        first[..3]
-    );
-    assert_eq!(
-        [
-            d.volumes[0].values[1],
-            d.volumes[1].values[1],
-            d.volumes[2].values[1]
-        ],
-        first[3..6]
-    );
+    assert_eq!([d.volumes[0].values[0], d.volumes[1].values[0], d.volumes[2].values[0]], first[..3]);
+    assert_eq!([d.volumes[0].values[1], d.volumes[1].values[1], d.volumes[2].values[1]], first[3..6]);
 }
 
 /// Header numbers of lines 3-6: the origin and the three axis vectors.
 fn header_vectors(text: &str) -> (DVec3, [DVec3; 3]) {
     let num = |line: &str, skip: usize| -> DVec3 {
-        let v: Vec<f64> = line
-            .split_whitespace()
-            .skip(skip)
-            .take(3)
-            .map(|t| t.parse().unwrap())
-            .collect();
+        let v: Vec<f64> = line.split_whitespace().skip(skip).take(3).map(|t| t.parse().unwrap()).collect();
         DVec3::new(v[0], v[1], v[2])
     };
     let lines: Vec<&str> = text.lines().collect();
-    (
-        num(lines[2], 1),
-        [num(lines[3], 1), num(lines[4], 1), num(lines[5], 1)],
-    )
+    (num(lines[2], 1), [num(lines[3], 1), num(lines[4], 1), num(lines[5], 1)])
 }
 
 #[test]
@@ -231,11 +169,7 @@ fn non_orthogonal_voxels_sit_where_the_header_says() {
 #[test]
 fn angstrom_flagged_axis_is_converted() {
     let g: VolumeGrid = load(&dir().join("grid20ang.cube")).volumes.remove(0);
-    assert!(
-        (g.step(0) - DVec3::X * 1.151300 * BOHR_PER_ANGSTROM).length() < 1e-9,
-        "{}",
-        g.step(0)
-    );
+    assert!((g.step(0) - DVec3::X * 1.151300 * BOHR_PER_ANGSTROM).length() < 1e-9, "{}", g.step(0));
     // Axes 2 and 3 carry positive counts: bohr.
     assert!((g.step(1) - DVec3::Y * 1.215025).length() < 1e-9);
     assert!((g.step(2) - DVec3::Z * 1.239406).length() < 1e-9);
@@ -243,9 +177,7 @@ fn angstrom_flagged_axis_is_converted() {
 
 #[test]
 fn cubegen_density_integrates_to_something_positive() {
-    let g = load(&dir().join("cubegen_h2o_5points.cube"))
-        .volumes
-        .remove(0);
+    let g = load(&dir().join("cubegen_h2o_5points.cube")).volumes.remove(0);
     let integral: f64 = g.values.iter().map(|&v| v as f64).sum::<f64>() * g.voxel_volume();
     println!(
         "cubegen_h2o_5points: sum(rho) * dV = {integral:.4} electrons on a 5x5x5 grid (10 expected on a fine one)"

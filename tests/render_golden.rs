@@ -17,12 +17,7 @@ fn settings(mode: SliceMode, atoms: AtomStyle) -> RenderSettings {
     s
 }
 
-fn render(
-    doc: &orbcloud::model::Document,
-    s: &RenderSettings,
-    yaw: f32,
-    pitch: f32,
-) -> image::RgbaImage {
+fn render(doc: &orbcloud::model::Document, s: &RenderSettings, yaw: f32, pitch: f32) -> image::RgbaImage {
     let ctx = lavapipe();
     let mut cam = default_camera(doc);
     cam.orbit(yaw.to_radians(), pitch.to_radians());
@@ -33,11 +28,7 @@ fn render(
 fn background(s: &RenderSettings) -> [u8; 3] {
     // sRGB encoding of the linear background colour.
     s.background.map(|c| {
-        let v = if c <= 0.0031308 {
-            12.92 * c
-        } else {
-            1.055 * c.powf(1.0 / 2.4) - 0.055
-        };
+        let v = if c <= 0.0031308 { 12.92 * c } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 };
         (v * 255.0).round() as u8
     })
 }
@@ -55,12 +46,7 @@ fn atoms_only() {
 fn space_filling() {
     let s = settings(SliceMode::ViewAligned, AtomStyle::SpaceFilling);
     let img = render(&scene(None), &s, 20.0, 25.0);
-    let ball = render(
-        &scene(None),
-        &settings(SliceMode::ViewAligned, AtomStyle::BallAndStick),
-        20.0,
-        25.0,
-    );
+    let ball = render(&scene(None), &settings(SliceMode::ViewAligned, AtomStyle::BallAndStick), 20.0, 25.0);
     assert!(coverage(&img, background(&s)) > 1.5 * coverage(&ball, background(&s)));
     assert_golden("space_filling", &img);
 }
@@ -100,17 +86,56 @@ fn sheared_grid() {
 /// The p orbital is positive above the molecular plane (z > 0) and negative below: both the red
 /// and the blue colour must show.
 fn assert_two_coloured_lobes(img: &image::RgbaImage) {
-    let red = img
-        .pixels()
-        .filter(|p| p[0] as i32 > p[2] as i32 + 30)
-        .count();
-    let blue = img
-        .pixels()
-        .filter(|p| p[2] as i32 > p[0] as i32 + 30)
-        .count();
+    let red = img.pixels().filter(|p| p[0] as i32 > p[2] as i32 + 30).count();
+    let blue = img.pixels().filter(|p| p[2] as i32 > p[0] as i32 + 30).count();
     let n = (img.width() * img.height()) as usize;
-    assert!(
-        red * 50 > n && blue * 50 > n,
-        "red {red} blue {blue} of {n} pixels"
-    );
+    assert!(red * 50 > n && blue * 50 > n, "red {red} blue {blue} of {n} pixels");
+}
+
+fn shaped(shape: orbcloud::scene::Shape, shading: bool) -> RenderSettings {
+    use orbcloud::scene::TransferKind;
+    let mut s = settings(SliceMode::ViewAligned, AtomStyle::BallAndStick);
+    let t = &mut s.volume.transfer;
+    t.kind = TransferKind::Shaped;
+    t.positive.shape = shape;
+    t.negative.shape = shape;
+    t.shading = shading;
+    s
+}
+
+#[test]
+fn lit_gaussian_shells() {
+    let mut s = shaped(orbcloud::scene::Shape::Gaussian, true);
+    s.volume.transfer.boundary = 0.5;
+    let img = render(&scene(Some(p_orbital(40, false))), &s, 65.0, 20.0);
+    assert_two_coloured_lobes(&img);
+    assert_golden("lit_gaussian_shells", &img);
+}
+
+#[test]
+fn contour_shells() {
+    let mut s = shaped(orbcloud::scene::Shape::Sinusoidal, false);
+    for lobe in [&mut s.volume.transfer.positive, &mut s.volume.transfer.negative] {
+        lobe.center = 0.15;
+        lobe.width = 0.25;
+        lobe.opacity = 0.6;
+    }
+    let img = render(&scene(Some(p_orbital(40, false))), &s, 65.0, 20.0);
+    assert_two_coloured_lobes(&img);
+    assert_golden("contour_shells", &img);
+}
+
+#[test]
+fn clipped_cloud() {
+    let mut s = settings(SliceMode::ViewAligned, AtomStyle::BallAndStick);
+    s.volume.clip.enabled = true;
+    s.volume.clip.normal = [0.0, 0.0, 1.0];
+    let doc = scene(Some(p_orbital(40, false)));
+    let clipped = render(&doc, &s, 65.0, 20.0);
+    s.volume.clip.enabled = false;
+    let whole = render(&doc, &s, 65.0, 20.0);
+    // The plane z = 0 removes the positive (red, z > 0) lobe and keeps the negative one.
+    let red = |img: &image::RgbaImage| img.pixels().filter(|p| p[0] as i32 > p[2] as i32 + 30).count();
+    assert!(red(&clipped) * 4 < red(&whole), "clipping left {} of {} red pixels", red(&clipped), red(&whole));
+    assert_golden("clipped_cloud", &clipped);
 }

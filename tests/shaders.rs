@@ -18,10 +18,7 @@ fn every_shader_file_is_registered() {
 
 /// Files that only serve as prerequisites of other modules (they have no entry points).
 fn prerequisites() -> Vec<&'static str> {
-    SHADER_MODULES
-        .iter()
-        .flat_map(|(name, parts)| parts.iter().copied().filter(move |p| p != name))
-        .collect()
+    SHADER_MODULES.iter().flat_map(|(name, parts)| parts.iter().copied().filter(move |p| p != name)).collect()
 }
 
 #[test]
@@ -30,18 +27,12 @@ fn every_shader_module_validates() {
     let mut validated = 0;
     for (name, _) in SHADERS.iter().filter(|(n, _)| !prereqs.contains(n)) {
         let source = module_source(name);
-        let module = naga::front::wgsl::parse_str(&source)
+        let module =
+            naga::front::wgsl::parse_str(&source).unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&source)));
+        naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::default())
+            .validate(&module)
             .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&source)));
-        naga::valid::Validator::new(
-            naga::valid::ValidationFlags::all(),
-            naga::valid::Capabilities::default(),
-        )
-        .validate(&module)
-        .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&source)));
-        assert!(
-            !module.entry_points.is_empty(),
-            "{name} has no entry points"
-        );
+        assert!(!module.entry_points.is_empty(), "{name} has no entry points");
         validated += 1;
     }
     assert!(validated >= 4, "only {validated} shader modules found");
@@ -51,9 +42,6 @@ fn every_shader_module_validates() {
 fn every_prerequisite_is_registered() {
     let names: Vec<&str> = SHADERS.iter().map(|(n, _)| *n).collect();
     for p in prerequisites() {
-        assert!(
-            names.contains(&p),
-            "{p} is a prerequisite but not in gpu::SHADERS"
-        );
+        assert!(names.contains(&p), "{p} is a prerequisite but not in gpu::SHADERS");
     }
 }

@@ -11,11 +11,7 @@ fn harness() -> Harness<'static, OrbApp> {
         .with_size([1000.0, 700.0])
         .wgpu_setup(wgpu_setup(true))
         .build_eframe(|cc| OrbApp::new(cc, Vec::new()));
-    assert!(
-        h.state().error.is_none(),
-        "viewer failed to start: {:?}",
-        h.state().error
-    );
+    assert!(h.state().error.is_none(), "viewer failed to start: {:?}", h.state().error);
     h
 }
 
@@ -62,11 +58,7 @@ fn a_bad_file_reports_an_error_and_keeps_the_open_document() {
     h.run_steps(1);
     let dir = tempfile::tempdir().unwrap();
     let bad = dir.path().join("broken.cube");
-    std::fs::write(
-        &bad,
-        "title\ncomment\n    2 0.0 0.0 0.0\n    3 0.5 0.0 0.0\n",
-    )
-    .unwrap();
+    std::fs::write(&bad, "title\ncomment\n    2 0.0 0.0 0.0\n    3 0.5 0.0 0.0\n").unwrap();
     let ctx = h.ctx.clone();
     h.state_mut().open(bad, &ctx);
     for _ in 0..200 {

@@ -28,22 +28,13 @@ impl LoadJob {
             let _ = tx.send(load_with_progress(&p, &counter, &repaint));
             repaint();
         });
-        Self {
-            path,
-            read,
-            total,
-            result,
-        }
+        Self { path, read, total, result }
     }
 
     /// Fraction of the file read (0..1), and whether it is being parsed.
     pub fn progress(&self) -> (f32, bool) {
         let read = self.read.load(Ordering::Relaxed);
-        let f = if self.total == 0 {
-            0.0
-        } else {
-            read as f32 / self.total as f32
-        };
+        let f = if self.total == 0 { 0.0 } else { read as f32 / self.total as f32 };
         (f.min(1.0), self.total > 0 && read >= self.total)
     }
 
@@ -52,15 +43,8 @@ impl LoadJob {
     }
 }
 
-fn load_with_progress(
-    path: &Path,
-    counter: &AtomicU64,
-    repaint: &dyn Fn(),
-) -> Result<Document, LoadError> {
-    let io = |source| LoadError::Io {
-        path: path.display().to_string(),
-        source,
-    };
+fn load_with_progress(path: &Path, counter: &AtomicU64, repaint: &dyn Fn()) -> Result<Document, LoadError> {
+    let io = |source| LoadError::Io { path: path.display().to_string(), source };
     let mut file = std::fs::File::open(path).map_err(io)?;
     let mut bytes = Vec::new();
     let mut chunk = vec![0u8; 1 << 20];

@@ -22,17 +22,10 @@ pub fn run(files: Vec<PathBuf>) -> eframe::Result<()> {
             .with_title("orbcloud")
             .with_inner_size([1280.0, 800.0])
             .with_drag_and_drop(true),
-        wgpu_options: egui_wgpu::WgpuConfiguration {
-            wgpu_setup: wgpu_setup(false),
-            ..Default::default()
-        },
+        wgpu_options: egui_wgpu::WgpuConfiguration { wgpu_setup: wgpu_setup(false), ..Default::default() },
         ..Default::default()
     };
-    eframe::run_native(
-        "orbcloud",
-        options,
-        Box::new(|cc| Ok(Box::new(OrbApp::new(cc, files)))),
-    )
+    eframe::run_native("orbcloud", options, Box::new(|cc| Ok(Box::new(OrbApp::new(cc, files)))))
 }
 
 /// The window's device: the renderer's features and the adapter's limits. `lavapipe` picks
@@ -47,9 +40,7 @@ pub fn wgpu_setup(lavapipe: bool) -> egui_wgpu::WgpuSetup {
                 .iter()
                 .find(|a| a.get_info().device_type == wgpu::DeviceType::Cpu)
                 .cloned()
-                .ok_or_else(|| {
-                    "no Vulkan CPU adapter (install mesa-vulkan-drivers libvulkan1)".to_owned()
-                })
+                .ok_or_else(|| "no Vulkan CPU adapter (install mesa-vulkan-drivers libvulkan1)".to_owned())
         }));
     }
     egui_wgpu::WgpuSetup::CreateNew(setup)
@@ -68,13 +59,10 @@ pub struct OrbApp {
 
 impl OrbApp {
     pub fn new(cc: &eframe::CreationContext<'_>, files: Vec<PathBuf>) -> Self {
-        let viewport = cc.wgpu_render_state.as_ref().map(|rs| {
-            Viewport::new(GpuContext::from_parts(
-                rs.adapter.clone(),
-                rs.device.clone(),
-                rs.queue.clone(),
-            ))
-        });
+        let viewport = cc
+            .wgpu_render_state
+            .as_ref()
+            .map(|rs| Viewport::new(GpuContext::from_parts(rs.adapter.clone(), rs.device.clone(), rs.queue.clone())));
         let mut app = Self {
             doc: Document::default(),
             view: ViewState::default(),
@@ -137,12 +125,7 @@ impl OrbApp {
             self.open(next, ctx);
         }
         let dropped: Vec<PathBuf> = ctx.input(|i| {
-            i.raw
-                .dropped_files
-                .iter()
-                .map(|f| f.path().to_path_buf())
-                .filter(|p| !p.as_os_str().is_empty())
-                .collect()
+            i.raw.dropped_files.iter().map(|f| f.path().to_path_buf()).filter(|p| !p.as_os_str().is_empty()).collect()
         });
         for path in dropped.into_iter().rev() {
             self.queue.push(path);
@@ -169,10 +152,7 @@ impl OrbApp {
         let size = vp.size().unwrap_or([1280, 800]);
         let default_name = format!(
             "orbcloud-{}.png",
-            std::time::SystemTime::now()
-                .duration_since(std::time::UNIX_EPOCH)
-                .map(|d| d.as_secs())
-                .unwrap_or(0)
+            std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map(|d| d.as_secs()).unwrap_or(0)
         );
         let path = rfd::FileDialog::new()
             .add_filter("PNG image", &["png"])
@@ -198,9 +178,8 @@ impl eframe::App for OrbApp {
         self.apply(&before);
         match action {
             panels::Action::Open => {
-                if let Some(path) = rfd::FileDialog::new()
-                    .add_filter("Gaussian cube", &["cube", "cub", "gz"])
-                    .pick_file()
+                if let Some(path) =
+                    rfd::FileDialog::new().add_filter("Gaussian cube", &["cube", "cub", "gz"]).pick_file()
                 {
                     self.open(path, &ctx);
                 } else {

@@ -20,54 +20,36 @@ pub struct Viewport {
 impl Viewport {
     pub fn new(ctx: GpuContext) -> Self {
         let renderer = Renderer::new(&ctx);
-        Self {
-            ctx,
-            renderer,
-            target: None,
-            drawn: None,
-            generation: 0,
-        }
+        Self { ctx, renderer, target: None, drawn: None, generation: 0 }
     }
 
     /// Uploads a document's molecule and chosen volume.
     pub fn set_document(&mut self, doc: &Document, view: &ViewState) -> Result<(), GpuError> {
-        self.renderer
-            .set_volume(&self.ctx, doc.volumes.get(view.volume))?;
-        self.renderer
-            .set_molecule(&self.ctx, &doc.molecule, view.settings.atoms);
+        self.renderer.set_volume(&self.ctx, doc.volumes.get(view.volume))?;
+        self.renderer.set_molecule(&self.ctx, &doc.molecule, view.settings.atoms);
         self.generation += 1;
         Ok(())
     }
 
     pub fn set_volume(&mut self, doc: &Document, index: usize) -> Result<(), GpuError> {
-        self.renderer
-            .set_volume(&self.ctx, doc.volumes.get(index))?;
+        self.renderer.set_volume(&self.ctx, doc.volumes.get(index))?;
         self.generation += 1;
         Ok(())
     }
 
     pub fn set_atom_style(&mut self, doc: &Document, view: &ViewState) {
-        self.renderer
-            .set_molecule(&self.ctx, &doc.molecule, view.settings.atoms);
+        self.renderer.set_molecule(&self.ctx, &doc.molecule, view.settings.atoms);
         self.generation += 1;
     }
 
     /// Shows the view in the remaining space of `ui`, applying mouse and keyboard input to
     /// `view.camera`.
-    pub fn show(
-        &mut self,
-        ui: &mut egui::Ui,
-        render_state: &egui_wgpu::RenderState,
-        view: &mut ViewState,
-    ) {
+    pub fn show(&mut self, ui: &mut egui::Ui, render_state: &egui_wgpu::RenderState, view: &mut ViewState) {
         let rect = ui.available_rect_before_wrap();
         let response = ui.allocate_rect(rect, Sense::click_and_drag());
         handle_input(ui, &response, view);
         let ppp = ui.ctx().pixels_per_point();
-        let size = [
-            (rect.width() * ppp).round().max(1.0) as u32,
-            (rect.height() * ppp).round().max(1.0) as u32,
-        ];
+        let size = [(rect.width() * ppp).round().max(1.0) as u32, (rect.height() * ppp).round().max(1.0) as u32];
         if self.target.as_ref().is_none_or(|(t, _)| t.size != size) {
             let target = OffscreenTarget::new(&self.ctx.device, size);
             let mut egui_renderer = render_state.renderer.write();
@@ -94,18 +76,9 @@ impl Viewport {
         if let Some((target, id)) = &self.target {
             if self.drawn != Some(key) {
                 let mut encoder =
-                    self.ctx
-                        .device
-                        .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                            label: Some("viewport"),
-                        });
-                let frame = FrameInput {
-                    camera: &view.camera,
-                    settings: &view.settings,
-                    size,
-                };
-                self.renderer
-                    .render(&self.ctx, &mut encoder, &target.color_view, &frame);
+                    self.ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("viewport") });
+                let frame = FrameInput { camera: &view.camera, settings: &view.settings, size };
+                self.renderer.render(&self.ctx, &mut encoder, &target.color_view, &frame);
                 self.ctx.queue.submit([encoder.finish()]);
                 self.drawn = Some(key);
             }
@@ -115,25 +88,12 @@ impl Viewport {
     }
 
     /// Renders the current view at `size` and reads it back (for screenshots).
-    pub fn snapshot(
-        &mut self,
-        view: &ViewState,
-        size: [u32; 2],
-    ) -> Result<image::RgbaImage, GpuError> {
+    pub fn snapshot(&mut self, view: &ViewState, size: [u32; 2]) -> Result<image::RgbaImage, GpuError> {
         let target = OffscreenTarget::new(&self.ctx.device, size);
-        let mut encoder = self
-            .ctx
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("snapshot"),
-            });
-        let frame = FrameInput {
-            camera: &view.camera,
-            settings: &view.settings,
-            size,
-        };
-        self.renderer
-            .render(&self.ctx, &mut encoder, &target.color_view, &frame);
+        let mut encoder =
+            self.ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("snapshot") });
+        let frame = FrameInput { camera: &view.camera, settings: &view.settings, size };
+        self.renderer.render(&self.ctx, &mut encoder, &target.color_view, &frame);
         self.ctx.queue.submit([encoder.finish()]);
         // The viewport's own frame must be redrawn: the renderer's buffers changed size.
         self.drawn = None;

@@ -92,23 +92,13 @@ fn is_space(b: u8) -> bool {
     matches!(b, b' ' | b'\t' | b'\n' | b'\r' | 0x0b | 0x0c)
 }
 
-fn error(
-    file: &str,
-    line: usize,
-    expected: impl Into<String>,
-    found: impl Into<String>,
-) -> ParseError {
-    ParseError {
-        file: file.to_string(),
-        line,
-        expected: expected.into(),
-        found: found.into(),
-    }
+fn error(file: &str, line: usize, expected: impl Into<String>, found: impl Into<String>) -> ParseError {
+    ParseError { file: file.to_string(), line, expected: expected.into(), found: found.into() }
 }
 
-const LINE3: &str = "`NAtoms ox oy oz [NVal]` (an integer atom count, the origin, optionally the integer number of values per point)";
-const ID_LINE: &str =
-    "the data-set line `m id1 … idm` that follows the atoms when NAtoms is negative";
+const LINE3: &str =
+    "`NAtoms ox oy oz [NVal]` (an integer atom count, the origin, optionally the integer number of values per point)";
+const ID_LINE: &str = "the data-set line `m id1 … idm` that follows the atoms when NAtoms is negative";
 
 impl CubeFile {
     /// Points along each axis.
@@ -128,19 +118,12 @@ impl CubeFile {
     pub fn parse(file: &str, text: &str) -> Result<Self, ParseError> {
         let bytes = text.as_bytes();
         if text.trim().is_empty() {
-            return Err(error(
-                file,
-                1,
-                "a cube file: two comment lines, then `NAtoms ox oy oz`",
-                "an empty file",
-            ));
+            return Err(error(file, 1, "a cube file: two comment lines, then `NAtoms ox oy oz`", "an empty file"));
         }
         let mut lines = Lines::new(file, text);
         let comments = [
             lines.next_line("comment line 1")?.to_string(),
-            lines
-                .next_line("comment line 2, then `NAtoms ox oy oz`")?
-                .to_string(),
+            lines.next_line("comment line 2, then `NAtoms ox oy oz`")?.to_string(),
         ];
 
         // Line 3: NAtoms ox oy oz [NVal]
@@ -161,21 +144,10 @@ impl CubeFile {
         };
 
         // Lines 4-6: N vx vy vz
-        let mut axes = [CubeAxis {
-            count: 0,
-            step: [0.0; 3],
-        }; 3];
+        let mut axes = [CubeAxis { count: 0, step: [0.0; 3] }; 3];
         for (a, axis) in axes.iter_mut().enumerate() {
-            let expected = || {
-                format!(
-                    "axis {} as `N vx vy vz` (an integer point count, the step vector)",
-                    a + 1
-                )
-            };
-            let l = lines.next_line("").map_err(|e| ParseError {
-                expected: expected(),
-                ..e
-            })?;
+            let expected = || format!("axis {} as `N vx vy vz` (an integer point count, the step vector)", a + 1);
+            let l = lines.next_line("").map_err(|e| ParseError { expected: expected(), ..e })?;
             let t: Vec<&str> = l.split_whitespace().collect();
             let bad = || lines.error(&expected(), &excerpt(l));
             if t.len() != 4 {
@@ -183,31 +155,17 @@ impl CubeFile {
             }
             let count: i64 = t[0].parse().map_err(|_| bad())?;
             if count == 0 {
-                return Err(lines.error(
-                    &format!("a non-zero number of points on axis {}", a + 1),
-                    "0",
-                ));
+                return Err(lines.error(&format!("a non-zero number of points on axis {}", a + 1), "0"));
             }
-            *axis = CubeAxis {
-                count,
-                step: read3(&t[1..4]).ok_or_else(bad)?,
-            };
+            *axis = CubeAxis { count, step: read3(&t[1..4]).ok_or_else(bad)? };
         }
         let dims = axes.map(|a| a.count.unsigned_abs());
         let grid_points = dims.iter().try_fold(1u64, |p, &n| p.checked_mul(n));
-        let per_point = if natoms >= 0 {
-            nval.unwrap_or(1) as u64
-        } else {
-            1
-        };
+        let per_point = if natoms >= 0 { nval.unwrap_or(1) as u64 } else { 1 };
         match grid_points.and_then(|p| p.checked_mul(per_point)) {
             Some(n) if n <= MAX_GRID_VALUES => {}
             _ => {
-                let per = if per_point > 1 {
-                    format!(" × {per_point} values per point")
-                } else {
-                    String::new()
-                };
+                let per = if per_point > 1 { format!(" × {per_point} values per point") } else { String::new() };
                 return Err(error(
                     file,
                     6,
@@ -235,61 +193,33 @@ impl CubeFile {
         let mut atoms = Vec::with_capacity(n_atoms as usize);
         for i in 0..n_atoms {
             let expected = || format!("atom {} of {n_atoms} as `Z charge x y z`", i + 1);
-            let l = lines.next_line("").map_err(|e| ParseError {
-                expected: expected(),
-                ..e
-            })?;
+            let l = lines.next_line("").map_err(|e| ParseError { expected: expected(), ..e })?;
             let t: Vec<&str> = l.split_whitespace().collect();
             let bad = || lines.error(&expected(), &excerpt(l));
             if t.len() != 5 {
                 return Err(bad());
             }
             let z: i64 = t[0].parse().map_err(|_| bad())?;
-            let z = u32::try_from(z).map_err(|_| {
-                lines.error(
-                    &format!("a non-negative atomic number for atom {}", i + 1),
-                    t[0],
-                )
-            })?;
+            let z = u32::try_from(z)
+                .map_err(|_| lines.error(&format!("a non-negative atomic number for atom {}", i + 1), t[0]))?;
             let charge = parse_real(t[1]).ok_or_else(bad)?;
-            atoms.push(CubeAtom {
-                z,
-                charge,
-                position: read3(&t[2..5]).ok_or_else(bad)?,
-            });
+            atoms.push(CubeAtom { z, charge, position: read3(&t[2..5]).ok_or_else(bad)? });
         }
         let mut pos = text.len() - lines.rest().len();
 
         // The data-set line, then the values.
         let shape = |m: u64| {
-            let per = if m > 1 {
-                format!(" × {m} values per point")
-            } else {
-                String::new()
-            };
+            let per = if m > 1 { format!(" × {m} values per point") } else { String::new() };
             format!("{}×{}×{} points{per}", dims[0], dims[1], dims[2])
         };
         let (dataset_ids, values) = if natoms < 0 {
             let (ids, id_line) = read_dataset_ids(file, text, &mut pos)?;
             let m = ids.len() as u64;
             if let Some(n) = nval.filter(|&n| n > 1 && n as u64 != m) {
-                return Err(error(
-                    file,
-                    id_line,
-                    format!("{n} data-set ids (NVal on line 3)"),
-                    format!("{m}"),
-                ));
+                return Err(error(file, id_line, format!("{n} data-set ids (NVal on line 3)"), format!("{m}")));
             }
-            if grid_points
-                .checked_mul(m)
-                .is_none_or(|n| n > MAX_GRID_VALUES)
-            {
-                return Err(error(
-                    file,
-                    id_line,
-                    format!("at most {MAX_GRID_VALUES} grid values"),
-                    shape(m),
-                ));
+            if grid_points.checked_mul(m).is_none_or(|n| n > MAX_GRID_VALUES) {
+                return Err(error(file, id_line, format!("at most {MAX_GRID_VALUES} grid values"), shape(m)));
             }
             let values = read_values(file, bytes, pos, grid_points * m, &shape(m))?;
             (Some(ids), values)
@@ -301,15 +231,9 @@ impl CubeFile {
             let m = ids.len() as u64;
             let plain = count_tokens(&bytes[end..]) + m + 1 == grid_points;
             if plain {
-                (
-                    None,
-                    read_values(file, bytes, start, grid_points, &shape(1))?,
-                )
+                (None, read_values(file, bytes, start, grid_points, &shape(1))?)
             } else {
-                if grid_points
-                    .checked_mul(m)
-                    .is_none_or(|n| n > MAX_GRID_VALUES)
-                {
+                if grid_points.checked_mul(m).is_none_or(|n| n > MAX_GRID_VALUES) {
                     return Err(error(
                         file,
                         line_at(bytes, start),
@@ -317,38 +241,19 @@ impl CubeFile {
                         shape(m),
                     ));
                 }
-                (
-                    Some(ids),
-                    read_values(file, bytes, end, grid_points * m, &shape(m))?,
-                )
+                (Some(ids), read_values(file, bytes, end, grid_points * m, &shape(m))?)
             }
         } else {
-            (
-                None,
-                read_values(file, bytes, pos, grid_points * per_point, &shape(per_point))?,
-            )
+            (None, read_values(file, bytes, pos, grid_points * per_point, &shape(per_point))?)
         };
 
-        Ok(Self {
-            comments,
-            natoms,
-            origin,
-            nval,
-            axes,
-            atoms,
-            dataset_ids,
-            values,
-        })
+        Ok(Self { comments, natoms, origin, nval, axes, atoms, dataset_ids, values })
     }
 
     /// The model: positions in bohr, one volume per data set, ghosts for Z = 0.
     pub fn into_document(self, source: &str) -> Document {
         let scale = |axis: &CubeAxis| {
-            if axis.is_angstrom() {
-                BOHR_PER_ANGSTROM
-            } else {
-                1.0
-            }
+            if axis.is_angstrom() { BOHR_PER_ANGSTROM } else { 1.0 }
         };
         // Origin and atoms follow the unit flag of the first axis (see the module documentation).
         let frame = scale(&self.axes[0]);
@@ -381,11 +286,7 @@ impl CubeFile {
             (Some(ids), _) => ids.iter().map(|id| format!("MO {id}")).collect(),
             (None, 1) => {
                 let c = self.comments[1].trim();
-                vec![if c.is_empty() {
-                    "values".to_string()
-                } else {
-                    c.to_string()
-                }]
+                vec![if c.is_empty() { "values".to_string() } else { c.to_string() }]
             }
             (None, m) => (1..=m).map(|id| format!("data set {id}")).collect(),
         };
@@ -404,13 +305,7 @@ impl CubeFile {
                 .collect()
         };
 
-        Document {
-            source: source.to_string(),
-            title,
-            molecule,
-            volumes,
-            wavefunction: None,
-        }
+        Document { source: source.to_string(), title, molecule, volumes, wavefunction: None }
     }
 }
 
@@ -435,19 +330,12 @@ fn next_token<'a>(text: &'a str, pos: &mut usize) -> Option<(usize, &'a str)> {
 
 /// 1-based line of the last non-blank byte (the header's last line when no data follow).
 fn last_line(bytes: &[u8]) -> usize {
-    line_at(
-        bytes,
-        bytes.iter().rposition(|&b| !is_space(b)).unwrap_or(0),
-    )
+    line_at(bytes, bytes.iter().rposition(|&b| !is_space(b)).unwrap_or(0))
 }
 
 /// `m id1 … idm` after the atoms of a NAtoms < 0 file (may wrap over lines). Returns the ids
 /// and the line of `m`, and moves `pos` past the last id.
-fn read_dataset_ids(
-    file: &str,
-    text: &str,
-    pos: &mut usize,
-) -> Result<(Vec<i64>, usize), ParseError> {
+fn read_dataset_ids(file: &str, text: &str, pos: &mut usize) -> Result<(Vec<i64>, usize), ParseError> {
     let bytes = text.as_bytes();
     let Some((off, tok)) = next_token(text, pos) else {
         return Err(error(file, last_line(bytes), ID_LINE, "end of file"));
@@ -458,21 +346,11 @@ fn read_dataset_ids(
         _ => return Err(error(file, line, ID_LINE, excerpt(tok))),
     };
     if m > MAX_GRID_VALUES {
-        return Err(error(
-            file,
-            line,
-            format!("at most {MAX_GRID_VALUES} data sets"),
-            tok,
-        ));
+        return Err(error(file, line, format!("at most {MAX_GRID_VALUES} data sets"), tok));
     }
     let mut ids = Vec::new();
     for k in 0..m {
-        let expected = || {
-            format!(
-                "data-set id {} of {m} (`m id1 … idm` after the atoms)",
-                k + 1
-            )
-        };
+        let expected = || format!("data-set id {} of {m} (`m id1 … idm` after the atoms)", k + 1);
         let Some((off, tok)) = next_token(text, pos) else {
             return Err(error(file, last_line(bytes), expected(), "end of file"));
         };
@@ -490,18 +368,13 @@ fn read_dataset_ids(
 fn molden_ids(text: &str, pos: usize) -> Option<(Vec<i64>, usize, usize)> {
     let mut start = pos;
     while start < text.len() {
-        let end = text[start..]
-            .find('\n')
-            .map_or(text.len(), |e| start + e + 1);
+        let end = text[start..].find('\n').map_or(text.len(), |e| start + e + 1);
         let line = &text[start..end];
         if line.trim().is_empty() {
             start = end;
             continue;
         }
-        let ints: Vec<i64> = line
-            .split_whitespace()
-            .map(|t| t.parse().ok())
-            .collect::<Option<_>>()?;
+        let ints: Vec<i64> = line.split_whitespace().map(|t| t.parse().ok()).collect::<Option<_>>()?;
         let (&m, ids) = ints.split_first()?;
         return (m >= 1 && ids.len() as i64 == m).then(|| (ids.to_vec(), start, end));
     }
@@ -537,10 +410,7 @@ fn nth_token_offset(text: &[u8], start: usize, k: u64) -> usize {
 }
 
 fn token_at(text: &[u8], offset: usize) -> String {
-    let end = text[offset..]
-        .iter()
-        .position(|&b| is_space(b))
-        .map_or(text.len(), |e| offset + e);
+    let end = text[offset..].iter().position(|&b| is_space(b)).map_or(text.len(), |e| offset + e);
     excerpt(&String::from_utf8_lossy(&text[offset..end]))
 }
 
@@ -563,13 +433,7 @@ struct BadValue {
 
 /// Reads exactly `expected` values from `start` to the end of `text`; `shape` describes the
 /// grid for messages.
-fn read_values(
-    file: &str,
-    text: &[u8],
-    start: usize,
-    expected: u64,
-    shape: &str,
-) -> Result<Vec<f32>, ParseError> {
+fn read_values(file: &str, text: &[u8], start: usize, expected: u64, shape: &str) -> Result<Vec<f32>, ParseError> {
     read_values_chunked(file, text, start, expected, shape, CHUNK_BYTES)
 }
 
@@ -582,14 +446,7 @@ fn read_values_chunked(
     chunk_bytes: usize,
 ) -> Result<Vec<f32>, ParseError> {
     let what = || format!("{expected} grid values ({shape})");
-    let short = |found: u64| {
-        error(
-            file,
-            last_line(text),
-            what(),
-            format!("only {found} before the end of the file"),
-        )
-    };
+    let short = |found: u64| error(file, last_line(text), what(), format!("only {found} before the end of the file"));
     // Every value needs a character and a separator: refuse a grid the data cannot hold
     // before allocating anything for it.
     if expected.saturating_mul(2) > (text.len() - start) as u64 + 1 {
@@ -598,15 +455,9 @@ fn read_values_chunked(
 
     let ranges = split_chunks(text, start, chunk_bytes);
     let results: Vec<Result<Vec<f32>, BadValue>> = if ranges.len() > 1 {
-        ranges
-            .par_iter()
-            .map(|&(s, e)| parse_chunk(text, s, e))
-            .collect()
+        ranges.par_iter().map(|&(s, e)| parse_chunk(text, s, e)).collect()
     } else {
-        ranges
-            .iter()
-            .map(|&(s, e)| parse_chunk(text, s, e))
-            .collect()
+        ranges.iter().map(|&(s, e)| parse_chunk(text, s, e)).collect()
     };
 
     let mut chunks = Vec::with_capacity(results.len());
@@ -623,12 +474,7 @@ fn read_values_chunked(
                     Fault::NotANumber => format!("a number (grid value {n} of {expected})"),
                     Fault::NotFinite => format!("a finite number (grid value {n} of {expected})"),
                 };
-                return Err(error(
-                    file,
-                    line_at(text, bad.offset),
-                    expected,
-                    token_at(text, bad.offset),
-                ));
+                return Err(error(file, line_at(text, bad.offset), expected, token_at(text, bad.offset)));
             }
         }
     }
@@ -702,11 +548,7 @@ fn parse_chunk(text: &[u8], start: usize, end: usize) -> Result<Vec<f32>, BadVal
             })?,
         };
         if !v.is_finite() {
-            return Err(BadValue {
-                offset: start + i,
-                index: out.len(),
-                fault: Fault::NotFinite,
-            });
+            return Err(BadValue { offset: start + i, index: out.len(), fault: Fault::NotFinite });
         }
         out.push(v);
         i += used;
@@ -721,10 +563,7 @@ fn fortran_real(s: &[u8]) -> Option<(f32, usize)> {
     if !token.iter().any(|&b| b == b'D' || b == b'd') {
         return None;
     }
-    let fixed: Vec<u8> = token
-        .iter()
-        .map(|&b| if b == b'D' || b == b'd' { b'E' } else { b })
-        .collect();
+    let fixed: Vec<u8> = token.iter().map(|&b| if b == b'D' || b == b'd' { b'E' } else { b }).collect();
     fast_float2::parse::<f32, _>(&fixed).ok().map(|v| (v, len))
 }
 
@@ -794,10 +633,7 @@ mod tests {
         assert!((g.step(1).y - 0.25 * BOHR_PER_ANGSTROM).abs() < 1e-12);
         assert!((g.step(2).z - 0.2 * BOHR_PER_ANGSTROM).abs() < 1e-12);
         assert!(close(g.origin(), DVec3::new(BOHR_PER_ANGSTROM, 0.0, 0.0)));
-        assert!(close(
-            d.molecule.atoms[0].position,
-            DVec3::new(0.0, 0.0, 0.74 * BOHR_PER_ANGSTROM)
-        ));
+        assert!(close(d.molecule.atoms[0].position, DVec3::new(0.0, 0.0, 0.74 * BOHR_PER_ANGSTROM)));
 
         // Only axis 2 flagged: only its vector converts; origin and atoms stay bohr (N1 > 0).
         let text = format!(
@@ -808,17 +644,12 @@ mod tests {
         assert!((g.step(0).x - 0.5).abs() < 1e-12);
         assert!((g.step(1).y - 0.25 * BOHR_PER_ANGSTROM).abs() < 1e-12);
         assert!(close(g.origin(), DVec3::new(1.0, 0.0, 0.0)));
-        assert!(close(
-            d.molecule.atoms[0].position,
-            DVec3::new(0.0, 0.0, 0.74)
-        ));
+        assert!(close(d.molecule.atoms[0].position, DVec3::new(0.0, 0.0, 0.74)));
     }
 
     #[test]
     fn non_orthogonal_axes_are_a_full_affine_map() {
-        let text = format!(
-            "c\nc\n 0  -1.0 2.0 0.5\n 2 0.5 0.1 0.0\n 2 0.2 0.4 0.0\n 3 0.0 0.1 0.3\n{TWELVE}"
-        );
+        let text = format!("c\nc\n 0  -1.0 2.0 0.5\n 2 0.5 0.1 0.0\n 2 0.2 0.4 0.0\n 3 0.0 0.1 0.3\n{TWELVE}");
         let d = doc(&text);
         let g = &d.volumes[0];
         assert!(!g.is_orthogonal());
@@ -916,9 +747,7 @@ mod tests {
         assert_eq!(d.volumes.len(), 1);
         assert_eq!(
             d.volumes[0].values,
-            (0..12)
-                .map(|v| [5, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11][v] as f32)
-                .collect::<Vec<_>>()
+            (0..12).map(|v| [5, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11][v] as f32).collect::<Vec<_>>()
         );
         // 2×2×3 with one integer line `1 6` and 12 values: a data-set line.
         let d = doc(&small(&format!("1 6\n{TWELVE}")));
@@ -927,15 +756,8 @@ mod tests {
 
     #[test]
     fn exponent_forms() {
-        let d = doc(&small(
-            "1.0E+000 -2.5D-01 3.0d+00 4.0E-001 5e0 6.\n.5 +7.0E+00 8.0e-0 9.0D0 1.0E+001 -0.0\n",
-        ));
-        assert_eq!(
-            d.volumes[0].values,
-            vec![
-                1.0, -0.25, 3.0, 0.4, 5.0, 6.0, 0.5, 7.0, 8.0, 9.0, 10.0, -0.0
-            ]
-        );
+        let d = doc(&small("1.0E+000 -2.5D-01 3.0d+00 4.0E-001 5e0 6.\n.5 +7.0E+00 8.0e-0 9.0D0 1.0E+001 -0.0\n"));
+        assert_eq!(d.volumes[0].values, vec![1.0, -0.25, 3.0, 0.4, 5.0, 6.0, 0.5, 7.0, 8.0, 9.0, 10.0, -0.0]);
     }
 
     #[test]
@@ -953,13 +775,11 @@ mod tests {
 
     #[test]
     fn ghost_atoms() {
-        let text = small(TWELVE)
-            .replacen(" 1   -1.0", " 2   -1.0", 1)
-            .replacen(
-                "    8   8.0   0.0 0.0 0.1\n",
-                "    8   8.0   0.0 0.0 0.1\n    0   0.0   1.0 0.0 0.0\n",
-                1,
-            );
+        let text = small(TWELVE).replacen(" 1   -1.0", " 2   -1.0", 1).replacen(
+            "    8   8.0   0.0 0.0 0.1\n",
+            "    8   8.0   0.0 0.0 0.1\n    0   0.0   1.0 0.0 0.0\n",
+            1,
+        );
         let d = doc(&text);
         let g = &d.molecule.atoms[1];
         assert_eq!((g.z, g.ghost, g.charge), (0, true, 0.0));
@@ -1005,28 +825,17 @@ mod tests {
             assert_eq!(v, want, "chunk {chunk}");
         }
         // Garbage at value 200 (line 6 + 34), one extra value, one missing.
-        let bad = text.replacen(
-            &format!(" {:.5E}", (199.0 - 100.0) * 1.234e-3_f32),
-            " 1.0x",
-            1,
-        );
+        let bad = text.replacen(&format!(" {:.5E}", (199.0 - 100.0) * 1.234e-3_f32), " 1.0x", 1);
         let extra = format!("{text} 9.9E-01\n");
         let cut = &text[..text.trim_end().rfind(' ').unwrap()];
         for chunk in [3, 50, CHUNK_BYTES] {
-            let e =
-                read_values_chunked("t", bad.as_bytes(), start, 216, "6×6×6", chunk).unwrap_err();
-            assert_eq!(
-                (e.line, e.found.as_str()),
-                (40, "\"1.0x\""),
-                "chunk {chunk}"
-            );
+            let e = read_values_chunked("t", bad.as_bytes(), start, 216, "6×6×6", chunk).unwrap_err();
+            assert_eq!((e.line, e.found.as_str()), (40, "\"1.0x\""), "chunk {chunk}");
             assert!(e.expected.contains("value 200 of 216"), "{e}");
-            let e =
-                read_values_chunked("t", extra.as_bytes(), start, 216, "6×6×6", chunk).unwrap_err();
+            let e = read_values_chunked("t", extra.as_bytes(), start, 216, "6×6×6", chunk).unwrap_err();
             assert_eq!(e.line, 43);
             assert!(e.found.contains("value 217"), "{e}");
-            let e =
-                read_values_chunked("t", cut.as_bytes(), start, 216, "6×6×6", chunk).unwrap_err();
+            let e = read_values_chunked("t", cut.as_bytes(), start, 216, "6×6×6", chunk).unwrap_err();
             assert_eq!(e.line, 42);
             assert!(e.found.contains("only 215"), "{e}");
         }
@@ -1036,9 +845,7 @@ mod tests {
 
     #[test]
     fn truncated_data() {
-        let e = err(&small(
-            "  1.0E-01  2.0E-01  3.0E-01  4.0E-01  5.0E-01  6.0E-01\n  7.0E-01\n\n",
-        ));
+        let e = err(&small("  1.0E-01  2.0E-01  3.0E-01  4.0E-01  5.0E-01  6.0E-01\n  7.0E-01\n\n"));
         assert_eq!(e.line, 9);
         assert!(e.expected.contains("12 grid values (2×2×3 points)"), "{e}");
         assert!(e.found.contains("only 7"), "{e}");
@@ -1053,10 +860,7 @@ mod tests {
         let e = err(&small(&format!("{TWELVE}  1.3E+00\n")));
         assert_eq!(e.line, 10);
         assert!(e.expected.contains("12 grid values"), "{e}");
-        assert!(
-            e.found.contains("value 13") && e.found.contains("1.3E+00"),
-            "{e}"
-        );
+        assert!(e.found.contains("value 13") && e.found.contains("1.3E+00"), "{e}");
     }
 
     #[test]
@@ -1069,10 +873,7 @@ mod tests {
         // Atom line with a missing column.
         let e = err(&small(TWELVE).replacen("8   8.0   0.0 0.0 0.1", "8   8.0   0.0 0.0", 1));
         assert_eq!(e.line, 7);
-        assert!(
-            e.expected.contains("atom 1 of 1 as `Z charge x y z`"),
-            "{e}"
-        );
+        assert!(e.expected.contains("atom 1 of 1 as `Z charge x y z`"), "{e}");
     }
 
     #[test]
@@ -1084,9 +885,7 @@ mod tests {
 
     #[test]
     fn garbage_token() {
-        let e = err(&small(
-            "  1.0E-01  2.0E-01  3.0E-01\n  4.0E-01  abc  6.0E-01\n",
-        ));
+        let e = err(&small("  1.0E-01  2.0E-01  3.0E-01\n  4.0E-01  abc  6.0E-01\n"));
         assert_eq!(e.line, 9);
         assert_eq!(e.found, "\"abc\"");
         assert!(e.expected.contains("a number (grid value 5 of 12)"), "{e}");
@@ -1099,10 +898,7 @@ mod tests {
         for bad in ["NaN", "nan", "inf", "-Infinity", "1.0E+999"] {
             let e = err(&small(&TWELVE.replacen("9.0E-01", bad, 1)));
             assert_eq!(e.line, 9, "{bad}");
-            assert!(
-                e.expected.contains("a finite number (grid value 9 of 12)"),
-                "{e}"
-            );
+            assert!(e.expected.contains("a finite number (grid value 9 of 12)"), "{e}");
         }
     }
 
@@ -1110,10 +906,7 @@ mod tests {
     fn zero_dimension() {
         let e = err(&small(TWELVE).replacen("    2   0.0 0.4", "    0   0.0 0.4", 1));
         assert_eq!(e.line, 5);
-        assert!(
-            e.expected.contains("non-zero number of points on axis 2"),
-            "{e}"
-        );
+        assert!(e.expected.contains("non-zero number of points on axis 2"), "{e}");
     }
 
     #[test]
@@ -1123,11 +916,7 @@ mod tests {
         let e = err(text);
         assert!(t.elapsed().as_millis() < 100);
         assert_eq!(e.line, 6);
-        assert!(
-            e.expected
-                .contains(&format!("at most {MAX_GRID_VALUES} grid values")),
-            "{e}"
-        );
+        assert!(e.expected.contains(&format!("at most {MAX_GRID_VALUES} grid values")), "{e}");
         assert!(e.found.contains("100000×100000×100000"), "{e}");
         // Within the limit but far beyond what the file holds.
         let text = "c\nc\n 0 0 0 0\n 1000 1 0 0\n 1000 0 1 0\n 1000 0 0 1\n 1.0 2.0\n 3.0\n";
@@ -1136,8 +925,7 @@ mod tests {
         assert!(e.expected.contains("1000000000 grid values"), "{e}");
         assert!(e.found.contains("only 3"), "{e}");
         // Many data sets.
-        let text =
-            "c\nc\n -1 0 0 0\n 1000 1 0 0\n 1000 0 1 0\n 1000 0 0 1\n 1 1 0 0 0\n 2 6 7\n 1.0\n";
+        let text = "c\nc\n -1 0 0 0\n 1000 1 0 0\n 1000 0 1 0\n 1000 0 0 1\n 1 1 0 0 0\n 2 6 7\n 1.0\n";
         let e = err(text);
         assert_eq!(e.line, 8);
         assert!(e.expected.contains("at most"), "{e}");

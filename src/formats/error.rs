@@ -14,10 +14,7 @@ pub struct ParseError {
 #[derive(Debug, Error)]
 pub enum LoadError {
     #[error("{path}: {source}")]
-    Io {
-        path: String,
-        source: std::io::Error,
-    },
+    Io { path: String, source: std::io::Error },
     #[error("{path}: not a text file (invalid UTF-8 at byte {offset})")]
     NotText { path: String, offset: usize },
     #[error("{path}: unknown file type (expected .cube, .cub or .cube.gz)")]

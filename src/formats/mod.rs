@@ -18,10 +18,7 @@ pub const MAX_GRID_VALUES: u64 = 1 << 30;
 /// Reads a file from disk, picking the reader by extension (`.cube`, `.cub`, `.cube.gz`).
 pub fn load(path: &Path) -> Result<Document, LoadError> {
     reader_for(path)?;
-    let bytes = std::fs::read(path).map_err(|source| LoadError::Io {
-        path: path.display().to_string(),
-        source,
-    })?;
+    let bytes = std::fs::read(path).map_err(|source| LoadError::Io { path: path.display().to_string(), source })?;
     load_bytes(path, &bytes)
 }
 
@@ -41,26 +38,18 @@ enum Reader {
 }
 
 fn reader_for(path: &Path) -> Result<Reader, LoadError> {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().to_lowercase())
-        .unwrap_or_default();
+    let name = path.file_name().map(|n| n.to_string_lossy().to_lowercase()).unwrap_or_default();
     let base = name.strip_suffix(".gz").unwrap_or(&name);
     if base.ends_with(".cube") || base.ends_with(".cub") {
         Ok(Reader::Cube)
     } else {
-        Err(LoadError::UnknownFormat {
-            path: path.display().to_string(),
-        })
+        Err(LoadError::UnknownFormat { path: path.display().to_string() })
     }
 }
 
 /// Reads a whole file, transparently gunzipping `*.gz`.
 pub fn read_text(path: &Path) -> Result<String, LoadError> {
-    let bytes = std::fs::read(path).map_err(|source| LoadError::Io {
-        path: path.display().to_string(),
-        source,
-    })?;
+    let bytes = std::fs::read(path).map_err(|source| LoadError::Io { path: path.display().to_string(), source })?;
     gunzip_text(&path.display().to_string(), &bytes)
 }
 
@@ -71,16 +60,11 @@ pub fn gunzip_text(name: &str, bytes: &[u8]) -> Result<String, LoadError> {
         let mut out = Vec::new();
         flate2::read::MultiGzDecoder::new(bytes)
             .read_to_end(&mut out)
-            .map_err(|source| LoadError::Io {
-                path: name.to_string(),
-                source,
-            })?;
+            .map_err(|source| LoadError::Io { path: name.to_string(), source })?;
         out
     } else {
         bytes.to_vec()
     };
-    String::from_utf8(bytes).map_err(|e| LoadError::NotText {
-        path: name.to_string(),
-        offset: e.utf8_error().valid_up_to(),
-    })
+    String::from_utf8(bytes)
+        .map_err(|e| LoadError::NotText { path: name.to_string(), offset: e.utf8_error().valid_up_to() })
 }

@@ -14,12 +14,7 @@ pub(crate) struct Lines<'a> {
 
 impl<'a> Lines<'a> {
     pub fn new(file: &'a str, text: &'a str) -> Self {
-        Self {
-            file,
-            text,
-            pos: 0,
-            line: 0,
-        }
+        Self { file, text, pos: 0, line: 0 }
     }
 
     /// The next line, without its trailing `\r`, or an error saying what was expected.
@@ -64,11 +59,7 @@ pub(crate) fn excerpt(s: &str) -> String {
         return "an empty line".into();
     }
     let short: String = s.chars().take(60).collect();
-    if short.len() < s.len() {
-        format!("\"{short}…\"")
-    } else {
-        format!("\"{short}\"")
-    }
+    if short.len() < s.len() { format!("\"{short}…\"") } else { format!("\"{short}\"") }
 }
 
 /// A Fortran-style real number: also accepts `D`/`d` exponents (`1.0D-03`).
@@ -76,9 +67,7 @@ pub(crate) fn excerpt(s: &str) -> String {
 pub(crate) fn parse_real(token: &str) -> Option<f64> {
     let v = match token.parse::<f64>() {
         Ok(v) => v,
-        Err(_) if token.contains(['D', 'd']) => {
-            token.replace(['D', 'd'], "E").parse::<f64>().ok()?
-        }
+        Err(_) if token.contains(['D', 'd']) => token.replace(['D', 'd'], "E").parse::<f64>().ok()?,
         Err(_) => return None,
     };
     v.is_finite().then_some(v)
@@ -86,8 +75,5 @@ pub(crate) fn parse_real(token: &str) -> Option<f64> {
 
 /// 1-based number of the line holding byte `offset` of `text`.
 pub(crate) fn line_at(text: &[u8], offset: usize) -> usize {
-    1 + text[..offset.min(text.len())]
-        .iter()
-        .filter(|&&b| b == b'\n')
-        .count()
+    1 + text[..offset.min(text.len())].iter().filter(|&&b| b == b'\n').count()
 }

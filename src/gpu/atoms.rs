@@ -44,35 +44,20 @@ const BALL_FRACTION: f32 = 0.24;
 /// Stick radius in ball-and-stick, ångström.
 const STICK_RADIUS_ANG: f32 = 0.13;
 
-fn attribute(
-    shader_location: u32,
-    format: wgpu::VertexFormat,
-    offset: u64,
-) -> wgpu::VertexAttribute {
-    wgpu::VertexAttribute {
-        format,
-        offset,
-        shader_location,
-    }
+fn attribute(shader_location: u32, format: wgpu::VertexFormat, offset: u64) -> wgpu::VertexAttribute {
+    wgpu::VertexAttribute { format, offset, shader_location }
 }
 
 fn linear_color(srgb: [u8; 3]) -> [f32; 4] {
     let lin = |c: u8| {
         let c = c as f32 / 255.0;
-        if c <= 0.04045 {
-            c / 12.92
-        } else {
-            ((c + 0.055) / 1.055).powf(2.4)
-        }
+        if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
     };
     [lin(srgb[0]), lin(srgb[1]), lin(srgb[2]), 1.0]
 }
 
 /// The impostor instances for a molecule in a style: plain data, testable without a GPU.
-pub fn instances(
-    molecule: &Molecule,
-    style: AtomStyle,
-) -> (Vec<SphereInstance>, Vec<CylinderInstance>) {
+pub fn instances(molecule: &Molecule, style: AtomStyle) -> (Vec<SphereInstance>, Vec<CylinderInstance>) {
     let bohr = BOHR_PER_ANGSTROM as f32;
     let spheres = match style {
         AtomStyle::Hidden => Vec::new(),
@@ -90,11 +75,7 @@ pub fn instances(
                     radius *= 0.5;
                     color = [0.35, 0.35, 0.35, 1.0];
                 }
-                SphereInstance {
-                    center: a.position.as_vec3().to_array(),
-                    radius,
-                    color,
-                }
+                SphereInstance { center: a.position.as_vec3().to_array(), radius, color }
             })
             .collect(),
     };
@@ -113,10 +94,7 @@ pub fn instances(
                     _pad: 0.0,
                     color,
                 };
-                [
-                    half(pa, linear_color(a.element().color)),
-                    half(pc, linear_color(c.element().color)),
-                ]
+                [half(pa, linear_color(a.element().color)), half(pc, linear_color(c.element().color))]
             })
             .collect(),
         _ => Vec::new(),
@@ -158,47 +136,43 @@ impl AtomsPass {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let pipeline =
-            |label: &str, vs: &str, fs: &str, stride: u64, attributes: &[wgpu::VertexAttribute]| {
-                device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                    label: Some(label),
-                    layout: Some(&pipeline_layout),
-                    vertex: wgpu::VertexState {
-                        module: &module,
-                        entry_point: Some(vs),
-                        compilation_options: Default::default(),
-                        buffers: &[Some(wgpu::VertexBufferLayout {
-                            array_stride: stride,
-                            step_mode: wgpu::VertexStepMode::Instance,
-                            attributes,
-                        })],
-                    },
-                    primitive: wgpu::PrimitiveState {
-                        cull_mode: None,
-                        ..Default::default()
-                    },
-                    depth_stencil: Some(wgpu::DepthStencilState {
-                        format: DEPTH_FORMAT,
-                        depth_write_enabled: Some(true),
-                        depth_compare: Some(wgpu::CompareFunction::Less),
-                        stencil: Default::default(),
-                        bias: Default::default(),
-                    }),
-                    multisample: Default::default(),
-                    fragment: Some(wgpu::FragmentState {
-                        module: &module,
-                        entry_point: Some(fs),
-                        compilation_options: Default::default(),
-                        targets: &[Some(wgpu::ColorTargetState {
-                            format: SCENE_FORMAT,
-                            blend: None,
-                            write_mask: wgpu::ColorWrites::ALL,
-                        })],
-                    }),
-                    multiview_mask: None,
-                    cache: None,
-                })
-            };
+        let pipeline = |label: &str, vs: &str, fs: &str, stride: u64, attributes: &[wgpu::VertexAttribute]| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(label),
+                layout: Some(&pipeline_layout),
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some(vs),
+                    compilation_options: Default::default(),
+                    buffers: &[Some(wgpu::VertexBufferLayout {
+                        array_stride: stride,
+                        step_mode: wgpu::VertexStepMode::Instance,
+                        attributes,
+                    })],
+                },
+                primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: DEPTH_FORMAT,
+                    depth_write_enabled: Some(true),
+                    depth_compare: Some(wgpu::CompareFunction::Less),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some(fs),
+                    compilation_options: Default::default(),
+                    targets: &[Some(wgpu::ColorTargetState {
+                        format: SCENE_FORMAT,
+                        blend: None,
+                        write_mask: wgpu::ColorWrites::ALL,
+                    })],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
         let spheres_pipeline = pipeline(
             "sphere impostors",
             "vs_sphere",
@@ -228,19 +202,9 @@ impl AtomsPass {
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("atoms bind group"),
             layout: &layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: globals.as_entire_binding(),
-            }],
+            entries: &[wgpu::BindGroupEntry { binding: 0, resource: globals.as_entire_binding() }],
         });
-        Self {
-            spheres_pipeline,
-            cylinders_pipeline,
-            globals,
-            bind_group,
-            spheres: None,
-            cylinders: None,
-        }
+        Self { spheres_pipeline, cylinders_pipeline, globals, bind_group, spheres: None, cylinders: None }
     }
 
     /// Uploads the impostor instances of a molecule in a style.
@@ -249,26 +213,16 @@ impl AtomsPass {
         let (spheres, cylinders) = instances(molecule, style);
         let upload = |label: &str, bytes: &[u8], n: usize| {
             (n > 0).then(|| {
-                let buffer = ctx
-                    .device
-                    .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                        label: Some(label),
-                        contents: bytes,
-                        usage: wgpu::BufferUsages::VERTEX,
-                    });
+                let buffer = ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some(label),
+                    contents: bytes,
+                    usage: wgpu::BufferUsages::VERTEX,
+                });
                 (buffer, n as u32)
             })
         };
-        self.spheres = upload(
-            "sphere instances",
-            bytemuck::cast_slice(&spheres),
-            spheres.len(),
-        );
-        self.cylinders = upload(
-            "cylinder instances",
-            bytemuck::cast_slice(&cylinders),
-            cylinders.len(),
-        );
+        self.spheres = upload("sphere instances", bytemuck::cast_slice(&spheres), spheres.len());
+        self.cylinders = upload("cylinder instances", bytemuck::cast_slice(&cylinders), cylinders.len());
     }
 
     pub fn prepare(&self, queue: &wgpu::Queue, clip_from_world: Mat4, eye: Vec3, target: Vec3) {
@@ -309,12 +263,7 @@ mod tests {
 
     #[test]
     fn ball_and_stick_has_two_half_bonds_per_bond() {
-        let atom = |z, x| Atom {
-            z,
-            charge: z as f64,
-            position: DVec3::new(x, 0.0, 0.0),
-            ghost: false,
-        };
+        let atom = |z, x| Atom { z, charge: z as f64, position: DVec3::new(x, 0.0, 0.0), ghost: false };
         let m = Molecule::new(vec![atom(6, 0.0), atom(8, 2.28)]);
         assert_eq!(m.bonds.len(), 1);
         let (s, c) = instances(&m, AtomStyle::BallAndStick);

@@ -14,9 +14,7 @@ pub enum GpuError {
     WrongAdapter { wanted: String, found: String },
     #[error("could not open the GPU device: {0}")]
     Device(String),
-    #[error(
-        "the volume is {dims:?} points, but this GPU holds 3D textures of at most {max} per side"
-    )]
+    #[error("the volume is {dims:?} points, but this GPU holds 3D textures of at most {max} per side")]
     VolumeTooLarge { dims: [usize; 3], max: u32 },
     #[error("reading back the frame failed: {0}")]
     Readback(String),
@@ -67,10 +65,7 @@ pub fn volume_format_for(features: wgpu::Features) -> wgpu::TextureFormat {
 }
 
 fn describe(info: &wgpu::AdapterInfo) -> String {
-    format!(
-        "{} ({:?}, {:?}, driver {})",
-        info.name, info.backend, info.device_type, info.driver_info
-    )
+    format!("{} ({:?}, {:?}, driver {})", info.name, info.backend, info.device_type, info.driver_info)
 }
 
 impl GpuContext {
@@ -95,11 +90,7 @@ impl GpuContext {
                     })
                     .ok_or_else(|| GpuError::WrongAdapter {
                         wanted: "Vulkan CPU (lavapipe)".into(),
-                        found: if found.is_empty() {
-                            "none".into()
-                        } else {
-                            found.join("; ")
-                        },
+                        found: if found.is_empty() { "none".into() } else { found.join("; ") },
                     })?
             }
             AdapterPreference::HighPerformance => {
@@ -110,9 +101,8 @@ impl GpuContext {
                 .map_err(|e| GpuError::NoAdapter(e.to_string()))?
             }
         };
-        let (device, queue) =
-            pollster::block_on(adapter.request_device(&device_descriptor(&adapter)))
-                .map_err(|e| GpuError::Device(e.to_string()))?;
+        let (device, queue) = pollster::block_on(adapter.request_device(&device_descriptor(&adapter)))
+            .map_err(|e| GpuError::Device(e.to_string()))?;
         Ok(Self::from_parts(adapter, device, queue))
     }
 
@@ -120,17 +110,8 @@ impl GpuContext {
     pub fn from_parts(adapter: wgpu::Adapter, device: wgpu::Device, queue: wgpu::Queue) -> Self {
         let info = adapter.get_info();
         let volume_format = volume_format_for(device.features());
-        log::info!(
-            "GPU: {}; volume textures {volume_format:?}",
-            describe(&info)
-        );
-        Self {
-            adapter,
-            device,
-            queue,
-            info,
-            volume_format,
-        }
+        log::info!("GPU: {}; volume textures {volume_format:?}", describe(&info));
+        Self { adapter, device, queue, info, volume_format }
     }
 
     /// One line naming the adapter, for logs and `bench` output.

@@ -52,8 +52,7 @@ impl GtoArrays {
                 prim_count: s.primitives.len() as u32,
                 weight_offset: out.weights.len() as u32,
             });
-            out.prims
-                .extend(s.primitives.iter().map(|[a, d]| [*a as f32, *d as f32]));
+            out.prims.extend(s.primitives.iter().map(|[a, d]| [*a as f32, *d as f32]));
             out.weights.extend(s.weights.iter().map(|&w| w as f32));
         }
         out
@@ -97,30 +96,15 @@ impl GtoBuffers {
         };
         // An empty expansion must evaluate to zero: the padding shell has l = 0 and no primitives.
         let shells = buffer("gto shells", bytemuck::cast_slice(&arrays.shells).to_vec());
-        let prims = buffer(
-            "gto primitives",
-            bytemuck::cast_slice(&arrays.prims).to_vec(),
-        );
-        let weights = buffer(
-            "gto weights",
-            bytemuck::cast_slice(&arrays.weights).to_vec(),
-        );
+        let prims = buffer("gto primitives", bytemuck::cast_slice(&arrays.prims).to_vec());
+        let weights = buffer("gto weights", bytemuck::cast_slice(&arrays.weights).to_vec());
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("gto bind group"),
             layout,
             entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: shells.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: prims.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: weights.as_entire_binding(),
-                },
+                wgpu::BindGroupEntry { binding: 0, resource: shells.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: prims.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: weights.as_entire_binding() },
             ],
         });
         Self { bind_group }
@@ -147,16 +131,9 @@ impl GridGeometry {
         let step = (hi - lo) / (n - 1) as f64;
         let world_from_grid = crate::model::VolumeGrid::affine(
             lo,
-            [
-                DVec3::new(step.x, 0.0, 0.0),
-                DVec3::new(0.0, step.y, 0.0),
-                DVec3::new(0.0, 0.0, step.z),
-            ],
+            [DVec3::new(step.x, 0.0, 0.0), DVec3::new(0.0, step.y, 0.0), DVec3::new(0.0, 0.0, step.z)],
         );
-        Self {
-            dims: [n; 3],
-            world_from_grid,
-        }
+        Self { dims: [n; 3], world_from_grid }
     }
 }
 
@@ -206,11 +183,7 @@ impl GtoFillPass {
             compilation_options: Default::default(),
             cache: None,
         });
-        Self {
-            pipeline,
-            fill_layout,
-            gto_layout,
-        }
+        Self { pipeline, fill_layout, gto_layout }
     }
 
     /// Evaluates `expansion` on `grid` into a new R32Float 3D texture (texel x = grid k).
@@ -224,18 +197,11 @@ impl GtoFillPass {
         let [nx, ny, nz] = grid.dims;
         let max = device.limits().max_texture_dimension_3d;
         if grid.dims.iter().any(|&d| d == 0 || d > max as usize) {
-            return Err(GpuError::VolumeTooLarge {
-                dims: grid.dims,
-                max,
-            });
+            return Err(GpuError::VolumeTooLarge { dims: grid.dims, max });
         }
         let texture = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("gto volume"),
-            size: wgpu::Extent3d {
-                width: nz as u32,
-                height: ny as u32,
-                depth_or_array_layers: nx as u32,
-            },
+            size: wgpu::Extent3d { width: nz as u32, height: ny as u32, depth_or_array_layers: nx as u32 },
             mip_level_count: 1,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D3,
@@ -259,33 +225,19 @@ impl GtoFillPass {
             label: Some("gto fill bind group"),
             layout: &self.fill_layout,
             entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: params.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::TextureView(&view),
-                },
+                wgpu::BindGroupEntry { binding: 0, resource: params.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&view) },
             ],
         });
         let gto = GtoBuffers::new(device, &self.gto_layout, &GtoArrays::new(expansion));
-        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("gto fill"),
-        });
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("gto fill") });
         {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("gto fill"),
-                timestamp_writes: None,
-            });
+            let mut pass = encoder
+                .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("gto fill"), timestamp_writes: None });
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, &fill_group, &[]);
             pass.set_bind_group(1, &gto.bind_group, &[]);
-            pass.dispatch_workgroups(
-                (nz as u32).div_ceil(4),
-                (ny as u32).div_ceil(4),
-                (nx as u32).div_ceil(4),
-            );
+            pass.dispatch_workgroups((nz as u32).div_ceil(4), (ny as u32).div_ceil(4), (nx as u32).div_ceil(4));
         }
         ctx.queue.submit([encoder.finish()]);
         Ok(texture)
@@ -294,18 +246,8 @@ impl GtoFillPass {
 
 /// A filled texture made ready for the slice renderer. `max_abs` scales the opacity (the CPU
 /// knows it from the evaluator or a coarse estimate).
-pub fn volume_from_texture(
-    texture: wgpu::Texture,
-    grid: &GridGeometry,
-    max_abs: f64,
-) -> VolumeTexture {
-    VolumeTexture::from_texture(
-        texture,
-        grid.dims,
-        grid.world_from_grid,
-        ValueKind::Signed,
-        max_abs,
-    )
+pub fn volume_from_texture(texture: wgpu::Texture, grid: &GridGeometry, max_abs: f64) -> VolumeTexture {
+    VolumeTexture::from_texture(texture, grid.dims, grid.world_from_grid, ValueKind::Signed, max_abs)
 }
 
 /// Reads an R32Float 3D texture back into cube order (x slowest, z fastest) — for tests, export
@@ -314,28 +256,20 @@ pub fn read_volume(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Vec<f32>
     let size = texture.size();
     let (w, h, d) = (size.width, size.height, size.depth_or_array_layers);
     let unpadded = 4 * w;
-    let padded =
-        unpadded.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let padded = unpadded.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
     let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("volume readback"),
         size: padded as u64 * h as u64 * d as u64,
         usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
         mapped_at_creation: false,
     });
-    let mut encoder = ctx
-        .device
-        .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("volume readback"),
-        });
+    let mut encoder =
+        ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("volume readback") });
     encoder.copy_texture_to_buffer(
         texture.as_image_copy(),
         wgpu::TexelCopyBufferInfo {
             buffer: &buffer,
-            layout: wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(padded),
-                rows_per_image: Some(h),
-            },
+            layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(padded), rows_per_image: Some(h) },
         },
         size,
     );
@@ -346,12 +280,8 @@ pub fn read_volume(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Vec<f32>
         let _ = tx.send(r);
     });
     let fail = |e: String| GpuError::Readback(e);
-    ctx.device
-        .poll(wgpu::PollType::wait_indefinitely())
-        .map_err(|e| fail(e.to_string()))?;
-    rx.recv()
-        .map_err(|e| fail(e.to_string()))?
-        .map_err(|e| fail(e.to_string()))?;
+    ctx.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| fail(e.to_string()))?;
+    rx.recv().map_err(|e| fail(e.to_string()))?.map_err(|e| fail(e.to_string()))?;
     let data = slice.get_mapped_range().map_err(|e| fail(e.to_string()))?;
     let mut out = Vec::with_capacity((w * h * d) as usize);
     for row in data.chunks(padded as usize) {

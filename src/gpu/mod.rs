@@ -25,53 +25,27 @@ pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
 /// Every WGSL shader, by file name, for validation and pipeline creation.
 pub const SHADERS: &[(&str, &str)] = &[
-    (
-        "volume_common.wgsl",
-        include_str!("../../shaders/volume_common.wgsl"),
-    ),
-    (
-        "volume_slices.wgsl",
-        include_str!("../../shaders/volume_slices.wgsl"),
-    ),
-    (
-        "volume_direct.wgsl",
-        include_str!("../../shaders/volume_direct.wgsl"),
-    ),
+    ("volume_common.wgsl", include_str!("../../shaders/volume_common.wgsl")),
+    ("volume_slices.wgsl", include_str!("../../shaders/volume_slices.wgsl")),
+    ("volume_direct.wgsl", include_str!("../../shaders/volume_direct.wgsl")),
     ("atoms.wgsl", include_str!("../../shaders/atoms.wgsl")),
     ("resolve.wgsl", include_str!("../../shaders/resolve.wgsl")),
-    (
-        "gto_common.wgsl",
-        include_str!("../../shaders/gto_common.wgsl"),
-    ),
+    ("gto_common.wgsl", include_str!("../../shaders/gto_common.wgsl")),
     ("gto_fill.wgsl", include_str!("../../shaders/gto_fill.wgsl")),
 ];
 
 /// Shaders that are only complete with others prepended (WGSL has no includes): the module
 /// for `name` is the concatenation of these files, in order.
 pub const SHADER_MODULES: &[(&str, &[&str])] = &[
-    (
-        "volume_slices.wgsl",
-        &["volume_common.wgsl", "volume_slices.wgsl"],
-    ),
-    (
-        "volume_direct.wgsl",
-        &[
-            "volume_common.wgsl",
-            "gto_common.wgsl",
-            "volume_direct.wgsl",
-        ],
-    ),
+    ("volume_slices.wgsl", &["volume_common.wgsl", "volume_slices.wgsl"]),
+    ("volume_direct.wgsl", &["volume_common.wgsl", "gto_common.wgsl", "volume_direct.wgsl"]),
     ("gto_fill.wgsl", &["gto_common.wgsl", "gto_fill.wgsl"]),
 ];
 
 /// The full source of a shader module: its prerequisites, then itself.
 pub fn module_source(name: &str) -> String {
     match SHADER_MODULES.iter().find(|(n, _)| *n == name) {
-        Some((_, parts)) => parts
-            .iter()
-            .map(|p| shader_source(p))
-            .collect::<Vec<_>>()
-            .join("\n"),
+        Some((_, parts)) => parts.iter().map(|p| shader_source(p)).collect::<Vec<_>>().join("\n"),
         None => shader_source(name).to_string(),
     }
 }

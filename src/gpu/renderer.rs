@@ -45,17 +45,11 @@ impl Renderer {
     pub fn set_molecule(&mut self, ctx: &GpuContext, molecule: &Molecule, style: AtomStyle) {
         self.atoms.set_molecule(ctx, molecule, style);
         // Pad by the largest space-filling radius so near/far planes never clip an atom.
-        self.molecule_bounds = molecule
-            .bounds()
-            .map(|(lo, hi)| (lo.as_vec3() - 4.5, hi.as_vec3() + 4.5));
+        self.molecule_bounds = molecule.bounds().map(|(lo, hi)| (lo.as_vec3() - 4.5, hi.as_vec3() + 4.5));
         self.update_bounds();
     }
 
-    pub fn set_volume(
-        &mut self,
-        ctx: &GpuContext,
-        grid: Option<&VolumeGrid>,
-    ) -> Result<(), GpuError> {
+    pub fn set_volume(&mut self, ctx: &GpuContext, grid: Option<&VolumeGrid>) -> Result<(), GpuError> {
         self.volume.set_volume(ctx, grid)?;
         self.update_bounds();
         Ok(())
@@ -82,8 +76,7 @@ impl Renderer {
     fn update_bounds(&mut self) {
         let volume = self.volume.volume().map(|v| {
             let c = v.grid_box.corners();
-            c.iter()
-                .fold((c[0], c[0]), |(lo, hi), &p| (lo.min(p), hi.max(p)))
+            c.iter().fold((c[0], c[0]), |(lo, hi), &p| (lo.min(p), hi.max(p)))
         });
         self.bounds = match (self.molecule_bounds, volume) {
             (Some(a), Some(b)) => Some((a.0.min(b.0), a.1.max(b.1))),
@@ -107,28 +100,13 @@ impl Renderer {
         let Some(buffers) = &self.buffers else { return };
         let cam = frame.camera;
         let aspect = frame.size[0].max(1) as f32 / frame.size[1].max(1) as f32;
-        let radius = self
-            .bounds
-            .map(|(lo, hi)| {
-                (hi - cam.target)
-                    .abs()
-                    .max((cam.target - lo).abs())
-                    .length()
-            })
-            .unwrap_or(10.0);
+        let radius =
+            self.bounds.map(|(lo, hi)| (hi - cam.target).abs().max((cam.target - lo).abs()).length()).unwrap_or(10.0);
         let clip_from_world = cam.clip_from_world(aspect, radius);
         let eye = cam.eye();
         let view_dir = (cam.target - eye).normalize_or(Vec3::NEG_Z);
-        self.atoms
-            .prepare(&ctx.queue, clip_from_world, eye, cam.target);
-        self.volume.prepare(
-            &ctx.device,
-            &ctx.queue,
-            clip_from_world,
-            eye,
-            view_dir,
-            &frame.settings.volume,
-        );
+        self.atoms.prepare(&ctx.queue, clip_from_world, eye, cam.target);
+        self.volume.prepare(&ctx.device, &ctx.queue, clip_from_world, eye, view_dir, &frame.settings.volume);
         let [r, g, b] = frame.settings.background;
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("scene"),
@@ -137,21 +115,13 @@ impl Renderer {
                 depth_slice: None,
                 resolve_target: None,
                 ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color {
-                        r: r as f64,
-                        g: g as f64,
-                        b: b as f64,
-                        a: 1.0,
-                    }),
+                    load: wgpu::LoadOp::Clear(wgpu::Color { r: r as f64, g: g as f64, b: b as f64, a: 1.0 }),
                     store: wgpu::StoreOp::Store,
                 },
             })],
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: &buffers.depth_view,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Store,
-                }),
+                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
                 stencil_ops: None,
             }),
             timestamp_writes: None,

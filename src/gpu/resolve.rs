@@ -74,11 +74,7 @@ impl ResolvePass {
         let texture = |label, format, usage| {
             device.create_texture(&wgpu::TextureDescriptor {
                 label: Some(label),
-                size: wgpu::Extent3d {
-                    width: size[0],
-                    height: size[1],
-                    depth_or_array_layers: 1,
-                },
+                size: wgpu::Extent3d { width: size[0], height: size[1], depth_or_array_layers: 1 },
                 mip_level_count: 1,
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D2,
@@ -88,45 +84,25 @@ impl ResolvePass {
             })
         };
         let attach = wgpu::TextureUsages::RENDER_ATTACHMENT;
-        let color = texture(
-            "scene colour",
-            SCENE_FORMAT,
-            attach | wgpu::TextureUsages::TEXTURE_BINDING,
-        );
+        let color = texture("scene colour", SCENE_FORMAT, attach | wgpu::TextureUsages::TEXTURE_BINDING);
         let depth = texture("scene depth", DEPTH_FORMAT, attach);
         let color_view = color.create_view(&Default::default());
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("resolve bind group"),
             layout: &self.layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::TextureView(&color_view),
-            }],
+            entries: &[wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&color_view) }],
         });
-        SceneBuffers {
-            size,
-            color_view,
-            depth_view: depth.create_view(&Default::default()),
-            bind_group,
-        }
+        SceneBuffers { size, color_view, depth_view: depth.create_view(&Default::default()), bind_group }
     }
 
-    pub fn draw(
-        &self,
-        encoder: &mut wgpu::CommandEncoder,
-        buffers: &SceneBuffers,
-        output: &wgpu::TextureView,
-    ) {
+    pub fn draw(&self, encoder: &mut wgpu::CommandEncoder, buffers: &SceneBuffers, output: &wgpu::TextureView) {
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("resolve"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
                 view: output,
                 depth_slice: None,
                 resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                    store: wgpu::StoreOp::Store,
-                },
+                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::BLACK), store: wgpu::StoreOp::Store },
             })],
             depth_stencil_attachment: None,
             timestamp_writes: None,

@@ -8,8 +8,8 @@ use super::gto::{GridGeometry, GtoArrays, GtoBuffers, gto_layout};
 use super::{DEPTH_FORMAT, GpuContext, GpuError, SCENE_FORMAT};
 use crate::model::cartesian::CartesianExpansion;
 use crate::model::{VolumeGrid, grid::ValueKind};
-use crate::scene::VolumeSettings;
 use crate::scene::slicing::{GridBox, Slices};
+use crate::scene::{TransferKind, VolumeSettings};
 
 /// Mirror of `VolumeUniforms` in volume_slices.wgsl.
 #[repr(C)]
@@ -24,8 +24,14 @@ pub struct VolumeUniforms {
     pub params: [f32; 4],
     pub flags: [u32; 4],
     pub flags_f: [f32; 4],
+    pub tf: [u32; 4],
+    pub tf_positive: [f32; 4],
+    pub tf_negative: [f32; 4],
+    pub tf_gradient: [f32; 4],
+    pub clip: [f32; 4],
+    pub light: [f32; 4],
 }
-const _: () = assert!(std::mem::size_of::<VolumeUniforms>() == 240);
+const _: () = assert!(std::mem::size_of::<VolumeUniforms>() == 336);
 
 /// Extinction per reference step below which a sample cannot be seen.
 const INVISIBLE: f32 = 1e-4;
@@ -67,6 +73,8 @@ pub struct VolumeTexture {
     pub grid_box: GridBox,
     pub kind: ValueKind,
     pub max_abs: f32,
+    /// Largest gradient magnitude (per bohr), the scale of gradient-based transfer functions.
+    pub max_grad: f32,
     /// Mean grid spacing (bohr): the step k1 refers to.
     pub step: f32,
 }
@@ -78,20 +86,13 @@ impl VolumeTexture {
         let [nx, ny, nz] = grid.dims;
         let max = ctx.device.limits().max_texture_dimension_3d;
         if grid.dims.iter().any(|&d| d == 0 || d > max as usize) {
-            return Err(GpuError::VolumeTooLarge {
-                dims: grid.dims,
-                max,
-            });
+            return Err(GpuError::VolumeTooLarge { dims: grid.dims, max });
         }
         let format = ctx.volume_format;
         let bytes: Vec<u8> = match format {
             wgpu::TextureFormat::R32Float => bytemuck::cast_slice(&grid.values).to_vec(),
             _ => {
-                let halves: Vec<half::f16> = grid
-                    .values
-                    .iter()
-                    .map(|&v| half::f16::from_f32(v))
-                    .collect();
+                let halves: Vec<half::f16> = grid.values.iter().map(|&v| half::f16::from_f32(v)).collect();
                 bytemuck::cast_slice(&halves).to_vec()
             }
         };
@@ -99,11 +100,7 @@ impl VolumeTexture {
             &ctx.queue,
             &wgpu::TextureDescriptor {
                 label: Some(&format!("volume {}", grid.label)),
-                size: wgpu::Extent3d {
-                    width: nz as u32,
-                    height: ny as u32,
-                    depth_or_array_layers: nx as u32,
-                },
+                size: wgpu::Extent3d { width: nz as u32, height: ny as u32, depth_or_array_layers: nx as u32 },
                 mip_level_count: 1,
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D3,
@@ -114,14 +111,9 @@ impl VolumeTexture {
             wgpu::util::TextureDataOrder::LayerMajor,
             &bytes,
         );
-        let mut volume = Self::from_texture(
-            texture,
-            grid.dims,
-            grid.world_from_grid,
-            grid.kind,
-            grid.stats.max_abs,
-        );
+        let mut volume = Self::from_texture(texture, grid.dims, grid.world_from_grid, grid.kind, grid.stats.max_abs);
         volume.grid_box = active_box(grid);
+        volume.max_grad = grid.max_gradient().max(1e-30) as f32;
         Ok(volume)
     }
 
@@ -144,9 +136,7 @@ impl VolumeTexture {
         );
         let tex_from_world = (tex_from_grid * world_from_grid.inverse()).as_mat4();
         let step = |a: usize| world_from_grid.col(a).truncate();
-        let voxel = glam::DMat3::from_cols(step(0), step(1), step(2))
-            .determinant()
-            .abs();
+        let voxel = glam::DMat3::from_cols(step(0), step(1), step(2)).determinant().abs();
         let edges = |a: usize| (step(a) * (dims[a].max(1) - 1) as f64).as_vec3();
         Self {
             texture,
@@ -159,6 +149,8 @@ impl VolumeTexture {
             },
             kind,
             max_abs: max_abs.max(1e-30) as f32,
+            // Without the values at hand: an orbital changes by about its maximum over half a bohr.
+            max_grad: (2.0 * max_abs).max(1e-30) as f32,
             step: voxel.cbrt().max(1e-6) as f32,
         }
     }
@@ -208,10 +200,7 @@ fn make_pipeline(
                 attributes: &wgpu::vertex_attr_array![0 => Float32x3],
             })],
         },
-        primitive: wgpu::PrimitiveState {
-            cull_mode: None,
-            ..Default::default()
-        },
+        primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
         // Test against the atoms' depth so they hide the cloud behind them; never write.
         depth_stencil: Some(wgpu::DepthStencilState {
             format: DEPTH_FORMAT,
@@ -272,12 +261,8 @@ impl VolumePass {
         });
         let gto_layout = gto_layout(device, wgpu::ShaderStages::FRAGMENT);
         let pipeline = make_pipeline(device, "volume_slices.wgsl", "fs_main", &[Some(&layout)]);
-        let direct_pipeline = make_pipeline(
-            device,
-            "volume_direct.wgsl",
-            "fs_direct",
-            &[Some(&layout), Some(&gto_layout)],
-        );
+        let direct_pipeline =
+            make_pipeline(device, "volume_direct.wgsl", "fs_direct", &[Some(&layout), Some(&gto_layout)]);
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("volume sampler"),
             address_mode_u: wgpu::AddressMode::ClampToEdge,
@@ -319,11 +304,7 @@ impl VolumePass {
     }
 
     /// Replaces the volume shown (None shows none).
-    pub fn set_volume(
-        &mut self,
-        ctx: &GpuContext,
-        grid: Option<&VolumeGrid>,
-    ) -> Result<(), GpuError> {
+    pub fn set_volume(&mut self, ctx: &GpuContext, grid: Option<&VolumeGrid>) -> Result<(), GpuError> {
         let volume = grid.map(|g| VolumeTexture::upload(ctx, g)).transpose()?;
         self.set_texture(ctx, volume);
         Ok(())
@@ -342,11 +323,7 @@ impl VolumePass {
         // The texture binding is unused by the direct shader but part of the shared layout.
         let placeholder = ctx.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("direct-mode placeholder volume"),
-            size: wgpu::Extent3d {
-                width: 1,
-                height: 1,
-                depth_or_array_layers: 1,
-            },
+            size: wgpu::Extent3d { width: 1, height: 1, depth_or_array_layers: 1 },
             mip_level_count: 1,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D3,
@@ -362,11 +339,7 @@ impl VolumePass {
             max_abs,
         );
         self.set_texture(ctx, Some(shape));
-        self.direct = Some(GtoBuffers::new(
-            &ctx.device,
-            &self.gto_layout,
-            &GtoArrays::new(expansion),
-        ));
+        self.direct = Some(GtoBuffers::new(&ctx.device, &self.gto_layout, &GtoArrays::new(expansion)));
     }
 
     /// Shows a volume already on the GPU (None shows none).
@@ -378,18 +351,9 @@ impl VolumePass {
                 label: Some("volume bind group"),
                 layout: &self.layout,
                 entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: self.uniforms.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: wgpu::BindingResource::TextureView(&v.view),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: wgpu::BindingResource::Sampler(&self.sampler),
-                    },
+                    wgpu::BindGroupEntry { binding: 0, resource: self.uniforms.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&v.view) },
+                    wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&self.sampler) },
                 ],
             })
         });
@@ -414,13 +378,7 @@ impl VolumePass {
         if !settings.visible {
             return;
         }
-        let Slices {
-            vertices,
-            normal,
-            spacing,
-        } = vol
-            .grid_box
-            .slices(settings.mode, settings.slices, eye, view_dir);
+        let Slices { vertices, normal, spacing } = vol.grid_box.slices(settings.mode, settings.slices, eye, view_dir);
         if vertices.is_empty() {
             return;
         }
@@ -430,6 +388,16 @@ impl VolumePass {
         queue.write_buffer(&self.vertices, 0, bytemuck::cast_slice(&vertices));
         self.vertex_count = vertices.len() as u32;
         let signed = vol.kind == ValueKind::Signed;
+        let t = &settings.transfer;
+        let lobe = |l: &crate::scene::transfer::Lobe| [l.center, l.width, l.opacity, 0.0];
+        let bits =
+            u32::from(t.shading) | (u32::from(t.needs_gradient()) << 1) | (u32::from(settings.clip.enabled) << 2);
+        let clip_normal = Vec3::from(settings.clip.normal).normalize_or(Vec3::Z);
+        let box_centre =
+            vol.grid_box.origin + 0.5 * (vol.grid_box.edges[0] + vol.grid_box.edges[1] + vol.grid_box.edges[2]);
+        let back = -view_dir;
+        let right = Vec3::Y.cross(back).normalize_or(Vec3::X);
+        let light = (back + 0.6 * back.cross(right) - 0.4 * right).normalize();
         let rgb = |c: [f32; 3]| Vec4::new(c[0], c[1], c[2], 1.0).to_array();
         let u = VolumeUniforms {
             clip_from_world: clip_from_world.to_cols_array_2d(),
@@ -440,12 +408,13 @@ impl VolumePass {
             negative_color: rgb(settings.negative_color),
             params: [settings.k1, settings.k2, 1.0 / vol.max_abs, vol.step],
             flags: [u32::from(signed), 0, 0, 0],
-            flags_f: [
-                visibility_threshold(settings.k1, settings.k2, signed),
-                0.0,
-                0.0,
-                0.0,
-            ],
+            flags_f: [visibility_threshold(settings.k1, settings.k2, signed), 0.0, 0.0, 0.0],
+            tf: [u32::from(t.kind == TransferKind::Shaped), t.positive.shape.index(), t.negative.shape.index(), bits],
+            tf_positive: lobe(&t.positive),
+            tf_negative: lobe(&t.negative),
+            tf_gradient: [t.gradient_power, t.boundary.clamp(0.0, 1.0), 1.0 / vol.max_grad, 0.0],
+            clip: clip_normal.extend(clip_normal.dot(box_centre) + settings.clip.offset).to_array(),
+            light: light.extend(0.0).to_array(),
         };
         queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
     }

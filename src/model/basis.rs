@@ -88,17 +88,7 @@ mod tests {
     #[test]
     fn cartesian_order_is_alphabetical() {
         assert_eq!(cartesian_powers(1), vec![[1, 0, 0], [0, 1, 0], [0, 0, 1]]);
-        assert_eq!(
-            cartesian_powers(2),
-            vec![
-                [2, 0, 0],
-                [1, 1, 0],
-                [1, 0, 1],
-                [0, 2, 0],
-                [0, 1, 1],
-                [0, 0, 2]
-            ]
-        );
+        assert_eq!(cartesian_powers(2), vec![[2, 0, 0], [1, 1, 0], [1, 0, 1], [0, 2, 0], [0, 1, 1], [0, 0, 2]]);
         for l in 0..=MAX_L {
             assert_eq!(cartesian_powers(l).len(), n_cartesian(l));
         }

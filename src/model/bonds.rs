@@ -19,11 +19,7 @@ const MAX_ATOMS_PER_CELL: usize = 256;
 
 /// Bonds between non-ghost atoms, each pair once with `a < b`, sorted.
 pub fn infer_bonds(atoms: &[Atom]) -> Vec<Bond> {
-    let max_radius = atoms
-        .iter()
-        .filter(|a| !a.ghost)
-        .map(|a| a.element().covalent_radius as f64)
-        .fold(0.0, f64::max);
+    let max_radius = atoms.iter().filter(|a| !a.ghost).map(|a| a.element().covalent_radius as f64).fold(0.0, f64::max);
     // A cell as wide as the longest possible bond: neighbours lie in the 27 cells around.
     let cell = ((2.0 * max_radius + BOND_TOLERANCE_ANG) * BOHR_PER_ANGSTROM).max(1e-3);
     let key = |p: DVec3| {
@@ -73,32 +69,19 @@ mod tests {
     use super::*;
 
     fn atom(z: u32, x: f64, y: f64, zz: f64) -> Atom {
-        Atom {
-            z,
-            charge: z as f64,
-            position: DVec3::new(x, y, zz) * BOHR_PER_ANGSTROM,
-            ghost: false,
-        }
+        Atom { z, charge: z as f64, position: DVec3::new(x, y, zz) * BOHR_PER_ANGSTROM, ghost: false }
     }
 
     #[test]
     fn water_has_two_bonds() {
-        let atoms = vec![
-            atom(8, 0.0, 0.0, 0.0),
-            atom(1, 0.757, 0.586, 0.0),
-            atom(1, -0.757, 0.586, 0.0),
-        ];
+        let atoms = vec![atom(8, 0.0, 0.0, 0.0), atom(1, 0.757, 0.586, 0.0), atom(1, -0.757, 0.586, 0.0)];
         let bonds = infer_bonds(&atoms);
         assert_eq!(bonds, vec![Bond { a: 0, b: 1 }, Bond { a: 0, b: 2 }]);
     }
 
     #[test]
     fn ghosts_and_distant_atoms_do_not_bond() {
-        let mut atoms = vec![
-            atom(6, 0.0, 0.0, 0.0),
-            atom(6, 1.54, 0.0, 0.0),
-            atom(6, 5.0, 0.0, 0.0),
-        ];
+        let mut atoms = vec![atom(6, 0.0, 0.0, 0.0), atom(6, 1.54, 0.0, 0.0), atom(6, 5.0, 0.0, 0.0)];
         assert_eq!(infer_bonds(&atoms).len(), 1);
         atoms[1].ghost = true;
         assert!(infer_bonds(&atoms).is_empty());
@@ -115,24 +98,17 @@ mod tests {
         // A pseudo-random cloud of carbons: the spatial hash must find exactly the brute-force pairs.
         let mut s = 12345u64;
         let mut rnd = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
+            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
             (s >> 11) as f64 / (1u64 << 53) as f64
         };
-        let atoms: Vec<Atom> = (0..400)
-            .map(|_| atom(6, rnd() * 15.0 - 7.0, rnd() * 15.0, rnd() * 15.0))
-            .collect();
+        let atoms: Vec<Atom> = (0..400).map(|_| atom(6, rnd() * 15.0 - 7.0, rnd() * 15.0, rnd() * 15.0)).collect();
         let fast = infer_bonds(&atoms);
         let mut slow = Vec::new();
         for i in 0..atoms.len() {
             for j in i + 1..atoms.len() {
                 let d = atoms[i].position.distance(atoms[j].position) / BOHR_PER_ANGSTROM;
                 if d > MIN_BOND_ANG && d < 0.76 * 2.0 + BOND_TOLERANCE_ANG {
-                    slow.push(Bond {
-                        a: i as u32,
-                        b: j as u32,
-                    });
+                    slow.push(Bond { a: i as u32, b: j as u32 });
                 }
             }
         }

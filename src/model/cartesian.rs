@@ -40,9 +40,7 @@ impl CartesianExpansion {
                 let angular: f64 = cartesian_powers(s.l)
                     .iter()
                     .zip(&s.weights)
-                    .map(|([a, b, c], w)| {
-                        w * d.x.powi(*a as i32) * d.y.powi(*b as i32) * d.z.powi(*c as i32)
-                    })
+                    .map(|([a, b, c], w)| w * d.x.powi(*a as i32) * d.y.powi(*b as i32) * d.z.powi(*c as i32))
                     .sum();
                 radial * angular
             })

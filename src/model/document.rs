@@ -19,9 +19,7 @@ impl Document {
     /// an empty document.
     pub fn bounds(&self) -> Option<(glam::DVec3, glam::DVec3)> {
         let atoms = self.molecule.atoms.iter().flat_map(|a| {
-            let r = glam::DVec3::splat(
-                a.element().covalent_radius as f64 * super::units::BOHR_PER_ANGSTROM,
-            );
+            let r = glam::DVec3::splat(a.element().covalent_radius as f64 * super::units::BOHR_PER_ANGSTROM);
             [a.position - r, a.position + r]
         });
         let points = atoms.chain(self.volumes.iter().flat_map(|v| v.corners()));

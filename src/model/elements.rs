@@ -22,11 +22,7 @@ pub fn element(z: u32) -> &'static ElementData {
 /// Atomic number from a symbol, case-insensitive ("C", "cl", "HE").
 pub fn atomic_number(symbol: &str) -> Option<u32> {
     let s = symbol.trim();
-    ELEMENTS
-        .iter()
-        .position(|e| e.symbol.eq_ignore_ascii_case(s))
-        .filter(|&z| z > 0)
-        .map(|z| z as u32)
+    ELEMENTS.iter().position(|e| e.symbol.eq_ignore_ascii_case(s)).filter(|&z| z > 0).map(|z| z as u32)
 }
 
 #[cfg(test)]
@@ -49,10 +45,7 @@ mod tests {
     #[test]
     fn radii_are_physical() {
         for (z, e) in ELEMENTS.iter().enumerate().skip(1) {
-            assert!(
-                e.covalent_radius > 0.2 && e.covalent_radius < 2.6,
-                "Z={z} {e:?}"
-            );
+            assert!(e.covalent_radius > 0.2 && e.covalent_radius < 2.6, "Z={z} {e:?}");
             assert!(e.vdw_radius >= e.covalent_radius, "Z={z} {e:?}");
         }
         // Carbon: 0.76 Å covalent (sp3), 1.70-1.77 Å vdW.

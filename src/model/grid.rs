@@ -30,13 +30,7 @@ impl GridStats {
         let n = values.len() as f64;
         let mean = sum / n;
         let sigma = (sum2 / n - mean * mean).max(0.0).sqrt();
-        Self {
-            min,
-            max,
-            mean,
-            sigma,
-            max_abs: min.abs().max(max.abs()),
-        }
+        Self { min, max, mean, sigma, max_abs: min.abs().max(max.abs()) }
     }
 }
 
@@ -63,42 +57,17 @@ pub struct VolumeGrid {
 
 impl VolumeGrid {
     /// Builds a grid; `values.len()` must equal the product of `dims`.
-    pub fn new(
-        label: impl Into<String>,
-        dims: [usize; 3],
-        world_from_grid: DMat4,
-        values: Vec<f32>,
-    ) -> Self {
-        assert_eq!(
-            values.len(),
-            dims[0] * dims[1] * dims[2],
-            "grid values do not match dims"
-        );
+    pub fn new(label: impl Into<String>, dims: [usize; 3], world_from_grid: DMat4, values: Vec<f32>) -> Self {
+        assert_eq!(values.len(), dims[0] * dims[1] * dims[2], "grid values do not match dims");
         let stats = GridStats::of(&values);
         // A grid with clearly negative values is an orbital (or a difference density).
-        let kind = if stats.min < -1e-3 * stats.max_abs {
-            ValueKind::Signed
-        } else {
-            ValueKind::Density
-        };
-        Self {
-            label: label.into(),
-            dims,
-            world_from_grid,
-            values,
-            stats,
-            kind,
-        }
+        let kind = if stats.min < -1e-3 * stats.max_abs { ValueKind::Signed } else { ValueKind::Density };
+        Self { label: label.into(), dims, world_from_grid, values, stats, kind }
     }
 
     /// `world_from_grid` from an origin and the three step vectors (columns), all bohr.
     pub fn affine(origin: DVec3, steps: [DVec3; 3]) -> DMat4 {
-        DMat4::from_cols(
-            steps[0].extend(0.0),
-            steps[1].extend(0.0),
-            steps[2].extend(0.0),
-            origin.extend(1.0),
-        )
+        DMat4::from_cols(steps[0].extend(0.0), steps[1].extend(0.0), steps[2].extend(0.0), origin.extend(1.0))
     }
 
     pub fn origin(&self) -> DVec3 {
@@ -126,8 +95,7 @@ impl VolumeGrid {
 
     /// World position (bohr) of grid point (i, j, k).
     pub fn point(&self, i: usize, j: usize, k: usize) -> DVec3 {
-        self.world_from_grid
-            .transform_point3(DVec3::new(i as f64, j as f64, k as f64))
+        self.world_from_grid.transform_point3(DVec3::new(i as f64, j as f64, k as f64))
     }
 
     /// The parallelepiped spanned by the grid points: origin plus edges (n−1)·step.
@@ -144,9 +112,7 @@ impl VolumeGrid {
         let e = self.box_edges();
         let o = self.origin();
         std::array::from_fn(|n| {
-            o + e.x_axis * (n & 1) as f64
-                + e.y_axis * ((n >> 1) & 1) as f64
-                + e.z_axis * ((n >> 2) & 1) as f64
+            o + e.x_axis * (n & 1) as f64 + e.y_axis * ((n >> 1) & 1) as f64 + e.z_axis * ((n >> 2) & 1) as f64
         })
     }
 
@@ -160,10 +126,7 @@ impl VolumeGrid {
                 let row = &self.values[self.index(i, j, 0)..self.index(i, j, 0) + nz];
                 let first = row.iter().position(|v| v.abs() >= threshold);
                 let Some(first) = first else { continue };
-                let last = row
-                    .iter()
-                    .rposition(|v| v.abs() >= threshold)
-                    .unwrap_or(first);
+                let last = row.iter().rposition(|v| v.abs() >= threshold).unwrap_or(first);
                 for (a, v) in [i, j, first].into_iter().enumerate() {
                     lo[a] = lo[a].min(v);
                 }
@@ -172,35 +135,47 @@ impl VolumeGrid {
                 }
             }
         }
-        (lo[0] != usize::MAX).then(|| {
-            (
-                lo.map(|v| v.saturating_sub(1)),
-                std::array::from_fn(|a| (hi[a] + 1).min(self.dims[a] - 1)),
-            )
-        })
+        (lo[0] != usize::MAX)
+            .then(|| (lo.map(|v| v.saturating_sub(1)), std::array::from_fn(|a| (hi[a] + 1).min(self.dims[a] - 1))))
+    }
+
+    /// Largest gradient magnitude (per bohr) by central differences over interior points.
+    pub fn max_gradient(&self) -> f64 {
+        let [nx, ny, nz] = self.dims;
+        if nx < 3 || ny < 3 || nz < 3 {
+            return 0.0;
+        }
+        // Differences along grid axes give Jᵀ∇ with J the step matrix: ∇ = J⁻ᵀ·(differences).
+        let j = DMat3::from_cols(self.step(0), self.step(1), self.step(2));
+        let inv_t = j.inverse().transpose();
+        let mut best = 0.0f64;
+        for i in 1..nx - 1 {
+            for jj in 1..ny - 1 {
+                for k in 1..nz - 1 {
+                    let d = DVec3::new(
+                        (self.value(i + 1, jj, k) - self.value(i - 1, jj, k)) as f64,
+                        (self.value(i, jj + 1, k) - self.value(i, jj - 1, k)) as f64,
+                        (self.value(i, jj, k + 1) - self.value(i, jj, k - 1)) as f64,
+                    ) * 0.5;
+                    best = best.max((inv_t * d).length());
+                }
+            }
+        }
+        best
     }
 
     /// Voxel volume in bohr³ (|det| of the step vectors).
     pub fn voxel_volume(&self) -> f64 {
-        DMat3::from_cols(self.step(0), self.step(1), self.step(2))
-            .determinant()
-            .abs()
+        DMat3::from_cols(self.step(0), self.step(1), self.step(2)).determinant().abs()
     }
 
     /// Trilinear interpolation at fractional grid coordinates, clamped to the grid.
     pub fn sample(&self, g: DVec3) -> f64 {
         let clampi = |v: f64, n: usize| v.clamp(0.0, (n.max(1) - 1) as f64);
-        let (x, y, z) = (
-            clampi(g.x, self.dims[0]),
-            clampi(g.y, self.dims[1]),
-            clampi(g.z, self.dims[2]),
-        );
+        let (x, y, z) = (clampi(g.x, self.dims[0]), clampi(g.y, self.dims[1]), clampi(g.z, self.dims[2]));
         let (i0, j0, k0) = (x.floor() as usize, y.floor() as usize, z.floor() as usize);
-        let (i1, j1, k1) = (
-            (i0 + 1).min(self.dims[0] - 1),
-            (j0 + 1).min(self.dims[1] - 1),
-            (k0 + 1).min(self.dims[2] - 1),
-        );
+        let (i1, j1, k1) =
+            ((i0 + 1).min(self.dims[0] - 1), (j0 + 1).min(self.dims[1] - 1), (k0 + 1).min(self.dims[2] - 1));
         let (fx, fy, fz) = (x - i0 as f64, y - j0 as f64, z - k0 as f64);
         let v = |i, j, k| self.value(i, j, k) as f64;
         let lerp = |a: f64, b: f64, t: f64| a + (b - a) * t;
@@ -214,8 +189,7 @@ impl VolumeGrid {
     /// Trilinear value at a world position (bohr); `None` outside the grid box.
     pub fn sample_world(&self, p: DVec3) -> Option<f64> {
         let g = self.world_from_grid.inverse().transform_point3(p);
-        let inside =
-            (0..3).all(|a| g[a] >= -1e-9 && g[a] <= (self.dims[a].max(1) - 1) as f64 + 1e-9);
+        let inside = (0..3).all(|a| g[a] >= -1e-9 && g[a] <= (self.dims[a].max(1) - 1) as f64 + 1e-9);
         inside.then(|| self.sample(g))
     }
 }
@@ -228,11 +202,7 @@ mod tests {
         let dims = [4, 5, 6];
         let w = VolumeGrid::affine(
             DVec3::new(-1.0, 2.0, 0.5),
-            [
-                DVec3::new(0.5, 0.1, 0.0),
-                DVec3::new(0.0, 0.4, 0.0),
-                DVec3::new(0.0, 0.0, 0.3),
-            ],
+            [DVec3::new(0.5, 0.1, 0.0), DVec3::new(0.0, 0.4, 0.0), DVec3::new(0.0, 0.0, 0.3)],
         );
         let mut values = Vec::new();
         for i in 0..4 {
@@ -260,9 +230,7 @@ mod tests {
         let g = linear_grid();
         let v = g.sample(DVec3::new(1.5, 2.25, 4.5));
         assert!((v - (1.5 + 22.5 - 13.5)).abs() < 1e-9);
-        let p = g
-            .world_from_grid
-            .transform_point3(DVec3::new(1.5, 2.25, 4.5));
+        let p = g.world_from_grid.transform_point3(DVec3::new(1.5, 2.25, 4.5));
         assert!((g.sample_world(p).unwrap() - v).abs() < 1e-9);
         assert!(g.sample_world(DVec3::new(100.0, 0.0, 0.0)).is_none());
     }
@@ -276,6 +244,16 @@ mod tests {
         values[g.index(3, 3, 1)] = 1.0;
         let g = VolumeGrid::new("a", [6, 5, 4], DMat4::IDENTITY, values);
         assert_eq!(g.active_bounds(0.5), Some(([1, 0, 0], [4, 4, 3])));
+    }
+
+    #[test]
+    fn max_gradient_of_a_linear_field() {
+        // value = i + 10 j − 3 k on steps (0.5, 0.1, 0)/(0, 0.4, 0)/(0, 0, 0.3): the world gradient
+        // solves Jᵀ∇ = (1, 10, −3).
+        let g = linear_grid();
+        let j = DMat3::from_cols(g.step(0), g.step(1), g.step(2));
+        let expected = (j.inverse().transpose() * DVec3::new(1.0, 10.0, -3.0)).length();
+        assert!((g.max_gradient() - expected).abs() < 1e-4 * expected);
     }
 
     #[test]

@@ -47,10 +47,7 @@ pub struct Wavefunction {
 impl Wavefunction {
     /// Orbitals of one spin, with their indices into `orbitals`, in file order.
     pub fn of_spin(&self, spin: Spin) -> impl Iterator<Item = (usize, &MolecularOrbital)> {
-        self.orbitals
-            .iter()
-            .enumerate()
-            .filter(move |(_, o)| o.spin == spin)
+        self.orbitals.iter().enumerate().filter(move |(_, o)| o.spin == spin)
     }
 
     /// Index of the highest occupied orbital of a spin (by energy), if any.

@@ -19,13 +19,7 @@ pub struct Camera {
 
 impl Default for Camera {
     fn default() -> Self {
-        Self {
-            target: Vec3::ZERO,
-            yaw: 0.0,
-            pitch: 0.0,
-            distance: 20.0,
-            fov_y: 30f32.to_radians(),
-        }
+        Self { target: Vec3::ZERO, yaw: 0.0, pitch: 0.0, distance: 20.0, fov_y: 30f32.to_radians() }
     }
 }
 
@@ -65,9 +59,7 @@ impl Camera {
 
     /// Near and far planes that bracket everything within `scene_radius` of the target.
     fn depth_range(&self, scene_radius: f32) -> (f32, f32) {
-        let near = (self.distance - scene_radius)
-            .max(self.distance * 1e-3)
-            .max(1e-3);
+        let near = (self.distance - scene_radius).max(self.distance * 1e-3).max(1e-3);
         let far = self.distance + scene_radius.max(1.0);
         (near, far)
     }
@@ -75,8 +67,7 @@ impl Camera {
     /// wgpu clip space (depth 0..1, y up) from world.
     pub fn clip_from_world(&self, aspect: f32, scene_radius: f32) -> Mat4 {
         let (near, far) = self.depth_range(scene_radius);
-        let proj =
-            glam::camera::rh::proj::directx::perspective(self.fov_y, aspect.max(1e-3), near, far);
+        let proj = glam::camera::rh::proj::directx::perspective(self.fov_y, aspect.max(1e-3), near, far);
         proj * self.view_from_world()
     }
 

@@ -3,6 +3,8 @@
 pub mod camera;
 pub mod settings;
 pub mod slicing;
+pub mod transfer;
 
 pub use camera::Camera;
 pub use settings::{AtomStyle, RenderSettings, SliceMode, VolumeSettings};
+pub use transfer::{ClipPlane, Shape, Transfer, TransferKind};

@@ -2,6 +2,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::transfer::{ClipPlane, Transfer};
+
 /// How the volume is cut into slices.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 pub enum SliceMode {
@@ -26,6 +28,10 @@ pub struct VolumeSettings {
     pub positive_color: [f32; 3],
     /// Linear RGB for negative ψ (or the thin end of a density ramp).
     pub negative_color: [f32; 3],
+    /// Seed 004's shaped transfer functions, gradient shading and boundary enhancement (when
+    /// `transfer.kind` is `Shaped`; k1 and k2 apply to the power law).
+    pub transfer: Transfer,
+    pub clip: ClipPlane,
 }
 
 impl Default for VolumeSettings {
@@ -38,6 +44,8 @@ impl Default for VolumeSettings {
             k2: 0.6,
             positive_color: [0.90, 0.12, 0.10],
             negative_color: [0.10, 0.30, 0.95],
+            transfer: Transfer::default(),
+            clip: ClipPlane::default(),
         }
     }
 }
@@ -60,10 +68,6 @@ pub struct RenderSettings {
 
 impl Default for RenderSettings {
     fn default() -> Self {
-        Self {
-            volume: VolumeSettings::default(),
-            atoms: AtomStyle::default(),
-            background: [0.02, 0.02, 0.03],
-        }
+        Self { volume: VolumeSettings::default(), atoms: AtomStyle::default(), background: [0.02, 0.02, 0.03] }
     }
 }

@@ -29,28 +29,13 @@ impl GridBox {
     pub fn corners(&self) -> [Vec3; 8] {
         let e = self.edges;
         std::array::from_fn(|n| {
-            self.origin
-                + e[0] * (n & 1) as f32
-                + e[1] * ((n >> 1) & 1) as f32
-                + e[2] * ((n >> 2) & 1) as f32
+            self.origin + e[0] * (n & 1) as f32 + e[1] * ((n >> 1) & 1) as f32 + e[2] * ((n >> 2) & 1) as f32
         })
     }
 
     /// The 12 edges as pairs of corner indices.
-    const EDGES: [(usize, usize); 12] = [
-        (0, 1),
-        (2, 3),
-        (4, 5),
-        (6, 7),
-        (0, 2),
-        (1, 3),
-        (4, 6),
-        (5, 7),
-        (0, 4),
-        (1, 5),
-        (2, 6),
-        (3, 7),
-    ];
+    const EDGES: [(usize, usize); 12] =
+        [(0, 1), (2, 3), (4, 5), (6, 7), (0, 2), (1, 3), (4, 6), (5, 7), (0, 4), (1, 5), (2, 6), (3, 7)];
 
     pub fn slices(&self, mode: SliceMode, count: u32, eye: Vec3, view_dir: Vec3) -> Slices {
         match mode {
@@ -64,11 +49,7 @@ impl GridBox {
         let n = view_dir.normalize_or(Vec3::NEG_Z);
         let corners = self.corners();
         let depths = corners.map(|c| c.dot(n));
-        let (lo, hi) = depths
-            .iter()
-            .fold((f32::INFINITY, f32::NEG_INFINITY), |(l, h), &d| {
-                (l.min(d), h.max(d))
-            });
+        let (lo, hi) = depths.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(l, h), &d| (l.min(d), h.max(d)));
         let count = count.max(1);
         let spacing = (hi - lo) / count as f32;
         let mut vertices = Vec::with_capacity(count as usize * 12);
@@ -85,11 +66,7 @@ impl GridBox {
             }
             triangulate_convex(&mut poly, n, &mut vertices);
         }
-        Slices {
-            vertices,
-            normal: n,
-            spacing,
-        }
+        Slices { vertices, normal: n, spacing }
     }
 
     /// Seed 000's three stacks: planes of constant grid coordinate along the axis that faces the
@@ -97,11 +74,8 @@ impl GridBox {
     pub fn axis_aligned(&self, count: u32, eye: Vec3, view_dir: Vec3) -> Slices {
         let v = view_dir.normalize_or(Vec3::NEG_Z);
         let e = self.edges;
-        let normals =
-            [e[1].cross(e[2]), e[2].cross(e[0]), e[0].cross(e[1])].map(|c| c.normalize_or(Vec3::Z));
-        let axis = (0..3)
-            .max_by(|&a, &b| normals[a].dot(v).abs().total_cmp(&normals[b].dot(v).abs()))
-            .unwrap_or(0);
+        let normals = [e[1].cross(e[2]), e[2].cross(e[0]), e[0].cross(e[1])].map(|c| c.normalize_or(Vec3::Z));
+        let axis = (0..3).max_by(|&a, &b| normals[a].dot(v).abs().total_cmp(&normals[b].dot(v).abs())).unwrap_or(0);
         let (u, w) = ((axis + 1) % 3, (axis + 2) % 3);
         let count = count.max(1);
         let mut normal = normals[axis];
@@ -121,11 +95,7 @@ impl GridBox {
             let quad = [p, p + e[u], p + e[u] + e[w], p + e[w]];
             vertices.extend_from_slice(&[quad[0], quad[1], quad[2], quad[0], quad[2], quad[3]]);
         }
-        Slices {
-            vertices,
-            normal,
-            spacing,
-        }
+        Slices { vertices, normal, spacing }
     }
 }
 
@@ -138,9 +108,7 @@ fn triangulate_convex(poly: &mut [Vec3], normal: Vec3, out: &mut Vec<Vec3>) {
     let (bu, bv) = normal.any_orthonormal_pair();
     poly.sort_by(|a, b| {
         let (da, db) = (*a - centroid, *b - centroid);
-        da.dot(bv)
-            .atan2(da.dot(bu))
-            .total_cmp(&db.dot(bv).atan2(db.dot(bu)))
+        da.dot(bv).atan2(da.dot(bu)).total_cmp(&db.dot(bv).atan2(db.dot(bu)))
     });
     for i in 1..poly.len() - 1 {
         out.extend_from_slice(&[poly[0], poly[i], poly[i + 1]]);
@@ -152,16 +120,11 @@ mod tests {
     use super::*;
 
     fn unit_cube() -> GridBox {
-        GridBox {
-            origin: Vec3::ZERO,
-            edges: [Vec3::X * 2.0, Vec3::Y * 2.0, Vec3::Z * 2.0],
-        }
+        GridBox { origin: Vec3::ZERO, edges: [Vec3::X * 2.0, Vec3::Y * 2.0, Vec3::Z * 2.0] }
     }
 
     fn area(tris: &[Vec3]) -> f32 {
-        tris.chunks(3)
-            .map(|t| 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length())
-            .sum()
+        tris.chunks(3).map(|t| 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length()).sum()
     }
 
     #[test]
@@ -179,19 +142,11 @@ mod tests {
         let b = unit_cube();
         let s = b.view_aligned(9, Vec3::new(1.0, 1.0, 1.0));
         for v in &s.vertices {
-            assert!(
-                v.cmpge(Vec3::splat(-1e-4)).all() && v.cmple(Vec3::splat(2.0 + 1e-4)).all(),
-                "{v}"
-            );
+            assert!(v.cmpge(Vec3::splat(-1e-4)).all() && v.cmple(Vec3::splat(2.0 + 1e-4)).all(), "{v}");
         }
         // The middle slice through the centre of a cube perpendicular to a diagonal is a regular
         // hexagon of side √2·(edge/2): area (3√3/2)·2.
-        let mid: Vec<Vec3> = s
-            .vertices
-            .iter()
-            .copied()
-            .filter(|v| (v.dot(Vec3::ONE) - 3.0).abs() < 1e-3)
-            .collect();
+        let mid: Vec<Vec3> = s.vertices.iter().copied().filter(|v| (v.dot(Vec3::ONE) - 3.0).abs() < 1e-3).collect();
         assert_eq!(mid.len(), 4 * 3);
         assert!((area(&mid) - 3.0 * 3f32.sqrt()).abs() < 1e-3);
         // All triangles wind consistently (no inverted fan).
@@ -202,10 +157,7 @@ mod tests {
 
     #[test]
     fn axis_aligned_picks_the_facing_stack_back_to_front() {
-        let b = GridBox {
-            origin: Vec3::ZERO,
-            edges: [Vec3::X * 4.0, Vec3::new(1.0, 2.0, 0.0), Vec3::Z * 3.0],
-        };
+        let b = GridBox { origin: Vec3::ZERO, edges: [Vec3::X * 4.0, Vec3::new(1.0, 2.0, 0.0), Vec3::Z * 3.0] };
         let eye = Vec3::new(2.0, 1.0, 20.0);
         let s = b.axis_aligned(6, eye, Vec3::new(0.1, 0.0, -1.0));
         assert!((s.normal - Vec3::NEG_Z).length() < 1e-6);

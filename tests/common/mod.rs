@@ -12,23 +12,13 @@ pub fn lavapipe() -> GpuContext {
     let ctx = GpuContext::headless(AdapterPreference::LavapipeOnly).unwrap_or_else(|e| {
         panic!("GPU tests need the Vulkan CPU adapter (lavapipe): {e}. Install: apt-get install -y mesa-vulkan-drivers libvulkan1")
     });
-    assert_eq!(
-        ctx.info.backend,
-        wgpu::Backend::Vulkan,
-        "tests must run on Vulkan, got {}",
-        ctx.describe()
-    );
+    assert_eq!(ctx.info.backend, wgpu::Backend::Vulkan, "tests must run on Vulkan, got {}", ctx.describe());
     eprintln!("test adapter: {}", ctx.describe());
     ctx
 }
 
 fn atom(z: u32, ang: [f64; 3]) -> Atom {
-    Atom {
-        z,
-        charge: z as f64,
-        position: DVec3::from(ang) * BOHR_PER_ANGSTROM,
-        ghost: false,
-    }
+    Atom { z, charge: z as f64, position: DVec3::from(ang) * BOHR_PER_ANGSTROM, ghost: false }
 }
 
 /// Formaldehyde-like skeleton in the xy plane, C=O along x, centred near the origin.
@@ -47,24 +37,12 @@ pub fn p_orbital(n: usize, sheared: bool) -> VolumeGrid {
     let half = 4.5;
     let h = 2.0 * half / (n - 1) as f64;
     let steps = if sheared {
-        [
-            DVec3::new(h, 0.0, 0.0),
-            DVec3::new(0.35 * h, h, 0.0),
-            DVec3::new(0.0, 0.2 * h, h),
-        ]
+        [DVec3::new(h, 0.0, 0.0), DVec3::new(0.35 * h, h, 0.0), DVec3::new(0.0, 0.2 * h, h)]
     } else {
-        [
-            DVec3::new(h, 0.0, 0.0),
-            DVec3::new(0.0, h, 0.0),
-            DVec3::new(0.0, 0.0, h),
-        ]
+        [DVec3::new(h, 0.0, 0.0), DVec3::new(0.0, h, 0.0), DVec3::new(0.0, 0.0, h)]
     };
     let origin = DVec3::splat(-half)
-        - if sheared {
-            0.5 * (n - 1) as f64 * (steps[1] - DVec3::new(0.0, h, 0.0))
-        } else {
-            DVec3::ZERO
-        };
+        - if sheared { 0.5 * (n - 1) as f64 * (steps[1] - DVec3::new(0.0, h, 0.0)) } else { DVec3::ZERO };
     let world = VolumeGrid::affine(origin, steps);
     let mut values = Vec::with_capacity(n * n * n);
     for i in 0..n {
@@ -76,12 +54,7 @@ pub fn p_orbital(n: usize, sheared: bool) -> VolumeGrid {
             }
         }
     }
-    VolumeGrid::new(
-        if sheared { "sheared p" } else { "p" },
-        [n, n, n],
-        world,
-        values,
-    )
+    VolumeGrid::new(if sheared { "sheared p" } else { "p" }, [n, n, n], world, values)
 }
 
 pub fn scene(with_volume: Option<VolumeGrid>) -> Document {
@@ -109,26 +82,14 @@ pub fn assert_golden(name: &str, actual: &image::RgbaImage) {
         return;
     }
     let expected = image::open(&reference)
-        .unwrap_or_else(|e| {
-            panic!(
-                "{}: {e} (run with ORBCLOUD_BLESS=1 to create it)",
-                reference.display()
-            )
-        })
+        .unwrap_or_else(|e| panic!("{}: {e} (run with ORBCLOUD_BLESS=1 to create it)", reference.display()))
         .to_rgba8();
-    assert_eq!(
-        expected.dimensions(),
-        actual.dimensions(),
-        "{name}: size differs from the reference"
-    );
+    assert_eq!(expected.dimensions(), actual.dimensions(), "{name}: size differs from the reference");
     let mut diff = image::RgbaImage::new(actual.width(), actual.height());
     let (mut bad, mut sum) = (0usize, 0u64);
     for (x, y, a) in actual.enumerate_pixels() {
         let e = expected.get_pixel(x, y);
-        let d = (0..4)
-            .map(|c| (a[c] as i32 - e[c] as i32).unsigned_abs())
-            .max()
-            .unwrap_or(0);
+        let d = (0..4).map(|c| (a[c] as i32 - e[c] as i32).unsigned_abs()).max().unwrap_or(0);
         sum += d as u64;
         if d > 8 {
             bad += 1;
@@ -149,9 +110,6 @@ pub fn assert_golden(name: &str, actual: &image::RgbaImage) {
 
 /// Fraction of pixels that differ from the background colour by more than a few counts.
 pub fn coverage(img: &image::RgbaImage, background: [u8; 3]) -> f64 {
-    let covered = img
-        .pixels()
-        .filter(|p| (0..3).any(|c| (p[c] as i32 - background[c] as i32).abs() > 6))
-        .count();
+    let covered = img.pixels().filter(|p| (0..3).any(|c| (p[c] as i32 - background[c] as i32).abs() > 6)).count();
     covered as f64 / (img.width() * img.height()) as f64
 }
