@@ -4,7 +4,7 @@
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use orbcloud::app::{OrbApp, wgpu_setup};
-use orbcloud::scene::SliceMode;
+use orbcloud::scene::{SliceMode, TransferKind};
 
 fn harness() -> Harness<'static, OrbApp> {
     let h = Harness::builder()
@@ -27,6 +27,12 @@ fn starts_on_the_demo_and_changes_controls() {
     h.get_by_label("axis stacks").click();
     h.run_steps(2);
     assert_eq!(h.state().view.settings.volume.mode, SliceMode::AxisAligned);
+
+    h.get_by_label("Transfer function").click();
+    h.run_steps(2);
+    h.get_by_label("shapes").click();
+    h.run_steps(2);
+    assert_eq!(h.state().view.settings.volume.transfer.kind, TransferKind::Shaped);
 
     h.get_by_label("show cloud").click();
     h.run_steps(2);

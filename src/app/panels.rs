@@ -4,7 +4,8 @@ use egui::{ComboBox, RichText, Slider};
 
 use super::OrbApp;
 use crate::model::{grid::ValueKind, units::ANGSTROM_PER_BOHR};
-use crate::scene::{AtomStyle, SliceMode};
+use crate::scene::transfer::{Lobe, PRESETS};
+use crate::scene::{AtomStyle, ClipPlane, Shape, SliceMode, Transfer, TransferKind};
 
 pub enum Action {
     None,
@@ -107,6 +108,16 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
                 ui.label(neg);
             });
             ui.label(RichText::new("α = k1·ρ^k2, ρ = ψ² (orbital) or density, scaled to its maximum").small().weak());
+            ComboBox::from_label("colour preset").selected_text("choose…").show_ui(ui, |ui| {
+                for (name, pos, neg) in PRESETS {
+                    if ui.selectable_label(false, *name).clicked() {
+                        vs.positive_color = *pos;
+                        vs.negative_color = *neg;
+                    }
+                }
+            });
+            transfer_editor(ui, &mut vs.transfer);
+            clip_editor(ui, &mut vs.clip);
 
             ui.separator();
             ui.heading("Atoms");
@@ -160,4 +171,68 @@ pub fn error_window(ui: &mut egui::Ui, app: &mut OrbApp) {
     if !open {
         app.error = None;
     }
+}
+
+fn lobe_editor(ui: &mut egui::Ui, label: &str, lobe: &mut Lobe) {
+    ui.horizontal(|ui| {
+        ui.label(label);
+        ComboBox::from_id_salt(label).selected_text(lobe.shape.name()).show_ui(ui, |ui| {
+            for shape in Shape::ALL {
+                ui.selectable_value(&mut lobe.shape, shape, shape.name());
+            }
+        });
+    });
+    let width_label = if lobe.shape == Shape::Sinusoidal { "spacing" } else { "width" };
+    ui.add(Slider::new(&mut lobe.center, 0.0..=1.0).text("centre (× max)"));
+    ui.add(Slider::new(&mut lobe.width, 0.005..=0.5).logarithmic(true).text(width_label));
+    ui.add(Slider::new(&mut lobe.opacity, 0.0..=2.0).text("opacity"));
+    // The shape over t = |value| / max|value|.
+    let (rect, _) = ui.allocate_exact_size(egui::vec2(ui.available_width().min(220.0), 36.0), egui::Sense::hover());
+    let painter = ui.painter_at(rect);
+    painter.rect_filled(rect, 2.0, ui.visuals().extreme_bg_color);
+    let points: Vec<egui::Pos2> = (0..=100)
+        .map(|i| {
+            let t = i as f32 / 100.0;
+            let f = lobe.shape.factor(t, lobe.center, lobe.width);
+            egui::pos2(rect.left() + t * rect.width(), rect.bottom() - f * (rect.height() - 2.0))
+        })
+        .collect();
+    painter.add(egui::Shape::line(points, egui::Stroke::new(1.5, ui.visuals().strong_text_color())));
+}
+
+fn transfer_editor(ui: &mut egui::Ui, t: &mut Transfer) {
+    ui.collapsing("Transfer function", |ui| {
+        ui.horizontal(|ui| {
+            ui.selectable_value(&mut t.kind, TransferKind::PowerLaw, "power law (k1, k2)");
+            ui.selectable_value(&mut t.kind, TransferKind::Shaped, "shapes");
+        });
+        if t.kind == TransferKind::Shaped {
+            lobe_editor(ui, "ψ > 0", &mut t.positive);
+            lobe_editor(ui, "ψ < 0", &mut t.negative);
+        }
+        ui.checkbox(&mut t.shading, "shading from the gradient");
+        ui.add(Slider::new(&mut t.boundary, 0.0..=1.0).text("boundary enhancement"));
+        ui.add(Slider::new(&mut t.gradient_power, 0.0..=3.0).text("gradient weight (2D)"));
+    });
+}
+
+fn clip_editor(ui: &mut egui::Ui, clip: &mut ClipPlane) {
+    ui.collapsing("Clipping plane", |ui| {
+        ui.checkbox(&mut clip.enabled, "clip the cloud");
+        ui.horizontal(|ui| {
+            ui.label("normal");
+            for (c, name) in clip.normal.iter_mut().zip(["x", "y", "z"]) {
+                ui.add(egui::DragValue::new(c).speed(0.02).range(-1.0..=1.0).prefix(name));
+            }
+        });
+        ui.horizontal(|ui| {
+            for (name, n) in [("x", [1.0, 0.0, 0.0]), ("y", [0.0, 1.0, 0.0]), ("z", [0.0, 0.0, 1.0])] {
+                if ui.button(format!("⊥{name}")).clicked() {
+                    clip.normal = n;
+                }
+            }
+        });
+        ui.add(Slider::new(&mut clip.offset, -15.0..=15.0).text("offset (bohr)"));
+        ui.label(RichText::new("Ctrl + drag in the view moves the plane").small().weak());
+    });
 }

@@ -106,6 +106,13 @@ impl Viewport {
 }
 
 fn handle_input(ui: &egui::Ui, response: &egui::Response, view: &mut ViewState) {
+    let clip_drag = ui.input(|i| i.modifiers.command) && view.settings.volume.clip.enabled;
+    if clip_drag && response.dragged_by(PointerButton::Primary) {
+        // Ctrl + drag moves the clipping plane: a view height of drag is the camera distance.
+        let h = response.rect.height().max(1.0);
+        view.settings.volume.clip.offset -= response.drag_delta().y / h * view.camera.distance * 0.5;
+        return;
+    }
     let cam = &mut view.camera;
     if response.dragged_by(PointerButton::Primary) {
         let d = response.drag_delta();
