@@ -66,3 +66,142 @@ impl Wavefunction {
             .map(|(i, _)| i)
     }
 }
+
+/// Which orbital a user means: `homo`, `lumo`, `homo-2`, `lumo+1`, or a 1-based index into the
+/// orbitals of the chosen spin (as programs number them).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum OrbitalSpec {
+    /// HOMO − n.
+    Homo(usize),
+    /// LUMO + n.
+    Lumo(usize),
+    /// 1-based index within the spin's orbitals.
+    Index(usize),
+}
+
+impl std::str::FromStr for OrbitalSpec {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, String> {
+        let t = s.trim().to_ascii_lowercase().replace('−', "-");
+        let offset = |rest: &str, sign: char| -> Result<usize, String> {
+            if rest.is_empty() {
+                return Ok(0);
+            }
+            rest.strip_prefix(sign)
+                .and_then(|n| n.parse::<usize>().ok())
+                .ok_or_else(|| format!("expected homo, lumo, homo-N, lumo+N or an index, got {s:?}"))
+        };
+        if let Some(rest) = t.strip_prefix("homo") {
+            Ok(Self::Homo(offset(rest, '-')?))
+        } else if let Some(rest) = t.strip_prefix("lumo") {
+            Ok(Self::Lumo(offset(rest, '+')?))
+        } else {
+            match t.parse::<usize>() {
+                Ok(n) if n >= 1 => Ok(Self::Index(n)),
+                _ => Err(format!("expected homo, lumo, homo-N, lumo+N or a 1-based index, got {s:?}")),
+            }
+        }
+    }
+}
+
+impl Wavefunction {
+    /// Indices into `orbitals` of one spin, sorted by energy (stable for equal energies).
+    pub fn by_energy(&self, spin: Spin) -> Vec<usize> {
+        let mut v: Vec<usize> = self.of_spin(spin).map(|(i, _)| i).collect();
+        v.sort_by(|&a, &b| self.orbitals[a].energy.total_cmp(&self.orbitals[b].energy));
+        v
+    }
+
+    /// The spin a request for `spin` falls back to: beta asks of a restricted wavefunction
+    /// mean its (alpha) spatial orbitals.
+    fn effective_spin(&self, spin: Spin) -> Spin {
+        if self.restricted { Spin::Alpha } else { spin }
+    }
+
+    /// Resolves a user's orbital request to an index into `orbitals`.
+    pub fn resolve(&self, spec: OrbitalSpec, spin: Spin) -> Option<usize> {
+        let spin = self.effective_spin(spin);
+        match spec {
+            OrbitalSpec::Index(n) => self.of_spin(spin).nth(n - 1).map(|(i, _)| i),
+            OrbitalSpec::Homo(k) => {
+                let order = self.by_energy(spin);
+                let h = order.iter().position(|&i| Some(i) == self.homo(spin))?;
+                h.checked_sub(k).map(|p| order[p])
+            }
+            OrbitalSpec::Lumo(k) => {
+                let order = self.by_energy(spin);
+                let l = order.iter().position(|&i| Some(i) == self.lumo(spin))?;
+                order.get(l + k).copied()
+            }
+        }
+    }
+
+    /// "HOMO", "HOMO−2", "LUMO+1" for orbitals near the frontier (within `range`), else None.
+    pub fn frontier_label(&self, index: usize, range: usize) -> Option<String> {
+        let spin = self.orbitals.get(index)?.spin;
+        let order = self.by_energy(spin);
+        let pos = order.iter().position(|&i| i == index)?;
+        let homo = self.homo(spin).and_then(|h| order.iter().position(|&i| i == h));
+        let lumo = self.lumo(spin).and_then(|l| order.iter().position(|&i| i == l));
+        match (homo, lumo) {
+            (Some(h), _) if pos <= h && h - pos <= range => {
+                Some(if pos == h { "HOMO".into() } else { format!("HOMO−{}", h - pos) })
+            }
+            (_, Some(l)) if pos >= l && pos - l <= range => {
+                Some(if pos == l { "LUMO".into() } else { format!("LUMO+{}", pos - l) })
+            }
+            _ => None,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn wf(occupations: &[f64], energies: &[f64]) -> Wavefunction {
+        Wavefunction {
+            orbitals: occupations
+                .iter()
+                .zip(energies)
+                .map(|(&occupation, &energy)| MolecularOrbital {
+                    energy,
+                    occupation,
+                    spin: Spin::Alpha,
+                    symmetry: String::new(),
+                    coefficients: vec![],
+                })
+                .collect(),
+            restricted: true,
+            ..Default::default()
+        }
+    }
+
+    #[test]
+    fn specs_parse() {
+        assert_eq!("homo".parse(), Ok(OrbitalSpec::Homo(0)));
+        assert_eq!("HOMO-2".parse(), Ok(OrbitalSpec::Homo(2)));
+        assert_eq!("lumo+1".parse(), Ok(OrbitalSpec::Lumo(1)));
+        assert_eq!("7".parse(), Ok(OrbitalSpec::Index(7)));
+        assert!("0".parse::<OrbitalSpec>().is_err());
+        assert!("homo+1".parse::<OrbitalSpec>().is_err());
+        assert!("banana".parse::<OrbitalSpec>().is_err());
+    }
+
+    #[test]
+    fn frontier_orbitals_by_energy_not_file_order() {
+        // File order scrambled; energies decide.
+        let w = wf(&[2.0, 0.0, 2.0, 2.0, 0.0], &[-0.5, 0.3, -1.0, -0.2, 0.1]);
+        assert_eq!(w.homo(Spin::Alpha), Some(3));
+        assert_eq!(w.lumo(Spin::Alpha), Some(4));
+        assert_eq!(w.resolve(OrbitalSpec::Homo(1), Spin::Alpha), Some(0));
+        assert_eq!(w.resolve(OrbitalSpec::Homo(2), Spin::Alpha), Some(2));
+        assert_eq!(w.resolve(OrbitalSpec::Homo(3), Spin::Alpha), None);
+        assert_eq!(w.resolve(OrbitalSpec::Lumo(1), Spin::Beta), Some(1));
+        assert_eq!(w.resolve(OrbitalSpec::Index(2), Spin::Alpha), Some(1));
+        assert_eq!(w.frontier_label(0, 3).as_deref(), Some("HOMO−1"));
+        assert_eq!(w.frontier_label(1, 3).as_deref(), Some("LUMO+1"));
+        assert_eq!(w.frontier_label(2, 1), None);
+    }
+}
