@@ -2,6 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::model::orbitals::{Spin, Wavefunction};
 use crate::scene::{Camera, RenderSettings};
 
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
@@ -18,3 +19,53 @@ pub const KEY_ROTATE: f32 = 5.0 * std::f32::consts::PI / 180.0;
 pub const KEY_ZOOM: f32 = 1.1;
 /// Mouse orbit, radians per point dragged.
 pub const DRAG_ROTATE: f32 = 0.008;
+
+/// What of a wavefunction is shown.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub enum Shown {
+    /// An orbital, by index into `Wavefunction::orbitals`.
+    Orbital(usize),
+    #[default]
+    Density,
+    SpinDensity,
+}
+
+/// The orbital browser's choices.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct OrbitalView {
+    pub shown: Shown,
+    pub spin: Spin,
+    /// Evaluate per slice sample (seed 004's direct mode) instead of on a GPU-filled grid.
+    pub direct: bool,
+    /// Restrict the orbital to the shells ticked in `shell_mask`.
+    pub ao_filter: bool,
+    pub shell_mask: Vec<bool>,
+    /// Points per axis of the GPU grid.
+    pub grid_points: usize,
+}
+
+impl Default for OrbitalView {
+    fn default() -> Self {
+        Self {
+            shown: Shown::Density,
+            spin: Spin::Alpha,
+            direct: false,
+            ao_filter: false,
+            shell_mask: Vec::new(),
+            grid_points: 72,
+        }
+    }
+}
+
+impl OrbitalView {
+    /// Opens on the HOMO, as a chemist expects.
+    pub fn for_wavefunction(wf: &Wavefunction) -> Self {
+        let shown = wf.homo(Spin::Alpha).map_or(Shown::Density, Shown::Orbital);
+        Self { shown, shell_mask: vec![true; wf.basis.shells.len()], ..Self::default() }
+    }
+
+    /// The spin whose orbitals are listed (restricted wavefunctions have only alpha).
+    pub fn spin_of(&self, wf: &Wavefunction) -> Spin {
+        if wf.restricted { Spin::Alpha } else { self.spin }
+    }
+}

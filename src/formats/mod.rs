@@ -2,6 +2,7 @@
 //! malformed input as a typed error naming the file, the line and what was expected.
 
 pub mod cube;
+pub mod cube_write;
 mod error;
 mod text;
 

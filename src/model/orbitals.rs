@@ -1,10 +1,10 @@
 //! Molecular orbitals over a basis: coefficients, energies, occupations, spin.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::basis::Basis;
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Spin {
     Alpha,
     Beta,

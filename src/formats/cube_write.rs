@@ -1,0 +1,97 @@
+//! Writing Gaussian cube files (what `orbcloud cube` produces; PySCF, VMD and this crate's reader
+//! read them back).
+
+use std::fmt::Write;
+
+use crate::model::{Molecule, VolumeGrid};
+
+/// Cube text for one or more grids of identical geometry over `molecule` (all bohr). Several
+/// grids are written as a multi-orbital cube: negative atom count, the id line, values
+/// interleaved per point.
+///
+/// Panics if `grids` is empty or their geometries differ (a caller's bug, not input).
+pub fn write(title: &str, description: &str, molecule: &Molecule, grids: &[(&VolumeGrid, i64)]) -> String {
+    let (first, _) = grids.first().expect("at least one grid");
+    assert!(
+        grids.iter().all(|(g, _)| g.dims == first.dims && g.world_from_grid == first.world_from_grid),
+        "grids of one cube file share their geometry"
+    );
+    let mut out = String::with_capacity(first.values.len() * grids.len() * 14 + 4096);
+    let line = |s: &str| s.replace(['\n', '\r'], " ");
+    let _ = writeln!(out, "{}", line(title));
+    let _ = writeln!(out, "{}", line(description));
+    let o = first.origin();
+    let natoms = molecule.atoms.len() as i64;
+    let signed_natoms = if grids.len() > 1 { -natoms } else { natoms };
+    let _ = writeln!(out, "{signed_natoms:5} {:12.6} {:12.6} {:12.6}", o.x, o.y, o.z);
+    for axis in 0..3 {
+        let v = first.step(axis);
+        let _ = writeln!(out, "{:5} {:12.6} {:12.6} {:12.6}", first.dims[axis], v.x, v.y, v.z);
+    }
+    for a in &molecule.atoms {
+        let p = a.position;
+        let _ = writeln!(out, "{:5} {:12.6} {:12.6} {:12.6} {:12.6}", a.z, a.charge, p.x, p.y, p.z);
+    }
+    if grids.len() > 1 {
+        let ids: Vec<String> = grids.iter().map(|(_, id)| id.to_string()).collect();
+        let _ = writeln!(out, "{:5} {}", grids.len(), ids.join(" "));
+    }
+    let [nx, ny, nz] = first.dims;
+    for i in 0..nx {
+        for j in 0..ny {
+            // Each (x, y) row starts a new line, six values per line.
+            let mut n = 0;
+            for k in 0..nz {
+                for (g, _) in grids {
+                    let _ = write!(out, " {:12.5E}", g.value(i, j, k));
+                    n += 1;
+                    if n % 6 == 0 {
+                        out.push('\n');
+                    }
+                }
+            }
+            if n % 6 != 0 {
+                out.push('\n');
+            }
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::DVec3;
+
+    use super::*;
+    use crate::model::Atom;
+
+    #[test]
+    fn written_cubes_read_back() {
+        let world = VolumeGrid::affine(
+            DVec3::new(-1.0, 0.5, 2.0),
+            [DVec3::new(0.3, 0.0, 0.0), DVec3::new(0.1, 0.25, 0.0), DVec3::new(0.0, 0.0, 0.2)],
+        );
+        let dims = [3, 4, 7];
+        let n = dims.iter().product::<usize>();
+        let a = VolumeGrid::new("a", dims, world, (0..n).map(|i| (i as f32 - 40.0) * 1.5e-3).collect());
+        let b = VolumeGrid::new("b", dims, world, (0..n).map(|i| (i as f32).sin()).collect());
+        let molecule = Molecule::new(vec![
+            Atom { z: 8, charge: 8.0, position: DVec3::new(0.0, 1.0, 2.5), ghost: false },
+            Atom { z: 1, charge: 1.0, position: DVec3::new(1.4, 1.0, 3.5), ghost: false },
+        ]);
+        for grids in [vec![(&a, 7)], vec![(&a, 7), (&b, 9)]] {
+            let text = write("t", "d", &molecule, &grids);
+            let doc = crate::formats::cube::parse("written.cube", &text).unwrap();
+            assert_eq!(doc.volumes.len(), grids.len());
+            assert_eq!(doc.molecule.atoms.len(), 2);
+            assert!((doc.molecule.atoms[1].position - molecule.atoms[1].position).length() < 1e-6);
+            for (read, (orig, _)) in doc.volumes.iter().zip(&grids) {
+                assert_eq!(read.dims, dims);
+                assert!((read.world_from_grid - world).abs_diff_eq(glam::DMat4::ZERO, 1e-6));
+                for (x, y) in read.values.iter().zip(&orig.values) {
+                    assert!((x - y).abs() <= 1e-5 * y.abs().max(1e-30), "{x} vs {y}");
+                }
+            }
+        }
+    }
+}
