@@ -11,6 +11,13 @@ pub mod wavefunction;
 pub use error::{LoadError, ParseError};
 pub use wavefunction::OverlapFn;
 
+/// The plain reference overlap matrix the readers' tests check orbitals with.
+#[cfg(test)]
+#[path = "../../tests/fixtures/readers/ref_overlap.rs"]
+mod ref_overlap;
+#[cfg(test)]
+use crate::model::basis::{Basis, ShellKind};
+
 use std::path::Path;
 
 use crate::model::Document;

@@ -732,3 +732,308 @@ pub fn molden_cartesian_order(l: u32) -> Vec<[u32; 3]> {
         _ => cartesian_powers(l),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::basis::Basis;
+
+    use super::super::ref_overlap;
+
+    fn doc(text: &str) -> Document {
+        parse("t.molden", text, None).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    fn err(text: &str) -> ParseError {
+        match parse("t.molden", text, None) {
+            Ok(_) => panic!("parsed a malformed file"),
+            Err(e) => e,
+        }
+    }
+
+    const H2: &str = "[Molden Format]
+[Title]
+ hydrogen molecule
+[Atoms] Angs
+H 1 1 0.0 0.0 0.0
+H 2 1 0.0 0.0 0.74
+[GTO]
+1 0
+s 2 1.00
+ 1.0D+00 0.5
+ 0.5D+00 0.5
+
+2 0
+s 2 1.00
+ 1.0D+00 0.5
+ 0.5D+00 0.5
+
+[MO]
+ Sym= 1a
+ Ene= -0.6
+ Spin= Alpha
+ Occup= 2.0
+ 1 0.5
+ 2 0.5
+ Occup= 0.0
+ Ene= 0.7
+ Sym= 2a
+ 2 -0.9
+";
+
+    #[test]
+    fn restricted_file_with_sparse_coefficients() {
+        let d = doc(H2);
+        assert_eq!(d.title, "hydrogen molecule");
+        let a = &d.molecule.atoms;
+        assert_eq!(a.len(), 2);
+        assert!((a[1].position.z - 0.74 * BOHR_PER_ANGSTROM).abs() < 1e-12);
+        let wf = d.wavefunction.expect("wavefunction");
+        assert!(wf.restricted);
+        assert_eq!(wf.basis.n_functions(), 2);
+        assert_eq!(wf.orbitals.len(), 2);
+        let o = &wf.orbitals[1];
+        assert_eq!(
+            (o.energy, o.occupation, o.symmetry.as_str()),
+            (0.7, 0.0, "2a")
+        );
+        // Index 1 missing: 0. The contraction is normalised, its norm folded into the orbital.
+        let n = super::super::wavefunction::contraction_norm(0, &[1.0, 0.5], &[0.5, 0.5]);
+        assert_eq!(o.coefficients[0], 0.0);
+        assert!((o.coefficients[1] + 0.9 * n).abs() < 1e-12);
+        assert_eq!(wf.normalization.repair, "unchecked");
+        assert_eq!(wf.homo(Spin::Alpha), Some(0));
+    }
+
+    /// A one-atom file with one shell and one orbital whose coefficients are 1, 2, 3, ….
+    fn one_shell(tags: &str, label: &str, n: usize) -> Wavefunction {
+        let sp = label.eq_ignore_ascii_case("sp");
+        let prim = if sp { " 1.0 1.0 1.0" } else { " 1.0 1.0" };
+        let coefs: String = (1..=n).map(|i| format!("{i} {i}.0\n")).collect();
+        let text = format!(
+            "[Molden Format]\n{tags}\n[Atoms] AU\nC 1 6 0 0 0\n[GTO]\n1 0\n{label} 1 1.00\n{prim}\n\n[MO]\nEne= 0\nSpin= Alpha\nOccup= 0\n{coefs}"
+        );
+        doc(&text).wavefunction.expect("wavefunction")
+    }
+
+    fn model_values(wf: &Wavefunction) -> Vec<f64> {
+        wf.orbitals[0].coefficients.clone()
+    }
+
+    #[test]
+    fn cartesian_orders_become_alphabetical() {
+        // Molden d: xx yy zz xy xz yz -> xx xy xz yy yz zz.
+        let wf = one_shell("", "d", 6);
+        assert_eq!(wf.basis.shells[0].kind, ShellKind::Cartesian);
+        assert_eq!(model_values(&wf), vec![1.0, 4.0, 5.0, 2.0, 6.0, 3.0]);
+        // Molden f: xxx yyy zzz xyy xxy xxz xzz yzz yyz xyz.
+        let wf = one_shell("", "f", 10);
+        // Alphabetical: xxx xxy xxz xyy xyz xzz yyy yyz yzz zzz.
+        assert_eq!(
+            model_values(&wf),
+            vec![1.0, 5.0, 6.0, 4.0, 10.0, 7.0, 2.0, 9.0, 8.0, 3.0]
+        );
+        let wf = one_shell("", "g", 15);
+        let file = molden_cartesian_order(4);
+        let model = cartesian_powers(4);
+        for (k, p) in file.iter().enumerate() {
+            let m = model.iter().position(|q| q == p).expect("component");
+            assert_eq!(model_values(&wf)[m], (k + 1) as f64, "{p:?}");
+        }
+    }
+
+    #[test]
+    fn sp_shells_split_into_s_and_p() {
+        let wf = one_shell("", "SP", 4);
+        let kinds: Vec<u32> = wf.basis.shells.iter().map(|s| s.l).collect();
+        assert_eq!(kinds, vec![0, 1]);
+        assert_eq!(model_values(&wf), vec![1.0, 2.0, 3.0, 4.0]);
+    }
+
+    #[test]
+    fn pure_tags_anywhere_any_case() {
+        let pure = |tags: &str, label: &str, n: usize| {
+            let wf = one_shell(tags, label, n);
+            assert_eq!(wf.basis.n_functions(), n, "{tags} {label}");
+            wf.basis.shells[0].kind
+        };
+        assert_eq!(pure("[5d]", "d", 5), ShellKind::Pure);
+        assert_eq!(pure("[5D]", "f", 7), ShellKind::Pure);
+        assert_eq!(pure("[5D7F]", "f", 7), ShellKind::Pure);
+        assert_eq!(pure("[5D10F]", "d", 5), ShellKind::Pure);
+        assert_eq!(pure("[5D10F]", "f", 10), ShellKind::Cartesian);
+        assert_eq!(pure("[7F]", "f", 7), ShellKind::Pure);
+        assert_eq!(pure("[7F]", "d", 6), ShellKind::Cartesian);
+        assert_eq!(pure("[9G]", "g", 9), ShellKind::Pure);
+        assert_eq!(pure("", "g", 15), ShellKind::Cartesian);
+        // Pure order is kept as written.
+        assert_eq!(
+            model_values(&one_shell("[5D]", "d", 5)),
+            vec![1.0, 2.0, 3.0, 4.0, 5.0]
+        );
+        // A tag after [MO] still counts.
+        let text = format!(
+            "{}[5D]\n",
+            H2.replace(
+                "s 2 1.00\n 1.0D+00 0.5\n 0.5D+00 0.5\n\n2 0",
+                "d 1 1.00\n 1.0 1.0\n\n2 0"
+            )
+        );
+        let d = doc(&text);
+        assert_eq!(
+            d.wavefunction.expect("wf").basis.shells[0].kind,
+            ShellKind::Pure
+        );
+    }
+
+    #[test]
+    fn unrestricted_alpha_before_beta() {
+        let text = H2.replace(" Sym= 2a", " Sym= 2a\n Spin= Beta").replace(
+            " 2 -0.9\n",
+            " 2 -0.9\n Spin= Alpha\n Ene= 0.8\n Occup= 0\n 1 1\n",
+        );
+        let wf = doc(&text).wavefunction.expect("wf");
+        assert!(!wf.restricted);
+        let spins: Vec<Spin> = wf.orbitals.iter().map(|o| o.spin).collect();
+        assert_eq!(spins, vec![Spin::Alpha, Spin::Alpha, Spin::Beta]);
+        assert_eq!(wf.orbitals[2].energy, 0.7);
+    }
+
+    #[test]
+    fn units_ghosts_extra_sections_and_repeated_headers() {
+        let text = H2
+            .replace("[Atoms] Angs\nH 1 1", "[ATOMS] (au)\nHe1 1 0")
+            .replace(
+                "[Title]",
+                "[Molden Format]\n[Molpro variables]\n_X= 1.0\n[Title]",
+            )
+            + "[SCFCONV]\n scf-first 1 THROUGH 3\n -1.0\n";
+        let d = doc(&text);
+        let a = &d.molecule.atoms;
+        assert!(a[0].ghost && a[0].z == 2 && a[0].charge == 0.0);
+        assert!(!a[1].ghost && a[1].z == 1);
+        assert_eq!(a[1].position.z, 0.74);
+        assert_eq!(d.wavefunction.expect("wf").normalization.program, "Molpro");
+        let text = H2.replace("[Atoms] Angs\nH 1 1", "[Atoms] AU\nBq 1 0");
+        let a = &doc(&text).molecule.atoms;
+        assert!(a[0].ghost && a[0].z == 0);
+    }
+
+    #[test]
+    fn fewer_orbitals_than_functions() {
+        let text = H2.replace(" Occup= 0.0\n Ene= 0.7\n Sym= 2a\n 2 -0.9\n", "");
+        let wf = doc(&text).wavefunction.expect("wf");
+        assert_eq!((wf.basis.n_functions(), wf.orbitals.len()), (2, 1));
+    }
+
+    #[test]
+    fn malformed_files_name_their_line() {
+        let cases: Vec<(String, usize, &str)> = vec![
+            ("hello\n".into(), 1, "[Molden Format]"),
+            (
+                H2.replace("H 2 1 0.0 0.0 0.74", "H 2 1 0.0 0.0"),
+                6,
+                "name index Z x y z",
+            ),
+            (
+                H2.replace("H 2 1 0.0 0.0 0.74", "H 2 one 0.0 0.0 0.74"),
+                6,
+                "name index Z x y z",
+            ),
+            (
+                H2.replace("[Atoms] Angs", "[Atoms] furlongs"),
+                4,
+                "AU or Angs",
+            ),
+            (H2.replace("[GTO]", "[GTO"), 7, "section header"),
+            (H2.replacen("s 2 1.00", "q 2 1.00", 1), 9, "a shell"),
+            (
+                H2.replacen("s 2 1.00", "s 99 1.00", 1),
+                9,
+                "primitive count",
+            ),
+            (
+                H2.replacen(" 0.5D+00 0.5", " 0.5D+00 x", 1),
+                11,
+                "exponent coefficient",
+            ),
+            (
+                H2.replacen(" 0.5D+00 0.5", " -0.5 0.5", 1),
+                11,
+                "positive exponent",
+            ),
+            (H2.replacen("s 2 1.00", "sp 2 1.00", 1), 10, "p-coefficient"),
+            (H2.replacen("1 0\ns", "s", 1), 8, "atom line"),
+            (H2.replacen("2 0\n", "7 0\n", 1), 14, "atoms of [Atoms]"),
+            (H2.replace(" 2 -0.9", " 3 -0.9"), 25, "indices 1..=2"),
+            (H2.replace(" 2 -0.9", " 0 -0.9"), 28, "index ≥ 1"),
+            (
+                H2.replace(" 2 -0.9", " 2 -0.9 7"),
+                28,
+                "coefficient `index value`",
+            ),
+            (H2.replace("Spin= Alpha", "Spin= Up"), 21, "Spin= Beta"),
+            (H2.replace("Ene= -0.6", "Ene= low"), 20, "energy"),
+            (H2.replace("Occup= 2.0", "Occup= two"), 22, "occupation"),
+            (
+                H2.replace(
+                    "[MO]\n Sym= 1a\n Ene= -0.6\n Spin= Alpha\n Occup= 2.0\n",
+                    "[MO]\n",
+                ),
+                19,
+                "orbital header",
+            ),
+            (format!("{H2} Ene= 1.0\n"), 29, "last orbital"),
+            (
+                H2.split("[MO]").next().unwrap_or("").to_string(),
+                17,
+                "[MO]",
+            ),
+            (H2.replace("[GTO]", "[GTX]"), 28, "[GTO]"),
+            (format!("{H2}[GTO]\n"), 29, "one [GTO]"),
+        ];
+        let mut wrong = Vec::new();
+        for (text, line, expected) in cases {
+            let Err(e) = parse("t.molden", &text, None) else {
+                wrong.push(format!("wanted line {line} \"{expected}\", but it parsed"));
+                continue;
+            };
+            if e.line != line || !e.expected.contains(expected) || e.file != "t.molden" {
+                wrong.push(format!("wanted line {line} \"{expected}\", got {e}"));
+            }
+        }
+        assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+    }
+
+    #[test]
+    fn absurd_orbital_matrices_are_refused_before_allocating() {
+        // 200 h shells (21 functions each) on one atom and 2^28/4000 + 1 orbitals would be
+        // too many to build here; check the guard on its own instead.
+        let n_mo = MAX_MO_VALUES / 4200 + 1;
+        let mut text = String::from("[Molden Format]\n[Atoms] AU\nC 1 6 0 0 0\n[GTO]\n1 0\n");
+        for _ in 0..200 {
+            text.push_str("h 1 1.00\n 1.0 1.0\n");
+        }
+        text.push_str("[MO]\n");
+        for _ in 0..n_mo {
+            text.push_str("Ene= 0\n1 1\n");
+        }
+        let e = err(&text);
+        assert!(e.expected.contains("orbital coefficients"), "{e}");
+        assert_eq!(e.line, 406);
+    }
+
+    #[test]
+    fn overlap_check_selects_no_repair_for_a_correct_file() {
+        let overlap = |b: &Basis| ref_overlap::reference_overlap(b);
+        // One normalised s function per atom: the bonding orbital 1/sqrt(2(1+S)).
+        let text = "[Molden Format]\n[Atoms] AU\nH 1 1 0 0 0\nH 2 1 0 0 1.4\n[GTO]\n1 0\ns 1 1.0\n 1.0 1.0\n\n2 0\ns 1 1.0\n 1.0 1.0\n[MO]\nEne= -0.5\nOccup= 2\n";
+        let s12 = (-0.5f64 * 1.4 * 1.4).exp(); // overlap of two unit s Gaussians, exponent 1
+        let c = 1.0 / (2.0 * (1.0 + s12)).sqrt();
+        let text = format!("{text}1 {c:.15}\n2 {c:.15}\n");
+        let d = parse("t.molden", &text, Some(&overlap)).expect("parse");
+        let n = d.wavefunction.expect("wf").normalization;
+        assert_eq!(n.repair, "none");
+        assert!(n.residual < 1e-12, "{n:?}");
+    }
+}
