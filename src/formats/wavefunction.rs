@@ -409,3 +409,180 @@ mod tests {
         assert_eq!(program_named_in("water"), None);
     }
 }
+
+#[cfg(test)]
+mod repair_tests {
+    use glam::DVec3;
+
+    use super::super::ref_overlap::reference_overlap;
+    use super::*;
+    use crate::model::basis::Shell;
+
+    fn shell(atom: usize, z: f64, l: u32, kind: ShellKind, exps: &[f64], coefs: &[f64]) -> Shell {
+        Shell {
+            atom,
+            center: DVec3::new(0.0, 0.0, z),
+            l,
+            kind,
+            exponents: exps.to_vec(),
+            coefficients: coefs.to_vec(),
+        }
+    }
+
+    /// Two centres with s, p and a d (and f) shell each; orbitals orthonormal (Gram–Schmidt in
+    /// the overlap metric), normalised contractions.
+    fn correct(kind: ShellKind) -> Wavefunction {
+        let mut shells = Vec::new();
+        for (atom, z) in [(0, 0.0), (1, 1.6)] {
+            shells.push(shell(
+                atom,
+                z,
+                0,
+                ShellKind::Cartesian,
+                &[3.0, 0.6],
+                &[0.4, 0.7],
+            ));
+            shells.push(shell(
+                atom,
+                z,
+                1,
+                ShellKind::Cartesian,
+                &[1.2, 0.3],
+                &[0.5, 0.6],
+            ));
+            shells.push(shell(atom, z, 2, kind, &[0.9], &[1.0]));
+            shells.push(shell(atom, z, 3, kind, &[0.7], &[1.0]));
+        }
+        let mut wf = Wavefunction {
+            basis: Basis { shells },
+            restricted: true,
+            ..Default::default()
+        };
+        normalize_contractions(&mut wf);
+        let s = reference_overlap(&wf.basis);
+        let n = wf.basis.n_functions();
+        let dot = |a: &[f64], b: &[f64]| -> f64 {
+            (0..n)
+                .map(|i| (0..n).map(|j| a[i] * s[i * n + j] * b[j]).sum::<f64>())
+                .sum()
+        };
+        let mut cols: Vec<Vec<f64>> = Vec::new();
+        for k in 0..n {
+            let mut v: Vec<f64> = (0..n).map(|i| if i == k { 1.0 } else { 0.1 }).collect();
+            for c in &cols {
+                let p = dot(&v, c);
+                v.iter_mut().zip(c).for_each(|(x, y)| *x -= p * y);
+            }
+            let norm = dot(&v, &v).sqrt();
+            v.iter_mut().for_each(|x| *x /= norm);
+            cols.push(v);
+        }
+        wf.orbitals = cols
+            .into_iter()
+            .enumerate()
+            .map(|(i, coefficients)| MolecularOrbital {
+                energy: i as f64,
+                occupation: if i < 3 { 2.0 } else { 0.0 },
+                spin: Spin::Alpha,
+                symmetry: String::new(),
+                coefficients,
+            })
+            .collect();
+        wf
+    }
+
+    fn run(wf: Wavefunction, program: Option<&str>) -> Normalization {
+        check_and_repair(wf, program, Some(&reference_overlap)).normalization
+    }
+
+    /// The rows of the cartesian l = 2..4 functions scaled by `f(powers, l)`.
+    fn scale_rows(wf: &mut Wavefunction, f: impl Fn([u32; 3], u32) -> f64) {
+        let offsets = wf.basis.shell_offsets();
+        for (s, &first) in wf.basis.shells.iter().zip(&offsets) {
+            if s.kind == ShellKind::Cartesian && s.l >= 2 {
+                for (k, p) in cartesian_powers(s.l).into_iter().enumerate() {
+                    for o in &mut wf.orbitals {
+                        o.coefficients[first + k] *= f(p, s.l);
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn correct_orbitals_need_no_repair() {
+        for kind in [ShellKind::Cartesian, ShellKind::Pure] {
+            let n = run(correct(kind), None);
+            assert_eq!(n.repair, "none");
+            assert!(n.residual < 1e-10, "{n:?}");
+        }
+    }
+
+    #[test]
+    fn turbomole_cfour_and_psi4_quirks_are_undone() {
+        // Turbomole: the orbitals are written for d, f functions √3, √15 times too small.
+        let mut wf = correct(ShellKind::Cartesian);
+        scale_rows(&mut wf, |_, l| {
+            1.0 / double_factorial(2 * l as i64 - 1).sqrt()
+        });
+        let n = run(wf, None);
+        assert_eq!(n.program, "Turbomole", "{n:?}");
+        assert!(n.residual < 1e-10);
+        // CFOUR: components written without their double-factorial normalisation.
+        let mut wf = correct(ShellKind::Cartesian);
+        scale_rows(&mut wf, |p, _| 1.0 / component_double_factorials(p).sqrt());
+        let n = run(wf, None);
+        assert_eq!(n.program, "CFOUR", "{n:?}");
+        assert!(n.residual < 1e-10);
+        // Psi4 <= 1.3.2: components normalised like x^l.
+        let mut wf = correct(ShellKind::Cartesian);
+        scale_rows(&mut wf, |p, l| {
+            (double_factorial(2 * l as i64 - 1) / component_double_factorials(p)).sqrt()
+        });
+        let n = run(wf, Some("Psi4"));
+        assert_eq!(n.program, "Psi4 <= 1.3.2", "{n:?}");
+        assert!(n.residual < 1e-10);
+    }
+
+    #[test]
+    fn orca_quirks_are_undone() {
+        let mut wf = correct(ShellKind::Pure);
+        let offsets = wf.basis.shell_offsets();
+        for (s, &first) in wf.basis.shells.iter_mut().zip(&offsets) {
+            let p = match s.l {
+                0 => [0, 0, 0],
+                1 => [1, 0, 0],
+                2 => [1, 1, 0],
+                _ => [1, 1, 1],
+            };
+            for (c, &a) in s.coefficients.iter_mut().zip(&s.exponents) {
+                *c *= cartesian_norm(a, p);
+            }
+            if s.l == 3 {
+                for o in &mut wf.orbitals {
+                    o.coefficients[first + 5] *= -1.0;
+                    o.coefficients[first + 6] *= -1.0;
+                }
+            }
+        }
+        let n = run(wf, None);
+        assert_eq!(n.program, "ORCA", "{n:?}");
+        assert!(n.residual < 1e-10, "{n:?}");
+    }
+
+    #[test]
+    fn unrepairable_files_are_kept_with_their_residual() {
+        let mut wf = correct(ShellKind::Cartesian);
+        wf.orbitals[0].coefficients[0] += 0.3;
+        let n = run(wf, Some("ORCA"));
+        assert_eq!((n.repair.as_str(), n.program.as_str()), ("none", "ORCA"));
+        assert!(n.residual > 1e-3, "{n:?}");
+    }
+
+    #[test]
+    fn without_an_overlap_nothing_is_checked() {
+        let wf = check_and_repair(correct(ShellKind::Pure), Some("ORCA"), None);
+        assert_eq!(wf.normalization.repair, "unchecked");
+        assert!(wf.normalization.residual.is_nan());
+    }
+}
