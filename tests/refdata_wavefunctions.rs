@@ -294,3 +294,34 @@ fn expected_value_tables_are_readable() {
         }
     }
 }
+
+#[test]
+fn every_wavefunction_extension_dispatches_also_gzipped() {
+    use std::io::Write;
+    let tmp = tempfile::tempdir().expect("tempdir");
+    for (src, names) in [
+        (
+            "he2_ghost_psi4_1.0.molden",
+            &["a.molden", "a.molden.input", "a.mold", "a.MOLDEN.gz"][..],
+        ),
+        (
+            "water_dimer_ghost.fchk",
+            &["b.fchk", "b.fch", "b.fchk.gz"][..],
+        ),
+    ] {
+        let bytes = std::fs::read(dir().join(src)).expect("read");
+        for name in names {
+            let path = tmp.path().join(name);
+            let data = if name.ends_with(".gz") {
+                let mut gz = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
+                gz.write_all(&bytes).expect("gzip");
+                gz.finish().expect("gzip")
+            } else {
+                bytes.clone()
+            };
+            std::fs::write(&path, data).expect("write");
+            let doc = formats::load(&path).unwrap_or_else(|e| panic!("{name}: {e}"));
+            assert!(doc.wavefunction.is_some(), "{name}");
+        }
+    }
+}

@@ -241,6 +241,14 @@ impl FchkFile {
                     ));
                 };
                 k += 1;
+                if record_header(l).is_some() {
+                    return Err(error(
+                        file,
+                        k,
+                        format!("{n} values for \"{label}\" (line {line_no})"),
+                        format!("a new record after {got}"),
+                    ));
+                }
                 for t in l.split_whitespace() {
                     if got == n {
                         return Err(error(
@@ -268,14 +276,6 @@ impl FchkFile {
                         reals.push(parse_real(t).ok_or_else(bad)?);
                     }
                     got += 1;
-                }
-                if record_header(l).is_some() {
-                    return Err(error(
-                        file,
-                        k,
-                        format!("{n} values for \"{label}\" (line {line_no})"),
-                        format!("a new record after {got}"),
-                    ));
                 }
             }
             if is_geometry_label(label) && kind == 'R' {
@@ -629,5 +629,182 @@ pub fn gaussian_cartesian_order(l: u32) -> Vec<[u32; 3]> {
             .map(powers)
             .collect(),
         _ => cartesian_powers(l).into_iter().rev().collect(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ints(label: &str, v: &[i64]) -> String {
+        let mut s = format!("{label:<43}I   N={:>12}\n", v.len());
+        for row in v.chunks(6) {
+            s.extend(row.iter().map(|x| format!("{x:>12}")));
+            s.push('\n');
+        }
+        s
+    }
+
+    fn reals(label: &str, v: &[f64]) -> String {
+        let mut s = format!("{label:<43}R   N={:>12}\n", v.len());
+        for row in v.chunks(5) {
+            s.extend(row.iter().map(|x| format!("{x:>16.8E}")));
+            s.push('\n');
+        }
+        s
+    }
+
+    fn int(label: &str, v: i64) -> String {
+        format!("{label:<43}I     {v:>12}\n")
+    }
+
+    /// Two atoms (the second a ghost), shells sp, cartesian d, pure d, cartesian g on atom 1 and
+    /// s on atom 2; one alpha orbital per function with coefficients 1, 2, 3, … in row 0.
+    fn file(beta: bool, extra: &str) -> String {
+        let types = [-1i64, 2, -2, 4, 0];
+        let nbf = 4 + 6 + 5 + 15 + 1;
+        let mut c = vec![0.0; nbf * nbf];
+        for (k, v) in c.iter_mut().take(nbf).enumerate() {
+            *v = (k + 1) as f64;
+        }
+        let mut t = String::from(
+            "water\nSP        RHF                                                         STO-3G\n",
+        );
+        t += &int("Number of atoms", 2);
+        t += &int("Number of alpha electrons", 2);
+        t += &int("Number of beta electrons", 1);
+        t += &int("Number of basis functions", nbf as i64);
+        t += &ints("Atomic numbers", &[8, 1]);
+        t += &reals("Nuclear charges", &[8.0, 0.0]);
+        t += &reals(
+            "Current cartesian coordinates",
+            &[0.0, 0.0, 0.0, 0.0, 0.0, 1.5],
+        );
+        t += &ints("Shell types", &types);
+        t += &ints("Number of primitives per shell", &[1, 1, 1, 1, 1]);
+        t += &ints("Shell to atom map", &[1, 1, 1, 1, 2]);
+        t += &reals("Primitive exponents", &[1.0, 0.8, 0.9, 0.7, 0.5]);
+        t += &reals("Contraction coefficients", &[1.0; 5]);
+        t += &reals(
+            "P(S=P) Contraction coefficients",
+            &[1.0, 0.0, 0.0, 0.0, 0.0],
+        );
+        t += "Total Energy                               R     -7.5D+01\n";
+        t += &reals(
+            "Alpha Orbital Energies",
+            &(0..nbf).map(|i| i as f64).collect::<Vec<_>>(),
+        );
+        t += &reals("Alpha MO coefficients", &c);
+        if beta {
+            t += &reals(
+                "Beta Orbital Energies",
+                &(0..nbf).map(|i| i as f64).collect::<Vec<_>>(),
+            );
+            t += &reals("Beta MO coefficients", &c);
+        }
+        t += "Route                                      C   N=           2\nsp hf/sto-3g    extra      \n";
+        t += extra;
+        t
+    }
+
+    fn doc(text: &str) -> Document {
+        parse("t.fchk", text, None).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    #[test]
+    fn shells_orders_occupations_and_ghosts() {
+        let d = doc(&file(false, ""));
+        let a = &d.molecule.atoms;
+        assert!(!a[0].ghost && a[1].ghost && a[1].z == 1);
+        let wf = d.wavefunction.expect("wf");
+        let ls: Vec<(u32, ShellKind)> = wf.basis.shells.iter().map(|s| (s.l, s.kind)).collect();
+        use ShellKind::{Cartesian as C, Pure as P};
+        assert_eq!(ls, vec![(0, C), (1, C), (2, C), (2, P), (4, C), (0, C)]);
+        assert_eq!(wf.basis.shells[1].coefficients, vec![1.0]);
+        assert_eq!(wf.basis.shells[1].exponents, vec![1.0]);
+        let c = &wf.orbitals[0].coefficients;
+        // sp: s x y z as written.
+        assert_eq!(&c[..4], &[1.0, 2.0, 3.0, 4.0]);
+        // Cartesian d written xx yy zz xy xz yz.
+        assert_eq!(&c[4..10], &[5.0, 8.0, 9.0, 6.0, 10.0, 7.0]);
+        // Pure d as written.
+        assert_eq!(&c[10..15], &[11.0, 12.0, 13.0, 14.0, 15.0]);
+        // Cartesian g written reverse alphabetical: zzzz first, xxxx last.
+        let g: Vec<f64> = (16..=30).rev().map(|v| v as f64).collect();
+        assert_eq!(&c[15..30], g.as_slice());
+        assert_eq!(c[30], 31.0);
+        // Restricted open shell: 2 alpha, 1 beta electrons.
+        let occ: Vec<f64> = wf.orbitals.iter().take(3).map(|o| o.occupation).collect();
+        assert_eq!(occ, vec![2.0, 1.0, 0.0]);
+        assert!(wf.restricted);
+    }
+
+    #[test]
+    fn unrestricted_occupations_per_spin() {
+        let wf = doc(&file(true, "")).wavefunction.expect("wf");
+        assert!(!wf.restricted);
+        let occ = |spin| -> Vec<f64> {
+            wf.of_spin(spin)
+                .take(3)
+                .map(|(_, o)| o.occupation)
+                .collect()
+        };
+        assert_eq!(occ(Spin::Alpha), vec![1.0, 1.0, 0.0]);
+        assert_eq!(occ(Spin::Beta), vec![1.0, 0.0, 0.0]);
+    }
+
+    #[test]
+    fn scan_geometries_are_exposed() {
+        let frames = [0.0, 0.0, 0.0, 0.0, 0.0, 1.6, 0.0, 0.0, 0.0, 0.0, 0.0, 1.7];
+        let extra = reals("Opt point       1 Geometries", &frames)
+            + &reals(
+                "Opt point       1 Results for each geome",
+                &[1.0, 2.0, 3.0, 4.0],
+            );
+        let g = geometries("t.fchk", &file(false, &extra)).expect("geometries");
+        assert_eq!(g.len(), 3);
+        assert_eq!(g[0][1].z, 1.5);
+        assert_eq!(g[2][1].z, 1.7);
+        let bad = reals("IRC point       1 Geometries", &[0.0; 5]);
+        let e = geometries("t.fchk", &file(false, &bad)).expect_err("odd geometry");
+        assert!(e.expected.contains("multiple of 3 × 2"), "{e}");
+    }
+
+    #[test]
+    fn malformed_files_name_their_line() {
+        let good = file(false, "");
+        let line_of = |needle: &str| {
+            good.lines()
+                .position(|l| l.starts_with(needle))
+                .map(|i| i + 1)
+                .unwrap_or(0)
+        };
+        let n_lines = good.lines().count();
+        let mo = line_of("Alpha MO coefficients");
+        let cases: Vec<(String, usize, &str)> = vec![
+            ("x\n".into(), 1, "an fchk file"),
+            (good.replace("Number of atoms          ", "Number of atoms\n"), 3, "a record"),
+            (good.replace("           1           1           1           2", "           1           1           x           2"), line_of("Shell to atom map") + 1, "an integer value 4 of 5"),
+            (good.replace("I                2\nNumber of beta", "I              two\nNumber of beta"), line_of("Number of alpha"), "a value of type I"),
+            (good.replacen("1.50000000E0", "1.5000000QE0", 1), line_of("Current cartesian") + 2, "a real value 6 of 6"),
+            (good.replace("Shell to atom map                          I   N=           5", "Shell to atom map                          I   N=     9999999"), line_of("Shell to atom map"), "an array length the file can hold"),
+            (good.replace("Shell to atom map                          I   N=           5", "Shell to atom map                          I   N=           6"), line_of("Shell to atom map") + 2, "6 values"),
+            (good.replace("           1           1           1           2", "           1           1           1           3"), line_of("Shell to atom map"), "atom numbers 1..=2"),
+            (good.replace("Number of basis functions                  I               31", "Number of basis functions                  I               30"), line_of("Number of basis functions"), "31 basis functions"),
+            (good.replace("Alpha MO coefficients", "Alpha MO coefficientz"), n_lines, "Alpha MO coefficients"),
+            (good.replace("Shell types                                I   N=           5\n          -1           2          -2           4           0", "Shell types                                I   N=           5\n          -1           2          -2           9           0"), line_of("Shell types"), "shell types"),
+        ];
+        let _ = mo;
+        let mut wrong = Vec::new();
+        for (text, line, expected) in cases {
+            let Err(e) = parse("t.fchk", &text, None) else {
+                wrong.push(format!("wanted line {line} \"{expected}\", but it parsed"));
+                continue;
+            };
+            if e.line != line || !e.expected.contains(expected) {
+                wrong.push(format!("wanted line {line} \"{expected}\", got {e}"));
+            }
+        }
+        assert!(wrong.is_empty(), "{}", wrong.join("\n"));
     }
 }
