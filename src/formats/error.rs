@@ -17,7 +17,9 @@ pub enum LoadError {
     Io { path: String, source: std::io::Error },
     #[error("{path}: not a text file (invalid UTF-8 at byte {offset})")]
     NotText { path: String, offset: usize },
-    #[error("{path}: unknown file type (expected .cube, .cub or .cube.gz)")]
+    #[error(
+        "{path}: unknown file type (expected .cube, .cub, .molden, .molden.input, .mold, .fchk or .fch, optionally .gz)"
+    )]
     UnknownFormat { path: String },
     #[error(transparent)]
     Parse(#[from] ParseError),

@@ -4,9 +4,20 @@
 pub mod cube;
 pub mod cube_write;
 mod error;
+pub mod fchk;
+pub mod molden;
 mod text;
+pub mod wavefunction;
 
 pub use error::{LoadError, ParseError};
+pub use wavefunction::OverlapFn;
+
+/// The plain reference overlap matrix the readers' tests check orbitals with.
+#[cfg(test)]
+#[path = "../../tests/fixtures/readers/ref_overlap.rs"]
+mod ref_overlap;
+#[cfg(test)]
+use crate::model::basis::{Basis, ShellKind};
 
 use std::path::Path;
 
@@ -16,19 +27,37 @@ use crate::model::Document;
 /// is beyond any GPU texture the viewer can use.
 pub const MAX_GRID_VALUES: u64 = 1 << 30;
 
-/// Reads a file from disk, picking the reader by extension (`.cube`, `.cub`, `.cube.gz`).
+/// The overlap function wavefunction readers check orbitals with; `None` until the analytic
+/// overlap of `model::gto` is available, in which case orbitals are kept as written (their
+/// [`crate::model::orbitals::Normalization`] says "unchecked").
+pub const DEFAULT_OVERLAP: Option<OverlapFn<'static>> = None;
+
+/// Reads a file from disk, picking the reader by extension: `.cube`, `.cub`, `.molden`,
+/// `.molden.input`, `.mold`, `.fchk`, `.fch`, each also gzipped (`.gz`).
 pub fn load(path: &Path) -> Result<Document, LoadError> {
+    load_with(path, DEFAULT_OVERLAP)
+}
+
+/// [`load`] with the overlap function that checks (and selects repairs for) wavefunctions.
+pub fn load_with(path: &Path, overlap: Option<OverlapFn>) -> Result<Document, LoadError> {
     reader_for(path)?;
     let bytes = std::fs::read(path).map_err(|source| LoadError::Io { path: path.display().to_string(), source })?;
-    load_bytes(path, &bytes)
+    load_bytes_with(path, &bytes, overlap)
 }
 
 /// Parses a file's bytes already in memory; `path` picks the reader and names the file in errors.
 pub fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Document, LoadError> {
+    load_bytes_with(path, bytes, DEFAULT_OVERLAP)
+}
+
+/// [`load_bytes`] with the overlap function that checks wavefunctions.
+pub fn load_bytes_with(path: &Path, bytes: &[u8], overlap: Option<OverlapFn>) -> Result<Document, LoadError> {
     let name = path.display().to_string();
     let text = gunzip_text(&name, bytes)?;
     let mut doc = match reader_for(path)? {
         Reader::Cube => cube::parse(&name, &text)?,
+        Reader::Molden => molden::parse(&name, &text, overlap)?,
+        Reader::Fchk => fchk::parse(&name, &text, overlap)?,
     };
     doc.source = name;
     Ok(doc)
@@ -36,6 +65,8 @@ pub fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Document, LoadError> {
 
 enum Reader {
     Cube,
+    Molden,
+    Fchk,
 }
 
 fn reader_for(path: &Path) -> Result<Reader, LoadError> {
@@ -43,6 +74,10 @@ fn reader_for(path: &Path) -> Result<Reader, LoadError> {
     let base = name.strip_suffix(".gz").unwrap_or(&name);
     if base.ends_with(".cube") || base.ends_with(".cub") {
         Ok(Reader::Cube)
+    } else if base.ends_with(".molden") || base.ends_with(".molden.input") || base.ends_with(".mold") {
+        Ok(Reader::Molden)
+    } else if base.ends_with(".fchk") || base.ends_with(".fch") {
+        Ok(Reader::Fchk)
     } else {
         Err(LoadError::UnknownFormat { path: path.display().to_string() })
     }

@@ -1,0 +1,527 @@
+//! What the Molden and fchk readers share once a file has been read: conversion of the file's
+//! basis-function order into orbcloud's, the orthonormality check of the orbitals, and the
+//! repairs for writers whose coefficients do not follow the format's normalisation.
+//!
+//! The readers hand over a [`Wavefunction`] already in orbcloud's function order but with the
+//! file's numbers as written: contraction coefficients taken literally (they multiply
+//! normalised primitives), orbital coefficients for those literal functions.
+//! [`check_and_repair`] then
+//! 1. measures the residual max |CᵀSC − I| of the orbitals as read (alpha and beta separately),
+//! 2. if it exceeds [`AS_READ_TOLERANCE`], tries every [`Repair`] and keeps the one with the
+//!    smallest residual, provided it is below [`REPAIRED_TOLERANCE`] and clearly better than the
+//!    file as read; otherwise the file is kept as read and its residual recorded,
+//! 3. normalises every contraction, folding the norm into the orbital coefficients, so that the
+//!    model's basis functions have unit norm as `model::basis` promises. This changes no orbital.
+//!
+//! The residual is a property of the orbitals as functions (the overlaps of the orbitals), so it
+//! does not depend on how the contractions are scaled as long as `overlap` treats the
+//! coefficients literally.
+
+use rayon::prelude::*;
+
+use crate::model::basis::{Basis, ShellKind, cartesian_powers};
+use crate::model::orbitals::{MolecularOrbital, Normalization, Spin, Wavefunction};
+
+/// The analytic overlap matrix of a basis (n × n, row-major): contraction coefficients multiply
+/// normalised primitives, each cartesian component and each pure function on its own.
+pub type OverlapFn<'a> = &'a (dyn Fn(&Basis) -> Vec<f64> + Sync);
+
+/// Orbitals whose residual max |CᵀSC − I| is at most this are taken as written.
+pub const AS_READ_TOLERANCE: f64 = 1e-5;
+/// A repair is accepted when it brings the residual to at most this (and to a tenth of the
+/// residual as read or less).
+pub const REPAIRED_TOLERANCE: f64 = 1e-4;
+
+/// The writer quirks the readers know how to undo.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Repair {
+    /// ORCA: primitive normalisation folded into the contraction coefficients (for pure shells
+    /// that of the xy, xyz, xxyz component), opposite signs for the f±3, g±3 and g±4 functions.
+    Orca,
+    /// Psi4 before 1.0: primitive normalisation folded into the coefficients, pure d and f
+    /// scaled like the xx and xxx components.
+    Psi4Pre10,
+    /// Turbomole: cartesian d, f, g functions too small by √3, √15, √105.
+    Turbomole,
+    /// CFOUR 2.1: cartesian components normalised without the (2a−1)!!(2b−1)!!(2c−1)!! factor.
+    Cfour,
+    /// Contractions written without normalisation.
+    Contractions,
+    /// Psi4 up to 1.3.2: unnormalised contractions, cartesian components normalised like x^l.
+    Psi4Upto132,
+}
+
+impl Repair {
+    pub const ALL: [Repair; 6] =
+        [Repair::Orca, Repair::Psi4Pre10, Repair::Turbomole, Repair::Cfour, Repair::Contractions, Repair::Psi4Upto132];
+
+    /// The program known to write files that need this repair.
+    pub fn program(self) -> &'static str {
+        match self {
+            Repair::Orca => "ORCA",
+            Repair::Psi4Pre10 => "Psi4 < 1.0",
+            Repair::Turbomole => "Turbomole",
+            Repair::Cfour => "CFOUR",
+            Repair::Contractions => "unknown",
+            Repair::Psi4Upto132 => "Psi4 <= 1.3.2",
+        }
+    }
+
+    /// What the repair does, as recorded in [`Normalization::repair`].
+    pub fn describe(self) -> &'static str {
+        match self {
+            Repair::Orca => {
+                "ORCA: primitive normalisation removed from the contraction coefficients, signs of f±3, g±3, g±4 flipped"
+            }
+            Repair::Psi4Pre10 => "Psi4 < 1.0: primitive normalisation removed from the contraction coefficients",
+            Repair::Turbomole => "Turbomole: cartesian d, f, g functions scaled by √3, √15, √105",
+            Repair::Cfour => "CFOUR: cartesian components rescaled by √((2a−1)!!(2b−1)!!(2c−1)!!)",
+            Repair::Contractions => "contractions normalised",
+            Repair::Psi4Upto132 => {
+                "Psi4 <= 1.3.2: contractions normalised, cartesian components rescaled from the x^l normalisation"
+            }
+        }
+    }
+
+    /// Applies the repair to a wavefunction in literal file semantics.
+    pub fn apply(self, wf: &Wavefunction) -> Wavefunction {
+        let mut out = wf.clone();
+        let offsets = out.basis.shell_offsets();
+        // Per-function factors on the orbital coefficients (1 where untouched).
+        let mut row_factor = vec![1.0; out.basis.n_functions()];
+        for (shell, &first) in out.basis.shells.iter_mut().zip(&offsets) {
+            let l = shell.l;
+            let pure = shell.kind == ShellKind::Pure;
+            match self {
+                Repair::Orca | Repair::Psi4Pre10 => {
+                    let powers = match (l, pure) {
+                        (0, _) => Some([0, 0, 0]),
+                        (1, _) => Some([1, 0, 0]),
+                        (2, true) => Some([1, 1, 0]),
+                        (3, true) => Some([1, 1, 1]),
+                        (4, true) if self == Repair::Orca => Some([2, 1, 1]),
+                        _ => None,
+                    };
+                    if let Some(p) = powers {
+                        let extra = match (self, l, pure) {
+                            (Repair::Psi4Pre10, 2, true) => 3f64.sqrt(),
+                            (Repair::Psi4Pre10, 3, true) => 15f64.sqrt(),
+                            _ => 1.0,
+                        };
+                        for (c, &a) in shell.coefficients.iter_mut().zip(&shell.exponents) {
+                            *c *= extra / cartesian_norm(a, p);
+                        }
+                    }
+                    if self == Repair::Orca && pure && (l == 3 || l == 4) {
+                        // m = ±3 (and ±4) sit after 0, ±1, ±2: positions 5.. in the shell.
+                        for f in &mut row_factor[first + 5..first + 2 * l as usize + 1] {
+                            *f = -1.0;
+                        }
+                    }
+                }
+                Repair::Turbomole => {
+                    if !pure && (2..=4).contains(&l) {
+                        let s = double_factorial(2 * l as i64 - 1).sqrt();
+                        shell.coefficients.iter_mut().for_each(|c| *c *= s);
+                    }
+                }
+                Repair::Cfour => {
+                    if !pure && (2..=4).contains(&l) {
+                        for (k, p) in cartesian_powers(l).iter().enumerate() {
+                            row_factor[first + k] = component_double_factorials(*p).sqrt();
+                        }
+                    }
+                }
+                Repair::Contractions | Repair::Psi4Upto132 => {
+                    let n = contraction_norm(shell.l, &shell.exponents, &shell.coefficients);
+                    if n > 0.0 && n.is_finite() {
+                        shell.coefficients.iter_mut().for_each(|c| *c /= n);
+                    }
+                    if self == Repair::Psi4Upto132 && !pure && (2..=4).contains(&l) {
+                        let dl = double_factorial(2 * l as i64 - 1);
+                        for (k, p) in cartesian_powers(l).iter().enumerate() {
+                            row_factor[first + k] = (component_double_factorials(*p) / dl).sqrt();
+                        }
+                    }
+                }
+            }
+        }
+        if row_factor.iter().any(|&f| f != 1.0) {
+            for mo in &mut out.orbitals {
+                for (c, f) in mo.coefficients.iter_mut().zip(&row_factor) {
+                    *c *= f;
+                }
+            }
+        }
+        out
+    }
+}
+
+/// Norm of the contraction Σ cᵢ gᵢ of normalised primitives of angular momentum `l` (the same
+/// for every cartesian component and every pure function of the shell).
+pub fn contraction_norm(l: u32, exponents: &[f64], coefficients: &[f64]) -> f64 {
+    let power = l as f64 + 1.5;
+    let mut sum = 0.0;
+    for (&a, &ca) in exponents.iter().zip(coefficients) {
+        for (&b, &cb) in exponents.iter().zip(coefficients) {
+            sum += ca * cb * (2.0 * (a * b).sqrt() / (a + b)).powf(power);
+        }
+    }
+    sum.max(0.0).sqrt()
+}
+
+/// Normalisation constant of the cartesian primitive x^a y^b z^c exp(−α r²).
+pub fn cartesian_norm(alpha: f64, powers: [u32; 3]) -> f64 {
+    let l: u32 = powers.iter().sum();
+    let pre = (2.0 * alpha / std::f64::consts::PI).powf(1.5) * (4.0 * alpha).powi(l as i32);
+    (pre / component_double_factorials(powers)).sqrt()
+}
+
+/// (2a−1)!! (2b−1)!! (2c−1)!!
+fn component_double_factorials(p: [u32; 3]) -> f64 {
+    p.iter().map(|&n| double_factorial(2 * n as i64 - 1)).product()
+}
+
+/// n!! with (−1)!! = 1.
+fn double_factorial(n: i64) -> f64 {
+    let mut out = 1.0;
+    let mut k = n;
+    while k > 1 {
+        out *= k as f64;
+        k -= 2;
+    }
+    out
+}
+
+/// Scales every contraction to unit norm and folds the norm into the orbital coefficients: the
+/// orbitals stay the same functions, the basis functions become unit-normalised.
+pub fn normalize_contractions(wf: &mut Wavefunction) {
+    let offsets = wf.basis.shell_offsets();
+    let mut row_factor = vec![1.0; wf.basis.n_functions()];
+    for (shell, &first) in wf.basis.shells.iter_mut().zip(&offsets) {
+        let n = contraction_norm(shell.l, &shell.exponents, &shell.coefficients);
+        if n > 0.0 && n.is_finite() && n != 1.0 {
+            shell.coefficients.iter_mut().for_each(|c| *c /= n);
+            row_factor[first..first + shell.n_functions()].fill(n);
+        }
+    }
+    if row_factor.iter().any(|&f| f != 1.0) {
+        for mo in &mut wf.orbitals {
+            for (c, f) in mo.coefficients.iter_mut().zip(&row_factor) {
+                *c *= f;
+            }
+        }
+    }
+}
+
+/// max |CᵀSC − I| over the orbitals of each spin, with `s` the n × n overlap matrix.
+pub fn residual(orbitals: &[MolecularOrbital], s: &[f64]) -> f64 {
+    let n = (s.len() as f64).sqrt().round() as usize;
+    [Spin::Alpha, Spin::Beta]
+        .iter()
+        .map(|&spin| {
+            let c: Vec<&[f64]> = orbitals
+                .iter()
+                .filter(|o| o.spin == spin && o.coefficients.len() == n)
+                .map(|o| o.coefficients.as_slice())
+                .collect();
+            let sc: Vec<Vec<f64>> = c
+                .par_iter()
+                .map(|cj| {
+                    (0..n)
+                        .map(|i| {
+                            let row = &s[i * n..(i + 1) * n];
+                            row.iter().zip(cj.iter()).map(|(a, b)| a * b).sum()
+                        })
+                        .collect()
+                })
+                .collect();
+            c.par_iter()
+                .enumerate()
+                .map(|(i, ci)| {
+                    sc.iter()
+                        .enumerate()
+                        .map(|(j, scj)| {
+                            let m: f64 = ci.iter().zip(scj).map(|(a, b)| a * b).sum();
+                            let target = if i == j { 1.0 } else { 0.0 };
+                            (m - target).abs()
+                        })
+                        .fold(0.0, f64::max)
+                })
+                .reduce(|| 0.0, f64::max)
+        })
+        .fold(0.0, f64::max)
+}
+
+/// Checks the orbitals of a freshly read wavefunction and undoes a known writer quirk when the
+/// check fails (see the module documentation). `program` is the writer the file names, if any.
+/// Without an overlap function nothing is checked: the file is kept as read, residual NaN.
+pub fn check_and_repair(wf: Wavefunction, program: Option<&str>, overlap: Option<OverlapFn>) -> Wavefunction {
+    let named = program.unwrap_or("unknown").to_string();
+    let Some(overlap) = overlap else {
+        let mut wf = wf;
+        normalize_contractions(&mut wf);
+        wf.normalization = Normalization { program: named, repair: "unchecked".into(), residual: f64::NAN };
+        return wf;
+    };
+    let measure = |wf: &Wavefunction| {
+        let mut canonical = wf.clone();
+        normalize_contractions(&mut canonical);
+        let s = overlap(&canonical.basis);
+        let r = residual(&canonical.orbitals, &s);
+        (canonical, if r.is_nan() { f64::INFINITY } else { r })
+    };
+    let (as_read, raw) = measure(&wf);
+    let mut passing: Vec<(Repair, Wavefunction, f64)> = Vec::new();
+    if raw > AS_READ_TOLERANCE {
+        for repair in Repair::ALL {
+            let (fixed, r) = measure(&repair.apply(&wf));
+            if r <= REPAIRED_TOLERANCE && r <= 0.1 * raw {
+                passing.push((repair, fixed, r));
+            }
+        }
+    }
+    // The smallest residual wins; among residuals within a factor 2 of it, the program the file
+    // names, then the order of [`Repair::ALL`].
+    let min = passing.iter().map(|p| p.2).fold(f64::INFINITY, f64::min);
+    let pick = passing
+        .iter()
+        .position(|p| p.2 <= 2.0 * min && named_program(p.0, program))
+        .or_else(|| passing.iter().position(|p| p.2 <= 2.0 * min));
+    let best = pick.map(|i| passing.swap_remove(i));
+    match best {
+        Some((repair, mut fixed, r)) => {
+            fixed.normalization = Normalization {
+                program: repair.program().to_string(),
+                repair: repair.describe().to_string(),
+                residual: r,
+            };
+            fixed
+        }
+        None => {
+            let mut wf = as_read;
+            wf.normalization = Normalization { program: named, repair: "none".into(), residual: raw };
+            wf
+        }
+    }
+}
+
+/// Whether the file itself names the program that needs `repair`.
+fn named_program(repair: Repair, program: Option<&str>) -> bool {
+    program.is_some_and(|p| {
+        let p = p.to_ascii_lowercase();
+        let r = repair.program().to_ascii_lowercase();
+        r.split_whitespace().next().is_some_and(|w| p.starts_with(w))
+    })
+}
+
+/// Guesses the writer from free text (a title, a comment): the first program named in it.
+pub fn program_named_in(text: &str) -> Option<&'static str> {
+    let t = text.to_ascii_lowercase();
+    [
+        ("orca", "ORCA"),
+        ("psi4", "Psi4"),
+        ("turbomole", "Turbomole"),
+        ("cfour", "CFOUR"),
+        ("molpro", "Molpro"),
+        ("pyscf", "PySCF"),
+        ("q-chem", "Q-Chem"),
+        ("qchem", "Q-Chem"),
+        ("gaussian", "Gaussian"),
+        ("molden", "Molden"),
+    ]
+    .into_iter()
+    .find(|(key, _)| t.contains(key))
+    .map(|(_, name)| name)
+}
+
+/// Component powers written as letters ("xxy") → [2, 1, 0].
+pub(crate) fn powers(letters: &str) -> [u32; 3] {
+    let count = |ch| letters.chars().filter(|&c| c == ch).count() as u32;
+    [count('x'), count('y'), count('z')]
+}
+
+/// For each component of a file's cartesian order, its index in orbcloud's order.
+pub(crate) fn to_model_order(file_order: &[[u32; 3]]) -> Vec<usize> {
+    let l = file_order.first().map_or(0, |p| p.iter().sum());
+    let model = cartesian_powers(l);
+    file_order.iter().map(|p| model.iter().position(|q| q == p).unwrap_or(0)).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn double_factorials() {
+        assert_eq!(double_factorial(-1), 1.0);
+        assert_eq!(double_factorial(0), 1.0);
+        assert_eq!(double_factorial(5), 15.0);
+        assert_eq!(double_factorial(7), 105.0);
+        assert_eq!(component_double_factorials([2, 1, 1]), 3.0);
+    }
+
+    #[test]
+    fn contraction_of_one_primitive_is_normalised() {
+        assert!((contraction_norm(2, &[0.8], &[1.0]) - 1.0).abs() < 1e-15);
+        assert!((contraction_norm(0, &[1.0, 1.0], &[0.5, 0.5]) - 1.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn orders_map_to_alphabetical() {
+        let molden_d: Vec<_> = "xx yy zz xy xz yz".split(' ').map(powers).collect();
+        assert_eq!(to_model_order(&molden_d), vec![0, 3, 5, 1, 2, 4]);
+    }
+
+    #[test]
+    fn program_names() {
+        assert_eq!(program_named_in("Molden file created by orca_2mkl"), Some("ORCA"));
+        assert_eq!(program_named_in("water"), None);
+    }
+}
+
+#[cfg(test)]
+mod repair_tests {
+    use glam::DVec3;
+
+    use super::super::ref_overlap::reference_overlap;
+    use super::*;
+    use crate::model::basis::Shell;
+
+    fn shell(atom: usize, z: f64, l: u32, kind: ShellKind, exps: &[f64], coefs: &[f64]) -> Shell {
+        Shell { atom, center: DVec3::new(0.0, 0.0, z), l, kind, exponents: exps.to_vec(), coefficients: coefs.to_vec() }
+    }
+
+    /// Two centres with s, p and a d (and f) shell each; orbitals orthonormal (Gram–Schmidt in
+    /// the overlap metric), normalised contractions.
+    fn correct(kind: ShellKind) -> Wavefunction {
+        let mut shells = Vec::new();
+        for (atom, z) in [(0, 0.0), (1, 1.6)] {
+            shells.push(shell(atom, z, 0, ShellKind::Cartesian, &[3.0, 0.6], &[0.4, 0.7]));
+            shells.push(shell(atom, z, 1, ShellKind::Cartesian, &[1.2, 0.3], &[0.5, 0.6]));
+            shells.push(shell(atom, z, 2, kind, &[0.9], &[1.0]));
+            shells.push(shell(atom, z, 3, kind, &[0.7], &[1.0]));
+        }
+        let mut wf = Wavefunction { basis: Basis { shells }, restricted: true, ..Default::default() };
+        normalize_contractions(&mut wf);
+        let s = reference_overlap(&wf.basis);
+        let n = wf.basis.n_functions();
+        let dot = |a: &[f64], b: &[f64]| -> f64 {
+            (0..n).map(|i| (0..n).map(|j| a[i] * s[i * n + j] * b[j]).sum::<f64>()).sum()
+        };
+        let mut cols: Vec<Vec<f64>> = Vec::new();
+        for k in 0..n {
+            let mut v: Vec<f64> = (0..n).map(|i| if i == k { 1.0 } else { 0.1 }).collect();
+            for c in &cols {
+                let p = dot(&v, c);
+                v.iter_mut().zip(c).for_each(|(x, y)| *x -= p * y);
+            }
+            let norm = dot(&v, &v).sqrt();
+            v.iter_mut().for_each(|x| *x /= norm);
+            cols.push(v);
+        }
+        wf.orbitals = cols
+            .into_iter()
+            .enumerate()
+            .map(|(i, coefficients)| MolecularOrbital {
+                energy: i as f64,
+                occupation: if i < 3 { 2.0 } else { 0.0 },
+                spin: Spin::Alpha,
+                symmetry: String::new(),
+                coefficients,
+            })
+            .collect();
+        wf
+    }
+
+    fn run(wf: Wavefunction, program: Option<&str>) -> Normalization {
+        check_and_repair(wf, program, Some(&reference_overlap)).normalization
+    }
+
+    /// The rows of the cartesian l = 2..4 functions scaled by `f(powers, l)`.
+    fn scale_rows(wf: &mut Wavefunction, f: impl Fn([u32; 3], u32) -> f64) {
+        let offsets = wf.basis.shell_offsets();
+        for (s, &first) in wf.basis.shells.iter().zip(&offsets) {
+            if s.kind == ShellKind::Cartesian && s.l >= 2 {
+                for (k, p) in cartesian_powers(s.l).into_iter().enumerate() {
+                    for o in &mut wf.orbitals {
+                        o.coefficients[first + k] *= f(p, s.l);
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn correct_orbitals_need_no_repair() {
+        for kind in [ShellKind::Cartesian, ShellKind::Pure] {
+            let n = run(correct(kind), None);
+            assert_eq!(n.repair, "none");
+            assert!(n.residual < 1e-10, "{n:?}");
+        }
+    }
+
+    #[test]
+    fn turbomole_cfour_and_psi4_quirks_are_undone() {
+        // Turbomole: the orbitals are written for d, f functions √3, √15 times too small.
+        let mut wf = correct(ShellKind::Cartesian);
+        scale_rows(&mut wf, |_, l| 1.0 / double_factorial(2 * l as i64 - 1).sqrt());
+        let n = run(wf, None);
+        assert_eq!(n.program, "Turbomole", "{n:?}");
+        assert!(n.residual < 1e-10);
+        // CFOUR: components written without their double-factorial normalisation.
+        let mut wf = correct(ShellKind::Cartesian);
+        scale_rows(&mut wf, |p, _| 1.0 / component_double_factorials(p).sqrt());
+        let n = run(wf, None);
+        assert_eq!(n.program, "CFOUR", "{n:?}");
+        assert!(n.residual < 1e-10);
+        // Psi4 <= 1.3.2: components normalised like x^l.
+        let mut wf = correct(ShellKind::Cartesian);
+        scale_rows(&mut wf, |p, l| (double_factorial(2 * l as i64 - 1) / component_double_factorials(p)).sqrt());
+        let n = run(wf, Some("Psi4"));
+        assert_eq!(n.program, "Psi4 <= 1.3.2", "{n:?}");
+        assert!(n.residual < 1e-10);
+    }
+
+    #[test]
+    fn orca_quirks_are_undone() {
+        let mut wf = correct(ShellKind::Pure);
+        let offsets = wf.basis.shell_offsets();
+        for (s, &first) in wf.basis.shells.iter_mut().zip(&offsets) {
+            let p = match s.l {
+                0 => [0, 0, 0],
+                1 => [1, 0, 0],
+                2 => [1, 1, 0],
+                _ => [1, 1, 1],
+            };
+            for (c, &a) in s.coefficients.iter_mut().zip(&s.exponents) {
+                *c *= cartesian_norm(a, p);
+            }
+            if s.l == 3 {
+                for o in &mut wf.orbitals {
+                    o.coefficients[first + 5] *= -1.0;
+                    o.coefficients[first + 6] *= -1.0;
+                }
+            }
+        }
+        let n = run(wf, None);
+        assert_eq!(n.program, "ORCA", "{n:?}");
+        assert!(n.residual < 1e-10, "{n:?}");
+    }
+
+    #[test]
+    fn unrepairable_files_are_kept_with_their_residual() {
+        let mut wf = correct(ShellKind::Cartesian);
+        wf.orbitals[0].coefficients[0] += 0.3;
+        let n = run(wf, Some("ORCA"));
+        assert_eq!((n.repair.as_str(), n.program.as_str()), ("none", "ORCA"));
+        assert!(n.residual > 1e-3, "{n:?}");
+    }
+
+    #[test]
+    fn without_an_overlap_nothing_is_checked() {
+        let wf = check_and_repair(correct(ShellKind::Pure), Some("ORCA"), None);
+        assert_eq!(wf.normalization.repair, "unchecked");
+        assert!(wf.normalization.residual.is_nan());
+    }
+}
