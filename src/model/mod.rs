@@ -10,6 +10,7 @@ pub mod elements;
 pub mod grid;
 pub mod molecule;
 pub mod orbitals;
+pub mod solid_harmonics;
 pub mod units;
 
 pub use document::Document;
