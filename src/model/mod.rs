@@ -1,4 +1,5 @@
-//! The in-memory model: molecules, elements, bonds and volume grids.
+//! The in-memory model: molecules, elements, bonds, volume grids, basis sets and orbitals
+//! (with their evaluation: `gto`, `overlap`, `solid_harmonics`).
 //!
 //! Everything here is in bohr and knows nothing of files, the GPU or the UI.
 
@@ -9,11 +10,15 @@ pub mod document;
 mod element_table;
 pub mod elements;
 pub mod grid;
+pub mod gto;
 pub mod molecule;
 pub mod orbitals;
+pub mod overlap;
+pub mod solid_harmonics;
 pub mod units;
 
 pub use document::Document;
 pub use grid::{GridStats, VolumeGrid};
+pub use gto::{GridSpec, PreparedBasis};
 pub use molecule::{Atom, Bond, Molecule};
 pub use orbitals::{MolecularOrbital, Spin, Wavefunction};

@@ -1,0 +1,1066 @@
+//! Evaluation of Gaussian basis functions, orbitals and densities at points and on grids.
+//!
+//! [`PreparedBasis`] is a [`Basis`] turned into plain flat arrays, ready to evaluate (here on the
+//! CPU, and as the data a GPU kernel uploads):
+//! - per primitive the exponent and a coefficient that already folds in the primitive's
+//!   normalisation (for the x^l component) and the renormalisation of the contraction, so that
+//!   every contracted function has unit norm whatever the file's contraction;
+//! - per angular momentum the factor that makes each cartesian component unit-normalised and the
+//!   cartesian → pure matrix ([`super::solid_harmonics`]);
+//! - per primitive and per shell a cutoff radius.
+//!
+//! Cutoffs: with ε = [`PreparedBasis::threshold`] (default [`DEFAULT_THRESHOLD`] = 1e-12), the
+//! primitive j of a shell is dropped at distances r where a bound of its contribution to any
+//! function of the shell, |c_j| · A_l · r^l · exp(−α_j r²), is below ε / n_primitives (A_l bounds
+//! the angular factor of the unit-normalised functions). So beyond the shell's cutoff radius (the
+//! largest of its primitives') every function of the shell is exactly 0, and everywhere the value
+//! differs from the uncut one by less than ε in absolute terms (bohr^−3/2). Cost therefore grows
+//! linearly with the size of the molecule.
+//!
+//! Grids are evaluated row by row (a row is the fastest axis, z in cube order): along a row the
+//! squared distance to a centre is a quadratic in the point index, so exp(−α r²) follows from a
+//! two-multiplication recurrence (re-seeded with an exact `exp` every [`RESEED`] points), and the
+//! angular part of a shell contracted with the orbital's coefficients is a polynomial of degree l
+//! in the index, evaluated by Horner's rule.
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use super::basis::{Basis, ShellKind, cartesian_powers, n_cartesian};
+use super::orbitals::{Spin, Wavefunction};
+use super::solid_harmonics::{cart_to_pure, component_factor, double_factorial_m1};
+
+/// Default absolute cutoff threshold for basis-function values (bohr^−3/2).
+pub const DEFAULT_THRESHOLD: f64 = 1e-12;
+
+/// Highest angular momentum the evaluator's fixed-size tables hold.
+pub const MAX_EVAL_L: u32 = 6;
+
+/// Points between exact re-evaluations of exp(−α r²) along a grid row.
+pub const RESEED: usize = 32;
+
+/// One shell in evaluation-ready form; indices point into [`PreparedBasis`]'s flat arrays.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PreparedShell {
+    /// Centre in bohr.
+    pub center: [f64; 3],
+    pub l: u32,
+    pub pure: bool,
+    /// Index of the shell's first basis function.
+    pub first_function: u32,
+    pub n_functions: u32,
+    /// Index of the shell's first cartesian component in a flat per-shell cartesian array.
+    pub first_cartesian: u32,
+    pub first_primitive: u32,
+    pub n_primitives: u32,
+    /// Beyond this distance (bohr) every function of the shell is 0.
+    pub cutoff: f64,
+}
+
+impl PreparedShell {
+    pub fn center(&self) -> DVec3 {
+        DVec3::from_array(self.center)
+    }
+
+    pub fn primitives(&self) -> std::ops::Range<usize> {
+        self.first_primitive as usize..(self.first_primitive + self.n_primitives) as usize
+    }
+
+    pub fn functions(&self) -> std::ops::Range<usize> {
+        self.first_function as usize..(self.first_function + self.n_functions) as usize
+    }
+
+    fn cartesians(&self) -> std::ops::Range<usize> {
+        let n = n_cartesian(self.l);
+        self.first_cartesian as usize..self.first_cartesian as usize + n
+    }
+}
+
+/// A basis in flat, evaluation-ready form (see the module documentation).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PreparedBasis {
+    pub shells: Vec<PreparedShell>,
+    /// Per primitive: exponent.
+    pub exponents: Vec<f64>,
+    /// Per primitive: contraction coefficient × primitive normalisation (x^l component) ×
+    /// contraction renormalisation.
+    pub coefficients: Vec<f64>,
+    /// Per primitive: squared radius beyond which the primitive is dropped.
+    pub primitive_cutoffs2: Vec<f64>,
+    /// Per l (0..=max l): cartesian powers in orbcloud order.
+    pub powers: Vec<Vec<[u32; 3]>>,
+    /// Per l: the factor making each cartesian component unit-normalised.
+    pub component_factors: Vec<Vec<f64>>,
+    /// Per l: cartesian → pure matrix, row-major (2l+1) × n_cart.
+    pub pure_matrices: Vec<Vec<f64>>,
+    /// Absolute value threshold the cutoffs were built for.
+    pub threshold: f64,
+    n_functions: usize,
+    n_cartesians: usize,
+}
+
+/// A regular grid of points: point (i, j, k) = origin + i·steps[0] + j·steps[1] + k·steps[2];
+/// values are stored x slowest, z fastest (cube order).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GridSpec {
+    pub origin: DVec3,
+    pub steps: [DVec3; 3],
+    pub dims: [usize; 3],
+}
+
+impl GridSpec {
+    pub fn new(origin: DVec3, steps: [DVec3; 3], dims: [usize; 3]) -> Self {
+        Self {
+            origin,
+            steps,
+            dims,
+        }
+    }
+
+    pub fn point(&self, i: usize, j: usize, k: usize) -> DVec3 {
+        self.origin + i as f64 * self.steps[0] + j as f64 * self.steps[1] + k as f64 * self.steps[2]
+    }
+
+    pub fn len(&self) -> usize {
+        self.dims[0] * self.dims[1] * self.dims[2]
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+/// Normalisation of a primitive x^l exp(−α r²).
+fn primitive_norm(alpha: f64, l: u32) -> f64 {
+    (2.0 * alpha / std::f64::consts::PI).powf(0.75) * (4.0 * alpha).powf(l as f64 / 2.0)
+        / double_factorial_m1(2 * l as i64).sqrt()
+}
+
+/// Smallest r such that c · r^l · exp(−α r²) < eps for every r' ≥ r (c > 0).
+fn primitive_radius(c: f64, alpha: f64, l: u32, eps: f64) -> f64 {
+    if c <= 0.0 || alpha <= 0.0 {
+        return if c <= 0.0 { 0.0 } else { f64::INFINITY };
+    }
+    let g = |r: f64| c.ln() + l as f64 * r.max(1e-300).ln() - alpha * r * r - eps.ln();
+    let peak = (l as f64 / (2.0 * alpha)).sqrt();
+    if g(peak) < 0.0 {
+        return 0.0;
+    }
+    let (mut lo, mut hi) = (peak, peak + 1.0 / alpha.sqrt());
+    while g(hi) >= 0.0 {
+        lo = hi;
+        hi *= 2.0;
+    }
+    for _ in 0..80 {
+        let mid = 0.5 * (lo + hi);
+        if g(mid) >= 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    hi
+}
+
+impl PreparedBasis {
+    pub fn new(basis: &Basis) -> Self {
+        Self::with_threshold(basis, DEFAULT_THRESHOLD)
+    }
+
+    /// Prepares `basis` with cutoffs for an absolute value threshold `threshold` (0 keeps every
+    /// primitive everywhere).
+    ///
+    /// Panics when a shell has l > [`MAX_EVAL_L`] (readers reject those: `basis::MAX_L`).
+    pub fn with_threshold(basis: &Basis, threshold: f64) -> Self {
+        assert!(
+            basis.shells.iter().all(|s| s.l <= MAX_EVAL_L),
+            "angular momentum above {MAX_EVAL_L}"
+        );
+        let max_l = basis.shells.iter().map(|s| s.l).max().unwrap_or(0);
+        let powers: Vec<_> = (0..=max_l).map(cartesian_powers).collect();
+        let component_factors: Vec<Vec<f64>> = powers
+            .iter()
+            .map(|ps| ps.iter().map(|p| component_factor(*p)).collect())
+            .collect();
+        let pure_matrices: Vec<Vec<f64>> = (0..=max_l).map(cart_to_pure).collect();
+        // Bounds of |angular part| / r^l over the functions of a shell.
+        let angular_bound = |l: u32, pure: bool| -> f64 {
+            let f = &component_factors[l as usize];
+            if pure {
+                let t = &pure_matrices[l as usize];
+                let nc = f.len();
+                (0..2 * l as usize + 1)
+                    .map(|k| (0..nc).map(|i| (t[k * nc + i] * f[i]).abs()).sum::<f64>())
+                    .fold(0.0, f64::max)
+            } else {
+                f.iter().cloned().fold(0.0, f64::max)
+            }
+        };
+
+        let mut out = Self {
+            shells: Vec::with_capacity(basis.shells.len()),
+            exponents: Vec::new(),
+            coefficients: Vec::new(),
+            primitive_cutoffs2: Vec::new(),
+            powers,
+            component_factors: component_factors.clone(),
+            pure_matrices: pure_matrices.clone(),
+            threshold,
+            n_functions: 0,
+            n_cartesians: 0,
+        };
+        for shell in &basis.shells {
+            let l = shell.l;
+            let pure = shell.kind == ShellKind::Pure;
+            let n_prim = shell.exponents.len().min(shell.coefficients.len());
+            let mut coefs: Vec<f64> = (0..n_prim)
+                .map(|j| shell.coefficients[j] * primitive_norm(shell.exponents[j], l))
+                .collect();
+            // Norm² of the contracted x^l component.
+            let mut norm2 = 0.0;
+            for a in 0..n_prim {
+                for b in 0..n_prim {
+                    let p = shell.exponents[a] + shell.exponents[b];
+                    norm2 += coefs[a]
+                        * coefs[b]
+                        * (std::f64::consts::PI / p).powf(1.5)
+                        * double_factorial_m1(2 * l as i64)
+                        / (2.0 * p).powi(l as i32);
+                }
+            }
+            if norm2 > 0.0 && norm2.is_finite() {
+                let s = 1.0 / norm2.sqrt();
+                coefs.iter_mut().for_each(|c| *c *= s);
+            }
+            let bound = angular_bound(l, pure);
+            let first_primitive = out.exponents.len() as u32;
+            let mut cutoff: f64 = 0.0;
+            for (&alpha, &c) in shell.exponents.iter().zip(&coefs) {
+                let r = if threshold > 0.0 {
+                    primitive_radius(c.abs() * bound, alpha, l, threshold / n_prim as f64)
+                } else {
+                    f64::INFINITY
+                };
+                cutoff = cutoff.max(r);
+                out.exponents.push(alpha);
+                out.coefficients.push(c);
+                out.primitive_cutoffs2.push(r * r);
+            }
+            let n_functions = shell.n_functions() as u32;
+            out.shells.push(PreparedShell {
+                center: shell.center.to_array(),
+                l,
+                pure,
+                first_function: out.n_functions as u32,
+                n_functions,
+                first_cartesian: out.n_cartesians as u32,
+                first_primitive,
+                n_primitives: n_prim as u32,
+                cutoff,
+            });
+            out.n_functions += n_functions as usize;
+            out.n_cartesians += n_cartesian(l);
+        }
+        out
+    }
+
+    pub fn n_functions(&self) -> usize {
+        self.n_functions
+    }
+
+    /// Radial part Σ c_j exp(−α_j r²) and, when `with_derivative`, Σ −2α_j c_j exp(−α_j r²).
+    fn radial(&self, shell: &PreparedShell, r2: f64) -> (f64, f64) {
+        let (mut v, mut dv) = (0.0, 0.0);
+        for j in shell.primitives() {
+            if r2 <= self.primitive_cutoffs2[j] {
+                let e = self.coefficients[j] * (-self.exponents[j] * r2).exp();
+                v += e;
+                dv -= 2.0 * self.exponents[j] * e;
+            }
+        }
+        (v, dv)
+    }
+
+    /// Values (and gradients when `grads` is given) of one shell's functions at `d` = point −
+    /// centre, written to `out[..n_functions]`; `cart` is scratch for the cartesian components.
+    fn shell_values(
+        &self,
+        shell: &PreparedShell,
+        d: DVec3,
+        out: &mut [f64],
+        mut grads: Option<&mut [DVec3]>,
+        cart: &mut Vec<f64>,
+        cart_grad: &mut Vec<DVec3>,
+    ) {
+        let n = shell.n_functions as usize;
+        let r2 = d.length_squared();
+        if r2 > shell.cutoff * shell.cutoff {
+            out[..n].fill(0.0);
+            if let Some(g) = grads {
+                g[..n].fill(DVec3::ZERO);
+            }
+            return;
+        }
+        let l = shell.l as usize;
+        let (rad, drad) = self.radial(shell, r2);
+        let mut pw = [[1.0f64; 8]; 3];
+        for axis in 0..3 {
+            for k in 1..=l + 1 {
+                pw[axis][k] = pw[axis][k - 1] * d[axis];
+            }
+        }
+        let powers = &self.powers[l];
+        let factors = &self.component_factors[l];
+        cart.clear();
+        cart_grad.clear();
+        for (p, f) in powers.iter().zip(factors) {
+            let [a, b, c] = [p[0] as usize, p[1] as usize, p[2] as usize];
+            let mono = pw[0][a] * pw[1][b] * pw[2][c];
+            cart.push(f * mono * rad);
+            if grads.is_some() {
+                let dm = |axis: usize, e: usize| -> f64 {
+                    // ∂/∂axis of x^a y^b z^c without the other two factors.
+                    if e == 0 {
+                        0.0
+                    } else {
+                        e as f64 * pw[axis][e - 1]
+                    }
+                };
+                let gx = dm(0, a) * pw[1][b] * pw[2][c] * rad
+                    + pw[0][a + 1] * pw[1][b] * pw[2][c] * drad;
+                let gy = pw[0][a] * dm(1, b) * pw[2][c] * rad
+                    + pw[0][a] * pw[1][b + 1] * pw[2][c] * drad;
+                let gz = pw[0][a] * pw[1][b] * dm(2, c) * rad
+                    + pw[0][a] * pw[1][b] * pw[2][c + 1] * drad;
+                cart_grad.push(*f * DVec3::new(gx, gy, gz));
+            }
+        }
+        if shell.pure {
+            let t = &self.pure_matrices[l];
+            let nc = cart.len();
+            for k in 0..n {
+                let row = &t[k * nc..(k + 1) * nc];
+                out[k] = row.iter().zip(cart.iter()).map(|(a, b)| a * b).sum();
+                if let Some(g) = grads.as_deref_mut() {
+                    g[k] = row
+                        .iter()
+                        .zip(cart_grad.iter())
+                        .fold(DVec3::ZERO, |acc, (a, b)| acc + *a * *b);
+                }
+            }
+        } else {
+            out[..n].copy_from_slice(cart);
+            if let Some(g) = grads {
+                g[..n].copy_from_slice(cart_grad);
+            }
+        }
+    }
+
+    /// All basis-function values at `point` (bohr), in the basis's order.
+    pub fn basis_values(&self, point: DVec3) -> Vec<f64> {
+        let mut out = vec![0.0; self.n_functions];
+        let (mut c, mut cg) = (Vec::new(), Vec::new());
+        for s in &self.shells {
+            let r = s.functions();
+            self.shell_values(s, point - s.center(), &mut out[r], None, &mut c, &mut cg);
+        }
+        out
+    }
+
+    /// All basis-function values and gradients at `point`.
+    pub fn basis_values_and_gradients(&self, point: DVec3) -> (Vec<f64>, Vec<DVec3>) {
+        let mut out = vec![0.0; self.n_functions];
+        let mut grads = vec![DVec3::ZERO; self.n_functions];
+        let (mut c, mut cg) = (Vec::new(), Vec::new());
+        for s in &self.shells {
+            let r = s.functions();
+            self.shell_values(
+                s,
+                point - s.center(),
+                &mut out[r.clone()],
+                Some(&mut grads[r]),
+                &mut c,
+                &mut cg,
+            );
+        }
+        (out, grads)
+    }
+
+    /// ψ(point) = Σ_k c_k χ_k(point).
+    pub fn orbital_value(&self, coefficients: &[f64], point: DVec3) -> f64 {
+        dot(coefficients, &self.basis_values(point))
+    }
+
+    /// ψ(point) and ∇ψ(point).
+    pub fn orbital_value_and_gradient(&self, coefficients: &[f64], point: DVec3) -> (f64, DVec3) {
+        let (v, g) = self.basis_values_and_gradients(point);
+        let grad = coefficients
+            .iter()
+            .zip(&g)
+            .fold(DVec3::ZERO, |acc, (c, g)| acc + *c * *g);
+        (dot(coefficients, &v), grad)
+    }
+
+    /// Electron density Σ n_i |ψ_i|² over all orbitals (alpha and beta; a restricted orbital
+    /// carries its occupation up to 2).
+    pub fn density(&self, wf: &Wavefunction, point: DVec3) -> f64 {
+        let v = self.basis_values(point);
+        wf.orbitals
+            .iter()
+            .filter(|o| o.occupation != 0.0)
+            .map(|o| {
+                let psi = dot(&o.coefficients, &v);
+                o.occupation * psi * psi
+            })
+            .sum()
+    }
+
+    /// Spin density ρα − ρβ (see [`spin_weight`]).
+    pub fn spin_density(&self, wf: &Wavefunction, point: DVec3) -> f64 {
+        let v = self.basis_values(point);
+        wf.orbitals
+            .iter()
+            .map(|o| (spin_weight(wf, o.occupation, o.spin), o))
+            .filter(|(w, _)| *w != 0.0)
+            .map(|(w, o)| {
+                let psi = dot(&o.coefficients, &v);
+                w * psi * psi
+            })
+            .sum()
+    }
+
+    /// Coefficients restricted to the basis functions in `subset` (others set to 0): the
+    /// "atomic orbital selector" view of an orbital, or a single basis function with a
+    /// coefficient of 1.
+    pub fn masked_coefficients(&self, coefficients: &[f64], subset: &[usize]) -> Vec<f64> {
+        let mut out = vec![0.0; self.n_functions];
+        for &i in subset {
+            if i < out.len() {
+                out[i] = coefficients.get(i).copied().unwrap_or(0.0);
+            }
+        }
+        out
+    }
+
+    /// Per shell, the orbital's coefficients on the shell's cartesian monomials x^a y^b z^c
+    /// (component factors and pure transformation folded in); flat, indexed by
+    /// `first_cartesian`. Also returns which shells have any non-zero coefficient.
+    pub fn monomial_coefficients(&self, coefficients: &[f64]) -> (Vec<f64>, Vec<bool>) {
+        let mut d = vec![0.0; self.n_cartesians];
+        let mut active = vec![false; self.shells.len()];
+        for (si, s) in self.shells.iter().enumerate() {
+            let l = s.l as usize;
+            let f = &self.component_factors[l];
+            let nc = f.len();
+            let c = |k: usize| coefficients.get(s.first_function as usize + k).copied();
+            let out = &mut d[s.cartesians()];
+            if s.pure {
+                let t = &self.pure_matrices[l];
+                for k in 0..s.n_functions as usize {
+                    let ck = c(k).unwrap_or(0.0);
+                    if ck != 0.0 {
+                        for i in 0..nc {
+                            out[i] += ck * t[k * nc + i];
+                        }
+                    }
+                }
+            } else {
+                for (i, o) in out.iter_mut().enumerate() {
+                    *o = c(i).unwrap_or(0.0);
+                }
+            }
+            for i in 0..nc {
+                out[i] *= f[i];
+            }
+            active[si] = out.iter().any(|v| *v != 0.0);
+        }
+        (d, active)
+    }
+
+    /// An orbital (or any combination of basis functions) on a grid, cube order.
+    pub fn eval_grid(&self, coefficients: &[f64], grid: &GridSpec) -> Vec<f64> {
+        self.grid_sum(&[(coefficients, 1.0)], false, grid)
+    }
+
+    /// As [`Self::eval_grid`], stored as f32 (what [`super::VolumeGrid`] holds).
+    pub fn eval_grid_f32(&self, coefficients: &[f64], grid: &GridSpec) -> Vec<f32> {
+        self.eval_grid(coefficients, grid)
+            .into_iter()
+            .map(|v| v as f32)
+            .collect()
+    }
+
+    /// Only the basis functions in `subset` of an orbital, on a grid.
+    pub fn eval_grid_subset(
+        &self,
+        coefficients: &[f64],
+        subset: &[usize],
+        grid: &GridSpec,
+    ) -> Vec<f64> {
+        self.eval_grid(&self.masked_coefficients(coefficients, subset), grid)
+    }
+
+    /// Electron density on a grid.
+    pub fn density_grid(&self, wf: &Wavefunction, grid: &GridSpec) -> Vec<f64> {
+        let sets: Vec<(&[f64], f64)> = wf
+            .orbitals
+            .iter()
+            .filter(|o| o.occupation != 0.0)
+            .map(|o| (o.coefficients.as_slice(), o.occupation))
+            .collect();
+        self.grid_sum(&sets, true, grid)
+    }
+
+    /// Spin density on a grid.
+    pub fn spin_density_grid(&self, wf: &Wavefunction, grid: &GridSpec) -> Vec<f64> {
+        let sets: Vec<(&[f64], f64)> = wf
+            .orbitals
+            .iter()
+            .map(|o| {
+                (
+                    o.coefficients.as_slice(),
+                    spin_weight(wf, o.occupation, o.spin),
+                )
+            })
+            .filter(|(_, w)| *w != 0.0)
+            .collect();
+        self.grid_sum(&sets, true, grid)
+    }
+
+    /// Σ_s w_s ψ_s (or Σ_s w_s ψ_s² when `square`) on a grid.
+    fn grid_sum(&self, sets: &[(&[f64], f64)], square: bool, grid: &GridSpec) -> Vec<f64> {
+        let [nx, ny, nz] = grid.dims;
+        let mut out = vec![0.0; grid.len()];
+        if out.is_empty() || sets.is_empty() {
+            return out;
+        }
+        let prepared: Vec<(Vec<f64>, Vec<bool>, f64)> = sets
+            .iter()
+            .map(|(c, w)| {
+                let (d, a) = self.monomial_coefficients(c);
+                (d, a, *w)
+            })
+            .collect();
+        let any_active: Vec<bool> = (0..self.shells.len())
+            .map(|s| prepared.iter().any(|p| p.1[s]))
+            .collect();
+        const BLOCK: usize = 8;
+        let v = grid.steps[2];
+        let _ = nx;
+        out.par_chunks_mut(ny * nz)
+            .enumerate()
+            .for_each(|(ix, slab)| {
+                let mut scratch = RowScratch::new(nz, prepared.len());
+                let mut candidates = Vec::new();
+                for iy0 in (0..ny).step_by(BLOCK) {
+                    let iy1 = (iy0 + BLOCK).min(ny);
+                    // Bounding sphere of the block's points.
+                    let corner = grid.point(ix, iy0, 0);
+                    let ey = (iy1 - iy0 - 1) as f64 * grid.steps[1];
+                    let ez = (nz - 1) as f64 * v;
+                    let centre = corner + 0.5 * (ey + ez);
+                    let radius = (0.5 * (ey + ez)).length().max((0.5 * (ey - ez)).length());
+                    candidates.clear();
+                    for (si, s) in self.shells.iter().enumerate() {
+                        if any_active[si] && s.center().distance(centre) <= s.cutoff + radius {
+                            candidates.push(si);
+                        }
+                    }
+                    for iy in iy0..iy1 {
+                        let row = &mut slab[iy * nz..(iy + 1) * nz];
+                        let p0 = grid.point(ix, iy, 0);
+                        self.row(&prepared, &candidates, p0, v, square, row, &mut scratch);
+                    }
+                }
+            });
+        out
+    }
+
+    /// One grid row: points p0 + k·v, k = 0..out.len().
+    #[allow(clippy::too_many_arguments)]
+    fn row(
+        &self,
+        sets: &[(Vec<f64>, Vec<bool>, f64)],
+        candidates: &[usize],
+        p0: DVec3,
+        v: DVec3,
+        square: bool,
+        out: &mut [f64],
+        scratch: &mut RowScratch,
+    ) {
+        let n = out.len();
+        let single = sets.len() == 1 && !square;
+        if !single {
+            for acc in scratch.psi.iter_mut() {
+                acc.fill(0.0);
+            }
+        }
+        let a = v.length_squared();
+        for &si in candidates {
+            let s = &self.shells[si];
+            let u = p0 - s.center();
+            let b = u.dot(v);
+            let c0 = u.length_squared();
+            let Some((k0, k1)) = interval(a, b, c0, s.cutoff * s.cutoff, n) else {
+                continue;
+            };
+            // Radial part along the row.
+            let rad = &mut scratch.radial[k0..k1];
+            rad.fill(0.0);
+            let mut any = false;
+            for j in s.primitives() {
+                let Some((j0, j1)) = interval(a, b, c0, self.primitive_cutoffs2[j], n) else {
+                    continue;
+                };
+                let (j0, j1) = (j0.max(k0), j1.min(k1));
+                if j0 >= j1 {
+                    continue;
+                }
+                any = true;
+                let alpha = self.exponents[j];
+                let cj = self.coefficients[j];
+                let w = (-2.0 * alpha * a).exp();
+                let mut k = j0;
+                while k < j1 {
+                    let kf = k as f64;
+                    let r2 = (a * kf + 2.0 * b) * kf + c0;
+                    let mut g = cj * (-alpha * r2).exp();
+                    let mut q = (-alpha * (2.0 * (b + a * kf) + a)).exp();
+                    let end = (k + RESEED).min(j1);
+                    for r in &mut rad[k - k0..end - k0] {
+                        *r += g;
+                        g *= q;
+                        q *= w;
+                    }
+                    k = end;
+                }
+            }
+            if !any {
+                continue;
+            }
+            // Angular polynomial in t = k − km, expanded around the point nearest the centre.
+            let km = if a > 0.0 {
+                (-b / a).round().clamp(k0 as f64, (k1 - 1) as f64)
+            } else {
+                k0 as f64
+            };
+            let uc = u + km * v;
+            let l = s.l as usize;
+            let powers = &self.powers[l];
+            let binom = axis_polynomials(uc, v, l);
+            for (set, (d, active, _)) in sets.iter().enumerate() {
+                if !active[si] {
+                    continue;
+                }
+                let d = &d[s.cartesians()];
+                let mut poly = [0.0f64; 8];
+                for (i, p) in powers.iter().enumerate() {
+                    if d[i] == 0.0 {
+                        continue;
+                    }
+                    let mut term = [0.0f64; 8];
+                    let bx = &binom[0][p[0] as usize];
+                    let by = &binom[1][p[1] as usize];
+                    let bz = &binom[2][p[2] as usize];
+                    // (x-poly · y-poly) · z-poly.
+                    let mut xy = [0.0f64; 8];
+                    for (i1, cx) in bx.iter().enumerate().take(p[0] as usize + 1) {
+                        for (i2, cy) in by.iter().enumerate().take(p[1] as usize + 1) {
+                            xy[i1 + i2] += cx * cy;
+                        }
+                    }
+                    for (i1, cxy) in xy.iter().enumerate().take((p[0] + p[1]) as usize + 1) {
+                        for (i2, cz) in bz.iter().enumerate().take(p[2] as usize + 1) {
+                            term[i1 + i2] += cxy * cz;
+                        }
+                    }
+                    for e in 0..=l {
+                        poly[e] += d[i] * term[e];
+                    }
+                }
+                let target: &mut [f64] = if single {
+                    &mut out[..]
+                } else {
+                    &mut scratch.psi[set][..]
+                };
+                if l == 0 {
+                    let c = poly[0];
+                    for (o, r) in target[k0..k1].iter_mut().zip(rad.iter()) {
+                        *o += c * r;
+                    }
+                } else {
+                    for (idx, (o, r)) in target[k0..k1].iter_mut().zip(rad.iter()).enumerate() {
+                        let t = (k0 + idx) as f64 - km;
+                        let mut h = poly[l];
+                        for e in (0..l).rev() {
+                            h = h * t + poly[e];
+                        }
+                        *o += h * r;
+                    }
+                }
+            }
+        }
+        if !single {
+            for (set, (_, _, w)) in sets.iter().enumerate() {
+                let psi = &scratch.psi[set];
+                if square {
+                    for (o, p) in out.iter_mut().zip(psi) {
+                        *o += w * p * p;
+                    }
+                } else {
+                    for (o, p) in out.iter_mut().zip(psi) {
+                        *o += w * p;
+                    }
+                }
+            }
+        }
+    }
+}
+
+struct RowScratch {
+    radial: Vec<f64>,
+    psi: Vec<Vec<f64>>,
+}
+
+impl RowScratch {
+    fn new(n: usize, sets: usize) -> Self {
+        Self {
+            radial: vec![0.0; n],
+            psi: vec![vec![0.0; n]; if sets > 1 { sets } else { 1 }],
+        }
+    }
+}
+
+/// For each axis and power e ≤ l, the coefficients of (u + t·v)^e as a polynomial in t.
+fn axis_polynomials(u: DVec3, v: DVec3, l: usize) -> [[[f64; 8]; 8]; 3] {
+    let mut out = [[[0.0; 8]; 8]; 3];
+    for axis in 0..3 {
+        out[axis][0][0] = 1.0;
+        for e in 1..=l {
+            let (prev, cur) = out[axis].split_at_mut(e);
+            let prev = &prev[e - 1];
+            for j in 0..=e {
+                let mut c = 0.0;
+                if j < e {
+                    c += prev[j] * u[axis];
+                }
+                if j > 0 {
+                    c += prev[j - 1] * v[axis];
+                }
+                cur[0][j] = c;
+            }
+        }
+    }
+    out
+}
+
+/// Indices k in 0..n with a·k² + 2b·k + c0 ≤ r2max, as a half-open range.
+fn interval(a: f64, b: f64, c0: f64, r2max: f64, n: usize) -> Option<(usize, usize)> {
+    if r2max.is_infinite() {
+        return Some((0, n));
+    }
+    if a <= 0.0 {
+        return (c0 <= r2max).then_some((0, n));
+    }
+    let disc = b * b - a * (c0 - r2max);
+    if disc < 0.0 {
+        return None;
+    }
+    let sq = disc.sqrt();
+    let lo = ((-b - sq) / a).ceil().max(0.0);
+    let hi = ((-b + sq) / a).floor();
+    if hi < lo || hi < 0.0 {
+        return None;
+    }
+    let lo = lo as usize;
+    let hi = (hi as usize + 1).min(n);
+    (lo < hi).then_some((lo, hi))
+}
+
+/// Weight of an orbital in the spin density: +n for alpha and −n for beta orbitals of an
+/// unrestricted wavefunction; for a restricted one, the unpaired part min(n, 2 − n) (an
+/// open-shell orbital with occupation 1 counts as alpha).
+pub fn spin_weight(wf: &Wavefunction, occupation: f64, spin: Spin) -> f64 {
+    if wf.restricted {
+        occupation.min(2.0 - occupation).max(0.0)
+    } else {
+        match spin {
+            Spin::Alpha => occupation,
+            Spin::Beta => -occupation,
+        }
+    }
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::basis::Shell;
+    use crate::model::orbitals::MolecularOrbital;
+    use crate::model::overlap::overlap_matrix;
+    use crate::model::solid_harmonics::cartesian_overlap;
+
+    fn shell(center: DVec3, l: u32, kind: ShellKind, scale: f64) -> Shell {
+        Shell {
+            atom: 0,
+            center,
+            l,
+            kind,
+            exponents: vec![4.0 * scale, 1.1 * scale, 0.3 * scale],
+            coefficients: vec![0.3, 0.5, 0.4],
+        }
+    }
+
+    /// Shells up to h on three centres, cartesian and pure.
+    fn test_basis() -> Basis {
+        let centres = [
+            DVec3::ZERO,
+            DVec3::new(1.2, -0.4, 0.7),
+            DVec3::new(-0.9, 1.5, -0.3),
+        ];
+        let mut shells = Vec::new();
+        for l in 0..=5 {
+            shells.push(shell(centres[l as usize % 3], l, ShellKind::Pure, 1.0));
+            shells.push(shell(
+                centres[(l as usize + 1) % 3],
+                l,
+                ShellKind::Cartesian,
+                0.7,
+            ));
+        }
+        Basis { shells }
+    }
+
+    fn pseudo_random(n: usize, seed: u64) -> Vec<f64> {
+        let mut x = seed;
+        (0..n)
+            .map(|_| {
+                x = x
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                ((x >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+            })
+            .collect()
+    }
+
+    fn points(n: usize, seed: u64, half: f64) -> Vec<DVec3> {
+        let r = pseudo_random(3 * n, seed);
+        r.chunks(3)
+            .map(|c| DVec3::new(c[0], c[1], c[2]) * half)
+            .collect()
+    }
+
+    #[test]
+    fn self_overlap_is_unit_for_every_l() {
+        for l in 0..=5 {
+            for kind in [ShellKind::Cartesian, ShellKind::Pure] {
+                let basis = Basis {
+                    shells: vec![shell(DVec3::new(0.3, 0.1, -0.2), l, kind, 1.0)],
+                };
+                let s = overlap_matrix(&basis);
+                let n = basis.n_functions();
+                let want = match kind {
+                    ShellKind::Cartesian => cartesian_overlap(l),
+                    ShellKind::Pure if l == 1 => cartesian_overlap(1),
+                    ShellKind::Pure => {
+                        let mut id = vec![0.0; n * n];
+                        (0..n).for_each(|i| id[i * n + i] = 1.0);
+                        id
+                    }
+                };
+                for (i, (a, b)) in s.iter().zip(&want).enumerate() {
+                    assert!((a - b).abs() < 1e-12, "l={l} {kind:?} [{i}] {a} vs {b}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn overlap_matches_numerical_quadrature() {
+        // Two displaced d and f shells: a brute-force sum on a fine grid.
+        let basis = Basis {
+            shells: vec![
+                shell(DVec3::new(0.0, 0.0, 0.0), 2, ShellKind::Pure, 1.0),
+                shell(DVec3::new(0.6, -0.3, 0.4), 3, ShellKind::Cartesian, 1.0),
+            ],
+        };
+        let pb = PreparedBasis::with_threshold(&basis, 0.0);
+        let s = overlap_matrix(&basis);
+        let n = pb.n_functions();
+        let (h, m) = (0.15, 56i32);
+        let mut num = vec![0.0; n * n];
+        for i in -m..m {
+            for j in -m..m {
+                for k in -m..m {
+                    let p = DVec3::new(i as f64, j as f64, k as f64) * h + DVec3::splat(0.3 * h);
+                    let v = pb.basis_values(p);
+                    for a in 0..n {
+                        if v[a] == 0.0 {
+                            continue;
+                        }
+                        for b in 0..n {
+                            num[a * n + b] += v[a] * v[b] * h * h * h;
+                        }
+                    }
+                }
+            }
+        }
+        for (a, b) in s.iter().zip(&num) {
+            assert!((a - b).abs() < 1e-9, "{a} vs {b}");
+        }
+    }
+
+    #[test]
+    fn gradients_match_finite_differences() {
+        let pb = PreparedBasis::new(&test_basis());
+        let h = 1e-5;
+        for p in points(20, 7, 2.0) {
+            let (v, g) = pb.basis_values_and_gradients(p);
+            assert_eq!(v, pb.basis_values(p));
+            for axis in 0..3 {
+                let mut e = DVec3::ZERO;
+                e[axis] = h;
+                let (vp, vm) = (pb.basis_values(p + e), pb.basis_values(p - e));
+                for f in 0..v.len() {
+                    let fd = (vp[f] - vm[f]) / (2.0 * h);
+                    assert!(
+                        (fd - g[f][axis]).abs() < 1e-6 * (1.0 + fd.abs()),
+                        "function {f} axis {axis}: {fd} vs {}",
+                        g[f][axis]
+                    );
+                }
+            }
+            let c = pseudo_random(v.len(), 3);
+            let (psi, grad) = pb.orbital_value_and_gradient(&c, p);
+            assert!((psi - pb.orbital_value(&c, p)).abs() < 1e-14);
+            let want = g.iter().zip(&c).fold(DVec3::ZERO, |a, (g, c)| a + *c * *g);
+            assert!((grad - want).length() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn grid_equals_point_evaluation() {
+        let pb = PreparedBasis::new(&test_basis());
+        let c = pseudo_random(pb.n_functions(), 11);
+        let grid = GridSpec::new(
+            DVec3::new(-4.0, -3.5, -4.2),
+            [
+                DVec3::new(0.9, 0.1, 0.0),
+                DVec3::new(0.05, 0.7, 0.1),
+                DVec3::new(0.02, -0.03, 0.13),
+            ],
+            [9, 11, 67],
+        );
+        let values = pb.eval_grid(&c, &grid);
+        let f32s = pb.eval_grid_f32(&c, &grid);
+        let [nx, ny, nz] = grid.dims;
+        let mut worst: f64 = 0.0;
+        for i in 0..nx {
+            for j in 0..ny {
+                for k in 0..nz {
+                    let idx = (i * ny + j) * nz + k;
+                    let want = pb.orbital_value(&c, grid.point(i, j, k));
+                    worst = worst.max((values[idx] - want).abs());
+                    assert!((f32s[idx] as f64 - want).abs() <= 1e-6 * (1.0 + want.abs()));
+                }
+            }
+        }
+        assert!(worst < 1e-11, "worst {worst}");
+        // Orthogonal steps along z only, a long row.
+        let grid = GridSpec::new(
+            DVec3::new(-5.0, -5.0, -6.0),
+            [DVec3::X * 1.1, DVec3::Y * 0.9, DVec3::Z * 0.04],
+            [10, 12, 300],
+        );
+        let values = pb.eval_grid(&c, &grid);
+        for (idx, v) in values.iter().enumerate().step_by(7) {
+            let (i, j, k) = (idx / (12 * 300), idx / 300 % 12, idx % 300);
+            let want = pb.orbital_value(&c, grid.point(i, j, k));
+            assert!((v - want).abs() < 1e-11, "{v} vs {want}");
+        }
+    }
+
+    #[test]
+    fn subset_and_density_grids_match_points() {
+        let basis = test_basis();
+        let pb = PreparedBasis::new(&basis);
+        let n = pb.n_functions();
+        let orbital = |seed, occupation, spin| MolecularOrbital {
+            energy: -0.5,
+            occupation,
+            spin,
+            symmetry: String::new(),
+            coefficients: pseudo_random(n, seed),
+        };
+        let wf = Wavefunction {
+            basis: basis.clone(),
+            orbitals: vec![
+                orbital(1, 1.0, Spin::Alpha),
+                orbital(2, 1.0, Spin::Alpha),
+                orbital(3, 1.0, Spin::Beta),
+                orbital(4, 0.0, Spin::Beta),
+            ],
+            restricted: false,
+            normalization: Default::default(),
+        };
+        let grid = GridSpec::new(
+            DVec3::splat(-3.0),
+            [DVec3::X * 0.6, DVec3::Y * 0.55, DVec3::new(0.0, 0.01, 0.2)],
+            [11, 12, 31],
+        );
+        let rho = pb.density_grid(&wf, &grid);
+        let spin = pb.spin_density_grid(&wf, &grid);
+        let subset = [0usize, 3, 7, 20, n - 1];
+        let c = &wf.orbitals[0].coefficients;
+        let part = pb.eval_grid_subset(c, &subset, &grid);
+        let single = pb.eval_grid_subset(&vec![1.0; n], &[5], &grid);
+        for i in 0..11 {
+            for j in 0..12 {
+                for k in 0..31 {
+                    let idx = (i * 12 + j) * 31 + k;
+                    let p = grid.point(i, j, k);
+                    let r = pb.density(&wf, p);
+                    assert!((rho[idx] - r).abs() <= 1e-11 * (1.0 + r));
+                    let s = pb.spin_density(&wf, p);
+                    assert!((spin[idx] - s).abs() <= 1e-11 * (1.0 + s.abs()));
+                    let v = pb.basis_values(p);
+                    let want: f64 = subset.iter().map(|&f| c[f] * v[f]).sum();
+                    assert!((part[idx] - want).abs() < 1e-11);
+                    assert!((single[idx] - v[5]).abs() < 1e-11);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn cutoff_gives_exact_zero_far_away_and_stays_within_threshold() {
+        let basis = test_basis();
+        let cut = PreparedBasis::new(&basis);
+        let full = PreparedBasis::with_threshold(&basis, 0.0);
+        for s in &cut.shells {
+            assert!(s.cutoff.is_finite() && s.cutoff > 1.0 && s.cutoff < 30.0);
+        }
+        let far = DVec3::new(40.0, -35.0, 20.0);
+        assert!(cut.basis_values(far).iter().all(|v| *v == 0.0));
+        let mut worst: f64 = 0.0;
+        for p in points(400, 5, 14.0) {
+            let (a, b) = (cut.basis_values(p), full.basis_values(p));
+            for (x, y) in a.iter().zip(&b) {
+                worst = worst.max((x - y).abs());
+            }
+        }
+        assert!(worst <= DEFAULT_THRESHOLD, "worst {worst}");
+        // Just outside each shell's radius, its functions are 0 in the cut basis and tiny in full.
+        for s in &cut.shells {
+            let p = s.center() + DVec3::new(1.0, 2.0, 2.0) / 3.0 * (s.cutoff * 1.0001);
+            let (a, b) = (cut.basis_values(p), full.basis_values(p));
+            for f in s.functions() {
+                assert_eq!(a[f], 0.0);
+                assert!(b[f].abs() <= DEFAULT_THRESHOLD);
+            }
+        }
+    }
+}
