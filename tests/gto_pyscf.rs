@@ -54,14 +54,8 @@ struct Fixture {
     overlap_elements: Vec<(usize, usize, f64)>,
 }
 
-const MOLECULES: &[&str] = &[
-    "h2o_cart_631gs",
-    "h2o_pure_ccpvtz",
-    "n2_ccpvqz",
-    "ne_ccpv5z",
-    "benzene_631gs",
-    "h2o_cation_uhf",
-];
+const MOLECULES: &[&str] =
+    &["h2o_cart_631gs", "h2o_pure_ccpvtz", "n2_ccpvqz", "ne_ccpv5z", "benzene_631gs", "h2o_cation_uhf"];
 
 fn load(name: &str) -> (Fixture, Wavefunction) {
     let text = std::fs::read_to_string(format!("{DIR}/{name}.json")).expect("fixture");
@@ -73,11 +67,7 @@ fn load(name: &str) -> (Fixture, Wavefunction) {
             atom: s.atom,
             center: DVec3::from_array(fx.atoms[s.atom].xyz),
             l: s.l,
-            kind: if s.pure {
-                ShellKind::Pure
-            } else {
-                ShellKind::Cartesian
-            },
+            kind: if s.pure { ShellKind::Pure } else { ShellKind::Cartesian },
             exponents: s.exponents.clone(),
             coefficients: s.coefficients.clone(),
         })
@@ -90,11 +80,7 @@ fn load(name: &str) -> (Fixture, Wavefunction) {
             .map(|o| MolecularOrbital {
                 energy: o.energy,
                 occupation: o.occupation,
-                spin: if o.spin == "beta" {
-                    Spin::Beta
-                } else {
-                    Spin::Alpha
-                },
+                spin: if o.spin == "beta" { Spin::Beta } else { Spin::Alpha },
                 symmetry: String::new(),
                 coefficients: o.coefficients.clone(),
             })
@@ -108,18 +94,13 @@ fn load(name: &str) -> (Fixture, Wavefunction) {
 }
 
 fn alpha_orbital(fx: &Fixture, index: usize) -> &[f64] {
-    &fx.orbitals
-        .iter()
-        .find(|o| o.spin == "alpha" && o.index == index)
-        .expect("orbital in fixture")
-        .coefficients
+    &fx.orbitals.iter().find(|o| o.spin == "alpha" && o.index == index).expect("orbital in fixture").coefficients
 }
 
 #[test]
 fn cart_to_pure_matches_pyscf() {
     let text = std::fs::read_to_string(format!("{DIR}/cart2sph.json")).unwrap();
-    let fx: std::collections::BTreeMap<String, Vec<Vec<f64>>> =
-        serde_json::from_str(&text).unwrap();
+    let fx: std::collections::BTreeMap<String, Vec<Vec<f64>>> = serde_json::from_str(&text).unwrap();
     for l in 0..=5u32 {
         let rows = &fx[&l.to_string()];
         let t = cart_to_pure(l);
@@ -166,10 +147,7 @@ fn orbitals_and_densities_match_pyscf() {
             let p = DVec3::from_array(*p);
             for (c, want) in [(homo, fx.homo_values[i]), (lumo, fx.lumo_values[i])] {
                 let got = pb.orbital_value(c, p);
-                assert!(
-                    (got - want).abs() <= 1e-8,
-                    "{name} point {i}: {got} vs {want}"
-                );
+                assert!((got - want).abs() <= 1e-8, "{name} point {i}: {got} vs {want}");
                 w_orb = w_orb.max((got - want).abs());
             }
             let rho = pb.density(&wf, p);
@@ -198,11 +176,7 @@ fn overlap_matches_pyscf_and_orbitals_are_orthonormal() {
             assert!((s[i * n + i] - d).abs() < 1e-10, "{name} S[{i},{i}]");
         }
         for &(i, j, v) in &fx.overlap_elements {
-            assert!(
-                (s[i * n + j] - v).abs() < 1e-10,
-                "{name} S[{i},{j}] = {} vs {v}",
-                s[i * n + j]
-            );
+            assert!((s[i * n + j] - v).abs() < 1e-10, "{name} S[{i},{j}] = {} vs {v}", s[i * n + j]);
         }
         let residual = orthonormality_residual(&wf);
         println!("{name}: max |CᵀSC − I| = {residual:.2e}");

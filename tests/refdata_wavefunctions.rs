@@ -2,8 +2,9 @@
 //! CFOUR, Molpro, Molden, Gaussian and Q-Chem) load with the expected sizes, and the writer quirks
 //! its MANIFEST.md lists are detected and repaired.
 //!
-//! The orbitals are checked here with a plain reference overlap matrix
-//! (tests/fixtures/readers/ref_overlap.rs).
+//! The readers check orbitals with the analytic overlap of `model::overlap`; a plain, independent
+//! reference overlap (tests/fixtures/readers/ref_overlap.rs) cross-checks it. HOMO, LUMO and
+//! density values are compared with the corpus's expected tables (IOData + GBasis).
 
 use std::path::{Path, PathBuf};
 
@@ -24,7 +25,7 @@ fn dir() -> PathBuf {
 }
 
 fn load(path: &Path) -> Document {
-    match formats::load_with(path, Some(&ref_overlap::reference_overlap)) {
+    match formats::load(path) {
         Ok(d) => d,
         Err(e) => panic!("{e}"),
     }
@@ -269,4 +270,57 @@ fn every_wavefunction_extension_dispatches_also_gzipped() {
             assert!(doc.wavefunction.is_some(), "{name}");
         }
     }
+}
+
+#[test]
+fn the_analytic_overlap_agrees_with_the_reference_overlap() {
+    for e in EXPECTED {
+        let doc = load(&dir().join(e.name));
+        let basis = &doc.wavefunction.as_ref().expect("wavefunction").basis;
+        let ours = orbcloud::model::overlap::overlap_matrix_as_written(basis);
+        let reference = ref_overlap::reference_overlap(basis);
+        let worst = ours.iter().zip(&reference).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+        assert!(worst < 1e-9, "{}: overlap matrices differ by {worst:e}", e.name);
+    }
+}
+
+#[test]
+fn orbitals_and_densities_match_the_expected_values() {
+    use orbcloud::model::gto::PreparedBasis;
+    let mut report = String::new();
+    for e in EXPECTED {
+        let doc = load(&dir().join(e.name));
+        let wf = doc.wavefunction.as_ref().expect("wavefunction");
+        let prepared = PreparedBasis::new(&wf.basis);
+        let mut worst = [0.0f64; 3];
+        for (k, kind) in ["homo", "lumo", "density"].iter().enumerate() {
+            let table = expected_values(e.name, kind);
+            let orbital = match *kind {
+                "homo" => wf.homo(Spin::Alpha),
+                "lumo" => wf.lumo(Spin::Alpha),
+                _ => None,
+            };
+            for x in &table {
+                let p = glam::DVec3::from(x.point);
+                let (ours, err) = match orbital {
+                    Some(i) => {
+                        let v = prepared.orbital_value(&wf.orbitals[i].coefficients, p);
+                        (v, (v - x.value).abs())
+                    }
+                    None => {
+                        let v = prepared.density(wf, p);
+                        (v, (v - x.value).abs() / x.value.abs().max(1e-12))
+                    }
+                };
+                worst[k] = worst[k].max(err);
+                let tolerance = if orbital.is_some() { 1e-6 } else { 1e-5 };
+                assert!(err <= tolerance, "{} {kind} at {:?}: {ours:.9e}, expected {:.9e}", e.name, x.point, x.value);
+            }
+        }
+        report.push_str(&format!(
+            "{:38} homo {:.1e}  lumo {:.1e}  density (rel) {:.1e}\n",
+            e.name, worst[0], worst[1], worst[2]
+        ));
+    }
+    eprintln!("{report}");
 }

@@ -27,10 +27,9 @@ use crate::model::Document;
 /// is beyond any GPU texture the viewer can use.
 pub const MAX_GRID_VALUES: u64 = 1 << 30;
 
-/// The overlap function wavefunction readers check orbitals with; `None` until the analytic
-/// overlap of `model::gto` is available, in which case orbitals are kept as written (their
-/// [`crate::model::orbitals::Normalization`] says "unchecked").
-pub const DEFAULT_OVERLAP: Option<OverlapFn<'static>> = None;
+/// The overlap function wavefunction readers check orbitals (and choose writer repairs) with:
+/// the analytic overlap of the functions as the file writes them.
+pub const DEFAULT_OVERLAP: Option<OverlapFn<'static>> = Some(&crate::model::overlap::overlap_matrix_as_written);
 
 /// Reads a file from disk, picking the reader by extension: `.cube`, `.cub`, `.molden`,
 /// `.molden.input`, `.mold`, `.fchk`, `.fch`, each also gzipped (`.gz`).

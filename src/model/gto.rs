@@ -110,11 +110,7 @@ pub struct GridSpec {
 
 impl GridSpec {
     pub fn new(origin: DVec3, steps: [DVec3; 3], dims: [usize; 3]) -> Self {
-        Self {
-            origin,
-            steps,
-            dims,
-        }
+        Self { origin, steps, dims }
     }
 
     pub fn point(&self, i: usize, j: usize, k: usize) -> DVec3 {
@@ -172,16 +168,11 @@ impl PreparedBasis {
     ///
     /// Panics when a shell has l > [`MAX_EVAL_L`] (readers reject those: `basis::MAX_L`).
     pub fn with_threshold(basis: &Basis, threshold: f64) -> Self {
-        assert!(
-            basis.shells.iter().all(|s| s.l <= MAX_EVAL_L),
-            "angular momentum above {MAX_EVAL_L}"
-        );
+        assert!(basis.shells.iter().all(|s| s.l <= MAX_EVAL_L), "angular momentum above {MAX_EVAL_L}");
         let max_l = basis.shells.iter().map(|s| s.l).max().unwrap_or(0);
         let powers: Vec<_> = (0..=max_l).map(cartesian_powers).collect();
-        let component_factors: Vec<Vec<f64>> = powers
-            .iter()
-            .map(|ps| ps.iter().map(|p| component_factor(*p)).collect())
-            .collect();
+        let component_factors: Vec<Vec<f64>> =
+            powers.iter().map(|ps| ps.iter().map(|p| component_factor(*p)).collect()).collect();
         let pure_matrices: Vec<Vec<f64>> = (0..=max_l).map(cart_to_pure).collect();
         // Bounds of |angular part| / r^l over the functions of a shell.
         let angular_bound = |l: u32, pure: bool| -> f64 {
@@ -213,19 +204,16 @@ impl PreparedBasis {
             let l = shell.l;
             let pure = shell.kind == ShellKind::Pure;
             let n_prim = shell.exponents.len().min(shell.coefficients.len());
-            let mut coefs: Vec<f64> = (0..n_prim)
-                .map(|j| shell.coefficients[j] * primitive_norm(shell.exponents[j], l))
-                .collect();
+            let mut coefs: Vec<f64> =
+                (0..n_prim).map(|j| shell.coefficients[j] * primitive_norm(shell.exponents[j], l)).collect();
             // Norm² of the contracted x^l component.
             let mut norm2 = 0.0;
             for a in 0..n_prim {
                 for b in 0..n_prim {
                     let p = shell.exponents[a] + shell.exponents[b];
-                    norm2 += coefs[a]
-                        * coefs[b]
-                        * (std::f64::consts::PI / p).powf(1.5)
-                        * double_factorial_m1(2 * l as i64)
-                        / (2.0 * p).powi(l as i32);
+                    norm2 +=
+                        coefs[a] * coefs[b] * (std::f64::consts::PI / p).powf(1.5) * double_factorial_m1(2 * l as i64)
+                            / (2.0 * p).powi(l as i32);
                 }
             }
             if norm2 > 0.0 && norm2.is_finite() {
@@ -320,18 +308,11 @@ impl PreparedBasis {
             if grads.is_some() {
                 let dm = |axis: usize, e: usize| -> f64 {
                     // ∂/∂axis of x^a y^b z^c without the other two factors.
-                    if e == 0 {
-                        0.0
-                    } else {
-                        e as f64 * pw[axis][e - 1]
-                    }
+                    if e == 0 { 0.0 } else { e as f64 * pw[axis][e - 1] }
                 };
-                let gx = dm(0, a) * pw[1][b] * pw[2][c] * rad
-                    + pw[0][a + 1] * pw[1][b] * pw[2][c] * drad;
-                let gy = pw[0][a] * dm(1, b) * pw[2][c] * rad
-                    + pw[0][a] * pw[1][b + 1] * pw[2][c] * drad;
-                let gz = pw[0][a] * pw[1][b] * dm(2, c) * rad
-                    + pw[0][a] * pw[1][b] * pw[2][c + 1] * drad;
+                let gx = dm(0, a) * pw[1][b] * pw[2][c] * rad + pw[0][a + 1] * pw[1][b] * pw[2][c] * drad;
+                let gy = pw[0][a] * dm(1, b) * pw[2][c] * rad + pw[0][a] * pw[1][b + 1] * pw[2][c] * drad;
+                let gz = pw[0][a] * pw[1][b] * dm(2, c) * rad + pw[0][a] * pw[1][b] * pw[2][c + 1] * drad;
                 cart_grad.push(*f * DVec3::new(gx, gy, gz));
             }
         }
@@ -342,10 +323,7 @@ impl PreparedBasis {
                 let row = &t[k * nc..(k + 1) * nc];
                 out[k] = row.iter().zip(cart.iter()).map(|(a, b)| a * b).sum();
                 if let Some(g) = grads.as_deref_mut() {
-                    g[k] = row
-                        .iter()
-                        .zip(cart_grad.iter())
-                        .fold(DVec3::ZERO, |acc, (a, b)| acc + *a * *b);
+                    g[k] = row.iter().zip(cart_grad.iter()).fold(DVec3::ZERO, |acc, (a, b)| acc + *a * *b);
                 }
             }
         } else {
@@ -374,14 +352,7 @@ impl PreparedBasis {
         let (mut c, mut cg) = (Vec::new(), Vec::new());
         for s in &self.shells {
             let r = s.functions();
-            self.shell_values(
-                s,
-                point - s.center(),
-                &mut out[r.clone()],
-                Some(&mut grads[r]),
-                &mut c,
-                &mut cg,
-            );
+            self.shell_values(s, point - s.center(), &mut out[r.clone()], Some(&mut grads[r]), &mut c, &mut cg);
         }
         (out, grads)
     }
@@ -394,10 +365,7 @@ impl PreparedBasis {
     /// ψ(point) and ∇ψ(point).
     pub fn orbital_value_and_gradient(&self, coefficients: &[f64], point: DVec3) -> (f64, DVec3) {
         let (v, g) = self.basis_values_and_gradients(point);
-        let grad = coefficients
-            .iter()
-            .zip(&g)
-            .fold(DVec3::ZERO, |acc, (c, g)| acc + *c * *g);
+        let grad = coefficients.iter().zip(&g).fold(DVec3::ZERO, |acc, (c, g)| acc + *c * *g);
         (dot(coefficients, &v), grad)
     }
 
@@ -484,19 +452,11 @@ impl PreparedBasis {
 
     /// As [`Self::eval_grid`], stored as f32 (what [`super::VolumeGrid`] holds).
     pub fn eval_grid_f32(&self, coefficients: &[f64], grid: &GridSpec) -> Vec<f32> {
-        self.eval_grid(coefficients, grid)
-            .into_iter()
-            .map(|v| v as f32)
-            .collect()
+        self.eval_grid(coefficients, grid).into_iter().map(|v| v as f32).collect()
     }
 
     /// Only the basis functions in `subset` of an orbital, on a grid.
-    pub fn eval_grid_subset(
-        &self,
-        coefficients: &[f64],
-        subset: &[usize],
-        grid: &GridSpec,
-    ) -> Vec<f64> {
+    pub fn eval_grid_subset(&self, coefficients: &[f64], subset: &[usize], grid: &GridSpec) -> Vec<f64> {
         self.eval_grid(&self.masked_coefficients(coefficients, subset), grid)
     }
 
@@ -516,12 +476,7 @@ impl PreparedBasis {
         let sets: Vec<(&[f64], f64)> = wf
             .orbitals
             .iter()
-            .map(|o| {
-                (
-                    o.coefficients.as_slice(),
-                    spin_weight(wf, o.occupation, o.spin),
-                )
-            })
+            .map(|o| (o.coefficients.as_slice(), spin_weight(wf, o.occupation, o.spin)))
             .filter(|(_, w)| *w != 0.0)
             .collect();
         self.grid_sum(&sets, true, grid)
@@ -541,38 +496,34 @@ impl PreparedBasis {
                 (d, a, *w)
             })
             .collect();
-        let any_active: Vec<bool> = (0..self.shells.len())
-            .map(|s| prepared.iter().any(|p| p.1[s]))
-            .collect();
+        let any_active: Vec<bool> = (0..self.shells.len()).map(|s| prepared.iter().any(|p| p.1[s])).collect();
         const BLOCK: usize = 8;
         let v = grid.steps[2];
         let _ = nx;
-        out.par_chunks_mut(ny * nz)
-            .enumerate()
-            .for_each(|(ix, slab)| {
-                let mut scratch = RowScratch::new(nz, prepared.len());
-                let mut candidates = Vec::new();
-                for iy0 in (0..ny).step_by(BLOCK) {
-                    let iy1 = (iy0 + BLOCK).min(ny);
-                    // Bounding sphere of the block's points.
-                    let corner = grid.point(ix, iy0, 0);
-                    let ey = (iy1 - iy0 - 1) as f64 * grid.steps[1];
-                    let ez = (nz - 1) as f64 * v;
-                    let centre = corner + 0.5 * (ey + ez);
-                    let radius = (0.5 * (ey + ez)).length().max((0.5 * (ey - ez)).length());
-                    candidates.clear();
-                    for (si, s) in self.shells.iter().enumerate() {
-                        if any_active[si] && s.center().distance(centre) <= s.cutoff + radius {
-                            candidates.push(si);
-                        }
-                    }
-                    for iy in iy0..iy1 {
-                        let row = &mut slab[iy * nz..(iy + 1) * nz];
-                        let p0 = grid.point(ix, iy, 0);
-                        self.row(&prepared, &candidates, p0, v, square, row, &mut scratch);
+        out.par_chunks_mut(ny * nz).enumerate().for_each(|(ix, slab)| {
+            let mut scratch = RowScratch::new(nz, prepared.len());
+            let mut candidates = Vec::new();
+            for iy0 in (0..ny).step_by(BLOCK) {
+                let iy1 = (iy0 + BLOCK).min(ny);
+                // Bounding sphere of the block's points.
+                let corner = grid.point(ix, iy0, 0);
+                let ey = (iy1 - iy0 - 1) as f64 * grid.steps[1];
+                let ez = (nz - 1) as f64 * v;
+                let centre = corner + 0.5 * (ey + ez);
+                let radius = (0.5 * (ey + ez)).length().max((0.5 * (ey - ez)).length());
+                candidates.clear();
+                for (si, s) in self.shells.iter().enumerate() {
+                    if any_active[si] && s.center().distance(centre) <= s.cutoff + radius {
+                        candidates.push(si);
                     }
                 }
-            });
+                for iy in iy0..iy1 {
+                    let row = &mut slab[iy * nz..(iy + 1) * nz];
+                    let p0 = grid.point(ix, iy, 0);
+                    self.row(&prepared, &candidates, p0, v, square, row, &mut scratch);
+                }
+            }
+        });
         out
     }
 
@@ -639,11 +590,7 @@ impl PreparedBasis {
                 continue;
             }
             // Angular polynomial in t = k − km, expanded around the point nearest the centre.
-            let km = if a > 0.0 {
-                (-b / a).round().clamp(k0 as f64, (k1 - 1) as f64)
-            } else {
-                k0 as f64
-            };
+            let km = if a > 0.0 { (-b / a).round().clamp(k0 as f64, (k1 - 1) as f64) } else { k0 as f64 };
             let uc = u + km * v;
             let l = s.l as usize;
             let powers = &self.powers[l];
@@ -678,11 +625,7 @@ impl PreparedBasis {
                         poly[e] += d[i] * term[e];
                     }
                 }
-                let target: &mut [f64] = if single {
-                    &mut out[..]
-                } else {
-                    &mut scratch.psi[set][..]
-                };
+                let target: &mut [f64] = if single { &mut out[..] } else { &mut scratch.psi[set][..] };
                 if l == 0 {
                     let c = poly[0];
                     for (o, r) in target[k0..k1].iter_mut().zip(rad.iter()) {
@@ -724,10 +667,7 @@ struct RowScratch {
 
 impl RowScratch {
     fn new(n: usize, sets: usize) -> Self {
-        Self {
-            radial: vec![0.0; n],
-            psi: vec![vec![0.0; n]; if sets > 1 { sets } else { 1 }],
-        }
+        Self { radial: vec![0.0; n], psi: vec![vec![0.0; n]; if sets > 1 { sets } else { 1 }] }
     }
 }
 
@@ -816,20 +756,11 @@ mod tests {
 
     /// Shells up to h on three centres, cartesian and pure.
     fn test_basis() -> Basis {
-        let centres = [
-            DVec3::ZERO,
-            DVec3::new(1.2, -0.4, 0.7),
-            DVec3::new(-0.9, 1.5, -0.3),
-        ];
+        let centres = [DVec3::ZERO, DVec3::new(1.2, -0.4, 0.7), DVec3::new(-0.9, 1.5, -0.3)];
         let mut shells = Vec::new();
         for l in 0..=5 {
             shells.push(shell(centres[l as usize % 3], l, ShellKind::Pure, 1.0));
-            shells.push(shell(
-                centres[(l as usize + 1) % 3],
-                l,
-                ShellKind::Cartesian,
-                0.7,
-            ));
+            shells.push(shell(centres[(l as usize + 1) % 3], l, ShellKind::Cartesian, 0.7));
         }
         Basis { shells }
     }
@@ -838,9 +769,7 @@ mod tests {
         let mut x = seed;
         (0..n)
             .map(|_| {
-                x = x
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
+                x = x.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
                 ((x >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
             })
             .collect()
@@ -848,18 +777,14 @@ mod tests {
 
     fn points(n: usize, seed: u64, half: f64) -> Vec<DVec3> {
         let r = pseudo_random(3 * n, seed);
-        r.chunks(3)
-            .map(|c| DVec3::new(c[0], c[1], c[2]) * half)
-            .collect()
+        r.chunks(3).map(|c| DVec3::new(c[0], c[1], c[2]) * half).collect()
     }
 
     #[test]
     fn self_overlap_is_unit_for_every_l() {
         for l in 0..=5 {
             for kind in [ShellKind::Cartesian, ShellKind::Pure] {
-                let basis = Basis {
-                    shells: vec![shell(DVec3::new(0.3, 0.1, -0.2), l, kind, 1.0)],
-                };
+                let basis = Basis { shells: vec![shell(DVec3::new(0.3, 0.1, -0.2), l, kind, 1.0)] };
                 let s = overlap_matrix(&basis);
                 let n = basis.n_functions();
                 let want = match kind {
@@ -947,11 +872,7 @@ mod tests {
         let c = pseudo_random(pb.n_functions(), 11);
         let grid = GridSpec::new(
             DVec3::new(-4.0, -3.5, -4.2),
-            [
-                DVec3::new(0.9, 0.1, 0.0),
-                DVec3::new(0.05, 0.7, 0.1),
-                DVec3::new(0.02, -0.03, 0.13),
-            ],
+            [DVec3::new(0.9, 0.1, 0.0), DVec3::new(0.05, 0.7, 0.1), DVec3::new(0.02, -0.03, 0.13)],
             [9, 11, 67],
         );
         let values = pb.eval_grid(&c, &grid);

@@ -20,12 +20,7 @@ fn overlap_1d(la: usize, lb: usize, xpa: f64, xpb: f64, p: f64) -> [[f64; 8]; 8]
     let h = 0.5 / p;
     s[0][0] = 1.0;
     for i in 0..la {
-        s[i + 1][0] = xpa * s[i][0]
-            + if i > 0 {
-                i as f64 * h * s[i - 1][0]
-            } else {
-                0.0
-            };
+        s[i + 1][0] = xpa * s[i][0] + if i > 0 { i as f64 * h * s[i - 1][0] } else { 0.0 };
     }
     for j in 0..lb {
         for i in 0..=la {
@@ -185,11 +180,41 @@ pub fn orthonormality_residual(wf: &Wavefunction) -> f64 {
     [Spin::Alpha, Spin::Beta]
         .iter()
         .map(|&spin| {
-            let c: Vec<&[f64]> = wf
-                .of_spin(spin)
-                .map(|(_, o)| o.coefficients.as_slice())
-                .collect();
+            let c: Vec<&[f64]> = wf.of_spin(spin).map(|(_, o)| o.coefficients.as_slice()).collect();
             orthonormality_error(&s, n, &c)
         })
         .fold(0.0, f64::max)
+}
+
+/// Norm of a shell's contraction as written: √(Σ_pq d_p d_q ⟨g_p|g_q⟩) for coefficients d of
+/// normalised primitives g of angular momentum l, ⟨g_p|g_q⟩ = (2√(α_p α_q)/(α_p + α_q))^(l + 3/2).
+pub fn contraction_norm(shell: &super::basis::Shell) -> f64 {
+    let e = &shell.exponents;
+    let d = &shell.coefficients;
+    let power = shell.l as f64 + 1.5;
+    let mut sum = 0.0;
+    for p in 0..e.len() {
+        for q in 0..e.len() {
+            sum += d[p] * d[q] * (2.0 * (e[p] * e[q]).sqrt() / (e[p] + e[q])).powf(power);
+        }
+    }
+    sum.max(0.0).sqrt()
+}
+
+/// The overlap matrix of the functions exactly as a file writes them: contractions *not*
+/// renormalised (what the orbitals' coefficients refer to before a reader normalises them).
+pub fn overlap_matrix_as_written(basis: &Basis) -> Vec<f64> {
+    let mut s = overlap_matrix(basis);
+    let n = basis.n_functions();
+    let mut scale = Vec::with_capacity(n);
+    for shell in &basis.shells {
+        let norm = contraction_norm(shell);
+        scale.extend(std::iter::repeat_n(norm, shell.n_functions()));
+    }
+    for i in 0..n {
+        for j in 0..n {
+            s[i * n + j] *= scale[i] * scale[j];
+        }
+    }
+    s
 }

@@ -49,9 +49,7 @@ fn binomial(n: i64, k: i64) -> f64 {
 /// ∏ (2p − 1)!! over the three powers: the squared norm of x^a y^b z^c e^(−αr²) relative to
 /// the common radial factor shared by all components of a shell.
 fn monomial_norm2(p: [u32; 3]) -> f64 {
-    p.iter()
-        .map(|&a| double_factorial_m1(2 * a as i64))
-        .product()
+    p.iter().map(|&a| double_factorial_m1(2 * a as i64)).product()
 }
 
 /// Factor that turns the component x^a y^b z^c of a primitive normalised for x^l into a
@@ -142,11 +140,7 @@ pub fn cart_to_pure(l: u32) -> Vec<f64> {
     for k in 0..np {
         let mono = solid_harmonic_monomials(l, pure_m(k));
         // x^a y^b z^c = sqrt(∏(2p−1)!!) · (unit-normalised component), up to the shell factor.
-        let row: Vec<f64> = mono
-            .iter()
-            .zip(&powers)
-            .map(|(c, p)| c * monomial_norm2(*p).sqrt())
-            .collect();
+        let row: Vec<f64> = mono.iter().zip(&powers).map(|(c, p)| c * monomial_norm2(*p).sqrt()).collect();
         let mut norm2 = 0.0;
         for i in 0..nc {
             for j in 0..nc {
@@ -172,10 +166,7 @@ mod tests {
 
     #[test]
     fn orders_and_signs_follow_gaussian() {
-        assert_eq!(
-            (0..7).map(pure_m).collect::<Vec<_>>(),
-            vec![0, 1, -1, 2, -2, 3, -3]
-        );
+        assert_eq!((0..7).map(pure_m).collect::<Vec<_>>(), vec![0, 1, -1, 2, -2, 3, -3]);
         // d0 ∝ 2zz − xx − yy in unit-normalised components: (zz − (xx + yy)/2).
         assert!((entry(2, 0, [0, 0, 2]) - 1.0).abs() < 1e-14);
         assert!((entry(2, 0, [2, 0, 0]) + 0.5).abs() < 1e-14);
