@@ -2,6 +2,9 @@
 
 use serde::Serialize;
 
+use crate::model::basis::ShellKind;
+use crate::model::orbitals::{Normalization, Spin, Wavefunction};
+use crate::model::units::EV_PER_HARTREE;
 use crate::model::{Document, GridStats, grid::ValueKind, units::ANGSTROM_PER_BOHR};
 
 #[derive(Serialize)]
@@ -28,6 +31,30 @@ pub struct GridInfo {
 }
 
 #[derive(Serialize)]
+pub struct OrbitalInfo {
+    /// 1-based number within its spin, as programs count.
+    pub number: usize,
+    pub spin: Spin,
+    pub symmetry: String,
+    pub energy_hartree: f64,
+    pub occupation: f64,
+}
+
+#[derive(Serialize)]
+pub struct WavefunctionInfo {
+    pub basis_functions: usize,
+    pub shells: usize,
+    pub max_l: u32,
+    pub pure_shells: usize,
+    pub restricted: bool,
+    /// The writer detected, the repair applied and max |CᵀSC − I| after it.
+    pub normalization: Normalization,
+    pub homo: Option<OrbitalInfo>,
+    pub lumo: Option<OrbitalInfo>,
+    pub orbitals: Vec<OrbitalInfo>,
+}
+
+#[derive(Serialize)]
 pub struct DocumentInfo {
     pub source: String,
     pub title: String,
@@ -35,6 +62,32 @@ pub struct DocumentInfo {
     pub atoms: Vec<AtomInfo>,
     pub bonds: usize,
     pub grids: Vec<GridInfo>,
+    pub wavefunction: Option<WavefunctionInfo>,
+}
+
+fn orbital_info(wf: &Wavefunction, i: usize) -> OrbitalInfo {
+    let o = &wf.orbitals[i];
+    OrbitalInfo {
+        number: wf.of_spin(o.spin).position(|(j, _)| j == i).map_or(0, |p| p + 1),
+        spin: o.spin,
+        symmetry: o.symmetry.clone(),
+        energy_hartree: o.energy,
+        occupation: o.occupation,
+    }
+}
+
+fn wavefunction_info(wf: &Wavefunction) -> WavefunctionInfo {
+    WavefunctionInfo {
+        basis_functions: wf.basis.n_functions(),
+        shells: wf.basis.shells.len(),
+        max_l: wf.basis.shells.iter().map(|s| s.l).max().unwrap_or(0),
+        pure_shells: wf.basis.shells.iter().filter(|s| s.kind == ShellKind::Pure).count(),
+        restricted: wf.restricted,
+        normalization: wf.normalization.clone(),
+        homo: wf.homo(Spin::Alpha).map(|i| orbital_info(wf, i)),
+        lumo: wf.lumo(Spin::Alpha).map(|i| orbital_info(wf, i)),
+        orbitals: (0..wf.orbitals.len()).map(|i| orbital_info(wf, i)).collect(),
+    }
 }
 
 pub fn describe(doc: &Document) -> DocumentInfo {
@@ -72,6 +125,7 @@ pub fn describe(doc: &Document) -> DocumentInfo {
                 stats: g.stats,
             })
             .collect(),
+        wavefunction: doc.wavefunction.as_ref().map(wavefunction_info),
     }
 }
 
@@ -116,6 +170,40 @@ pub fn text(doc: &Document) -> String {
         }
         let st = g.stats;
         let _ = writeln!(s, "    min {:.6e}  max {:.6e}  mean {:.6e}  σ {:.6e}", st.min, st.max, st.mean, st.sigma);
+    }
+    if let Some(w) = &info.wavefunction {
+        let n = &w.normalization;
+        let _ = writeln!(
+            s,
+            "basis: {} functions in {} shells (max l = {}, {} pure), {}",
+            w.basis_functions,
+            w.shells,
+            w.max_l,
+            w.pure_shells,
+            if w.restricted { "restricted" } else { "unrestricted" }
+        );
+        let _ = writeln!(
+            s,
+            "written by {}; repair: {}; max |CᵀSC − I| = {:.2e}{}",
+            n.program,
+            n.repair,
+            n.residual,
+            if n.residual > 1e-5 { "  ⚠ not orthonormal" } else { "" }
+        );
+        for (name, o) in [("HOMO", &w.homo), ("LUMO", &w.lumo)] {
+            if let Some(o) = o {
+                let _ = writeln!(
+                    s,
+                    "{name}: MO {} {:?} {} E = {:.6} Eh ({:.3} eV), occupation {:.3}",
+                    o.number,
+                    o.spin,
+                    o.symmetry,
+                    o.energy_hartree,
+                    o.energy_hartree * EV_PER_HARTREE,
+                    o.occupation
+                );
+            }
+        }
     }
     s
 }

@@ -5,12 +5,18 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, Parser, Subcommand, ValueEnum};
+use glam::DVec3;
+use orbcloud::formats::cube_write;
 use orbcloud::gpu::{AdapterPreference, GpuContext};
 use orbcloud::headless::{Headless, default_camera};
 use orbcloud::model::Document;
+use orbcloud::model::VolumeGrid;
+use orbcloud::model::gto::{GridSpec, PreparedBasis};
+use orbcloud::model::orbitals::{OrbitalSpec, Spin, Wavefunction};
 use orbcloud::scene::transfer::PRESETS;
 use orbcloud::scene::{AtomStyle, Camera, ClipPlane, RenderSettings, Shape, SliceMode, TransferKind};
 use orbcloud::{demo, formats, info};
+use rayon::prelude::*;
 
 #[derive(Parser)]
 #[command(name = "orbcloud", version, about = "Molecular orbitals and densities as GPU-rendered clouds")]
@@ -34,9 +40,124 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Evaluate an orbital or the density at points (bohr in, `x y z value` out).
+    Eval {
+        file: PathBuf,
+        #[command(flatten)]
+        what: WhatArgs,
+        /// File of points, one `x y z` (bohr) per line; `-` reads standard input.
+        #[arg(long)]
+        points: PathBuf,
+    },
+    /// Write an orbital or the density on a grid as a Gaussian cube file (like cubegen).
+    Cube {
+        file: PathBuf,
+        #[command(flatten)]
+        what: WhatArgs,
+        /// Points per axis (ignored with --spacing).
+        #[arg(long, default_value_t = 80)]
+        grid: usize,
+        /// Grid spacing in bohr (same on every axis).
+        #[arg(long)]
+        spacing: Option<f64>,
+        /// Space around the atoms, bohr.
+        #[arg(long, default_value_t = 3.0)]
+        margin: f64,
+        #[arg(short, long)]
+        output: PathBuf,
+    },
     /// Print performance figures.
     #[command(subcommand)]
     Bench(BenchCommand),
+}
+
+#[derive(Args)]
+struct WhatArgs {
+    /// homo, lumo, homo-N, lumo+N, or a 1-based orbital number of the chosen spin.
+    #[arg(long, default_value = "homo", allow_hyphen_values = true)]
+    orbital: OrbitalSpec,
+    /// Spin of the orbital (unrestricted wavefunctions).
+    #[arg(long, value_enum, default_value_t = SpinArg::Alpha)]
+    spin: SpinArg,
+    /// The total electron density instead of an orbital.
+    #[arg(long, conflicts_with = "spin_density")]
+    density: bool,
+    /// The spin density (α − β) instead of an orbital.
+    #[arg(long)]
+    spin_density: bool,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum SpinArg {
+    Alpha,
+    Beta,
+}
+
+/// What `eval` and `cube` compute.
+enum Quantity {
+    Orbital(usize),
+    Density,
+    SpinDensity,
+}
+
+impl WhatArgs {
+    fn resolve(&self, wf: &Wavefunction) -> Result<Quantity> {
+        if self.density {
+            return Ok(Quantity::Density);
+        }
+        if self.spin_density {
+            return Ok(Quantity::SpinDensity);
+        }
+        let spin = match self.spin {
+            SpinArg::Alpha => Spin::Alpha,
+            SpinArg::Beta => Spin::Beta,
+        };
+        wf.resolve(self.orbital, spin)
+            .map(Quantity::Orbital)
+            .ok_or_else(|| anyhow::anyhow!("no orbital {:?} of spin {spin:?} in this file", self.orbital))
+    }
+
+    fn label(&self, q: &Quantity, wf: &Wavefunction) -> String {
+        match q {
+            Quantity::Density => "total electron density".into(),
+            Quantity::SpinDensity => "spin density".into(),
+            Quantity::Orbital(i) => {
+                let o = &wf.orbitals[*i];
+                let n = wf.of_spin(o.spin).position(|(j, _)| j == *i).map_or(0, |p| p + 1);
+                format!("MO {n} ({:?}) E={:.6} Eh occ={:.3} {}", o.spin, o.energy, o.occupation, o.symmetry)
+            }
+        }
+    }
+}
+
+fn wavefunction_of(doc: &Document) -> Result<&Wavefunction> {
+    doc.wavefunction.as_ref().ok_or_else(|| {
+        anyhow::anyhow!("{} holds no basis set or orbitals (a Molden or fchk file is needed)", doc.source)
+    })
+}
+
+fn read_points(path: &Path) -> Result<Vec<DVec3>> {
+    let text = if path.as_os_str() == "-" {
+        std::io::read_to_string(std::io::stdin())?
+    } else {
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?
+    };
+    let mut points = Vec::new();
+    for (n, line) in text.lines().enumerate() {
+        let line = line.trim();
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        let v: Vec<f64> =
+            line.split_whitespace().take(3).map(str::parse).collect::<Result<_, _>>().map_err(|_| {
+                anyhow::anyhow!("{}:{}: expected `x y z` in bohr, found {line:?}", path.display(), n + 1)
+            })?;
+        if v.len() < 3 || v.iter().any(|x| !x.is_finite()) {
+            bail!("{}:{}: expected `x y z` in bohr, found {line:?}", path.display(), n + 1);
+        }
+        points.push(DVec3::new(v[0], v[1], v[2]));
+    }
+    Ok(points)
 }
 
 #[derive(Subcommand)]
@@ -293,6 +414,78 @@ fn main() -> Result<()> {
             } else {
                 print!("{}", info::text(&doc));
             }
+            Ok(())
+        }
+        Some(Command::Eval { file, what, points }) => {
+            let doc = formats::load(&file)?;
+            let wf = wavefunction_of(&doc)?;
+            let q = what.resolve(wf)?;
+            let prepared = PreparedBasis::new(&wf.basis);
+            let points = read_points(&points)?;
+            let values: Vec<f64> = points
+                .par_iter()
+                .map(|&p| match q {
+                    Quantity::Orbital(i) => prepared.orbital_value(&wf.orbitals[i].coefficients, p),
+                    Quantity::Density => prepared.density(wf, p),
+                    Quantity::SpinDensity => prepared.spin_density(wf, p),
+                })
+                .collect();
+            let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+            use std::io::Write;
+            for (p, v) in points.iter().zip(values) {
+                writeln!(out, "{:.10} {:.10} {:.10} {:.15e}", p.x, p.y, p.z, v)?;
+            }
+            Ok(())
+        }
+        Some(Command::Cube { file, what, grid, spacing, margin, output }) => {
+            let doc = formats::load(&file)?;
+            let wf = wavefunction_of(&doc)?;
+            let q = what.resolve(wf)?;
+            let (lo, hi) = doc.molecule.bounds().ok_or_else(|| anyhow::anyhow!("{}: no atoms", doc.source))?;
+            let (lo, hi) = (lo - DVec3::splat(margin), hi + DVec3::splat(margin));
+            let dims = match spacing {
+                Some(h) if h > 0.0 => ((hi - lo) / h).ceil().as_uvec3().to_array().map(|n| n as usize + 1),
+                Some(h) => bail!("--spacing must be positive, got {h}"),
+                None => [grid.max(2); 3],
+            };
+            if dims.iter().map(|&d| d as u64).product::<u64>() > formats::MAX_GRID_VALUES {
+                bail!("a {dims:?} grid is too large");
+            }
+            // cubegen's convention: the grid spans the box exactly, spacing = extent / (n − 1).
+            let step = match spacing {
+                Some(h) => DVec3::splat(h),
+                None => (hi - lo) / (dims[0] - 1) as f64,
+            };
+            let spec = GridSpec::new(
+                lo,
+                [DVec3::new(step.x, 0.0, 0.0), DVec3::new(0.0, step.y, 0.0), DVec3::new(0.0, 0.0, step.z)],
+                dims,
+            );
+            let prepared = PreparedBasis::new(&wf.basis);
+            let t = Instant::now();
+            let values: Vec<f64> = match q {
+                Quantity::Orbital(i) => prepared.eval_grid(&wf.orbitals[i].coefficients, &spec),
+                Quantity::Density => prepared.density_grid(wf, &spec),
+                Quantity::SpinDensity => prepared.spin_density_grid(wf, &spec),
+            };
+            let seconds = t.elapsed().as_secs_f64();
+            let world = VolumeGrid::affine(spec.origin, spec.steps);
+            let label = what.label(&q, wf);
+            let grid = VolumeGrid::new(&label, dims, world, values.iter().map(|&v| v as f32).collect());
+            let id = match q {
+                Quantity::Orbital(i) => wf.of_spin(wf.orbitals[i].spin).position(|(j, _)| j == i).map_or(0, |p| p + 1),
+                _ => 0,
+            };
+            let text =
+                cube_write::write(&format!("{} {}", doc.source, label), &label, &doc.molecule, &[(&grid, id as i64)]);
+            std::fs::write(&output, text).with_context(|| format!("writing {}", output.display()))?;
+            eprintln!(
+                "wrote {} ({}×{}×{}, {label}; evaluated in {seconds:.3} s)",
+                output.display(),
+                dims[0],
+                dims[1],
+                dims[2]
+            );
             Ok(())
         }
         Some(Command::Bench(BenchCommand::Render { file, view, frames, lavapipe })) => {

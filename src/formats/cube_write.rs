@@ -23,14 +23,16 @@ pub fn write(title: &str, description: &str, molecule: &Molecule, grids: &[(&Vol
     let o = first.origin();
     let natoms = molecule.atoms.len() as i64;
     let signed_natoms = if grids.len() > 1 { -natoms } else { natoms };
-    let _ = writeln!(out, "{signed_natoms:5} {:12.6} {:12.6} {:12.6}", o.x, o.y, o.z);
+    // Ten decimals, not the customary six: a six-decimal spacing misplaces the last points of
+    // an 80-point axis by ~1e-5 bohr, visible in the values read back.
+    let _ = writeln!(out, "{signed_natoms:5} {:16.10} {:16.10} {:16.10}", o.x, o.y, o.z);
     for axis in 0..3 {
         let v = first.step(axis);
-        let _ = writeln!(out, "{:5} {:12.6} {:12.6} {:12.6}", first.dims[axis], v.x, v.y, v.z);
+        let _ = writeln!(out, "{:5} {:16.10} {:16.10} {:16.10}", first.dims[axis], v.x, v.y, v.z);
     }
     for a in &molecule.atoms {
         let p = a.position;
-        let _ = writeln!(out, "{:5} {:12.6} {:12.6} {:12.6} {:12.6}", a.z, a.charge, p.x, p.y, p.z);
+        let _ = writeln!(out, "{:5} {:16.10} {:16.10} {:16.10} {:16.10}", a.z, a.charge, p.x, p.y, p.z);
     }
     if grids.len() > 1 {
         let ids: Vec<String> = grids.iter().map(|(_, id)| id.to_string()).collect();

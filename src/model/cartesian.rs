@@ -47,3 +47,63 @@ impl CartesianExpansion {
             .sum()
     }
 }
+
+impl CartesianExpansion {
+    /// The combination Σ_i c_i χ_i of a prepared basis's functions (an orbital's coefficients,
+    /// or a masked subset), shells with no weight left out.
+    pub fn from_coefficients(basis: &super::gto::PreparedBasis, coefficients: &[f64]) -> Self {
+        let (weights, active) = basis.monomial_coefficients(coefficients);
+        let mut shells = Vec::new();
+        for (s, &on) in basis.shells.iter().zip(&active) {
+            let n = super::basis::n_cartesian(s.l);
+            if on {
+                shells.push(CartesianShell {
+                    center: s.center(),
+                    l: s.l,
+                    cutoff: s.cutoff,
+                    primitives: s.primitives().map(|p| [basis.exponents[p], basis.coefficients[p]]).collect(),
+                    weights: weights[s.first_cartesian as usize..s.first_cartesian as usize + n].to_vec(),
+                });
+            }
+        }
+        Self { shells }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::DVec3;
+
+    use super::*;
+    use crate::model::basis::{Basis, Shell, ShellKind};
+    use crate::model::gto::PreparedBasis;
+
+    #[test]
+    fn expansion_equals_the_evaluator() {
+        // Cartesian and pure shells up to h, contracted, on three centres.
+        let mut shells = Vec::new();
+        for (i, l) in (0..=5u32).enumerate() {
+            for kind in [ShellKind::Cartesian, ShellKind::Pure] {
+                shells.push(Shell {
+                    atom: i % 3,
+                    center: DVec3::new(i as f64 * 0.4 - 1.0, 0.3 * (i % 2) as f64, -0.2 * i as f64),
+                    l,
+                    kind,
+                    exponents: vec![2.5, 0.6, 0.15],
+                    coefficients: vec![0.2, 0.5, 0.4],
+                });
+            }
+        }
+        let basis = Basis { shells };
+        let prepared = PreparedBasis::new(&basis);
+        let n = prepared.n_functions();
+        let coefficients: Vec<f64> = (0..n).map(|i| ((i * 37 % 11) as f64 - 5.0) / 7.0).collect();
+        let e = CartesianExpansion::from_coefficients(&prepared, &coefficients);
+        for k in 0..40 {
+            let p = DVec3::new((k as f64 * 0.37).sin() * 2.0, (k as f64 * 0.91).cos() * 1.5, k as f64 * 0.05 - 1.0);
+            let want = prepared.orbital_value(&coefficients, p);
+            let got = e.value(p);
+            assert!((got - want).abs() <= 1e-10 * want.abs().max(1.0), "{p}: {got} vs {want}");
+        }
+    }
+}

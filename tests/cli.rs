@@ -1,0 +1,116 @@
+//! The command line end to end: `eval` reproduces the corpus's expected values, `cube` writes a
+//! file the cube reader reads back with the same numbers, `info --json` describes wavefunctions,
+//! and bad input fails with a message, not a panic.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+const DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/refdata/real-world");
+
+fn orbcloud(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_orbcloud")).args(args).output().expect("run orbcloud")
+}
+
+fn refdata(name: &str) -> String {
+    let p = PathBuf::from(DIR).join(name);
+    assert!(p.exists(), "reference corpus missing: {}", p.display());
+    p.display().to_string()
+}
+
+#[test]
+fn eval_reproduces_expected_values() {
+    let dir = tempfile::tempdir().unwrap();
+    for (file, kind, flags, tolerance) in [
+        ("nh3_orca.molden", "homo", &["--orbital", "homo"][..], 1e-6),
+        ("o2_cc_pvtz_cart.fchk", "lumo", &["--orbital", "lumo"][..], 1e-6),
+        ("h2o_ccpvdz_cfour.molden", "density", &["--density"][..], 1e-5),
+    ] {
+        let table = std::fs::read_to_string(PathBuf::from(DIR).join("expected").join(format!("{file}.{kind}.tsv")))
+            .expect("expected table");
+        let points = dir.path().join("points.txt");
+        let expected: Vec<[f64; 4]> = table
+            .lines()
+            .filter(|l| !l.trim().is_empty())
+            .map(|l| {
+                let v: Vec<f64> = l.split_whitespace().map(|t| t.parse().unwrap()).collect();
+                [v[0], v[1], v[2], v[3]]
+            })
+            .collect();
+        let text: String = expected.iter().map(|v| format!("{} {} {}\n", v[0], v[1], v[2])).collect();
+        std::fs::write(&points, text).unwrap();
+        let mut args = vec!["eval", &refdata(file)].into_iter().map(String::from).collect::<Vec<_>>();
+        args.extend(flags.iter().map(|s| s.to_string()));
+        args.extend(["--points".to_string(), points.display().to_string()]);
+        let out = orbcloud(&args.iter().map(String::as_str).collect::<Vec<_>>());
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let stdout = String::from_utf8(out.stdout).unwrap();
+        let got: Vec<f64> = stdout.lines().map(|l| l.split_whitespace().nth(3).unwrap().parse().unwrap()).collect();
+        assert_eq!(got.len(), expected.len());
+        for (g, e) in got.iter().zip(&expected) {
+            let err = if kind == "density" { (g - e[3]).abs() / e[3].abs().max(1e-12) } else { (g - e[3]).abs() };
+            assert!(err <= tolerance, "{file} {kind}: {g} vs {}", e[3]);
+        }
+    }
+}
+
+#[test]
+fn cube_output_reads_back() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_path = dir.path().join("homo.cube");
+    let out = orbcloud(&[
+        "cube",
+        &refdata("water_hf_sto3g_qchem5.2.fchk"),
+        "--orbital",
+        "homo",
+        "--grid",
+        "24",
+        "-o",
+        out_path.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let cube = orbcloud::formats::load(&out_path).expect("the cube reader reads it");
+    let grid = &cube.volumes[0];
+    assert_eq!(grid.dims, [24, 24, 24]);
+    assert_eq!(cube.molecule.atoms.len(), 3);
+    let doc = orbcloud::formats::load(std::path::Path::new(&refdata("water_hf_sto3g_qchem5.2.fchk"))).unwrap();
+    let wf = doc.wavefunction.as_ref().unwrap();
+    let homo = &wf.orbitals[wf.homo(orbcloud::model::Spin::Alpha).unwrap()].coefficients;
+    let prepared = orbcloud::model::gto::PreparedBasis::new(&wf.basis);
+    for (i, j, k) in [(3, 5, 7), (12, 12, 12), (20, 2, 17), (0, 0, 0)] {
+        let want = prepared.orbital_value(homo, grid.point(i, j, k));
+        let got = grid.value(i, j, k) as f64;
+        // The file holds 6 significant digits.
+        assert!((got - want).abs() <= 1e-5 * want.abs() + 1e-12, "({i},{j},{k}): {got} vs {want}");
+    }
+}
+
+#[test]
+fn info_json_describes_the_wavefunction() {
+    let out = orbcloud(&["info", &refdata("nh3_turbomole.molden"), "--json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let wf = &v["wavefunction"];
+    assert_eq!(wf["normalization"]["program"], "Turbomole");
+    assert!(wf["normalization"]["residual"].as_f64().unwrap() < 1e-6);
+    assert_eq!(wf["basis_functions"], 52);
+    assert!(wf["homo"].is_object() && wf["lumo"].is_object());
+}
+
+#[test]
+fn bad_input_fails_cleanly() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad.molden");
+    std::fs::write(&bad, "[Molden Format]\n[Atoms] AU\nO 1 8 0.0 zero 0.0\n").unwrap();
+    for args in [
+        vec!["info", bad.to_str().unwrap()],
+        vec!["eval", &refdata("nh3_orca.molden"), "--orbital", "homo-99", "--points", "-"],
+        vec!["cube", &refdata("aelta.cube"), "-o", "/dev/null"],
+        vec!["render", "/nonexistent.cube", "-o", "/dev/null"],
+    ] {
+        let out = orbcloud(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{args:?} succeeded");
+        assert!(!err.contains("panicked"), "{args:?} panicked: {err}");
+        assert!(!err.trim().is_empty(), "{args:?} gave no message");
+    }
+}
