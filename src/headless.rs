@@ -1,16 +1,105 @@
 //! Rendering a document to an image without a window: the CLI's `render`, the benchmarks and
 //! the golden-image tests use this, through the same [`Renderer`] as the viewer.
 
+use glam::DVec3;
+
+use crate::gpu::gto::{GridGeometry, GtoFillPass, read_volume, volume_from_texture};
 use crate::gpu::{FrameInput, GpuContext, GpuError, OffscreenTarget, Renderer};
-use crate::model::Document;
+use crate::model::cartesian::CartesianExpansion;
+use crate::model::gto::{GridSpec, PreparedBasis};
+use crate::model::orbitals::Quantity;
+use crate::model::{Document, VolumeGrid};
 use crate::scene::{Camera, RenderSettings};
 
-/// A camera that frames everything in the document from the default direction.
+/// Space (bohr) around the atoms in which orbitals are evaluated.
+pub const ORBITAL_MARGIN: f64 = 4.5;
+
+/// A camera that frames everything in the document from the default direction: its grids, or
+/// for a wavefunction the box its orbitals are evaluated in.
 pub fn default_camera(doc: &Document) -> Camera {
-    match doc.bounds() {
+    let bounds = match (&doc.wavefunction, doc.molecule.bounds()) {
+        (Some(_), Some((lo, hi))) => Some((lo - DVec3::splat(ORBITAL_MARGIN), hi + DVec3::splat(ORBITAL_MARGIN))),
+        _ => doc.bounds(),
+    };
+    match bounds {
         Some((lo, hi)) => Camera::framing(lo.as_vec3(), hi.as_vec3()),
         None => Camera::default(),
     }
+}
+
+/// The grid a wavefunction's orbitals are evaluated on: the atoms plus [`ORBITAL_MARGIN`],
+/// `points` per axis.
+pub fn orbital_geometry(doc: &Document, points: usize) -> Option<GridGeometry> {
+    let (lo, hi) = doc.molecule.bounds()?;
+    let margin = DVec3::splat(ORBITAL_MARGIN);
+    Some(GridGeometry::cube(lo - margin, hi + margin, points))
+}
+
+/// How to show a quantity of a wavefunction.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WavefunctionView<'a> {
+    pub quantity: Quantity,
+    /// Seed 004's direct mode (orbitals only): evaluate per slice sample, no grid.
+    pub direct: bool,
+    /// Points per axis of the evaluation grid.
+    pub points: usize,
+    /// Per shell, whether it contributes (the atomic-orbital selector); `None`: all.
+    pub shells: Option<&'a [bool]>,
+}
+
+/// Puts a wavefunction's orbital or density into `renderer`: orbitals through the GPU (a filled
+/// texture, or direct evaluation per sample), densities evaluated on the CPU. `fill` caches the
+/// compute pipeline between calls.
+pub fn show_wavefunction(
+    ctx: &GpuContext,
+    renderer: &mut Renderer,
+    fill: &mut Option<GtoFillPass>,
+    doc: &Document,
+    view: &WavefunctionView,
+) -> Result<(), GpuError> {
+    let (Some(wf), Some(geometry)) = (&doc.wavefunction, orbital_geometry(doc, view.points)) else {
+        return Ok(());
+    };
+    let prepared = PreparedBasis::new(&wf.basis);
+    match view.quantity {
+        Quantity::Orbital(i) => {
+            let mut coefficients = wf.orbitals[i].coefficients.clone();
+            if let Some(mask) = view.shells {
+                for ((shell, offset), &keep) in wf.basis.shells.iter().zip(wf.basis.shell_offsets()).zip(mask) {
+                    if !keep {
+                        coefficients[offset..offset + shell.n_functions()].fill(0.0);
+                    }
+                }
+            }
+            let expansion = CartesianExpansion::from_coefficients(&prepared, &coefficients);
+            let fill = fill.get_or_insert_with(|| GtoFillPass::new(ctx));
+            let texture = fill.fill(ctx, &expansion, &geometry)?;
+            // The filled values give the range that scales the opacity (and the gradient scale).
+            let grid = VolumeGrid::new("orbital", geometry.dims, geometry.world_from_grid, read_volume(ctx, &texture)?);
+            if view.direct {
+                renderer.set_direct(ctx, &expansion, &geometry, grid.stats.max_abs);
+            } else {
+                let mut volume = volume_from_texture(texture, &geometry, grid.stats.max_abs);
+                volume.max_grad = grid.max_gradient().max(1e-30) as f32;
+                renderer.set_volume_texture(ctx, volume);
+            }
+        }
+        Quantity::Density | Quantity::SpinDensity => {
+            let spec = GridSpec::new(
+                geometry.world_from_grid.w_axis.truncate(),
+                std::array::from_fn(|a| geometry.world_from_grid.col(a).truncate()),
+                geometry.dims,
+            );
+            let (values, label) = if view.quantity == Quantity::Density {
+                (prepared.density_grid(wf, &spec), "total density")
+            } else {
+                (prepared.spin_density_grid(wf, &spec), "spin density")
+            };
+            let values = values.iter().map(|&v| v as f32).collect();
+            renderer.set_volume(ctx, Some(&VolumeGrid::new(label, geometry.dims, geometry.world_from_grid, values)))?;
+        }
+    }
+    Ok(())
 }
 
 /// A renderer with an offscreen target of a fixed size.

@@ -8,11 +8,11 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 use glam::DVec3;
 use orbcloud::formats::cube_write;
 use orbcloud::gpu::{AdapterPreference, GpuContext};
-use orbcloud::headless::{Headless, default_camera};
+use orbcloud::headless::{Headless, WavefunctionView, default_camera, show_wavefunction};
 use orbcloud::model::Document;
 use orbcloud::model::VolumeGrid;
 use orbcloud::model::gto::{GridSpec, PreparedBasis};
-use orbcloud::model::orbitals::{OrbitalSpec, Spin, Wavefunction};
+use orbcloud::model::orbitals::{OrbitalSpec, Quantity, Spin, Wavefunction};
 use orbcloud::scene::transfer::PRESETS;
 use orbcloud::scene::{AtomStyle, Camera, ClipPlane, RenderSettings, Shape, SliceMode, TransferKind};
 use orbcloud::{demo, formats, info};
@@ -93,11 +93,34 @@ enum SpinArg {
     Beta,
 }
 
-/// What `eval` and `cube` compute.
-enum Quantity {
-    Orbital(usize),
-    Density,
-    SpinDensity,
+/// How `render` and `bench` show a wavefunction (Molden, fchk).
+#[derive(Args)]
+struct WavefunctionArgs {
+    #[command(flatten)]
+    what: WhatArgs,
+    /// Evaluate the orbital per slice sample from the basis functions (seed 004's direct mode)
+    /// instead of on a GPU-filled grid.
+    #[arg(long)]
+    direct: bool,
+    /// Points per axis of the grid orbitals are evaluated on.
+    #[arg(long, default_value_t = 72)]
+    grid_points: usize,
+}
+
+impl WavefunctionArgs {
+    /// Puts the requested quantity into the headless renderer, when the document has a wavefunction.
+    fn apply(&self, ctx: &GpuContext, h: &mut Headless, doc: &Document) -> Result<()> {
+        let Some(wf) = &doc.wavefunction else { return Ok(()) };
+        let view = WavefunctionView {
+            quantity: self.what.resolve(wf)?,
+            direct: self.direct,
+            points: self.grid_points.clamp(8, 512),
+            shells: None,
+        };
+        let mut fill = None;
+        show_wavefunction(ctx, &mut h.renderer, &mut fill, doc, &view)?;
+        Ok(())
+    }
 }
 
 impl WhatArgs {
@@ -174,6 +197,8 @@ enum BenchCommand {
         /// Use the CPU Vulkan adapter (lavapipe) even when a GPU is present.
         #[arg(long)]
         lavapipe: bool,
+        #[command(flatten)]
+        wavefunction: WavefunctionArgs,
     },
 }
 
@@ -189,6 +214,8 @@ struct RenderArgs {
     /// Use the CPU Vulkan adapter (lavapipe) even when a GPU is present.
     #[arg(long)]
     lavapipe: bool,
+    #[command(flatten)]
+    wavefunction: WavefunctionArgs,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -402,6 +429,7 @@ fn main() -> Result<()> {
             let ctx = gpu(args.lavapipe)?;
             let settings = args.view.settings();
             let mut h = Headless::new(&ctx, &doc, args.view.volume_index(&doc)?, &settings, args.view.size)?;
+            args.wavefunction.apply(&ctx, &mut h, &doc)?;
             let img = h.render(&ctx, &args.view.camera(&doc), &settings)?;
             img.save(&args.output).with_context(|| format!("writing {}", args.output.display()))?;
             eprintln!("wrote {} ({}x{}, {})", args.output.display(), img.width(), img.height(), ctx.describe());
@@ -488,12 +516,13 @@ fn main() -> Result<()> {
             );
             Ok(())
         }
-        Some(Command::Bench(BenchCommand::Render { file, view, frames, lavapipe })) => {
+        Some(Command::Bench(BenchCommand::Render { file, view, frames, lavapipe, wavefunction })) => {
             let doc = load(file.as_deref())?;
             let ctx = gpu(lavapipe)?;
             let settings = view.settings();
             let camera = view.camera(&doc);
             let mut h = Headless::new(&ctx, &doc, view.volume_index(&doc)?, &settings, view.size)?;
+            wavefunction.apply(&ctx, &mut h, &doc)?;
             let wait = |ctx: &GpuContext| ctx.device.poll(wgpu::PollType::wait_indefinitely()).map(|_| ());
             for _ in 0..2 {
                 h.draw(&ctx, &camera, &settings);

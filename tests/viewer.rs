@@ -83,3 +83,39 @@ fn a_bad_file_reports_an_error_and_keeps_the_open_document() {
     h.run_steps(2);
     assert!(h.state().error.is_none());
 }
+
+#[test]
+fn a_molden_file_opens_on_its_homo_and_the_browser_switches_orbitals() {
+    use orbcloud::model::orbitals::Quantity;
+    let path =
+        std::path::PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/refdata/real-world/nh3_orca.molden"));
+    assert!(path.exists(), "reference corpus missing: {}", path.display());
+    let mut h = Harness::builder()
+        .with_size([1200.0, 800.0])
+        .wgpu_setup(wgpu_setup(true))
+        .build_eframe(|cc| OrbApp::new(cc, vec![path]));
+    for _ in 0..300 {
+        h.run_steps(1);
+        if !h.state().is_loading() && h.state().doc.wavefunction.is_some() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    h.run_steps(2);
+    let app = h.state();
+    assert!(app.error.is_none(), "{:?}", app.error);
+    let wf = app.doc.wavefunction.as_ref().expect("the Molden file loaded");
+    let homo = wf.homo(orbcloud::model::Spin::Alpha).unwrap();
+    assert_eq!(app.orbitals.shown, Quantity::Orbital(homo), "opens on the HOMO");
+    let lumo = wf.lumo(orbcloud::model::Spin::Alpha).unwrap();
+    h.get_by_label(&format!("MO {}", lumo + 1)).click();
+    h.run_steps(2);
+    assert_eq!(h.state().orbitals.shown, Quantity::Orbital(lumo));
+    h.get_by_label("per sample (direct)").click();
+    h.run_steps(2);
+    assert!(h.state().orbitals.direct);
+    h.get_by_label("total density").click();
+    h.run_steps(2);
+    assert_eq!(h.state().orbitals.shown, Quantity::Density);
+    assert!(h.state().error.is_none(), "{:?}", h.state().error);
+}

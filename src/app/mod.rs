@@ -1,6 +1,7 @@
 //! The eframe viewer: the only module that uses egui and rfd.
 
 mod loader;
+mod orbitals;
 mod panels;
 pub mod state;
 mod viewport;
@@ -9,10 +10,11 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use crate::gpu::{GpuContext, context::device_descriptor};
+use crate::headless::WavefunctionView;
 use crate::headless::default_camera;
 use crate::model::Document;
 use loader::LoadJob;
-pub use state::ViewState;
+pub use state::{OrbitalView, ViewState};
 use viewport::Viewport;
 
 /// Opens the window on `files` (the bundled demo when empty) and runs until it closes.
@@ -49,6 +51,9 @@ pub fn wgpu_setup(lavapipe: bool) -> egui_wgpu::WgpuSetup {
 pub struct OrbApp {
     pub doc: Document,
     pub view: ViewState,
+    /// The orbital browser's choices (documents with a wavefunction).
+    pub orbitals: OrbitalView,
+    scroll_to_frontier: bool,
     viewport: Option<Viewport>,
     job: Option<LoadJob>,
     /// Files given on the command line or dropped, waiting to be loaded one after another.
@@ -66,6 +71,8 @@ impl OrbApp {
         let mut app = Self {
             doc: Document::default(),
             view: ViewState::default(),
+            orbitals: OrbitalView::default(),
+            scroll_to_frontier: false,
             viewport,
             job: None,
             queue: files.into_iter().rev().collect(),
@@ -105,8 +112,26 @@ impl OrbApp {
             return;
         }
         self.status = format!("opened {}", doc.source);
+        self.orbitals = doc.wavefunction.as_ref().map(OrbitalView::for_wavefunction).unwrap_or_default();
+        self.scroll_to_frontier = true;
         self.doc = doc;
         self.view = view;
+        self.show_wavefunction();
+    }
+
+    /// Computes what the orbital browser asks for and hands it to the viewport.
+    fn show_wavefunction(&mut self) {
+        let Some(vp) = &mut self.viewport else { return };
+        let ov = &self.orbitals;
+        let view = WavefunctionView {
+            quantity: ov.shown,
+            direct: ov.direct,
+            points: ov.grid_points,
+            shells: ov.ao_filter.then_some(ov.shell_mask.as_slice()),
+        };
+        if let Err(e) = vp.show_wavefunction(&self.doc, &view) {
+            self.error = Some(e.to_string());
+        }
     }
 
     fn poll_job(&mut self, ctx: &egui::Context) {
@@ -175,6 +200,11 @@ impl eframe::App for OrbApp {
         let action = panels::top_bar(ui, self);
         panels::status_bar(ui, self);
         panels::side_panel(ui, self);
+        let orbitals_before = self.orbitals.clone();
+        orbitals::panel(ui, &self.doc, &mut self.orbitals, &mut self.scroll_to_frontier);
+        if self.orbitals != orbitals_before {
+            self.show_wavefunction();
+        }
         self.apply(&before);
         match action {
             panels::Action::Open => {

@@ -3,6 +3,7 @@
 use egui::{ComboBox, RichText, Slider};
 
 use super::OrbApp;
+use crate::model::orbitals::Quantity;
 use crate::model::{grid::ValueKind, units::ANGSTROM_PER_BOHR};
 use crate::scene::transfer::{Lobe, PRESETS};
 use crate::scene::{AtomStyle, ClipPlane, Shape, SliceMode, Transfer, TransferKind};
@@ -48,6 +49,19 @@ pub fn status_bar(ui: &mut egui::Ui, app: &OrbApp) {
             }
             let m = &app.doc.molecule;
             ui.label(format!("{} atoms ({}), {} bonds", m.atoms.len(), m.formula(), m.bonds.len()));
+            if let (Some(wf), Quantity::Orbital(i)) = (&app.doc.wavefunction, app.orbitals.shown) {
+                let o = &wf.orbitals[i];
+                ui.separator();
+                ui.label(format!(
+                    "{} {:?} {} E = {:.5} Eh ({:.3} eV), occupation {:.2}",
+                    wf.frontier_label(i, 50).unwrap_or_else(|| format!("MO {}", i + 1)),
+                    o.spin,
+                    o.symmetry,
+                    o.energy,
+                    o.energy * crate::model::units::EV_PER_HARTREE,
+                    o.occupation
+                ));
+            }
             if let Some(g) = app.doc.volumes.get(app.view.volume) {
                 ui.separator();
                 let h: Vec<String> = (0..3).map(|a| format!("{:.3}", g.step(a).length())).collect();
@@ -75,7 +89,11 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
             let view = &mut app.view;
             ui.heading("Volume");
             if app.doc.volumes.is_empty() {
-                ui.label("no volume in this file");
+                ui.label(if app.doc.wavefunction.is_some() {
+                    "computed from the basis set: choose it under Orbitals"
+                } else {
+                    "no volume in this file"
+                });
             } else {
                 let label = ui.label("data set");
                 ComboBox::from_id_salt("data set")
@@ -227,7 +245,7 @@ fn clip_editor(ui: &mut egui::Ui, clip: &mut ClipPlane) {
         });
         ui.horizontal(|ui| {
             for (name, n) in [("x", [1.0, 0.0, 0.0]), ("y", [0.0, 1.0, 0.0]), ("z", [0.0, 0.0, 1.0])] {
-                if ui.button(format!("⊥{name}")).clicked() {
+                if ui.button(format!("normal {name}")).clicked() {
                     clip.normal = n;
                 }
             }

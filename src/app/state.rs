@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::model::orbitals::{Spin, Wavefunction};
+use crate::model::orbitals::{Quantity, Spin, Wavefunction};
 use crate::scene::{Camera, RenderSettings};
 
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
@@ -20,20 +20,10 @@ pub const KEY_ZOOM: f32 = 1.1;
 /// Mouse orbit, radians per point dragged.
 pub const DRAG_ROTATE: f32 = 0.008;
 
-/// What of a wavefunction is shown.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-pub enum Shown {
-    /// An orbital, by index into `Wavefunction::orbitals`.
-    Orbital(usize),
-    #[default]
-    Density,
-    SpinDensity,
-}
-
 /// The orbital browser's choices.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct OrbitalView {
-    pub shown: Shown,
+    pub shown: Quantity,
     pub spin: Spin,
     /// Evaluate per slice sample (seed 004's direct mode) instead of on a GPU-filled grid.
     pub direct: bool,
@@ -47,7 +37,7 @@ pub struct OrbitalView {
 impl Default for OrbitalView {
     fn default() -> Self {
         Self {
-            shown: Shown::Density,
+            shown: Quantity::Density,
             spin: Spin::Alpha,
             direct: false,
             ao_filter: false,
@@ -60,7 +50,7 @@ impl Default for OrbitalView {
 impl OrbitalView {
     /// Opens on the HOMO, as a chemist expects.
     pub fn for_wavefunction(wf: &Wavefunction) -> Self {
-        let shown = wf.homo(Spin::Alpha).map_or(Shown::Density, Shown::Orbital);
+        let shown = wf.homo(Spin::Alpha).map_or(Quantity::Density, Quantity::Orbital);
         Self { shown, shell_mask: vec![true; wf.basis.shells.len()], ..Self::default() }
     }
 

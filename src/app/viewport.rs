@@ -4,12 +4,15 @@
 use egui::{Key, PointerButton, Sense};
 
 use super::state::{DRAG_ROTATE, KEY_ROTATE, KEY_ZOOM, ViewState};
+use crate::gpu::gto::GtoFillPass;
 use crate::gpu::{FrameInput, GpuContext, GpuError, OffscreenTarget, Renderer};
+use crate::headless::WavefunctionView;
 use crate::model::Document;
 
 pub struct Viewport {
     pub ctx: GpuContext,
     renderer: Renderer,
+    fill: Option<GtoFillPass>,
     target: Option<(OffscreenTarget, egui::TextureId)>,
     /// The state the texture currently shows; a frame is drawn only when this changes.
     drawn: Option<(ViewState, [u32; 2], u64)>,
@@ -20,7 +23,7 @@ pub struct Viewport {
 impl Viewport {
     pub fn new(ctx: GpuContext) -> Self {
         let renderer = Renderer::new(&ctx);
-        Self { ctx, renderer, target: None, drawn: None, generation: 0 }
+        Self { ctx, renderer, fill: None, target: None, drawn: None, generation: 0 }
     }
 
     /// Uploads a document's molecule and chosen volume.
@@ -33,6 +36,13 @@ impl Viewport {
 
     pub fn set_volume(&mut self, doc: &Document, index: usize) -> Result<(), GpuError> {
         self.renderer.set_volume(&self.ctx, doc.volumes.get(index))?;
+        self.generation += 1;
+        Ok(())
+    }
+
+    /// Shows a wavefunction's orbital or density (see [`crate::headless::show_wavefunction`]).
+    pub fn show_wavefunction(&mut self, doc: &Document, view: &WavefunctionView) -> Result<(), GpuError> {
+        crate::headless::show_wavefunction(&self.ctx, &mut self.renderer, &mut self.fill, doc, view)?;
         self.generation += 1;
         Ok(())
     }
@@ -134,6 +144,10 @@ fn handle_input(ui: &egui::Ui, response: &egui::Response, view: &mut ViewState) 
         return;
     }
     ui.input(|i| {
+        // Shift + arrows belong to the orbital browser.
+        if i.modifiers.shift {
+            return;
+        }
         let step = |k| i.key_pressed(k) as i32 as f32;
         cam.orbit(
             (step(Key::ArrowLeft) - step(Key::ArrowRight)) * KEY_ROTATE,

@@ -67,6 +67,18 @@ impl Wavefunction {
     }
 }
 
+/// What of a wavefunction is evaluated or shown.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub enum Quantity {
+    /// An orbital, by index into `Wavefunction::orbitals`.
+    Orbital(usize),
+    /// The total electron density Σ occ |φ|².
+    #[default]
+    Density,
+    /// α − β density.
+    SpinDensity,
+}
+
 /// Which orbital a user means: `homo`, `lumo`, `homo-2`, `lumo+1`, or a 1-based index into the
 /// orbitals of the chosen spin (as programs number them).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -146,7 +158,7 @@ impl Wavefunction {
         let lumo = self.lumo(spin).and_then(|l| order.iter().position(|&i| i == l));
         match (homo, lumo) {
             (Some(h), _) if pos <= h && h - pos <= range => {
-                Some(if pos == h { "HOMO".into() } else { format!("HOMO−{}", h - pos) })
+                Some(if pos == h { "HOMO".into() } else { format!("HOMO-{}", h - pos) })
             }
             (_, Some(l)) if pos >= l && pos - l <= range => {
                 Some(if pos == l { "LUMO".into() } else { format!("LUMO+{}", pos - l) })
@@ -200,7 +212,7 @@ mod tests {
         assert_eq!(w.resolve(OrbitalSpec::Homo(3), Spin::Alpha), None);
         assert_eq!(w.resolve(OrbitalSpec::Lumo(1), Spin::Beta), Some(1));
         assert_eq!(w.resolve(OrbitalSpec::Index(2), Spin::Alpha), Some(1));
-        assert_eq!(w.frontier_label(0, 3).as_deref(), Some("HOMO−1"));
+        assert_eq!(w.frontier_label(0, 3).as_deref(), Some("HOMO-1"));
         assert_eq!(w.frontier_label(1, 3).as_deref(), Some("LUMO+1"));
         assert_eq!(w.frontier_label(2, 1), None);
     }
