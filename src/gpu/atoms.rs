@@ -120,16 +120,7 @@ impl AtomsPass {
         });
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("atoms bind group layout"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
-            }],
+            entries: &[super::uniform_entry(0, wgpu::ShaderStages::VERTEX_FRAGMENT)],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("atoms pipeline layout"),
@@ -193,12 +184,7 @@ impl AtomsPass {
                 attribute(3, wgpu::VertexFormat::Float32x4, 32),
             ],
         );
-        let globals = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("atoms globals"),
-            size: std::mem::size_of::<AtomGlobals>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let globals = super::uniform_buffer(device, "atoms globals", std::mem::size_of::<AtomGlobals>());
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("atoms bind group"),
             layout: &layout,

@@ -65,16 +65,7 @@ pub struct GtoBuffers {
 }
 
 pub fn gto_layout(device: &wgpu::Device, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayout {
-    let storage = |binding| wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only: true },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    };
+    let storage = |binding| super::buffer_entry(binding, visibility, wgpu::BufferBindingType::Storage { read_only: true });
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("gto bind group layout"),
         entries: &[storage(0), storage(1), storage(2)],
@@ -147,16 +138,7 @@ impl GtoFillPass {
         let fill_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("gto fill layout"),
             entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
+                super::uniform_entry(0, wgpu::ShaderStages::COMPUTE),
                 wgpu::BindGroupLayoutEntry {
                     binding: 1,
                     visibility: wgpu::ShaderStages::COMPUTE,
@@ -253,39 +235,6 @@ pub fn volume_from_texture(texture: wgpu::Texture, grid: &GridGeometry, max_abs:
 /// Reads an R32Float 3D texture back into cube order (x slowest, z fastest) — for tests, export
 /// and checks against the CPU.
 pub fn read_volume(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Vec<f32>, GpuError> {
-    let size = texture.size();
-    let (w, h, d) = (size.width, size.height, size.depth_or_array_layers);
-    let unpadded = 4 * w;
-    let padded = unpadded.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-    let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("volume readback"),
-        size: padded as u64 * h as u64 * d as u64,
-        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-        mapped_at_creation: false,
-    });
-    let mut encoder =
-        ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("volume readback") });
-    encoder.copy_texture_to_buffer(
-        texture.as_image_copy(),
-        wgpu::TexelCopyBufferInfo {
-            buffer: &buffer,
-            layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(padded), rows_per_image: Some(h) },
-        },
-        size,
-    );
-    ctx.queue.submit([encoder.finish()]);
-    let slice = buffer.slice(..);
-    let (tx, rx) = std::sync::mpsc::channel();
-    slice.map_async(wgpu::MapMode::Read, move |r| {
-        let _ = tx.send(r);
-    });
-    let fail = |e: String| GpuError::Readback(e);
-    ctx.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| fail(e.to_string()))?;
-    rx.recv().map_err(|e| fail(e.to_string()))?.map_err(|e| fail(e.to_string()))?;
-    let data = slice.get_mapped_range().map_err(|e| fail(e.to_string()))?;
-    let mut out = Vec::with_capacity((w * h * d) as usize);
-    for row in data.chunks(padded as usize) {
-        out.extend_from_slice(bytemuck::cast_slice(&row[..unpadded as usize]));
-    }
-    Ok(out)
+    let bytes = super::readback::read_texture(&ctx.device, &ctx.queue, texture, 4)?;
+    Ok(bytemuck::pod_collect_to_vec(&bytes))
 }

@@ -6,6 +6,7 @@
 pub mod atoms;
 pub mod context;
 pub mod gto;
+pub mod readback;
 pub mod renderer;
 pub mod resolve;
 pub mod target;
@@ -48,6 +49,31 @@ pub fn module_source(name: &str) -> String {
         Some((_, parts)) => parts.iter().map(|p| shader_source(p)).collect::<Vec<_>>().join("\n"),
         None => shader_source(name).to_string(),
     }
+}
+
+/// A bind-group layout entry for a buffer (uniform, or read-only storage).
+pub(crate) fn buffer_entry(binding: u32, visibility: wgpu::ShaderStages, ty: wgpu::BufferBindingType) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
+        count: None,
+    }
+}
+
+/// A uniform-buffer layout entry.
+pub(crate) fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+    buffer_entry(binding, visibility, wgpu::BufferBindingType::Uniform)
+}
+
+/// A uniform buffer of `size` bytes, written with `queue.write_buffer`.
+pub(crate) fn uniform_buffer(device: &wgpu::Device, label: &str, size: usize) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: size as u64,
+        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
 }
 
 pub(crate) fn shader_source(name: &str) -> &'static str {

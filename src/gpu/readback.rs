@@ -1,0 +1,49 @@
+//! Copying textures back to memory (blocking): frames for PNGs and tests, filled volumes.
+
+use super::GpuError;
+
+/// The texels of `texture` (all layers), rows packed tightly, `bytes_per_texel` each.
+pub fn read_texture(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    texture: &wgpu::Texture,
+    bytes_per_texel: u32,
+) -> Result<Vec<u8>, GpuError> {
+    let size = texture.size();
+    let (w, h, layers) = (size.width, size.height, size.depth_or_array_layers);
+    let unpadded = bytes_per_texel * w;
+    let align = wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let padded = unpadded.div_ceil(align) * align;
+    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback"),
+        size: padded as u64 * h as u64 * layers as u64,
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("readback") });
+    encoder.copy_texture_to_buffer(
+        texture.as_image_copy(),
+        wgpu::TexelCopyBufferInfo {
+            buffer: &buffer,
+            layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(padded), rows_per_image: Some(h) },
+        },
+        size,
+    );
+    queue.submit([encoder.finish()]);
+    let fail = |e: String| GpuError::Readback(e);
+    let slice = buffer.slice(..);
+    let (tx, rx) = std::sync::mpsc::channel();
+    slice.map_async(wgpu::MapMode::Read, move |r| {
+        let _ = tx.send(r);
+    });
+    device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| fail(e.to_string()))?;
+    rx.recv().map_err(|e| fail(e.to_string()))?.map_err(|e| fail(e.to_string()))?;
+    let data = slice.get_mapped_range().map_err(|e| fail(e.to_string()))?;
+    let mut out = Vec::with_capacity((unpadded * h * layers) as usize);
+    for row in data.chunks(padded as usize) {
+        out.extend_from_slice(&row[..unpadded as usize]);
+    }
+    drop(data);
+    buffer.unmap();
+    Ok(out)
+}
