@@ -37,7 +37,7 @@ pub const DEFAULT_THRESHOLD: f64 = 1e-12;
 pub const MAX_EVAL_L: u32 = 6;
 
 /// Points between exact re-evaluations of exp(−α r²) along a grid row.
-pub const RESEED: usize = 32;
+pub const RESEED: usize = 64;
 
 /// One shell in evaluation-ready form; indices point into [`PreparedBasis`]'s flat arrays.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -560,7 +560,10 @@ impl PreparedBasis {
             rad.fill(0.0);
             let mut any = false;
             for j in s.primitives() {
-                let Some((j0, j1)) = interval(a, b, c0, self.primitive_cutoffs2[j], n) else {
+                // Beyond α r² = 690 the exponential underflows anyway; bounding the interval
+                // there also bounds the recurrence ratios (no overflow without a threshold).
+                let r2max = self.primitive_cutoffs2[j].min(690.0 / self.exponents[j]);
+                let Some((j0, j1)) = interval(a, b, c0, r2max, n) else {
                     continue;
                 };
                 let (j0, j1) = (j0.max(k0), j1.min(k1));
@@ -568,23 +571,13 @@ impl PreparedBasis {
                     continue;
                 }
                 any = true;
-                let alpha = self.exponents[j];
-                let cj = self.coefficients[j];
-                let w = (-2.0 * alpha * a).exp();
-                let mut k = j0;
-                while k < j1 {
-                    let kf = k as f64;
-                    let r2 = (a * kf + 2.0 * b) * kf + c0;
-                    let mut g = cj * (-alpha * r2).exp();
-                    let mut q = (-alpha * (2.0 * (b + a * kf) + a)).exp();
-                    let end = (k + RESEED).min(j1);
-                    for r in &mut rad[k - k0..end - k0] {
-                        *r += g;
-                        g *= q;
-                        q *= w;
-                    }
-                    k = end;
-                }
+                accumulate_gaussian(
+                    &mut rad[j0 - k0..j1 - k0],
+                    j0,
+                    self.coefficients[j],
+                    self.exponents[j],
+                    [a, b, c0],
+                );
             }
             if !any {
                 continue;
@@ -668,6 +661,52 @@ struct RowScratch {
 impl RowScratch {
     fn new(n: usize, sets: usize) -> Self {
         Self { radial: vec![0.0; n], psi: vec![vec![0.0; n]; if sets > 1 { sets } else { 1 }] }
+    }
+}
+
+/// Adds c·exp(−α r²(k)) to `rad[k − k_start]` for k = k_start.., where
+/// r²(k) = a k² + 2b k + c0 (`quad` = [a, b, c0]).
+///
+/// Four interleaved recurrences (points k, k+1, k+2, k+3 of each group of four) keep the
+/// multiplications independent; each segment of [`RESEED`] points starts from exact `exp`s.
+fn accumulate_gaussian(rad: &mut [f64], k_start: usize, c: f64, alpha: f64, quad: [f64; 3]) {
+    let [a, b, c0] = quad;
+    // Ratio between the stride-4 ratios of consecutive groups: exp(−32 α a).
+    let big_w = (-32.0 * alpha * a).exp();
+    // Ratio between the stride-4 ratios of neighbouring lanes: exp(−8 α a).
+    let lane_w = (-8.0 * alpha * a).exp();
+    let step_w = (-2.0 * alpha * a).exp();
+    let n = rad.len();
+    let mut start = 0;
+    while start < n {
+        let end = (start + RESEED).min(n);
+        let kf = (k_start + start) as f64;
+        let r2 = (a * kf + 2.0 * b) * kf + c0;
+        let mut g = [0.0f64; 4];
+        g[0] = c * (-alpha * r2).exp();
+        let mut q = (-alpha * (2.0 * (b + a * kf) + a)).exp();
+        for lane in 1..4 {
+            g[lane] = g[lane - 1] * q;
+            q *= step_w;
+        }
+        let mut big_q = [0.0f64; 4];
+        big_q[0] = (-alpha * (8.0 * (a * kf + b) + 16.0 * a)).exp();
+        for lane in 1..4 {
+            big_q[lane] = big_q[lane - 1] * lane_w;
+        }
+        let seg = &mut rad[start..end];
+        let mut chunks = seg.chunks_exact_mut(4);
+        for chunk in &mut chunks {
+            for lane in 0..4 {
+                chunk[lane] += g[lane];
+                g[lane] *= big_q[lane];
+                big_q[lane] *= big_w;
+            }
+        }
+        for (r, gl) in chunks.into_remainder().iter_mut().zip(g) {
+            *r += gl;
+        }
+        start = end;
     }
 }
 
@@ -890,6 +929,24 @@ mod tests {
             }
         }
         assert!(worst < 1e-11, "worst {worst}");
+        // Without cutoffs, tight primitives far along a row must neither underflow nor overflow.
+        let mut tight = test_basis();
+        tight.shells.push(Shell {
+            atom: 0,
+            center: DVec3::new(0.1, 0.2, 0.3),
+            l: 1,
+            kind: ShellKind::Cartesian,
+            exponents: vec![9.0e4, 5.0e3, 800.0],
+            coefficients: vec![0.2, 0.5, 0.6],
+        });
+        let uncut = PreparedBasis::with_threshold(&tight, 0.0);
+        let c = pseudo_random(uncut.n_functions(), 13);
+        let values = uncut.eval_grid(&c, &grid);
+        for (idx, v) in values.iter().enumerate().step_by(5) {
+            let (i, j, k) = (idx / (ny * nz), idx / nz % ny, idx % nz);
+            let want = uncut.orbital_value(&c, grid.point(i, j, k));
+            assert!((v - want).abs() < 1e-11, "uncut: {v} vs {want}");
+        }
         // Orthogonal steps along z only, a long row.
         let grid = GridSpec::new(
             DVec3::new(-5.0, -5.0, -6.0),
