@@ -10,23 +10,15 @@ use orbcloud::model::basis::{Basis, Shell, ShellKind};
 use orbcloud::model::gto::{GridSpec, PreparedBasis};
 use serde_json::Value;
 
-const FIXTURE: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/tests/fixtures/gto/benzene_631gs.json"
-);
+const FIXTURE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/gto/benzene_631gs.json");
 
 fn floats(v: &Value) -> Vec<f64> {
-    v.as_array()
-        .expect("array")
-        .iter()
-        .map(|x| x.as_f64().expect("number"))
-        .collect()
+    v.as_array().expect("array").iter().map(|x| x.as_f64().expect("number")).collect()
 }
 
 /// The basis, the HOMO's coefficients and the atom positions of the fixture.
 fn benzene() -> (Basis, Vec<f64>, Vec<DVec3>) {
-    let fx: Value =
-        serde_json::from_str(&std::fs::read_to_string(FIXTURE).expect("fixture")).expect("json");
+    let fx: Value = serde_json::from_str(&std::fs::read_to_string(FIXTURE).expect("fixture")).expect("json");
     let atoms: Vec<DVec3> = fx["atoms"]
         .as_array()
         .expect("atoms")
@@ -46,11 +38,7 @@ fn benzene() -> (Basis, Vec<f64>, Vec<DVec3>) {
                 atom,
                 center: atoms[atom],
                 l: s["l"].as_u64().expect("l") as u32,
-                kind: if s["pure"].as_bool().expect("pure") {
-                    ShellKind::Pure
-                } else {
-                    ShellKind::Cartesian
-                },
+                kind: if s["pure"].as_bool().expect("pure") { ShellKind::Pure } else { ShellKind::Cartesian },
                 exponents: floats(&s["exponents"]),
                 coefficients: floats(&s["coefficients"]),
             }
@@ -68,18 +56,10 @@ fn benzene() -> (Basis, Vec<f64>, Vec<DVec3>) {
 
 fn cubegen_grid(atoms: &[DVec3], n: usize) -> GridSpec {
     let margin = 3.0;
-    let lo = atoms
-        .iter()
-        .fold(DVec3::splat(f64::INFINITY), |a, p| a.min(*p));
-    let hi = atoms
-        .iter()
-        .fold(DVec3::splat(f64::NEG_INFINITY), |a, p| a.max(*p));
+    let lo = atoms.iter().fold(DVec3::splat(f64::INFINITY), |a, p| a.min(*p));
+    let hi = atoms.iter().fold(DVec3::splat(f64::NEG_INFINITY), |a, p| a.max(*p));
     let step = (hi - lo + 2.0 * margin) / (n - 1) as f64;
-    GridSpec::new(
-        lo - DVec3::splat(margin),
-        [DVec3::X * step.x, DVec3::Y * step.y, DVec3::Z * step.z],
-        [n; 3],
-    )
+    GridSpec::new(lo - DVec3::splat(margin), [DVec3::X * step.x, DVec3::Y * step.y, DVec3::Z * step.z], [n; 3])
 }
 
 fn bench(c: &mut Criterion) {
@@ -92,9 +72,7 @@ fn bench(c: &mut Criterion) {
     group.bench_function("benzene_homo_80cubed", |b| {
         b.iter(|| black_box(prepared.eval_grid_f32(black_box(&homo), &grid)))
     });
-    group.bench_function("prepare_basis", |b| {
-        b.iter(|| black_box(PreparedBasis::new(black_box(&basis))))
-    });
+    group.bench_function("prepare_basis", |b| b.iter(|| black_box(PreparedBasis::new(black_box(&basis)))));
     group.finish();
 }
 

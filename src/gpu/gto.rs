@@ -65,7 +65,8 @@ pub struct GtoBuffers {
 }
 
 pub fn gto_layout(device: &wgpu::Device, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayout {
-    let storage = |binding| super::buffer_entry(binding, visibility, wgpu::BufferBindingType::Storage { read_only: true });
+    let storage =
+        |binding| super::buffer_entry(binding, visibility, wgpu::BufferBindingType::Storage { read_only: true });
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("gto bind group layout"),
         entries: &[storage(0), storage(1), storage(2)],
