@@ -28,10 +28,10 @@ use glam::DVec3;
 
 use super::ParseError;
 use super::text::{excerpt, parse_real};
-use super::wavefunction::{OverlapFn, check_and_repair, powers, program_named_in, to_model_order};
+use super::wavefunction::{OverlapFn, wavefunction_document, powers, program_named_in, to_model_order};
 use crate::model::basis::{Basis, MAX_L, Shell, ShellKind, cartesian_powers};
 use crate::model::orbitals::{MolecularOrbital, Spin, Wavefunction};
-use crate::model::{Atom, Document, Molecule};
+use crate::model::{Atom, Document};
 
 /// Parses fchk text into a document, checking the orbitals with `overlap`.
 pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Document, ParseError> {
@@ -495,15 +495,7 @@ impl FchkFile {
             }
         }
         let wf = Wavefunction { basis, orbitals, restricted: !unrestricted, normalization: Default::default() };
-        let wf = check_and_repair(wf, program_named_in(&self.title), overlap);
-        let title = if self.title.is_empty() { source.to_string() } else { self.title.clone() };
-        Ok(Document {
-            source: source.to_string(),
-            title,
-            molecule: Molecule::new(atoms),
-            volumes: vec![],
-            wavefunction: Some(wf),
-        })
+        Ok(wavefunction_document(source, &self.title, atoms, wf, program_named_in(&self.title), overlap))
     }
 }
 

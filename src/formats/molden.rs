@@ -27,12 +27,12 @@ use glam::DVec3;
 
 use super::ParseError;
 use super::text::{excerpt, parse_real};
-use super::wavefunction::{OverlapFn, check_and_repair, powers, program_named_in, to_model_order};
+use super::wavefunction::{OverlapFn, wavefunction_document, powers, program_named_in, to_model_order};
 use crate::model::basis::{Basis, MAX_L, Shell, ShellKind, cartesian_powers};
 use crate::model::elements::atomic_number;
 use crate::model::orbitals::{MolecularOrbital, Spin, Wavefunction};
 use crate::model::units::BOHR_PER_ANGSTROM;
-use crate::model::{Atom, Document, Molecule};
+use crate::model::{Atom, Document};
 
 /// Largest orbital-coefficient matrix (orbitals × basis functions) a file may imply before
 /// anything is allocated: 2²⁸ values, 2 GiB of f64.
@@ -330,15 +330,7 @@ impl MoldenFile {
         orbitals.sort_by_key(|o| o.spin == Spin::Beta);
         let restricted = !orbitals.iter().any(|o| o.spin == Spin::Beta);
         let wf = Wavefunction { basis, orbitals, restricted, normalization: Default::default() };
-        let wf = check_and_repair(wf, self.program(), overlap);
-        let title = if self.title.is_empty() { source.to_string() } else { self.title.clone() };
-        Ok(Document {
-            source: source.to_string(),
-            title,
-            molecule: Molecule::new(atoms),
-            volumes: vec![],
-            wavefunction: Some(wf),
-        })
+        Ok(wavefunction_document(source, &self.title, atoms, wf, self.program(), overlap))
     }
 }
 

@@ -253,6 +253,25 @@ pub fn residual(orbitals: &[MolecularOrbital], s: &[f64]) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// The document a wavefunction file gives: its atoms and its checked (and if need be repaired)
+/// orbitals. The title falls back to the source's name.
+pub fn wavefunction_document(
+    source: &str,
+    title: &str,
+    atoms: Vec<crate::model::Atom>,
+    wf: Wavefunction,
+    program: Option<&str>,
+    overlap: Option<OverlapFn>,
+) -> crate::model::Document {
+    crate::model::Document {
+        source: source.to_string(),
+        title: if title.is_empty() { source.to_string() } else { title.to_string() },
+        molecule: crate::model::Molecule::new(atoms),
+        volumes: vec![],
+        wavefunction: Some(check_and_repair(wf, program, overlap)),
+    }
+}
+
 /// Checks the orbitals of a freshly read wavefunction and undoes a known writer quirk when the
 /// check fails (see the module documentation). `program` is the writer the file names, if any.
 /// Without an overlap function nothing is checked: the file is kept as read, residual NaN.
