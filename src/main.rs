@@ -108,9 +108,11 @@ struct WavefunctionArgs {
 }
 
 impl WavefunctionArgs {
-    /// Puts the requested quantity into the headless renderer, when the document has a wavefunction.
-    fn apply(&self, ctx: &GpuContext, h: &mut Headless, doc: &Document) -> Result<()> {
-        let Some(wf) = &doc.wavefunction else { return Ok(()) };
+    /// Puts the requested quantity into the headless renderer, when the document has a
+    /// wavefunction; returns how long that took (GPU fill and read-back included).
+    fn apply(&self, ctx: &GpuContext, h: &mut Headless, doc: &Document) -> Result<Option<f64>> {
+        let Some(wf) = &doc.wavefunction else { return Ok(None) };
+        let start = Instant::now();
         let view = WavefunctionView {
             quantity: self.what.resolve(wf)?,
             direct: self.direct,
@@ -119,7 +121,7 @@ impl WavefunctionArgs {
         };
         let mut fill = None;
         show_wavefunction(ctx, &mut h.renderer, &mut fill, doc, &view)?;
-        Ok(())
+        Ok(Some(start.elapsed().as_secs_f64()))
     }
 }
 
@@ -522,7 +524,13 @@ fn main() -> Result<()> {
             let settings = view.settings();
             let camera = view.camera(&doc);
             let mut h = Headless::new(&ctx, &doc, view.volume_index(&doc)?, &settings, view.size)?;
-            wavefunction.apply(&ctx, &mut h, &doc)?;
+            if let Some(seconds) = wavefunction.apply(&ctx, &mut h, &doc)? {
+                let n = wavefunction.grid_points;
+                println!(
+                    "wavefunction_setup_ms={:.1} (grid {n}^3: GPU fill and read-back for the value range)",
+                    seconds * 1e3
+                );
+            }
             let wait = |ctx: &GpuContext| ctx.device.poll(wgpu::PollType::wait_indefinitely()).map(|_| ());
             for _ in 0..2 {
                 h.draw(&ctx, &camera, &settings);

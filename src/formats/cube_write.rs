@@ -39,25 +39,67 @@ pub fn write(title: &str, description: &str, molecule: &Molecule, grids: &[(&Vol
         let _ = writeln!(out, "{:5} {}", grids.len(), ids.join(" "));
     }
     let [nx, ny, nz] = first.dims;
+    let mut bytes = out.into_bytes();
     for i in 0..nx {
         for j in 0..ny {
             // Each (x, y) row starts a new line, six values per line.
             let mut n = 0;
             for k in 0..nz {
                 for (g, _) in grids {
-                    let _ = write!(out, " {:12.5E}", g.value(i, j, k));
+                    push_scientific(&mut bytes, g.value(i, j, k));
                     n += 1;
                     if n % 6 == 0 {
-                        out.push('\n');
+                        bytes.push(b'\n');
                     }
                 }
             }
             if n % 6 != 0 {
-                out.push('\n');
+                bytes.push(b'\n');
             }
         }
     }
-    out
+    // Everything written is ASCII.
+    String::from_utf8(bytes).unwrap_or_default()
+}
+
+/// Appends ` ±d.dddddE±XX` (13 bytes for two-digit exponents), the Fortran layout cube files
+/// use, six significant digits — without `format!`, which dominates writing a large grid.
+fn push_scientific(out: &mut Vec<u8>, v: f32) {
+    let v = v as f64;
+    if v == 0.0 || !v.is_finite() {
+        out.extend_from_slice(b"  0.00000E+00");
+        return;
+    }
+    let a = v.abs();
+    let mut e = a.log10().floor() as i32;
+    let mut m = (a / 10f64.powi(e) * 1e5).round_ties_even() as u64;
+    // log10 may be off by one at powers of ten, and rounding may carry into a new digit.
+    if m >= 1_000_000 {
+        m = (m + 5) / 10;
+        e += 1;
+    } else if m < 100_000 {
+        m = (a / 10f64.powi(e - 1) * 1e5).round_ties_even() as u64;
+        e -= 1;
+    }
+    out.push(b' ');
+    out.push(if v < 0.0 { b'-' } else { b' ' });
+    out.push(b'0' + (m / 100_000) as u8);
+    out.push(b'.');
+    let mut rest = m % 100_000;
+    let mut digits = [b'0'; 5];
+    for d in digits.iter_mut().rev() {
+        *d = b'0' + (rest % 10) as u8;
+        rest /= 10;
+    }
+    out.extend_from_slice(&digits);
+    out.push(b'E');
+    out.push(if e < 0 { b'-' } else { b'+' });
+    let e = e.unsigned_abs();
+    if e >= 100 {
+        out.push(b'0' + (e / 100) as u8);
+    }
+    out.push(b'0' + (e / 10 % 10) as u8);
+    out.push(b'0' + (e % 10) as u8);
 }
 
 #[cfg(test)]
@@ -66,6 +108,34 @@ mod tests {
 
     use super::*;
     use crate::model::Atom;
+
+    #[test]
+    fn scientific_digits_are_correctly_rounded() {
+        let mut s = 0x2545F4914F6CDD1Du64;
+        for i in 0..20_000 {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            let exp = (s % 70) as i32 - 40;
+            let mantissa = (s >> 11) as f64 / (1u64 << 53) as f64 * 9.0 + 1.0;
+            let sign = if i % 2 == 0 { 1.0 } else { -1.0 };
+            let v = (sign * mantissa * 10f64.powi(exp)) as f32;
+            let mut out = Vec::new();
+            push_scientific(&mut out, v);
+            let text = String::from_utf8(out).unwrap();
+            // Exact decimal rounding may differ in the last digit when the value sits within an
+            // ulp of a tie; anything more is a bug.
+            let expected: f64 = format!("{:.5E}", v as f64).parse().unwrap();
+            let got: f64 = text.trim().parse().unwrap();
+            assert!((got - expected).abs() <= 1.01e-5 * expected.abs(), "{v:e} → {text}");
+            assert_eq!(text.len(), 13, "{text}");
+        }
+        for (v, text) in [(1.0f32, "  1.00000E+00"), (-0.000123456, " -1.23456E-04"), (9.999996e-3, "  1.00000E-02")] {
+            let mut out = Vec::new();
+            push_scientific(&mut out, v);
+            assert_eq!(String::from_utf8(out).unwrap(), text);
+        }
+    }
 
     #[test]
     fn written_cubes_read_back() {

@@ -28,7 +28,7 @@ use glam::DVec3;
 
 use super::ParseError;
 use super::text::{excerpt, parse_real};
-use super::wavefunction::{OverlapFn, wavefunction_document, powers, program_named_in, to_model_order};
+use super::wavefunction::{OverlapFn, powers, program_named_in, to_model_order, wavefunction_document};
 use crate::model::basis::{Basis, MAX_L, Shell, ShellKind, cartesian_powers};
 use crate::model::orbitals::{MolecularOrbital, Spin, Wavefunction};
 use crate::model::{Atom, Document};
