@@ -65,21 +65,24 @@ pub fn write(title: &str, description: &str, molecule: &Molecule, grids: &[(&Vol
 /// Appends ` ±d.dddddE±XX` (13 bytes for two-digit exponents), the Fortran layout cube files
 /// use, six significant digits — without `format!`, which dominates writing a large grid.
 fn push_scientific(out: &mut Vec<u8>, v: f32) {
-    let v = v as f64;
     if v == 0.0 || !v.is_finite() {
         out.extend_from_slice(b"  0.00000E+00");
         return;
     }
-    let a = v.abs();
-    let mut e = a.log10().floor() as i32;
-    let mut m = (a / 10f64.powi(e) * 1e5).round_ties_even() as u64;
-    // log10 may be off by one at powers of ten, and rounding may carry into a new digit.
+    let a = v.abs() as f64;
+    // The decimal exponent from the binary one (log10 2 ≈ 0.30103), corrected against a table
+    // of powers of ten: cheaper than log10 and powi per value.
+    let mut e = ((a.log2().floor()) * std::f64::consts::LOG10_2).floor() as i32;
+    if a >= pow10(e + 1) {
+        e += 1;
+    } else if a < pow10(e) {
+        e -= 1;
+    }
+    let mut m = (a * pow10(5 - e)).round_ties_even() as u64;
+    // Rounding may carry into a seventh digit (9.999996 → 10.0000).
     if m >= 1_000_000 {
         m = (m + 5) / 10;
         e += 1;
-    } else if m < 100_000 {
-        m = (a / 10f64.powi(e - 1) * 1e5).round_ties_even() as u64;
-        e -= 1;
     }
     out.push(b' ');
     out.push(if v < 0.0 { b'-' } else { b' ' });
@@ -100,6 +103,14 @@ fn push_scientific(out: &mut Vec<u8>, v: f32) {
     }
     out.push(b'0' + (e / 10 % 10) as u8);
     out.push(b'0' + (e % 10) as u8);
+}
+
+/// 10^k for the exponents an f32 and six digits can need, from a table.
+fn pow10(k: i32) -> f64 {
+    const LO: i32 = -60;
+    static TABLE: std::sync::OnceLock<Vec<f64>> = std::sync::OnceLock::new();
+    let table = TABLE.get_or_init(|| (LO..=60).map(|k| format!("1e{k}").parse().unwrap_or(0.0)).collect());
+    table[(k - LO).clamp(0, table.len() as i32 - 1) as usize]
 }
 
 #[cfg(test)]
