@@ -301,8 +301,8 @@ def main():
         write_fchk(stem + ".fchk", title, method, basis_label, mol, mf, keep)
         ref = expected(name, mol, mf, keep, random_points(mol))
         with open(stem + ".expected.json", "w") as f:
-            json.dump(ref, f, indent=1)
-            f.write("\n")
+            # One key per line; floats as repr (exact round trip).
+            f.write("{\n" + ",\n".join(" %s: %s" % (json.dumps(k), json.dumps(v)) for k, v in ref.items()) + "\n}\n")
         sizes = {ext: os.path.getsize(stem + ext) for ext in (".molden", ".fchk", ".expected.json")}
         for ext, size in sizes.items():
             assert size < MAX_BYTES, (name + ext, size)
