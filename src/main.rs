@@ -493,22 +493,24 @@ fn main() -> Result<()> {
             );
             let prepared = PreparedBasis::new(&wf.basis);
             let t = Instant::now();
-            let values: Vec<f64> = match q {
-                Quantity::Orbital(i) => prepared.eval_grid(&wf.orbitals[i].coefficients, &spec),
-                Quantity::Density => prepared.density_grid(wf, &spec),
-                Quantity::SpinDensity => prepared.spin_density_grid(wf, &spec),
+            let values: Vec<f32> = match q {
+                Quantity::Orbital(i) => prepared.eval_grid_f32(&wf.orbitals[i].coefficients, &spec),
+                Quantity::Density => prepared.density_grid(wf, &spec).iter().map(|&v| v as f32).collect(),
+                Quantity::SpinDensity => prepared.spin_density_grid(wf, &spec).iter().map(|&v| v as f32).collect(),
             };
             let seconds = t.elapsed().as_secs_f64();
             let world = VolumeGrid::affine(spec.origin, spec.steps);
             let label = what.label(&q, wf);
-            let grid = VolumeGrid::new(&label, dims, world, values.iter().map(|&v| v as f32).collect());
+            let grid = VolumeGrid::new(&label, dims, world, values);
             let id = match q {
                 Quantity::Orbital(i) => wf.of_spin(wf.orbitals[i].spin).position(|(j, _)| j == i).map_or(0, |p| p + 1),
                 _ => 0,
             };
-            let text =
-                cube_write::write(&format!("{} {}", doc.source, label), &label, &doc.molecule, &[(&grid, id as i64)]);
-            std::fs::write(&output, text).with_context(|| format!("writing {}", output.display()))?;
+            let file = std::fs::File::create(&output).with_context(|| format!("creating {}", output.display()))?;
+            let mut w = std::io::BufWriter::with_capacity(1 << 20, file);
+            let title = format!("{} {}", doc.source, label);
+            cube_write::write_to(&mut w, &title, &label, &doc.molecule, &[(&grid, id as i64)])
+                .with_context(|| format!("writing {}", output.display()))?;
             eprintln!(
                 "wrote {} ({}×{}×{}, {label}; evaluated in {seconds:.3} s)",
                 output.display(),

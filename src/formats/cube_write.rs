@@ -1,22 +1,38 @@
 //! Writing Gaussian cube files (what `orbcloud cube` produces; PySCF, VMD and this crate's reader
 //! read them back).
 
-use std::fmt::Write;
+use std::fmt::Write as _;
+use std::io::Write;
 
 use crate::model::{Molecule, VolumeGrid};
 
-/// Cube text for one or more grids of identical geometry over `molecule` (all bohr). Several
-/// grids are written as a multi-orbital cube: negative atom count, the id line, values
+/// Cube text for one or more grids of identical geometry over `molecule` (all bohr); see
+/// [`write_to`].
+pub fn write(title: &str, description: &str, molecule: &Molecule, grids: &[(&VolumeGrid, i64)]) -> String {
+    let mut bytes = Vec::new();
+    // Writing to memory cannot fail; everything written is ASCII.
+    let _ = write_to(&mut bytes, title, description, molecule, grids);
+    String::from_utf8(bytes).unwrap_or_default()
+}
+
+/// Writes a cube file for one or more grids of identical geometry over `molecule` (all bohr).
+/// Several grids are written as a multi-orbital cube: negative atom count, the id line, values
 /// interleaved per point.
 ///
 /// Panics if `grids` is empty or their geometries differ (a caller's bug, not input).
-pub fn write(title: &str, description: &str, molecule: &Molecule, grids: &[(&VolumeGrid, i64)]) -> String {
+pub fn write_to(
+    w: &mut impl Write,
+    title: &str,
+    description: &str,
+    molecule: &Molecule,
+    grids: &[(&VolumeGrid, i64)],
+) -> std::io::Result<()> {
     let (first, _) = grids.first().expect("at least one grid");
     assert!(
         grids.iter().all(|(g, _)| g.dims == first.dims && g.world_from_grid == first.world_from_grid),
         "grids of one cube file share their geometry"
     );
-    let mut out = String::with_capacity(first.values.len() * grids.len() * 14 + 4096);
+    let mut out = String::with_capacity(4096);
     let line = |s: &str| s.replace(['\n', '\r'], " ");
     let _ = writeln!(out, "{}", line(title));
     let _ = writeln!(out, "{}", line(description));
@@ -38,15 +54,18 @@ pub fn write(title: &str, description: &str, molecule: &Molecule, grids: &[(&Vol
         let ids: Vec<String> = grids.iter().map(|(_, id)| id.to_string()).collect();
         let _ = writeln!(out, "{:5} {}", grids.len(), ids.join(" "));
     }
+    w.write_all(out.as_bytes())?;
     let [nx, ny, nz] = first.dims;
-    let mut bytes = out.into_bytes();
+    let pow10 = pow10_table();
+    let mut bytes = Vec::with_capacity(nz * grids.len() * 14 + 16);
     for i in 0..nx {
         for j in 0..ny {
             // Each (x, y) row starts a new line, six values per line.
+            bytes.clear();
             let mut n = 0;
             for k in 0..nz {
                 for (g, _) in grids {
-                    push_scientific(&mut bytes, g.value(i, j, k));
+                    push_scientific(&mut bytes, g.value(i, j, k), pow10);
                     n += 1;
                     if n % 6 == 0 {
                         bytes.push(b'\n');
@@ -56,61 +75,63 @@ pub fn write(title: &str, description: &str, molecule: &Molecule, grids: &[(&Vol
             if n % 6 != 0 {
                 bytes.push(b'\n');
             }
+            w.write_all(&bytes)?;
         }
     }
-    // Everything written is ASCII.
-    String::from_utf8(bytes).unwrap_or_default()
+    w.flush()
 }
 
-/// Appends ` ±d.dddddE±XX` (13 bytes for two-digit exponents), the Fortran layout cube files
-/// use, six significant digits — without `format!`, which dominates writing a large grid.
-fn push_scientific(out: &mut Vec<u8>, v: f32) {
+/// Powers of ten 10^k for k in [`POW10_LO`]..=60: an f32 with six digits never needs more.
+const POW10_LO: i32 = -60;
+
+fn pow10_table() -> &'static [f64] {
+    static TABLE: std::sync::OnceLock<Vec<f64>> = std::sync::OnceLock::new();
+    // Parsed, not multiplied, so each entry is the correctly rounded power.
+    TABLE.get_or_init(|| (POW10_LO..=60).map(|k| format!("1e{k}").parse().unwrap_or(0.0)).collect())
+}
+
+/// Appends ` ±d.dddddE±XX` (13 bytes), the Fortran layout cube files use, six significant
+/// digits — without `format!`, which dominates writing a large grid.
+fn push_scientific(out: &mut Vec<u8>, v: f32, pow10: &[f64]) {
     if v == 0.0 || !v.is_finite() {
         out.extend_from_slice(b"  0.00000E+00");
         return;
     }
     let a = v.abs() as f64;
-    // The decimal exponent from the binary one (log10 2 ≈ 0.30103), corrected against a table
-    // of powers of ten: cheaper than log10 and powi per value.
-    let mut e = ((a.log2().floor()) * std::f64::consts::LOG10_2).floor() as i32;
-    if a >= pow10(e + 1) {
+    let p = |k: i32| pow10[(k - POW10_LO).clamp(0, pow10.len() as i32 - 1) as usize];
+    // The decimal exponent from the binary one (log10 2 ≈ 0.30103), then corrected by one
+    // against the table.
+    let binary = ((a.to_bits() >> 52) & 0x7ff) as i32 - 1023;
+    let mut e = (binary as f64 * std::f64::consts::LOG10_2).floor() as i32;
+    if a >= p(e + 1) {
         e += 1;
-    } else if a < pow10(e) {
+    } else if a < p(e) {
         e -= 1;
     }
-    let mut m = (a * pow10(5 - e)).round_ties_even() as u64;
+    let mut m = (a * p(5 - e)).round_ties_even() as u64;
     // Rounding may carry into a seventh digit (9.999996 → 10.0000).
     if m >= 1_000_000 {
         m = (m + 5) / 10;
         e += 1;
     }
-    out.push(b' ');
-    out.push(if v < 0.0 { b'-' } else { b' ' });
-    out.push(b'0' + (m / 100_000) as u8);
-    out.push(b'.');
+    let mut b = *b"  0.00000E+00";
+    if v < 0.0 {
+        b[1] = b'-';
+    }
+    b[2] = b'0' + (m / 100_000) as u8;
     let mut rest = m % 100_000;
-    let mut digits = [b'0'; 5];
-    for d in digits.iter_mut().rev() {
+    for d in b[4..9].iter_mut().rev() {
         *d = b'0' + (rest % 10) as u8;
         rest /= 10;
     }
-    out.extend_from_slice(&digits);
-    out.push(b'E');
-    out.push(if e < 0 { b'-' } else { b'+' });
-    let e = e.unsigned_abs();
-    if e >= 100 {
-        out.push(b'0' + (e / 100) as u8);
+    if e < 0 {
+        b[10] = b'-';
     }
-    out.push(b'0' + (e / 10 % 10) as u8);
-    out.push(b'0' + (e % 10) as u8);
-}
-
-/// 10^k for the exponents an f32 and six digits can need, from a table.
-fn pow10(k: i32) -> f64 {
-    const LO: i32 = -60;
-    static TABLE: std::sync::OnceLock<Vec<f64>> = std::sync::OnceLock::new();
-    let table = TABLE.get_or_init(|| (LO..=60).map(|k| format!("1e{k}").parse().unwrap_or(0.0)).collect());
-    table[(k - LO).clamp(0, table.len() as i32 - 1) as usize]
+    let e = e.unsigned_abs();
+    b[11] = b'0' + (e / 10 % 10) as u8;
+    b[12] = b'0' + (e % 10) as u8;
+    // f32 exponents stay within ±45: two digits always suffice.
+    out.extend_from_slice(&b);
 }
 
 #[cfg(test)]
@@ -132,7 +153,7 @@ mod tests {
             let sign = if i % 2 == 0 { 1.0 } else { -1.0 };
             let v = (sign * mantissa * 10f64.powi(exp)) as f32;
             let mut out = Vec::new();
-            push_scientific(&mut out, v);
+            push_scientific(&mut out, v, pow10_table());
             let text = String::from_utf8(out).unwrap();
             // Exact decimal rounding may differ in the last digit when the value sits within an
             // ulp of a tie; anything more is a bug.
@@ -143,7 +164,7 @@ mod tests {
         }
         for (v, text) in [(1.0f32, "  1.00000E+00"), (-0.000123456, " -1.23456E-04"), (9.999996e-3, "  1.00000E-02")] {
             let mut out = Vec::new();
-            push_scientific(&mut out, v);
+            push_scientific(&mut out, v, pow10_table());
             assert_eq!(String::from_utf8(out).unwrap(), text);
         }
     }
