@@ -18,8 +18,8 @@ struct VolumeUniforms {
     flags: vec4<u32>,
     // x: the smallest |value| / max|value| that can be seen at these k1, k2
     flags_f: vec4<f32>,
-    // x: transfer kind (0 power law, 1 shaped), y/z: shape of the positive/negative lobe,
-    // w: bit 0 shading, bit 1 gradient needed, bit 2 clipping
+    // y/z: shape of the positive/negative lobe, w: bit 0 shading (x unused: the power law,
+    // the gradient and clipping are pipeline overrides)
     tf: vec4<u32>,
     // centre, width, peak opacity (fractions of max|value|), unused
     tf_positive: vec4<f32>,
@@ -73,11 +73,17 @@ fn shape_factor(shape: u32, t: f32, c: f32, w_in: f32) -> f32 {
 }
 
 fn clipped(world: vec3<f32>) -> bool {
-    return (u.tf.w & 4u) != 0u && dot(u.clip.xyz, world) > u.clip.w;
+    return CLIP && dot(u.clip.xyz, world) > u.clip.w;
 }
 
+// Specialised per pipeline (overrides, not uniforms): a branch on a uniform still costs the
+// untaken side on a CPU rasteriser, and the gradient is six extra samples.
+override GRADIENT: bool = false;
+override SHAPED: bool = false;
+override CLIP: bool = false;
+
 fn needs_gradient() -> bool {
-    return (u.tf.w & 2u) != 0u;
+    return GRADIENT;
 }
 
 // Premultiplied colour of one sample with gradient `grad` (world units; ignored unless the
@@ -87,7 +93,7 @@ fn shade(value: f32, grad: vec3<f32>, from_eye: vec3<f32>) -> vec4<f32> {
     let scaled = value * u.params.z;
     var extinction: f32;
     var color: vec3<f32>;
-    if (u.tf.x == 0u) {
+    if (!SHAPED) {
         // Below this magnitude a sample is invisible (computed on the CPU from k1, k2).
         if (abs(scaled) < u.flags_f.x) {
             return vec4<f32>(-1.0);

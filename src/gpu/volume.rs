@@ -156,8 +156,49 @@ impl VolumeTexture {
     }
 }
 
+/// Which variant of the slice shader a frame needs: each is its own pipeline, specialised by
+/// WGSL override constants.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+struct Variant {
+    direct: bool,
+    gradient: bool,
+    shaped: bool,
+    clip: bool,
+}
+
+/// A slice shader module and its pipeline layout.
+struct SliceShader {
+    module: wgpu::ShaderModule,
+    layout: wgpu::PipelineLayout,
+    fragment_entry: &'static str,
+}
+
+impl SliceShader {
+    fn new(
+        device: &wgpu::Device,
+        name: &str,
+        fragment_entry: &'static str,
+        groups: &[Option<&wgpu::BindGroupLayout>],
+    ) -> Self {
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some(name),
+            source: wgpu::ShaderSource::Wgsl(super::module_source(name).into()),
+        });
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(name),
+            bind_group_layouts: groups,
+            immediate_size: 0,
+        });
+        Self { module, layout, fragment_entry }
+    }
+}
+
 pub struct VolumePass {
-    pipeline: wgpu::RenderPipeline,
+    slices: SliceShader,
+    direct_shader: SliceShader,
+    pipelines: std::collections::HashMap<Variant, wgpu::RenderPipeline>,
+    /// The variant this frame draws with (set in `prepare`).
+    variant: Variant,
     layout: wgpu::BindGroupLayout,
     sampler: wgpu::Sampler,
     uniforms: wgpu::Buffer,
@@ -165,35 +206,24 @@ pub struct VolumePass {
     vertex_count: u32,
     bind_group: Option<wgpu::BindGroup>,
     volume: Option<VolumeTexture>,
-    direct_pipeline: wgpu::RenderPipeline,
     gto_layout: wgpu::BindGroupLayout,
     /// Basis functions of the orbital shown in direct mode (then `volume` holds only its box).
     direct: Option<GtoBuffers>,
 }
 
-/// The slice pipeline with a fragment shader from `module` (volume_slices or volume_direct).
-fn make_pipeline(
-    device: &wgpu::Device,
-    module: &str,
-    fragment_entry: &str,
-    groups: &[Option<&wgpu::BindGroupLayout>],
-) -> wgpu::RenderPipeline {
-    let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some(module),
-        source: wgpu::ShaderSource::Wgsl(super::module_source(module).into()),
-    });
-    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some(module),
-        bind_group_layouts: groups,
-        immediate_size: 0,
-    });
+/// The slice pipeline for one shader variant.
+fn make_pipeline(device: &wgpu::Device, shader: &SliceShader, variant: Variant) -> wgpu::RenderPipeline {
+    let flag = |b: bool| f64::from(u8::from(b));
+    let constants =
+        [("GRADIENT", flag(variant.gradient)), ("SHAPED", flag(variant.shaped)), ("CLIP", flag(variant.clip))];
+    let options = wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() };
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some(module),
-        layout: Some(&layout),
+        label: Some(&format!("volume slices {variant:?}")),
+        layout: Some(&shader.layout),
         vertex: wgpu::VertexState {
-            module: &shader,
+            module: &shader.module,
             entry_point: Some("vs_main"),
-            compilation_options: Default::default(),
+            compilation_options: options.clone(),
             buffers: &[Some(wgpu::VertexBufferLayout {
                 array_stride: 12,
                 step_mode: wgpu::VertexStepMode::Vertex,
@@ -211,9 +241,9 @@ fn make_pipeline(
         }),
         multisample: Default::default(),
         fragment: Some(wgpu::FragmentState {
-            module: &shader,
-            entry_point: Some(fragment_entry),
-            compilation_options: Default::default(),
+            module: &shader.module,
+            entry_point: Some(shader.fragment_entry),
+            compilation_options: options,
             targets: &[Some(wgpu::ColorTargetState {
                 format: SCENE_FORMAT,
                 blend: Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING),
@@ -251,9 +281,11 @@ impl VolumePass {
             ],
         });
         let gto_layout = gto_layout(device, wgpu::ShaderStages::FRAGMENT);
-        let pipeline = make_pipeline(device, "volume_slices.wgsl", "fs_main", &[Some(&layout)]);
-        let direct_pipeline =
-            make_pipeline(device, "volume_direct.wgsl", "fs_direct", &[Some(&layout), Some(&gto_layout)]);
+        let slices = SliceShader::new(device, "volume_slices.wgsl", "fs_main", &[Some(&layout)]);
+        let direct_shader =
+            SliceShader::new(device, "volume_direct.wgsl", "fs_direct", &[Some(&layout), Some(&gto_layout)]);
+        let variant = Variant { direct: false, gradient: false, shaped: false, clip: false };
+        let pipelines = [(variant, make_pipeline(device, &slices, variant))].into_iter().collect();
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("volume sampler"),
             address_mode_u: wgpu::AddressMode::ClampToEdge,
@@ -266,7 +298,10 @@ impl VolumePass {
         let uniforms = super::uniform_buffer(device, "volume uniforms", std::mem::size_of::<VolumeUniforms>());
         let vertices = Self::vertex_buffer(device, 1024);
         Self {
-            pipeline,
+            slices,
+            direct_shader,
+            pipelines,
+            variant,
             layout,
             sampler,
             uniforms,
@@ -274,7 +309,6 @@ impl VolumePass {
             vertex_count: 0,
             bind_group: None,
             volume: None,
-            direct_pipeline,
             gto_layout,
             direct: None,
         }
@@ -375,9 +409,19 @@ impl VolumePass {
         self.vertex_count = vertices.len() as u32;
         let signed = vol.kind == ValueKind::Signed;
         let t = &settings.transfer;
+        self.variant = Variant {
+            direct: self.direct.is_some(),
+            gradient: t.needs_gradient(),
+            shaped: t.kind == TransferKind::Shaped,
+            clip: settings.clip.enabled,
+        };
+        if !self.pipelines.contains_key(&self.variant) {
+            let shader = if self.variant.direct { &self.direct_shader } else { &self.slices };
+            let pipeline = make_pipeline(device, shader, self.variant);
+            self.pipelines.insert(self.variant, pipeline);
+        }
         let lobe = |l: &crate::scene::transfer::Lobe| [l.center, l.width, l.opacity, 0.0];
-        let bits =
-            u32::from(t.shading) | (u32::from(t.needs_gradient()) << 1) | (u32::from(settings.clip.enabled) << 2);
+        let bits = u32::from(t.shading);
         let clip_normal = Vec3::from(settings.clip.normal).normalize_or(Vec3::Z);
         let box_centre =
             vol.grid_box.origin + 0.5 * (vol.grid_box.edges[0] + vol.grid_box.edges[1] + vol.grid_box.edges[2]);
@@ -395,7 +439,7 @@ impl VolumePass {
             params: [settings.k1, settings.k2, 1.0 / vol.max_abs, vol.step],
             flags: [u32::from(signed), 0, 0, 0],
             flags_f: [visibility_threshold(settings.k1, settings.k2, signed), 0.0, 0.0, 0.0],
-            tf: [u32::from(t.kind == TransferKind::Shaped), t.positive.shape.index(), t.negative.shape.index(), bits],
+            tf: [0, t.positive.shape.index(), t.negative.shape.index(), bits],
             tf_positive: lobe(&t.positive),
             tf_negative: lobe(&t.negative),
             tf_gradient: [t.gradient_power, t.boundary.clamp(0.0, 1.0), 1.0 / vol.max_grad, 0.0],
@@ -412,12 +456,10 @@ impl VolumePass {
         if self.vertex_count == 0 {
             return;
         }
-        match &self.direct {
-            Some(gto) => {
-                pass.set_pipeline(&self.direct_pipeline);
-                pass.set_bind_group(1, &gto.bind_group, &[]);
-            }
-            None => pass.set_pipeline(&self.pipeline),
+        let Some(pipeline) = self.pipelines.get(&self.variant) else { return };
+        pass.set_pipeline(pipeline);
+        if let Some(gto) = &self.direct {
+            pass.set_bind_group(1, &gto.bind_group, &[]);
         }
         pass.set_bind_group(0, bind_group, &[]);
         pass.set_vertex_buffer(0, self.vertices.slice(..self.vertex_count as u64 * 12));
