@@ -528,6 +528,73 @@ mod repair_tests {
         assert!(n.residual < 1e-10, "{n:?}");
     }
 
+    /// The project's own PySCF Molden fixtures, written back the way each program's quirk would
+    /// write them: the repair must find the program and give back the same orbitals.
+    #[test]
+    fn quirks_applied_to_pyscf_molden_files_are_undone() {
+        use crate::model::gto::PreparedBasis;
+        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/wavefunctions");
+        let load = |name: &str| {
+            let text = std::fs::read_to_string(format!("{dir}/{name}"))
+                .unwrap_or_else(|e| panic!("{dir}/{name}: {e} (run scripts/make_wavefunction_fixtures.py)"));
+            let doc = super::super::molden::parse(name, &text, Some(&reference_overlap)).expect("fixture parses");
+            doc.wavefunction.expect("a wavefunction")
+        };
+        let points: Vec<DVec3> = (0..25)
+            .map(|k| DVec3::new((k as f64 * 0.7).sin() * 2.0, (k as f64 * 1.3).cos() * 2.0, k as f64 * 0.1 - 1.2))
+            .collect();
+        let values = |wf: &Wavefunction| -> Vec<f64> {
+            let pb = PreparedBasis::new(&wf.basis);
+            wf.orbitals
+                .iter()
+                .take(8)
+                .flat_map(|o| points.iter().map(|&p| pb.orbital_value(&o.coefficients, p)).collect::<Vec<_>>())
+                .collect()
+        };
+        type Quirk = fn(&mut Wavefunction);
+        let turbomole: Quirk = |wf| scale_rows(wf, |_, l| 1.0 / double_factorial(2 * l as i64 - 1).sqrt());
+        let cfour: Quirk = |wf| scale_rows(wf, |p, _| 1.0 / component_double_factorials(p).sqrt());
+        let psi4: Quirk =
+            |wf| scale_rows(wf, |p, l| (double_factorial(2 * l as i64 - 1) / component_double_factorials(p)).sqrt());
+        let orca: Quirk = |wf| {
+            let offsets = wf.basis.shell_offsets();
+            for (s, &first) in wf.basis.shells.iter_mut().zip(&offsets) {
+                let p = match s.l {
+                    0 => [0, 0, 0],
+                    1 => [1, 0, 0],
+                    2 => [1, 1, 0],
+                    _ => [1, 1, 1],
+                };
+                for (c, &a) in s.coefficients.iter_mut().zip(&s.exponents) {
+                    *c *= cartesian_norm(a, p);
+                }
+                if s.l == 3 && s.kind == ShellKind::Pure {
+                    for o in &mut wf.orbitals {
+                        o.coefficients[first + 5] *= -1.0;
+                        o.coefficients[first + 6] *= -1.0;
+                    }
+                }
+            }
+        };
+        for (name, quirk, named, expected) in [
+            ("h2o_cart_631gs.molden", turbomole, None, "Turbomole"),
+            ("h2o_cart_631gs.molden", cfour, None, "CFOUR"),
+            ("h2o_cart_631gs.molden", psi4, Some("Psi4"), "Psi4 <= 1.3.2"),
+            ("h2o_ccpvtz.molden", orca, None, "ORCA"),
+        ] {
+            let good = load(name);
+            assert_eq!(good.normalization.repair, "none", "{name}");
+            let mut bad = good.clone();
+            quirk(&mut bad);
+            bad.normalization = Normalization::default();
+            let fixed = check_and_repair(bad, named, Some(&reference_overlap));
+            assert_eq!(fixed.normalization.program, expected, "{name}: {:?}", fixed.normalization);
+            assert!(fixed.normalization.residual < 1e-8, "{name}: {:?}", fixed.normalization);
+            let worst = values(&good).iter().zip(values(&fixed)).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+            assert!(worst < 1e-10, "{name} as {expected}: orbitals differ by {worst:e} after the repair");
+        }
+    }
+
     #[test]
     fn unrepairable_files_are_kept_with_their_residual() {
         let mut wf = correct(ShellKind::Cartesian);
