@@ -502,9 +502,9 @@ mod repair_tests {
         assert!(n.residual < 1e-10);
     }
 
-    #[test]
-    fn orca_quirks_are_undone() {
-        let mut wf = correct(ShellKind::Pure);
+    /// What ORCA does to a correct file: primitive normalisation folded into the contraction
+    /// coefficients, and the signs of the pure f±3 functions flipped.
+    fn orca_quirk(wf: &mut Wavefunction) {
         let offsets = wf.basis.shell_offsets();
         for (s, &first) in wf.basis.shells.iter_mut().zip(&offsets) {
             let p = match s.l {
@@ -516,13 +516,19 @@ mod repair_tests {
             for (c, &a) in s.coefficients.iter_mut().zip(&s.exponents) {
                 *c *= cartesian_norm(a, p);
             }
-            if s.l == 3 {
+            if s.l == 3 && s.kind == ShellKind::Pure {
                 for o in &mut wf.orbitals {
                     o.coefficients[first + 5] *= -1.0;
                     o.coefficients[first + 6] *= -1.0;
                 }
             }
         }
+    }
+
+    #[test]
+    fn orca_quirks_are_undone() {
+        let mut wf = correct(ShellKind::Pure);
+        orca_quirk(&mut wf);
         let n = run(wf, None);
         assert_eq!(n.program, "ORCA", "{n:?}");
         assert!(n.residual < 1e-10, "{n:?}");
@@ -556,26 +562,7 @@ mod repair_tests {
         let cfour: Quirk = |wf| scale_rows(wf, |p, _| 1.0 / component_double_factorials(p).sqrt());
         let psi4: Quirk =
             |wf| scale_rows(wf, |p, l| (double_factorial(2 * l as i64 - 1) / component_double_factorials(p)).sqrt());
-        let orca: Quirk = |wf| {
-            let offsets = wf.basis.shell_offsets();
-            for (s, &first) in wf.basis.shells.iter_mut().zip(&offsets) {
-                let p = match s.l {
-                    0 => [0, 0, 0],
-                    1 => [1, 0, 0],
-                    2 => [1, 1, 0],
-                    _ => [1, 1, 1],
-                };
-                for (c, &a) in s.coefficients.iter_mut().zip(&s.exponents) {
-                    *c *= cartesian_norm(a, p);
-                }
-                if s.l == 3 && s.kind == ShellKind::Pure {
-                    for o in &mut wf.orbitals {
-                        o.coefficients[first + 5] *= -1.0;
-                        o.coefficients[first + 6] *= -1.0;
-                    }
-                }
-            }
-        };
+        let orca: Quirk = orca_quirk;
         for (name, quirk, named, expected) in [
             ("h2o_cart_631gs.molden", turbomole, None, "Turbomole"),
             ("h2o_cart_631gs.molden", cfour, None, "CFOUR"),
