@@ -55,28 +55,29 @@ pub fn write_to(
         let _ = writeln!(out, "{:5} {}", grids.len(), ids.join(" "));
     }
     w.write_all(out.as_bytes())?;
-    let [nx, ny, nz] = first.dims;
+    let nz = first.dims[2].max(1);
     let pow10 = pow10_table();
     let mut bytes = Vec::with_capacity(nz * grids.len() * 14 + 16);
-    for i in 0..nx {
-        for j in 0..ny {
-            // Each (x, y) row starts a new line, six values per line.
-            bytes.clear();
-            let mut n = 0;
-            for k in 0..nz {
-                for (g, _) in grids {
-                    push_scientific(&mut bytes, g.value(i, j, k), pow10);
-                    n += 1;
-                    if n % 6 == 0 {
-                        bytes.push(b'\n');
-                    }
+    // Values are stored in cube order: an (x, y) row is `nz` consecutive values of each grid.
+    let mut rows: Vec<std::slice::Chunks<f32>> = grids.iter().map(|(g, _)| g.values.chunks(nz)).collect();
+    for _ in 0..first.values.len() / nz {
+        let row: Vec<&[f32]> = rows.iter_mut().filter_map(|r| r.next()).collect();
+        // Each (x, y) row starts a new line, six values per line.
+        bytes.clear();
+        let mut n = 0;
+        for k in 0..nz {
+            for values in &row {
+                push_scientific(&mut bytes, values[k], pow10);
+                n += 1;
+                if n % 6 == 0 {
+                    bytes.push(b'\n');
                 }
             }
-            if n % 6 != 0 {
-                bytes.push(b'\n');
-            }
-            w.write_all(&bytes)?;
         }
+        if n % 6 != 0 {
+            bytes.push(b'\n');
+        }
+        w.write_all(&bytes)?;
     }
     w.flush()
 }
@@ -102,13 +103,17 @@ fn push_scientific(out: &mut Vec<u8>, v: f32, pow10: &[f64]) {
     // The decimal exponent from the binary one (log10 2 ≈ 0.30103), then corrected by one
     // against the table.
     let binary = ((a.to_bits() >> 52) & 0x7ff) as i32 - 1023;
-    let mut e = (binary as f64 * std::f64::consts::LOG10_2).floor() as i32;
+    // ⌊binary · log10 2⌋ with log10 2 ≈ 1233/4096; the arithmetic shift floors negatives too.
+    // (Integer arithmetic: `floor` and `round` are library calls on baseline x86-64.)
+    let mut e = (binary * 1233) >> 12;
     if a >= p(e + 1) {
         e += 1;
     } else if a < p(e) {
         e -= 1;
     }
-    let mut m = (a * p(5 - e)).round_ties_even() as u64;
+    // Round half up: within an ulp of a tie this may differ from exact decimal rounding in the
+    // sixth digit, which a cube file's precision does not notice.
+    let mut m = (a * p(5 - e) + 0.5) as u64;
     // Rounding may carry into a seventh digit (9.999996 → 10.0000).
     if m >= 1_000_000 {
         m = (m + 5) / 10;
