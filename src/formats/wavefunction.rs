@@ -17,10 +17,9 @@
 //! does not depend on how the contractions are scaled as long as `overlap` treats the
 //! coefficients literally.
 
-use rayon::prelude::*;
-
 use crate::model::basis::{Basis, ShellKind, cartesian_powers};
 use crate::model::orbitals::{MolecularOrbital, Normalization, Spin, Wavefunction};
+use crate::model::overlap::orthonormality_error;
 
 /// The analytic overlap matrix of a basis (n × n, row-major): contraction coefficients multiply
 /// normalised primitives, each cartesian component and each pure function on its own.
@@ -214,7 +213,8 @@ pub fn normalize_contractions(wf: &mut Wavefunction) {
     }
 }
 
-/// max |CᵀSC − I| over the orbitals of each spin, with `s` the n × n overlap matrix.
+/// max |CᵀSC − I| over the orbitals of each spin, with `s` the n × n overlap matrix
+/// (orbitals whose length is not n are left out).
 pub fn residual(orbitals: &[MolecularOrbital], s: &[f64]) -> f64 {
     let n = (s.len() as f64).sqrt().round() as usize;
     [Spin::Alpha, Spin::Beta]
@@ -225,30 +225,7 @@ pub fn residual(orbitals: &[MolecularOrbital], s: &[f64]) -> f64 {
                 .filter(|o| o.spin == spin && o.coefficients.len() == n)
                 .map(|o| o.coefficients.as_slice())
                 .collect();
-            let sc: Vec<Vec<f64>> = c
-                .par_iter()
-                .map(|cj| {
-                    (0..n)
-                        .map(|i| {
-                            let row = &s[i * n..(i + 1) * n];
-                            row.iter().zip(cj.iter()).map(|(a, b)| a * b).sum()
-                        })
-                        .collect()
-                })
-                .collect();
-            c.par_iter()
-                .enumerate()
-                .map(|(i, ci)| {
-                    sc.iter()
-                        .enumerate()
-                        .map(|(j, scj)| {
-                            let m: f64 = ci.iter().zip(scj).map(|(a, b)| a * b).sum();
-                            let target = if i == j { 1.0 } else { 0.0 };
-                            (m - target).abs()
-                        })
-                        .fold(0.0, f64::max)
-                })
-                .reduce(|| 0.0, f64::max)
+            orthonormality_error(s, n, &c)
         })
         .fold(0.0, f64::max)
 }
