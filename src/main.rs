@@ -18,6 +18,9 @@ use orbcloud::scene::{AtomStyle, Camera, ClipPlane, RenderSettings, Shape, Slice
 use orbcloud::{demo, formats, info};
 use rayon::prelude::*;
 
+#[path = "cli/scan.rs"]
+mod scan_cli;
+
 #[derive(Parser)]
 #[command(name = "orbcloud", version, about = "Molecular orbitals and densities as GPU-rendered clouds")]
 struct Cli {
@@ -66,6 +69,9 @@ enum Command {
         #[arg(short, long)]
         output: PathBuf,
     },
+    /// Dihedral scans: make a manifest, inspect, render or export an angle.
+    #[command(subcommand)]
+    Scan(scan_cli::ScanCommand),
     /// Print performance figures.
     #[command(subcommand)]
     Bench(BenchCommand),
@@ -202,6 +208,8 @@ enum BenchCommand {
         #[command(flatten)]
         wavefunction: WavefunctionArgs,
     },
+    /// Frame time against the number of resident key volumes K of a scan (seed 000's Fig. 6).
+    Keyvolumes(scan_cli::KeyVolumeBench),
 }
 
 #[derive(Args)]
@@ -520,6 +528,8 @@ fn main() -> Result<()> {
             );
             Ok(())
         }
+        Some(Command::Scan(command)) => scan_cli::run(command),
+        Some(Command::Bench(BenchCommand::Keyvolumes(args))) => scan_cli::bench_keyvolumes(args),
         Some(Command::Bench(BenchCommand::Render { file, view, frames, lavapipe, wavefunction })) => {
             let doc = load(file.as_deref())?;
             let ctx = gpu(lavapipe)?;

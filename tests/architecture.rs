@@ -8,7 +8,7 @@ const RULES: &[(&str, &[&str])] = &[
     ("formats", &["scene", "gpu", "headless", "app", "wgpu", "egui", "eframe", "rfd"]),
     ("scene", &["formats", "gpu", "headless", "app", "wgpu", "egui", "eframe", "rfd"]),
     ("gpu", &["formats", "headless", "app", "demo", "egui", "eframe", "rfd"]),
-    ("headless.rs", &["formats", "app", "egui", "eframe", "rfd"]),
+    ("headless", &["formats", "app", "egui", "eframe", "rfd"]),
     ("info.rs", &["gpu", "headless", "app", "wgpu", "egui", "eframe"]),
 ];
 

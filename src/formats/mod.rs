@@ -6,6 +6,7 @@ pub mod cube_write;
 mod error;
 pub mod fchk;
 pub mod molden;
+pub mod scan;
 mod text;
 pub mod wavefunction;
 

@@ -29,6 +29,7 @@ pub const SHADERS: &[(&str, &str)] = &[
     ("volume_common.wgsl", include_str!("../../shaders/volume_common.wgsl")),
     ("volume_slices.wgsl", include_str!("../../shaders/volume_slices.wgsl")),
     ("volume_direct.wgsl", include_str!("../../shaders/volume_direct.wgsl")),
+    ("volume_morph.wgsl", include_str!("../../shaders/volume_morph.wgsl")),
     ("atoms.wgsl", include_str!("../../shaders/atoms.wgsl")),
     ("resolve.wgsl", include_str!("../../shaders/resolve.wgsl")),
     ("gto_common.wgsl", include_str!("../../shaders/gto_common.wgsl")),
@@ -40,6 +41,7 @@ pub const SHADERS: &[(&str, &str)] = &[
 pub const SHADER_MODULES: &[(&str, &[&str])] = &[
     ("volume_slices.wgsl", &["volume_common.wgsl", "volume_slices.wgsl"]),
     ("volume_direct.wgsl", &["volume_common.wgsl", "gto_common.wgsl", "volume_direct.wgsl"]),
+    ("volume_morph.wgsl", &["volume_common.wgsl", "volume_morph.wgsl"]),
     ("gto_fill.wgsl", &["gto_common.wgsl", "gto_fill.wgsl"]),
 ];
 

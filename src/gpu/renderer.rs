@@ -61,6 +61,19 @@ impl Renderer {
         self.update_bounds();
     }
 
+    /// Shows θ between two key volumes of a scan (seed 000), mixed (1−k):k.
+    pub fn set_morph(
+        &mut self,
+        ctx: &GpuContext,
+        a: VolumeTexture,
+        b: VolumeTexture,
+        k: f32,
+        mode: crate::scene::Interpolation,
+    ) {
+        self.volume.set_morph(ctx, a, b, k, mode);
+        self.update_bounds();
+    }
+
     /// Shows an orbital evaluated per fragment from its basis functions (seed 004's direct mode).
     pub fn set_direct(
         &mut self,

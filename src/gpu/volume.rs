@@ -9,7 +9,7 @@ use super::{DEPTH_FORMAT, GpuContext, GpuError, SCENE_FORMAT};
 use crate::model::cartesian::CartesianExpansion;
 use crate::model::{VolumeGrid, grid::ValueKind};
 use crate::scene::slicing::{GridBox, Slices};
-use crate::scene::{TransferKind, VolumeSettings};
+use crate::scene::{Interpolation, TransferKind, VolumeSettings};
 
 /// Mirror of `VolumeUniforms` in volume_slices.wgsl.
 #[repr(C)]
@@ -63,7 +63,9 @@ fn active_box(grid: &VolumeGrid) -> GridBox {
     }
 }
 
-/// A grid uploaded to the GPU, with what the shader needs to place and scale it.
+/// A grid uploaded to the GPU, with what the shader needs to place and scale it. Clones share
+/// the texture.
+#[derive(Debug, Clone)]
 pub struct VolumeTexture {
     pub texture: wgpu::Texture,
     pub view: wgpu::TextureView,
@@ -83,12 +85,17 @@ impl VolumeTexture {
     /// Uploads a grid. The texture's x (fastest) axis is the grid's k (cube files' fastest), so
     /// no transposition is needed; `tex_from_world` swaps the axes instead.
     pub fn upload(ctx: &GpuContext, grid: &VolumeGrid) -> Result<Self, GpuError> {
+        Self::upload_as(ctx, grid, ctx.volume_format)
+    }
+
+    /// [`Self::upload`] into a texture of `format` (R32Float needs the device's
+    /// FLOAT32_FILTERABLE; R16Float always filters).
+    pub fn upload_as(ctx: &GpuContext, grid: &VolumeGrid, format: wgpu::TextureFormat) -> Result<Self, GpuError> {
         let [nx, ny, nz] = grid.dims;
         let max = ctx.device.limits().max_texture_dimension_3d;
         if grid.dims.iter().any(|&d| d == 0 || d > max as usize) {
             return Err(GpuError::VolumeTooLarge { dims: grid.dims, max });
         }
-        let format = ctx.volume_format;
         let bytes: Vec<u8> = match format {
             wgpu::TextureFormat::R32Float => bytemuck::cast_slice(&grid.values).to_vec(),
             _ => {
@@ -156,11 +163,60 @@ impl VolumeTexture {
     }
 }
 
+/// Which fragment program draws the slices.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+enum Program {
+    /// One 3D texture.
+    Slices,
+    /// Seed 004's direct mode: the orbital from its basis functions.
+    Direct,
+    /// Two key volumes mixed per sample.
+    Exact,
+    /// Seed 000's three passes per slice: attenuate, add (1−k)A, add kB.
+    Attenuate,
+    AddA,
+    AddB,
+}
+
+impl Program {
+    fn entry(self) -> &'static str {
+        match self {
+            Program::Slices => "fs_main",
+            Program::Direct => "fs_direct",
+            Program::Exact => "fs_exact",
+            Program::Attenuate => "fs_attenuate",
+            Program::AddA => "fs_add_a",
+            Program::AddB => "fs_add_b",
+        }
+    }
+
+    /// Premultiplied "over" for one pass per frame; the three-pass programs blend as seed 000:
+    /// dst·(1 − α) for the attenuation, dst + src for the two additions.
+    fn blend(self) -> wgpu::BlendState {
+        let component =
+            |src, dst| wgpu::BlendComponent { src_factor: src, dst_factor: dst, operation: wgpu::BlendOperation::Add };
+        match self {
+            Program::Attenuate => {
+                let c = component(wgpu::BlendFactor::Zero, wgpu::BlendFactor::OneMinusSrcAlpha);
+                wgpu::BlendState { color: c, alpha: c }
+            }
+            Program::AddA | Program::AddB => {
+                let c = component(wgpu::BlendFactor::One, wgpu::BlendFactor::One);
+                wgpu::BlendState { color: c, alpha: c }
+            }
+            _ => wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING,
+        }
+    }
+}
+
+/// The programs of one frame, in the order each slice is drawn with them.
+const THREE_PASS: [Program; 3] = [Program::Attenuate, Program::AddA, Program::AddB];
+
 /// Which variant of the slice shader a frame needs: each is its own pipeline, specialised by
 /// WGSL override constants.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 struct Variant {
-    direct: bool,
+    program: Program,
     gradient: bool,
     shaped: bool,
     clip: bool,
@@ -170,16 +226,10 @@ struct Variant {
 struct SliceShader {
     module: wgpu::ShaderModule,
     layout: wgpu::PipelineLayout,
-    fragment_entry: &'static str,
 }
 
 impl SliceShader {
-    fn new(
-        device: &wgpu::Device,
-        name: &str,
-        fragment_entry: &'static str,
-        groups: &[Option<&wgpu::BindGroupLayout>],
-    ) -> Self {
+    fn new(device: &wgpu::Device, name: &str, groups: &[Option<&wgpu::BindGroupLayout>]) -> Self {
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some(name),
             source: wgpu::ShaderSource::Wgsl(super::module_source(name).into()),
@@ -189,16 +239,31 @@ impl SliceShader {
             bind_group_layouts: groups,
             immediate_size: 0,
         });
-        Self { module, layout, fragment_entry }
+        Self { module, layout }
     }
+}
+
+/// The second key volume of an interpolated frame, and how to mix.
+struct Morph {
+    /// Keeps B's texture alive while its bind group is in use.
+    _partner: VolumeTexture,
+    bind_group: wgpu::BindGroup,
+    k: f32,
+    mode: Interpolation,
 }
 
 pub struct VolumePass {
     slices: SliceShader,
     direct_shader: SliceShader,
+    morph_shader: SliceShader,
     pipelines: std::collections::HashMap<Variant, wgpu::RenderPipeline>,
-    /// The variant this frame draws with (set in `prepare`).
+    /// The variant this frame draws with (set in `prepare`); three-pass frames draw each slice
+    /// with the three programs in turn.
     variant: Variant,
+    /// This frame's slices (vertex ranges, back to front).
+    ranges: Vec<std::ops::Range<u32>>,
+    morph_layout: wgpu::BindGroupLayout,
+    morph: Option<Morph>,
     layout: wgpu::BindGroupLayout,
     sampler: wgpu::Sampler,
     uniforms: wgpu::Buffer,
@@ -212,8 +277,17 @@ pub struct VolumePass {
 }
 
 /// The slice pipeline for one shader variant.
-fn make_pipeline(device: &wgpu::Device, shader: &SliceShader, variant: Variant) -> wgpu::RenderPipeline {
+fn make_pipeline(
+    device: &wgpu::Device,
+    shaders: (&SliceShader, &SliceShader, &SliceShader),
+    variant: Variant,
+) -> wgpu::RenderPipeline {
     let flag = |b: bool| f64::from(u8::from(b));
+    let shader = match variant.program {
+        Program::Slices => &shaders.0,
+        Program::Direct => &shaders.1,
+        _ => &shaders.2,
+    };
     let constants =
         [("GRADIENT", flag(variant.gradient)), ("SHAPED", flag(variant.shaped)), ("CLIP", flag(variant.clip))];
     let options = wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() };
@@ -242,11 +316,11 @@ fn make_pipeline(device: &wgpu::Device, shader: &SliceShader, variant: Variant) 
         multisample: Default::default(),
         fragment: Some(wgpu::FragmentState {
             module: &shader.module,
-            entry_point: Some(shader.fragment_entry),
+            entry_point: Some(variant.program.entry()),
             compilation_options: options,
             targets: &[Some(wgpu::ColorTargetState {
                 format: SCENE_FORMAT,
-                blend: Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING),
+                blend: Some(variant.program.blend()),
                 write_mask: wgpu::ColorWrites::ALL,
             })],
         }),
@@ -281,11 +355,25 @@ impl VolumePass {
             ],
         });
         let gto_layout = gto_layout(device, wgpu::ShaderStages::FRAGMENT);
-        let slices = SliceShader::new(device, "volume_slices.wgsl", "fs_main", &[Some(&layout)]);
-        let direct_shader =
-            SliceShader::new(device, "volume_direct.wgsl", "fs_direct", &[Some(&layout), Some(&gto_layout)]);
-        let variant = Variant { direct: false, gradient: false, shaped: false, clip: false };
-        let pipelines = [(variant, make_pipeline(device, &slices, variant))].into_iter().collect();
+        let morph_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("key volume B layout"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                    view_dimension: wgpu::TextureViewDimension::D3,
+                    multisampled: false,
+                },
+                count: None,
+            }],
+        });
+        let slices = SliceShader::new(device, "volume_slices.wgsl", &[Some(&layout)]);
+        let direct_shader = SliceShader::new(device, "volume_direct.wgsl", &[Some(&layout), Some(&gto_layout)]);
+        let morph_shader = SliceShader::new(device, "volume_morph.wgsl", &[Some(&layout), Some(&morph_layout)]);
+        let variant = Variant { program: Program::Slices, gradient: false, shaped: false, clip: false };
+        let pipelines =
+            [(variant, make_pipeline(device, (&slices, &direct_shader, &morph_shader), variant))].into_iter().collect();
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("volume sampler"),
             address_mode_u: wgpu::AddressMode::ClampToEdge,
@@ -300,8 +388,12 @@ impl VolumePass {
         Self {
             slices,
             direct_shader,
+            morph_shader,
             pipelines,
             variant,
+            ranges: Vec::new(),
+            morph_layout,
+            morph: None,
             layout,
             sampler,
             uniforms,
@@ -365,6 +457,7 @@ impl VolumePass {
     /// Shows a volume already on the GPU (None shows none).
     pub fn set_texture(&mut self, ctx: &GpuContext, volume: Option<VolumeTexture>) {
         self.direct = None;
+        self.morph = None;
         self.volume = volume;
         self.bind_group = self.volume.as_ref().map(|v| {
             ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -377,6 +470,18 @@ impl VolumePass {
                 ],
             })
         });
+    }
+
+    /// Seed 000's interpolated frame: key volumes `a` and `b` (one grid, one scale: `a`'s box
+    /// and `max_abs` are used) mixed (1−k):k as `mode` says.
+    pub fn set_morph(&mut self, ctx: &GpuContext, a: VolumeTexture, b: VolumeTexture, k: f32, mode: Interpolation) {
+        self.set_texture(ctx, Some(a));
+        let bind_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("key volume B"),
+            layout: &self.morph_layout,
+            entries: &[wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&b.view) }],
+        });
+        self.morph = Some(Morph { _partner: b, bind_group, k: k.clamp(0.0, 1.0), mode });
     }
 
     pub fn volume(&self) -> Option<&VolumeTexture> {
@@ -398,7 +503,9 @@ impl VolumePass {
         if !settings.visible {
             return;
         }
-        let Slices { vertices, normal, spacing } = vol.grid_box.slices(settings.mode, settings.slices, eye, view_dir);
+        let slices = vol.grid_box.slices(settings.mode, settings.slices, eye, view_dir);
+        self.ranges = slices.ranges().collect();
+        let Slices { vertices, normal, spacing, .. } = slices;
         if vertices.is_empty() {
             return;
         }
@@ -409,16 +516,24 @@ impl VolumePass {
         self.vertex_count = vertices.len() as u32;
         let signed = vol.kind == ValueKind::Signed;
         let t = &settings.transfer;
+        let program = match (&self.direct, &self.morph) {
+            (Some(_), _) => Program::Direct,
+            (None, Some(m)) if m.mode == Interpolation::ThreePass => Program::Attenuate,
+            (None, Some(_)) => Program::Exact,
+            (None, None) => Program::Slices,
+        };
         self.variant = Variant {
-            direct: self.direct.is_some(),
+            program,
             gradient: t.needs_gradient(),
             shaped: t.kind == TransferKind::Shaped,
             clip: settings.clip.enabled,
         };
-        if !self.pipelines.contains_key(&self.variant) {
-            let shader = if self.variant.direct { &self.direct_shader } else { &self.slices };
-            let pipeline = make_pipeline(device, shader, self.variant);
-            self.pipelines.insert(self.variant, pipeline);
+        for variant in self.programs().map(|program| Variant { program, ..self.variant }) {
+            if !self.pipelines.contains_key(&variant) {
+                let shaders = (&self.slices, &self.direct_shader, &self.morph_shader);
+                let pipeline = make_pipeline(device, shaders, variant);
+                self.pipelines.insert(variant, pipeline);
+            }
         }
         let lobe = |l: &crate::scene::transfer::Lobe| [l.center, l.width, l.opacity, 0.0];
         let bits = u32::from(t.shading);
@@ -438,7 +553,12 @@ impl VolumePass {
             negative_color: rgb(settings.negative_color),
             params: [settings.k1, settings.k2, 1.0 / vol.max_abs, vol.step],
             flags: [u32::from(signed), 0, 0, 0],
-            flags_f: [visibility_threshold(settings.k1, settings.k2, signed), 0.0, 0.0, 0.0],
+            flags_f: [
+                visibility_threshold(settings.k1, settings.k2, signed),
+                self.morph.as_ref().map_or(0.0, |m| m.k),
+                0.0,
+                0.0,
+            ],
             tf: [0, t.positive.shape.index(), t.negative.shape.index(), bits],
             tf_positive: lobe(&t.positive),
             tf_negative: lobe(&t.negative),
@@ -449,6 +569,17 @@ impl VolumePass {
         queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
     }
 
+    /// The programs each slice is drawn with this frame, in order.
+    fn programs(&self) -> impl Iterator<Item = Program> + use<> {
+        let programs: &'static [Program] = match self.variant.program {
+            Program::Attenuate => &THREE_PASS,
+            Program::Slices => &[Program::Slices],
+            Program::Direct => &[Program::Direct],
+            _ => &[Program::Exact],
+        };
+        programs.iter().copied()
+    }
+
     pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>) {
         let Some(bind_group) = &self.bind_group else {
             return;
@@ -456,13 +587,40 @@ impl VolumePass {
         if self.vertex_count == 0 {
             return;
         }
-        let Some(pipeline) = self.pipelines.get(&self.variant) else { return };
-        pass.set_pipeline(pipeline);
+        let pipelines: Option<Vec<&wgpu::RenderPipeline>> =
+            self.programs().map(|program| self.pipelines.get(&Variant { program, ..self.variant })).collect();
+        let Some(pipelines) = pipelines else { return };
+        pass.set_bind_group(0, bind_group, &[]);
         if let Some(gto) = &self.direct {
             pass.set_bind_group(1, &gto.bind_group, &[]);
         }
-        pass.set_bind_group(0, bind_group, &[]);
+        if let Some(morph) = &self.morph {
+            pass.set_bind_group(1, &morph.bind_group, &[]);
+        }
         pass.set_vertex_buffer(0, self.vertices.slice(..self.vertex_count as u64 * 12));
-        pass.draw(0..self.vertex_count, 0..1);
+        if let [pipeline] = pipelines.as_slice() {
+            pass.set_pipeline(pipeline);
+            pass.draw(0..self.vertex_count, 0..1);
+            return;
+        }
+        // Seed 000's three passes: each slice is finished before the next one starts.
+        for range in &self.ranges {
+            for pipeline in &pipelines {
+                pass.set_pipeline(pipeline);
+                pass.draw(range.clone(), 0..1);
+            }
+        }
     }
+}
+
+/// Bytes one texel of a volume format takes.
+pub fn texel_bytes(format: wgpu::TextureFormat) -> u64 {
+    format.block_copy_size(None).unwrap_or(4) as u64
+}
+
+/// How much memory resident volumes (a scan's key volumes) may take. wgpu reports no heap
+/// sizes; the largest buffer the device allows is the nearest limit (lavapipe: its 2 GiB heap,
+/// the paper's cards: their video memory), and three quarters of it leaves room for the frame.
+pub fn residency_budget(limits: &wgpu::Limits) -> u64 {
+    limits.max_buffer_size.min(16 << 30) / 4 * 3
 }

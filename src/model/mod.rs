@@ -14,6 +14,7 @@ pub mod gto;
 pub mod molecule;
 pub mod orbitals;
 pub mod overlap;
+pub mod scan;
 pub mod solid_harmonics;
 pub mod units;
 

@@ -37,19 +37,20 @@ fn overlap_1d(la: usize, lb: usize, xpa: f64, xpb: f64, p: f64) -> [[f64; 8]; 8]
     s
 }
 
-/// Block of S between two shells, row-major n_functions(a) × n_functions(b).
-fn shell_pair(pb: &PreparedBasis, a: &PreparedShell, b: &PreparedShell) -> Vec<f64> {
+/// Block of S between shell `a` of basis `ba` and shell `b` of basis `bb`, row-major
+/// n_functions(a) × n_functions(b).
+fn shell_pair(ba: &PreparedBasis, a: &PreparedShell, bb: &PreparedBasis, b: &PreparedShell) -> Vec<f64> {
     let (la, lb) = (a.l as usize, b.l as usize);
-    let (pa, pbw) = (&pb.powers[la], &pb.powers[lb]);
-    let (fa, fb) = (&pb.component_factors[la], &pb.component_factors[lb]);
+    let (pa, pbw) = (&ba.powers[la], &bb.powers[lb]);
+    let (fa, fb) = (&ba.component_factors[la], &bb.component_factors[lb]);
     let (na, nb) = (pa.len(), pbw.len());
     let mut cart = vec![0.0; na * nb];
     let ab = a.center() - b.center();
     let r2 = ab.length_squared();
     for i in a.primitives() {
-        let (alpha, ca) = (pb.exponents[i], pb.coefficients[i]);
+        let (alpha, ca) = (ba.exponents[i], ba.coefficients[i]);
         for j in b.primitives() {
-            let (beta, cb) = (pb.exponents[j], pb.coefficients[j]);
+            let (beta, cb) = (bb.exponents[j], bb.coefficients[j]);
             let p = alpha + beta;
             let e = (-alpha * beta / p * r2).exp();
             if e < PAIR_SCREEN {
@@ -79,7 +80,7 @@ fn shell_pair(pb: &PreparedBasis, a: &PreparedShell, b: &PreparedShell) -> Vec<f
     }
     // Pure transformations: left T_a, right T_bᵀ.
     let left = if a.pure {
-        let t = &pb.pure_matrices[la];
+        let t = &ba.pure_matrices[la];
         let m = a.n_functions as usize;
         let mut out = vec![0.0; m * nb];
         for k in 0..m {
@@ -97,7 +98,7 @@ fn shell_pair(pb: &PreparedBasis, a: &PreparedShell, b: &PreparedShell) -> Vec<f
         cart
     };
     if b.pure {
-        let t = &pb.pure_matrices[lb];
+        let t = &bb.pure_matrices[lb];
         let m = a.n_functions as usize;
         let n = b.n_functions as usize;
         let mut out = vec![0.0; m * n];
@@ -126,7 +127,7 @@ impl PreparedBasis {
             .flat_map_iter(|ia| {
                 (0..=ia).map(move |ib| {
                     let (a, b) = (&self.shells[ia], &self.shells[ib]);
-                    (ia, ib, shell_pair(self, a, b))
+                    (ia, ib, shell_pair(self, a, self, b))
                 })
             })
             .collect();
@@ -143,6 +144,30 @@ impl PreparedBasis {
         }
         s
     }
+}
+
+/// The overlap ⟨χ_μ|χ'_ν⟩ between the functions of two bases (for instance one molecule at two
+/// geometries), row-major n(a) × n(b).
+pub fn cross_overlap(a: &PreparedBasis, b: &PreparedBasis) -> Vec<f64> {
+    let nb = b.n_functions();
+    let rows: Vec<Vec<f64>> = a
+        .shells
+        .par_iter()
+        .map(|sa| {
+            let mut rows = vec![0.0; sa.n_functions as usize * nb];
+            for sb in &b.shells {
+                let block = shell_pair(a, sa, b, sb);
+                let n = sb.n_functions as usize;
+                for u in 0..sa.n_functions as usize {
+                    for (v, j) in sb.functions().enumerate() {
+                        rows[u * nb + j] = block[u * n + v];
+                    }
+                }
+            }
+            rows
+        })
+        .collect();
+    rows.concat()
 }
 
 /// max |CᵀSC − I| over a set of orbitals (coefficient vectors) given the overlap matrix `s`

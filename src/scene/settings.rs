@@ -14,6 +14,17 @@ pub enum SliceMode {
     AxisAligned,
 }
 
+/// How a frame between two key volumes (a dihedral scan, seed 000) mixes them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+pub enum Interpolation {
+    /// Both volumes sampled and mixed per sample, ψ = (1−k)ψA + kψB: the interpolated orbital.
+    #[default]
+    Exact,
+    /// Seed 000's real-time approximation: per slice, three blending passes (attenuate by A_i,
+    /// add (1−k)A_i, add kB_i).
+    ThreePass,
+}
+
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct VolumeSettings {
     pub visible: bool,

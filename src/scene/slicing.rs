@@ -23,6 +23,20 @@ pub struct Slices {
     pub normal: Vec3,
     /// Distance between neighbouring planes along `normal`.
     pub spacing: f32,
+    /// Index of each slice's first vertex, back to front (a slice ends where the next starts).
+    pub starts: Vec<u32>,
+}
+
+impl Slices {
+    /// The vertex range of each slice, back to front (empty slices skipped).
+    pub fn ranges(&self) -> impl Iterator<Item = std::ops::Range<u32>> + '_ {
+        let end = self.vertices.len() as u32;
+        self.starts
+            .iter()
+            .enumerate()
+            .map(move |(i, &s)| s..self.starts.get(i + 1).copied().unwrap_or(end))
+            .filter(|r| !r.is_empty())
+    }
 }
 
 impl GridBox {
@@ -31,6 +45,24 @@ impl GridBox {
         std::array::from_fn(|n| {
             self.origin + e[0] * (n & 1) as f32 + e[1] * ((n >> 1) & 1) as f32 + e[2] * ((n >> 2) & 1) as f32
         })
+    }
+
+    /// The smallest box with this box's edge directions that holds both boxes (for boxes cut
+    /// from one grid, whose edges are parallel).
+    pub fn union(&self, other: &GridBox) -> GridBox {
+        let m = glam::Mat3::from_cols(self.edges[0], self.edges[1], self.edges[2]);
+        if m.determinant().abs() < 1e-12 {
+            return *self;
+        }
+        let inv = m.inverse();
+        // Both boxes' corners in this box's coordinates (0..1 spans this box).
+        let (lo, hi) = self
+            .corners()
+            .iter()
+            .chain(other.corners().iter())
+            .map(|&c| inv * (c - self.origin))
+            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p)));
+        GridBox { origin: self.origin + m * lo, edges: std::array::from_fn(|a| self.edges[a] * (hi[a] - lo[a])) }
     }
 
     /// The 12 edges as pairs of corner indices.
@@ -53,8 +85,10 @@ impl GridBox {
         let count = count.max(1);
         let spacing = (hi - lo) / count as f32;
         let mut vertices = Vec::with_capacity(count as usize * 12);
+        let mut starts = Vec::with_capacity(count as usize);
         // Far to near: the first plane is deepest.
         for s in 0..count {
+            starts.push(vertices.len() as u32);
             let d = hi - (s as f32 + 0.5) * spacing;
             let mut poly: Vec<Vec3> = Vec::with_capacity(6);
             for &(a, b) in &Self::EDGES {
@@ -66,7 +100,7 @@ impl GridBox {
             }
             triangulate_convex(&mut poly, n, &mut vertices);
         }
-        Slices { vertices, normal: n, spacing }
+        Slices { vertices, normal: n, spacing, starts }
     }
 
     /// Seed 000's three stacks: planes of constant grid coordinate along the axis that faces the
@@ -88,14 +122,16 @@ impl GridBox {
         // Planes at fractions t along the axis; start with the one farthest from the eye.
         let far_first = e[axis].dot(normal) > 0.0;
         let mut vertices = Vec::with_capacity(count as usize * 6);
+        let mut starts = Vec::with_capacity(count as usize);
         for s in 0..count {
+            starts.push(vertices.len() as u32);
             let i = if far_first { count - 1 - s } else { s };
             let t = (i as f32 + 0.5) / count as f32;
             let p = self.origin + e[axis] * t;
             let quad = [p, p + e[u], p + e[u] + e[w], p + e[w]];
             vertices.extend_from_slice(&[quad[0], quad[1], quad[2], quad[0], quad[2], quad[3]]);
         }
-        Slices { vertices, normal, spacing }
+        Slices { vertices, normal, spacing, starts }
     }
 }
 

@@ -1,6 +1,8 @@
 //! Rendering a document to an image without a window: the CLI's `render`, the benchmarks and
 //! the golden-image tests use this, through the same [`Renderer`] as the viewer.
 
+pub mod scan;
+
 use glam::DVec3;
 
 use crate::gpu::gto::{GridGeometry, GtoFillPass, read_volume, volume_from_texture};

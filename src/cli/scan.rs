@@ -1,0 +1,397 @@
+//! `orbcloud scan …` and `orbcloud bench keyvolumes`: dihedral scans from the command line.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use clap::{Args, Subcommand, ValueEnum};
+use orbcloud::formats::cube_write;
+use orbcloud::formats::scan::{Follow, ScanFile, init, load_scan};
+use orbcloud::gpu::volume::{VolumeTexture, residency_budget, texel_bytes};
+use orbcloud::gpu::{GpuContext, OffscreenTarget, Renderer};
+use orbcloud::headless::scan::{DEFAULT_SCAN_POINTS, KeyOptions, ScanScene};
+use orbcloud::model::VolumeGrid;
+use orbcloud::scene::Interpolation;
+
+use super::{ViewArgs, gpu};
+
+#[derive(Subcommand)]
+pub enum ScanCommand {
+    /// Write DIR/<name>.scan.toml from a directory of Molden/fchk files, one per angle.
+    Init {
+        dir: PathBuf,
+        /// The dihedral's atoms, 1-based (default: the bonded dihedral that changes most).
+        #[arg(long, value_parser = parse_dihedral)]
+        dihedral: Option<[usize; 4]>,
+        /// Print the manifest instead of writing it.
+        #[arg(long)]
+        dry_run: bool,
+    },
+    /// Frames, orbitals, energies, sign flips and character swaps of a scan.
+    Info {
+        scan: PathBuf,
+        #[arg(long, value_enum)]
+        follow: Option<FollowArg>,
+    },
+    /// Render the scan's orbitals at an angle, side by side, to a PNG.
+    Render(ScanRenderArgs),
+    /// Write the exactly interpolated orbital at an angle as a cube file.
+    Export {
+        scan: PathBuf,
+        #[arg(long, allow_hyphen_values = true)]
+        angle: f64,
+        /// Which of the scan's orbitals (as the manifest names them).
+        #[arg(long, default_value = "homo", allow_hyphen_values = true)]
+        orbital: String,
+        #[command(flatten)]
+        keys: KeyArgs,
+        #[arg(short, long)]
+        output: PathBuf,
+    },
+}
+
+#[derive(Args)]
+pub struct KeyArgs {
+    /// Points along the longest side of the common grid.
+    #[arg(long, default_value_t = DEFAULT_SCAN_POINTS)]
+    points: usize,
+    /// Follow each orbital by index (name) or by overlap (character); default: the manifest's.
+    #[arg(long, value_enum)]
+    follow: Option<FollowArg>,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub enum FollowArg {
+    Index,
+    Overlap,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub enum InterpolationArg {
+    /// Both key volumes mixed per sample (the interpolated orbital).
+    Exact,
+    /// Seed 000's three blending passes per slice.
+    ThreePass,
+}
+
+impl From<InterpolationArg> for Interpolation {
+    fn from(m: InterpolationArg) -> Self {
+        match m {
+            InterpolationArg::Exact => Interpolation::Exact,
+            InterpolationArg::ThreePass => Interpolation::ThreePass,
+        }
+    }
+}
+
+#[derive(Args)]
+pub struct ScanRenderArgs {
+    scan: PathBuf,
+    #[arg(long, allow_hyphen_values = true)]
+    angle: f64,
+    #[arg(long = "interpolation", value_enum, default_value_t = InterpolationArg::Exact)]
+    interpolation: InterpolationArg,
+    /// Only this orbital (as the manifest names it); default: all, left to right.
+    #[arg(long, allow_hyphen_values = true)]
+    orbital: Option<String>,
+    #[command(flatten)]
+    keys: KeyArgs,
+    #[command(flatten)]
+    view: ViewArgs,
+    /// Use the CPU Vulkan adapter (lavapipe) even when a GPU is present.
+    #[arg(long)]
+    lavapipe: bool,
+    #[arg(short, long)]
+    output: PathBuf,
+}
+
+fn parse_dihedral(s: &str) -> Result<[usize; 4], String> {
+    let v: Vec<usize> =
+        s.split(',').map(|t| t.trim().parse::<usize>()).collect::<Result<_, _>>().map_err(|e| e.to_string())?;
+    match v[..] {
+        [a, b, c, d] if v.iter().all(|&x| x >= 1) => Ok([a - 1, b - 1, c - 1, d - 1]),
+        _ => Err(format!("expected four 1-based atom numbers i,j,k,l, got {s:?}")),
+    }
+}
+
+fn follow_of(arg: Option<FollowArg>, file: &ScanFile) -> Follow {
+    match arg {
+        Some(FollowArg::Index) => Follow::Index,
+        Some(FollowArg::Overlap) => Follow::Overlap,
+        None => file.follow,
+    }
+}
+
+/// Loads a scan and makes its key volumes, reporting progress on stderr.
+fn build(ctx: &GpuContext, path: &Path, keys: &KeyArgs) -> Result<ScanScene> {
+    let file = load_scan(path)?;
+    let options = KeyOptions {
+        points: keys.points.clamp(8, 512),
+        follow: follow_of(keys.follow, &file),
+        ..KeyOptions::default()
+    };
+    let t = Instant::now();
+    let scene = ScanScene::build(ctx, file.scan, &options, &mut |done, total| {
+        eprint!("\rkey volumes {done}/{total}");
+        true
+    })?;
+    eprintln!(
+        "\rkey volumes: {} of {:?} points, {:.1} MiB ({:.1} s)",
+        scene.slots() * scene.scan.frames.len(),
+        scene.grid.dims,
+        scene.bytes as f64 / 1048576.0,
+        t.elapsed().as_secs_f64()
+    );
+    for s in &scene.tracks.swaps {
+        eprintln!(
+            "note: at {}° {} overlaps the previous frame's orbital {:.3}, orbital {} overlaps it {:.3} (character swap{})",
+            scene.scan.frames[s.frame].angle,
+            scene.scan.orbitals[s.slot],
+            s.by_name_overlap,
+            s.by_overlap + 1,
+            s.best_overlap,
+            if scene.tracks.follow == Follow::Overlap { ", followed" } else { "; --follow overlap follows it" }
+        );
+    }
+    Ok(scene)
+}
+
+fn slot_of(scene: &ScanScene, name: &str) -> Result<usize> {
+    scene
+        .scan
+        .orbitals
+        .iter()
+        .position(|o| o.eq_ignore_ascii_case(name))
+        .with_context(|| format!("the scan shows {:?}, not {name:?}", scene.scan.orbitals))
+}
+
+pub fn run(command: ScanCommand) -> Result<()> {
+    match command {
+        ScanCommand::Init { dir, dihedral, dry_run } => {
+            let made = init(&dir, dihedral)?;
+            let d = made.dihedral.map(|i| i + 1);
+            eprintln!(
+                "dihedral {}-{}-{}-{}; {} frames from {:.2}° to {:.2}°",
+                d[0],
+                d[1],
+                d[2],
+                d[3],
+                made.frames.len(),
+                made.frames[0].1,
+                made.frames[made.frames.len() - 1].1
+            );
+            if dry_run {
+                print!("{}", made.text);
+            } else {
+                std::fs::write(&made.path, &made.text).with_context(|| format!("writing {}", made.path.display()))?;
+                println!("{}", made.path.display());
+            }
+            Ok(())
+        }
+        ScanCommand::Info { scan, follow } => {
+            let file = load_scan(&scan)?;
+            let tracks = file.scan.track(follow_of(follow, &file))?;
+            let s = &file.scan;
+            let d = s.dihedral.map(|i| i + 1);
+            println!(
+                "{}\ndihedral {}-{}-{}-{}, {} frames, {} atoms turn",
+                s.title,
+                d[0],
+                d[1],
+                d[2],
+                d[3],
+                s.frames.len(),
+                s.moving.len()
+            );
+            print!("{:>9}  {:<28}", "angle", "file");
+            for o in &s.orbitals {
+                print!("  {:>12} {:>5}", format!("E({o})"), "sign");
+            }
+            println!();
+            for (f, frame) in s.frames.iter().enumerate() {
+                print!("{:>9.2}  {:<28}", frame.angle, frame.source);
+                for slot in 0..s.orbitals.len() {
+                    let p = tracks.points[slot][f];
+                    let e = p.energy.map_or("-".into(), |e| format!("{e:.5}"));
+                    print!("  {e:>12} {:>5}", if p.flipped { "flip" } else { "" });
+                }
+                println!();
+            }
+            for slot in 0..s.orbitals.len() {
+                println!("{}: {} of {} steps flipped", s.orbitals[slot], tracks.flips(slot), s.frames.len() - 1);
+            }
+            for w in &tracks.swaps {
+                println!(
+                    "swap at {}°: {} (|overlap| {:.3}) vs orbital {} (|overlap| {:.3})",
+                    s.frames[w.frame].angle,
+                    s.orbitals[w.slot],
+                    w.by_name_overlap,
+                    w.by_overlap + 1,
+                    w.best_overlap
+                );
+            }
+            Ok(())
+        }
+        ScanCommand::Render(args) => {
+            let ctx = gpu(args.lavapipe)?;
+            let scene = build(&ctx, &args.scan, &args.keys)?;
+            let slots: Vec<usize> = match &args.orbital {
+                Some(name) => vec![slot_of(&scene, name)?],
+                None => (0..scene.slots()).collect(),
+            };
+            let settings = args.view.settings();
+            let mut camera = scene.camera();
+            camera.orbit(args.view.yaw.to_radians(), args.view.pitch.to_radians());
+            camera.zoom(1.0 / args.view.zoom.max(1e-3));
+            let image = scene.render(
+                &ctx,
+                &slots,
+                args.angle,
+                args.interpolation.into(),
+                &camera,
+                &settings,
+                args.view.size,
+            )?;
+            image.save(&args.output).with_context(|| format!("writing {}", args.output.display()))?;
+            for &slot in &slots {
+                eprintln!("{}", scene.label(slot, args.angle));
+            }
+            eprintln!("wrote {}", args.output.display());
+            Ok(())
+        }
+        ScanCommand::Export { scan, angle, orbital, keys, output } => {
+            let file = load_scan(&scan)?;
+            let follow = follow_of(keys.follow, &file);
+            let s = &file.scan;
+            let slot = s
+                .orbitals
+                .iter()
+                .position(|o| o.eq_ignore_ascii_case(&orbital))
+                .with_context(|| format!("the scan shows {:?}, not {orbital:?}", s.orbitals))?;
+            let (lo, hi) = s.range();
+            if !(lo..=hi).contains(&angle) {
+                bail!("--angle {angle} is outside the scan's {lo}°..{hi}°");
+            }
+            let tracks = s.track(follow)?;
+            let grid = s.common_grid(orbcloud::headless::ORBITAL_MARGIN, keys.points.clamp(8, 512));
+            let values = s.interpolated_values(&tracks, slot, angle, &grid);
+            let label = format!("{orbital} at {angle} deg (interpolated)");
+            let volume = VolumeGrid::new(&label, grid.dims, grid.world_from_grid, values);
+            let molecule = s.geometry_at(angle);
+            let title = format!("{}: {label}", s.title);
+            std::fs::write(&output, cube_write::write(&title, &label, &molecule, &[(&volume, 0)]))
+                .with_context(|| format!("writing {}", output.display()))?;
+            eprintln!("wrote {} ({:?} points)", output.display(), grid.dims);
+            Ok(())
+        }
+    }
+}
+
+/// `bench keyvolumes`: frame time against the number of resident key volumes K (the analogue
+/// of seed 000's Figure 6), and the largest K that fits the memory budget.
+#[derive(Args)]
+pub struct KeyVolumeBench {
+    /// A scan manifest; the bundled PSB3 demo when omitted.
+    scan: Option<PathBuf>,
+    /// Resident key volume counts to time.
+    #[arg(long, value_delimiter = ',', default_value = "2,8,32,128,512")]
+    counts: Vec<usize>,
+    /// Points along the longest side of the grid.
+    #[arg(long, default_value_t = DEFAULT_SCAN_POINTS)]
+    points: usize,
+    /// Frames to time per K (each at a different θ, so a different pair of volumes).
+    #[arg(long, default_value_t = 8)]
+    frames: usize,
+    #[arg(long, default_value = "400x300", value_parser = super::parse_size)]
+    size: [u32; 2],
+    #[arg(long)]
+    lavapipe: bool,
+}
+
+pub fn bench_keyvolumes(args: KeyVolumeBench) -> Result<()> {
+    let ctx = gpu(args.lavapipe)?;
+    let file = match &args.scan {
+        Some(path) => load_scan(path)?,
+        None => orbcloud::demo::scan()?,
+    };
+    let s = &file.scan;
+    let tracks = s.track(file.follow)?;
+    let grid = s.common_grid(orbcloud::headless::ORBITAL_MARGIN, args.points.clamp(8, 512));
+    // The real key volumes of the first orbital, cycled to make K distinct textures.
+    let sources: Vec<VolumeGrid> = (0..s.frames.len())
+        .map(|f| {
+            VolumeGrid::new(format!("key {f}"), grid.dims, grid.world_from_grid, s.key_values(&tracks, 0, f, &grid))
+        })
+        .collect();
+    let max_abs = sources.iter().map(|g| g.stats.max_abs).fold(1e-30, f64::max) as f32;
+    let format = wgpu::TextureFormat::R16Float;
+    let per_volume = grid.len() as u64 * texel_bytes(format);
+    let budget = residency_budget(&ctx.device.limits());
+    println!("adapter: {}", ctx.describe());
+    println!(
+        "grid {:?} ({:.2} MiB per key volume as {format:?}); budget {:.0} MiB (from max_buffer_size {} MiB); largest K = {}",
+        grid.dims,
+        per_volume as f64 / 1048576.0,
+        budget as f64 / 1048576.0,
+        ctx.device.limits().max_buffer_size >> 20,
+        budget / per_volume
+    );
+    let settings = orbcloud::scene::RenderSettings::default();
+    let (lo, hi) = (
+        grid.world_from_grid.w_axis.truncate(),
+        grid.world_from_grid.transform_point3(glam::DVec3::new(
+            grid.dims[0] as f64 - 1.0,
+            grid.dims[1] as f64 - 1.0,
+            grid.dims[2] as f64 - 1.0,
+        )),
+    );
+    let camera = orbcloud::scene::Camera::framing(lo.as_vec3(), hi.as_vec3());
+    let molecule = s.geometry_at(s.frames[0].angle);
+    let target = OffscreenTarget::new(&ctx.device, args.size);
+    println!("K,resident_MiB,exact_ms_median,three_pass_ms_median,upload_s");
+    for &k in &args.counts {
+        if k < 2 || k as u64 > budget / per_volume {
+            println!("{k},skipped (needs 2..={} to fit)", budget / per_volume);
+            continue;
+        }
+        let t = Instant::now();
+        let mut keys = Vec::with_capacity(k);
+        for i in 0..k {
+            let mut v = VolumeTexture::upload_as(&ctx, &sources[i % sources.len()], format)?;
+            v.max_abs = max_abs;
+            keys.push(v);
+        }
+        ctx.device.poll(wgpu::PollType::wait_indefinitely())?;
+        let upload = t.elapsed().as_secs_f64();
+        let mut renderer = Renderer::new(&ctx);
+        renderer.set_molecule(&ctx, &molecule, settings.atoms);
+        let mut medians = Vec::new();
+        for mode in [Interpolation::Exact, Interpolation::ThreePass] {
+            let mut times = Vec::new();
+            for f in 0..args.frames.max(1) + 1 {
+                // Spread the frames over all K volumes, as a drag across the whole range would.
+                let i = (f * (k - 1)) / args.frames.max(1);
+                let (a, b) = (i.min(k - 2), i.min(k - 2) + 1);
+                renderer.set_morph(&ctx, keys[a].clone(), keys[b].clone(), 0.37, mode);
+                let t = Instant::now();
+                let mut encoder =
+                    ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("bench") });
+                let frame = orbcloud::gpu::FrameInput { camera: &camera, settings: &settings, size: args.size };
+                renderer.render(&ctx, &mut encoder, &target.color_view, &frame);
+                ctx.queue.submit([encoder.finish()]);
+                ctx.device.poll(wgpu::PollType::wait_indefinitely())?;
+                if f > 0 {
+                    times.push(t.elapsed().as_secs_f64() * 1e3);
+                }
+            }
+            times.sort_by(f64::total_cmp);
+            medians.push(times[times.len() / 2]);
+        }
+        println!(
+            "{k},{:.1},{:.1},{:.1},{upload:.2}",
+            (k as u64 * per_volume) as f64 / 1048576.0,
+            medians[0],
+            medians[1]
+        );
+    }
+    Ok(())
+}

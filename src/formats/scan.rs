@@ -1,0 +1,379 @@
+//! Scan manifests (`*.scan.toml`): a dihedral scan as key frames, each an angle and the file(s)
+//! holding that frame's orbitals. Paths are relative to the manifest.
+//!
+//! ```toml
+//! title = "PSB3 cation: twist about C3=C4"
+//! dihedral = [2, 3, 4, 5]          # atom numbers, 1-based
+//! orbitals = ["homo", "lumo"]      # default; also "homo-1", "lumo+2", an index
+//! follow = "index"                 # or "overlap": follow each orbital's character
+//!
+//! [[frame]]
+//! angle = -180.0
+//! file = "psb3_m180.molden.gz"     # Molden or fchk
+//!
+//! [[frame]]
+//! angle = -150.0
+//! cubes = ["homo_m150.cube", "lumo_m150.cube"]   # or one cube per orbital
+//! ```
+
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+
+use super::{LoadError, ParseError};
+pub use crate::model::scan::Follow;
+use crate::model::scan::{ANGLE_TOLERANCE, FrameContent, KeyFrame, Scan, measure, most_changing_dihedral};
+use crate::model::{Document, Molecule};
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Manifest {
+    title: Option<String>,
+    dihedral: toml::Spanned<[usize; 4]>,
+    #[serde(default = "default_orbitals")]
+    orbitals: Vec<String>,
+    #[serde(default)]
+    follow: Follow,
+    #[serde(rename = "frame", default)]
+    frames: Vec<toml::Spanned<FrameEntry>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FrameEntry {
+    angle: f64,
+    file: Option<String>,
+    cubes: Option<Vec<String>>,
+}
+
+fn default_orbitals() -> Vec<String> {
+    vec!["homo".into(), "lumo".into()]
+}
+
+/// A scan as its manifest asks for it.
+#[derive(Debug, Clone)]
+pub struct ScanFile {
+    pub scan: Scan,
+    pub follow: Follow,
+}
+
+fn line_of(text: &str, offset: usize) -> usize {
+    text[..offset.min(text.len())].matches('\n').count() + 1
+}
+
+fn error(file: &str, line: usize, expected: impl Into<String>, found: impl Into<String>) -> ParseError {
+    ParseError { file: file.into(), line, expected: expected.into(), found: found.into() }
+}
+
+/// "C5H8N, 14 atoms" — enough to tell two molecules apart in a message.
+fn describe(m: &Molecule) -> String {
+    format!("{}, {} atoms", m.formula(), m.atoms.len())
+}
+
+/// Reads a manifest and every frame it names.
+pub fn load_scan(path: &Path) -> Result<ScanFile, LoadError> {
+    let text = super::read_text(path)?;
+    parse_scan(path, &text, &mut |p| super::load(p))
+}
+
+/// Parses manifest `text` (read from `path`), loading frames through `load` (tests substitute
+/// their own).
+pub fn parse_scan(
+    path: &Path,
+    text: &str,
+    load: &mut dyn FnMut(&Path) -> Result<Document, LoadError>,
+) -> Result<ScanFile, LoadError> {
+    let name = path.display().to_string();
+    let manifest: Manifest = toml::from_str(text).map_err(|e| {
+        let line = e.span().map_or(1, |s| line_of(text, s.start));
+        error(&name, line, "a scan manifest (title, dihedral, orbitals, [[frame]] angle + file or cubes)", e.message())
+    })?;
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let dihedral_line = line_of(text, manifest.dihedral.span().start);
+    let dihedral = *manifest.dihedral.get_ref();
+    if dihedral.contains(&0) {
+        return Err(error(&name, dihedral_line, "four atom numbers counted from 1", format!("{dihedral:?}")).into());
+    }
+    if manifest.frames.len() < 2 {
+        return Err(error(
+            &name,
+            line_of(text, text.len()),
+            "at least two [[frame]] entries",
+            manifest.frames.len().to_string(),
+        )
+        .into());
+    }
+    let mut frames: Vec<(usize, KeyFrame)> = Vec::with_capacity(manifest.frames.len());
+    let mut first_kind: Option<bool> = None;
+    for spanned in &manifest.frames {
+        let line = line_of(text, spanned.span().start);
+        let entry = spanned.get_ref();
+        if !entry.angle.is_finite() {
+            return Err(error(&name, line, "a finite angle in degrees", entry.angle.to_string()).into());
+        }
+        let (molecule, content, source) = match (&entry.file, &entry.cubes) {
+            (Some(file), None) => {
+                let doc = load(&dir.join(file))?;
+                let Some(wf) = doc.wavefunction else {
+                    return Err(error(&name, line, "a Molden or fchk file with orbitals", file.clone()).into());
+                };
+                (doc.molecule, FrameContent::Wavefunction(Box::new(wf)), file.clone())
+            }
+            (None, Some(cubes)) if !cubes.is_empty() => {
+                let mut molecule = None;
+                let mut volumes = Vec::new();
+                for cube in cubes {
+                    let doc = load(&dir.join(cube))?;
+                    molecule.get_or_insert(doc.molecule);
+                    volumes.extend(doc.volumes);
+                }
+                (molecule.unwrap_or_default(), FrameContent::Volumes(volumes), cubes.join(", "))
+            }
+            _ => {
+                return Err(error(
+                    &name,
+                    line,
+                    "a frame with either file = \"…\" or cubes = [\"…\", …]",
+                    "both or neither",
+                )
+                .into());
+            }
+        };
+        let is_cube = matches!(content, FrameContent::Volumes(_));
+        if *first_kind.get_or_insert(is_cube) != is_cube {
+            return Err(error(
+                &name,
+                line,
+                "every frame from the same kind of file (all Molden/fchk or all cubes)",
+                source,
+            )
+            .into());
+        }
+        frames.push((line, KeyFrame { angle: entry.angle, source, molecule, content }));
+    }
+    check_frames(&name, &frames)?;
+    frames.sort_by(|a, b| a.1.angle.total_cmp(&b.1.angle));
+    for pair in frames.windows(2) {
+        let ((l0, f0), (l1, f1)) = (&pair[0], &pair[1]);
+        if (f1.angle - f0.angle).abs() < ANGLE_TOLERANCE {
+            let (first, second) = if l0 < l1 { (l0, l1) } else { (l1, l0) };
+            return Err(error(
+                &name,
+                *second,
+                format!("an angle different from the frame on line {first}"),
+                format!("angle = {}", f1.angle),
+            )
+            .into());
+        }
+    }
+    let title = manifest
+        .title
+        .unwrap_or_else(|| path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default());
+    let dihedral = dihedral.map(|i| i - 1);
+    let scan = Scan::new(title, dihedral, manifest.orbitals, frames.into_iter().map(|(_, f)| f).collect())
+        .map_err(|e| error(&name, dihedral_line, "a dihedral about a bond that can turn", e.to_string()))?;
+    // Resolving the orbitals of every frame reports a missing one before anything is evaluated.
+    scan.track(crate::model::scan::Follow::Index)
+        .map_err(|e| error(&name, 1, "the orbitals the manifest names", e.to_string()))?;
+    Ok(ScanFile { scan, follow: manifest.follow })
+}
+
+/// Every frame must hold the first frame's atoms; cube series must share one grid.
+fn check_frames(name: &str, frames: &[(usize, KeyFrame)]) -> Result<(), ParseError> {
+    let Some((_, first)) = frames.first() else { return Ok(()) };
+    let same_atoms = |m: &Molecule| {
+        m.atoms.len() == first.molecule.atoms.len()
+            && m.atoms.iter().zip(&first.molecule.atoms).all(|(a, b)| a.z == b.z)
+    };
+    let first_grid = match &first.content {
+        FrameContent::Volumes(v) => v.first(),
+        FrameContent::Wavefunction(_) => None,
+    };
+    for (line, frame) in frames {
+        if !same_atoms(&frame.molecule) {
+            return Err(error(
+                name,
+                *line,
+                format!("the atoms of the first frame, in its order ({}: {})", first.source, describe(&first.molecule)),
+                format!("{}: {}", frame.source, describe(&frame.molecule)),
+            ));
+        }
+        if let (Some(g0), FrameContent::Volumes(volumes)) = (first_grid, &frame.content) {
+            for g in volumes {
+                let same = g.dims == g0.dims && g.world_from_grid.abs_diff_eq(g0.world_from_grid, 1e-6);
+                if !same {
+                    return Err(error(
+                        name,
+                        *line,
+                        format!(
+                            "the grid of {} ({:?} points, origin {:.4})",
+                            first.source,
+                            g0.dims,
+                            g0.world_from_grid.w_axis.truncate()
+                        ),
+                        format!(
+                            "{} on {:?} points, origin {:.4}",
+                            frame.source,
+                            g.dims,
+                            g.world_from_grid.w_axis.truncate()
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// A manifest written by [`init`].
+#[derive(Debug, Clone)]
+pub struct ScanInit {
+    pub path: PathBuf,
+    pub text: String,
+    /// 0-based atoms of the dihedral.
+    pub dihedral: [usize; 4],
+    /// (file name, angle) in scan order.
+    pub frames: Vec<(String, f64)>,
+}
+
+/// Whether a file name is a wavefunction the readers take (Molden or fchk, maybe gzipped).
+fn is_wavefunction_file(name: &str) -> bool {
+    let n = name.to_ascii_lowercase();
+    let n = n.strip_suffix(".gz").unwrap_or(&n);
+    [".molden", ".molden.input", ".mold", ".fchk", ".fch"].iter().any(|e| n.ends_with(e))
+}
+
+/// Builds `DIR/<dir name>.scan.toml` from the Molden/fchk files in `dir`: each frame's angle is
+/// the dihedral measured in its geometry (the given atoms, 0-based, or the bonded dihedral that
+/// changes most), frames sorted by angle. The text is returned, not written.
+pub fn init(dir: &Path, dihedral: Option<[usize; 4]>) -> Result<ScanInit, LoadError> {
+    let io = |source| LoadError::Io { path: dir.display().to_string(), source };
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .map_err(io)?
+        .filter_map(|e| e.ok())
+        .filter(|e| e.path().is_file())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| is_wavefunction_file(n))
+        .collect();
+    names.sort();
+    let dir_name = dir
+        .canonicalize()
+        .ok()
+        .and_then(|d| d.file_name().map(|s| s.to_string_lossy().into_owned()))
+        .unwrap_or_else(|| "scan".into());
+    let manifest_path = dir.join(format!("{dir_name}.scan.toml"));
+    let name = dir.display().to_string();
+    if names.len() < 2 {
+        return Err(error(
+            &name,
+            0,
+            "a directory with at least two Molden or fchk files",
+            format!("{} such files", names.len()),
+        )
+        .into());
+    }
+    let mut molecules = Vec::with_capacity(names.len());
+    for n in &names {
+        let doc = super::load(&dir.join(n))?;
+        if let Some(m0) = molecules.first() {
+            let m0: &Molecule = m0;
+            if m0.atoms.len() != doc.molecule.atoms.len()
+                || m0.atoms.iter().zip(&doc.molecule.atoms).any(|(a, b)| a.z != b.z)
+            {
+                return Err(error(
+                    &dir.join(n).display().to_string(),
+                    0,
+                    format!("the atoms of {} ({})", names[0], describe(m0)),
+                    describe(&doc.molecule),
+                )
+                .into());
+            }
+        }
+        molecules.push(doc.molecule);
+    }
+    let n_atoms = molecules[0].atoms.len();
+    let d = match dihedral {
+        Some(d) => {
+            if let Some(&bad) = d.iter().find(|&&i| i >= n_atoms) {
+                return Err(
+                    error(&name, 0, format!("dihedral atoms between 1 and {n_atoms}"), (bad + 1).to_string()).into()
+                );
+            }
+            d
+        }
+        None => most_changing_dihedral(&molecules)
+            .ok_or_else(|| error(&name, 0, "a bond with neighbours on both sides (give --dihedral i,j,k,l)", "none"))?,
+    };
+    let angles = unwrap_angles(&molecules.iter().map(|m| measure(m, d)).collect::<Vec<_>>());
+    let mut frames: Vec<(String, f64)> = names.into_iter().zip(angles).collect();
+    frames.sort_by(|a, b| a.1.total_cmp(&b.1));
+    for w in frames.windows(2) {
+        if (w[1].1 - w[0].1).abs() < ANGLE_TOLERANCE {
+            return Err(error(
+                &dir.join(&w[1].0).display().to_string(),
+                0,
+                format!("a dihedral different from {}'s", w[0].0),
+                format!("{:.3}° in both", w[1].1),
+            )
+            .into());
+        }
+    }
+    let mut text = format!(
+        "# Written by `orbcloud scan init`: angles measured from each file's geometry.\ntitle = \"{dir_name}\"\ndihedral = [{}, {}, {}, {}]\norbitals = [\"homo\", \"lumo\"]\n",
+        d[0] + 1,
+        d[1] + 1,
+        d[2] + 1,
+        d[3] + 1
+    );
+    for (file, angle) in &frames {
+        text.push_str(&format!(
+            "\n[[frame]]\nangle = {angle:.3}\nfile = \"{}\"\n",
+            file.replace('\\', "\\\\").replace('"', "\\\"")
+        ));
+    }
+    Ok(ScanInit { path: manifest_path, text, dihedral: d, frames })
+}
+
+/// Dihedrals measured in (−180, 180] made continuous: the sequence starts after the largest gap
+/// around the circle, so a scan from −180 to 0 is not split at ±180.
+fn unwrap_angles(measured: &[f64]) -> Vec<f64> {
+    let mut sorted: Vec<f64> = measured.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    let n = sorted.len();
+    if n < 2 {
+        return measured.to_vec();
+    }
+    // Gap after sorted[i] (the last one wraps around).
+    let gap = |i: usize| if i + 1 < n { sorted[i + 1] - sorted[i] } else { sorted[0] + 360.0 - sorted[n - 1] };
+    let widest = (0..n).max_by(|&a, &b| gap(a).total_cmp(&gap(b))).unwrap_or(n - 1);
+    if widest == n - 1 {
+        return measured.to_vec();
+    }
+    // Angles at or below the gap's start go round once; then centre the range on zero.
+    let cut = sorted[widest];
+    let shifted: Vec<f64> = measured.iter().map(|&a| if a <= cut { a + 360.0 } else { a }).collect();
+    let mid = (sorted[widest + 1] + cut + 360.0) / 2.0;
+    if mid > 180.0 { shifted.iter().map(|a| a - 360.0).collect() } else { shifted }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn unwrapping_keeps_a_scan_through_180_together() {
+        let u = unwrap_angles(&[180.0, -150.0, -90.0, 0.0]);
+        assert_eq!(u, vec![-180.0, -150.0, -90.0, 0.0]);
+        assert_eq!(unwrap_angles(&[-60.0, 0.0, 60.0]), vec![-60.0, 0.0, 60.0]);
+        let u = unwrap_angles(&[170.0, -170.0, 150.0]);
+        assert_eq!(u, vec![170.0, 190.0, 150.0]);
+    }
+
+    #[test]
+    fn wavefunction_files_are_recognised() {
+        assert!(is_wavefunction_file("a.molden.gz"));
+        assert!(is_wavefunction_file("B.FCHK"));
+        assert!(!is_wavefunction_file("a.cube"));
+        assert!(!is_wavefunction_file("a.scan.toml"));
+    }
+}

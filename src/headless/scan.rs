@@ -1,0 +1,229 @@
+//! A dihedral scan on the GPU (seed 000): every key volume of the chosen orbitals evaluated on
+//! one common grid and kept resident as a 3D texture, so any θ is drawn by mixing the two key
+//! volumes around it, with the skeleton turned to θ.
+
+use thiserror::Error;
+
+use super::ORBITAL_MARGIN;
+use crate::gpu::gto::{GtoFillPass, read_volume};
+use crate::gpu::volume::{VolumeTexture, residency_budget, texel_bytes};
+use crate::gpu::{FrameInput, GpuContext, GpuError, OffscreenTarget, Renderer};
+use crate::model::cartesian::CartesianExpansion;
+use crate::model::grid::ValueKind;
+use crate::model::scan::{Bracket, Follow, FrameContent, Scan, ScanError, ScanGrid, Tracks};
+use crate::model::units::EV_PER_HARTREE;
+use crate::model::{PreparedBasis, VolumeGrid};
+use crate::scene::{AtomStyle, Camera, Interpolation, RenderSettings};
+use glam::DVec3;
+
+/// Points along the longest side of the common grid unless asked otherwise.
+pub const DEFAULT_SCAN_POINTS: usize = 64;
+
+#[derive(Debug, Error)]
+pub enum ScanSceneError {
+    #[error(transparent)]
+    Gpu(#[from] GpuError),
+    #[error(transparent)]
+    Scan(#[from] ScanError),
+    #[error(
+        "{count} key volumes of {dims:?} points need {needed_mib:.0} MiB, more than the {budget_mib:.0} MiB this GPU \
+         allows; a grid of {fits} points along the longest side fits"
+    )]
+    OverBudget { count: usize, dims: [usize; 3], needed_mib: f64, budget_mib: f64, fits: usize },
+    #[error("cancelled")]
+    Cancelled,
+}
+
+/// How key volumes are made.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct KeyOptions {
+    /// Points along the longest side of the common grid (wavefunction frames).
+    pub points: usize,
+    /// R16Float (default: half the memory) or R32Float.
+    pub format: wgpu::TextureFormat,
+    /// Memory allowed for the key volumes (bytes); `None`: derived from the device limits.
+    pub budget: Option<u64>,
+    pub follow: Follow,
+}
+
+impl Default for KeyOptions {
+    fn default() -> Self {
+        Self { points: DEFAULT_SCAN_POINTS, format: wgpu::TextureFormat::R16Float, budget: None, follow: Follow::Index }
+    }
+}
+
+/// A scan with all its key volumes resident on the GPU.
+pub struct ScanScene {
+    pub scan: Scan,
+    pub tracks: Tracks,
+    pub grid: ScanGrid,
+    /// `keys[slot][frame]`, phase-aligned, each with the slot's common opacity scale.
+    keys: Vec<Vec<VolumeTexture>>,
+    /// Largest |ψ| per slot over all frames: one opacity scale for the whole scan, so the
+    /// cloud does not brighten or fade between frames for nothing.
+    pub scale: Vec<f64>,
+    /// Memory the key volumes take, and the budget they had to fit.
+    pub bytes: u64,
+    pub budget: u64,
+}
+
+impl ScanScene {
+    /// Evaluates every key volume (GPU compute for wavefunctions), reading each back once to
+    /// find its range, and keeps them as textures of `options.format`. `progress(done, total)`
+    /// is called after each; returning false cancels.
+    pub fn build(
+        ctx: &GpuContext,
+        scan: Scan,
+        options: &KeyOptions,
+        progress: &mut dyn FnMut(usize, usize) -> bool,
+    ) -> Result<Self, ScanSceneError> {
+        let tracks = scan.track(options.follow)?;
+        let grid = scan.common_grid(ORBITAL_MARGIN, options.points);
+        let slots = scan.orbitals.len();
+        let count = slots * scan.frames.len();
+        let per_volume = grid.len() as u64 * texel_bytes(options.format);
+        let budget = options.budget.unwrap_or_else(|| residency_budget(&ctx.device.limits()));
+        let needed = per_volume * count as u64;
+        if needed > budget {
+            let shrink = (budget as f64 / needed as f64).cbrt();
+            return Err(ScanSceneError::OverBudget {
+                count,
+                dims: grid.dims,
+                needed_mib: needed as f64 / 1048576.0,
+                budget_mib: budget as f64 / 1048576.0,
+                fits: ((options.points as f64 * shrink).floor() as usize).max(2),
+            });
+        }
+        let mut fill: Option<GtoFillPass> = None;
+        let mut grids: Vec<Vec<VolumeGrid>> = vec![Vec::with_capacity(scan.frames.len()); slots];
+        for (f, frame) in scan.frames.iter().enumerate() {
+            let prepared = match &frame.content {
+                FrameContent::Wavefunction(wf) => Some(PreparedBasis::new(&wf.basis)),
+                FrameContent::Volumes(_) => None,
+            };
+            for (slot, slot_grids) in grids.iter_mut().enumerate() {
+                let values = match (&prepared, scan.aligned_coefficients(&tracks, slot, f)) {
+                    (Some(prepared), Some(c)) => {
+                        let fill = fill.get_or_insert_with(|| GtoFillPass::new(ctx));
+                        let geometry =
+                            crate::gpu::gto::GridGeometry { dims: grid.dims, world_from_grid: grid.world_from_grid };
+                        let texture =
+                            fill.fill(ctx, &CartesianExpansion::from_coefficients(prepared, &c), &geometry)?;
+                        read_volume(ctx, &texture)?
+                    }
+                    _ => scan.key_values(&tracks, slot, f, &grid),
+                };
+                let label = format!("{} at {}°", scan.orbitals[slot], frame.angle);
+                slot_grids.push(VolumeGrid::new(label, grid.dims, grid.world_from_grid, values));
+                if !progress(f * slots + slot + 1, count) {
+                    return Err(ScanSceneError::Cancelled);
+                }
+            }
+        }
+        let mut keys = Vec::with_capacity(slots);
+        let mut scale = Vec::with_capacity(slots);
+        for slot_grids in &grids {
+            let max_abs = slot_grids.iter().map(|g| g.stats.max_abs).fold(1e-30, f64::max);
+            let max_grad = slot_grids.iter().map(|g| g.max_gradient()).fold(1e-30, f64::max);
+            // One box for the whole sweep: the union of where each frame's cloud is visible.
+            let mut textures: Vec<VolumeTexture> = Vec::with_capacity(slot_grids.len());
+            for g in slot_grids {
+                textures.push(VolumeTexture::upload_as(ctx, g, options.format)?);
+            }
+            let union = textures.iter().map(|t| t.grid_box).reduce(|a, b| a.union(&b));
+            for t in &mut textures {
+                t.max_abs = max_abs as f32;
+                t.max_grad = max_grad as f32;
+                if let Some(u) = union {
+                    t.grid_box = u;
+                }
+            }
+            keys.push(textures);
+            scale.push(max_abs);
+        }
+        Ok(Self { scan, tracks, grid, keys, scale, bytes: needed, budget })
+    }
+
+    pub fn slots(&self) -> usize {
+        self.keys.len()
+    }
+
+    /// Puts slot `slot` at θ into `renderer`: the two key volumes around θ and the skeleton
+    /// turned to θ.
+    pub fn show(
+        &self,
+        ctx: &GpuContext,
+        renderer: &mut Renderer,
+        slot: usize,
+        theta: f64,
+        mode: Interpolation,
+        style: AtomStyle,
+    ) {
+        let Bracket { a, b, k } = self.scan.bracket(theta);
+        let keys = &self.keys[slot];
+        renderer.set_morph(ctx, keys[a].clone(), keys[b].clone(), k as f32, mode);
+        renderer.set_molecule(ctx, &self.scan.geometry_at(theta), style);
+    }
+
+    /// A camera framing the common grid from the default direction.
+    pub fn camera(&self) -> Camera {
+        let g = &self.grid;
+        let far = DVec3::new(g.dims[0] as f64 - 1.0, g.dims[1] as f64 - 1.0, g.dims[2] as f64 - 1.0);
+        let (a, b) = (g.world_from_grid.w_axis.truncate(), g.world_from_grid.transform_point3(far));
+        Camera::framing(a.min(b).as_vec3(), a.max(b).as_vec3())
+    }
+
+    /// Renders `slots` at θ side by side (left to right), each `size`, into one image.
+    #[allow(clippy::too_many_arguments)]
+    pub fn render(
+        &self,
+        ctx: &GpuContext,
+        slots: &[usize],
+        theta: f64,
+        mode: Interpolation,
+        camera: &Camera,
+        settings: &RenderSettings,
+        size: [u32; 2],
+    ) -> Result<image::RgbaImage, GpuError> {
+        let mut out = image::RgbaImage::new(size[0] * slots.len() as u32, size[1]);
+        let mut renderer = Renderer::new(ctx);
+        let target = OffscreenTarget::new(&ctx.device, size);
+        for (n, &slot) in slots.iter().enumerate() {
+            self.show(ctx, &mut renderer, slot, theta, mode, settings.atoms);
+            let mut encoder =
+                ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("scan frame") });
+            renderer.render(ctx, &mut encoder, &target.color_view, &FrameInput { camera, settings, size });
+            ctx.queue.submit([encoder.finish()]);
+            let view = target.read_rgba(&ctx.device, &ctx.queue)?;
+            image::imageops::replace(&mut out, &view, (n as u32 * size[0]) as i64, 0);
+        }
+        Ok(out)
+    }
+
+    /// A slot's key volume in one frame.
+    pub fn key_volume(&self, slot: usize, frame: usize) -> &VolumeTexture {
+        &self.keys[slot][frame]
+    }
+
+    /// "HOMO  −0.3012 Eh  (−8.20 eV)" at θ, the energy interpolated between key frames.
+    pub fn label(&self, slot: usize, theta: f64) -> String {
+        let name = self.scan.orbitals[slot].to_uppercase().replace('-', "−");
+        match self.scan.energy_at(&self.tracks, slot, theta) {
+            Some(e) => format!("{name}  {e:.4} Eh  ({:.2} eV)", e * EV_PER_HARTREE).replace('-', "−"),
+            None => name,
+        }
+    }
+
+    /// The exactly interpolated volume of a slot at θ, evaluated on the CPU (for export).
+    pub fn interpolated_grid(&self, slot: usize, theta: f64) -> VolumeGrid {
+        let values = self.scan.interpolated_values(&self.tracks, slot, theta, &self.grid);
+        let mut g = VolumeGrid::new(
+            format!("{} at {theta}° (interpolated)", self.scan.orbitals[slot]),
+            self.grid.dims,
+            self.grid.world_from_grid,
+            values,
+        );
+        g.kind = ValueKind::Signed;
+        g
+    }
+}

@@ -1,0 +1,637 @@
+//! Dihedral scans (seed 000): key frames computed at known torsion angles θ, the skeleton at any
+//! θ between them, and which orbital of each frame continues which orbital of the previous one.
+//!
+//! Solvers return every orbital with an arbitrary sign and may reorder orbitals of similar
+//! energy between frames, so a frame's "HOMO" is matched to the previous frame's by overlap:
+//! its sign is flipped when the overlap is negative, and a different orbital is reported (or
+//! followed) when it overlaps the previous one better than the one of the same name.
+
+use glam::{DMat4, DQuat, DVec3};
+use thiserror::Error;
+
+use super::gto::{GridSpec, PreparedBasis};
+use super::molecule::Molecule;
+use super::orbitals::{OrbitalSpec, Spin, Wavefunction};
+use super::overlap::cross_overlap;
+use super::{Atom, VolumeGrid};
+
+/// Two key angles closer than this (degrees) are the same angle.
+pub const ANGLE_TOLERANCE: f64 = 1e-3;
+
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum ScanError {
+    #[error("a scan needs at least two frames, found {0}")]
+    TooFewFrames(usize),
+    #[error("atom {0} of the dihedral is beyond the {1} atoms of the molecule")]
+    AtomOutOfRange(usize, usize),
+    #[error("the dihedral's atoms must be four different atoms")]
+    RepeatedAtom,
+    #[error("atoms {0} and {1} of the dihedral lie in one ring: no fragment turns about their bond")]
+    Ring(usize, usize),
+    #[error("frame at {angle}°: no orbital {spec} (the frame's file has {available} orbitals of that spin)")]
+    MissingOrbital { angle: f64, spec: String, available: usize },
+    #[error("frame at {angle}°: {found} volumes for {wanted} orbitals")]
+    MissingVolume { angle: f64, wanted: usize, found: usize },
+}
+
+/// What a key frame holds for its orbitals.
+#[derive(Debug, Clone)]
+pub enum FrameContent {
+    /// Orbitals from a basis set (Molden, fchk): evaluated on the scan's common grid.
+    Wavefunction(Box<Wavefunction>),
+    /// Precomputed grids (cube files), one per requested orbital, all on one grid.
+    Volumes(Vec<VolumeGrid>),
+}
+
+#[derive(Debug, Clone)]
+pub struct KeyFrame {
+    /// θ of this frame (degrees), as the manifest labels it.
+    pub angle: f64,
+    /// Where the frame came from (for messages).
+    pub source: String,
+    pub molecule: Molecule,
+    pub content: FrameContent,
+}
+
+/// How an orbital slot picks its orbital in each frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Follow {
+    /// By name: "HOMO" is each frame's HOMO (character swaps are reported).
+    #[default]
+    Index,
+    /// By character: each frame's orbital is the one overlapping the previous frame's most.
+    Overlap,
+}
+
+#[derive(Debug, Clone)]
+pub struct Scan {
+    pub title: String,
+    /// The torsion's atoms, 0-based.
+    pub dihedral: [usize; 4],
+    /// What each view shows: the manifest's names ("homo", "lumo", "homo-1", …).
+    pub orbitals: Vec<String>,
+    /// Key frames, sorted by strictly increasing angle.
+    pub frames: Vec<KeyFrame>,
+    /// Atoms that turn with θ: the side of the j–k bond that holds k.
+    pub moving: Vec<usize>,
+}
+
+/// Where θ falls between the key frames: frames `a` ≤ θ ≤ `b` and the mixing ratio
+/// k = (θ − θa)/(θb − θa).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Bracket {
+    pub a: usize,
+    pub b: usize,
+    pub k: f64,
+}
+
+/// One orbital slot's choice in one frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TrackPoint {
+    /// Index into the frame's `Wavefunction::orbitals` (or its volumes).
+    pub index: usize,
+    /// ±1: the factor that aligns the phase with the previous frame.
+    pub sign: f64,
+    /// Orbital energy (Eh), when the frame has one.
+    pub energy: Option<f64>,
+    /// ⟨previous|this⟩ after the sign (1 for the first frame).
+    pub overlap: f64,
+    /// Whether the solver's sign was flipped.
+    pub flipped: bool,
+}
+
+/// A change of character: in `frame`, the orbital named like the slot is not the one that
+/// continues the previous frame's.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Swap {
+    pub slot: usize,
+    pub frame: usize,
+    /// The orbital of the slot's name, and its |overlap| with the previous frame's.
+    pub by_name: usize,
+    pub by_name_overlap: f64,
+    /// The orbital that overlaps the previous frame's most, and that |overlap|.
+    pub by_overlap: usize,
+    pub best_overlap: f64,
+}
+
+/// The orbitals each slot shows across the frames, phase-aligned.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Tracks {
+    /// `points[slot][frame]`.
+    pub points: Vec<Vec<TrackPoint>>,
+    pub swaps: Vec<Swap>,
+    pub follow: Follow,
+}
+
+impl Tracks {
+    /// How many frame-to-frame steps flipped the solver's sign, per slot.
+    pub fn flips(&self, slot: usize) -> usize {
+        self.points[slot].iter().filter(|p| p.flipped).count()
+    }
+}
+
+/// Orbitals further than this (in energy order) from the slot's named orbital are not
+/// considered as its continuation.
+const FOLLOW_WINDOW: usize = 3;
+
+/// The dihedral angle i–j–k–l (degrees, −180..180], IUPAC sign: positive when, looking along
+/// j→k, the far bond k–l is turned clockwise from the near bond j–i.
+pub fn dihedral(p: [DVec3; 4]) -> f64 {
+    let (b1, b2, b3) = (p[1] - p[0], p[2] - p[1], p[3] - p[2]);
+    let n1 = b1.cross(b2);
+    let n2 = b2.cross(b3);
+    let y = b2.length() * b1.dot(n2);
+    let x = n1.dot(n2);
+    y.atan2(x).to_degrees()
+}
+
+/// `angle` wrapped to (−180, 180].
+pub fn wrap_degrees(angle: f64) -> f64 {
+    let a = angle.rem_euclid(360.0);
+    if a > 180.0 { a - 360.0 } else { a }
+}
+
+/// The dihedral `d` (0-based atoms) measured in a molecule.
+pub fn measure(molecule: &Molecule, d: [usize; 4]) -> f64 {
+    dihedral(d.map(|i| molecule.atoms[i].position))
+}
+
+/// The atoms on k's side of the j–k bond (k included, j not): what turns when the dihedral
+/// about j–k changes. Fails when j can be reached from k without that bond (a ring).
+pub fn moving_fragment(molecule: &Molecule, j: usize, k: usize) -> Result<Vec<usize>, ScanError> {
+    let n = molecule.atoms.len();
+    let mut neighbours = vec![Vec::new(); n];
+    for b in &molecule.bonds {
+        let (a, c) = (b.a as usize, b.b as usize);
+        if (a == j && c == k) || (a == k && c == j) {
+            continue;
+        }
+        neighbours[a].push(c);
+        neighbours[c].push(a);
+    }
+    let mut seen = vec![false; n];
+    let mut stack = vec![k];
+    seen[k] = true;
+    while let Some(a) = stack.pop() {
+        for &c in &neighbours[a] {
+            if c == j {
+                return Err(ScanError::Ring(j + 1, k + 1));
+            }
+            if !seen[c] {
+                seen[c] = true;
+                stack.push(c);
+            }
+        }
+    }
+    Ok((0..n).filter(|&i| seen[i]).collect())
+}
+
+/// Turns `moving` atoms rigidly about the axis through `positions[j]` → `positions[k]` so that
+/// the dihedral about j–k grows by `degrees`.
+pub fn twist(positions: &mut [DVec3], moving: &[usize], j: usize, k: usize, degrees: f64) {
+    let origin = positions[k];
+    let axis = (positions[k] - positions[j]).normalize_or_zero();
+    if axis == DVec3::ZERO {
+        return;
+    }
+    let rotation = DQuat::from_axis_angle(axis, degrees.to_radians());
+    for &i in moving {
+        positions[i] = origin + rotation * (positions[i] - origin);
+    }
+}
+
+/// The bonded torsion i–j–k–l whose angle changes most across `molecules` (all with the same
+/// atoms; bonds from the first), or None when no bond has neighbours on both sides. Ring bonds
+/// are skipped; the outer atoms are each side's heaviest neighbour, lowest number on ties.
+pub fn most_changing_dihedral(molecules: &[Molecule]) -> Option<[usize; 4]> {
+    let first = molecules.first()?;
+    let n = first.atoms.len();
+    let mut neighbours = vec![Vec::new(); n];
+    for b in &first.bonds {
+        neighbours[b.a as usize].push(b.b as usize);
+        neighbours[b.b as usize].push(b.a as usize);
+    }
+    let outer = |centre: usize, other: usize| {
+        neighbours[centre]
+            .iter()
+            .copied()
+            .filter(|&x| x != other)
+            .max_by(|&a, &b| first.atoms[a].z.cmp(&first.atoms[b].z).then(b.cmp(&a)))
+    };
+    let mut best: Option<([usize; 4], f64)> = None;
+    for b in &first.bonds {
+        let (j, k) = (b.a.min(b.b) as usize, b.a.max(b.b) as usize);
+        let (Some(i), Some(l)) = (outer(j, k), outer(k, j)) else { continue };
+        if i == l || moving_fragment(first, j, k).is_err() {
+            continue;
+        }
+        let d = [i, j, k, l];
+        // Spread of the angle around its first value, unwrapped.
+        let start = measure(first, d);
+        let (lo, hi) = molecules.iter().fold((0.0f64, 0.0f64), |(lo, hi), m| {
+            let delta = wrap_degrees(measure(m, d) - start);
+            (lo.min(delta), hi.max(delta))
+        });
+        if best.is_none_or(|(_, s)| hi - lo > s + 1e-9) {
+            best = Some((d, hi - lo));
+        }
+    }
+    best.map(|(d, _)| d)
+}
+
+impl Scan {
+    /// Checks the dihedral against the molecule and finds the moving fragment. `frames` must be
+    /// sorted by angle without duplicates (the manifest reader reports those with their lines).
+    pub fn new(
+        title: String,
+        dihedral: [usize; 4],
+        orbitals: Vec<String>,
+        frames: Vec<KeyFrame>,
+    ) -> Result<Self, ScanError> {
+        if frames.len() < 2 {
+            return Err(ScanError::TooFewFrames(frames.len()));
+        }
+        let n = frames[0].molecule.atoms.len();
+        if let Some(&bad) = dihedral.iter().find(|&&i| i >= n) {
+            return Err(ScanError::AtomOutOfRange(bad + 1, n));
+        }
+        let mut sorted = dihedral;
+        sorted.sort_unstable();
+        if sorted.windows(2).any(|w| w[0] == w[1]) {
+            return Err(ScanError::RepeatedAtom);
+        }
+        let moving = moving_fragment(&frames[0].molecule, dihedral[1], dihedral[2])?;
+        Ok(Self { title, dihedral, orbitals, frames, moving })
+    }
+
+    /// The angle range covered by the key frames.
+    pub fn range(&self) -> (f64, f64) {
+        (self.frames[0].angle, self.frames[self.frames.len() - 1].angle)
+    }
+
+    pub fn angles(&self) -> Vec<f64> {
+        self.frames.iter().map(|f| f.angle).collect()
+    }
+
+    /// The two key frames around θ (clamped to the scan's range).
+    pub fn bracket(&self, theta: f64) -> Bracket {
+        let (lo, hi) = self.range();
+        let t = theta.clamp(lo, hi);
+        let b = self.frames.iter().position(|f| f.angle >= t).unwrap_or(self.frames.len() - 1).max(1);
+        let a = b - 1;
+        let (ta, tb) = (self.frames[a].angle, self.frames[b].angle);
+        Bracket { a, b, k: ((t - ta) / (tb - ta)).clamp(0.0, 1.0) }
+    }
+
+    /// The skeleton at θ: each bracketing frame's moving fragment turned towards θ by its share
+    /// of the measured twist between them, then the two blended (1−k):k, so the result is each
+    /// key frame's own geometry at its angle and a rigid rotation for rigid scans.
+    pub fn geometry_at(&self, theta: f64) -> Molecule {
+        let Bracket { a, b, k } = self.bracket(theta);
+        let (fa, fb) = (&self.frames[a].molecule, &self.frames[b].molecule);
+        let [_, j, kk, _] = self.dihedral;
+        let delta = wrap_degrees(measure(fb, self.dihedral) - measure(fa, self.dihedral));
+        let mut pa: Vec<DVec3> = fa.atoms.iter().map(|x| x.position).collect();
+        let mut pb: Vec<DVec3> = fb.atoms.iter().map(|x| x.position).collect();
+        twist(&mut pa, &self.moving, j, kk, k * delta);
+        twist(&mut pb, &self.moving, j, kk, -(1.0 - k) * delta);
+        let atoms: Vec<Atom> = fa
+            .atoms
+            .iter()
+            .zip(pa.iter().zip(&pb))
+            .map(|(atom, (&p, &q))| Atom { position: p.lerp(q, k), ..atom.clone() })
+            .collect();
+        Molecule { atoms, bonds: self.frames[0].molecule.bonds.clone() }
+    }
+
+    /// The angle of the key frame nearest to θ.
+    pub fn nearest_frame(&self, theta: f64) -> usize {
+        let Bracket { a, b, k } = self.bracket(theta);
+        if k <= 0.5 { a } else { b }
+    }
+
+    /// Chooses each slot's orbital in every frame and aligns its phase with the previous frame
+    /// by overlap: analytic overlaps between the frames' basis sets for wavefunctions, sums over
+    /// the common grid for cube series.
+    pub fn track(&self, follow: Follow) -> Result<Tracks, ScanError> {
+        let specs: Vec<Option<OrbitalSpec>> = self.orbitals.iter().map(|s| s.parse().ok()).collect();
+        let mut points: Vec<Vec<TrackPoint>> = vec![Vec::with_capacity(self.frames.len()); self.orbitals.len()];
+        let mut swaps = Vec::new();
+        let mut previous: Option<(PreparedBasis, &KeyFrame)> = None;
+        for (f, frame) in self.frames.iter().enumerate() {
+            let named = self.named_orbitals(frame, &specs)?;
+            let basis = match &frame.content {
+                FrameContent::Wavefunction(wf) => Some(PreparedBasis::with_threshold(&wf.basis, 0.0)),
+                FrameContent::Volumes(_) => None,
+            };
+            let overlaps = match (&previous, &basis) {
+                (Some((pb, pf)), Some(b)) => Some(FrameOverlap::Basis(cross_overlap(pb, b), pf)),
+                (Some((_, pf)), None) => Some(FrameOverlap::Grid(pf)),
+                _ => None,
+            };
+            for (slot, &by_name) in named.iter().enumerate() {
+                let energy_of = |i: usize| match &frame.content {
+                    FrameContent::Wavefunction(wf) => Some(wf.orbitals[i].energy),
+                    FrameContent::Volumes(_) => None,
+                };
+                let Some(overlaps) = &overlaps else {
+                    let point = TrackPoint {
+                        index: by_name,
+                        sign: 1.0,
+                        energy: energy_of(by_name),
+                        overlap: 1.0,
+                        flipped: false,
+                    };
+                    points[slot].push(point);
+                    continue;
+                };
+                let prev = points[slot][f - 1];
+                let candidates = candidates(frame, by_name);
+                let overlap_with = |i: usize| prev.sign * overlaps.between(prev.index, frame, i);
+                let (best, best_overlap) = candidates
+                    .iter()
+                    .map(|&i| (i, overlap_with(i)))
+                    .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
+                    .unwrap_or((by_name, overlap_with(by_name)));
+                let named_overlap = overlap_with(by_name);
+                if best != by_name && best_overlap.abs() > named_overlap.abs() + 1e-6 {
+                    swaps.push(Swap {
+                        slot,
+                        frame: f,
+                        by_name,
+                        by_name_overlap: named_overlap.abs(),
+                        by_overlap: best,
+                        best_overlap: best_overlap.abs(),
+                    });
+                }
+                let (index, o) = match follow {
+                    Follow::Index => (by_name, named_overlap),
+                    Follow::Overlap => (best, best_overlap),
+                };
+                let sign = if o < 0.0 { -1.0 } else { 1.0 };
+                points[slot].push(TrackPoint {
+                    index,
+                    sign,
+                    energy: energy_of(index),
+                    overlap: o * sign,
+                    flipped: sign < 0.0,
+                });
+            }
+            previous = Some((basis.unwrap_or_else(empty_basis), frame));
+        }
+        Ok(Tracks { points, swaps, follow })
+    }
+
+    /// Each slot's orbital by name in one frame.
+    fn named_orbitals(&self, frame: &KeyFrame, specs: &[Option<OrbitalSpec>]) -> Result<Vec<usize>, ScanError> {
+        match &frame.content {
+            FrameContent::Wavefunction(wf) => specs
+                .iter()
+                .zip(&self.orbitals)
+                .map(|(spec, name)| {
+                    spec.and_then(|s| wf.resolve(s, Spin::Alpha)).ok_or_else(|| ScanError::MissingOrbital {
+                        angle: frame.angle,
+                        spec: name.clone(),
+                        available: wf.of_spin(Spin::Alpha).count(),
+                    })
+                })
+                .collect(),
+            FrameContent::Volumes(v) if v.len() >= self.orbitals.len() => Ok((0..self.orbitals.len()).collect()),
+            FrameContent::Volumes(v) => {
+                Err(ScanError::MissingVolume { angle: frame.angle, wanted: self.orbitals.len(), found: v.len() })
+            }
+        }
+    }
+}
+
+/// A placeholder for frames without a basis (cube series compare on the grid instead).
+fn empty_basis() -> PreparedBasis {
+    PreparedBasis::new(&super::basis::Basis::default())
+}
+
+/// The orbitals that may continue a slot's orbital in `frame`: same spin, within
+/// [`FOLLOW_WINDOW`] of the named one in energy order; all volumes of a cube frame.
+fn candidates(frame: &KeyFrame, by_name: usize) -> Vec<usize> {
+    match &frame.content {
+        FrameContent::Wavefunction(wf) => {
+            let order = wf.by_energy(wf.orbitals[by_name].spin);
+            let pos = order.iter().position(|&i| i == by_name).unwrap_or(0);
+            order[pos.saturating_sub(FOLLOW_WINDOW)..(pos + FOLLOW_WINDOW + 1).min(order.len())].to_vec()
+        }
+        FrameContent::Volumes(v) => (0..v.len()).collect(),
+    }
+}
+
+/// Overlaps between the previous frame's orbitals and this frame's.
+enum FrameOverlap<'a> {
+    /// ⟨χ_prev|χ_this⟩ (row-major) and the previous frame.
+    Basis(Vec<f64>, &'a KeyFrame),
+    /// Σ a·b·dV over the common grid.
+    Grid(&'a KeyFrame),
+}
+
+impl FrameOverlap<'_> {
+    fn between(&self, prev_index: usize, frame: &KeyFrame, index: usize) -> f64 {
+        match (self, &frame.content) {
+            (FrameOverlap::Basis(s, prev), FrameContent::Wavefunction(wf)) => {
+                let FrameContent::Wavefunction(pwf) = &prev.content else { return 0.0 };
+                let (ca, cb) = (&pwf.orbitals[prev_index].coefficients, &wf.orbitals[index].coefficients);
+                let nb = wf.basis.n_functions().max(1);
+                ca.iter()
+                    .enumerate()
+                    .map(|(u, &x)| x * cb.iter().enumerate().map(|(v, &y)| s[u * nb + v] * y).sum::<f64>())
+                    .sum()
+            }
+            (FrameOverlap::Grid(prev), FrameContent::Volumes(vb)) => {
+                let FrameContent::Volumes(va) = &prev.content else { return 0.0 };
+                grid_overlap(&va[prev_index], &vb[index])
+            }
+            _ => 0.0,
+        }
+    }
+}
+
+/// ∫ a·b dV over two grids of the same shape (the caller checks they share one grid).
+pub fn grid_overlap(a: &VolumeGrid, b: &VolumeGrid) -> f64 {
+    a.values.iter().zip(&b.values).map(|(&x, &y)| x as f64 * y as f64).sum::<f64>() * a.voxel_volume()
+}
+
+/// Where key volumes live: a grid's placement and shape.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ScanGrid {
+    pub world_from_grid: DMat4,
+    pub dims: [usize; 3],
+}
+
+impl ScanGrid {
+    pub fn spec(&self) -> GridSpec {
+        GridSpec::new(
+            self.world_from_grid.w_axis.truncate(),
+            std::array::from_fn(|a| self.world_from_grid.col(a).truncate()),
+            self.dims,
+        )
+    }
+
+    pub fn len(&self) -> usize {
+        self.dims.iter().product()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+impl Scan {
+    /// The grid all key volumes share: for cube series the cubes' grid; otherwise the box
+    /// holding every frame's atoms plus `margin` (bohr), cubic voxels, `points` along its
+    /// longest side.
+    pub fn common_grid(&self, margin: f64, points: usize) -> ScanGrid {
+        if let FrameContent::Volumes(v) = &self.frames[0].content
+            && let Some(g) = v.first()
+        {
+            return ScanGrid { world_from_grid: g.world_from_grid, dims: g.dims };
+        }
+        let (lo, hi) = self
+            .frames
+            .iter()
+            .filter_map(|f| f.molecule.bounds())
+            .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), (a, b)| (lo.min(a), hi.max(b)));
+        let (lo, hi) = (lo - DVec3::splat(margin), hi + DVec3::splat(margin));
+        let extent = (hi - lo).max(DVec3::splat(1e-6));
+        let points = points.max(2);
+        let step = extent.max_element() / (points - 1) as f64;
+        let dims = extent.to_array().map(|e| ((e / step - 1e-9).ceil() as usize + 1).clamp(2, points));
+        // Centre the (slightly larger) grid on the box.
+        let span = DVec3::new(dims[0] as f64 - 1.0, dims[1] as f64 - 1.0, dims[2] as f64 - 1.0) * step;
+        let origin = lo - 0.5 * (span - extent);
+        let steps = [DVec3::X * step, DVec3::Y * step, DVec3::Z * step];
+        ScanGrid { world_from_grid: VolumeGrid::affine(origin, steps), dims }
+    }
+
+    /// A slot's coefficient vector in `frame`, sign-aligned (wavefunction frames).
+    pub fn aligned_coefficients(&self, tracks: &Tracks, slot: usize, frame: usize) -> Option<Vec<f64>> {
+        let p = tracks.points[slot][frame];
+        match &self.frames[frame].content {
+            FrameContent::Wavefunction(wf) => {
+                Some(wf.orbitals[p.index].coefficients.iter().map(|c| c * p.sign).collect())
+            }
+            FrameContent::Volumes(_) => None,
+        }
+    }
+
+    /// A slot's key volume in `frame` on `grid`, sign-aligned: evaluated on the CPU for
+    /// wavefunction frames, the cube's values for cube frames.
+    pub fn key_values(&self, tracks: &Tracks, slot: usize, frame: usize, grid: &ScanGrid) -> Vec<f32> {
+        let p = tracks.points[slot][frame];
+        match &self.frames[frame].content {
+            FrameContent::Wavefunction(wf) => {
+                let c = self.aligned_coefficients(tracks, slot, frame).unwrap_or_default();
+                PreparedBasis::new(&wf.basis).eval_grid_f32(&c, &grid.spec())
+            }
+            FrameContent::Volumes(v) => v[p.index].values.iter().map(|&x| x * p.sign as f32).collect(),
+        }
+    }
+
+    /// The exactly interpolated volume at θ: (1−k)·ψa + k·ψb of the two bracketing key frames.
+    pub fn interpolated_values(&self, tracks: &Tracks, slot: usize, theta: f64, grid: &ScanGrid) -> Vec<f32> {
+        let Bracket { a, b, k } = self.bracket(theta);
+        let (va, vb) = (self.key_values(tracks, slot, a, grid), self.key_values(tracks, slot, b, grid));
+        let (wa, wb) = ((1.0 - k) as f32, k as f32);
+        va.iter().zip(&vb).map(|(&x, &y)| wa * x + wb * y).collect()
+    }
+
+    /// A slot's orbital energy at θ (Eh), interpolated linearly between the key frames.
+    pub fn energy_at(&self, tracks: &Tracks, slot: usize, theta: f64) -> Option<f64> {
+        let Bracket { a, b, k } = self.bracket(theta);
+        let (ea, eb) = (tracks.points[slot][a].energy?, tracks.points[slot][b].energy?);
+        Some((1.0 - k) * ea + k * eb)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn atom(z: u32, p: [f64; 3]) -> Atom {
+        Atom { z, charge: z as f64, position: DVec3::from(p), ghost: false }
+    }
+
+    /// Butane-like chain C–C–C–C with one H on each end carbon.
+    fn chain() -> Molecule {
+        Molecule::new(vec![
+            atom(6, [-1.3, 1.2, 0.0]),
+            atom(6, [0.0, 0.0, 0.0]),
+            atom(6, [1.5, 0.0, 0.0]),
+            atom(6, [2.8, 1.2, 0.0]),
+            atom(1, [-2.2, 0.6, 0.0]),
+            atom(1, [3.7, 0.6, 0.0]),
+        ])
+    }
+
+    #[test]
+    fn dihedral_sign_and_wrap() {
+        let m = chain();
+        assert!((measure(&m, [0, 1, 2, 3]).abs() - 0.0).abs() < 1e-9);
+        let mut p: Vec<DVec3> = m.atoms.iter().map(|a| a.position).collect();
+        let moving = moving_fragment(&m, 1, 2).unwrap();
+        assert_eq!(moving, vec![2, 3, 5]);
+        for target in [30.0, -75.0, 120.0, 179.0] {
+            let mut q = p.clone();
+            twist(&mut q, &moving, 1, 2, target);
+            let d = dihedral([q[0], q[1], q[2], q[3]]);
+            assert!((d - target).abs() < 1e-9, "{d} vs {target}");
+        }
+        twist(&mut p, &moving, 1, 2, 200.0);
+        assert!((dihedral([p[0], p[1], p[2], p[3]]) - (-160.0)).abs() < 1e-9);
+        assert_eq!(wrap_degrees(-180.0), 180.0);
+        assert_eq!(wrap_degrees(540.0), 180.0);
+    }
+
+    #[test]
+    fn ring_bonds_do_not_turn() {
+        // Cyclobutane-like square: every bond is in the ring.
+        let m = Molecule::new(vec![
+            atom(6, [0.0, 0.0, 0.0]),
+            atom(6, [2.9, 0.0, 0.0]),
+            atom(6, [2.9, 2.9, 0.0]),
+            atom(6, [0.0, 2.9, 0.0]),
+        ]);
+        assert_eq!(moving_fragment(&m, 0, 1), Err(ScanError::Ring(1, 2)));
+        assert_eq!(most_changing_dihedral(&[m.clone(), m]), None);
+    }
+
+    fn frames(angles: &[f64]) -> Vec<KeyFrame> {
+        let base = chain();
+        let moving = moving_fragment(&base, 1, 2).unwrap();
+        angles
+            .iter()
+            .map(|&angle| {
+                let mut m = base.clone();
+                let mut p: Vec<DVec3> = m.atoms.iter().map(|a| a.position).collect();
+                twist(&mut p, &moving, 1, 2, angle);
+                for (a, q) in m.atoms.iter_mut().zip(p) {
+                    a.position = q;
+                }
+                KeyFrame { angle, source: format!("{angle}"), molecule: m, content: FrameContent::Volumes(vec![]) }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn geometry_follows_theta() {
+        let scan = Scan::new("t".into(), [0, 1, 2, 3], vec![], frames(&[-180.0, -90.0, 0.0])).unwrap();
+        for theta in [-180.0, -150.0, -90.0, -45.0, -10.0, 0.0] {
+            let m = scan.geometry_at(theta);
+            assert!((wrap_degrees(measure(&m, [0, 1, 2, 3]) - theta)).abs() < 1e-9, "{theta}");
+            // Rigid: bond lengths unchanged.
+            let d = (m.atoms[3].position - m.atoms[2].position).length();
+            assert!((d - (chain().atoms[3].position - chain().atoms[2].position).length()).abs() < 1e-9);
+        }
+        assert_eq!(scan.bracket(-100.0), Bracket { a: 0, b: 1, k: 80.0 / 90.0 });
+        assert_eq!(scan.bracket(-300.0).k, 0.0);
+        assert_eq!(scan.bracket(-90.0).b, 1);
+        let picked = most_changing_dihedral(&scan.frames.iter().map(|f| f.molecule.clone()).collect::<Vec<_>>());
+        assert_eq!(picked, Some([0, 1, 2, 3]));
+    }
+}
