@@ -3,7 +3,7 @@
 
     OMP_NUM_THREADS=2 python3 scripts/make_psb3_scan.py [--out assets/psb3]
 
-(PySCF, numpy and geomeTRIC; see scripts/requirements.txt. About 3 minutes on 2 cores.)
+(PySCF, numpy and geomeTRIC; see scripts/requirements.txt. About 4 minutes on 2 cores.)
 
 PSB3, the retinal model protonated Schiff base H2C=CH-CH=CH-CH=NH2+ (charge +1, singlet,
 14 atoms), in the atom order C1 C2 C3 C4 C5 N, then H1a H1b (on C1), H2, H3, H4, H5 (on C2..C5),
@@ -12,13 +12,13 @@ HNa HNb (on N), so that the central dihedral C2-C3-C4-C5 is atoms 2 3 4 5 (1-bas
 1. A planar all-trans guess is optimised at RHF/6-31G* (pure d) with geomeTRIC through
    pyscf.geomopt (GAU_TIGHT criteria). The minimum is then moved rigidly so that the C3-C4
    midpoint is at the origin, C3->C4 points along +x and the molecular plane is the xy plane
-   (the viewer's default camera looks along -z).
+   (the viewer's default camera looks along -z), flattened onto z = 0 and rounded to 1e-6 A.
 2. Rigid scan: the C4 half (H4, C5, H5, N, HNa, HNb; C4 itself lies on the axis) is rotated
    about the C3-C4 axis so that the dihedral C2-C3-C4-C5 takes the 15 angles of ANGLES
    (-180 = the planar trans minimum, 0 = cis); every measured dihedral is checked to 1e-6
    degrees and every intra-fragment distance to 1e-9 Angstrom.
 3. Each geometry: single-point RHF/6-31G*, symmetry off, pure d, conv_tol 1e-10, the default
-   MINAO initial guess (deterministic; no guess carried between frames). The Molden file holds
+   MINAO initial guess (deterministic; no guess carried between frames), on one thread. The Molden file holds
    the full basis but only the orbital window HOMO-3 .. LUMO+3 (8 MOs, energies and
    occupations; symmetry label "A"); orbital signs are the solver's, not adjusted, so the
    files exercise a reader's sign alignment. Files: psb3_m180.molden.gz .. psb3_000.molden.gz
@@ -29,8 +29,10 @@ HNa HNb (on N), so that the central dihedral C2-C3-C4-C5 is atoms 2 3 4 5 (1-bas
    each HOMO/LUMO among the previous frame's window, RHF stability, and the fraction of the
    HOMO and LUMO on the C=N side (Mulliken and Lowdin orbital populations).
 
-The output is deterministic on a given machine and thread count (orbital signs come straight
-from the eigensolver, so another BLAS may flip some of them).
+The output is byte-identical from run to run on a given machine: the optimised minimum is
+rounded to 1e-6 A and the single points run on one thread (with two, OpenMP reductions change
+the last printed digits). Orbital signs come straight from the eigensolver, so another BLAS
+may flip some of them.
 """
 
 from __future__ import annotations
@@ -234,13 +236,19 @@ def main() -> None:
     # 1. Optimised planar trans minimum.
     import geometric
     xyz_min = standard_frame(optimise(guess_geometry()))
+    print("  max |z| out of the xy plane after optimisation: %.2e A (then set to 0)"
+          % np.abs(xyz_min[:, 2]).max())
+    # Multithreaded integrals make the optimiser's last bits vary from run to run: flatten
+    # (the minimum is planar) and round to 1e-6 A (+ 0.0 turns -0.0 into 0.0), so the scan
+    # geometries, and with one thread the SCF and the files, are the same on every run.
+    xyz_min[:, 2] = 0.0
+    xyz_min = np.round(xyz_min, 6) + 0.0
     mol_min = build_mol(xyz_min)
     print("geomeTRIC %s: RHF/%s minimum (%.0f s)" % (geometric.__version__, BASIS, time.time() - t0))
     for name, idx in [("C1-C2-C3-C4", (0, 1, 2, 3)), ("C2-C3-C4-C5", DIHEDRAL),
                       ("C3-C4-C5-N", (2, 3, 4, 5)), ("H3-C3-C4-H4", (9, 2, 3, 10)),
                       ("H1a-C1-C2-C3", (6, 0, 1, 2)), ("C4-C5-N-HNa", (3, 4, 5, 12))]:
         print("  dihedral %-13s %12.6f" % (name, dihedral(xyz_min, idx)))
-    print("  max |z| out of the xy plane: %.2e A" % np.abs(xyz_min[:, 2]).max())
     bonds = [(0, 1), (1, 2), (2, 3), (3, 4), (4, 5)]
     print("  backbone bonds (A): " + "  ".join(
         "%s-%s %.4f" % (LABELS[i], LABELS[j], np.linalg.norm(xyz_min[i] - xyz_min[j]))
@@ -254,7 +262,8 @@ def main() -> None:
     for a in ANGLES:
         xyz = scan_geometry(xyz_min, float(a))
         mol = build_mol(xyz)
-        mf = run_rhf(mol)
+        with lib.with_omp_threads(1):  # bit-reproducible SCF (2 threads: last digits vary)
+            mf = run_rhf(mol)
         homo = int(np.where(mf.mo_occ > 0)[0].max())
         lumo = homo + 1
         lo, hi = homo - WINDOW_BELOW, lumo + WINDOW_ABOVE + 1

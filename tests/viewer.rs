@@ -7,10 +7,7 @@ use orbcloud::app::{OrbApp, wgpu_setup};
 use orbcloud::scene::{SliceMode, TransferKind};
 
 fn harness() -> Harness<'static, OrbApp> {
-    let h = Harness::builder()
-        .with_size([1000.0, 700.0])
-        .wgpu_setup(wgpu_setup(true))
-        .build_eframe(|cc| OrbApp::new(cc, Vec::new()));
+    let h = Harness::builder().with_size([1000.0, 700.0]).wgpu_setup(wgpu_setup(true)).build_eframe(OrbApp::cube_demo);
     assert!(h.state().error.is_none(), "viewer failed to start: {:?}", h.state().error);
     h
 }

@@ -3,6 +3,7 @@
 mod loader;
 mod orbitals;
 mod panels;
+pub mod scan;
 pub mod state;
 mod viewport;
 
@@ -14,6 +15,7 @@ use crate::headless::WavefunctionView;
 use crate::headless::default_camera;
 use crate::model::Document;
 use loader::LoadJob;
+use scan::{ScanJob, ScanSource, ScanView};
 pub use state::{OrbitalView, ViewState};
 use viewport::Viewport;
 
@@ -60,10 +62,35 @@ pub struct OrbApp {
     queue: Vec<PathBuf>,
     pub error: Option<String>,
     pub status: String,
+    /// An open dihedral scan (shown instead of `doc`), and one being prepared.
+    pub scan: Option<ScanView>,
+    scan_job: Option<ScanJob>,
+    /// Points along the longest side of a scan's common grid.
+    pub scan_points: usize,
 }
 
 impl OrbApp {
+    /// Opens `files`, or with none the bundled PSB3 scan.
     pub fn new(cc: &eframe::CreationContext<'_>, files: Vec<PathBuf>) -> Self {
+        let demo = files.is_empty();
+        let mut app = Self::empty(cc, files);
+        if demo {
+            app.open_scan(ScanSource::Demo, &cc.egui_ctx);
+        }
+        app
+    }
+
+    /// Opens the bundled formaldehyde cube (a single volume, no scan).
+    pub fn cube_demo(cc: &eframe::CreationContext<'_>) -> Self {
+        let mut app = Self::empty(cc, Vec::new());
+        match crate::demo::document() {
+            Ok(doc) => app.show_document(doc),
+            Err(e) => app.error = Some(e.to_string()),
+        }
+        app
+    }
+
+    fn empty(cc: &eframe::CreationContext<'_>, files: Vec<PathBuf>) -> Self {
         let viewport = cc
             .wgpu_render_state
             .as_ref()
@@ -78,27 +105,46 @@ impl OrbApp {
             queue: files.into_iter().rev().collect(),
             error: None,
             status: String::new(),
+            scan: None,
+            scan_job: None,
+            scan_points: crate::headless::scan::DEFAULT_SCAN_POINTS,
         };
         if app.viewport.is_none() {
             app.error = Some("no wgpu render state: the viewer needs eframe's wgpu backend".into());
         }
-        if app.queue.is_empty() {
-            match crate::demo::document() {
-                Ok(doc) => app.show_document(doc),
-                Err(e) => app.error = Some(e.to_string()),
-            }
-        }
         app
     }
 
-    /// Starts loading a file in the background; what is shown stays until it has loaded.
+    /// A new handle on the window's device (for scan views and the key-volume job).
+    fn gpu_context(&self) -> Option<GpuContext> {
+        let c = &self.viewport.as_ref()?.ctx;
+        Some(GpuContext::from_parts(c.adapter.clone(), c.device.clone(), c.queue.clone()))
+    }
+
+    /// Starts loading a file in the background (a `.scan.toml` opens as a scan); what is shown
+    /// stays until it has loaded.
     pub fn open(&mut self, path: PathBuf, ctx: &egui::Context) {
+        if path.to_string_lossy().to_ascii_lowercase().ends_with(".scan.toml") {
+            self.open_scan(ScanSource::File(path), ctx);
+            return;
+        }
         let ctx = ctx.clone();
         self.job = Some(LoadJob::start(path, move || ctx.request_repaint()));
     }
 
+    /// Loads a scan and makes its key volumes in the background.
+    pub fn open_scan(&mut self, source: ScanSource, ctx: &egui::Context) {
+        let Some(gpu) = self.gpu_context() else { return };
+        if let Some(job) = self.scan_job.take() {
+            job.cancel();
+        }
+        let ctx = ctx.clone();
+        let options = crate::headless::scan::KeyOptions { points: self.scan_points, ..Default::default() };
+        self.scan_job = Some(ScanJob::start(gpu, source, options, move || ctx.request_repaint()));
+    }
+
     pub fn is_loading(&self) -> bool {
-        self.job.is_some() || !self.queue.is_empty()
+        self.job.is_some() || !self.queue.is_empty() || self.scan_job.is_some()
     }
 
     fn show_document(&mut self, doc: Document) {
@@ -112,6 +158,7 @@ impl OrbApp {
             return;
         }
         self.status = format!("opened {}", doc.source);
+        self.scan = None;
         self.orbitals = doc.wavefunction.as_ref().map(OrbitalView::for_wavefunction).unwrap_or_default();
         self.scroll_to_frontier = true;
         self.doc = doc;
@@ -144,6 +191,39 @@ impl OrbApp {
                 Err(e) => self.error = Some(e.to_string()),
             }
         }
+        if let Some(job) = &self.scan_job
+            && let Some(result) = job.poll()
+        {
+            let name = job.name.clone();
+            self.scan_job = None;
+            match result {
+                Ok(scene) => {
+                    let ctxs = self.viewport.as_ref().map(|v| {
+                        let c = &v.ctx;
+                        (c.adapter.clone(), c.device.clone(), c.queue.clone())
+                    });
+                    if let Some((a, d, q)) = ctxs {
+                        self.view.camera = scene.camera();
+                        self.status = format!(
+                            "opened {name}: {} key volumes, {:.1} MiB of {:.0} MiB",
+                            scene.slots() * scene.scan.frames.len(),
+                            scene.bytes as f64 / 1048576.0,
+                            scene.budget as f64 / 1048576.0
+                        );
+                        if !scene.tracks.swaps.is_empty() {
+                            self.status += &format!(
+                                "; {} orbital character swap(s) (see `orbcloud scan info`)",
+                                scene.tracks.swaps.len()
+                            );
+                        }
+                        let make = || GpuContext::from_parts(a.clone(), d.clone(), q.clone());
+                        self.scan = Some(ScanView::new(scene, &make));
+                    }
+                }
+                Err(e) if e == "cancelled" => self.status = format!("{name}: cancelled"),
+                Err(e) => self.error = Some(e),
+            }
+        }
         if self.job.is_none()
             && let Some(next) = self.queue.pop()
         {
@@ -167,6 +247,9 @@ impl OrbApp {
         }
         if before.settings.atoms != self.view.settings.atoms {
             vp.set_atom_style(&self.doc, &self.view);
+            if let Some(scan) = &mut self.scan {
+                scan::restyle(scan);
+            }
         }
     }
 
@@ -174,7 +257,10 @@ impl OrbApp {
     /// when no file dialog is available.
     fn screenshot(&mut self) {
         let Some(vp) = &mut self.viewport else { return };
-        let size = vp.size().unwrap_or([1280, 800]);
+        let mut size = vp.size().unwrap_or([1280, 800]);
+        if let Some(scan) = &self.scan {
+            size = scan.views.first().and_then(|v| v.size()).unwrap_or([640, 600]);
+        }
         let default_name = format!(
             "orbcloud-{}.png",
             std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map(|d| d.as_secs()).unwrap_or(0)
@@ -184,7 +270,21 @@ impl OrbApp {
             .set_file_name(&default_name)
             .save_file()
             .unwrap_or_else(|| PathBuf::from(&default_name));
-        match vp.snapshot(&self.view, size).map(|img| img.save(&path)) {
+        let shot = match &mut self.scan {
+            Some(scan) => {
+                let mut out = image::RgbaImage::new(size[0] * scan.views.len() as u32, size[1]);
+                let mut result = Ok(());
+                for (n, v) in scan.views.iter_mut().enumerate() {
+                    match v.snapshot(&self.view, size) {
+                        Ok(img) => image::imageops::replace(&mut out, &img, (n as u32 * size[0]) as i64, 0),
+                        Err(e) => result = Err(e),
+                    }
+                }
+                result.map(|()| out)
+            }
+            None => vp.snapshot(&self.view, size),
+        };
+        match shot.map(|img| img.save(&path)) {
             Ok(Ok(())) => self.status = format!("saved {}", path.display()),
             Ok(Err(e)) => self.error = Some(format!("{}: {e}", path.display())),
             Err(e) => self.error = Some(e.to_string()),
@@ -208,8 +308,12 @@ impl eframe::App for OrbApp {
         self.apply(&before);
         match action {
             panels::Action::Open => {
-                if let Some(path) =
-                    rfd::FileDialog::new().add_filter("Gaussian cube", &["cube", "cub", "gz"]).pick_file()
+                if let Some(path) = rfd::FileDialog::new()
+                    .add_filter(
+                        "Cube, Molden, fchk, scan",
+                        &["cube", "cub", "molden", "mold", "fchk", "fch", "toml", "gz"],
+                    )
+                    .pick_file()
                 {
                     self.open(path, &ctx);
                 } else {
@@ -217,13 +321,24 @@ impl eframe::App for OrbApp {
                 }
             }
             panels::Action::Screenshot => self.screenshot(),
-            panels::Action::ResetView => self.view.camera = default_camera(&self.doc),
+            panels::Action::ResetView => {
+                self.view.camera = match &self.scan {
+                    Some(scan) => scan.scene.camera(),
+                    None => default_camera(&self.doc),
+                }
+            }
             panels::Action::None => {}
         }
         panels::error_window(ui, self);
+        if let Some(scan) = &mut self.scan {
+            scan::controls(ui, scan);
+        }
         egui::CentralPanel::no_frame().show(ui, |ui| {
-            if let (Some(vp), Some(rs)) = (&mut self.viewport, frame.wgpu_render_state()) {
-                vp.show(ui, rs, &mut self.view);
+            let Some(rs) = frame.wgpu_render_state() else { return };
+            match (&mut self.scan, &mut self.viewport) {
+                (Some(scan), _) => scan::views(ui, rs, scan, &mut self.view),
+                (None, Some(vp)) => vp.show(ui, rs, &mut self.view),
+                (None, None) => {}
             }
         });
         if self.is_loading() {

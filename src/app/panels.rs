@@ -31,7 +31,8 @@ pub fn top_bar(ui: &mut egui::Ui, app: &OrbApp) -> Action {
                 action = Action::ResetView;
             }
             ui.separator();
-            ui.label(RichText::new(&app.doc.source).weak());
+            let source = app.scan.as_ref().map_or(app.doc.source.as_str(), |s| s.scene.scan.title.as_str());
+            ui.label(RichText::new(source).weak());
         });
     });
     action
@@ -46,6 +47,36 @@ pub fn status_bar(ui: &mut egui::Ui, app: &OrbApp) {
                 ui.add(egui::ProgressBar::new(f).desired_width(160.0).text(text));
                 ui.label(job.path.display().to_string());
                 ui.separator();
+            }
+            if let Some(job) = &app.scan_job {
+                let (done, total) = job.progress();
+                let f = if total == 0 { 0.0 } else { done as f32 / total as f32 };
+                ui.add(egui::ProgressBar::new(f).desired_width(160.0).text(format!("key volumes {done}/{total}")));
+                ui.label(&job.name);
+                if ui.button("Cancel").clicked() {
+                    job.cancel();
+                }
+                ui.separator();
+            }
+            if let Some(scan) = &app.scan {
+                let s = &scan.scene.scan;
+                let d = s.dihedral.map(|i| i + 1);
+                ui.label(format!(
+                    "{}: dihedral {}-{}-{}-{}, {} key frames {:.0}°…{:.0}°",
+                    s.title,
+                    d[0],
+                    d[1],
+                    d[2],
+                    d[3],
+                    s.frames.len(),
+                    s.range().0,
+                    s.range().1
+                ));
+                if !app.status.is_empty() {
+                    ui.separator();
+                    ui.label(RichText::new(&app.status).weak());
+                }
+                return;
             }
             let m = &app.doc.molecule;
             ui.label(format!("{} atoms ({}), {} bonds", m.atoms.len(), m.formula(), m.bonds.len()));

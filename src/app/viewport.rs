@@ -7,7 +7,20 @@ use super::state::{DRAG_ROTATE, KEY_ROTATE, KEY_ZOOM, ViewState};
 use crate::gpu::gto::GtoFillPass;
 use crate::gpu::{FrameInput, GpuContext, GpuError, OffscreenTarget, Renderer};
 use crate::headless::WavefunctionView;
+use crate::headless::scan::ScanScene;
 use crate::model::Document;
+
+/// How a drag in a scan view twists the dihedral (seed 000: horizontal drag changes θ).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct TwistInput {
+    /// Every primary drag twists (else the view orbits, unless the drag starts on the bond).
+    pub drag_twists: bool,
+    /// The rotatable bond (world, bohr): a drag that starts on it twists.
+    pub bond: Option<[glam::Vec3; 2]>,
+}
+
+/// Screen distance (points) within which a press grabs the rotatable bond.
+const BOND_GRAB: f32 = 10.0;
 
 pub struct Viewport {
     pub ctx: GpuContext,
@@ -18,12 +31,16 @@ pub struct Viewport {
     drawn: Option<(ViewState, [u32; 2], u64)>,
     /// Bumped whenever the renderer's data changes.
     generation: u64,
+    /// Whether the current drag twists the dihedral.
+    twisting: bool,
+    /// The scan frame shown: (θ, interpolation), for tests and redraws.
+    pub scan_shown: Option<(f64, crate::scene::Interpolation)>,
 }
 
 impl Viewport {
     pub fn new(ctx: GpuContext) -> Self {
         let renderer = Renderer::new(&ctx);
-        Self { ctx, renderer, fill: None, target: None, drawn: None, generation: 0 }
+        Self { ctx, renderer, fill: None, target: None, drawn: None, generation: 0, twisting: false, scan_shown: None }
     }
 
     /// Uploads a document's molecule and chosen volume.
@@ -47,6 +64,20 @@ impl Viewport {
         Ok(())
     }
 
+    /// Shows slot `slot` of a scan at θ (both key volumes and the twisted skeleton).
+    pub fn show_scan(
+        &mut self,
+        scene: &ScanScene,
+        slot: usize,
+        theta: f64,
+        mode: crate::scene::Interpolation,
+        style: crate::scene::AtomStyle,
+    ) {
+        scene.show(&self.ctx, &mut self.renderer, slot, theta, mode, style);
+        self.scan_shown = Some((theta, mode));
+        self.generation += 1;
+    }
+
     pub fn set_atom_style(&mut self, doc: &Document, view: &ViewState) {
         self.renderer.set_molecule(&self.ctx, &doc.molecule, view.settings.atoms);
         self.generation += 1;
@@ -55,11 +86,46 @@ impl Viewport {
     /// Shows the view in the remaining space of `ui`, applying mouse and keyboard input to
     /// `view.camera`.
     pub fn show(&mut self, ui: &mut egui::Ui, render_state: &egui_wgpu::RenderState, view: &mut ViewState) {
+        self.show_twistable(ui, render_state, view, None);
+    }
+
+    /// [`Self::show`] for a scan view: returns the twist dragged this frame, as a fraction of
+    /// the view's width (positive to the right).
+    pub fn show_twistable(
+        &mut self,
+        ui: &mut egui::Ui,
+        render_state: &egui_wgpu::RenderState,
+        view: &mut ViewState,
+        twist: Option<TwistInput>,
+    ) -> f32 {
         let rect = ui.available_rect_before_wrap();
         let response = ui.allocate_rect(rect, Sense::click_and_drag());
-        handle_input(ui, &response, view);
         let ppp = ui.ctx().pixels_per_point();
         let size = [(rect.width() * ppp).round().max(1.0) as u32, (rect.height() * ppp).round().max(1.0) as u32];
+        let mut twisted = 0.0;
+        if let Some(t) = twist {
+            if response.drag_started_by(PointerButton::Primary) {
+                let on_bond = t.bond.zip(response.interact_pointer_pos()).is_some_and(|(bond, p)| {
+                    let clip_from_world = self.renderer.clip_from_world(&view.camera, size);
+                    let to_screen = |w: glam::Vec3| {
+                        let c = clip_from_world * w.extend(1.0);
+                        let ndc = c.truncate() / c.w.max(1e-6);
+                        rect.min + egui::vec2((ndc.x * 0.5 + 0.5) * rect.width(), (0.5 - ndc.y * 0.5) * rect.height())
+                    };
+                    distance_to_segment(p, to_screen(bond[0]), to_screen(bond[1])) < BOND_GRAB
+                });
+                self.twisting = t.drag_twists || on_bond;
+            }
+            if !response.dragged() {
+                self.twisting = false;
+            }
+            if self.twisting && response.dragged_by(PointerButton::Primary) {
+                twisted = response.drag_delta().x / rect.width().max(1.0);
+            }
+        }
+        if !self.twisting {
+            handle_input(ui, &response, view);
+        }
         if self.target.as_ref().is_none_or(|(t, _)| t.size != size) {
             let target = OffscreenTarget::new(&self.ctx.device, size);
             let mut egui_renderer = render_state.renderer.write();
@@ -95,6 +161,7 @@ impl Viewport {
             let uv = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
             ui.painter().image(*id, rect, uv, egui::Color32::WHITE);
         }
+        twisted
     }
 
     /// Renders the current view at `size` and reads it back (for screenshots).
@@ -113,6 +180,12 @@ impl Viewport {
     pub fn size(&self) -> Option<[u32; 2]> {
         self.target.as_ref().map(|(t, _)| t.size)
     }
+}
+
+fn distance_to_segment(p: egui::Pos2, a: egui::Pos2, b: egui::Pos2) -> f32 {
+    let ab = b - a;
+    let t = ((p - a).dot(ab) / ab.length_sq().max(1e-6)).clamp(0.0, 1.0);
+    (p - (a + t * ab)).length()
 }
 
 fn handle_input(ui: &egui::Ui, response: &egui::Response, view: &mut ViewState) {

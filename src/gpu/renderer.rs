@@ -97,6 +97,16 @@ impl Renderer {
         };
     }
 
+    /// The projection a frame of `size` pixels uses: the depth range holds everything drawn.
+    pub fn clip_from_world(&self, camera: &Camera, size: [u32; 2]) -> glam::Mat4 {
+        let aspect = size[0].max(1) as f32 / size[1].max(1) as f32;
+        let radius = self
+            .bounds
+            .map(|(lo, hi)| (hi - camera.target).abs().max((camera.target - lo).abs()).length())
+            .unwrap_or(10.0);
+        camera.clip_from_world(aspect, radius)
+    }
+
     /// Records the frame into `encoder`: clear, opaque impostors, slices back to front, all in
     /// the float scene buffer; then copies that into `output` (a [`super::COLOR_FORMAT`] view of
     /// `frame.size`).
@@ -112,10 +122,7 @@ impl Renderer {
         }
         let Some(buffers) = &self.buffers else { return };
         let cam = frame.camera;
-        let aspect = frame.size[0].max(1) as f32 / frame.size[1].max(1) as f32;
-        let radius =
-            self.bounds.map(|(lo, hi)| (hi - cam.target).abs().max((cam.target - lo).abs()).length()).unwrap_or(10.0);
-        let clip_from_world = cam.clip_from_world(aspect, radius);
+        let clip_from_world = self.clip_from_world(cam, frame.size);
         let eye = cam.eye();
         let view_dir = (cam.target - eye).normalize_or(Vec3::NEG_Z);
         self.atoms.prepare(&ctx.queue, clip_from_world, eye, cam.target);

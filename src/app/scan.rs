@@ -1,0 +1,305 @@
+//! Dihedral scans in the window: HOMO and LUMO side by side with linked cameras and θ, a θ
+//! slider with the key angles as ticks, play/loop, and the orbital energies against θ.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::mpsc::{Receiver, channel};
+
+use egui::{Key, RichText};
+use egui_plot::{Legend, Line, Plot, VLine};
+
+use super::state::ViewState;
+use super::viewport::{TwistInput, Viewport};
+use crate::formats::scan::{ScanFile, load_scan};
+use crate::gpu::GpuContext;
+use crate::headless::scan::{KeyOptions, ScanScene};
+use crate::model::scan::Follow;
+use crate::model::units::EV_PER_HARTREE;
+use crate::scene::Interpolation;
+
+/// Where a scan comes from.
+pub enum ScanSource {
+    File(PathBuf),
+    /// The bundled PSB3 scan.
+    Demo,
+}
+
+/// Loads a scan and makes its key volumes on a background thread (the GPU compute pass runs
+/// there too), with progress and cancellation; the window keeps what it shows meanwhile.
+pub struct ScanJob {
+    pub name: String,
+    done: Arc<AtomicUsize>,
+    total: Arc<AtomicUsize>,
+    cancel: Arc<AtomicBool>,
+    result: Receiver<Result<ScanScene, String>>,
+}
+
+impl ScanJob {
+    pub fn start(
+        ctx: GpuContext,
+        source: ScanSource,
+        options: KeyOptions,
+        repaint: impl Fn() + Send + 'static,
+    ) -> Self {
+        let name = match &source {
+            ScanSource::File(p) => p.display().to_string(),
+            ScanSource::Demo => crate::demo::SCAN_NAME.to_string(),
+        };
+        let (done, total, cancel) =
+            (Arc::new(AtomicUsize::new(0)), Arc::new(AtomicUsize::new(0)), Arc::new(AtomicBool::new(false)));
+        let (tx, result) = channel();
+        let (d, t, c) = (done.clone(), total.clone(), cancel.clone());
+        std::thread::spawn(move || {
+            let run = || -> Result<ScanScene, String> {
+                let file: ScanFile = match &source {
+                    ScanSource::File(p) => load_scan(p),
+                    ScanSource::Demo => crate::demo::scan(),
+                }
+                .map_err(|e| e.to_string())?;
+                let options = KeyOptions {
+                    follow: if options.follow == Follow::Index { file.follow } else { options.follow },
+                    ..options
+                };
+                ScanScene::build(&ctx, file.scan, &options, &mut |n, of| {
+                    d.store(n, Ordering::Relaxed);
+                    t.store(of, Ordering::Relaxed);
+                    repaint();
+                    !c.load(Ordering::Relaxed)
+                })
+                .map_err(|e| e.to_string())
+            };
+            let _ = tx.send(run());
+            repaint();
+        });
+        Self { name, done, total, cancel, result }
+    }
+
+    /// Key volumes made so far, of how many.
+    pub fn progress(&self) -> (usize, usize) {
+        (self.done.load(Ordering::Relaxed), self.total.load(Ordering::Relaxed))
+    }
+
+    pub fn cancel(&self) {
+        self.cancel.store(true, Ordering::Relaxed);
+    }
+
+    pub fn poll(&self) -> Option<Result<ScanScene, String>> {
+        self.result.try_recv().ok()
+    }
+}
+
+/// An open scan: its resident key volumes, θ, and one view per orbital.
+pub struct ScanView {
+    pub scene: ScanScene,
+    /// Degrees, within the scan's range.
+    pub theta: f64,
+    pub mode: Interpolation,
+    pub playing: bool,
+    /// Bounce between the ends instead of stopping.
+    pub looping: bool,
+    /// Animation speed, degrees per second.
+    pub speed: f64,
+    /// Primary drags twist θ (seed 000); else they orbit and only a drag on the bond twists.
+    pub drag_twists: bool,
+    direction: f64,
+    pub views: Vec<Viewport>,
+}
+
+impl ScanView {
+    /// One viewport per orbital of the scan, all on the window's device.
+    pub fn new(scene: ScanScene, make_context: &dyn Fn() -> GpuContext) -> Self {
+        let views = (0..scene.slots()).map(|_| Viewport::new(make_context())).collect();
+        // Open where the picture says most: the key frame nearest the middle of the range.
+        let (lo, hi) = scene.scan.range();
+        let theta = scene.scan.frames[scene.scan.nearest_frame(0.5 * (lo + hi))].angle;
+        Self {
+            scene,
+            theta,
+            mode: Interpolation::Exact,
+            playing: false,
+            looping: true,
+            speed: 30.0,
+            drag_twists: true,
+            direction: 1.0,
+            views,
+        }
+    }
+
+    pub fn set_theta(&mut self, theta: f64) {
+        let (lo, hi) = self.scene.scan.range();
+        self.theta = theta.clamp(lo, hi);
+    }
+
+    /// Moves θ on by `dt` seconds of animation.
+    fn advance(&mut self, dt: f64) {
+        let (lo, hi) = self.scene.scan.range();
+        let mut t = self.theta + self.direction * self.speed * dt;
+        if t >= hi || t <= lo {
+            if self.looping {
+                self.direction = -self.direction;
+            } else {
+                self.playing = false;
+            }
+            t = t.clamp(lo, hi);
+        }
+        self.theta = t;
+    }
+
+    /// The key angle before (`-1`) or after (`+1`) θ.
+    fn step_key(&mut self, dir: i32) {
+        let angles = self.scene.scan.angles();
+        let next = if dir > 0 {
+            angles.iter().copied().find(|&a| a > self.theta + 1e-6)
+        } else {
+            angles.iter().rev().copied().find(|&a| a < self.theta - 1e-6)
+        };
+        if let Some(a) = next {
+            self.theta = a;
+        }
+    }
+
+    /// The rotatable bond j–k at θ, for grabbing it with the mouse.
+    fn bond(&self) -> [glam::Vec3; 2] {
+        let m = self.scene.scan.geometry_at(self.theta);
+        let [_, j, k, _] = self.scene.scan.dihedral;
+        [m.atoms[j].position.as_vec3(), m.atoms[k].position.as_vec3()]
+    }
+}
+
+/// The bottom panel: θ slider with key ticks, play/loop, interpolation mode, energy plot.
+pub fn controls(ui: &mut egui::Ui, scan: &mut ScanView) {
+    egui::Panel::bottom("scan controls").resizable(true).default_size(190.0).show(ui, |ui| {
+        let (lo, hi) = scan.scene.scan.range();
+        ui.horizontal(|ui| {
+            let play = if scan.playing { "Pause" } else { "Play" };
+            if ui.button(play).on_hover_text("Animate θ (Space)").clicked() {
+                scan.playing = !scan.playing;
+            }
+            ui.checkbox(&mut scan.looping, "loop");
+            ui.add(egui::DragValue::new(&mut scan.speed).range(1.0..=360.0).suffix(" °/s"))
+                .on_hover_text("animation speed");
+            ui.separator();
+            ui.label("θ");
+            let width = (ui.available_width() - 420.0).max(160.0);
+            ui.spacing_mut().slider_width = width;
+            let mut theta = scan.theta;
+            let slider = ui.add(egui::Slider::new(&mut theta, lo..=hi).suffix("°").fixed_decimals(1).text("dihedral"));
+            if slider.changed() {
+                scan.set_theta(theta);
+            }
+            key_ticks(ui, slider.rect, scan, width);
+            ui.separator();
+            ui.radio_value(&mut scan.mode, Interpolation::Exact, "exact")
+                .on_hover_text("mix the two key volumes per sample");
+            ui.radio_value(&mut scan.mode, Interpolation::ThreePass, "three-pass")
+                .on_hover_text("seed 000: attenuate, add (1−k)A, add kB per slice");
+            ui.checkbox(&mut scan.drag_twists, "drag twists")
+                .on_hover_text("a horizontal drag changes θ (right-drag pans); off: drag the bond");
+        });
+        energy_plot(ui, scan);
+    });
+}
+
+/// Marks the key angles under the slider.
+fn key_ticks(ui: &egui::Ui, rect: egui::Rect, scan: &ScanView, width: f32) {
+    let (lo, hi) = scan.scene.scan.range();
+    let painter = ui.painter();
+    // The slider's rail starts at the left of its rect and is `width` long (the handle's
+    // radius inset at each end).
+    let inset = rect.height() * 0.5;
+    let x0 = rect.left() + inset;
+    let x1 = rect.left() + width - inset;
+    let stroke = egui::Stroke::new(1.5, ui.visuals().widgets.inactive.fg_stroke.color);
+    for a in scan.scene.scan.angles() {
+        let x = x0 + ((a - lo) / (hi - lo).max(1e-9)) as f32 * (x1 - x0);
+        painter.line_segment([egui::pos2(x, rect.bottom() - 4.0), egui::pos2(x, rect.bottom() + 1.0)], stroke);
+    }
+}
+
+/// E(orbital) for every slot and the gap between the first two, in eV, against θ.
+fn energy_plot(ui: &mut egui::Ui, scan: &ScanView) {
+    let s = &scan.scene;
+    let series: Vec<(String, Vec<[f64; 2]>)> = (0..s.slots())
+        .filter_map(|slot| {
+            let points: Option<Vec<[f64; 2]>> = s
+                .scan
+                .frames
+                .iter()
+                .enumerate()
+                .map(|(f, fr)| s.tracks.points[slot][f].energy.map(|e| [fr.angle, e * EV_PER_HARTREE]))
+                .collect();
+            points.map(|p| (format!("E({})", s.scan.orbitals[slot].to_uppercase()), p))
+        })
+        .collect();
+    if series.is_empty() {
+        ui.label(RichText::new("no orbital energies in these files").weak());
+        return;
+    }
+    let gap: Option<Vec<[f64; 2]>> = (series.len() >= 2)
+        .then(|| series[0].1.iter().zip(&series[1].1).map(|(a, b)| [a[0], (b[1] - a[1]).abs()]).collect());
+    Plot::new("scan energies")
+        .legend(Legend::default())
+        .x_axis_label("θ (degrees)")
+        .y_axis_label("eV")
+        .allow_scroll(false)
+        .show(ui, |plot| {
+            for (name, points) in series {
+                plot.line(Line::new(name, points));
+            }
+            if let Some(gap) = gap {
+                plot.line(Line::new("gap", gap));
+            }
+            plot.vline(VLine::new("θ", scan.theta));
+        });
+}
+
+/// The orbital views side by side, each labelled with its orbital and energy at θ; drags and
+/// keys change θ; both views share `view` (camera and settings).
+pub fn views(ui: &mut egui::Ui, render_state: &egui_wgpu::RenderState, scan: &mut ScanView, view: &mut ViewState) {
+    let dt = ui.input(|i| i.stable_dt) as f64;
+    if !ui.ctx().egui_wants_keyboard_input() {
+        let (space, prev, next) = ui
+            .input(|i| (i.key_pressed(Key::Space), i.key_pressed(Key::OpenBracket), i.key_pressed(Key::CloseBracket)));
+        if space {
+            scan.playing = !scan.playing;
+        }
+        if prev {
+            scan.step_key(-1);
+        }
+        if next {
+            scan.step_key(1);
+        }
+    }
+    if scan.playing {
+        scan.advance(dt.min(0.1));
+        ui.ctx().request_repaint();
+    }
+    let twist = TwistInput { drag_twists: scan.drag_twists, bond: Some(scan.bond()) };
+    let (lo, hi) = scan.scene.scan.range();
+    let n = scan.views.len().max(1);
+    let mut dragged = 0.0;
+    let style = view.settings.atoms;
+    ui.columns(n, |columns| {
+        for (slot, (ui, vp)) in columns.iter_mut().zip(scan.views.iter_mut()).enumerate() {
+            if vp.scan_shown != Some((scan.theta, scan.mode)) {
+                vp.show_scan(&scan.scene, slot, scan.theta, scan.mode, style);
+            }
+            ui.horizontal(|ui| {
+                ui.strong(scan.scene.label(slot, scan.theta));
+                ui.label(RichText::new(format!("θ = {:.1}°", scan.theta)).weak());
+            });
+            dragged += vp.show_twistable(ui, render_state, view, Some(twist));
+        }
+    });
+    if dragged != 0.0 {
+        scan.set_theta(scan.theta + dragged as f64 * (hi - lo));
+    }
+}
+
+/// Re-applies the atom style to every view (after the side panel changed it).
+pub fn restyle(scan: &mut ScanView) {
+    for vp in &mut scan.views {
+        vp.scan_shown = None;
+    }
+}
