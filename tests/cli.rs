@@ -114,3 +114,62 @@ fn bad_input_fails_cleanly() {
         assert!(!err.trim().is_empty(), "{args:?} gave no message");
     }
 }
+
+#[test]
+fn scan_export_writes_the_interpolated_orbital_and_render_writes_both_views() {
+    let dir = tempfile::tempdir().unwrap();
+    let manifest = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/psb3/psb3.scan.toml");
+    let cube = dir.path().join("homo.cube");
+    let out = orbcloud(&[
+        "scan",
+        "export",
+        manifest,
+        "--angle",
+        "-97.5",
+        "--orbital",
+        "homo",
+        "--points",
+        "24",
+        "-o",
+        cube.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let doc = orbcloud::formats::load(&cube).unwrap();
+    let file = orbcloud::formats::scan::load_scan(std::path::Path::new(manifest)).unwrap();
+    let tracks = file.scan.track(orbcloud::model::scan::Follow::Index).unwrap();
+    let grid = file.scan.common_grid(orbcloud::headless::ORBITAL_MARGIN, 24);
+    let want = file.scan.interpolated_values(&tracks, 0, -97.5, &grid);
+    let got = &doc.volumes[0];
+    assert_eq!(got.dims, grid.dims);
+    let scale = want.iter().fold(0f32, |m, v| m.max(v.abs()));
+    let worst = got.values.iter().zip(&want).fold(0f32, |m, (a, b)| m.max((a - b).abs()));
+    assert!(worst <= 1e-4 * scale, "exported values differ by {worst} (max |ψ| {scale})");
+    // The skeleton in the file is the one at θ.
+    let d = orbcloud::model::scan::measure(&doc.molecule, file.scan.dihedral);
+    assert!((d + 97.5).abs() < 1e-3, "dihedral in the cube: {d}");
+
+    let png = dir.path().join("scan.png");
+    let out = orbcloud(&[
+        "scan",
+        "render",
+        manifest,
+        "--angle",
+        "-90",
+        "--interpolation",
+        "three-pass",
+        "--points",
+        "24",
+        "--size",
+        "96x64",
+        "--lavapipe",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let img = image::open(&png).unwrap();
+    assert_eq!((img.width(), img.height()), (192, 64), "two views side by side");
+
+    let out = orbcloud(&["scan", "render", manifest, "--angle", "-90", "--orbital", "homo-7", "-o", "x.png"]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("homo-7"));
+}

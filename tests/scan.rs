@@ -12,8 +12,8 @@ use orbcloud::formats::scan::{init, load_scan};
 use orbcloud::gpu::volume::VolumeTexture;
 use orbcloud::gpu::{FrameInput, OffscreenTarget, Renderer};
 use orbcloud::headless::scan::{KeyOptions, ScanScene};
-use orbcloud::model::scan::{Follow, Scan, Tracks, measure};
 use orbcloud::model::VolumeGrid;
+use orbcloud::model::scan::{Follow, Scan, Tracks, measure};
 use orbcloud::scene::{Interpolation, RenderSettings};
 
 fn psb3() -> Scan {
@@ -102,7 +102,9 @@ fn the_skeleton_follows_theta_and_the_charge_moves_at_minus_90() {
                     let w = v[(i * ny + j) * nz + k] as f64;
                     let nearest = (0..atoms.len())
                         .min_by(|&a, &b| {
-                            (atoms[a].position - p).length_squared().total_cmp(&(atoms[b].position - p).length_squared())
+                            (atoms[a].position - p)
+                                .length_squared()
+                                .total_cmp(&(atoms[b].position - p).length_squared())
                         })
                         .unwrap();
                     all += w * w;
@@ -115,7 +117,11 @@ fn the_skeleton_follows_theta_and_the_charge_moves_at_minus_90() {
         on / all
     };
     let (homo, lumo) = (fraction_moving(0), fraction_moving(1));
-    eprintln!("at -90°: HOMO {:.1}% on the C=N side, LUMO {:.1}% on the allyl side", homo * 100.0, (1.0 - lumo) * 100.0);
+    eprintln!(
+        "at -90°: HOMO {:.1}% on the C=N side, LUMO {:.1}% on the allyl side",
+        homo * 100.0,
+        (1.0 - lumo) * 100.0
+    );
     assert!(homo > 0.8, "HOMO on the C=N side: {homo}");
     assert!(lumo < 0.2, "LUMO on the C=N side: {lumo}");
 }
@@ -305,7 +311,10 @@ fn manifest_errors_name_the_file_and_line() {
         "dihedral = [2, 3, 4, 5]\n[[frame]]\nangle = -180\nfile = \"psb3_m180.molden.gz\"\n[[frame]]\nangle = -90\nfile = \"water.molden\"\n",
     );
     let e = load_err(&p);
-    assert!(e.contains("atoms.scan.toml:5") && e.contains("water.molden") && e.contains("the atoms of the first frame"), "{e}");
+    assert!(
+        e.contains("atoms.scan.toml:5") && e.contains("water.molden") && e.contains("the atoms of the first frame"),
+        "{e}"
+    );
 
     let p = write(dir.path(), "bad.scan.toml", "dihedral = [2, 3, 4]\n");
     let e = load_err(&p);
@@ -380,7 +389,12 @@ fn init_measures_the_most_changing_dihedral_and_sorts() {
     assert_eq!(loaded.scan.frames.len(), 4);
     // Files of another molecule are refused by name.
     let water = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/wavefunctions");
-    let w = std::fs::read_dir(&water).unwrap().filter_map(|e| e.ok()).map(|e| e.path()).find(|p| p.to_string_lossy().ends_with(".molden")).unwrap();
+    let w = std::fs::read_dir(&water)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .map(|e| e.path())
+        .find(|p| p.to_string_lossy().ends_with(".molden"))
+        .unwrap();
     std::fs::copy(&w, dir.path().join("zz_other.molden")).unwrap();
     let e = init(dir.path(), None).unwrap_err().to_string();
     assert!(e.contains("zz_other.molden"), "{e}");

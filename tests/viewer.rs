@@ -7,7 +7,10 @@ use orbcloud::app::{OrbApp, wgpu_setup};
 use orbcloud::scene::{SliceMode, TransferKind};
 
 fn harness() -> Harness<'static, OrbApp> {
-    let h = Harness::builder().with_size([1000.0, 700.0]).wgpu_setup(wgpu_setup(true)).build_eframe(OrbApp::cube_demo);
+    let h = Harness::builder()
+        .with_size([1000.0, 700.0])
+        .wgpu_setup(wgpu_setup(true))
+        .build_eframe(|cc| OrbApp::cube_demo(cc));
     assert!(h.state().error.is_none(), "viewer failed to start: {:?}", h.state().error);
     h
 }
@@ -115,4 +118,51 @@ fn a_molden_file_opens_on_its_homo_and_the_browser_switches_orbitals() {
     h.run_steps(2);
     assert_eq!(h.state().orbitals.shown, Quantity::Density);
     assert!(h.state().error.is_none(), "{:?}", h.state().error);
+}
+
+#[test]
+fn the_scan_demo_opens_side_by_side_and_a_drag_twists_both_views() {
+    let mut h = Harness::builder()
+        .with_size([1100.0, 720.0])
+        .wgpu_setup(wgpu_setup(true))
+        .build_eframe(|cc| OrbApp::new(cc, Vec::new()));
+    // The key volumes are made on a background thread.
+    let start = std::time::Instant::now();
+    while h.state().scan.is_none() {
+        assert!(h.state().error.is_none(), "scan failed: {:?}", h.state().error);
+        assert!(start.elapsed().as_secs() < 300, "the PSB3 key volumes did not finish");
+        std::thread::sleep(std::time::Duration::from_millis(100));
+        h.run_steps(1);
+    }
+    h.run_steps(2);
+    let scan = h.state().scan.as_ref().unwrap();
+    assert_eq!(scan.theta, -90.0, "opens at the twisted geometry");
+    assert_eq!(scan.shown().len(), 2, "HOMO and LUMO side by side");
+    assert!(scan.shown().iter().all(|s| s.map(|(t, _)| t) == Some(-90.0)), "{:?}", scan.shown());
+    h.get_by_label("Play");
+    assert!(h.query_all_by_label("dihedral").count() >= 1, "the θ slider");
+
+    // Seed 000: a horizontal drag across the (left) view turns the bond.
+    let from = egui::pos2(500.0, 260.0);
+    h.hover_at(from);
+    h.drag_at(from);
+    h.run_steps(1);
+    for i in 1..=6 {
+        h.hover_at(from + egui::vec2(15.0 * i as f32, 0.0));
+        h.run_steps(1);
+    }
+    h.drop_at(from + egui::vec2(90.0, 0.0));
+    h.run_steps(3);
+    let scan = h.state().scan.as_ref().unwrap();
+    let theta = scan.theta;
+    assert!(theta > -85.0, "θ after dragging right: {theta}");
+    for (slot, shown) in scan.shown().iter().enumerate() {
+        assert_eq!(shown.map(|(t, _)| t), Some(theta), "view {slot} does not show the new θ");
+    }
+
+    // The interpolation mode switches both views.
+    h.get_by_label("three-pass").click();
+    h.run_steps(2);
+    let scan = h.state().scan.as_ref().unwrap();
+    assert!(scan.shown().iter().all(|s| s.map(|(_, m)| m) == Some(orbcloud::scene::Interpolation::ThreePass)));
 }

@@ -103,7 +103,7 @@ pub struct ScanView {
     /// Primary drags twist θ (seed 000); else they orbit and only a drag on the bond twists.
     pub drag_twists: bool,
     direction: f64,
-    pub views: Vec<Viewport>,
+    pub(super) views: Vec<Viewport>,
 }
 
 impl ScanView {
@@ -124,6 +124,11 @@ impl ScanView {
             direction: 1.0,
             views,
         }
+    }
+
+    /// The θ and interpolation each view last drew (None before its first frame).
+    pub fn shown(&self) -> Vec<Option<(f64, Interpolation)>> {
+        self.views.iter().map(|v| v.scan_shown).collect()
     }
 
     pub fn set_theta(&mut self, theta: f64) {
@@ -294,6 +299,7 @@ pub fn views(ui: &mut egui::Ui, render_state: &egui_wgpu::RenderState, scan: &mu
     });
     if dragged != 0.0 {
         scan.set_theta(scan.theta + dragged as f64 * (hi - lo));
+        ui.ctx().request_repaint();
     }
 }
 
