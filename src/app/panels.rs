@@ -119,7 +119,17 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
         egui::ScrollArea::vertical().show(ui, |ui| {
             let view = &mut app.view;
             ui.heading("Volume");
-            if app.doc.volumes.is_empty() {
+            if let Some(scan) = &app.scan {
+                let g = scan.scene.grid.dims;
+                ui.label(format!(
+                    "{} key volumes of {}×{}×{} points ({:.1} MiB resident)",
+                    scan.scene.slots() * scan.scene.scan.frames.len(),
+                    g[0],
+                    g[1],
+                    g[2],
+                    scan.scene.bytes as f64 / 1048576.0
+                ));
+            } else if app.doc.volumes.is_empty() {
                 ui.label(if app.doc.wavefunction.is_some() {
                     "computed from the basis set: choose it under Orbitals"
                 } else {
@@ -199,9 +209,12 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
                 });
             });
             ui.separator();
-            ui.label(
-                RichText::new("drag: rotate · right/middle drag: pan · wheel: zoom · arrows, +/−: keys").small().weak(),
-            );
+            let help = if app.scan.as_ref().is_some_and(|s| s.drag_twists) {
+                "drag: twist θ · right/middle drag: pan · wheel: zoom · arrows: rotate · Space: play · [ ]: key angles"
+            } else {
+                "drag: rotate (on the bond: twist) · right/middle drag: pan · wheel: zoom · arrows, +/−: keys"
+            };
+            ui.label(RichText::new(help).small().weak());
         });
     });
 }
