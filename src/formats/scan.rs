@@ -264,6 +264,25 @@ pub fn init(dir: &Path, dihedral: Option<[usize; 4]>) -> Result<ScanInit, LoadEr
     let manifest_path = dir.join(format!("{dir_name}.scan.toml"));
     let name = dir.display().to_string();
     if names.len() < 2 {
+        // A Gaussian scan job's fchk holds every point's geometry but orbitals for the last
+        // only: say so rather than "one file".
+        if let [only] = names.as_slice()
+            && only.to_ascii_lowercase().contains(".fch")
+        {
+            let path = dir.join(only);
+            let text = super::read_text(&path)?;
+            let n = super::fchk::geometries(&path.display().to_string(), &text)?.len();
+            if n > 1 {
+                return Err(error(
+                    &path.display().to_string(),
+                    0,
+                    "one Molden or fchk file per angle (a scan job's fchk holds orbitals for its last geometry \
+                     only: keep a checkpoint per point and run formchk on each)",
+                    format!("{n} geometries in one file"),
+                )
+                .into());
+            }
+        }
         return Err(error(
             &name,
             0,

@@ -97,7 +97,8 @@ pub struct TrackPoint {
     pub energy: Option<f64>,
     /// ⟨previous|this⟩ after the sign (1 for the first frame).
     pub overlap: f64,
-    /// Whether the solver's sign was flipped.
+    /// Whether the solver turned this orbital's sign over since the previous frame (⟨previous
+    /// as written|this as written⟩ < 0): the steps alignment undoes.
     pub flipped: bool,
 }
 
@@ -125,7 +126,7 @@ pub struct Tracks {
 }
 
 impl Tracks {
-    /// How many frame-to-frame steps flipped the solver's sign, per slot.
+    /// How many frame-to-frame steps the solver turned the slot's orbital over.
     pub fn flips(&self, slot: usize) -> usize {
         self.points[slot].iter().filter(|p| p.flipped).count()
     }
@@ -375,7 +376,7 @@ impl Scan {
                     sign,
                     energy: energy_of(index),
                     overlap: o * sign,
-                    flipped: sign < 0.0,
+                    flipped: sign != prev.sign,
                 });
             }
             previous = Some((basis.unwrap_or_else(empty_basis), frame));
@@ -560,12 +561,12 @@ mod tests {
     /// Butane-like chain C–C–C–C with one H on each end carbon.
     fn chain() -> Molecule {
         Molecule::new(vec![
-            atom(6, [-1.3, 1.2, 0.0]),
+            atom(6, [-1.9, 1.9, 0.0]),
             atom(6, [0.0, 0.0, 0.0]),
-            atom(6, [1.5, 0.0, 0.0]),
-            atom(6, [2.8, 1.2, 0.0]),
-            atom(1, [-2.2, 0.6, 0.0]),
-            atom(1, [3.7, 0.6, 0.0]),
+            atom(6, [2.9, 0.0, 0.0]),
+            atom(6, [4.8, 1.9, 0.0]),
+            atom(1, [-3.8, 1.4, 0.0]),
+            atom(1, [6.7, 1.4, 0.0]),
         ])
     }
 
