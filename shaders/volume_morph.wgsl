@@ -1,43 +1,37 @@
 // Seed 000's interpolation between two key volumes A and B on one grid, θ between their
-// angles with ratio k = u.flags_f.y. Prepended: volume_common.wgsl (`volume` is A).
+// angles with ratio k = u.flags_f.y (`volume` is A).
 //
 // exact (fs_exact): the two volumes sampled and mixed per sample, ψ = (1−k)ψA + kψB, then one
 // premultiplied "over" blend.
 // three-pass (fs_attenuate, fs_add_a, fs_add_b, drawn in turn for every slice through blend
 // states): d_i = d_{i−1}(1 − A_i) + (1−k)A_i + kB_i, with B_i in the attenuation when k > 0.5.
+// Prepended: volume_common.wgsl, volume_gradient.wgsl.
 
 @group(1) @binding(0) var volume_b: texture_3d<f32>;
 
-// w.x·A + w.y·B at uvw, sampling only what is weighted.
-fn mixed_at(uvw: vec3<f32>, w: vec2<f32>) -> f32 {
+// The weights of A and B this fragment samples (set first by each entry point).
+var<private> weights: vec2<f32>;
+
+// weights.x·A + weights.y·B at uvw, sampling only what is weighted.
+fn field(uvw: vec3<f32>) -> f32 {
     var v = 0.0;
-    if (w.x != 0.0) {
-        v += w.x * textureSampleLevel(volume, volume_sampler, uvw, 0.0).r;
+    if (weights.x != 0.0) {
+        v += weights.x * textureSampleLevel(volume, volume_sampler, uvw, 0.0).r;
     }
-    if (w.y != 0.0) {
-        v += w.y * textureSampleLevel(volume_b, volume_sampler, uvw, 0.0).r;
+    if (weights.y != 0.0) {
+        v += weights.y * textureSampleLevel(volume_b, volume_sampler, uvw, 0.0).r;
     }
     return v;
 }
 
 // Premultiplied colour of the mix w at this fragment (alpha < 0: invisible).
 fn shade_mix(in: VertexOut, w: vec2<f32>) -> vec4<f32> {
-    let value = mixed_at(in.uvw, w);
+    weights = w;
     var grad = vec3<f32>(0.0);
     if (needs_gradient()) {
-        let h = 1.0 / vec3<f32>(textureDimensions(volume));
-        let dx = vec3<f32>(h.x, 0.0, 0.0);
-        let dy = vec3<f32>(0.0, h.y, 0.0);
-        let dz = vec3<f32>(0.0, 0.0, h.z);
-        let g_tex = vec3<f32>(
-            (mixed_at(in.uvw + dx, w) - mixed_at(in.uvw - dx, w)) / (2.0 * h.x),
-            (mixed_at(in.uvw + dy, w) - mixed_at(in.uvw - dy, w)) / (2.0 * h.y),
-            (mixed_at(in.uvw + dz, w) - mixed_at(in.uvw - dz, w)) / (2.0 * h.z),
-        );
-        let m = mat3x3<f32>(u.tex_from_world[0].xyz, u.tex_from_world[1].xyz, u.tex_from_world[2].xyz);
-        grad = transpose(m) * g_tex;
+        grad = field_gradient(in.uvw);
     }
-    return shade(value, grad, in.from_eye);
+    return shade(field(in.uvw), grad, in.from_eye);
 }
 
 fn k() -> f32 {

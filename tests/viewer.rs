@@ -15,6 +15,19 @@ fn harness() -> Harness<'static, OrbApp> {
     h
 }
 
+/// A primary-button drag `dx` points to the right from `from`, in five moves.
+fn drag_right(h: &mut Harness<'static, OrbApp>, from: egui::Pos2, dx: f32) {
+    h.hover_at(from);
+    h.drag_at(from);
+    h.run_steps(1);
+    for i in 1..=5 {
+        h.hover_at(from + egui::vec2(dx * i as f32 / 5.0, 0.0));
+        h.run_steps(1);
+    }
+    h.drop_at(from + egui::vec2(dx, 0.0));
+    h.run_steps(1);
+}
+
 #[test]
 fn starts_on_the_demo_and_changes_controls() {
     let mut h = harness();
@@ -44,16 +57,7 @@ fn dragging_the_view_orbits_the_camera() {
     let mut h = harness();
     h.run_steps(2);
     let yaw = h.state().view.camera.yaw;
-    let start = egui::pos2(650.0, 350.0);
-    h.hover_at(start);
-    h.drag_at(start);
-    h.run_steps(1);
-    for i in 1..=5 {
-        h.hover_at(start + egui::vec2(20.0 * i as f32, 0.0));
-        h.run_steps(1);
-    }
-    h.drop_at(start + egui::vec2(100.0, 0.0));
-    h.run_steps(1);
+    drag_right(&mut h, egui::pos2(650.0, 350.0), 100.0);
     let moved = h.state().view.camera.yaw;
     assert!((moved - yaw).abs() > 0.3, "yaw {yaw} -> {moved}");
 }
@@ -143,16 +147,8 @@ fn the_scan_demo_opens_side_by_side_and_a_drag_twists_both_views() {
     assert!(h.query_all_by_label("dihedral").count() >= 1, "the θ slider");
 
     // Seed 000: a horizontal drag across the (left) view turns the bond.
-    let from = egui::pos2(500.0, 260.0);
-    h.hover_at(from);
-    h.drag_at(from);
-    h.run_steps(1);
-    for i in 1..=6 {
-        h.hover_at(from + egui::vec2(15.0 * i as f32, 0.0));
-        h.run_steps(1);
-    }
-    h.drop_at(from + egui::vec2(90.0, 0.0));
-    h.run_steps(3);
+    drag_right(&mut h, egui::pos2(500.0, 260.0), 90.0);
+    h.run_steps(2);
     let scan = h.state().scan.as_ref().unwrap();
     let theta = scan.theta;
     assert!(theta > -85.0, "θ after dragging right: {theta}");

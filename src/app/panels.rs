@@ -60,14 +60,10 @@ pub fn status_bar(ui: &mut egui::Ui, app: &OrbApp) {
             }
             if let Some(scan) = &app.scan {
                 let s = &scan.scene.scan;
-                let d = s.dihedral.map(|i| i + 1);
                 ui.label(format!(
-                    "{}: dihedral {}-{}-{}-{}, {} key frames {:.0}°…{:.0}°",
+                    "{}: dihedral {}, {} key frames {:.0}°…{:.0}°",
                     s.title,
-                    d[0],
-                    d[1],
-                    d[2],
-                    d[3],
+                    s.dihedral_label(),
                     s.frames.len(),
                     s.range().0,
                     s.range().1

@@ -191,14 +191,10 @@ pub fn run(command: ScanCommand) -> Result<()> {
             let file = load_scan(&scan)?;
             let tracks = file.scan.track(follow_of(follow, &file))?;
             let s = &file.scan;
-            let d = s.dihedral.map(|i| i + 1);
             println!(
-                "{}\ndihedral {}-{}-{}-{}, {} frames, {} atoms turn",
+                "{}\ndihedral {}, {} frames, {} atoms turn",
                 s.title,
-                d[0],
-                d[1],
-                d[2],
-                d[3],
+                s.dihedral_label(),
                 s.frames.len(),
                 s.moving.len()
             );

@@ -27,6 +27,7 @@ pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// Every WGSL shader, by file name, for validation and pipeline creation.
 pub const SHADERS: &[(&str, &str)] = &[
     ("volume_common.wgsl", include_str!("../../shaders/volume_common.wgsl")),
+    ("volume_gradient.wgsl", include_str!("../../shaders/volume_gradient.wgsl")),
     ("volume_slices.wgsl", include_str!("../../shaders/volume_slices.wgsl")),
     ("volume_direct.wgsl", include_str!("../../shaders/volume_direct.wgsl")),
     ("volume_morph.wgsl", include_str!("../../shaders/volume_morph.wgsl")),
@@ -39,9 +40,9 @@ pub const SHADERS: &[(&str, &str)] = &[
 /// Shaders that are only complete with others prepended (WGSL has no includes): the module
 /// for `name` is the concatenation of these files, in order.
 pub const SHADER_MODULES: &[(&str, &[&str])] = &[
-    ("volume_slices.wgsl", &["volume_common.wgsl", "volume_slices.wgsl"]),
+    ("volume_slices.wgsl", &["volume_common.wgsl", "volume_gradient.wgsl", "volume_slices.wgsl"]),
     ("volume_direct.wgsl", &["volume_common.wgsl", "gto_common.wgsl", "volume_direct.wgsl"]),
-    ("volume_morph.wgsl", &["volume_common.wgsl", "volume_morph.wgsl"]),
+    ("volume_morph.wgsl", &["volume_common.wgsl", "volume_gradient.wgsl", "volume_morph.wgsl"]),
     ("gto_fill.wgsl", &["gto_common.wgsl", "gto_fill.wgsl"]),
 ];
 

@@ -329,6 +329,20 @@ fn make_pipeline(
     })
 }
 
+/// A filterable 3D texture, read by the slice fragment shaders.
+fn volume_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: true },
+            view_dimension: wgpu::TextureViewDimension::D3,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
 impl VolumePass {
     pub fn new(ctx: &GpuContext) -> Self {
         let device = &ctx.device;
@@ -336,16 +350,7 @@ impl VolumePass {
             label: Some("volume bind group layout"),
             entries: &[
                 super::uniform_entry(0, wgpu::ShaderStages::VERTEX_FRAGMENT),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                        view_dimension: wgpu::TextureViewDimension::D3,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
+                volume_entry(1),
                 wgpu::BindGroupLayoutEntry {
                     binding: 2,
                     visibility: wgpu::ShaderStages::FRAGMENT,
@@ -357,16 +362,7 @@ impl VolumePass {
         let gto_layout = gto_layout(device, wgpu::ShaderStages::FRAGMENT);
         let morph_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("key volume B layout"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Texture {
-                    sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                    view_dimension: wgpu::TextureViewDimension::D3,
-                    multisampled: false,
-                },
-                count: None,
-            }],
+            entries: &[volume_entry(0)],
         });
         let slices = SliceShader::new(device, "volume_slices.wgsl", &[Some(&layout)]);
         let direct_shader = SliceShader::new(device, "volume_direct.wgsl", &[Some(&layout), Some(&gto_layout)]);

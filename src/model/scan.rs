@@ -266,6 +266,11 @@ impl Scan {
         Ok(Self { title, dihedral, orbitals, frames, moving })
     }
 
+    /// The dihedral as chemists write it: "2-3-4-5" (1-based).
+    pub fn dihedral_label(&self) -> String {
+        self.dihedral.map(|i| (i + 1).to_string()).join("-")
+    }
+
     /// The angle range covered by the key frames.
     pub fn range(&self) -> (f64, f64) {
         (self.frames[0].angle, self.frames[self.frames.len() - 1].angle)
