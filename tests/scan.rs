@@ -47,7 +47,8 @@ fn phase_alignment_undoes_the_solvers_sign_flips() {
     assert!(tracks.swaps.is_empty(), "no character swaps in PSB3's frontier orbitals: {:?}", tracks.swaps);
     // Flipping one frame's orbital in the input is seen and undone.
     let mut flipped = scan.clone();
-    if let orbcloud::model::scan::FrameContent::Wavefunction(wf) = &mut flipped.frames[4].content {
+    if let orbcloud::model::scan::FrameContent::Wavefunctions(w) = &mut flipped.frames[4].content {
+        let wf = &mut w[0];
         let homo = tracks.points[0][4].index;
         wf.orbitals[homo].coefficients.iter_mut().for_each(|c| *c = -*c);
     }
@@ -61,7 +62,8 @@ fn swapped_orbitals_are_reported_and_followed_by_overlap() {
     // HOMO and HOMO−1 trading places in one frame is what a character swap looks like.
     let scan = psb3();
     let mut swapped = scan.clone();
-    if let orbcloud::model::scan::FrameContent::Wavefunction(wf) = &mut swapped.frames[2].content {
+    if let orbcloud::model::scan::FrameContent::Wavefunctions(w) = &mut swapped.frames[2].content {
+        let wf = &mut w[0];
         let spin = orbcloud::model::Spin::Alpha;
         let (h, h1) = (wf.homo(spin).unwrap(), wf.resolve("homo-1".parse().unwrap(), spin).unwrap());
         let c = wf.orbitals[h].coefficients.clone();
@@ -452,4 +454,34 @@ fn key_volumes_respect_the_budget_and_can_be_cancelled() {
     .expect("cancelled");
     assert!(matches!(e, orbcloud::headless::scan::ScanSceneError::Cancelled), "{e}");
     assert_eq!(calls, 3, "stops at the first refusal");
+}
+
+#[test]
+fn each_view_may_read_its_own_files() {
+    // The same orbital from two files side by side (here the same files twice, so both views
+    // must track exactly as one file does).
+    let dir = tempfile::tempdir().unwrap();
+    let names = ["psb3_m180.molden.gz", "psb3_m150.molden.gz", "psb3_m120.molden.gz"];
+    copy_frames(dir.path(), &names);
+    let mut text =
+        "dihedral = [2, 3, 4, 5]\norbitals = [\"homo\", \"homo\"]\ncaptions = [\"RHF\", \"RHF again\"]\n".to_string();
+    for (n, a) in names.iter().zip([-180, -150, -120]) {
+        text += &format!("\n[[frame]]\nangle = {a}\nfiles = [\"{n}\", \"{n}\"]\n");
+    }
+    let two = load_scan(&write(dir.path(), "two.scan.toml", &text)).unwrap();
+    assert_eq!(two.scan.captions, ["RHF", "RHF again"]);
+    let t2 = two.scan.track(Follow::Index).unwrap();
+    let one = psb3().track(Follow::Index).unwrap();
+    for slot in 0..2 {
+        for f in 0..3 {
+            assert_eq!(t2.points[slot][f], one.points[0][f], "slot {slot} frame {f}");
+        }
+    }
+    let bad = text.replacen(
+        "files = [\"psb3_m150.molden.gz\", \"psb3_m150.molden.gz\"]",
+        "files = [\"psb3_m150.molden.gz\"]",
+        1,
+    );
+    let e = load_err(&write(dir.path(), "bad.scan.toml", &bad));
+    assert!(e.contains("bad.scan.toml:9") && e.contains("one file per orbital (2)"), "{e}");
 }

@@ -6,10 +6,12 @@
 //! dihedral = [2, 3, 4, 5]          # atom numbers, 1-based
 //! orbitals = ["homo", "lumo"]      # default; also "homo-1", "lumo+2", an index
 //! follow = "index"                 # or "overlap": follow each orbital's character
+//! captions = ["RHF", "B3LYP"]      # optional, one per view
 //!
 //! [[frame]]
 //! angle = -180.0
-//! file = "psb3_m180.molden.gz"     # Molden or fchk
+//! file = "psb3_m180.molden.gz"     # Molden or fchk, for every view; or one per view:
+//! # files = ["rhf/m180.molden", "b3lyp/m180.molden"]
 //!
 //! [[frame]]
 //! angle = -150.0
@@ -34,6 +36,9 @@ struct Manifest {
     orbitals: Vec<String>,
     #[serde(default)]
     follow: Follow,
+    /// A caption per view, e.g. ["RHF", "B3LYP"] when each view reads its own files.
+    #[serde(default)]
+    captions: Vec<String>,
     #[serde(rename = "frame", default)]
     frames: Vec<toml::Spanned<FrameEntry>>,
 }
@@ -43,6 +48,8 @@ struct Manifest {
 struct FrameEntry {
     angle: f64,
     file: Option<String>,
+    /// One Molden/fchk file per orbital slot: the same orbital from two methods side by side.
+    files: Option<Vec<String>>,
     cubes: Option<Vec<String>>,
 }
 
@@ -63,6 +70,11 @@ fn line_of(text: &str, offset: usize) -> usize {
 
 fn error(file: &str, line: usize, expected: impl Into<String>, found: impl Into<String>) -> ParseError {
     ParseError { file: file.into(), line, expected: expected.into(), found: found.into() }
+}
+
+/// Whether two molecules have the same elements in the same order.
+fn same_atoms(a: &Molecule, b: &Molecule) -> bool {
+    a.atoms.len() == b.atoms.len() && a.atoms.iter().zip(&b.atoms).all(|(x, y)| x.z == y.z)
 }
 
 /// "C5H8N, 14 atoms" — enough to tell two molecules apart in a message.
@@ -111,15 +123,38 @@ pub fn parse_scan(
         if !entry.angle.is_finite() {
             return Err(error(&name, line, "a finite angle in degrees", entry.angle.to_string()).into());
         }
-        let (molecule, content, source) = match (&entry.file, &entry.cubes) {
-            (Some(file), None) => {
-                let doc = load(&dir.join(file))?;
-                let Some(wf) = doc.wavefunction else {
-                    return Err(error(&name, line, "a Molden or fchk file with orbitals", file.clone()).into());
-                };
-                (doc.molecule, FrameContent::Wavefunction(Box::new(wf)), file.clone())
+        let single = entry.file.as_ref().map(std::slice::from_ref);
+        let files =
+            if entry.file.is_some() && entry.files.is_some() { None } else { single.or(entry.files.as_deref()) };
+        let (molecule, content, source) = match (files, &entry.cubes) {
+            (Some(files), None) if !files.is_empty() => {
+                if entry.file.is_none() && files.len() != manifest.orbitals.len() {
+                    return Err(error(
+                        &name,
+                        line,
+                        format!("one file per orbital ({})", manifest.orbitals.len()),
+                        format!("{} files", files.len()),
+                    )
+                    .into());
+                }
+                let mut molecule: Option<Molecule> = None;
+                let mut wavefunctions = Vec::with_capacity(files.len());
+                for file in files {
+                    let doc = load(&dir.join(file))?;
+                    let Some(wf) = doc.wavefunction else {
+                        return Err(error(&name, line, "a Molden or fchk file with orbitals", file.clone()).into());
+                    };
+                    if let Some(m) = &molecule
+                        && !same_atoms(m, &doc.molecule)
+                    {
+                        return Err(error(&name, line, format!("the atoms of {}", files[0]), file.clone()).into());
+                    }
+                    molecule.get_or_insert(doc.molecule);
+                    wavefunctions.push(wf);
+                }
+                (molecule.unwrap_or_default(), FrameContent::Wavefunctions(wavefunctions), files.join(", "))
             }
-            (None, Some(cubes)) if !cubes.is_empty() => {
+            (None, Some(cubes)) if !cubes.is_empty() && entry.files.is_none() => {
                 let mut molecule = None;
                 let mut volumes = Vec::new();
                 for cube in cubes {
@@ -133,7 +168,7 @@ pub fn parse_scan(
                 return Err(error(
                     &name,
                     line,
-                    "a frame with either file = \"…\" or cubes = [\"…\", …]",
+                    "a frame with one of file = \"…\", files = [\"…\", …] or cubes = [\"…\", …]",
                     "both or neither",
                 )
                 .into());
@@ -170,8 +205,9 @@ pub fn parse_scan(
         .title
         .unwrap_or_else(|| path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default());
     let dihedral = dihedral.map(|i| i - 1);
-    let scan = Scan::new(title, dihedral, manifest.orbitals, frames.into_iter().map(|(_, f)| f).collect())
+    let mut scan = Scan::new(title, dihedral, manifest.orbitals, frames.into_iter().map(|(_, f)| f).collect())
         .map_err(|e| error(&name, dihedral_line, "a dihedral about a bond that can turn", e.to_string()))?;
+    scan.captions = manifest.captions;
     // Resolving the orbitals of every frame reports a missing one before anything is evaluated.
     scan.track(crate::model::scan::Follow::Index)
         .map_err(|e| error(&name, 1, "the orbitals the manifest names", e.to_string()))?;
@@ -181,13 +217,10 @@ pub fn parse_scan(
 /// Every frame must hold the first frame's atoms; cube series must share one grid.
 fn check_frames(name: &str, frames: &[(usize, KeyFrame)]) -> Result<(), ParseError> {
     let Some((_, first)) = frames.first() else { return Ok(()) };
-    let same_atoms = |m: &Molecule| {
-        m.atoms.len() == first.molecule.atoms.len()
-            && m.atoms.iter().zip(&first.molecule.atoms).all(|(a, b)| a.z == b.z)
-    };
+    let same_atoms = |m: &Molecule| same_atoms(m, &first.molecule);
     let first_grid = match &first.content {
         FrameContent::Volumes(v) => v.first(),
-        FrameContent::Wavefunction(_) => None,
+        FrameContent::Wavefunctions(_) => None,
     };
     for (line, frame) in frames {
         if !same_atoms(&frame.molecule) {
@@ -296,9 +329,7 @@ pub fn init(dir: &Path, dihedral: Option<[usize; 4]>) -> Result<ScanInit, LoadEr
         let doc = super::load(&dir.join(n))?;
         if let Some(m0) = molecules.first() {
             let m0: &Molecule = m0;
-            if m0.atoms.len() != doc.molecule.atoms.len()
-                || m0.atoms.iter().zip(&doc.molecule.atoms).any(|(a, b)| a.z != b.z)
-            {
+            if !same_atoms(m0, &doc.molecule) {
                 return Err(error(
                     &dir.join(n).display().to_string(),
                     0,

@@ -10,7 +10,7 @@ use crate::gpu::volume::{VolumeTexture, residency_budget, texel_bytes};
 use crate::gpu::{FrameInput, GpuContext, GpuError, OffscreenTarget, Renderer};
 use crate::model::cartesian::CartesianExpansion;
 use crate::model::grid::ValueKind;
-use crate::model::scan::{Bracket, Follow, FrameContent, Scan, ScanError, ScanGrid, Tracks};
+use crate::model::scan::{Bracket, Follow, Scan, ScanError, ScanGrid, Tracks};
 use crate::model::units::EV_PER_HARTREE;
 use crate::model::{PreparedBasis, VolumeGrid};
 use crate::scene::{AtomStyle, Camera, Interpolation, RenderSettings};
@@ -97,18 +97,15 @@ impl ScanScene {
         let mut fill: Option<GtoFillPass> = None;
         let mut grids: Vec<Vec<VolumeGrid>> = vec![Vec::with_capacity(scan.frames.len()); slots];
         for (f, frame) in scan.frames.iter().enumerate() {
-            let prepared = match &frame.content {
-                FrameContent::Wavefunction(wf) => Some(PreparedBasis::new(&wf.basis)),
-                FrameContent::Volumes(_) => None,
-            };
             for (slot, slot_grids) in grids.iter_mut().enumerate() {
-                let values = match (&prepared, scan.aligned_coefficients(&tracks, slot, f)) {
-                    (Some(prepared), Some(c)) => {
+                let values = match (frame.wavefunction(slot), scan.aligned_coefficients(&tracks, slot, f)) {
+                    (Some(wf), Some(c)) => {
+                        let prepared = PreparedBasis::new(&wf.basis);
                         let fill = fill.get_or_insert_with(|| GtoFillPass::new(ctx));
                         let geometry =
                             crate::gpu::gto::GridGeometry { dims: grid.dims, world_from_grid: grid.world_from_grid };
                         let texture =
-                            fill.fill(ctx, &CartesianExpansion::from_coefficients(prepared, &c), &geometry)?;
+                            fill.fill(ctx, &CartesianExpansion::from_coefficients(&prepared, &c), &geometry)?;
                         read_volume(ctx, &texture)?
                     }
                     _ => scan.key_values(&tracks, slot, f, &grid),
@@ -205,9 +202,12 @@ impl ScanScene {
         &self.keys[slot][frame]
     }
 
-    /// "HOMO  −0.3012 Eh  (−8.20 eV)" at θ, the energy interpolated between key frames.
+    /// "HOMO  −0.3012 Eh  (−8.20 eV)" (after the view's caption, if any) at θ, the energy interpolated between key frames.
     pub fn label(&self, slot: usize, theta: f64) -> String {
-        let name = self.scan.orbitals[slot].to_uppercase().replace('-', "−");
+        let mut name = self.scan.orbitals[slot].to_uppercase().replace('-', "−");
+        if let Some(caption) = self.scan.captions.get(slot).filter(|c| !c.is_empty()) {
+            name = format!("{caption}: {name}");
+        }
         match self.scan.energy_at(&self.tracks, slot, theta) {
             Some(e) => format!("{name}  {e:.4} Eh  ({:.2} eV)", e * EV_PER_HARTREE).replace('-', "−"),
             None => name,

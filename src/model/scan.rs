@@ -37,8 +37,9 @@ pub enum ScanError {
 /// What a key frame holds for its orbitals.
 #[derive(Debug, Clone)]
 pub enum FrameContent {
-    /// Orbitals from a basis set (Molden, fchk): evaluated on the scan's common grid.
-    Wavefunction(Box<Wavefunction>),
+    /// Orbitals from basis sets (Molden, fchk), evaluated on the scan's common grid: one file
+    /// for every slot, or one per slot (the same orbital from two methods side by side).
+    Wavefunctions(Vec<Wavefunction>),
     /// Precomputed grids (cube files), one per requested orbital, all on one grid.
     Volumes(Vec<VolumeGrid>),
 }
@@ -71,6 +72,8 @@ pub struct Scan {
     pub dihedral: [usize; 4],
     /// What each view shows: the manifest's names ("homo", "lumo", "homo-1", …).
     pub orbitals: Vec<String>,
+    /// Optional caption per view (say the method, when each view reads its own files).
+    pub captions: Vec<String>,
     /// Key frames, sorted by strictly increasing angle.
     pub frames: Vec<KeyFrame>,
     /// Atoms that turn with θ: the side of the j–k bond that holds k.
@@ -263,7 +266,7 @@ impl Scan {
             return Err(ScanError::RepeatedAtom);
         }
         let moving = moving_fragment(&frames[0].molecule, dihedral[1], dihedral[2])?;
-        Ok(Self { title, dihedral, orbitals, frames, moving })
+        Ok(Self { title, dihedral, orbitals, captions: Vec::new(), frames, moving })
     }
 
     /// The dihedral as chemists write it: "2-3-4-5" (1-based).
@@ -321,43 +324,48 @@ impl Scan {
     /// by overlap: analytic overlaps between the frames' basis sets for wavefunctions, sums over
     /// the common grid for cube series.
     pub fn track(&self, follow: Follow) -> Result<Tracks, ScanError> {
-        let specs: Vec<Option<OrbitalSpec>> = self.orbitals.iter().map(|s| s.parse().ok()).collect();
-        let mut points: Vec<Vec<TrackPoint>> = vec![Vec::with_capacity(self.frames.len()); self.orbitals.len()];
+        let mut points: Vec<Vec<TrackPoint>> = Vec::with_capacity(self.orbitals.len());
         let mut swaps = Vec::new();
-        let mut previous: Option<(PreparedBasis, &KeyFrame)> = None;
-        for (f, frame) in self.frames.iter().enumerate() {
-            let named = self.named_orbitals(frame, &specs)?;
-            let basis = match &frame.content {
-                FrameContent::Wavefunction(wf) => Some(PreparedBasis::with_threshold(&wf.basis, 0.0)),
-                FrameContent::Volumes(_) => None,
-            };
-            let overlaps = match (&previous, &basis) {
-                (Some((pb, pf)), Some(b)) => Some(FrameOverlap::Basis(cross_overlap(pb, b), pf)),
-                (Some((_, pf)), None) => Some(FrameOverlap::Grid(pf)),
-                _ => None,
-            };
-            for (slot, &by_name) in named.iter().enumerate() {
-                let energy_of = |i: usize| match &frame.content {
-                    FrameContent::Wavefunction(wf) => Some(wf.orbitals[i].energy),
-                    FrameContent::Volumes(_) => None,
-                };
-                let Some(overlaps) = &overlaps else {
-                    let point = TrackPoint {
+        for (slot, name) in self.orbitals.iter().enumerate() {
+            let spec: Option<OrbitalSpec> = name.parse().ok();
+            let mut track: Vec<TrackPoint> = Vec::with_capacity(self.frames.len());
+            let mut previous_basis: Option<PreparedBasis> = None;
+            for (f, frame) in self.frames.iter().enumerate() {
+                let by_name = self.named_orbital(frame, slot, spec)?;
+                let wf = frame.wavefunction(slot);
+                let energy_of = |i: usize| wf.map(|w| w.orbitals[i].energy);
+                let basis = wf.map(|w| PreparedBasis::with_threshold(&w.basis, 0.0));
+                let Some(&prev) = track.last() else {
+                    track.push(TrackPoint {
                         index: by_name,
                         sign: 1.0,
                         energy: energy_of(by_name),
                         overlap: 1.0,
                         flipped: false,
-                    };
-                    points[slot].push(point);
+                    });
+                    previous_basis = basis;
                     continue;
                 };
-                let prev = points[slot][f - 1];
-                let candidates = candidates(frame, by_name);
-                let overlap_with = |i: usize| prev.sign * overlaps.between(prev.index, frame, i);
-                let (best, best_overlap) = candidates
-                    .iter()
-                    .map(|&i| (i, overlap_with(i)))
+                let before = &self.frames[f - 1];
+                // ⟨previous aligned|candidate⟩: analytic between the two frames' basis sets, or
+                // over the common grid for cube series.
+                let overlap_with: Box<dyn Fn(usize) -> f64> =
+                    match (before.wavefunction(slot), wf, &previous_basis, &basis) {
+                        (Some(pwf), Some(wf), Some(pb), Some(b)) => {
+                            let s = cross_overlap(pb, b);
+                            let ca = &pwf.orbitals[prev.index].coefficients;
+                            Box::new(move |i| prev.sign * bilinear(ca, &s, &wf.orbitals[i].coefficients))
+                        }
+                        _ => match (&before.content, &frame.content) {
+                            (FrameContent::Volumes(va), FrameContent::Volumes(vb)) => {
+                                Box::new(move |i| prev.sign * grid_overlap(&va[prev.index], &vb[i]))
+                            }
+                            _ => Box::new(|_| 0.0),
+                        },
+                    };
+                let (best, best_overlap) = candidates(frame, slot, by_name)
+                    .into_iter()
+                    .map(|i| (i, overlap_with(i)))
                     .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
                     .unwrap_or((by_name, overlap_with(by_name)));
                 let named_overlap = overlap_with(by_name);
@@ -376,85 +384,67 @@ impl Scan {
                     Follow::Overlap => (best, best_overlap),
                 };
                 let sign = if o < 0.0 { -1.0 } else { 1.0 };
-                points[slot].push(TrackPoint {
+                track.push(TrackPoint {
                     index,
                     sign,
                     energy: energy_of(index),
                     overlap: o * sign,
                     flipped: sign != prev.sign,
                 });
+                previous_basis = basis;
             }
-            previous = Some((basis.unwrap_or_else(empty_basis), frame));
+            points.push(track);
         }
         Ok(Tracks { points, swaps, follow })
     }
 
-    /// Each slot's orbital by name in one frame.
-    fn named_orbitals(&self, frame: &KeyFrame, specs: &[Option<OrbitalSpec>]) -> Result<Vec<usize>, ScanError> {
-        match &frame.content {
-            FrameContent::Wavefunction(wf) => specs
-                .iter()
-                .zip(&self.orbitals)
-                .map(|(spec, name)| {
-                    spec.and_then(|s| wf.resolve(s, Spin::Alpha)).ok_or_else(|| ScanError::MissingOrbital {
-                        angle: frame.angle,
-                        spec: name.clone(),
-                        available: wf.of_spin(Spin::Alpha).count(),
-                    })
-                })
-                .collect(),
-            FrameContent::Volumes(v) if v.len() >= self.orbitals.len() => Ok((0..self.orbitals.len()).collect()),
-            FrameContent::Volumes(v) => {
+    /// A slot's orbital by name in one frame.
+    fn named_orbital(&self, frame: &KeyFrame, slot: usize, spec: Option<OrbitalSpec>) -> Result<usize, ScanError> {
+        match (&frame.content, frame.wavefunction(slot)) {
+            (_, Some(wf)) => spec.and_then(|s| wf.resolve(s, Spin::Alpha)).ok_or_else(|| ScanError::MissingOrbital {
+                angle: frame.angle,
+                spec: self.orbitals[slot].clone(),
+                available: wf.of_spin(Spin::Alpha).count(),
+            }),
+            (FrameContent::Volumes(v), _) if slot < v.len() => Ok(slot),
+            (FrameContent::Volumes(v), _) => {
                 Err(ScanError::MissingVolume { angle: frame.angle, wanted: self.orbitals.len(), found: v.len() })
+            }
+            (FrameContent::Wavefunctions(_), None) => {
+                Err(ScanError::MissingVolume { angle: frame.angle, wanted: self.orbitals.len(), found: 0 })
             }
         }
     }
 }
 
-/// A placeholder for frames without a basis (cube series compare on the grid instead).
-fn empty_basis() -> PreparedBasis {
-    PreparedBasis::new(&super::basis::Basis::default())
+impl KeyFrame {
+    /// The wavefunction a slot's orbital comes from: the frame's only one, or the slot's own.
+    pub fn wavefunction(&self, slot: usize) -> Option<&Wavefunction> {
+        match &self.content {
+            FrameContent::Wavefunctions(w) if w.len() == 1 => w.first(),
+            FrameContent::Wavefunctions(w) => w.get(slot),
+            FrameContent::Volumes(_) => None,
+        }
+    }
+}
+
+/// aᵀ S b for S row-major len(a) × len(b).
+fn bilinear(a: &[f64], s: &[f64], b: &[f64]) -> f64 {
+    let nb = b.len().max(1);
+    a.iter().enumerate().map(|(u, &x)| x * b.iter().enumerate().map(|(v, &y)| s[u * nb + v] * y).sum::<f64>()).sum()
 }
 
 /// The orbitals that may continue a slot's orbital in `frame`: same spin, within
 /// [`FOLLOW_WINDOW`] of the named one in energy order; all volumes of a cube frame.
-fn candidates(frame: &KeyFrame, by_name: usize) -> Vec<usize> {
-    match &frame.content {
-        FrameContent::Wavefunction(wf) => {
+fn candidates(frame: &KeyFrame, slot: usize, by_name: usize) -> Vec<usize> {
+    match (&frame.content, frame.wavefunction(slot)) {
+        (_, Some(wf)) => {
             let order = wf.by_energy(wf.orbitals[by_name].spin);
             let pos = order.iter().position(|&i| i == by_name).unwrap_or(0);
             order[pos.saturating_sub(FOLLOW_WINDOW)..(pos + FOLLOW_WINDOW + 1).min(order.len())].to_vec()
         }
-        FrameContent::Volumes(v) => (0..v.len()).collect(),
-    }
-}
-
-/// Overlaps between the previous frame's orbitals and this frame's.
-enum FrameOverlap<'a> {
-    /// ⟨χ_prev|χ_this⟩ (row-major) and the previous frame.
-    Basis(Vec<f64>, &'a KeyFrame),
-    /// Σ a·b·dV over the common grid.
-    Grid(&'a KeyFrame),
-}
-
-impl FrameOverlap<'_> {
-    fn between(&self, prev_index: usize, frame: &KeyFrame, index: usize) -> f64 {
-        match (self, &frame.content) {
-            (FrameOverlap::Basis(s, prev), FrameContent::Wavefunction(wf)) => {
-                let FrameContent::Wavefunction(pwf) = &prev.content else { return 0.0 };
-                let (ca, cb) = (&pwf.orbitals[prev_index].coefficients, &wf.orbitals[index].coefficients);
-                let nb = wf.basis.n_functions().max(1);
-                ca.iter()
-                    .enumerate()
-                    .map(|(u, &x)| x * cb.iter().enumerate().map(|(v, &y)| s[u * nb + v] * y).sum::<f64>())
-                    .sum()
-            }
-            (FrameOverlap::Grid(prev), FrameContent::Volumes(vb)) => {
-                let FrameContent::Volumes(va) = &prev.content else { return 0.0 };
-                grid_overlap(&va[prev_index], &vb[index])
-            }
-            _ => 0.0,
-        }
+        (FrameContent::Volumes(v), _) => (0..v.len()).collect(),
+        _ => vec![by_name],
     }
 }
 
@@ -518,24 +508,21 @@ impl Scan {
     /// A slot's coefficient vector in `frame`, sign-aligned (wavefunction frames).
     pub fn aligned_coefficients(&self, tracks: &Tracks, slot: usize, frame: usize) -> Option<Vec<f64>> {
         let p = tracks.points[slot][frame];
-        match &self.frames[frame].content {
-            FrameContent::Wavefunction(wf) => {
-                Some(wf.orbitals[p.index].coefficients.iter().map(|c| c * p.sign).collect())
-            }
-            FrameContent::Volumes(_) => None,
-        }
+        let wf = self.frames[frame].wavefunction(slot)?;
+        Some(wf.orbitals[p.index].coefficients.iter().map(|c| c * p.sign).collect())
     }
 
     /// A slot's key volume in `frame` on `grid`, sign-aligned: evaluated on the CPU for
     /// wavefunction frames, the cube's values for cube frames.
     pub fn key_values(&self, tracks: &Tracks, slot: usize, frame: usize, grid: &ScanGrid) -> Vec<f32> {
         let p = tracks.points[slot][frame];
-        match &self.frames[frame].content {
-            FrameContent::Wavefunction(wf) => {
+        match (&self.frames[frame].content, self.frames[frame].wavefunction(slot)) {
+            (_, Some(wf)) => {
                 let c = self.aligned_coefficients(tracks, slot, frame).unwrap_or_default();
                 PreparedBasis::new(&wf.basis).eval_grid_f32(&c, &grid.spec())
             }
-            FrameContent::Volumes(v) => v[p.index].values.iter().map(|&x| x * p.sign as f32).collect(),
+            (FrameContent::Volumes(v), _) => v[p.index].values.iter().map(|&x| x * p.sign as f32).collect(),
+            _ => vec![0.0; grid.len()],
         }
     }
 
