@@ -443,6 +443,11 @@ fn key_volumes_respect_the_budget_and_can_be_cancelled() {
     let e = ScanScene::build(&ctx, psb3(), &options, &mut |_, _| true).err().expect("1 MiB cannot hold 30 volumes");
     let msg = e.to_string();
     assert!(msg.contains("30 key volumes") && msg.contains("points along the longest side fits"), "{msg}");
+    let orbcloud::headless::scan::ScanSceneError::OverBudget { fits, .. } = e else { panic!("{e}") };
+    // The grid offered does fit.
+    let options = KeyOptions { points: fits, budget: Some(1 << 20), ..KeyOptions::default() };
+    let scene = ScanScene::build(&ctx, psb3(), &options, &mut |_, _| true).expect("the offered grid fits");
+    assert!(scene.bytes <= 1 << 20);
     let options = KeyOptions { points: 16, ..KeyOptions::default() };
     let mut calls = 0;
     let e = ScanScene::build(&ctx, psb3(), &options, &mut |done, total| {

@@ -162,3 +162,35 @@ fn the_scan_demo_opens_side_by_side_and_a_drag_twists_both_views() {
     let scan = h.state().scan.as_ref().unwrap();
     assert!(scan.shown().iter().all(|s| s.map(|(_, m)| m) == Some(orbcloud::scene::Interpolation::ThreePass)));
 }
+
+#[test]
+fn a_scan_too_large_for_the_gpu_offers_a_coarser_grid() {
+    let manifest = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets/psb3/psb3.scan.toml");
+    let mut h = Harness::builder()
+        .with_size([1100.0, 720.0])
+        .wgpu_setup(wgpu_setup(true))
+        .build_eframe(|cc| OrbApp::cube_demo(cc));
+    h.state_mut().scan_budget = Some(1 << 20);
+    let ctx = h.ctx.clone();
+    h.state_mut().open(manifest, &ctx);
+    let start = std::time::Instant::now();
+    while h.state().error.is_none() {
+        assert!(start.elapsed().as_secs() < 60, "no budget error");
+        std::thread::sleep(std::time::Duration::from_millis(50));
+        h.run_steps(1);
+    }
+    let error = h.state().error.clone().unwrap();
+    assert!(error.contains("MiB") && error.contains("fits"), "{error}");
+    let fits = h.state().scan_retry.as_ref().map(|r| r.1).expect("a grid that fits is offered");
+    h.run_steps(2);
+    h.get_by_label(&format!("Open with {fits} points")).click();
+    h.run_steps(1);
+    while h.state().scan.is_none() {
+        assert!(h.state().error.is_none(), "{:?}", h.state().error);
+        assert!(start.elapsed().as_secs() < 240, "the coarser scan did not open");
+        std::thread::sleep(std::time::Duration::from_millis(50));
+        h.run_steps(1);
+    }
+    let scan = h.state().scan.as_ref().unwrap();
+    assert!(scan.scene.bytes <= 1 << 20, "{} bytes", scan.scene.bytes);
+}

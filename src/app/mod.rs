@@ -15,7 +15,7 @@ use crate::headless::WavefunctionView;
 use crate::headless::default_camera;
 use crate::model::Document;
 use loader::LoadJob;
-use scan::{ScanJob, ScanSource, ScanView};
+use scan::{ScanFailure, ScanJob, ScanSource, ScanView};
 pub use state::{OrbitalView, ViewState};
 use viewport::Viewport;
 
@@ -67,6 +67,10 @@ pub struct OrbApp {
     scan_job: Option<ScanJob>,
     /// Points along the longest side of a scan's common grid.
     pub scan_points: usize,
+    /// Memory allowed for a scan's key volumes (bytes); `None`: derived from the device.
+    pub scan_budget: Option<u64>,
+    /// A scan that did not fit the GPU's memory, and the grid that would.
+    pub scan_retry: Option<(ScanSource, usize)>,
 }
 
 impl OrbApp {
@@ -108,6 +112,8 @@ impl OrbApp {
             scan: None,
             scan_job: None,
             scan_points: crate::headless::scan::DEFAULT_SCAN_POINTS,
+            scan_retry: None,
+            scan_budget: None,
         };
         if app.viewport.is_none() {
             app.error = Some("no wgpu render state: the viewer needs eframe's wgpu backend".into());
@@ -139,7 +145,11 @@ impl OrbApp {
             job.cancel();
         }
         let ctx = ctx.clone();
-        let options = crate::headless::scan::KeyOptions { points: self.scan_points, ..Default::default() };
+        let options = crate::headless::scan::KeyOptions {
+            points: self.scan_points,
+            budget: self.scan_budget,
+            ..Default::default()
+        };
         self.scan_job = Some(ScanJob::start(gpu, source, options, move || ctx.request_repaint()));
     }
 
@@ -194,7 +204,7 @@ impl OrbApp {
         if let Some(job) = &self.scan_job
             && let Some(result) = job.poll()
         {
-            let name = job.name.clone();
+            let (name, source) = (job.name.clone(), job.source.clone());
             self.scan_job = None;
             match result {
                 Ok(scene) => {
@@ -220,8 +230,12 @@ impl OrbApp {
                         self.scan = Some(ScanView::new(scene, &make));
                     }
                 }
-                Err(e) if e == "cancelled" => self.status = format!("{name}: cancelled"),
-                Err(e) => self.error = Some(e),
+                Err(ScanFailure::Cancelled) => self.status = format!("{name}: cancelled"),
+                Err(ScanFailure::OverBudget { message, fits }) => {
+                    self.error = Some(format!("{name}: {message}"));
+                    self.scan_retry = Some((source, fits));
+                }
+                Err(ScanFailure::Other(e)) => self.error = Some(e),
             }
         }
         if self.job.is_none()

@@ -222,12 +222,24 @@ pub fn error_window(ui: &mut egui::Ui, app: &mut OrbApp) {
     let mut open = true;
     egui::Window::new("Could not open").open(&mut open).collapsible(false).show(ui.ctx(), |ui| {
         ui.label(RichText::new(&message).color(ui.visuals().error_fg_color));
-        if ui.button("Dismiss").clicked() {
-            app.error = None;
-        }
+        ui.horizontal(|ui| {
+            if let Some((source, fits)) = app.scan_retry.clone()
+                && ui.button(format!("Open with {fits} points")).on_hover_text("a coarser common grid").clicked()
+            {
+                app.scan_points = fits;
+                app.error = None;
+                app.scan_retry = None;
+                app.open_scan(source, ui.ctx());
+            }
+            if ui.button("Dismiss").clicked() {
+                app.error = None;
+                app.scan_retry = None;
+            }
+        });
     });
     if !open {
         app.error = None;
+        app.scan_retry = None;
     }
 }
 

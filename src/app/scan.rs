@@ -13,12 +13,13 @@ use super::state::ViewState;
 use super::viewport::{TwistInput, Viewport};
 use crate::formats::scan::{ScanFile, load_scan};
 use crate::gpu::GpuContext;
-use crate::headless::scan::{KeyOptions, ScanScene};
+use crate::headless::scan::{KeyOptions, ScanScene, ScanSceneError};
 use crate::model::scan::Follow;
 use crate::model::units::EV_PER_HARTREE;
 use crate::scene::Interpolation;
 
 /// Where a scan comes from.
+#[derive(Debug, Clone, PartialEq)]
 pub enum ScanSource {
     File(PathBuf),
     /// The bundled PSB3 scan.
@@ -29,10 +30,23 @@ pub enum ScanSource {
 /// there too), with progress and cancellation; the window keeps what it shows meanwhile.
 pub struct ScanJob {
     pub name: String,
+    pub source: ScanSource,
     done: Arc<AtomicUsize>,
     total: Arc<AtomicUsize>,
     cancel: Arc<AtomicBool>,
-    result: Receiver<Result<ScanScene, String>>,
+    result: Receiver<Result<ScanScene, ScanFailure>>,
+}
+
+/// Why a scan did not open.
+#[derive(Debug)]
+pub enum ScanFailure {
+    Cancelled,
+    /// The key volumes would not fit: a grid of `fits` points along the longest side would.
+    OverBudget {
+        message: String,
+        fits: usize,
+    },
+    Other(String),
 }
 
 impl ScanJob {
@@ -50,13 +64,14 @@ impl ScanJob {
             (Arc::new(AtomicUsize::new(0)), Arc::new(AtomicUsize::new(0)), Arc::new(AtomicBool::new(false)));
         let (tx, result) = channel();
         let (d, t, c) = (done.clone(), total.clone(), cancel.clone());
+        let job_source = source.clone();
         std::thread::spawn(move || {
-            let run = || -> Result<ScanScene, String> {
+            let run = || -> Result<ScanScene, ScanFailure> {
                 let file: ScanFile = match &source {
                     ScanSource::File(p) => load_scan(p),
                     ScanSource::Demo => crate::demo::scan(),
                 }
-                .map_err(|e| e.to_string())?;
+                .map_err(|e| ScanFailure::Other(e.to_string()))?;
                 let options = KeyOptions {
                     follow: if options.follow == Follow::Index { file.follow } else { options.follow },
                     ..options
@@ -67,12 +82,16 @@ impl ScanJob {
                     repaint();
                     !c.load(Ordering::Relaxed)
                 })
-                .map_err(|e| e.to_string())
+                .map_err(|e| match e {
+                    ScanSceneError::Cancelled => ScanFailure::Cancelled,
+                    ScanSceneError::OverBudget { fits, .. } => ScanFailure::OverBudget { message: e.to_string(), fits },
+                    e => ScanFailure::Other(e.to_string()),
+                })
             };
             let _ = tx.send(run());
             repaint();
         });
-        Self { name, done, total, cancel, result }
+        Self { name, source: job_source, done, total, cancel, result }
     }
 
     /// Key volumes made so far, of how many.
@@ -84,7 +103,7 @@ impl ScanJob {
         self.cancel.store(true, Ordering::Relaxed);
     }
 
-    pub fn poll(&self) -> Option<Result<ScanScene, String>> {
+    pub fn poll(&self) -> Option<Result<ScanScene, ScanFailure>> {
         self.result.try_recv().ok()
     }
 }

@@ -26,7 +26,7 @@ pub enum ScanSceneError {
     #[error(transparent)]
     Scan(#[from] ScanError),
     #[error(
-        "{count} key volumes of {dims:?} points need {needed_mib:.0} MiB, more than the {budget_mib:.0} MiB this GPU \
+        "{count} key volumes of {dims:?} points need {needed_mib:.1} MiB, more than the {budget_mib:.1} MiB this GPU \
          allows; a grid of {fits} points along the longest side fits"
     )]
     OverBudget { count: usize, dims: [usize; 3], needed_mib: f64, budget_mib: f64, fits: usize },
@@ -85,13 +85,20 @@ impl ScanScene {
         let budget = options.budget.unwrap_or_else(|| residency_budget(&ctx.device.limits()));
         let needed = per_volume * count as u64;
         if needed > budget {
-            let shrink = (budget as f64 / needed as f64).cbrt();
+            // The largest grid that fits: start from the cube-root estimate, then step down
+            // (dimensions round up, so the estimate may still be too large).
+            let texel = texel_bytes(options.format) * count as u64;
+            let estimate = (options.points as f64 * (budget as f64 / needed as f64).cbrt()).floor() as usize;
+            let fits = (2..=estimate.max(2))
+                .rev()
+                .find(|&p| scan.common_grid(ORBITAL_MARGIN, p).len() as u64 * texel <= budget)
+                .unwrap_or(2);
             return Err(ScanSceneError::OverBudget {
                 count,
                 dims: grid.dims,
                 needed_mib: needed as f64 / 1048576.0,
                 budget_mib: budget as f64 / 1048576.0,
-                fits: ((options.points as f64 * shrink).floor() as usize).max(2),
+                fits,
             });
         }
         let mut fill: Option<GtoFillPass> = None;
