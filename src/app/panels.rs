@@ -194,8 +194,11 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
 
             ui.separator();
             ui.collapsing("Atoms in file", |ui| {
+                // A scan's atoms where they are at θ.
+                let twisted = app.scan.as_ref().map(|s| s.scene.scan.geometry_at(s.theta));
+                let molecule = twisted.as_ref().unwrap_or(&app.doc.molecule);
                 egui::Grid::new("atoms").striped(true).show(ui, |ui| {
-                    for (i, a) in app.doc.molecule.atoms.iter().enumerate().take(500) {
+                    for (i, a) in molecule.atoms.iter().enumerate().take(500) {
                         let p = a.position * ANGSTROM_PER_BOHR;
                         ui.label(format!("{}", i + 1));
                         ui.label(format!("{}{}", a.element().symbol, if a.ghost { " (ghost)" } else { "" }));
@@ -205,10 +208,12 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
                 });
             });
             ui.separator();
-            let help = if app.scan.as_ref().is_some_and(|s| s.drag_twists) {
-                "drag: twist θ · right/middle drag: pan · wheel: zoom · arrows: rotate · Space: play · [ ]: key angles"
-            } else {
-                "drag: rotate (on the bond: twist) · right/middle drag: pan · wheel: zoom · arrows, +/−: keys"
+            let help = match &app.scan {
+                Some(s) if s.drag_twists => {
+                    "drag: twist θ · right/middle drag: pan · wheel: zoom · arrows: rotate · Space: play · [ ]: key angles"
+                }
+                Some(_) => "drag: rotate (from the bond: twist) · right/middle drag: pan · wheel: zoom · Space: play",
+                None => "drag: rotate · right/middle drag: pan · wheel: zoom · arrows, +/−: keys",
             };
             ui.label(RichText::new(help).small().weak());
         });
