@@ -490,3 +490,45 @@ fn each_view_may_read_its_own_files() {
     let e = load_err(&write(dir.path(), "bad.scan.toml", &bad));
     assert!(e.contains("bad.scan.toml:9") && e.contains("one file per orbital (2)"), "{e}");
 }
+
+#[test]
+fn per_point_fchk_files_with_optimisation_histories_make_a_scan() {
+    // scripts/make_scan_fchk_fixtures.py: three PSB3 frames as fchk files that also hold an
+    // optimisation history, as each point of a relaxed scan does.
+    let src = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/scan_fchk");
+    let dir = tempfile::tempdir().unwrap();
+    for e in std::fs::read_dir(&src).unwrap() {
+        let p = e.unwrap().path();
+        std::fs::copy(&p, dir.path().join(p.file_name().unwrap())).unwrap();
+    }
+    let one = dir.path().join("psb3_m090.fchk.gz");
+    let text = orbcloud::formats::read_text(&one).unwrap();
+    let geometries = orbcloud::formats::fchk::geometries("psb3_m090.fchk.gz", &text).unwrap();
+    assert_eq!(geometries.len(), 3, "the current geometry and two optimisation steps");
+    let made = init(dir.path(), None).unwrap();
+    assert_eq!(made.dihedral, [1, 2, 3, 4]);
+    let angles: Vec<f64> = made.frames.iter().map(|f| f.1).collect();
+    for (a, want) in angles.iter().zip([-120.0, -90.0, -60.0]) {
+        assert!((a - want).abs() < 1e-3, "the current geometry is measured, not a step: {angles:?}");
+    }
+    std::fs::write(&made.path, &made.text).unwrap();
+    let fchk = load_scan(&made.path).unwrap().scan;
+    let tracks = fchk.track(Follow::Index).unwrap();
+    // The same orbitals as the bundled Molden frames at these angles.
+    let molden = psb3();
+    let molden_tracks = molden.track(Follow::Index).unwrap();
+    let grid = molden.common_grid(orbcloud::headless::ORBITAL_MARGIN, 24);
+    for (f, angle) in [-120.0, -90.0, -60.0].into_iter().enumerate() {
+        let m = molden.frames.iter().position(|fr| fr.angle == angle).unwrap();
+        for slot in 0..2 {
+            let (e1, e2) = (tracks.points[slot][f].energy.unwrap(), molden_tracks.points[slot][m].energy.unwrap());
+            assert!((e1 - e2).abs() < 1e-6, "{angle}° slot {slot}: {e1} vs {e2}");
+            let a = fchk.key_values(&tracks, slot, f, &grid);
+            let b = molden.key_values(&molden_tracks, slot, m, &grid);
+            let dot: f64 = a.iter().zip(&b).map(|(&x, &y)| x as f64 * y as f64).sum();
+            let s = dot.signum() as f32;
+            let diff: Vec<f32> = a.iter().zip(&b).map(|(x, y)| x - s * y).collect();
+            assert!(norm(&diff) < 1e-4 * norm(&b), "{angle}° slot {slot}: {}", norm(&diff) / norm(&b));
+        }
+    }
+}
