@@ -191,6 +191,9 @@ impl ScanView {
     }
 }
 
+/// Slices per view while the user drags or the animation plays.
+const INTERACTIVE_SLICES: u32 = 64;
+
 /// The bottom panel: θ slider with key ticks, play/loop, interpolation mode, energy plot.
 pub fn controls(ui: &mut egui::Ui, scan: &mut ScanView) {
     egui::Panel::bottom("scan controls").resizable(true).default_size(190.0).show(ui, |ui| {
@@ -304,6 +307,13 @@ pub fn views(ui: &mut egui::Ui, render_state: &egui_wgpu::RenderState, scan: &mu
     let n = scan.views.len().max(1);
     let mut dragged = 0.0;
     let style = view.settings.atoms;
+    // While θ or the camera moves, draw with fewer slices (seed 001's dynamic level of detail);
+    // the full count returns with the first frame after the interaction.
+    let interacting = scan.playing || ui.input(|i| i.pointer.any_down());
+    let full_slices = view.settings.volume.slices;
+    if interacting {
+        view.settings.volume.slices = full_slices.min(INTERACTIVE_SLICES);
+    }
     ui.columns(n, |columns| {
         for (slot, (ui, vp)) in columns.iter_mut().zip(scan.views.iter_mut()).enumerate() {
             if vp.scan_shown != Some((scan.theta, scan.mode)) {
@@ -316,6 +326,7 @@ pub fn views(ui: &mut egui::Ui, render_state: &egui_wgpu::RenderState, scan: &mu
             dragged += vp.show_twistable(ui, render_state, view, Some(twist));
         }
     });
+    view.settings.volume.slices = full_slices;
     if dragged != 0.0 {
         scan.set_theta(scan.theta + dragged as f64 * (hi - lo));
         ui.ctx().request_repaint();
