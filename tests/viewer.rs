@@ -161,6 +161,21 @@ fn the_scan_demo_opens_side_by_side_and_a_drag_twists_both_views() {
     h.run_steps(2);
     let scan = h.state().scan.as_ref().unwrap();
     assert!(scan.shown().iter().all(|s| s.map(|(_, m)| m) == Some(orbcloud::scene::Interpolation::ThreePass)));
+
+    // Following orbitals by character makes the key volumes anew and keeps θ and the mode.
+    h.get_by_label("follow character").click();
+    h.run_steps(1);
+    let start = std::time::Instant::now();
+    while h.state().scan.as_ref().is_none_or(|s| s.scene.tracks.follow != orbcloud::model::scan::Follow::Overlap) {
+        assert!(h.state().error.is_none(), "{:?}", h.state().error);
+        assert!(start.elapsed().as_secs() < 300, "the scan was not reopened");
+        std::thread::sleep(std::time::Duration::from_millis(100));
+        h.run_steps(1);
+    }
+    h.run_steps(2);
+    let scan = h.state().scan.as_ref().unwrap();
+    assert_eq!(scan.theta, theta);
+    assert_eq!(scan.mode, orbcloud::scene::Interpolation::ThreePass);
 }
 
 #[test]

@@ -138,8 +138,19 @@ impl OrbApp {
         self.job = Some(LoadJob::start(path, move || ctx.request_repaint()));
     }
 
-    /// Loads a scan and makes its key volumes in the background.
+    /// Loads a scan and makes its key volumes in the background, following orbitals as its
+    /// manifest says.
     pub fn open_scan(&mut self, source: ScanSource, ctx: &egui::Context) {
+        self.open_scan_following(source, None, ctx);
+    }
+
+    /// [`Self::open_scan`], following orbitals by `follow` when given.
+    pub fn open_scan_following(
+        &mut self,
+        source: ScanSource,
+        follow: Option<crate::model::scan::Follow>,
+        ctx: &egui::Context,
+    ) {
         let Some(gpu) = self.gpu_context() else { return };
         if let Some(job) = self.scan_job.take() {
             job.cancel();
@@ -150,7 +161,7 @@ impl OrbApp {
             budget: self.scan_budget,
             ..Default::default()
         };
-        self.scan_job = Some(ScanJob::start(gpu, source, options, move || ctx.request_repaint()));
+        self.scan_job = Some(ScanJob::start(gpu, source, options, follow, move || ctx.request_repaint()));
     }
 
     pub fn is_loading(&self) -> bool {
@@ -213,7 +224,10 @@ impl OrbApp {
                         (c.adapter.clone(), c.device.clone(), c.queue.clone())
                     });
                     if let Some((a, d, q)) = ctxs {
-                        self.view.camera = scene.camera();
+                        let reopened = self.scan.take().filter(|old| old.source == source);
+                        if reopened.is_none() {
+                            self.view.camera = scene.camera();
+                        }
                         self.status = format!(
                             "opened {name}: {} key volumes, {:.1} MiB of {:.0} MiB",
                             scene.slots() * scene.scan.frames.len(),
@@ -227,7 +241,11 @@ impl OrbApp {
                             );
                         }
                         let make = || GpuContext::from_parts(a.clone(), d.clone(), q.clone());
-                        self.scan = Some(ScanView::new(scene, &make));
+                        let mut view = ScanView::new(scene, source, &make);
+                        if let Some(old) = &reopened {
+                            view.keep_interaction_of(old);
+                        }
+                        self.scan = Some(view);
                     }
                 }
                 Err(ScanFailure::Cancelled) => self.status = format!("{name}: cancelled"),
@@ -344,8 +362,9 @@ impl eframe::App for OrbApp {
             panels::Action::None => {}
         }
         panels::error_window(ui, self);
-        if let Some(scan) = &mut self.scan {
-            scan::controls(ui, scan);
+        let refollow = self.scan.as_mut().and_then(|scan| scan::controls(ui, scan).map(|f| (scan.source.clone(), f)));
+        if let Some((source, follow)) = refollow {
+            self.open_scan_following(source, Some(follow), &ctx);
         }
         egui::CentralPanel::no_frame().show(ui, |ui| {
             let Some(rs) = frame.wgpu_render_state() else { return };

@@ -50,10 +50,12 @@ pub enum ScanFailure {
 }
 
 impl ScanJob {
+    /// `follow`: how orbitals are followed across frames; `None`: as the manifest says.
     pub fn start(
         ctx: GpuContext,
         source: ScanSource,
         options: KeyOptions,
+        follow: Option<Follow>,
         repaint: impl Fn() + Send + 'static,
     ) -> Self {
         let name = match &source {
@@ -72,10 +74,7 @@ impl ScanJob {
                     ScanSource::Demo => crate::demo::scan(),
                 }
                 .map_err(|e| ScanFailure::Other(e.to_string()))?;
-                let options = KeyOptions {
-                    follow: if options.follow == Follow::Index { file.follow } else { options.follow },
-                    ..options
-                };
+                let options = KeyOptions { follow: follow.unwrap_or(file.follow), ..options };
                 ScanScene::build(&ctx, file.scan, &options, &mut |n, of| {
                     d.store(n, Ordering::Relaxed);
                     t.store(of, Ordering::Relaxed);
@@ -123,11 +122,13 @@ pub struct ScanView {
     pub drag_twists: bool,
     direction: f64,
     pub(super) views: Vec<Viewport>,
+    /// Where the scan came from (to open it again, following orbitals another way).
+    pub source: ScanSource,
 }
 
 impl ScanView {
     /// One viewport per orbital of the scan, all on the window's device.
-    pub fn new(scene: ScanScene, make_context: &dyn Fn() -> GpuContext) -> Self {
+    pub fn new(scene: ScanScene, source: ScanSource, make_context: &dyn Fn() -> GpuContext) -> Self {
         let views = (0..scene.slots()).map(|_| Viewport::new(make_context())).collect();
         // Open where the picture says most: the key frame nearest the middle of the range.
         let (lo, hi) = scene.scan.range();
@@ -142,7 +143,18 @@ impl ScanView {
             drag_twists: true,
             direction: 1.0,
             views,
+            source,
         }
+    }
+
+    /// Takes θ and the interaction settings of the same scan opened before (reopened to follow
+    /// its orbitals another way).
+    pub fn keep_interaction_of(&mut self, old: &ScanView) {
+        self.set_theta(old.theta);
+        self.mode = old.mode;
+        self.looping = old.looping;
+        self.speed = old.speed;
+        self.drag_twists = old.drag_twists;
     }
 
     /// The θ and interpolation each view last drew (None before its first frame).
@@ -194,8 +206,10 @@ impl ScanView {
 /// Slices per view while the user drags or the animation plays.
 const INTERACTIVE_SLICES: u32 = 64;
 
-/// The bottom panel: θ slider with key ticks, play/loop, interpolation mode, energy plot.
-pub fn controls(ui: &mut egui::Ui, scan: &mut ScanView) {
+/// The bottom panel: θ slider with key ticks, play/loop, interpolation mode, how orbitals are
+/// followed, energy plot. Returns a change of the following, which needs the key volumes anew.
+pub fn controls(ui: &mut egui::Ui, scan: &mut ScanView) -> Option<Follow> {
+    let mut follow = None;
     egui::Panel::bottom("scan controls").resizable(true).default_size(190.0).show(ui, |ui| {
         let (lo, hi) = scan.scene.scan.range();
         ui.horizontal(|ui| {
@@ -221,11 +235,24 @@ pub fn controls(ui: &mut egui::Ui, scan: &mut ScanView) {
                 .on_hover_text("mix the two key volumes per sample");
             ui.radio_value(&mut scan.mode, Interpolation::ThreePass, "three-pass")
                 .on_hover_text("seed 000: attenuate, add (1−k)A, add kB per slice");
+            let mut by_overlap = scan.scene.tracks.follow == Follow::Overlap;
+            let swaps = scan.scene.tracks.swaps.len();
+            if ui
+                .checkbox(&mut by_overlap, "follow character")
+                .on_hover_text(format!(
+                    "follow each orbital by overlap with the previous frame instead of by name \
+                     ({swaps} character swap(s) in this scan)"
+                ))
+                .changed()
+            {
+                follow = Some(if by_overlap { Follow::Overlap } else { Follow::Index });
+            }
             ui.checkbox(&mut scan.drag_twists, "drag twists")
                 .on_hover_text("a horizontal drag changes θ (right-drag pans); off: drag the bond");
         });
         energy_plot(ui, scan);
     });
+    follow
 }
 
 /// Marks the key angles under the slider.
