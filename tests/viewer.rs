@@ -124,6 +124,19 @@ fn a_molden_file_opens_on_its_homo_and_the_browser_switches_orbitals() {
     assert!(h.state().error.is_none(), "{:?}", h.state().error);
 }
 
+/// Steps the app until a scan that satisfies `ready` is open (key volumes are made on a
+/// background thread), failing on an error or after five minutes.
+fn wait_for_scan(h: &mut Harness<'static, OrbApp>, ready: impl Fn(&orbcloud::app::scan::ScanView) -> bool) {
+    let start = std::time::Instant::now();
+    while !h.state().scan.as_ref().is_some_and(&ready) {
+        assert!(h.state().error.is_none(), "scan failed: {:?}", h.state().error);
+        assert!(start.elapsed().as_secs() < 300, "no scan after five minutes");
+        std::thread::sleep(std::time::Duration::from_millis(50));
+        h.run_steps(1);
+    }
+    h.run_steps(2);
+}
+
 #[test]
 fn the_scan_demo_opens_side_by_side_and_a_drag_twists_both_views() {
     let mut h = Harness::builder()
@@ -131,14 +144,7 @@ fn the_scan_demo_opens_side_by_side_and_a_drag_twists_both_views() {
         .wgpu_setup(wgpu_setup(true))
         .build_eframe(|cc| OrbApp::new(cc, Vec::new()));
     // The key volumes are made on a background thread.
-    let start = std::time::Instant::now();
-    while h.state().scan.is_none() {
-        assert!(h.state().error.is_none(), "scan failed: {:?}", h.state().error);
-        assert!(start.elapsed().as_secs() < 300, "the PSB3 key volumes did not finish");
-        std::thread::sleep(std::time::Duration::from_millis(100));
-        h.run_steps(1);
-    }
-    h.run_steps(2);
+    wait_for_scan(&mut h, |_| true);
     let scan = h.state().scan.as_ref().unwrap();
     assert_eq!(scan.theta, -90.0, "opens at the twisted geometry");
     assert_eq!(scan.shown().len(), 2, "HOMO and LUMO side by side");
@@ -165,14 +171,7 @@ fn the_scan_demo_opens_side_by_side_and_a_drag_twists_both_views() {
     // Following orbitals by character makes the key volumes anew and keeps θ and the mode.
     h.get_by_label("follow character").click();
     h.run_steps(1);
-    let start = std::time::Instant::now();
-    while h.state().scan.as_ref().is_none_or(|s| s.scene.tracks.follow != orbcloud::model::scan::Follow::Overlap) {
-        assert!(h.state().error.is_none(), "{:?}", h.state().error);
-        assert!(start.elapsed().as_secs() < 300, "the scan was not reopened");
-        std::thread::sleep(std::time::Duration::from_millis(100));
-        h.run_steps(1);
-    }
-    h.run_steps(2);
+    wait_for_scan(&mut h, |s| s.scene.tracks.follow == orbcloud::model::scan::Follow::Overlap);
     let scan = h.state().scan.as_ref().unwrap();
     assert_eq!(scan.theta, theta);
     assert_eq!(scan.mode, orbcloud::scene::Interpolation::ThreePass);
@@ -200,12 +199,7 @@ fn a_scan_too_large_for_the_gpu_offers_a_coarser_grid() {
     h.run_steps(2);
     h.get_by_label(&format!("Open with {fits} points")).click();
     h.run_steps(1);
-    while h.state().scan.is_none() {
-        assert!(h.state().error.is_none(), "{:?}", h.state().error);
-        assert!(start.elapsed().as_secs() < 240, "the coarser scan did not open");
-        std::thread::sleep(std::time::Duration::from_millis(50));
-        h.run_steps(1);
-    }
+    wait_for_scan(&mut h, |_| true);
     let scan = h.state().scan.as_ref().unwrap();
     assert!(scan.scene.bytes <= 1 << 20, "{} bytes", scan.scene.bytes);
 }
