@@ -219,11 +219,9 @@ impl OrbApp {
             self.scan_job = None;
             match result {
                 Ok(scene) => {
-                    let ctxs = self.viewport.as_ref().map(|v| {
-                        let c = &v.ctx;
-                        (c.adapter.clone(), c.device.clone(), c.queue.clone())
-                    });
-                    if let Some((a, d, q)) = ctxs {
+                    // One device handle per view.
+                    let contexts: Option<Vec<GpuContext>> = (0..scene.slots()).map(|_| self.gpu_context()).collect();
+                    if let Some(contexts) = contexts {
                         let reopened = self.scan.take().filter(|old| old.source == source);
                         if reopened.is_none() {
                             self.view.camera = scene.camera();
@@ -240,8 +238,7 @@ impl OrbApp {
                                 scene.tracks.swaps.len()
                             );
                         }
-                        let make = || GpuContext::from_parts(a.clone(), d.clone(), q.clone());
-                        let mut view = ScanView::new(scene, source, &make);
+                        let mut view = ScanView::new(scene, source, contexts);
                         if let Some(old) = &reopened {
                             view.keep_interaction_of(old);
                         }

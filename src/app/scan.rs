@@ -127,9 +127,9 @@ pub struct ScanView {
 }
 
 impl ScanView {
-    /// One viewport per orbital of the scan, all on the window's device.
-    pub fn new(scene: ScanScene, source: ScanSource, make_context: &dyn Fn() -> GpuContext) -> Self {
-        let views = (0..scene.slots()).map(|_| Viewport::new(make_context())).collect();
+    /// One viewport per orbital of the scan, each on its handle of the window's device.
+    pub fn new(scene: ScanScene, source: ScanSource, contexts: Vec<GpuContext>) -> Self {
+        let views = contexts.into_iter().map(Viewport::new).collect();
         // Open where the picture says most: the key frame nearest the middle of the range.
         let (lo, hi) = scene.scan.range();
         let theta = scene.scan.frames[scene.scan.nearest_frame(0.5 * (lo + hi))].angle;
@@ -210,7 +210,7 @@ const INTERACTIVE_SLICES: u32 = 64;
 /// followed, energy plot. Returns a change of the following, which needs the key volumes anew.
 pub fn controls(ui: &mut egui::Ui, scan: &mut ScanView) -> Option<Follow> {
     let mut follow = None;
-    egui::Panel::bottom("scan controls").resizable(true).default_size(190.0).show(ui, |ui| {
+    egui::Panel::bottom("scan controls").resizable(true).default_size(215.0).show(ui, |ui| {
         let (lo, hi) = scan.scene.scan.range();
         ui.horizontal(|ui| {
             let play = if scan.playing { "Pause" } else { "Play" };
@@ -222,7 +222,8 @@ pub fn controls(ui: &mut egui::Ui, scan: &mut ScanView) -> Option<Follow> {
                 .on_hover_text("animation speed");
             ui.separator();
             ui.label("θ");
-            let width = (ui.available_width() - 420.0).max(160.0);
+            // Room for the value box and the slider's label after the rail.
+            let width = (ui.available_width() - 150.0).max(160.0);
             ui.spacing_mut().slider_width = width;
             let mut theta = scan.theta;
             let slider = ui.add(egui::Slider::new(&mut theta, lo..=hi).suffix("°").fixed_decimals(1).text("dihedral"));
@@ -230,7 +231,8 @@ pub fn controls(ui: &mut egui::Ui, scan: &mut ScanView) -> Option<Follow> {
                 scan.set_theta(theta);
             }
             key_ticks(ui, slider.rect, scan, width);
-            ui.separator();
+        });
+        ui.horizontal(|ui| {
             ui.radio_value(&mut scan.mode, Interpolation::Exact, "exact")
                 .on_hover_text("mix the two key volumes per sample");
             ui.radio_value(&mut scan.mode, Interpolation::ThreePass, "three-pass")
@@ -329,7 +331,9 @@ pub fn views(ui: &mut egui::Ui, render_state: &egui_wgpu::RenderState, scan: &mu
         scan.advance(dt.min(0.1));
         ui.ctx().request_repaint();
     }
-    let twist = TwistInput { drag_twists: scan.drag_twists, bond: Some(scan.bond()) };
+    // The bond's position matters only where a press may start a drag that grabs it.
+    let grab = !scan.drag_twists && ui.input(|i| i.pointer.primary_down());
+    let twist = TwistInput { drag_twists: scan.drag_twists, bond: grab.then(|| scan.bond()) };
     let (lo, hi) = scan.scene.scan.range();
     let n = scan.views.len().max(1);
     let mut dragged = 0.0;

@@ -11,6 +11,7 @@ use orbcloud::gpu::volume::{VolumeTexture, residency_budget, texel_bytes};
 use orbcloud::gpu::{GpuContext, OffscreenTarget, Renderer};
 use orbcloud::headless::scan::{DEFAULT_SCAN_POINTS, KeyOptions, ScanScene};
 use orbcloud::model::VolumeGrid;
+use orbcloud::model::scan::Scan;
 use orbcloud::scene::Interpolation;
 
 use super::{ViewArgs, gpu};
@@ -155,13 +156,8 @@ fn build(ctx: &GpuContext, path: &Path, keys: &KeyArgs) -> Result<ScanScene> {
     Ok(scene)
 }
 
-fn slot_of(scene: &ScanScene, name: &str) -> Result<usize> {
-    scene
-        .scan
-        .orbitals
-        .iter()
-        .position(|o| o.eq_ignore_ascii_case(name))
-        .with_context(|| format!("the scan shows {:?}, not {name:?}", scene.scan.orbitals))
+fn slot_of(scan: &Scan, name: &str) -> Result<usize> {
+    scan.slot(name).with_context(|| format!("the scan shows {:?}, not {name:?}", scan.orbitals))
 }
 
 pub fn run(command: ScanCommand) -> Result<()> {
@@ -231,7 +227,7 @@ pub fn run(command: ScanCommand) -> Result<()> {
             let ctx = gpu(args.lavapipe)?;
             let scene = build(&ctx, &args.scan, &args.keys)?;
             let slots: Vec<usize> = match &args.orbital {
-                Some(name) => vec![slot_of(&scene, name)?],
+                Some(name) => vec![slot_of(&scene.scan, name)?],
                 None => (0..scene.slots()).collect(),
             };
             let settings = args.view.settings();
@@ -258,20 +254,15 @@ pub fn run(command: ScanCommand) -> Result<()> {
             let file = load_scan(&scan)?;
             let follow = follow_of(keys.follow, &file);
             let s = &file.scan;
-            let slot = s
-                .orbitals
-                .iter()
-                .position(|o| o.eq_ignore_ascii_case(&orbital))
-                .with_context(|| format!("the scan shows {:?}, not {orbital:?}", s.orbitals))?;
+            let slot = slot_of(s, &orbital)?;
             let (lo, hi) = s.range();
             if !(lo..=hi).contains(&angle) {
                 bail!("--angle {angle} is outside the scan's {lo}°..{hi}°");
             }
             let tracks = s.track(follow)?;
             let grid = s.common_grid(orbcloud::headless::ORBITAL_MARGIN, keys.points.clamp(8, 512));
-            let values = s.interpolated_values(&tracks, slot, angle, &grid);
             let label = format!("{orbital} at {angle} deg (interpolated)");
-            let volume = VolumeGrid::new(&label, grid.dims, grid.world_from_grid, values);
+            let volume = s.interpolated_grid(&tracks, slot, angle, &grid, &label);
             let molecule = s.geometry_at(angle);
             let title = format!("{}: {label}", s.title);
             std::fs::write(&output, cube_write::write(&title, &label, &molecule, &[(&volume, 0)]))
@@ -332,14 +323,7 @@ pub fn bench_keyvolumes(args: KeyVolumeBench) -> Result<()> {
         budget / per_volume
     );
     let settings = orbcloud::scene::RenderSettings::default();
-    let (lo, hi) = (
-        grid.world_from_grid.w_axis.truncate(),
-        grid.world_from_grid.transform_point3(glam::DVec3::new(
-            grid.dims[0] as f64 - 1.0,
-            grid.dims[1] as f64 - 1.0,
-            grid.dims[2] as f64 - 1.0,
-        )),
-    );
+    let (lo, hi) = grid.bounds();
     let camera = orbcloud::scene::Camera::framing(lo.as_vec3(), hi.as_vec3());
     let molecule = s.geometry_at(s.frames[0].angle);
     let target = OffscreenTarget::new(&ctx.device, args.size);

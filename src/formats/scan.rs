@@ -209,8 +209,7 @@ pub fn parse_scan(
         .map_err(|e| error(&name, dihedral_line, "a dihedral about a bond that can turn", e.to_string()))?;
     scan.captions = manifest.captions;
     // Resolving the orbitals of every frame reports a missing one before anything is evaluated.
-    scan.track(crate::model::scan::Follow::Index)
-        .map_err(|e| error(&name, 1, "the orbitals the manifest names", e.to_string()))?;
+    scan.check_orbitals().map_err(|e| error(&name, 1, "the orbitals the manifest names", e.to_string()))?;
     Ok(ScanFile { scan, follow: manifest.follow })
 }
 

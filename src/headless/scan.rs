@@ -9,12 +9,10 @@ use crate::gpu::gto::{GtoFillPass, read_volume};
 use crate::gpu::volume::{VolumeTexture, residency_budget, texel_bytes};
 use crate::gpu::{FrameInput, GpuContext, GpuError, OffscreenTarget, Renderer};
 use crate::model::cartesian::CartesianExpansion;
-use crate::model::grid::ValueKind;
 use crate::model::scan::{Bracket, Follow, Scan, ScanError, ScanGrid, Tracks};
 use crate::model::units::EV_PER_HARTREE;
 use crate::model::{PreparedBasis, VolumeGrid};
 use crate::scene::{AtomStyle, Camera, Interpolation, RenderSettings};
-use glam::DVec3;
 
 /// Points along the longest side of the common grid unless asked otherwise.
 pub const DEFAULT_SCAN_POINTS: usize = 64;
@@ -128,16 +126,16 @@ impl ScanScene {
         let mut scale = Vec::with_capacity(slots);
         for slot_grids in &grids {
             let max_abs = slot_grids.iter().map(|g| g.stats.max_abs).fold(1e-30, f64::max);
-            let max_grad = slot_grids.iter().map(|g| g.max_gradient()).fold(1e-30, f64::max);
             // One box for the whole sweep: the union of where each frame's cloud is visible.
             let mut textures: Vec<VolumeTexture> = Vec::with_capacity(slot_grids.len());
             for g in slot_grids {
                 textures.push(VolumeTexture::upload_as(ctx, g, options.format)?);
             }
             let union = textures.iter().map(|t| t.grid_box).reduce(|a, b| a.union(&b));
+            let max_grad = textures.iter().map(|t| t.max_grad).fold(1e-30, f32::max);
             for t in &mut textures {
                 t.max_abs = max_abs as f32;
-                t.max_grad = max_grad as f32;
+                t.max_grad = max_grad;
                 if let Some(u) = union {
                     t.grid_box = u;
                 }
@@ -171,10 +169,8 @@ impl ScanScene {
 
     /// A camera framing the common grid from the default direction.
     pub fn camera(&self) -> Camera {
-        let g = &self.grid;
-        let far = DVec3::new(g.dims[0] as f64 - 1.0, g.dims[1] as f64 - 1.0, g.dims[2] as f64 - 1.0);
-        let (a, b) = (g.world_from_grid.w_axis.truncate(), g.world_from_grid.transform_point3(far));
-        Camera::framing(a.min(b).as_vec3(), a.max(b).as_vec3())
+        let (lo, hi) = self.grid.bounds();
+        Camera::framing(lo.as_vec3(), hi.as_vec3())
     }
 
     /// Renders `slots` at θ side by side (left to right), each `size`, into one image.
@@ -223,14 +219,7 @@ impl ScanScene {
 
     /// The exactly interpolated volume of a slot at θ, evaluated on the CPU (for export).
     pub fn interpolated_grid(&self, slot: usize, theta: f64) -> VolumeGrid {
-        let values = self.scan.interpolated_values(&self.tracks, slot, theta, &self.grid);
-        let mut g = VolumeGrid::new(
-            format!("{} at {theta}° (interpolated)", self.scan.orbitals[slot]),
-            self.grid.dims,
-            self.grid.world_from_grid,
-            values,
-        );
-        g.kind = ValueKind::Signed;
-        g
+        let label = format!("{} at {theta}° (interpolated)", self.scan.orbitals[slot]);
+        self.scan.interpolated_grid(&self.tracks, slot, theta, &self.grid, label)
     }
 }

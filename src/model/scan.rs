@@ -398,6 +398,17 @@ impl Scan {
         Ok(Tracks { points, swaps, follow })
     }
 
+    /// Checks that every frame has every slot's orbital, without computing any overlap.
+    pub fn check_orbitals(&self) -> Result<(), ScanError> {
+        for (slot, name) in self.orbitals.iter().enumerate() {
+            let spec: Option<OrbitalSpec> = name.parse().ok();
+            for frame in &self.frames {
+                self.named_orbital(frame, slot, spec)?;
+            }
+        }
+        Ok(())
+    }
+
     /// A slot's orbital by name in one frame.
     fn named_orbital(&self, frame: &KeyFrame, slot: usize, spec: Option<OrbitalSpec>) -> Result<usize, ScanError> {
         match (&frame.content, frame.wavefunction(slot)) {
@@ -473,6 +484,13 @@ impl ScanGrid {
         self.dims.iter().product()
     }
 
+    /// The corners of the (axis-aligned) grid box: lowest and highest point, bohr.
+    pub fn bounds(&self) -> (DVec3, DVec3) {
+        let far = DVec3::new(self.dims[0] as f64 - 1.0, self.dims[1] as f64 - 1.0, self.dims[2] as f64 - 1.0);
+        let (a, b) = (self.world_from_grid.w_axis.truncate(), self.world_from_grid.transform_point3(far));
+        (a.min(b), a.max(b))
+    }
+
     pub fn is_empty(&self) -> bool {
         self.len() == 0
     }
@@ -532,6 +550,26 @@ impl Scan {
         let (va, vb) = (self.key_values(tracks, slot, a, grid), self.key_values(tracks, slot, b, grid));
         let (wa, wb) = ((1.0 - k) as f32, k as f32);
         va.iter().zip(&vb).map(|(&x, &y)| wa * x + wb * y).collect()
+    }
+
+    /// [`Self::interpolated_values`] as a grid named `label`.
+    pub fn interpolated_grid(
+        &self,
+        tracks: &Tracks,
+        slot: usize,
+        theta: f64,
+        grid: &ScanGrid,
+        label: impl Into<String>,
+    ) -> VolumeGrid {
+        let values = self.interpolated_values(tracks, slot, theta, grid);
+        let mut g = VolumeGrid::new(label, grid.dims, grid.world_from_grid, values);
+        g.kind = super::grid::ValueKind::Signed;
+        g
+    }
+
+    /// The slot showing the orbital named `name` (as the manifest names it, any case).
+    pub fn slot(&self, name: &str) -> Option<usize> {
+        self.orbitals.iter().position(|o| o.eq_ignore_ascii_case(name))
     }
 
     /// A slot's orbital energy at θ (Eh), interpolated linearly between the key frames.
