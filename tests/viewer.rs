@@ -15,17 +15,37 @@ fn harness() -> Harness<'static, OrbApp> {
     h
 }
 
-/// A primary-button drag `dx` points to the right from `from`, in five moves.
-fn drag_right(h: &mut Harness<'static, OrbApp>, from: egui::Pos2, dx: f32) {
+/// A primary-button drag `dx` points to the right from `from`, in five moves; returns the
+/// views' (size on screen, size drawn) in the middle of the drag.
+fn drag_right(h: &mut Harness<'static, OrbApp>, from: egui::Pos2, dx: f32) -> Vec<([u32; 2], [u32; 2])> {
     h.hover_at(from);
     h.drag_at(from);
     h.run_steps(1);
+    let mut during = Vec::new();
     for i in 1..=5 {
         h.hover_at(from + egui::vec2(dx * i as f32 / 5.0, 0.0));
         h.run_steps(1);
+        if i == 3 {
+            during = h.state().view_sizes();
+        }
     }
     h.drop_at(from + egui::vec2(dx, 0.0));
     h.run_steps(1);
+    during
+}
+
+/// Lavapipe is a CPU adapter: while a drag runs every view draws fewer pixels (together at most
+/// `CPU_INTERACTIVE_PIXELS`); the first frame after it draws every pixel again.
+fn assert_drag_detail(h: &mut Harness<'static, OrbApp>, during: &[([u32; 2], [u32; 2])], views: usize) {
+    use orbcloud::app::detail::CPU_INTERACTIVE_PIXELS;
+    assert_eq!(during.len(), views, "{during:?}");
+    let drawn: u32 = during.iter().map(|(_, d)| d[0] * d[1]).sum();
+    assert!(drawn <= CPU_INTERACTIVE_PIXELS, "{drawn} pixels drawn during the drag: {during:?}");
+    assert!(during.iter().all(|(s, d)| d[0] < s[0] && d[1] < s[1]), "{during:?}");
+    h.run_steps(1);
+    let after = h.state().view_sizes();
+    assert_eq!(after.len(), views);
+    assert!(after.iter().all(|(s, d)| s == d), "full size after the drag: {after:?}");
 }
 
 #[test]
@@ -57,9 +77,10 @@ fn dragging_the_view_orbits_the_camera() {
     let mut h = harness();
     h.run_steps(2);
     let yaw = h.state().view.camera.yaw;
-    drag_right(&mut h, egui::pos2(650.0, 350.0), 100.0);
+    let during = drag_right(&mut h, egui::pos2(650.0, 350.0), 100.0);
     let moved = h.state().view.camera.yaw;
     assert!((moved - yaw).abs() > 0.3, "yaw {yaw} -> {moved}");
+    assert_drag_detail(&mut h, &during, 1);
 }
 
 #[test]
@@ -153,8 +174,9 @@ fn the_scan_demo_opens_side_by_side_and_a_drag_twists_both_views() {
     assert!(h.query_all_by_label("dihedral").count() >= 1, "the θ slider");
 
     // Seed 000: a horizontal drag across the (left) view turns the bond.
-    drag_right(&mut h, egui::pos2(500.0, 260.0), 90.0);
-    h.run_steps(2);
+    let during = drag_right(&mut h, egui::pos2(500.0, 260.0), 90.0);
+    assert_drag_detail(&mut h, &during, 2);
+    h.run_steps(1);
     let scan = h.state().scan.as_ref().unwrap();
     let theta = scan.theta;
     assert!(theta > -85.0, "θ after dragging right: {theta}");

@@ -1,5 +1,6 @@
 //! The eframe viewer: the only module that uses egui and rfd.
 
+pub mod detail;
 mod loader;
 mod orbitals;
 mod panels;
@@ -119,6 +120,16 @@ impl OrbApp {
             app.error = Some("no wgpu render state: the viewer needs eframe's wgpu backend".into());
         }
         app
+    }
+
+    /// Each view shown: (size on screen, size of its last frame), pixels. The frame is smaller
+    /// while a drag or the animation runs on a CPU adapter ([`detail`]).
+    pub fn view_sizes(&self) -> Vec<([u32; 2], [u32; 2])> {
+        let views: Vec<&Viewport> = match &self.scan {
+            Some(scan) => scan.views.iter().collect(),
+            None => self.viewport.iter().collect(),
+        };
+        views.into_iter().filter_map(|v| v.size().zip(v.rendered_size())).collect()
     }
 
     /// A new handle on the window's device (for scan views and the key-volume job).
@@ -367,7 +378,11 @@ impl eframe::App for OrbApp {
             let Some(rs) = frame.wgpu_render_state() else { return };
             match (&mut self.scan, &mut self.viewport) {
                 (Some(scan), _) => scan::views(ui, rs, scan, &mut self.view),
-                (None, Some(vp)) => vp.show(ui, rs, &mut self.view),
+                (None, Some(vp)) => {
+                    vp.detail =
+                        detail::Detail::for_frame(detail::interacting(ui.ctx(), false), vp.ctx.info.device_type, 1);
+                    vp.show(ui, rs, &mut self.view)
+                }
                 (None, None) => {}
             }
         });

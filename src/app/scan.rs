@@ -9,6 +9,7 @@ use std::sync::mpsc::{Receiver, channel};
 use egui::{Key, RichText};
 use egui_plot::{Legend, Line, Plot, VLine};
 
+use super::detail::{Detail, interacting};
 use super::state::ViewState;
 use super::viewport::{TwistInput, Viewport};
 use crate::formats::scan::{ScanFile, load_scan};
@@ -203,9 +204,6 @@ impl ScanView {
     }
 }
 
-/// Slices per view while the user drags or the animation plays.
-const INTERACTIVE_SLICES: u32 = 64;
-
 /// The bottom panel: θ slider with key ticks, play/loop, interpolation mode, how orbitals are
 /// followed, energy plot. Returns a change of the following, which needs the key volumes anew.
 pub fn controls(ui: &mut egui::Ui, scan: &mut ScanView) -> Option<Follow> {
@@ -338,13 +336,7 @@ pub fn views(ui: &mut egui::Ui, render_state: &egui_wgpu::RenderState, scan: &mu
     let n = scan.views.len().max(1);
     let mut dragged = 0.0;
     let style = view.settings.atoms;
-    // While θ or the camera moves, draw with fewer slices (seed 001's dynamic level of detail);
-    // the full count returns with the first frame after the interaction.
-    let interacting = scan.playing || ui.input(|i| i.pointer.any_down());
-    let full_slices = view.settings.volume.slices;
-    if interacting {
-        view.settings.volume.slices = full_slices.min(INTERACTIVE_SLICES);
-    }
+    let interacting = interacting(ui.ctx(), scan.playing);
     ui.columns(n, |columns| {
         for (slot, (ui, vp)) in columns.iter_mut().zip(scan.views.iter_mut()).enumerate() {
             if vp.scan_shown != Some((scan.theta, scan.mode)) {
@@ -354,10 +346,10 @@ pub fn views(ui: &mut egui::Ui, render_state: &egui_wgpu::RenderState, scan: &mu
                 ui.strong(scan.scene.label(slot, scan.theta));
                 ui.label(RichText::new(format!("θ = {:.1}°", scan.theta)).weak());
             });
+            vp.detail = Detail::for_frame(interacting, vp.ctx.info.device_type, n);
             dragged += vp.show_twistable(ui, render_state, view, Some(twist));
         }
     });
-    view.settings.volume.slices = full_slices;
     if dragged != 0.0 {
         scan.set_theta(scan.theta + dragged as f64 * (hi - lo));
         ui.ctx().request_repaint();

@@ -3,6 +3,7 @@
 
 use egui::{Key, PointerButton, Sense};
 
+use super::detail::Detail;
 use super::state::{DRAG_ROTATE, KEY_ROTATE, KEY_ZOOM, ViewState};
 use crate::gpu::gto::GtoFillPass;
 use crate::gpu::{FrameInput, GpuContext, GpuError, OffscreenTarget, Renderer};
@@ -27,6 +28,10 @@ pub struct Viewport {
     renderer: Renderer,
     fill: Option<GtoFillPass>,
     target: Option<(OffscreenTarget, egui::TextureId)>,
+    /// The view's size on screen, pixels (the target may be smaller while interacting).
+    shown_size: Option<[u32; 2]>,
+    /// What the next frames draw: set each frame by the caller.
+    pub detail: Detail,
     /// The state the texture currently shows; a frame is drawn only when this changes.
     drawn: Option<(ViewState, [u32; 2], u64)>,
     /// Bumped whenever the renderer's data changes.
@@ -40,7 +45,18 @@ pub struct Viewport {
 impl Viewport {
     pub fn new(ctx: GpuContext) -> Self {
         let renderer = Renderer::new(&ctx);
-        Self { ctx, renderer, fill: None, target: None, drawn: None, generation: 0, twisting: false, scan_shown: None }
+        Self {
+            ctx,
+            renderer,
+            fill: None,
+            target: None,
+            shown_size: None,
+            detail: Detail::FULL,
+            drawn: None,
+            generation: 0,
+            twisting: false,
+            scan_shown: None,
+        }
     }
 
     /// Uploads a document's molecule and chosen volume.
@@ -126,6 +142,9 @@ impl Viewport {
         if !self.twisting {
             handle_input(ui, &response, view);
         }
+        self.shown_size = Some(size);
+        let drawn = ViewState { settings: self.detail.apply(view.settings), ..*view };
+        let size = self.detail.render_size(size);
         if self.target.as_ref().is_none_or(|(t, _)| t.size != size) {
             let target = OffscreenTarget::new(&self.ctx.device, size);
             let mut egui_renderer = render_state.renderer.write();
@@ -148,12 +167,12 @@ impl Viewport {
             self.target = Some((target, id));
             self.drawn = None;
         }
-        let key = (*view, size, self.generation);
+        let key = (drawn, size, self.generation);
         if let Some((target, id)) = &self.target {
             if self.drawn != Some(key) {
                 let mut encoder =
                     self.ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("viewport") });
-                let frame = FrameInput { camera: &view.camera, settings: &view.settings, size };
+                let frame = FrameInput { camera: &drawn.camera, settings: &drawn.settings, size };
                 self.renderer.render(&self.ctx, &mut encoder, &target.color_view, &frame);
                 self.ctx.queue.submit([encoder.finish()]);
                 self.drawn = Some(key);
@@ -177,7 +196,14 @@ impl Viewport {
         target.read_rgba(&self.ctx.device, &self.ctx.queue)
     }
 
+    /// The view's size on screen, pixels.
     pub fn size(&self) -> Option<[u32; 2]> {
+        self.shown_size
+    }
+
+    /// The size of the last frame drawn (smaller than [`Self::size`] while interacting on a CPU
+    /// adapter).
+    pub fn rendered_size(&self) -> Option<[u32; 2]> {
         self.target.as_ref().map(|(t, _)| t.size)
     }
 }

@@ -290,6 +290,9 @@ pub struct KeyVolumeBench {
     frames: usize,
     #[arg(long, default_value = "400x300", value_parser = super::parse_size)]
     size: [u32; 2],
+    /// View-aligned slices per frame (the viewer draws 64 at most while θ is dragged).
+    #[arg(long, default_value_t = orbcloud::scene::RenderSettings::default().volume.slices)]
+    slices: u32,
     #[arg(long)]
     lavapipe: bool,
 }
@@ -322,7 +325,8 @@ pub fn bench_keyvolumes(args: KeyVolumeBench) -> Result<()> {
         ctx.device.limits().max_buffer_size >> 20,
         budget / per_volume
     );
-    let settings = orbcloud::scene::RenderSettings::default();
+    let mut settings = orbcloud::scene::RenderSettings::default();
+    settings.volume.slices = args.slices.clamp(1, 4096);
     let (lo, hi) = grid.bounds();
     let camera = orbcloud::scene::Camera::framing(lo.as_vec3(), hi.as_vec3());
     let molecule = s.geometry_at(s.frames[0].angle);
