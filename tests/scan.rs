@@ -341,6 +341,23 @@ fn manifest_errors_name_the_file_and_line() {
     );
     let e = load_err(&p);
     assert!(e.contains("lumo+30"), "{e}");
+
+    // A frame file that is missing or broken: the manifest's line, then the file's own error.
+    let p = write(
+        dir.path(),
+        "gone.scan.toml",
+        "dihedral = [2, 3, 4, 5]\n[[frame]]\nangle = -180\nfile = \"psb3_m180.molden.gz\"\n[[frame]]\nangle = -150\nfile = \"nope.molden\"\n",
+    );
+    let e = load_err(&p);
+    assert!(e.contains("gone.scan.toml:5") && e.contains("nope.molden"), "{e}");
+    write(dir.path(), "broken.molden", "[Molden Format]\n[Atoms] AU\nC 1 6 0.0 zero 0.0\n");
+    let p = write(
+        dir.path(),
+        "broken.scan.toml",
+        "dihedral = [2, 3, 4, 5]\n[[frame]]\nangle = -180\nfile = \"psb3_m180.molden.gz\"\n[[frame]]\nangle = -150\nfile = \"broken.molden\"\n",
+    );
+    let e = load_err(&p);
+    assert!(e.contains("broken.scan.toml:5") && e.contains("broken.molden:3"), "{e}");
 }
 
 #[test]

@@ -23,4 +23,7 @@ pub enum LoadError {
     UnknownFormat { path: String },
     #[error(transparent)]
     Parse(#[from] ParseError),
+    /// A file named by a manifest failed to load: the manifest's line comes first.
+    #[error("{manifest}:{line}: {inner}")]
+    Named { manifest: String, line: usize, inner: Box<LoadError> },
 }

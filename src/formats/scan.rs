@@ -120,6 +120,7 @@ pub fn parse_scan(
     for spanned in &manifest.frames {
         let line = line_of(text, spanned.span().start);
         let entry = spanned.get_ref();
+        let named = |e| LoadError::Named { manifest: name.clone(), line, inner: Box::new(e) };
         if !entry.angle.is_finite() {
             return Err(error(&name, line, "a finite angle in degrees", entry.angle.to_string()).into());
         }
@@ -140,7 +141,7 @@ pub fn parse_scan(
                 let mut molecule: Option<Molecule> = None;
                 let mut wavefunctions = Vec::with_capacity(files.len());
                 for file in files {
-                    let doc = load(&dir.join(file))?;
+                    let doc = load(&dir.join(file)).map_err(named)?;
                     let Some(wf) = doc.wavefunction else {
                         return Err(error(&name, line, "a Molden or fchk file with orbitals", file.clone()).into());
                     };
@@ -158,7 +159,7 @@ pub fn parse_scan(
                 let mut molecule = None;
                 let mut volumes = Vec::new();
                 for cube in cubes {
-                    let doc = load(&dir.join(cube))?;
+                    let doc = load(&dir.join(cube)).map_err(named)?;
                     molecule.get_or_insert(doc.molecule);
                     volumes.extend(doc.volumes);
                 }
