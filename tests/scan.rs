@@ -290,6 +290,18 @@ fn load_err(path: &Path) -> String {
     }
 }
 
+/// A manifest of the −180° PSB3 frame and `file` at `angle`.
+fn two_frames(dihedral: &str, angle: i32, file: &str) -> String {
+    format!(
+        "dihedral = {dihedral}\n[[frame]]\nangle = -180\nfile = \"psb3_m180.molden.gz\"\n[[frame]]\nangle = {angle}\nfile = \"{file}\"\n"
+    )
+}
+
+/// Writes a manifest into `dir` and returns the error loading it gives.
+fn manifest_err(dir: &Path, name: &str, text: &str) -> String {
+    load_err(&write(dir, name, text))
+}
+
 #[test]
 fn manifest_errors_name_the_file_and_line() {
     let dir = tempfile::tempdir().unwrap();
@@ -303,60 +315,37 @@ fn manifest_errors_name_the_file_and_line() {
         .expect("a water Molden fixture");
     std::fs::copy(&water, dir.path().join("water.molden")).unwrap();
 
-    let p = write(
+    let e = manifest_err(
         dir.path(),
         "dup.scan.toml",
         "dihedral = [2, 3, 4, 5]\n[[frame]]\nangle = -180\nfile = \"psb3_m180.molden.gz\"\n\n[[frame]]\nangle = -180.0\nfile = \"psb3_m150.molden.gz\"\n",
     );
-    let e = load_err(&p);
     assert!(e.contains("dup.scan.toml:6") && e.contains("different from the frame on line 2"), "{e}");
 
-    let p = write(
-        dir.path(),
-        "atoms.scan.toml",
-        "dihedral = [2, 3, 4, 5]\n[[frame]]\nangle = -180\nfile = \"psb3_m180.molden.gz\"\n[[frame]]\nangle = -90\nfile = \"water.molden\"\n",
-    );
-    let e = load_err(&p);
+    let e = manifest_err(dir.path(), "atoms.scan.toml", &two_frames("[2, 3, 4, 5]", -90, "water.molden"));
     assert!(
         e.contains("atoms.scan.toml:5") && e.contains("water.molden") && e.contains("the atoms of the first frame"),
         "{e}"
     );
 
-    let p = write(dir.path(), "bad.scan.toml", "dihedral = [2, 3, 4]\n");
-    let e = load_err(&p);
+    let e = manifest_err(dir.path(), "bad.scan.toml", "dihedral = [2, 3, 4]\n");
     assert!(e.contains("bad.scan.toml:1"), "{e}");
 
-    let p = write(
-        dir.path(),
-        "ring.scan.toml",
-        "dihedral = [2, 3, 40, 5]\n[[frame]]\nangle = -180\nfile = \"psb3_m180.molden.gz\"\n[[frame]]\nangle = -150\nfile = \"psb3_m150.molden.gz\"\n",
-    );
-    let e = load_err(&p);
+    let e = manifest_err(dir.path(), "ring.scan.toml", &two_frames("[2, 3, 40, 5]", -150, "psb3_m150.molden.gz"));
     assert!(e.contains("ring.scan.toml:1") && e.contains("atom 40"), "{e}");
 
-    let p = write(
+    let e = manifest_err(
         dir.path(),
         "orb.scan.toml",
-        "dihedral = [2, 3, 4, 5]\norbitals = [\"lumo+30\"]\n[[frame]]\nangle = -180\nfile = \"psb3_m180.molden.gz\"\n[[frame]]\nangle = -150\nfile = \"psb3_m150.molden.gz\"\n",
+        &format!("orbitals = [\"lumo+30\"]\n{}", two_frames("[2, 3, 4, 5]", -150, "psb3_m150.molden.gz")),
     );
-    let e = load_err(&p);
     assert!(e.contains("lumo+30"), "{e}");
 
     // A frame file that is missing or broken: the manifest's line, then the file's own error.
-    let p = write(
-        dir.path(),
-        "gone.scan.toml",
-        "dihedral = [2, 3, 4, 5]\n[[frame]]\nangle = -180\nfile = \"psb3_m180.molden.gz\"\n[[frame]]\nangle = -150\nfile = \"nope.molden\"\n",
-    );
-    let e = load_err(&p);
+    let e = manifest_err(dir.path(), "gone.scan.toml", &two_frames("[2, 3, 4, 5]", -150, "nope.molden"));
     assert!(e.contains("gone.scan.toml:5") && e.contains("nope.molden"), "{e}");
     write(dir.path(), "broken.molden", "[Molden Format]\n[Atoms] AU\nC 1 6 0.0 zero 0.0\n");
-    let p = write(
-        dir.path(),
-        "broken.scan.toml",
-        "dihedral = [2, 3, 4, 5]\n[[frame]]\nangle = -180\nfile = \"psb3_m180.molden.gz\"\n[[frame]]\nangle = -150\nfile = \"broken.molden\"\n",
-    );
-    let e = load_err(&p);
+    let e = manifest_err(dir.path(), "broken.scan.toml", &two_frames("[2, 3, 4, 5]", -150, "broken.molden"));
     assert!(e.contains("broken.scan.toml:5") && e.contains("broken.molden:3"), "{e}");
 }
 
