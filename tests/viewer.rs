@@ -197,6 +197,23 @@ fn the_scan_demo_opens_side_by_side_and_a_drag_twists_both_views() {
     let scan = h.state().scan.as_ref().unwrap();
     assert_eq!(scan.theta, theta);
     assert_eq!(scan.mode, orbcloud::scene::Interpolation::ThreePass);
+
+    // A manifest with one frame says where it is wrong, and the open scan stays.
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad.scan.toml");
+    std::fs::write(&bad, "dihedral = [2, 3, 4, 5]\n[[frame]]\nangle = 0\nfile = \"a.molden\"\n").unwrap();
+    let ctx = h.ctx.clone();
+    h.state_mut().open(bad, &ctx);
+    let start = std::time::Instant::now();
+    while h.state().error.is_none() {
+        assert!(start.elapsed().as_secs() < 60, "no error for the bad manifest");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+        h.run_steps(1);
+    }
+    let app = h.state();
+    let err = app.error.as_deref().unwrap();
+    assert!(err.contains("bad.scan.toml:"), "{err}");
+    assert_eq!(app.scan.as_ref().map(|s| s.theta), Some(theta), "the scan stays open");
 }
 
 #[test]
