@@ -158,6 +158,19 @@ fn wait_for_scan(h: &mut Harness<'static, OrbApp>, ready: impl Fn(&orbcloud::app
     h.run_steps(2);
 }
 
+/// Opens `path` and steps the app until it reports an error (failing after a minute).
+fn open_expecting_error(h: &mut Harness<'static, OrbApp>, path: std::path::PathBuf) -> String {
+    let ctx = h.ctx.clone();
+    h.state_mut().open(path.clone(), &ctx);
+    let start = std::time::Instant::now();
+    while h.state().error.is_none() {
+        assert!(start.elapsed().as_secs() < 60, "no error opening {}", path.display());
+        std::thread::sleep(std::time::Duration::from_millis(20));
+        h.run_steps(1);
+    }
+    h.state().error.clone().unwrap()
+}
+
 #[test]
 fn the_scan_demo_opens_side_by_side_and_a_drag_twists_both_views() {
     let mut h = Harness::builder()
@@ -202,18 +215,9 @@ fn the_scan_demo_opens_side_by_side_and_a_drag_twists_both_views() {
     let dir = tempfile::tempdir().unwrap();
     let bad = dir.path().join("bad.scan.toml");
     std::fs::write(&bad, "dihedral = [2, 3, 4, 5]\n[[frame]]\nangle = 0\nfile = \"a.molden\"\n").unwrap();
-    let ctx = h.ctx.clone();
-    h.state_mut().open(bad, &ctx);
-    let start = std::time::Instant::now();
-    while h.state().error.is_none() {
-        assert!(start.elapsed().as_secs() < 60, "no error for the bad manifest");
-        std::thread::sleep(std::time::Duration::from_millis(20));
-        h.run_steps(1);
-    }
-    let app = h.state();
-    let err = app.error.as_deref().unwrap();
+    let err = open_expecting_error(&mut h, bad);
     assert!(err.contains("bad.scan.toml:"), "{err}");
-    assert_eq!(app.scan.as_ref().map(|s| s.theta), Some(theta), "the scan stays open");
+    assert_eq!(h.state().scan.as_ref().map(|s| s.theta), Some(theta), "the scan stays open");
 }
 
 #[test]
@@ -224,15 +228,7 @@ fn a_scan_too_large_for_the_gpu_offers_a_coarser_grid() {
         .wgpu_setup(wgpu_setup(true))
         .build_eframe(|cc| OrbApp::cube_demo(cc));
     h.state_mut().scan_budget = Some(1 << 20);
-    let ctx = h.ctx.clone();
-    h.state_mut().open(manifest, &ctx);
-    let start = std::time::Instant::now();
-    while h.state().error.is_none() {
-        assert!(start.elapsed().as_secs() < 60, "no budget error");
-        std::thread::sleep(std::time::Duration::from_millis(50));
-        h.run_steps(1);
-    }
-    let error = h.state().error.clone().unwrap();
+    let error = open_expecting_error(&mut h, manifest);
     assert!(error.contains("MiB") && error.contains("fits"), "{error}");
     let fits = h.state().scan_retry.as_ref().map(|r| r.1).expect("a grid that fits is offered");
     h.run_steps(2);

@@ -336,7 +336,11 @@ pub fn views(ui: &mut egui::Ui, render_state: &egui_wgpu::RenderState, scan: &mu
     let n = scan.views.len().max(1);
     let mut dragged = 0.0;
     let style = view.settings.atoms;
-    let interacting = interacting(ui.ctx(), scan.playing);
+    // All views share one device, so one detail serves them.
+    let detail = scan
+        .views
+        .first()
+        .map_or(Detail::FULL, |vp| Detail::for_frame(interacting(ui.ctx(), scan.playing), vp.ctx.info.device_type, n));
     ui.columns(n, |columns| {
         for (slot, (ui, vp)) in columns.iter_mut().zip(scan.views.iter_mut()).enumerate() {
             if vp.scan_shown != Some((scan.theta, scan.mode)) {
@@ -346,7 +350,7 @@ pub fn views(ui: &mut egui::Ui, render_state: &egui_wgpu::RenderState, scan: &mu
                 ui.strong(scan.scene.label(slot, scan.theta));
                 ui.label(RichText::new(format!("θ = {:.1}°", scan.theta)).weak());
             });
-            vp.detail = Detail::for_frame(interacting, vp.ctx.info.device_type, n);
+            vp.detail = detail;
             dragged += vp.show_twistable(ui, render_state, view, Some(twist));
         }
     });
