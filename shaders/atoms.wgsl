@@ -9,6 +9,8 @@ struct Globals {
     light: vec4<f32>,
     // xyz: camera up vector
     up: vec4<f32>,
+    // x: high bits of this object's atom pick ids; the atom index is added
+    pick: vec4<u32>,
 };
 
 @group(0) @binding(0) var<uniform> g: Globals;
@@ -20,6 +22,7 @@ const CORNERS = array<vec2<f32>, 6>(
 
 struct FragOut {
     @location(0) color: vec4<f32>,
+    @location(1) id: u32,
     @builtin(frag_depth) depth: f32,
 };
 
@@ -46,11 +49,13 @@ struct SphereOut {
     @location(1) @interpolate(flat) center: vec3<f32>,
     @location(2) @interpolate(flat) radius: f32,
     @location(3) @interpolate(flat) color: vec4<f32>,
+    @location(4) @interpolate(flat) atom: u32,
 };
 
 @vertex
 fn vs_sphere(
     @builtin(vertex_index) vi: u32,
+    @builtin(instance_index) atom: u32,
     @location(0) center: vec3<f32>,
     @location(1) radius: f32,
     @location(2) color: vec4<f32>,
@@ -74,6 +79,7 @@ fn vs_sphere(
     out.center = center;
     out.radius = radius;
     out.color = color;
+    out.atom = atom;
     return out;
 }
 
@@ -93,6 +99,7 @@ fn fs_sphere(in: SphereOut) -> FragOut {
     let n = normalize(hit - in.center);
     var out: FragOut;
     out.color = vec4<f32>(shade(in.color.rgb, n, -rd), 1.0);
+    out.id = g.pick.x | in.atom;
     out.depth = depth_of(hit);
     return out;
 }
@@ -106,6 +113,7 @@ struct CylinderOut {
     @location(2) @interpolate(flat) p1: vec3<f32>,
     @location(3) @interpolate(flat) radius: f32,
     @location(4) @interpolate(flat) color: vec4<f32>,
+    @location(5) @interpolate(flat) atom: u32,
 };
 
 @vertex
@@ -115,6 +123,7 @@ fn vs_cylinder(
     @location(1) radius: f32,
     @location(2) p1: vec3<f32>,
     @location(3) color: vec4<f32>,
+    @location(4) atom: u32,
 ) -> CylinderOut {
     let axis = p1 - p0;
     let len = max(length(axis), 1e-6);
@@ -139,6 +148,7 @@ fn vs_cylinder(
     out.p1 = p1;
     out.radius = radius;
     out.color = color;
+    out.atom = atom;
     return out;
 }
 
@@ -168,6 +178,7 @@ fn fs_cylinder(in: CylinderOut) -> FragOut {
     let n = normalize(hit - in.p0 - a * h);
     var out: FragOut;
     out.color = vec4<f32>(shade(in.color.rgb, n, -rd), 1.0);
+    out.id = g.pick.x | in.atom;
     out.depth = depth_of(hit);
     return out;
 }

@@ -20,6 +20,8 @@ use rayon::prelude::*;
 
 #[path = "cli/scan.rs"]
 mod scan_cli;
+#[path = "cli/surface.rs"]
+mod surface_cli;
 
 #[derive(Parser)]
 #[command(name = "orbcloud", version, about = "Molecular orbitals and densities as GPU-rendered clouds")]
@@ -69,6 +71,8 @@ enum Command {
         #[arg(short, long)]
         output: PathBuf,
     },
+    /// Write isosurfaces (both signs of an orbital, or a density's) as OBJ, PLY or glTF.
+    Mesh(surface_cli::MeshArgs),
     /// Dihedral scans: make a manifest, inspect, render or export an angle.
     #[command(subcommand)]
     Scan(scan_cli::ScanCommand),
@@ -115,8 +119,8 @@ struct WavefunctionArgs {
 
 impl WavefunctionArgs {
     /// Puts the requested quantity into the headless renderer, when the document has a
-    /// wavefunction; returns how long that took (GPU fill and read-back included).
-    fn apply(&self, ctx: &GpuContext, h: &mut Headless, doc: &Document) -> Result<Option<f64>> {
+    /// wavefunction; returns how long that took (GPU fill and read-back included) and the grid.
+    fn apply(&self, ctx: &GpuContext, h: &mut Headless, doc: &Document) -> Result<Option<(f64, VolumeGrid)>> {
         let Some(wf) = &doc.wavefunction else { return Ok(None) };
         let start = Instant::now();
         let view = WavefunctionView {
@@ -126,8 +130,8 @@ impl WavefunctionArgs {
             shells: None,
         };
         let mut fill = None;
-        show_wavefunction(ctx, &mut h.renderer, &mut fill, doc, &view)?;
-        Ok(Some(start.elapsed().as_secs_f64()))
+        let grid = show_wavefunction(ctx, &mut h.renderer, &mut fill, doc, &view)?;
+        Ok(grid.map(|g| (start.elapsed().as_secs_f64(), g)))
     }
 }
 
@@ -210,6 +214,8 @@ enum BenchCommand {
     },
     /// Frame time against the number of resident key volumes K of a scan (seed 000's Fig. 6).
     Keyvolumes(scan_cli::KeyVolumeBench),
+    /// ms to extract an isosurface (both signs of an orbital) from a grid.
+    Isosurface(surface_cli::IsoBench),
 }
 
 #[derive(Args)]
@@ -226,6 +232,11 @@ struct RenderArgs {
     lavapipe: bool,
     #[command(flatten)]
     wavefunction: WavefunctionArgs,
+    #[command(flatten)]
+    iso: surface_cli::IsoArgs,
+    /// Print what is drawn at pixel X,Y of the image (an atom, a surface, or nothing).
+    #[arg(long, value_parser = surface_cli::parse_pixel)]
+    pick: Option<[u32; 2]>,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -438,11 +449,18 @@ fn main() -> Result<()> {
             let doc = load(args.file.as_deref())?;
             let ctx = gpu(args.lavapipe)?;
             let settings = args.view.settings();
-            let mut h = Headless::new(&ctx, &doc, args.view.volume_index(&doc)?, &settings, args.view.size)?;
-            args.wavefunction.apply(&ctx, &mut h, &doc)?;
+            let volume = args.view.volume_index(&doc)?;
+            let mut h = Headless::new(&ctx, &doc, volume, &settings, args.view.size)?;
+            let computed = args.wavefunction.apply(&ctx, &mut h, &doc)?.map(|(_, g)| g);
+            if let Some(grid) = computed.as_ref().or(volume.and_then(|i| doc.volumes.get(i))) {
+                surface_cli::show(&ctx, &mut h.renderer, grid, &args.iso);
+            }
             let img = h.render(&ctx, &args.view.camera(&doc), &settings)?;
             img.save(&args.output).with_context(|| format!("writing {}", args.output.display()))?;
             eprintln!("wrote {} ({}x{}, {})", args.output.display(), img.width(), img.height(), ctx.describe());
+            if let Some(pixel) = args.pick {
+                surface_cli::print_pick(&ctx, &h.renderer, &doc, pixel)?;
+            }
             Ok(())
         }
         Some(Command::Info { file, json }) => {
@@ -529,14 +547,16 @@ fn main() -> Result<()> {
             Ok(())
         }
         Some(Command::Scan(command)) => scan_cli::run(command),
+        Some(Command::Mesh(args)) => surface_cli::mesh(&args),
         Some(Command::Bench(BenchCommand::Keyvolumes(args))) => scan_cli::bench_keyvolumes(args),
+        Some(Command::Bench(BenchCommand::Isosurface(args))) => surface_cli::bench(&args),
         Some(Command::Bench(BenchCommand::Render { file, view, frames, lavapipe, wavefunction })) => {
             let doc = load(file.as_deref())?;
             let ctx = gpu(lavapipe)?;
             let settings = view.settings();
             let camera = view.camera(&doc);
             let mut h = Headless::new(&ctx, &doc, view.volume_index(&doc)?, &settings, view.size)?;
-            if let Some(seconds) = wavefunction.apply(&ctx, &mut h, &doc)? {
+            if let Some((seconds, _)) = wavefunction.apply(&ctx, &mut h, &doc)? {
                 let n = wavefunction.grid_points;
                 println!(
                     "wavefunction_setup_ms={:.1} (grid {n}^3: GPU fill and read-back for the value range)",

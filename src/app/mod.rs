@@ -2,11 +2,12 @@
 
 pub mod detail;
 mod loader;
+pub mod measure;
 mod orbitals;
 mod panels;
 pub mod scan;
 pub mod state;
-mod viewport;
+pub mod viewport;
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -72,6 +73,8 @@ pub struct OrbApp {
     pub scan_budget: Option<u64>,
     /// A scan that did not fit the GPU's memory, and the grid that would.
     pub scan_retry: Option<(ScanSource, usize)>,
+    /// Picked atoms and measurements between them.
+    pub measurements: measure::Measurements,
 }
 
 impl OrbApp {
@@ -115,11 +118,22 @@ impl OrbApp {
             scan_points: crate::headless::scan::DEFAULT_SCAN_POINTS,
             scan_retry: None,
             scan_budget: None,
+            measurements: measure::Measurements::default(),
         };
         if app.viewport.is_none() {
             app.error = Some("no wgpu render state: the viewer needs eframe's wgpu backend".into());
         }
         app
+    }
+
+    /// The σ of the grid shown (what isosurface levels in σ refer to) and whether its values
+    /// are signed (an orbital: two surfaces).
+    pub fn shown_grid(&self) -> (Option<f64>, bool) {
+        let computed = self.viewport.as_ref().and_then(|vp| vp.computed_grid());
+        match computed.or(self.doc.volumes.get(self.view.volume)) {
+            Some(g) => (Some(g.stats.sigma), g.kind == crate::model::grid::ValueKind::Signed),
+            None => (None, true),
+        }
     }
 
     /// Each view shown: (size on screen, size of its last frame), pixels. The frame is smaller
@@ -193,6 +207,7 @@ impl OrbApp {
         self.scan = None;
         self.orbitals = doc.wavefunction.as_ref().map(OrbitalView::for_wavefunction).unwrap_or_default();
         self.scroll_to_frontier = true;
+        self.measurements = measure::Measurements::default();
         self.doc = doc;
         self.view = view;
         self.show_wavefunction();
@@ -208,7 +223,7 @@ impl OrbApp {
             points: ov.grid_points,
             shells: ov.ao_filter.then_some(ov.shell_mask.as_slice()),
         };
-        if let Err(e) = vp.show_wavefunction(&self.doc, &view) {
+        if let Err(e) = vp.show_wavefunction(&self.doc, &view, &self.view) {
             self.error = Some(e.to_string());
         }
     }
@@ -280,10 +295,15 @@ impl OrbApp {
     /// Applies a change of the shown volume or atom style made in the panels.
     fn apply(&mut self, before: &ViewState) {
         let Some(vp) = &mut self.viewport else { return };
-        if before.volume != self.view.volume
-            && let Err(e) = vp.set_volume(&self.doc, self.view.volume)
-        {
-            self.error = Some(e.to_string());
+        if before.volume != self.view.volume {
+            if let Err(e) = vp.set_volume(&self.doc, &self.view) {
+                self.error = Some(e.to_string());
+            }
+        } else if before.settings.iso != self.view.settings.iso {
+            let triangles = vp.update_isosurfaces(&self.doc, &self.view);
+            if self.view.settings.iso.visible {
+                self.status = format!("isosurfaces: {triangles} triangles");
+            }
         }
         if before.settings.atoms != self.view.settings.atoms {
             vp.set_atom_style(&self.doc, &self.view);
@@ -381,7 +401,14 @@ impl eframe::App for OrbApp {
                 (None, Some(vp)) => {
                     vp.detail =
                         detail::Detail::for_frame(detail::interacting(ui.ctx(), false), vp.ctx.info.device_type, 1);
-                    vp.show(ui, rs, &mut self.view)
+                    vp.show(ui, rs, &mut self.view);
+                    if let Some(click) = vp.click.take() {
+                        let said = self.measurements.click(click, &self.doc.molecule);
+                        if !said.is_empty() {
+                            self.status = said;
+                        }
+                    }
+                    measure::overlay(ui, vp, &self.view.camera, &self.doc.molecule, &self.measurements);
                 }
                 (None, None) => {}
             }

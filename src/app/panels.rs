@@ -6,7 +6,7 @@ use super::OrbApp;
 use crate::model::orbitals::Quantity;
 use crate::model::{grid::ValueKind, units::ANGSTROM_PER_BOHR};
 use crate::scene::transfer::{Lobe, PRESETS};
-use crate::scene::{AtomStyle, ClipPlane, Shape, SliceMode, Transfer, TransferKind};
+use crate::scene::{AtomStyle, ClipPlane, IsoLevel, IsosurfaceSettings, Shape, SliceMode, Transfer, TransferKind};
 
 pub enum Action {
     None,
@@ -113,6 +113,7 @@ pub fn status_bar(ui: &mut egui::Ui, app: &OrbApp) {
 pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
     egui::Panel::left("controls").default_size(250.0).show(ui, |ui| {
         egui::ScrollArea::vertical().show(ui, |ui| {
+            let (grid_sigma, grid_signed) = app.shown_grid();
             let view = &mut app.view;
             ui.heading("Volume");
             if let Some(scan) = &app.scan {
@@ -174,6 +175,11 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
             transfer_editor(ui, &mut vs.transfer);
             clip_editor(ui, &mut vs.clip);
 
+            if app.scan.is_none() {
+                ui.separator();
+                isosurface_editor(ui, &mut view.settings.iso, grid_signed, grid_sigma);
+            }
+
             ui.separator();
             ui.heading("Atoms");
             ComboBox::from_label("style")
@@ -191,6 +197,11 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
                 ui.color_edit_button_rgb(&mut view.settings.background);
                 ui.label("background");
             });
+
+            if app.scan.is_none() {
+                ui.separator();
+                super::measure::panel(ui, &app.doc.molecule, &mut app.measurements);
+            }
 
             ui.separator();
             ui.collapsing("Atoms in file", |ui| {
@@ -309,5 +320,42 @@ fn clip_editor(ui: &mut egui::Ui, clip: &mut ClipPlane) {
         });
         ui.add(Slider::new(&mut clip.offset, -15.0..=15.0).text("offset (bohr)"));
         ui.label(RichText::new("Ctrl + drag in the view moves the plane").small().weak());
+    });
+}
+
+/// Isosurface controls: shown or not, the value (absolute, or in σ of a cube's grid), colours.
+fn isosurface_editor(ui: &mut egui::Ui, iso: &mut IsosurfaceSettings, signed: bool, sigma: Option<f64>) {
+    ui.heading("Isosurface");
+    ui.checkbox(&mut iso.visible, if signed { "show ψ = ±value" } else { "show ρ = value" });
+    ui.horizontal(|ui| {
+        let absolute = matches!(iso.level, IsoLevel::Absolute(_));
+        if ui.selectable_label(absolute, "atomic units").clicked() && !absolute {
+            iso.level = IsoLevel::Absolute(iso.level.value(sigma.unwrap_or(1.0)).max(1e-4));
+        }
+        if let Some(sigma) = sigma.filter(|s| *s > 0.0)
+            && ui.selectable_label(!absolute, "× σ of the grid").clicked()
+            && absolute
+        {
+            iso.level = IsoLevel::Sigma((iso.level.value(sigma) as f64 / sigma) as f32);
+        }
+    });
+    match &mut iso.level {
+        IsoLevel::Absolute(v) => {
+            ui.add(Slider::new(v, 1e-4..=0.5).logarithmic(true).text("value (a.u.)"));
+        }
+        IsoLevel::Sigma(s) => {
+            ui.add(Slider::new(s, 0.1..=20.0).logarithmic(true).text("σ"));
+        }
+    }
+    ui.horizontal(|ui| {
+        if signed {
+            ui.color_edit_button_rgb(&mut iso.positive_color);
+            ui.label("+");
+            ui.color_edit_button_rgb(&mut iso.negative_color);
+            ui.label("−");
+        } else {
+            ui.color_edit_button_rgb(&mut iso.density_color);
+            ui.label("surface");
+        }
     });
 }

@@ -5,11 +5,19 @@ use egui::{Key, PointerButton, Sense};
 
 use super::detail::Detail;
 use super::state::{DRAG_ROTATE, KEY_ROTATE, KEY_ZOOM, ViewState};
+use crate::gpu::frame::PickId;
 use crate::gpu::gto::GtoFillPass;
 use crate::gpu::{FrameInput, GpuContext, GpuError, OffscreenTarget, Renderer};
-use crate::headless::WavefunctionView;
 use crate::headless::scan::ScanScene;
-use crate::model::Document;
+use crate::headless::{WavefunctionView, show_isosurfaces};
+use crate::model::{Document, VolumeGrid};
+
+/// A click in the view: what the frame showed under the pointer, and whether Shift was held.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Click {
+    pub picked: Option<PickId>,
+    pub shift: bool,
+}
 
 /// How a drag in a scan view twists the dihedral (seed 000: horizontal drag changes θ).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -36,6 +44,13 @@ pub struct Viewport {
     drawn: Option<(ViewState, [u32; 2], u64)>,
     /// Bumped whenever the renderer's data changes.
     generation: u64,
+    /// A wavefunction's values on the grid shown (cube files' grids stay in the document):
+    /// isosurfaces are cut from it.
+    iso_grid: Option<VolumeGrid>,
+    /// The last click, until the caller takes it.
+    pub click: Option<Click>,
+    /// Where the view was laid out, and the size it was drawn at (for overlays).
+    layout: Option<(egui::Rect, [u32; 2])>,
     /// Whether the current drag twists the dihedral.
     twisting: bool,
     /// The scan frame shown: (θ, interpolation), for tests and redraws.
@@ -54,6 +69,9 @@ impl Viewport {
             detail: Detail::FULL,
             drawn: None,
             generation: 0,
+            iso_grid: None,
+            click: None,
+            layout: None,
             twisting: false,
             scan_shown: None,
         }
@@ -63,21 +81,45 @@ impl Viewport {
     pub fn set_document(&mut self, doc: &Document, view: &ViewState) -> Result<(), GpuError> {
         self.renderer.set_volume(&self.ctx, doc.volumes.get(view.volume))?;
         self.renderer.set_molecule(&self.ctx, &doc.molecule, view.settings.atoms);
-        self.generation += 1;
+        self.iso_grid = None;
+        self.update_isosurfaces(doc, view);
         Ok(())
     }
 
-    pub fn set_volume(&mut self, doc: &Document, index: usize) -> Result<(), GpuError> {
-        self.renderer.set_volume(&self.ctx, doc.volumes.get(index))?;
-        self.generation += 1;
+    pub fn set_volume(&mut self, doc: &Document, view: &ViewState) -> Result<(), GpuError> {
+        self.renderer.set_volume(&self.ctx, doc.volumes.get(view.volume))?;
+        self.update_isosurfaces(doc, view);
         Ok(())
     }
 
     /// Shows a wavefunction's orbital or density (see [`crate::headless::show_wavefunction`]).
-    pub fn show_wavefunction(&mut self, doc: &Document, view: &WavefunctionView) -> Result<(), GpuError> {
-        crate::headless::show_wavefunction(&self.ctx, &mut self.renderer, &mut self.fill, doc, view)?;
-        self.generation += 1;
+    pub fn show_wavefunction(
+        &mut self,
+        doc: &Document,
+        wavefunction: &WavefunctionView,
+        view: &ViewState,
+    ) -> Result<(), GpuError> {
+        self.iso_grid =
+            crate::headless::show_wavefunction(&self.ctx, &mut self.renderer, &mut self.fill, doc, wavefunction)?;
+        self.update_isosurfaces(doc, view);
         Ok(())
+    }
+
+    /// Cuts the isosurfaces `view` asks for from the grid shown; returns their triangle count.
+    pub fn update_isosurfaces(&mut self, doc: &Document, view: &ViewState) -> usize {
+        self.generation += 1;
+        match self.iso_grid.as_ref().or(doc.volumes.get(view.volume)) {
+            Some(grid) => show_isosurfaces(&self.ctx, &mut self.renderer, grid, &view.settings.iso),
+            None => {
+                self.renderer.surfaces.clear();
+                0
+            }
+        }
+    }
+
+    /// The grid isosurfaces are cut from, when it is not one of the document's.
+    pub fn computed_grid(&self) -> Option<&VolumeGrid> {
+        self.iso_grid.as_ref()
     }
 
     /// Shows slot `slot` of a scan at θ (both key volumes and the twisted skeleton).
@@ -121,14 +163,10 @@ impl Viewport {
         let mut twisted = 0.0;
         if let Some(t) = twist {
             if response.drag_started_by(PointerButton::Primary) {
+                self.layout = Some((rect, size));
                 let on_bond = t.bond.zip(response.interact_pointer_pos()).is_some_and(|(bond, p)| {
-                    let clip_from_world = self.renderer.clip_from_world(&view.camera, size);
-                    let to_screen = |w: glam::Vec3| {
-                        let c = clip_from_world * w.extend(1.0);
-                        let ndc = c.truncate() / c.w.max(1e-6);
-                        rect.min + egui::vec2((ndc.x * 0.5 + 0.5) * rect.width(), (0.5 - ndc.y * 0.5) * rect.height())
-                    };
-                    distance_to_segment(p, to_screen(bond[0]), to_screen(bond[1])) < BOND_GRAB
+                    let ends = (self.to_screen(&view.camera, bond[0]), self.to_screen(&view.camera, bond[1]));
+                    matches!(ends, (Some(a), Some(b)) if distance_to_segment(p, a, b) < BOND_GRAB)
                 });
                 self.twisting = t.drag_twists || on_bond;
             }
@@ -180,7 +218,30 @@ impl Viewport {
             let uv = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
             ui.painter().image(*id, rect, uv, egui::Color32::WHITE);
         }
+        self.layout = Some((rect, size));
+        if response.clicked_by(PointerButton::Primary)
+            && let Some(pos) = response.interact_pointer_pos()
+        {
+            // The frame just drawn is the one on screen: read its id under the pointer.
+            let rel = (pos - rect.min) / rect.size();
+            let pixel = [(rel.x * size[0] as f32) as u32, (rel.y * size[1] as f32) as u32];
+            let shift = ui.input(|i| i.modifiers.shift);
+            match self.renderer.pick(&self.ctx, pixel) {
+                Ok(picked) => self.click = Some(Click { picked, shift }),
+                Err(e) => log::warn!("picking failed: {e}"),
+            }
+        }
         twisted
+    }
+
+    /// Where world point `p` (bohr) lies on screen in the last frame laid out.
+    pub fn to_screen(&self, camera: &crate::scene::Camera, p: glam::Vec3) -> Option<egui::Pos2> {
+        let (rect, size) = self.layout?;
+        let c = self.renderer.clip_from_world(camera, size) * p.extend(1.0);
+        (c.w > 1e-6).then(|| {
+            let ndc = c.truncate() / c.w;
+            rect.min + egui::vec2((ndc.x * 0.5 + 0.5) * rect.width(), (0.5 - ndc.y * 0.5) * rect.height())
+        })
     }
 
     /// Renders the current view at `size` and reads it back (for screenshots).

@@ -5,6 +5,7 @@ pub mod cube;
 pub mod cube_write;
 mod error;
 pub mod fchk;
+pub mod mesh_write;
 pub mod molden;
 pub mod scan;
 mod text;

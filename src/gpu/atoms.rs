@@ -4,7 +4,8 @@
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
 
-use super::{DEPTH_FORMAT, GpuContext, SCENE_FORMAT};
+use super::GpuContext;
+use super::frame::{Draw, Phase, PickId, opaque_depth, opaque_targets};
 use crate::model::{Molecule, units::BOHR_PER_ANGSTROM};
 use crate::scene::AtomStyle;
 
@@ -16,8 +17,10 @@ pub struct AtomGlobals {
     pub eye: [f32; 4],
     pub light: [f32; 4],
     pub up: [f32; 4],
+    /// x: the high bits of this object's atom pick ids ([`PickId::atom_base`]).
+    pub pick: [u32; 4],
 }
-const _: () = assert!(std::mem::size_of::<AtomGlobals>() == 112);
+const _: () = assert!(std::mem::size_of::<AtomGlobals>() == 128);
 
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
@@ -34,7 +37,8 @@ pub struct CylinderInstance {
     pub p0: [f32; 3],
     pub radius: f32,
     pub p1: [f32; 3],
-    pub _pad: f32,
+    /// The atom this half-bond belongs to: picking it picks the atom.
+    pub atom: u32,
     pub color: [f32; 4],
 }
 const _: () = assert!(std::mem::size_of::<CylinderInstance>() == 48);
@@ -87,14 +91,14 @@ pub fn instances(molecule: &Molecule, style: AtomStyle) -> (Vec<SphereInstance>,
                 let (a, c) = (&molecule.atoms[b.a as usize], &molecule.atoms[b.b as usize]);
                 let (pa, pc) = (a.position.as_vec3(), c.position.as_vec3());
                 let mid = 0.5 * (pa + pc);
-                let half = |p: Vec3, color| CylinderInstance {
+                let half = |p: Vec3, atom, color| CylinderInstance {
                     p0: p.to_array(),
                     radius: STICK_RADIUS_ANG * bohr,
                     p1: mid.to_array(),
-                    _pad: 0.0,
+                    atom,
                     color,
                 };
-                [half(pa, linear_color(a.element().color)), half(pc, linear_color(c.element().color))]
+                [half(pa, b.a, linear_color(a.element().color)), half(pc, b.b, linear_color(c.element().color))]
             })
             .collect(),
         _ => Vec::new(),
@@ -142,23 +146,13 @@ impl AtomsPass {
                     })],
                 },
                 primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
-                depth_stencil: Some(wgpu::DepthStencilState {
-                    format: DEPTH_FORMAT,
-                    depth_write_enabled: Some(true),
-                    depth_compare: Some(wgpu::CompareFunction::Less),
-                    stencil: Default::default(),
-                    bias: Default::default(),
-                }),
+                depth_stencil: Some(opaque_depth()),
                 multisample: Default::default(),
                 fragment: Some(wgpu::FragmentState {
                     module: &module,
                     entry_point: Some(fs),
                     compilation_options: Default::default(),
-                    targets: &[Some(wgpu::ColorTargetState {
-                        format: SCENE_FORMAT,
-                        blend: None,
-                        write_mask: wgpu::ColorWrites::ALL,
-                    })],
+                    targets: &opaque_targets(),
                 }),
                 multiview_mask: None,
                 cache: None,
@@ -176,12 +170,13 @@ impl AtomsPass {
             "vs_cylinder",
             "fs_cylinder",
             48,
-            // Not vertex_attr_array!: the colour sits after the padding word.
+            // Not vertex_attr_array!: the atom index sits between p1 and the colour.
             &[
                 attribute(0, wgpu::VertexFormat::Float32x3, 0),
                 attribute(1, wgpu::VertexFormat::Float32, 12),
                 attribute(2, wgpu::VertexFormat::Float32x3, 16),
                 attribute(3, wgpu::VertexFormat::Float32x4, 32),
+                attribute(4, wgpu::VertexFormat::Uint32, 28),
             ],
         );
         let globals = super::uniform_buffer(device, "atoms globals", std::mem::size_of::<AtomGlobals>());
@@ -212,21 +207,32 @@ impl AtomsPass {
     }
 
     pub fn prepare(&self, queue: &wgpu::Queue, clip_from_world: Mat4, eye: Vec3, target: Vec3) {
-        let back = (eye - target).normalize_or(Vec3::Z);
-        let right = Vec3::Y.cross(back).normalize_or(Vec3::X);
-        let up = back.cross(right);
-        // A light above-left of the viewer, moving with the camera.
-        let light = (back + 0.6 * up - 0.4 * right).normalize();
+        let (light, up) = headlight(eye, target);
         let g = AtomGlobals {
             clip_from_world: clip_from_world.to_cols_array_2d(),
             eye: eye.extend(1.0).to_array(),
             light: light.extend(0.0).to_array(),
             up: up.extend(0.0).to_array(),
+            pick: [PickId::atom_base(0), 0, 0, 0],
         };
         queue.write_buffer(&self.globals, 0, bytemuck::bytes_of(&g));
     }
+}
 
-    pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>) {
+/// A light above-left of the viewer, moving with the camera, and the camera's up vector.
+pub fn headlight(eye: Vec3, target: Vec3) -> (Vec3, Vec3) {
+    let back = (eye - target).normalize_or(Vec3::Z);
+    let right = Vec3::Y.cross(back).normalize_or(Vec3::X);
+    let up = back.cross(right);
+    ((back + 0.6 * up - 0.4 * right).normalize(), up)
+}
+
+impl Draw for AtomsPass {
+    fn phases(&self) -> &'static [Phase] {
+        &[Phase::Opaque]
+    }
+
+    fn draw(&self, _phase: Phase, pass: &mut wgpu::RenderPass<'_>) {
         pass.set_bind_group(0, &self.bind_group, &[]);
         if let Some((buffer, n)) = &self.cylinders {
             pass.set_pipeline(&self.cylinders_pipeline);

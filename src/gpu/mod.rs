@@ -1,11 +1,14 @@
 //! The GPU layer: adapter and device selection, offscreen targets, and the render passes.
 //!
-//! Passes draw into views they do not own; the window, the CLI and the tests all call
-//! [`Renderer::render`]. Nothing here reads files or knows about the UI.
+//! Passes draw into targets they do not own, in the phases of a frame description
+//! ([`frame`]); the window, the CLI and the tests all call [`Renderer::render`]. Nothing here
+//! reads files or knows about the UI.
 
 pub mod atoms;
 pub mod context;
+pub mod frame;
 pub mod gto;
+pub mod isosurface;
 pub mod readback;
 pub mod renderer;
 pub mod resolve;
@@ -33,6 +36,7 @@ pub const SHADERS: &[(&str, &str)] = &[
     ("volume_morph.wgsl", include_str!("../../shaders/volume_morph.wgsl")),
     ("atoms.wgsl", include_str!("../../shaders/atoms.wgsl")),
     ("resolve.wgsl", include_str!("../../shaders/resolve.wgsl")),
+    ("isosurface.wgsl", include_str!("../../shaders/isosurface.wgsl")),
     ("gto_common.wgsl", include_str!("../../shaders/gto_common.wgsl")),
     ("gto_fill.wgsl", include_str!("../../shaders/gto_fill.wgsl")),
 ];

@@ -3,8 +3,10 @@
 use glam::Vec3;
 
 use super::atoms::AtomsPass;
+use super::frame::{Draw, FrameTargets, Phase, PhaseNode, PickId, STANDARD_FRAME};
 use super::gto::GridGeometry;
-use super::resolve::{ResolvePass, SceneBuffers};
+use super::isosurface::IsosurfacePass;
+use super::resolve::ResolvePass;
 use super::volume::{VolumePass, VolumeTexture};
 use super::{GpuContext, GpuError};
 use crate::model::cartesian::CartesianExpansion;
@@ -20,11 +22,16 @@ pub struct FrameInput<'a> {
     pub size: [u32; 2],
 }
 
+/// Draws a frame as [`STANDARD_FRAME`] describes it: each phase one render pass over the shared
+/// [`FrameTargets`], each drawer drawing in the phases it names.
 pub struct Renderer {
     pub volume: VolumePass,
     pub atoms: AtomsPass,
+    pub surfaces: IsosurfacePass,
     resolve: ResolvePass,
-    buffers: Option<SceneBuffers>,
+    frame: &'static [PhaseNode],
+    /// The targets at the last frame's size, and the resolve pass's view of their colour.
+    targets: Option<(FrameTargets, wgpu::BindGroup)>,
     /// Bounds of everything drawn (bohr), for the depth range.
     bounds: Option<(Vec3, Vec3)>,
     molecule_bounds: Option<(Vec3, Vec3)>,
@@ -35,8 +42,10 @@ impl Renderer {
         Self {
             volume: VolumePass::new(ctx),
             atoms: AtomsPass::new(ctx),
+            surfaces: IsosurfacePass::new(ctx),
             resolve: ResolvePass::new(ctx),
-            buffers: None,
+            frame: STANDARD_FRAME,
+            targets: None,
             bounds: None,
             molecule_bounds: None,
         }
@@ -107,8 +116,13 @@ impl Renderer {
         camera.clip_from_world(aspect, radius)
     }
 
-    /// Records the frame into `encoder`: clear, opaque impostors, slices back to front, all in
-    /// the float scene buffer; then copies that into `output` (a [`super::COLOR_FORMAT`] view of
+    /// The representations, in the order they draw within a phase.
+    fn drawers(&self) -> [&dyn Draw; 3] {
+        [&self.atoms, &self.surfaces, &self.volume]
+    }
+
+    /// Records the frame into `encoder`, phase by phase as the frame description orders them;
+    /// the last phase copies the float colour into `output` (a [`super::COLOR_FORMAT`] view of
     /// `frame.size`).
     pub fn render(
         &mut self,
@@ -117,40 +131,39 @@ impl Renderer {
         output: &wgpu::TextureView,
         frame: &FrameInput,
     ) {
-        if self.buffers.as_ref().is_none_or(|b| b.size != frame.size) {
-            self.buffers = Some(self.resolve.buffers(&ctx.device, frame.size));
+        if self.targets.as_ref().is_none_or(|(t, _)| t.size != frame.size.map(|v| v.max(1))) {
+            let targets = FrameTargets::new(&ctx.device, frame.size);
+            let bind = self.resolve.bind(&ctx.device, &targets.color_view);
+            self.targets = Some((targets, bind));
         }
-        let Some(buffers) = &self.buffers else { return };
         let cam = frame.camera;
         let clip_from_world = self.clip_from_world(cam, frame.size);
         let eye = cam.eye();
         let view_dir = (cam.target - eye).normalize_or(Vec3::NEG_Z);
         self.atoms.prepare(&ctx.queue, clip_from_world, eye, cam.target);
+        self.surfaces.prepare(&ctx.queue, clip_from_world, eye, super::atoms::headlight(eye, cam.target).0);
         self.volume.prepare(&ctx.device, &ctx.queue, clip_from_world, eye, view_dir, &frame.settings.volume);
-        let [r, g, b] = frame.settings.background;
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("scene"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &buffers.color_view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color { r: r as f64, g: g as f64, b: b as f64, a: 1.0 }),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &buffers.depth_view,
-                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        self.atoms.draw(&mut pass);
-        self.volume.draw(&mut pass);
-        drop(pass);
-        self.resolve.draw(encoder, buffers, output);
+        let Some((targets, resolve)) = &self.targets else { return };
+        for node in self.frame {
+            if node.phase == Phase::Resolve {
+                self.resolve.draw(encoder, resolve, output);
+                continue;
+            }
+            let mut pass = targets.begin(encoder, node, frame.settings.background);
+            for drawer in self.drawers().into_iter().filter(|d| d.phases().contains(&node.phase)) {
+                drawer.draw(node.phase, &mut pass);
+            }
+        }
+    }
+
+    /// What the last frame drew at `pixel` (x right, y down, in that frame's pixels): an atom,
+    /// a surface, or nothing. Blocks until the frame is done.
+    pub fn pick(&self, ctx: &GpuContext, pixel: [u32; 2]) -> Result<Option<PickId>, GpuError> {
+        let Some((targets, _)) = &self.targets else { return Ok(None) };
+        if pixel[0] >= targets.size[0] || pixel[1] >= targets.size[1] {
+            return Ok(None);
+        }
+        let bytes = super::readback::read_texel(&ctx.device, &ctx.queue, &targets.ids, pixel, 4)?;
+        Ok(PickId::decode(u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]])))
     }
 }

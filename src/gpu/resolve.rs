@@ -1,15 +1,6 @@
-//! The renderer's own float scene buffer and depth, and the pass that copies the scene buffer
-//! into the caller's target.
+//! The last phase of a frame: the float colour copied into the caller's 8-bit sRGB target.
 
-use super::{COLOR_FORMAT, DEPTH_FORMAT, GpuContext, SCENE_FORMAT};
-
-/// Scene colour (float) and depth at one size; rebuilt when the output size changes.
-pub struct SceneBuffers {
-    pub size: [u32; 2],
-    pub color_view: wgpu::TextureView,
-    pub depth_view: wgpu::TextureView,
-    pub bind_group: wgpu::BindGroup,
-}
+use super::{COLOR_FORMAT, GpuContext};
 
 pub struct ResolvePass {
     pipeline: wgpu::RenderPipeline,
@@ -69,33 +60,16 @@ impl ResolvePass {
         Self { pipeline, layout }
     }
 
-    pub fn buffers(&self, device: &wgpu::Device, size: [u32; 2]) -> SceneBuffers {
-        let size = [size[0].max(1), size[1].max(1)];
-        let texture = |label, format, usage| {
-            device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d { width: size[0], height: size[1], depth_or_array_layers: 1 },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage,
-                view_formats: &[],
-            })
-        };
-        let attach = wgpu::TextureUsages::RENDER_ATTACHMENT;
-        let color = texture("scene colour", SCENE_FORMAT, attach | wgpu::TextureUsages::TEXTURE_BINDING);
-        let depth = texture("scene depth", DEPTH_FORMAT, attach);
-        let color_view = color.create_view(&Default::default());
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+    /// The bind group through which the pass reads `color` (the frame's float colour).
+    pub fn bind(&self, device: &wgpu::Device, color: &wgpu::TextureView) -> wgpu::BindGroup {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("resolve bind group"),
             layout: &self.layout,
-            entries: &[wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&color_view) }],
-        });
-        SceneBuffers { size, color_view, depth_view: depth.create_view(&Default::default()), bind_group }
+            entries: &[wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(color) }],
+        })
     }
 
-    pub fn draw(&self, encoder: &mut wgpu::CommandEncoder, buffers: &SceneBuffers, output: &wgpu::TextureView) {
+    pub fn draw(&self, encoder: &mut wgpu::CommandEncoder, color: &wgpu::BindGroup, output: &wgpu::TextureView) {
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("resolve"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -110,7 +84,7 @@ impl ResolvePass {
             multiview_mask: None,
         });
         pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &buffers.bind_group, &[]);
+        pass.set_bind_group(0, color, &[]);
         pass.draw(0..3, 0..1);
     }
 }

@@ -575,8 +575,14 @@ impl VolumePass {
         };
         programs.iter().copied()
     }
+}
 
-    pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>) {
+impl super::frame::Draw for VolumePass {
+    fn phases(&self) -> &'static [super::frame::Phase] {
+        &[super::frame::Phase::Translucent]
+    }
+
+    fn draw(&self, _phase: super::frame::Phase, pass: &mut wgpu::RenderPass<'_>) {
         let Some(bind_group) = &self.bind_group else {
             return;
         };

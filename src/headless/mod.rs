@@ -8,10 +8,12 @@ use glam::DVec3;
 use crate::gpu::gto::{GridGeometry, GtoFillPass, read_volume, volume_from_texture};
 use crate::gpu::{FrameInput, GpuContext, GpuError, OffscreenTarget, Renderer};
 use crate::model::cartesian::CartesianExpansion;
+use crate::model::grid::ValueKind;
 use crate::model::gto::{GridSpec, PreparedBasis};
+use crate::model::isosurface::{self, Level, Mesh};
 use crate::model::orbitals::Quantity;
 use crate::model::{Document, VolumeGrid};
-use crate::scene::{Camera, RenderSettings};
+use crate::scene::{Camera, IsosurfaceSettings, RenderSettings};
 
 /// Space (bohr) around the atoms in which orbitals are evaluated.
 pub const ORBITAL_MARGIN: f64 = 4.5;
@@ -51,16 +53,17 @@ pub struct WavefunctionView<'a> {
 
 /// Puts a wavefunction's orbital or density into `renderer`: orbitals through the GPU (a filled
 /// texture, or direct evaluation per sample), densities evaluated on the CPU. `fill` caches the
-/// compute pipeline between calls.
+/// compute pipeline between calls. Returns the values on the grid (what isosurfaces are cut
+/// from), or `None` when the document has no wavefunction.
 pub fn show_wavefunction(
     ctx: &GpuContext,
     renderer: &mut Renderer,
     fill: &mut Option<GtoFillPass>,
     doc: &Document,
     view: &WavefunctionView,
-) -> Result<(), GpuError> {
+) -> Result<Option<VolumeGrid>, GpuError> {
     let (Some(wf), Some(geometry)) = (&doc.wavefunction, orbital_geometry(doc, view.points)) else {
-        return Ok(());
+        return Ok(None);
     };
     let prepared = PreparedBasis::new(&wf.basis);
     match view.quantity {
@@ -85,6 +88,7 @@ pub fn show_wavefunction(
                 volume.max_grad = grid.max_gradient().max(1e-30) as f32;
                 renderer.set_volume_texture(ctx, volume);
             }
+            Ok(Some(grid))
         }
         Quantity::Density | Quantity::SpinDensity => {
             let spec = GridSpec::new(
@@ -98,10 +102,37 @@ pub fn show_wavefunction(
                 (prepared.spin_density_grid(wf, &spec), "spin density")
             };
             let values = values.iter().map(|&v| v as f32).collect();
-            renderer.set_volume(ctx, Some(&VolumeGrid::new(label, geometry.dims, geometry.world_from_grid, values)))?;
+            let grid = VolumeGrid::new(label, geometry.dims, geometry.world_from_grid, values);
+            renderer.set_volume(ctx, Some(&grid))?;
+            Ok(Some(grid))
         }
     }
-    Ok(())
+}
+
+/// The isosurfaces `iso` asks for on `grid`, each with its colour: ψ = +v and ψ = −v for a
+/// signed grid, ρ = v for a density. Empty when `iso` is hidden.
+pub fn isosurfaces(grid: &VolumeGrid, iso: &IsosurfaceSettings) -> Vec<(Mesh, [f32; 3])> {
+    if !iso.visible {
+        return Vec::new();
+    }
+    let signed = grid.kind == ValueKind::Signed;
+    let levels = Level::pair(iso.level.value(grid.stats.sigma), signed);
+    let colors = if signed { vec![iso.positive_color, iso.negative_color] } else { vec![iso.density_color] };
+    isosurface::extract(grid, &levels).into_iter().zip(colors).collect()
+}
+
+/// Extracts the isosurfaces of `grid` and shows them in `renderer` (none when `iso` is hidden).
+/// Returns the number of triangles.
+pub fn show_isosurfaces(
+    ctx: &GpuContext,
+    renderer: &mut Renderer,
+    grid: &VolumeGrid,
+    iso: &IsosurfaceSettings,
+) -> usize {
+    let meshes = isosurfaces(grid, iso);
+    let refs: Vec<(&Mesh, [f32; 3])> = meshes.iter().map(|(m, c)| (m, *c)).collect();
+    renderer.surfaces.set_meshes(ctx, 0, &refs);
+    meshes.iter().map(|(m, _)| m.triangle_count()).sum()
 }
 
 /// A renderer with an offscreen target of a fixed size.
@@ -121,7 +152,11 @@ impl Headless {
     ) -> Result<Self, GpuError> {
         let mut renderer = Renderer::new(ctx);
         renderer.set_molecule(ctx, &doc.molecule, settings.atoms);
-        renderer.set_volume(ctx, volume_index.and_then(|i| doc.volumes.get(i)))?;
+        let grid = volume_index.and_then(|i| doc.volumes.get(i));
+        renderer.set_volume(ctx, grid)?;
+        if let Some(grid) = grid {
+            show_isosurfaces(ctx, &mut renderer, grid, &settings.iso);
+        }
         Ok(Self { renderer, target: OffscreenTarget::new(&ctx.device, size) })
     }
 

@@ -11,6 +11,8 @@ mod element_table;
 pub mod elements;
 pub mod grid;
 pub mod gto;
+pub mod isosurface;
+pub mod measure;
 pub mod molecule;
 pub mod orbitals;
 pub mod overlap;

@@ -139,16 +139,7 @@ impl Tracks {
 /// considered as its continuation.
 const FOLLOW_WINDOW: usize = 3;
 
-/// The dihedral angle i–j–k–l (degrees, −180..180], IUPAC sign: positive when, looking along
-/// j→k, the far bond k–l is turned clockwise from the near bond j–i.
-pub fn dihedral(p: [DVec3; 4]) -> f64 {
-    let (b1, b2, b3) = (p[1] - p[0], p[2] - p[1], p[3] - p[2]);
-    let n1 = b1.cross(b2);
-    let n2 = b2.cross(b3);
-    let y = b2.length() * b1.dot(n2);
-    let x = n1.dot(n2);
-    y.atan2(x).to_degrees()
-}
+pub use super::measure::dihedral;
 
 /// `angle` wrapped to (−180, 180].
 pub fn wrap_degrees(angle: f64) -> f64 {

@@ -6,5 +6,5 @@ pub mod slicing;
 pub mod transfer;
 
 pub use camera::Camera;
-pub use settings::{AtomStyle, Interpolation, RenderSettings, SliceMode, VolumeSettings};
+pub use settings::{AtomStyle, Interpolation, IsoLevel, IsosurfaceSettings, RenderSettings, SliceMode, VolumeSettings};
 pub use transfer::{ClipPlane, Shape, Transfer, TransferKind};

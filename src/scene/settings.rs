@@ -69,16 +69,68 @@ pub enum AtomStyle {
     Hidden,
 }
 
+/// Where an isosurface lies: an absolute value (atomic units: ψ in bohr^−3/2, ρ in bohr^−3) or
+/// a multiple of the grid's standard deviation σ.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum IsoLevel {
+    Absolute(f32),
+    Sigma(f32),
+}
+
+impl IsoLevel {
+    /// The absolute value for a grid whose values have standard deviation `sigma`.
+    pub fn value(self, sigma: f64) -> f32 {
+        match self {
+            IsoLevel::Absolute(v) => v.abs(),
+            IsoLevel::Sigma(s) => (s.abs() as f64 * sigma) as f32,
+        }
+    }
+}
+
+/// Opaque isosurfaces of the volume shown: ψ = ±v for an orbital in the two sign colours, ρ = v
+/// for a density.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct IsosurfaceSettings {
+    pub visible: bool,
+    pub level: IsoLevel,
+    /// Linear RGB of the ψ = +v surface.
+    pub positive_color: [f32; 3],
+    /// Linear RGB of the ψ = −v surface.
+    pub negative_color: [f32; 3],
+    /// Linear RGB of a density's surface.
+    pub density_color: [f32; 3],
+}
+
+impl Default for IsosurfaceSettings {
+    fn default() -> Self {
+        Self {
+            visible: false,
+            // The value Avogadro, Jmol and GaussView open orbitals at.
+            level: IsoLevel::Absolute(0.05),
+            positive_color: [0.85, 0.10, 0.08],
+            negative_color: [0.08, 0.25, 0.85],
+            density_color: [0.55, 0.62, 0.75],
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
 pub struct RenderSettings {
     pub volume: VolumeSettings,
     pub atoms: AtomStyle,
+    pub iso: IsosurfaceSettings,
     /// Linear RGB background.
     pub background: [f32; 3],
 }
 
 impl Default for RenderSettings {
     fn default() -> Self {
-        Self { volume: VolumeSettings::default(), atoms: AtomStyle::default(), background: [0.02, 0.02, 0.03] }
+        Self {
+            volume: VolumeSettings::default(),
+            atoms: AtomStyle::default(),
+            iso: IsosurfaceSettings::default(),
+            background: [0.02, 0.02, 0.03],
+        }
     }
 }

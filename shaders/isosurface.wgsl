@@ -1,0 +1,59 @@
+// Opaque isosurfaces: a triangle mesh per surface, lit with the field's gradient as the normal,
+// writing colour, depth and the surface's pick id.
+
+struct SurfaceUniforms {
+    clip_from_world: mat4x4<f32>,
+    // xyz: eye position (bohr)
+    eye: vec4<f32>,
+    // xyz: unit direction towards the light
+    light: vec4<f32>,
+    // rgb: linear colour
+    color: vec4<f32>,
+    // x: pick id
+    pick: vec4<u32>,
+};
+
+@group(0) @binding(0) var<uniform> u: SurfaceUniforms;
+
+struct VertexOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) world: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+};
+
+@vertex
+fn vs_main(@location(0) position: vec3<f32>, @location(1) normal: vec3<f32>) -> VertexOut {
+    var out: VertexOut;
+    out.clip = u.clip_from_world * vec4<f32>(position, 1.0);
+    out.world = position;
+    out.normal = normal;
+    return out;
+}
+
+struct FragOut {
+    @location(0) color: vec4<f32>,
+    @location(1) id: u32,
+};
+
+@fragment
+fn fs_main(in: VertexOut) -> FragOut {
+    let view = normalize(u.eye.xyz - in.world);
+    var n = normalize(in.normal);
+    // A surface cut open by the grid's box shows its inside: light that side too, a little
+    // darker so the cut reads as one.
+    var inner = 1.0;
+    if (dot(n, view) < 0.0) {
+        n = -n;
+        inner = 0.6;
+    }
+    let l = u.light.xyz;
+    let diffuse = max(dot(n, l), 0.0);
+    let h = normalize(l + view);
+    let specular = pow(max(dot(n, h), 0.0), 40.0);
+    let rim = pow(1.0 - max(dot(n, view), 0.0), 3.0);
+    let base = u.color.rgb * inner;
+    var out: FragOut;
+    out.color = vec4<f32>(base * (0.25 + 0.75 * diffuse) + vec3<f32>(0.3 * specular + 0.06 * rim) * inner, 1.0);
+    out.id = u.pick.x;
+    return out;
+}

@@ -1,0 +1,131 @@
+//! Picking atoms in the view and measuring between them: a click selects an atom, Shift-click
+//! adds to the selection, and 2, 3 or 4 selected atoms give a distance, an angle or a dihedral,
+//! kept in a list and drawn in the view.
+
+use egui::{Color32, RichText, Stroke};
+
+use super::viewport::{Click, Viewport};
+use crate::gpu::frame::PickId;
+use crate::model::Molecule;
+use crate::model::measure::Measurement;
+use crate::model::units::ANGSTROM_PER_BOHR;
+use crate::scene::Camera;
+
+/// The picked atoms and the measurements kept: plain data.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Measurements {
+    /// Atoms picked, in order (at most four).
+    pub selection: Vec<usize>,
+    pub list: Vec<Measurement>,
+}
+
+impl Measurements {
+    /// Applies a click; returns a status line describing what was picked.
+    pub fn click(&mut self, click: Click, molecule: &Molecule) -> String {
+        let Some(PickId::Atom { index, .. }) = click.picked else {
+            if click.picked.is_none() && !click.shift {
+                self.selection.clear();
+            }
+            return match click.picked {
+                Some(PickId::Surface { index, .. }) => format!("isosurface {}", index + 1),
+                _ => String::new(),
+            };
+        };
+        let atom = index as usize;
+        let Some(a) = molecule.atoms.get(atom) else { return String::new() };
+        let extends = click.shift && self.selection.len() < 4 && !self.selection.contains(&atom);
+        if !extends {
+            self.selection.clear();
+        }
+        self.selection.push(atom);
+        if let Some(m) = Measurement::new(&self.selection) {
+            // Growing a selection turns its distance into an angle, then a dihedral.
+            let grown = self.list.last().is_some_and(|last| self.selection.starts_with(&last.atoms));
+            if grown {
+                self.list.pop();
+            }
+            let label = m.label(molecule);
+            self.list.push(m);
+            return label;
+        }
+        let p = a.position * ANGSTROM_PER_BOHR;
+        format!("atom {} {} at {:.3} {:.3} {:.3} Å", atom + 1, a.element().symbol, p.x, p.y, p.z)
+    }
+}
+
+const COLOR: Color32 = Color32::from_rgb(255, 220, 90);
+
+/// Draws the selection and the measurements over the view.
+pub fn overlay(ui: &egui::Ui, vp: &Viewport, camera: &Camera, molecule: &Molecule, m: &Measurements) {
+    let painter = ui.painter();
+    let screen = |i: usize| molecule.atoms.get(i).and_then(|a| vp.to_screen(camera, a.position.as_vec3()));
+    for &i in &m.selection {
+        if let Some(p) = screen(i) {
+            painter.circle_stroke(p, 9.0, Stroke::new(2.0, COLOR));
+        }
+    }
+    for measurement in &m.list {
+        let points: Option<Vec<egui::Pos2>> = measurement.atoms.iter().map(|&i| screen(i)).collect();
+        let Some(points) = points else { continue };
+        painter.add(egui::Shape::dashed_line(&points, Stroke::new(1.5, COLOR), 6.0, 4.0));
+        let mid = points.iter().fold(egui::Vec2::ZERO, |s, p| s + p.to_vec2()) / points.len() as f32;
+        let text = measurement.label(molecule);
+        let value = text.rsplit_once(' ').map_or(text.as_str(), |(_, v)| v).to_string();
+        painter.text(
+            mid.to_pos2() + egui::vec2(6.0, -6.0),
+            egui::Align2::LEFT_BOTTOM,
+            value,
+            egui::FontId::proportional(15.0),
+            COLOR,
+        );
+    }
+}
+
+/// The side-panel list of measurements, each removable.
+pub fn panel(ui: &mut egui::Ui, molecule: &Molecule, m: &mut Measurements) {
+    ui.heading("Measurements");
+    if m.list.is_empty() {
+        ui.label(RichText::new("click an atom; Shift-click 2, 3 or 4 atoms to measure").small().weak());
+    }
+    let mut remove = None;
+    for (n, measurement) in m.list.iter().enumerate() {
+        ui.horizontal(|ui| {
+            if ui.small_button("✕").on_hover_text("remove").clicked() {
+                remove = Some(n);
+            }
+            ui.label(measurement.label(molecule));
+        });
+    }
+    if let Some(n) = remove {
+        m.list.remove(n);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::Atom;
+    use glam::DVec3;
+
+    #[test]
+    fn shift_clicks_grow_a_distance_into_an_angle_and_a_dihedral() {
+        let atom = |x: f64, y: f64, z: f64| Atom { z: 6, charge: 6.0, position: DVec3::new(x, y, z), ghost: false };
+        let mol =
+            Molecule::new(vec![atom(0.0, 2.0, 0.0), atom(0.0, 0.0, 0.0), atom(2.8, 0.0, 0.0), atom(2.8, 0.0, 2.0)]);
+        let mut m = Measurements::default();
+        let pick = |i: u32, shift| Click { picked: Some(PickId::Atom { object: 0, index: i }), shift };
+        assert!(m.click(pick(0, false), &mol).starts_with("atom 1 C"));
+        assert!(m.click(pick(1, true), &mol).ends_with("Å"));
+        m.click(pick(2, true), &mol);
+        let label = m.click(pick(3, true), &mol);
+        assert_eq!(m.list.len(), 1, "one dihedral, not a distance, an angle and a dihedral");
+        assert_eq!(m.list[0].atoms, vec![0, 1, 2, 3]);
+        assert!(label.ends_with("90.0°"), "{label}");
+        // A plain click starts again; the kept dihedral stays.
+        m.click(pick(2, false), &mol);
+        m.click(pick(1, true), &mol);
+        assert_eq!(m.list.len(), 2);
+        m.click(Click { picked: None, shift: false }, &mol);
+        assert!(m.selection.is_empty());
+    }
+}

@@ -1,0 +1,247 @@
+//! The frame as data: named targets that every pass shares, and the phases that draw into them,
+//! in the order the frame description gives.
+//!
+//! A representation (atoms, a cloud, an isosurface, later point splats or order-independent
+//! transparency) implements [`Draw`]: it says in which phases it draws and records its draws when
+//! the renderer opens that phase's render pass. Adding one means adding a drawer, not editing the
+//! frame.
+
+use super::{DEPTH_FORMAT, SCENE_FORMAT};
+
+/// Per-pixel object ids for picking (0: nothing).
+pub const ID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
+
+/// A target of the frame, by name.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Target {
+    /// Linear float colour (HDR): the scene is composited here.
+    Color,
+    /// Depth of the opaque geometry; a texture later phases can also sample.
+    Depth,
+    /// The id of the opaque surface in each pixel ([`PickId`]), read back for picking.
+    Ids,
+    /// The caller's 8-bit sRGB view.
+    Output,
+}
+
+/// One phase: one render pass over the shared targets.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Phase {
+    /// Opaque geometry (atoms, isosurfaces): clears colour, depth and ids, writes all three.
+    Opaque,
+    /// Translucent clouds back to front: blends over colour, tests depth without writing it.
+    Translucent,
+    /// Copies the float colour into the caller's output.
+    Resolve,
+}
+
+/// What a phase reads and writes, so the order can be checked and shown.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PhaseNode {
+    pub phase: Phase,
+    pub label: &'static str,
+    pub reads: &'static [Target],
+    pub writes: &'static [Target],
+}
+
+/// The frame every host draws: opaque geometry, then translucent clouds over it, then resolve.
+pub const STANDARD_FRAME: &[PhaseNode] = &[
+    PhaseNode {
+        phase: Phase::Opaque,
+        label: "opaque",
+        reads: &[],
+        writes: &[Target::Color, Target::Depth, Target::Ids],
+    },
+    PhaseNode {
+        phase: Phase::Translucent,
+        label: "translucent",
+        reads: &[Target::Color, Target::Depth],
+        writes: &[Target::Color],
+    },
+    PhaseNode { phase: Phase::Resolve, label: "resolve", reads: &[Target::Color], writes: &[Target::Output] },
+];
+
+/// True when every target a phase reads was written by an earlier phase.
+pub fn is_ordered(frame: &[PhaseNode]) -> bool {
+    frame
+        .iter()
+        .enumerate()
+        .all(|(n, node)| node.reads.iter().all(|t| frame[..n].iter().any(|earlier| earlier.writes.contains(t))))
+}
+
+/// A representation that draws in some phases of the frame.
+pub trait Draw {
+    /// The phases it draws in.
+    fn phases(&self) -> &'static [Phase];
+    /// Records its draws into the open render pass of `phase`.
+    fn draw(&self, phase: Phase, pass: &mut wgpu::RenderPass<'_>);
+}
+
+/// What an id in the [`Target::Ids`] target names. Bits 30–31: the kind; 24–29: the object;
+/// 0–23: the atom or surface within it (enough for 16 million atoms).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PickId {
+    Atom { object: u32, index: u32 },
+    Surface { object: u32, index: u32 },
+}
+
+const KIND_SHIFT: u32 = 30;
+const OBJECT_SHIFT: u32 = 24;
+const INDEX_MASK: u32 = (1 << OBJECT_SHIFT) - 1;
+
+impl PickId {
+    /// The high bits of every id of `kind` (1 atoms, 2 surfaces) in `object`; a shader adds the
+    /// index.
+    pub fn base(kind: u32, object: u32) -> u32 {
+        kind << KIND_SHIFT | (object & 0x3f) << OBJECT_SHIFT
+    }
+
+    pub fn atom_base(object: u32) -> u32 {
+        Self::base(1, object)
+    }
+
+    pub fn surface_base(object: u32) -> u32 {
+        Self::base(2, object)
+    }
+
+    pub fn encode(self) -> u32 {
+        match self {
+            PickId::Atom { object, index } => Self::atom_base(object) | (index & INDEX_MASK),
+            PickId::Surface { object, index } => Self::surface_base(object) | (index & INDEX_MASK),
+        }
+    }
+
+    pub fn decode(raw: u32) -> Option<Self> {
+        let (object, index) = ((raw >> OBJECT_SHIFT) & 0x3f, raw & INDEX_MASK);
+        match raw >> KIND_SHIFT {
+            1 => Some(PickId::Atom { object, index }),
+            2 => Some(PickId::Surface { object, index }),
+            _ => None,
+        }
+    }
+}
+
+/// The targets of one frame size; rebuilt when the size changes.
+pub struct FrameTargets {
+    pub size: [u32; 2],
+    pub color_view: wgpu::TextureView,
+    pub depth: wgpu::Texture,
+    pub depth_view: wgpu::TextureView,
+    pub ids: wgpu::Texture,
+    pub ids_view: wgpu::TextureView,
+}
+
+impl FrameTargets {
+    pub fn new(device: &wgpu::Device, size: [u32; 2]) -> Self {
+        let size = [size[0].max(1), size[1].max(1)];
+        let texture = |label, format, usage| {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d { width: size[0], height: size[1], depth_or_array_layers: 1 },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | usage,
+                view_formats: &[],
+            })
+        };
+        let read = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
+        let color = texture("frame colour", SCENE_FORMAT, wgpu::TextureUsages::TEXTURE_BINDING);
+        let depth = texture("frame depth", DEPTH_FORMAT, read);
+        let ids = texture("frame ids", ID_FORMAT, wgpu::TextureUsages::COPY_SRC);
+        Self {
+            size,
+            color_view: color.create_view(&Default::default()),
+            depth_view: depth.create_view(&Default::default()),
+            ids_view: ids.create_view(&Default::default()),
+            depth,
+            ids,
+        }
+    }
+
+    /// Opens the render pass of a drawing phase (not [`Phase::Resolve`]) over these targets.
+    pub fn begin<'e>(
+        &self,
+        encoder: &'e mut wgpu::CommandEncoder,
+        node: &PhaseNode,
+        background: [f32; 3],
+    ) -> wgpu::RenderPass<'e> {
+        let clear = node.phase == Phase::Opaque;
+        let attachment = |view, clear_to: wgpu::Color| wgpu::RenderPassColorAttachment {
+            view,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load: if clear { wgpu::LoadOp::Clear(clear_to) } else { wgpu::LoadOp::Load },
+                store: wgpu::StoreOp::Store,
+            },
+        };
+        let [r, g, b] = background.map(f64::from);
+        let mut colors = vec![Some(attachment(&self.color_view, wgpu::Color { r, g, b, a: 1.0 }))];
+        if node.writes.contains(&Target::Ids) {
+            colors.push(Some(attachment(&self.ids_view, wgpu::Color::TRANSPARENT)));
+        }
+        let depth_ops = node
+            .writes
+            .contains(&Target::Depth)
+            .then_some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store });
+        encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(node.label),
+            color_attachments: &colors,
+            // A phase that only reads depth opens it read-only.
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &self.depth_view,
+                depth_ops,
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        })
+    }
+}
+
+/// The colour targets of a pipeline drawing in [`Phase::Opaque`]: scene colour, then ids.
+pub fn opaque_targets() -> [Option<wgpu::ColorTargetState>; 2] {
+    [
+        Some(wgpu::ColorTargetState { format: SCENE_FORMAT, blend: None, write_mask: wgpu::ColorWrites::ALL }),
+        Some(wgpu::ColorTargetState { format: ID_FORMAT, blend: None, write_mask: wgpu::ColorWrites::ALL }),
+    ]
+}
+
+/// Depth state of opaque geometry: tested and written.
+pub fn opaque_depth() -> wgpu::DepthStencilState {
+    wgpu::DepthStencilState {
+        format: DEPTH_FORMAT,
+        depth_write_enabled: Some(true),
+        depth_compare: Some(wgpu::CompareFunction::Less),
+        stencil: Default::default(),
+        bias: Default::default(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_standard_frame_reads_only_what_was_written() {
+        assert!(is_ordered(STANDARD_FRAME));
+        let mut reversed = STANDARD_FRAME.to_vec();
+        reversed.reverse();
+        assert!(!is_ordered(&reversed));
+    }
+
+    #[test]
+    fn pick_ids_round_trip() {
+        for id in [
+            PickId::Atom { object: 0, index: 0 },
+            PickId::Atom { object: 5, index: 999_999 },
+            PickId::Surface { object: 63, index: 1 },
+        ] {
+            assert_eq!(PickId::decode(id.encode()), Some(id));
+        }
+        assert_eq!(PickId::decode(0), None);
+    }
+}

@@ -1,0 +1,174 @@
+//! Opaque, lit isosurfaces: one triangle mesh per surface (an orbital's +v and −v, a density's
+//! one), drawn in the opaque phase with depth and pick ids.
+
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat4, Vec3};
+use wgpu::util::DeviceExt;
+
+use super::GpuContext;
+use super::frame::{Draw, Phase, PickId, opaque_depth, opaque_targets};
+use crate::model::isosurface::Mesh;
+
+/// Mirror of `SurfaceUniforms` in isosurface.wgsl.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+pub struct SurfaceUniforms {
+    pub clip_from_world: [[f32; 4]; 4],
+    pub eye: [f32; 4],
+    pub light: [f32; 4],
+    pub color: [f32; 4],
+    pub pick: [u32; 4],
+}
+const _: () = assert!(std::mem::size_of::<SurfaceUniforms>() == 128);
+
+/// Interleaved position and normal, as the vertex buffer holds them.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+struct SurfaceVertex {
+    position: [f32; 3],
+    normal: [f32; 3],
+}
+
+struct GpuSurface {
+    vertices: wgpu::Buffer,
+    indices: wgpu::Buffer,
+    index_count: u32,
+    uniforms: wgpu::Buffer,
+    bind_group: wgpu::BindGroup,
+    color: [f32; 3],
+    pick: u32,
+}
+
+pub struct IsosurfacePass {
+    pipeline: wgpu::RenderPipeline,
+    layout: wgpu::BindGroupLayout,
+    surfaces: Vec<GpuSurface>,
+}
+
+impl IsosurfacePass {
+    pub fn new(ctx: &GpuContext) -> Self {
+        let device = &ctx.device;
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("isosurface.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(super::shader_source("isosurface.wgsl").into()),
+        });
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("isosurface bind group layout"),
+            entries: &[super::uniform_entry(0, wgpu::ShaderStages::VERTEX_FRAGMENT)],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("isosurface pipeline layout"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("isosurfaces"),
+            layout: Some(&pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[Some(wgpu::VertexBufferLayout {
+                    array_stride: std::mem::size_of::<SurfaceVertex>() as u64,
+                    step_mode: wgpu::VertexStepMode::Vertex,
+                    attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3],
+                })],
+            },
+            // Both sides: a surface cut by the grid's box shows its inside.
+            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+            depth_stencil: Some(opaque_depth()),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets: &opaque_targets(),
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        Self { pipeline, layout, surfaces: Vec::new() }
+    }
+
+    /// Replaces the surfaces shown: each mesh with its linear RGB colour. Surface `n` picks as
+    /// `PickId::Surface { object, index: n }`.
+    pub fn set_meshes(&mut self, ctx: &GpuContext, object: u32, meshes: &[(&Mesh, [f32; 3])]) {
+        let device = &ctx.device;
+        self.surfaces = meshes
+            .iter()
+            .enumerate()
+            .filter(|(_, (mesh, _))| !mesh.is_empty())
+            .map(|(n, (mesh, color))| {
+                let vertices: Vec<SurfaceVertex> = mesh
+                    .positions
+                    .iter()
+                    .zip(&mesh.normals)
+                    .map(|(p, n)| SurfaceVertex { position: p.to_array(), normal: n.to_array() })
+                    .collect();
+                let vertices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("isosurface vertices"),
+                    contents: bytemuck::cast_slice(&vertices),
+                    usage: wgpu::BufferUsages::VERTEX,
+                });
+                let indices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("isosurface indices"),
+                    contents: bytemuck::cast_slice(&mesh.indices),
+                    usage: wgpu::BufferUsages::INDEX,
+                });
+                let uniforms = super::uniform_buffer(device, "isosurface uniforms", size_of::<SurfaceUniforms>());
+                let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("isosurface bind group"),
+                    layout: &self.layout,
+                    entries: &[wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() }],
+                });
+                let pick = PickId::Surface { object, index: n as u32 }.encode();
+                GpuSurface {
+                    vertices,
+                    indices,
+                    index_count: mesh.indices.len() as u32,
+                    uniforms,
+                    bind_group,
+                    color: *color,
+                    pick,
+                }
+            })
+            .collect();
+    }
+
+    pub fn clear(&mut self) {
+        self.surfaces.clear();
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.surfaces.is_empty()
+    }
+
+    pub fn prepare(&self, queue: &wgpu::Queue, clip_from_world: Mat4, eye: Vec3, light: Vec3) {
+        for s in &self.surfaces {
+            let u = SurfaceUniforms {
+                clip_from_world: clip_from_world.to_cols_array_2d(),
+                eye: eye.extend(1.0).to_array(),
+                light: light.extend(0.0).to_array(),
+                color: [s.color[0], s.color[1], s.color[2], 1.0],
+                pick: [s.pick, 0, 0, 0],
+            };
+            queue.write_buffer(&s.uniforms, 0, bytemuck::bytes_of(&u));
+        }
+    }
+}
+
+impl Draw for IsosurfacePass {
+    fn phases(&self) -> &'static [Phase] {
+        &[Phase::Opaque]
+    }
+
+    fn draw(&self, _phase: Phase, pass: &mut wgpu::RenderPass<'_>) {
+        pass.set_pipeline(&self.pipeline);
+        for s in &self.surfaces {
+            pass.set_bind_group(0, &s.bind_group, &[]);
+            pass.set_vertex_buffer(0, s.vertices.slice(..));
+            pass.set_index_buffer(s.indices.slice(..), wgpu::IndexFormat::Uint32);
+            pass.draw_indexed(0..s.index_count, 0, 0..1);
+        }
+    }
+}

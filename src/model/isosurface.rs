@@ -1,0 +1,408 @@
+//! Isosurfaces of a grid by marching cubes, in parallel over slabs of cells.
+//!
+//! The case table is not typed in: it is derived once from the cube's faces. On each face the
+//! corners "inside" (value above the level) form runs in the face's cyclic order; each run is cut
+//! off by one segment from the edge where the walk enters it to the edge where it leaves. Two
+//! faces sharing an edge walk it in opposite directions, so the segments chain into closed loops,
+//! one polygon each. An ambiguous face (diagonal corners inside) always separates its inside
+//! corners, and because that choice depends on the face alone, neighbouring cells agree and the
+//! surface is closed. Normals come from the field's gradient, not from the triangles.
+
+use std::sync::LazyLock;
+
+use glam::{DMat3, DVec3, Vec3};
+use rayon::prelude::*;
+
+use super::VolumeGrid;
+
+/// A triangle mesh in world coordinates (bohr). Triangles wind counter-clockwise seen from
+/// outside (where the field is below the level); normals point outside.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Mesh {
+    pub positions: Vec<Vec3>,
+    pub normals: Vec<Vec3>,
+    pub indices: Vec<u32>,
+}
+
+impl Mesh {
+    pub fn triangle_count(&self) -> usize {
+        self.indices.len() / 3
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.indices.is_empty()
+    }
+
+    /// Total area (bohr²).
+    pub fn area(&self) -> f64 {
+        self.triangles().map(|[a, b, c]| 0.5 * (b - a).cross(c - a).length()).sum()
+    }
+
+    /// The corner positions of each triangle, in double precision.
+    pub fn triangles(&self) -> impl Iterator<Item = [DVec3; 3]> + '_ {
+        self.indices.chunks_exact(3).map(|t| std::array::from_fn(|c| self.positions[t[c] as usize].as_dvec3()))
+    }
+
+    /// Merges vertices at bit-identical positions (marching cubes computes a shared edge's
+    /// vertex the same way in both slabs that meet there), giving a closed surface one vertex
+    /// per point: what mesh files and topology checks want.
+    pub fn welded(&self) -> Mesh {
+        let mut map = std::collections::HashMap::with_capacity(self.positions.len());
+        let mut out = Mesh::default();
+        let remap: Vec<u32> = self
+            .positions
+            .iter()
+            .zip(&self.normals)
+            .map(|(p, n)| {
+                *map.entry(p.to_array().map(f32::to_bits)).or_insert_with(|| {
+                    out.positions.push(*p);
+                    out.normals.push(*n);
+                    (out.positions.len() - 1) as u32
+                })
+            })
+            .collect();
+        out.indices = self.indices.iter().map(|&i| remap[i as usize]).collect();
+        out
+    }
+
+    fn append(&mut self, other: Mesh) {
+        let base = self.positions.len() as u32;
+        self.positions.extend(other.positions);
+        self.normals.extend(other.normals);
+        self.indices.extend(other.indices.into_iter().map(|i| i + base));
+    }
+}
+
+/// One surface to extract: where `sign·value = level` (level > 0 for orbitals' ± pair), the
+/// inside being `sign·value > level`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Level {
+    pub value: f32,
+    pub sign: f32,
+}
+
+impl Level {
+    /// The surfaces an iso value gives: +v and −v for a signed field, v alone otherwise.
+    pub fn pair(iso: f32, signed: bool) -> Vec<Level> {
+        let iso = iso.abs();
+        let mut levels = vec![Level { value: iso, sign: 1.0 }];
+        if signed {
+            levels.push(Level { value: iso, sign: -1.0 });
+        }
+        levels
+    }
+}
+
+/// Cube corner `c` sits at offset (c & 1, c >> 1 & 1, c >> 2 & 1) along the grid axes (i, j, k).
+fn corner(c: usize) -> [usize; 3] {
+    [c & 1, (c >> 1) & 1, (c >> 2) & 1]
+}
+
+/// The 12 edges as corner pairs (low corner first), grouped by axis.
+static EDGES: LazyLock<[(usize, usize, usize); 12]> = LazyLock::new(|| {
+    let mut edges = [(0, 0, 0); 12];
+    let mut n = 0;
+    for axis in 0..3 {
+        for c in (0..8).filter(|c| c & (1 << axis) == 0) {
+            edges[n] = (c, c | 1 << axis, axis);
+            n += 1;
+        }
+    }
+    edges
+});
+
+fn edge_between(a: usize, b: usize) -> usize {
+    EDGES.iter().position(|&(p, q, _)| (p, q) == (a.min(b), a.max(b))).expect("corners share an edge")
+}
+
+/// Per case (bit c set: corner c inside), triangles as triples of edge numbers.
+static CASES: LazyLock<Vec<Vec<[u8; 3]>>> = LazyLock::new(|| (0..256).map(triangulate_case).collect());
+
+/// The six faces, each as its four corners counter-clockwise seen from outside the cube.
+fn faces() -> Vec<[usize; 4]> {
+    let mut faces = Vec::new();
+    for axis in 0..3 {
+        let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+        for side in 0..2 {
+            // Counter-clockwise about +axis in the (u, v) plane; reversed on the low side,
+            // whose outward normal is −axis.
+            let mut ring: Vec<usize> =
+                [(0, 0), (1, 0), (1, 1), (0, 1)].iter().map(|&(a, b)| side << axis | a << u | b << v).collect();
+            if side == 0 {
+                ring.reverse();
+            }
+            faces.push([ring[0], ring[1], ring[2], ring[3]]);
+        }
+    }
+    faces
+}
+
+fn triangulate_case(case: usize) -> Vec<[u8; 3]> {
+    let inside = |c: usize| case & (1 << c) != 0;
+    // next[e]: the edge where the loop through edge e continues.
+    let mut next = [usize::MAX; 12];
+    for ring in faces() {
+        for t in 0..4 {
+            let prev = ring[(t + 3) % 4];
+            if !inside(ring[t]) || inside(prev) {
+                continue;
+            }
+            // A run of inside corners starts at t; it ends before the first outside corner.
+            let mut u = t;
+            while inside(ring[(u + 1) % 4]) {
+                u = (u + 1) % 4;
+            }
+            next[edge_between(prev, ring[t])] = edge_between(ring[u], ring[(u + 1) % 4]);
+        }
+    }
+    let mut triangles = Vec::new();
+    let mut seen = [false; 12];
+    for start in 0..12 {
+        if next[start] == usize::MAX || seen[start] {
+            continue;
+        }
+        let mut polygon = Vec::new();
+        let mut e = start;
+        while !seen[e] {
+            seen[e] = true;
+            polygon.push(e as u8);
+            e = next[e];
+        }
+        // The walk runs counter-clockwise seen from outside the surface (the side away from the
+        // inside corners): fan it in that order.
+        for w in 1..polygon.len() - 1 {
+            triangles.push([polygon[0], polygon[w], polygon[w + 1]]);
+        }
+    }
+    triangles
+}
+
+/// The field's gradient (world units) at grid points by central differences, one-sided at the
+/// borders.
+struct Gradient<'a> {
+    grid: &'a VolumeGrid,
+    /// ∇_world = J⁻ᵀ ∇_index, J the step vectors as columns.
+    inv_t: DMat3,
+}
+
+impl Gradient<'_> {
+    fn at(&self, p: [usize; 3]) -> DVec3 {
+        let g = self.grid;
+        let mut d = DVec3::ZERO;
+        for a in 0..3 {
+            let (mut lo, mut hi) = (p, p);
+            lo[a] = p[a].saturating_sub(1);
+            hi[a] = (p[a] + 1).min(g.dims[a] - 1);
+            let span = (hi[a] - lo[a]).max(1) as f64;
+            d[a] = (g.value(hi[0], hi[1], hi[2]) - g.value(lo[0], lo[1], lo[2])) as f64 / span;
+        }
+        self.inv_t * d
+    }
+}
+
+/// Extracts one mesh per level. Cost is one pass over the grid for all levels together.
+pub fn extract(grid: &VolumeGrid, levels: &[Level]) -> Vec<Mesh> {
+    let [nx, ny, nz] = grid.dims;
+    if nx < 2 || ny < 2 || nz < 2 || levels.is_empty() {
+        return vec![Mesh::default(); levels.len()];
+    }
+    let jac = DMat3::from_cols(grid.step(0), grid.step(1), grid.step(2));
+    let gradient = Gradient { grid, inv_t: jac.inverse().transpose() };
+    let slabs: Vec<Vec<Mesh>> = (0..nx - 1).into_par_iter().map(|i| slab(grid, &gradient, levels, i)).collect();
+    let mut meshes = vec![Mesh::default(); levels.len()];
+    for slab in slabs {
+        for (mesh, part) in meshes.iter_mut().zip(slab) {
+            mesh.append(part);
+        }
+    }
+    meshes
+}
+
+/// Vertices already made on this slab's edges, per level: x edges at (j, k), and y and z edges
+/// on the slab's two planes.
+struct EdgeCache {
+    x: Vec<u32>,
+    y: [Vec<u32>; 2],
+    z: [Vec<u32>; 2],
+}
+
+/// The cells between planes i and i + 1.
+fn slab(grid: &VolumeGrid, gradient: &Gradient, levels: &[Level], i: usize) -> Vec<Mesh> {
+    let [_, ny, nz] = grid.dims;
+    let plane = ny * nz;
+    let values = [&grid.values[i * plane..(i + 1) * plane], &grid.values[(i + 1) * plane..(i + 2) * plane]];
+    levels
+        .iter()
+        .map(|level| {
+            // Inside flags of both planes, so each cell's case is eight byte loads.
+            let inside: [Vec<u8>; 2] =
+                values.map(|v| v.iter().map(|&x| u8::from(level.sign * x > level.value)).collect());
+            let mut cache = EdgeCache {
+                x: vec![u32::MAX; plane],
+                y: [vec![u32::MAX; plane], vec![u32::MAX; plane]],
+                z: [vec![u32::MAX; plane], vec![u32::MAX; plane]],
+            };
+            let mut mesh = Mesh::default();
+            for j in 0..ny - 1 {
+                for k in 0..nz - 1 {
+                    let mut case = 0usize;
+                    for c in 0..8 {
+                        let [dx, dy, dz] = corner(c);
+                        case |= (inside[dx][(j + dy) * nz + k + dz] as usize) << c;
+                    }
+                    if case == 0 || case == 255 {
+                        continue;
+                    }
+                    for tri in &CASES[case] {
+                        for &e in tri {
+                            let v = vertex(grid, gradient, level, &mut cache, &mut mesh, [i, j, k], e as usize);
+                            mesh.indices.push(v);
+                        }
+                    }
+                }
+            }
+            mesh
+        })
+        .collect()
+}
+
+/// The vertex on edge `e` of cell `cell`, made once per slab.
+fn vertex(
+    grid: &VolumeGrid,
+    gradient: &Gradient,
+    level: &Level,
+    cache: &mut EdgeCache,
+    mesh: &mut Mesh,
+    cell: [usize; 3],
+    e: usize,
+) -> u32 {
+    let nz = grid.dims[2];
+    let (c0, c1, axis) = EDGES[e];
+    let [dx, dy, dz] = corner(c0);
+    let [_, j, k] = cell;
+    let slot = match axis {
+        0 => &mut cache.x[(j + dy) * nz + k + dz],
+        1 => &mut cache.y[dx][j * nz + k + dz],
+        _ => &mut cache.z[dx][(j + dy) * nz + k],
+    };
+    if *slot != u32::MAX {
+        return *slot;
+    }
+    let p0 = std::array::from_fn(|a| cell[a] + corner(c0)[a]);
+    let p1 = std::array::from_fn(|a| cell[a] + corner(c1)[a]);
+    let (v0, v1) = (level.sign * grid.value(p0[0], p0[1], p0[2]), level.sign * grid.value(p1[0], p1[1], p1[2]));
+    let t = ((level.value - v0) / (v1 - v0)).clamp(0.0, 1.0) as f64;
+    let mut g = DVec3::new(p0[0] as f64, p0[1] as f64, p0[2] as f64);
+    g[axis] += t;
+    let position = grid.world_from_grid.transform_point3(g).as_vec3();
+    // Outside is where the signed field falls: the normal is −∇(sign·value).
+    let grad = gradient.at(p0).lerp(gradient.at(p1), t) * level.sign as f64;
+    let normal = (-grad).normalize_or_zero().as_vec3();
+    mesh.positions.push(position);
+    mesh.normals.push(normal);
+    *slot = (mesh.positions.len() - 1) as u32;
+    *slot
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// f = R² − |x − c|² sampled on `n`³ points spanning ±1.5 R, optionally sheared.
+    fn ball(n: usize, radius: f64, shear: f64) -> VolumeGrid {
+        let h = 3.0 * radius / (n - 1) as f64;
+        let steps = [DVec3::new(h, 0.0, 0.0), DVec3::new(shear * h, h, 0.0), DVec3::new(0.0, shear * h, h)];
+        let origin = -(steps[0] + steps[1] + steps[2]) * ((n - 1) as f64 / 2.0) + DVec3::new(0.3, -0.2, 0.1);
+        let world = VolumeGrid::affine(origin, steps);
+        let center = DVec3::new(0.3, -0.2, 0.1);
+        let mut values = Vec::with_capacity(n * n * n);
+        for i in 0..n {
+            for j in 0..n {
+                for k in 0..n {
+                    let p = world.transform_point3(DVec3::new(i as f64, j as f64, k as f64));
+                    values.push((radius * radius - (p - center).length_squared()) as f32);
+                }
+            }
+        }
+        VolumeGrid::new("ball", [n, n, n], world, values)
+    }
+
+    #[test]
+    fn every_case_gives_closed_oriented_loops() {
+        // Each edge crossed by the surface (its corners differ) is used by one polygon, once.
+        for case in 0..256usize {
+            let crossed: Vec<usize> =
+                (0..12).filter(|&e| (case >> EDGES[e].0 & 1) != (case >> EDGES[e].1 & 1)).collect();
+            let mut used: Vec<usize> = CASES[case].iter().flatten().map(|&e| e as usize).collect();
+            used.sort();
+            used.dedup();
+            assert_eq!(used, crossed, "case {case:08b}");
+        }
+        assert!(CASES[0].is_empty() && CASES[255].is_empty());
+        assert_eq!(CASES[1].len(), 1);
+    }
+
+    #[test]
+    fn a_ball_is_closed_with_outward_normals_and_the_right_area() {
+        for shear in [0.0, 0.35] {
+            let r = 2.0;
+            let grid = ball(41, r, shear);
+            let mesh = extract(&grid, &[Level { value: 0.0, sign: 1.0 }]).remove(0);
+            let area = mesh.area();
+            let exact = 4.0 * std::f64::consts::PI * r * r;
+            assert!((area / exact - 1.0).abs() < 0.01, "shear {shear}: area {area} vs {exact}");
+            let center = DVec3::new(0.3, -0.2, 0.1);
+            for [a, b, c] in mesh.triangles() {
+                let n = (b - a).cross(c - a);
+                assert!(n.dot((a + b + c) / 3.0 - center) > 0.0, "a triangle winds inwards");
+            }
+            for (p, n) in mesh.positions.iter().zip(&mesh.normals) {
+                let exact = (p.as_dvec3() - center).normalize();
+                assert!(n.as_dvec3().dot(exact) > 0.995, "normal {n} at {p}");
+            }
+            // Closed: every edge of the welded mesh has exactly two triangles, in opposite
+            // directions, and V − E + F = 2 for a sphere.
+            let w = mesh.welded();
+            let mut directed = std::collections::HashMap::new();
+            for t in w.indices.chunks_exact(3) {
+                for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+                    *directed.entry((a, b)).or_insert(0) += 1;
+                }
+            }
+            assert!(directed.iter().all(|(&(a, b), &n)| n == 1 && directed.get(&(b, a)) == Some(&1)));
+            let (v, e, f) = (w.positions.len() as i64, directed.len() as i64 / 2, w.triangle_count() as i64);
+            assert_eq!(v - e + f, 2, "shear {shear}");
+        }
+    }
+
+    #[test]
+    fn a_signed_field_gives_two_surfaces() {
+        // ψ = x·exp(−r²): a p orbital, two lobes of equal area, mirror images.
+        let n = 33;
+        let h = 8.0 / (n - 1) as f64;
+        let world = VolumeGrid::affine(DVec3::splat(-4.0), [DVec3::X * h, DVec3::Y * h, DVec3::Z * h]);
+        let mut values = Vec::new();
+        for i in 0..n {
+            for j in 0..n {
+                for k in 0..n {
+                    let p = world.transform_point3(DVec3::new(i as f64, j as f64, k as f64));
+                    values.push((p.x * (-p.length_squared()).exp()) as f32);
+                }
+            }
+        }
+        let grid = VolumeGrid::new("p", [n, n, n], world, values);
+        let meshes = extract(&grid, &Level::pair(0.1, true));
+        let (plus, minus) = (&meshes[0], &meshes[1]);
+        assert!(plus.triangle_count() > 100);
+        assert!((plus.area() / minus.area() - 1.0).abs() < 1e-3);
+        assert!(plus.positions.iter().all(|p| p.x > 0.0) && minus.positions.iter().all(|p| p.x < 0.0));
+        // Normals point away from each lobe's centre.
+        let c = |m: &Mesh| m.positions.iter().copied().sum::<Vec3>() / m.positions.len() as f32;
+        for m in [plus, minus] {
+            let centre = c(m);
+            let outward = m.positions.iter().zip(&m.normals).filter(|(p, n)| (**p - centre).dot(**n) > 0.0).count();
+            assert!(outward as f64 > 0.97 * m.positions.len() as f64);
+        }
+        assert!(extract(&grid, &Level::pair(10.0, true)).iter().all(Mesh::is_empty));
+    }
+}
