@@ -65,9 +65,10 @@ enum Command {
         /// Grid spacing in bohr (same on every axis).
         #[arg(long)]
         spacing: Option<f64>,
-        /// Space around the atoms, bohr.
-        #[arg(long, default_value_t = 3.0)]
-        margin: f64,
+        /// Space around the atoms, bohr (default: the box where the orbital or density decays
+        /// to 1 % of its largest value).
+        #[arg(long)]
+        margin: Option<f64>,
         #[arg(short, long)]
         output: PathBuf,
     },
@@ -497,8 +498,11 @@ fn main() -> Result<()> {
             let doc = formats::load(&file)?;
             let wf = wavefunction_of(&doc)?;
             let q = what.resolve(wf)?;
-            let (lo, hi) = doc.molecule.bounds().ok_or_else(|| anyhow::anyhow!("{}: no atoms", doc.source))?;
-            let (lo, hi) = (lo - DVec3::splat(margin), hi + DVec3::splat(margin));
+            let (lo, hi) = match margin {
+                Some(m) => doc.molecule.bounds().map(|(lo, hi)| (lo - DVec3::splat(m), hi + DVec3::splat(m))),
+                None => orbcloud::model::extent::quantity_box(wf, &doc.molecule, q),
+            }
+            .ok_or_else(|| anyhow::anyhow!("{}: no atoms", doc.source))?;
             let dims = match spacing {
                 Some(h) if h > 0.0 => ((hi - lo) / h).ceil().as_uvec3().to_array().map(|n| n as usize + 1),
                 Some(h) => bail!("--spacing must be positive, got {h}"),

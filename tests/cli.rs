@@ -173,3 +173,60 @@ fn scan_export_writes_the_interpolated_orbital_and_render_writes_both_views() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("homo-7"));
 }
+
+const FIXTURES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/wavefunctions");
+
+#[test]
+fn mesh_writes_both_signs_of_an_orbital_and_refuses_unknown_formats() {
+    let dir = tempfile::tempdir().unwrap();
+    let molden = format!("{FIXTURES}/h2o_cart_631gs.molden");
+    for ext in ["obj", "ply", "glb"] {
+        let out = dir.path().join(format!("homo.{ext}"));
+        let run = orbcloud(&["mesh", &molden, "--iso", "0.05", "--grid-points", "40", "-o", out.to_str().unwrap()]);
+        assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+        let said = String::from_utf8_lossy(&run.stderr);
+        assert!(said.contains("psi_plus_0.05") && said.contains("psi_minus_0.05"), "{said}");
+        assert!(std::fs::metadata(&out).unwrap().len() > 10_000);
+    }
+    let obj = std::fs::read_to_string(dir.path().join("homo.obj")).unwrap();
+    assert_eq!(obj.lines().filter(|l| l.starts_with("o ")).count(), 2);
+    let density = dir.path().join("rho.obj");
+    let run = orbcloud(&[
+        "mesh",
+        &molden,
+        "--density",
+        "--iso",
+        "0.05",
+        "--grid-points",
+        "40",
+        "-o",
+        density.to_str().unwrap(),
+    ]);
+    assert!(run.status.success());
+    assert_eq!(std::fs::read_to_string(density).unwrap().lines().filter(|l| l.starts_with("o ")).count(), 1);
+    let bad = orbcloud(&["mesh", &molden, "--iso", "0.05", "-o", dir.path().join("x.stl").to_str().unwrap()]);
+    assert!(!bad.status.success() && String::from_utf8_lossy(&bad.stderr).contains(".obj, .ply or .glb"));
+    let none = orbcloud(&["mesh", &molden, "-o", dir.path().join("x.obj").to_str().unwrap()]);
+    assert!(!none.status.success() && String::from_utf8_lossy(&none.stderr).contains("--iso"));
+}
+
+#[test]
+fn render_with_isosurfaces_and_a_pick() {
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("iso.png");
+    let molden = format!("{FIXTURES}/h2o_cart_631gs.molden");
+    let args = ["render", &molden, "--lavapipe", "--size", "160x120", "--grid-points", "40", "--no-volume"];
+    let run = orbcloud(
+        &[&args[..], &["--iso", "0.05", "--iso-sigma", "4", "-o", png.to_str().unwrap(), "--pick", "80,60"]].concat(),
+    );
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let said = String::from_utf8_lossy(&run.stderr);
+    assert!(said.contains("isosurfaces: 4 surface(s)"), "{said}");
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(stdout.starts_with("pick 80,60: "), "{stdout}");
+    // The view's centre is the molecule's: an atom or a lobe is there, not background.
+    assert!(!stdout.contains("nothing"), "{stdout}");
+    let corner = orbcloud(&[&args[..], &["-o", png.to_str().unwrap(), "--pick", "0,0"]].concat());
+    assert!(String::from_utf8_lossy(&corner.stdout).contains("pick 0,0: nothing"));
+    assert!(!orbcloud(&[&args[..], &["-o", png.to_str().unwrap(), "--pick", "3"]].concat()).status.success());
+}

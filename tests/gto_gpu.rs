@@ -118,13 +118,14 @@ fn gpu_fill_of_real_orbitals_matches_the_cpu_evaluator() {
         let doc = orbcloud::formats::load(&std::path::Path::new(dir).join(name)).unwrap_or_else(|e| panic!("{e}"));
         let wf = doc.wavefunction.as_ref().unwrap();
         let prepared = PreparedBasis::new(&wf.basis);
-        let geometry = orbcloud::headless::orbital_geometry(&doc, 28).unwrap();
-        let spec = GridSpec::new(
-            geometry.world_from_grid.w_axis.truncate(),
-            std::array::from_fn(|a| geometry.world_from_grid.col(a).truncate()),
-            geometry.dims,
-        );
         for i in [wf.homo(orbcloud::model::Spin::Alpha).unwrap(), wf.lumo(orbcloud::model::Spin::Alpha).unwrap()] {
+            let quantity = orbcloud::model::orbitals::Quantity::Orbital(i);
+            let geometry = orbcloud::headless::orbital_geometry(&doc, quantity, 28).unwrap();
+            let spec = GridSpec::new(
+                geometry.world_from_grid.w_axis.truncate(),
+                std::array::from_fn(|a| geometry.world_from_grid.col(a).truncate()),
+                geometry.dims,
+            );
             let c = &wf.orbitals[i].coefficients;
             let e = CartesianExpansion::from_coefficients(&prepared, c);
             let gpu = read_volume(&ctx, &fill.fill(&ctx, &e, &geometry).unwrap()).unwrap();

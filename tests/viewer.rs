@@ -238,3 +238,58 @@ fn a_scan_too_large_for_the_gpu_offers_a_coarser_grid() {
     let scan = h.state().scan.as_ref().unwrap();
     assert!(scan.scene.bytes <= 1 << 20, "{} bytes", scan.scene.bytes);
 }
+
+/// A primary click at `pos`, with Shift held when `shift`.
+fn click_at(h: &mut Harness<'static, OrbApp>, pos: egui::Pos2, shift: bool) {
+    let modifiers = if shift { egui::Modifiers::SHIFT } else { egui::Modifiers::NONE };
+    h.event(egui::Event::ModifiersChanged(modifiers));
+    h.hover_at(pos);
+    let button = |pressed| egui::Event::PointerButton { pos, button: egui::PointerButton::Primary, pressed, modifiers };
+    h.event(button(true));
+    h.run_steps(1);
+    h.event(button(false));
+    h.run_steps(1);
+    h.event(egui::Event::ModifiersChanged(egui::Modifiers::NONE));
+    h.run_steps(1);
+}
+
+#[test]
+fn isosurfaces_follow_the_slider_and_atoms_are_picked_and_measured() {
+    let mut h = harness();
+    h.run_steps(2);
+    h.get_by_label("show ψ = ±value").click();
+    h.run_steps(2);
+    assert!(h.state().view.settings.iso.visible);
+    let first = h.state().status.clone();
+    assert!(first.starts_with("isosurfaces: ") && !first.starts_with("isosurfaces: 0 "), "{first}");
+    // Dragging the iso value changes the surfaces.
+    let slider = h.get_by_label("value (a.u.)").rect();
+    let from = slider.left_center() + egui::vec2(slider.width() * 0.3, 0.0);
+    h.drag_at(from);
+    h.run_steps(1);
+    h.hover_at(from + egui::vec2(slider.width() * 0.2, 0.0));
+    h.run_steps(1);
+    h.drop_at(from + egui::vec2(slider.width() * 0.2, 0.0));
+    h.run_steps(2);
+    let level = h.state().view.settings.iso.level;
+    assert_ne!(level, orbcloud::scene::IsoLevel::Absolute(0.05), "the slider moved");
+    assert_ne!(h.state().status, first, "the surfaces were cut anew: {}", h.state().status);
+
+    // Hide the surfaces and the cloud so the atoms are what the clicks hit.
+    h.get_by_label("show ψ = ±value").click();
+    h.get_by_label("show cloud").click();
+    h.run_steps(2);
+    let o = h.state().atom_on_screen(1).expect("the oxygen is on screen");
+    click_at(&mut h, o, false);
+    assert!(h.state().status.starts_with("atom 2 O"), "{}", h.state().status);
+    let c = h.state().atom_on_screen(0).unwrap();
+    click_at(&mut h, c, true);
+    let app = h.state();
+    assert_eq!(app.measurements.selection, vec![1, 0]);
+    assert_eq!(app.measurements.list.len(), 1);
+    assert!(app.status.starts_with("O2–C1 1.") && app.status.ends_with(" Å"), "{}", app.status);
+    // A click on the background clears the selection and keeps the measurement.
+    click_at(&mut h, egui::pos2(985.0, 100.0), false);
+    assert!(h.state().measurements.selection.is_empty());
+    assert_eq!(h.state().measurements.list.len(), 1);
+}

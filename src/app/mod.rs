@@ -136,6 +136,12 @@ impl OrbApp {
         }
     }
 
+    /// Where atom `atom` of the open document is drawn in the window (for tests and overlays).
+    pub fn atom_on_screen(&self, atom: usize) -> Option<egui::Pos2> {
+        let position = self.doc.molecule.atoms.get(atom)?.position.as_vec3();
+        self.viewport.as_ref()?.to_screen(&self.view.camera, position)
+    }
+
     /// Each view shown: (size on screen, size of its last frame), pixels. The frame is smaller
     /// while a drag or the animation runs on a CPU adapter ([`detail`]).
     pub fn view_sizes(&self) -> Vec<([u32; 2], [u32; 2])> {

@@ -128,7 +128,7 @@ impl GridArgs {
         }
         let wf = wavefunction_of(doc)?;
         let q = self.what.resolve(wf)?;
-        let g = orbital_geometry(doc, self.grid_points.clamp(8, 512)).context("the file has no atoms")?;
+        let g = orbital_geometry(doc, q, self.grid_points.clamp(8, 512)).context("the file has no atoms")?;
         let spec = GridSpec::new(
             g.world_from_grid.w_axis.truncate(),
             std::array::from_fn(|a| g.world_from_grid.col(a).truncate()),

@@ -132,10 +132,7 @@ impl GridGeometry {
 impl GtoFillPass {
     pub fn new(ctx: &GpuContext) -> Self {
         let device = &ctx.device;
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("gto_fill.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(super::module_source("gto_fill.wgsl").into()),
-        });
+        let module = super::shader_module(device, "gto_fill.wgsl");
         let fill_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("gto fill layout"),
             entries: &[

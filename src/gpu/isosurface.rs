@@ -48,19 +48,8 @@ pub struct IsosurfacePass {
 impl IsosurfacePass {
     pub fn new(ctx: &GpuContext) -> Self {
         let device = &ctx.device;
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("isosurface.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(super::shader_source("isosurface.wgsl").into()),
-        });
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("isosurface bind group layout"),
-            entries: &[super::uniform_entry(0, wgpu::ShaderStages::VERTEX_FRAGMENT)],
-        });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("isosurface pipeline layout"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
+        let module = super::shader_module(device, "isosurface.wgsl");
+        let (layout, pipeline_layout) = super::uniform_layouts(device, "isosurface");
         let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("isosurfaces"),
             layout: Some(&pipeline_layout),

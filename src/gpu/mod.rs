@@ -58,6 +58,29 @@ pub fn module_source(name: &str) -> String {
     }
 }
 
+/// The shader module `name`, its prerequisites prepended ([`SHADER_MODULES`]).
+pub(crate) fn shader_module(device: &wgpu::Device, name: &str) -> wgpu::ShaderModule {
+    device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(name),
+        source: wgpu::ShaderSource::Wgsl(module_source(name).into()),
+    })
+}
+
+/// A bind-group layout of one uniform buffer (binding 0, vertex and fragment stages) and a
+/// pipeline layout of just that group: what the opaque passes use.
+pub(crate) fn uniform_layouts(device: &wgpu::Device, label: &str) -> (wgpu::BindGroupLayout, wgpu::PipelineLayout) {
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(&format!("{label} bind group layout")),
+        entries: &[uniform_entry(0, wgpu::ShaderStages::VERTEX_FRAGMENT)],
+    });
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(&format!("{label} pipeline layout")),
+        bind_group_layouts: &[Some(&layout)],
+        immediate_size: 0,
+    });
+    (layout, pipeline_layout)
+}
+
 /// A bind-group layout entry for a buffer (uniform, or read-only storage).
 pub(crate) fn buffer_entry(
     binding: u32,

@@ -10,10 +10,7 @@ pub struct ResolvePass {
 impl ResolvePass {
     pub fn new(ctx: &GpuContext) -> Self {
         let device = &ctx.device;
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("resolve.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(super::shader_source("resolve.wgsl").into()),
-        });
+        let module = super::shader_module(device, "resolve.wgsl");
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("resolve bind group layout"),
             entries: &[wgpu::BindGroupLayoutEntry {

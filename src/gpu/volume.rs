@@ -230,10 +230,7 @@ struct SliceShader {
 
 impl SliceShader {
     fn new(device: &wgpu::Device, name: &str, groups: &[Option<&wgpu::BindGroupLayout>]) -> Self {
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some(name),
-            source: wgpu::ShaderSource::Wgsl(super::module_source(name).into()),
-        });
+        let module = super::shader_module(device, name);
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some(name),
             bind_group_layouts: groups,

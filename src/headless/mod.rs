@@ -8,6 +8,7 @@ use glam::DVec3;
 use crate::gpu::gto::{GridGeometry, GtoFillPass, read_volume, volume_from_texture};
 use crate::gpu::{FrameInput, GpuContext, GpuError, OffscreenTarget, Renderer};
 use crate::model::cartesian::CartesianExpansion;
+use crate::model::extent::quantity_box;
 use crate::model::grid::ValueKind;
 use crate::model::gto::{GridSpec, PreparedBasis};
 use crate::model::isosurface::{self, Level, Mesh};
@@ -31,12 +32,11 @@ pub fn default_camera(doc: &Document) -> Camera {
     }
 }
 
-/// The grid a wavefunction's orbitals are evaluated on: the atoms plus [`ORBITAL_MARGIN`],
-/// `points` per axis.
-pub fn orbital_geometry(doc: &Document, points: usize) -> Option<GridGeometry> {
-    let (lo, hi) = doc.molecule.bounds()?;
-    let margin = DVec3::splat(ORBITAL_MARGIN);
-    Some(GridGeometry::cube(lo - margin, hi + margin, points))
+/// The grid a wavefunction's `quantity` is evaluated on, `points` per axis: the box where it
+/// decays to 1 % of its largest |value| ([`crate::model::extent::quantity_box`]).
+pub fn orbital_geometry(doc: &Document, quantity: Quantity, points: usize) -> Option<GridGeometry> {
+    let (lo, hi) = quantity_box(doc.wavefunction.as_ref()?, &doc.molecule, quantity)?;
+    Some(GridGeometry::cube(lo, hi, points))
 }
 
 /// How to show a quantity of a wavefunction.
@@ -62,7 +62,7 @@ pub fn show_wavefunction(
     doc: &Document,
     view: &WavefunctionView,
 ) -> Result<Option<VolumeGrid>, GpuError> {
-    let (Some(wf), Some(geometry)) = (&doc.wavefunction, orbital_geometry(doc, view.points)) else {
+    let (Some(wf), Some(geometry)) = (&doc.wavefunction, orbital_geometry(doc, view.quantity, view.points)) else {
         return Ok(None);
     };
     let prepared = PreparedBasis::new(&wf.basis);

@@ -200,108 +200,193 @@ impl Gradient<'_> {
     }
 }
 
-/// Extracts one mesh per level. Cost is one pass over the grid for all levels together.
+/// At most this many levels are extracted in one pass (one bit each per grid point).
+pub const MAX_LEVELS: usize = 8;
+
+/// Extracts one mesh per level (at most [`MAX_LEVELS`]; more are ignored), all in one pass over
+/// the grid, in parallel over runs of slabs.
 pub fn extract(grid: &VolumeGrid, levels: &[Level]) -> Vec<Mesh> {
+    let levels = &levels[..levels.len().min(MAX_LEVELS)];
     let [nx, ny, nz] = grid.dims;
     if nx < 2 || ny < 2 || nz < 2 || levels.is_empty() {
         return vec![Mesh::default(); levels.len()];
     }
     let jac = DMat3::from_cols(grid.step(0), grid.step(1), grid.step(2));
     let gradient = Gradient { grid, inv_t: jac.inverse().transpose() };
-    let slabs: Vec<Vec<Mesh>> = (0..nx - 1).into_par_iter().map(|i| slab(grid, &gradient, levels, i)).collect();
+    // A few runs per thread balance the load; within a run, consecutive slabs share a plane's
+    // flags and the vertices on it.
+    let slabs = nx - 1;
+    let runs = (4 * rayon::current_num_threads()).clamp(1, slabs);
+    let parts: Vec<Vec<Mesh>> = (0..runs)
+        .into_par_iter()
+        .map(|r| {
+            let mut run = Run::new(grid, &gradient, levels);
+            for i in r * slabs / runs..(r + 1) * slabs / runs {
+                run.slab(i);
+            }
+            run.meshes
+        })
+        .collect();
     let mut meshes = vec![Mesh::default(); levels.len()];
-    for slab in slabs {
-        for (mesh, part) in meshes.iter_mut().zip(slab) {
-            mesh.append(part);
+    for part in parts {
+        for (mesh, piece) in meshes.iter_mut().zip(part) {
+            mesh.append(piece);
         }
     }
     meshes
 }
 
-/// Vertices already made on this slab's edges, per level: x edges at (j, k), and y and z edges
-/// on the slab's two planes.
-struct EdgeCache {
-    x: Vec<u32>,
-    y: [Vec<u32>; 2],
-    z: [Vec<u32>; 2],
+/// One plane's flags: per grid point, bit L set when the point is inside level L; per row of
+/// points, `Some(flags)` when every point of the row has the same flags.
+#[derive(Default)]
+struct PlaneFlags {
+    points: Vec<u8>,
+    rows: Vec<Option<u8>>,
 }
 
-/// The cells between planes i and i + 1.
-fn slab(grid: &VolumeGrid, gradient: &Gradient, levels: &[Level], i: usize) -> Vec<Mesh> {
-    let [_, ny, nz] = grid.dims;
-    let plane = ny * nz;
-    let values = [&grid.values[i * plane..(i + 1) * plane], &grid.values[(i + 1) * plane..(i + 2) * plane]];
-    levels
-        .iter()
-        .map(|level| {
-            // Inside flags of both planes, so each cell's case is eight byte loads.
-            let inside: [Vec<u8>; 2] =
-                values.map(|v| v.iter().map(|&x| u8::from(level.sign * x > level.value)).collect());
-            let mut cache = EdgeCache {
-                x: vec![u32::MAX; plane],
-                y: [vec![u32::MAX; plane], vec![u32::MAX; plane]],
-                z: [vec![u32::MAX; plane], vec![u32::MAX; plane]],
-            };
-            let mut mesh = Mesh::default();
-            for j in 0..ny - 1 {
-                for k in 0..nz - 1 {
-                    let mut case = 0usize;
-                    for c in 0..8 {
-                        let [dx, dy, dz] = corner(c);
-                        case |= (inside[dx][(j + dy) * nz + k + dz] as usize) << c;
-                    }
-                    if case == 0 || case == 255 {
-                        continue;
-                    }
+impl PlaneFlags {
+    fn classify(&mut self, grid: &VolumeGrid, levels: &[Level], i: usize) {
+        let [_, ny, nz] = grid.dims;
+        let values = &grid.values[i * ny * nz..(i + 1) * ny * nz];
+        self.points.clear();
+        self.points.resize(values.len(), 0);
+        // One simple loop per level vectorises; a loop over levels inside would not.
+        for (l, level) in levels.iter().enumerate() {
+            for (bits, &v) in self.points.iter_mut().zip(values) {
+                *bits |= u8::from(level.sign * v > level.value) << l;
+            }
+        }
+        self.rows.clear();
+        self.rows.extend(self.points.chunks_exact(nz).map(|row| {
+            let (and, or) = row.iter().fold((u8::MAX, 0u8), |(a, o), &b| (a & b, o | b));
+            (and == or).then_some(and)
+        }));
+    }
+}
+
+/// A vertex made on an edge, valid while its stamp (which row of which plane) matches: the
+/// cache is never cleared, only overwritten.
+#[derive(Clone, Copy)]
+struct Cached {
+    stamp: u32,
+    vertex: u32,
+}
+
+/// Vertices made on the edges of the two rows of cells around the current one, per level:
+/// x edges (between planes i and i + 1) by row parity, y and z edges by plane parity (shared
+/// with the next slab) and, for z, row parity.
+struct EdgeCache {
+    x: Vec<Cached>,
+    y: Vec<Cached>,
+    z: Vec<Cached>,
+}
+
+/// Consecutive slabs extracted by one thread.
+struct Run<'a> {
+    grid: &'a VolumeGrid,
+    gradient: &'a Gradient<'a>,
+    levels: &'a [Level],
+    meshes: Vec<Mesh>,
+    caches: Vec<EdgeCache>,
+    /// Flags of the slab's two planes, and which plane the second one is.
+    flags: [PlaneFlags; 2],
+    flagged: Option<usize>,
+}
+
+impl<'a> Run<'a> {
+    fn new(grid: &'a VolumeGrid, gradient: &'a Gradient<'a>, levels: &'a [Level]) -> Self {
+        let nz = grid.dims[2];
+        let empty = Cached { stamp: u32::MAX, vertex: 0 };
+        let cache = || EdgeCache { x: vec![empty; 2 * nz], y: vec![empty; 2 * nz], z: vec![empty; 4 * nz] };
+        Self {
+            grid,
+            gradient,
+            levels,
+            meshes: vec![Mesh::default(); levels.len()],
+            caches: (0..levels.len()).map(|_| cache()).collect(),
+            flags: Default::default(),
+            flagged: None,
+        }
+    }
+
+    /// The cells between planes i and i + 1.
+    fn slab(&mut self, i: usize) {
+        let [_, ny, nz] = self.grid.dims;
+        if self.flagged == Some(i) {
+            self.flags.swap(0, 1);
+        } else {
+            self.flags[0].classify(self.grid, self.levels, i);
+        }
+        self.flags[1].classify(self.grid, self.levels, i + 1);
+        self.flagged = Some(i + 1);
+        let flags = std::mem::take(&mut self.flags);
+        for j in 0..ny - 1 {
+            // Most rows of cells lie wholly inside or outside every surface.
+            let uniform = [flags[0].rows[j], flags[0].rows[j + 1], flags[1].rows[j], flags[1].rows[j + 1]];
+            if uniform[0].is_some() && uniform.iter().all(|&u| u == uniform[0]) {
+                continue;
+            }
+            let points = [&flags[0].points, &flags[1].points];
+            let rows = [
+                [&points[0][j * nz..(j + 1) * nz], &points[0][(j + 1) * nz..(j + 2) * nz]],
+                [&points[1][j * nz..(j + 1) * nz], &points[1][(j + 1) * nz..(j + 2) * nz]],
+            ];
+            for k in 0..nz - 1 {
+                let corners: [u8; 8] = std::array::from_fn(|c| {
+                    let [dx, dy, dz] = corner(c);
+                    rows[dx][dy][k + dz]
+                });
+                if corners.iter().all(|&b| b == corners[0]) {
+                    continue;
+                }
+                for l in 0..self.levels.len() {
+                    let case = corners.iter().enumerate().fold(0, |case, (c, &b)| case | ((b >> l & 1) as usize) << c);
                     for tri in &CASES[case] {
                         for &e in tri {
-                            let v = vertex(grid, gradient, level, &mut cache, &mut mesh, [i, j, k], e as usize);
-                            mesh.indices.push(v);
+                            let v = self.vertex(l, [i, j, k], e as usize);
+                            self.meshes[l].indices.push(v);
                         }
                     }
                 }
             }
-            mesh
-        })
-        .collect()
-}
-
-/// The vertex on edge `e` of cell `cell`, made once per slab.
-fn vertex(
-    grid: &VolumeGrid,
-    gradient: &Gradient,
-    level: &Level,
-    cache: &mut EdgeCache,
-    mesh: &mut Mesh,
-    cell: [usize; 3],
-    e: usize,
-) -> u32 {
-    let nz = grid.dims[2];
-    let (c0, c1, axis) = EDGES[e];
-    let [dx, dy, dz] = corner(c0);
-    let [_, j, k] = cell;
-    let slot = match axis {
-        0 => &mut cache.x[(j + dy) * nz + k + dz],
-        1 => &mut cache.y[dx][j * nz + k + dz],
-        _ => &mut cache.z[dx][(j + dy) * nz + k],
-    };
-    if *slot != u32::MAX {
-        return *slot;
+        }
+        self.flags = flags;
     }
-    let p0 = std::array::from_fn(|a| cell[a] + corner(c0)[a]);
-    let p1 = std::array::from_fn(|a| cell[a] + corner(c1)[a]);
-    let (v0, v1) = (level.sign * grid.value(p0[0], p0[1], p0[2]), level.sign * grid.value(p1[0], p1[1], p1[2]));
-    let t = ((level.value - v0) / (v1 - v0)).clamp(0.0, 1.0) as f64;
-    let mut g = DVec3::new(p0[0] as f64, p0[1] as f64, p0[2] as f64);
-    g[axis] += t;
-    let position = grid.world_from_grid.transform_point3(g).as_vec3();
-    // Outside is where the signed field falls: the normal is −∇(sign·value).
-    let grad = gradient.at(p0).lerp(gradient.at(p1), t) * level.sign as f64;
-    let normal = (-grad).normalize_or_zero().as_vec3();
-    mesh.positions.push(position);
-    mesh.normals.push(normal);
-    *slot = (mesh.positions.len() - 1) as u32;
-    *slot
+
+    /// The vertex of level `l` on edge `e` of cell `cell`, made once.
+    fn vertex(&mut self, l: usize, cell: [usize; 3], e: usize) -> u32 {
+        let [_, ny, nz] = self.grid.dims;
+        let (c0, c1, axis) = EDGES[e];
+        let [dx, dy, dz] = corner(c0);
+        let [i, j, k] = cell;
+        let row = j + dy;
+        let plane = i + dx;
+        let cache = &mut self.caches[l];
+        let (slot, stamp) = match axis {
+            0 => (&mut cache.x[(row & 1) * nz + k + dz], i * ny + row),
+            1 => (&mut cache.y[(plane & 1) * nz + k + dz], plane * ny + j),
+            _ => (&mut cache.z[((plane & 1) * 2 + (row & 1)) * nz + k], plane * ny + row),
+        };
+        let stamp = stamp as u32;
+        if slot.stamp == stamp {
+            return slot.vertex;
+        }
+        let (grid, level) = (self.grid, self.levels[l]);
+        let p0: [usize; 3] = std::array::from_fn(|a| cell[a] + corner(c0)[a]);
+        let p1: [usize; 3] = std::array::from_fn(|a| cell[a] + corner(c1)[a]);
+        let (v0, v1) = (level.sign * grid.value(p0[0], p0[1], p0[2]), level.sign * grid.value(p1[0], p1[1], p1[2]));
+        let t = ((level.value - v0) / (v1 - v0)).clamp(0.0, 1.0) as f64;
+        let mut g = DVec3::new(p0[0] as f64, p0[1] as f64, p0[2] as f64);
+        g[axis] += t;
+        // Outside is where the signed field falls: the normal is −∇(sign·value).
+        let grad = self.gradient.at(p0).lerp(self.gradient.at(p1), t) * level.sign as f64;
+        let mesh = &mut self.meshes[l];
+        mesh.positions.push(grid.world_from_grid.transform_point3(g).as_vec3());
+        mesh.normals.push((-grad).normalize_or_zero().as_vec3());
+        let vertex = (mesh.positions.len() - 1) as u32;
+        *slot = Cached { stamp, vertex };
+        vertex
+    }
 }
 
 #[cfg(test)]

@@ -9,6 +9,7 @@ pub mod cartesian;
 pub mod document;
 mod element_table;
 pub mod elements;
+pub mod extent;
 pub mod grid;
 pub mod gto;
 pub mod isosurface;

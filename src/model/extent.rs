@@ -1,0 +1,113 @@
+//! Where an orbital or a density actually decays: the box a grid must span to hold it, rather
+//! than the atoms plus a fixed margin (which cuts off diffuse orbitals and single atoms' outer
+//! shells, and shows the box's faces as a square in the picture).
+
+use glam::DVec3;
+
+use super::Molecule;
+use super::gto::{GridSpec, PreparedBasis};
+use super::orbitals::{Quantity, Wavefunction};
+
+/// Where the search around the atoms starts (bohr): enough for most valence orbitals.
+pub const START_REACH: f64 = 4.5;
+
+/// The largest |value| a grid's faces may show, as a fraction of the largest |value| inside.
+pub const FACE_FRACTION: f64 = 0.01;
+/// Points per side of the coarse search grid.
+const SEARCH_POINTS: usize = 40;
+/// Values below this fraction of the maximum count as decayed on the coarse grid: a quarter of
+/// [`FACE_FRACTION`], so that values between coarse points stay under it.
+const SEARCH_FRACTION: f64 = 0.25 * FACE_FRACTION;
+/// The search box grows this many times at most when the field has not decayed at its faces.
+const GROWTHS: usize = 4;
+
+/// The box around `lo..hi` (the atoms) outside which |f| < [`FACE_FRACTION`]·max|f|. `reach`
+/// (bohr) is where the search starts looking around the atoms (the basis set's largest cutoff
+/// radius is a good start); `eval` gives f on a grid, x slowest, z fastest. The result is padded
+/// by one coarse step and never smaller than the atoms plus 1 bohr.
+pub fn decay_box(lo: DVec3, hi: DVec3, reach: f64, eval: impl Fn(&GridSpec) -> Vec<f64>) -> (DVec3, DVec3) {
+    let mut reach = reach.clamp(2.0, 40.0);
+    let fallback = (lo - DVec3::splat(reach), hi + DVec3::splat(reach));
+    for _ in 0..GROWTHS {
+        let (slo, shi) = (lo - DVec3::splat(reach), hi + DVec3::splat(reach));
+        let step = (shi - slo).max_element() / (SEARCH_POINTS - 1) as f64;
+        let dims = ((shi - slo) / step).ceil().as_uvec3().to_array().map(|n| n as usize + 1);
+        let spec = GridSpec::new(slo, [DVec3::X * step, DVec3::Y * step, DVec3::Z * step], dims);
+        let values = eval(&spec);
+        let max = values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        if max <= 0.0 || !max.is_finite() {
+            return fallback;
+        }
+        let (mut a, mut b) = ([usize::MAX; 3], [0usize; 3]);
+        for i in 0..dims[0] {
+            for j in 0..dims[1] {
+                for k in 0..dims[2] {
+                    if values[(i * dims[1] + j) * dims[2] + k].abs() >= SEARCH_FRACTION * max {
+                        for (axis, n) in [i, j, k].into_iter().enumerate() {
+                            a[axis] = a[axis].min(n);
+                            b[axis] = b[axis].max(n);
+                        }
+                    }
+                }
+            }
+        }
+        let at_face = (0..3).any(|axis| a[axis] == 0 || b[axis] + 1 >= dims[axis]);
+        if at_face {
+            // Not decayed inside the search box: look further out.
+            reach *= 1.8;
+            continue;
+        }
+        let corner = |n: [usize; 3]| slo + DVec3::new(n[0] as f64, n[1] as f64, n[2] as f64) * step;
+        let pad = DVec3::splat(step);
+        let (blo, bhi) = (corner(a) - pad, corner(b) + pad);
+        return (blo.min(lo - DVec3::ONE), bhi.max(hi + DVec3::ONE));
+    }
+    (lo - DVec3::splat(reach), hi + DVec3::splat(reach))
+}
+
+/// The box (bohr) a wavefunction's orbital or density is evaluated in: where it decays below
+/// [`FACE_FRACTION`] of its largest |value|. `None` without atoms.
+pub fn quantity_box(wf: &Wavefunction, molecule: &Molecule, quantity: Quantity) -> Option<(DVec3, DVec3)> {
+    let (lo, hi) = molecule.bounds()?;
+    let prepared = PreparedBasis::new(&wf.basis);
+    Some(decay_box(lo, hi, START_REACH, |spec| match quantity {
+        Quantity::Orbital(i) => prepared.eval_grid(&wf.orbitals[i].coefficients, spec),
+        Quantity::Density => prepared.density_grid(wf, spec),
+        Quantity::SpinDensity => prepared.spin_density_grid(wf, spec),
+    }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// f = exp(−a|r − c|) sampled on `spec`.
+    fn slater(spec: &GridSpec, c: DVec3, a: f64) -> Vec<f64> {
+        let mut out = Vec::with_capacity(spec.len());
+        for i in 0..spec.dims[0] {
+            for j in 0..spec.dims[1] {
+                for k in 0..spec.dims[2] {
+                    out.push((-a * (spec.point(i, j, k) - c).length()).exp());
+                }
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn the_box_holds_a_diffuse_function_and_trims_a_tight_one() {
+        let c = DVec3::new(0.5, -0.2, 0.0);
+        for (a, tight) in [(0.35, false), (3.0, true)] {
+            let (lo, hi) = decay_box(c, c, 4.0, |s| slater(s, c, a));
+            // exp(−a r) = 1 % at r = ln(100)/a: the faces lie at or beyond it ...
+            let r = 100f64.ln() / a;
+            for axis in 0..3 {
+                assert!(c[axis] - lo[axis] >= r * 0.98 && hi[axis] - c[axis] >= r * 0.98, "a {a}: {lo} {hi}");
+            }
+            // ... and not far beyond (one coarse step and the 1 bohr floor).
+            let extent = (hi - lo).max_element() / 2.0;
+            assert!(extent < (1.6 * r).max(1.0 + 0.5), "a {a}: half extent {extent} vs r {r}");
+            assert_eq!(tight, extent < 4.0, "a {a}: {extent}");
+        }
+    }
+}
