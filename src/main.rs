@@ -28,18 +28,27 @@ mod surface_cli;
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
-    /// Files to open in the viewer (cube, cube.gz); the bundled demo when none.
+    /// Files to open in the viewer: Gaussian cube (.cube, .cub), Molden (.molden, .molden.input,
+    /// .mold), Gaussian formatted checkpoint (.fchk, .fch), each also gzipped (.gz), or a scan
+    /// manifest (.scan.toml); the bundled demo when none.
     files: Vec<PathBuf>,
 }
 
 #[derive(Subcommand)]
 enum Command {
     /// Open the interactive viewer (the default).
-    Viewer { files: Vec<PathBuf> },
+    Viewer {
+        /// Files to open: Gaussian cube (.cube, .cub), Molden (.molden, .molden.input, .mold),
+        /// Gaussian formatted checkpoint (.fchk, .fch), each also gzipped (.gz), or a scan manifest
+        /// (.scan.toml); the bundled demo when none.
+        files: Vec<PathBuf>,
+    },
     /// Render a file to a PNG without a window.
     Render(RenderArgs),
     /// Print atoms and grids of a file.
     Info {
+        /// Gaussian cube (.cube, .cub), Molden (.molden, .molden.input, .mold) or Gaussian
+        /// formatted checkpoint (.fchk, .fch), each also gzipped (.gz).
         file: PathBuf,
         /// Machine-readable JSON instead of text.
         #[arg(long)]
@@ -221,7 +230,8 @@ enum BenchCommand {
 
 #[derive(Args)]
 struct RenderArgs {
-    /// A cube file; the bundled demo when omitted.
+    /// Gaussian cube (.cube, .cub), Molden (.molden, .molden.input, .mold) or Gaussian formatted
+    /// checkpoint (.fchk, .fch), each also gzipped (.gz); the bundled demo when omitted.
     file: Option<PathBuf>,
     /// Output PNG.
     #[arg(short, long)]

@@ -2,30 +2,32 @@
 //! file the cube reader reads back with the same numbers, `info --json` describes wavefunctions,
 //! and bad input fails with a message, not a panic.
 
-use std::path::PathBuf;
 use std::process::Command;
 
-const DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/refdata/real-world");
+mod common;
 
 fn orbcloud(args: &[&str]) -> std::process::Output {
     Command::new(env!("CARGO_BIN_EXE_orbcloud")).args(args).output().expect("run orbcloud")
 }
 
 fn refdata(name: &str) -> String {
-    let p = PathBuf::from(DIR).join(name);
+    let p = common::refdata_dir().join(name);
     assert!(p.exists(), "reference corpus missing: {}", p.display());
     p.display().to_string()
 }
 
 #[test]
 fn eval_reproduces_expected_values() {
+    if common::refdata("cli::eval_reproduces_expected_values").is_none() {
+        return;
+    }
     let dir = tempfile::tempdir().unwrap();
     for (file, kind, flags, tolerance) in [
         ("nh3_orca.molden", "homo", &["--orbital", "homo"][..], 1e-6),
         ("o2_cc_pvtz_cart.fchk", "lumo", &["--orbital", "lumo"][..], 1e-6),
         ("h2o_ccpvdz_cfour.molden", "density", &["--density"][..], 1e-5),
     ] {
-        let table = std::fs::read_to_string(PathBuf::from(DIR).join("expected").join(format!("{file}.{kind}.tsv")))
+        let table = std::fs::read_to_string(common::refdata_dir().join("expected").join(format!("{file}.{kind}.tsv")))
             .expect("expected table");
         let points = dir.path().join("points.txt");
         let expected: Vec<[f64; 4]> = table
@@ -55,6 +57,9 @@ fn eval_reproduces_expected_values() {
 
 #[test]
 fn cube_output_reads_back() {
+    if common::refdata("cli::cube_output_reads_back").is_none() {
+        return;
+    }
     let dir = tempfile::tempdir().unwrap();
     let out_path = dir.path().join("homo.cube");
     let out = orbcloud(&[
@@ -86,6 +91,9 @@ fn cube_output_reads_back() {
 
 #[test]
 fn info_json_describes_the_wavefunction() {
+    if common::refdata("cli::info_json_describes_the_wavefunction").is_none() {
+        return;
+    }
     let out = orbcloud(&["info", &refdata("nh3_turbomole.molden"), "--json"]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
@@ -98,6 +106,9 @@ fn info_json_describes_the_wavefunction() {
 
 #[test]
 fn bad_input_fails_cleanly() {
+    if common::refdata("cli::bad_input_fails_cleanly").is_none() {
+        return;
+    }
     let dir = tempfile::tempdir().unwrap();
     let bad = dir.path().join("bad.molden");
     std::fs::write(&bad, "[Molden Format]\n[Atoms] AU\nO 1 8 0.0 zero 0.0\n").unwrap();
@@ -229,4 +240,22 @@ fn render_with_isosurfaces_and_a_pick() {
     let corner = orbcloud(&[&args[..], &["-o", png.to_str().unwrap(), "--pick", "0,0"]].concat());
     assert!(String::from_utf8_lossy(&corner.stdout).contains("pick 0,0: nothing"));
     assert!(!orbcloud(&[&args[..], &["-o", png.to_str().unwrap(), "--pick", "3"]].concat()).status.success());
+}
+
+#[test]
+fn help_names_every_format_read() {
+    let text = |args: &[&str]| {
+        let out = orbcloud(args);
+        assert!(out.status.success(), "{args:?}");
+        String::from_utf8_lossy(&out.stdout).into_owned()
+    };
+    let one = [".cube", ".cub", ".molden", ".molden.input", ".mold", ".fchk", ".fch", ".gz"];
+    for args in [&["--help"][..], &["viewer", "--help"], &["info", "--help"], &["render", "--help"]] {
+        let help = text(args);
+        for ext in one {
+            assert!(help.contains(ext), "`orbcloud {}` does not name {ext}:\n{help}", args.join(" "));
+        }
+        let viewer = args.len() == 1 || args[0] == "viewer";
+        assert_eq!(help.contains(".scan.toml"), viewer, "`orbcloud {}`:\n{help}", args.join(" "));
+    }
 }

@@ -8,7 +8,7 @@ use orbcloud::formats::cube::{self, CubeFile};
 use orbcloud::model::units::BOHR_PER_ANGSTROM;
 use orbcloud::model::{Document, VolumeGrid};
 
-const DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/refdata/real-world");
+mod common;
 
 struct Expected {
     name: &'static str,
@@ -58,10 +58,9 @@ fn expected() -> Vec<Expected> {
     ]
 }
 
+/// The corpus; every test first asks `common::refdata`, which says when it is absent.
 fn dir() -> PathBuf {
-    let dir = PathBuf::from(DIR);
-    assert!(dir.is_dir(), "reference corpus missing: {} (it lives beside the project)", dir.display());
-    dir
+    common::refdata_dir()
 }
 
 fn load(path: &Path) -> Document {
@@ -93,6 +92,9 @@ fn agrees_to_printed_digits(value: f64, printed: &str) -> bool {
 
 #[test]
 fn every_reference_cube_loads_as_the_manifest_says() {
+    if common::refdata("refdata_cubes::every_reference_cube_loads_as_the_manifest_says").is_none() {
+        return;
+    }
     let table = expected();
     let mut seen = 0;
     let mut entries: Vec<PathBuf> = std::fs::read_dir(dir())
@@ -127,6 +129,9 @@ fn every_reference_cube_loads_as_the_manifest_says() {
 
 #[test]
 fn multi_orbital_cube_has_its_dataset_ids() {
+    if common::refdata("refdata_cubes::multi_orbital_cube_has_its_dataset_ids").is_none() {
+        return;
+    }
     let text = std::fs::read_to_string(dir().join("grid20mo6-8.cube")).unwrap();
     let file = CubeFile::parse("grid20mo6-8.cube", &text).unwrap();
     assert_eq!(file.natoms, -7);
@@ -152,6 +157,9 @@ fn header_vectors(text: &str) -> (DVec3, [DVec3; 3]) {
 
 #[test]
 fn non_orthogonal_voxels_sit_where_the_header_says() {
+    if common::refdata("refdata_cubes::non_orthogonal_voxels_sit_where_the_header_says").is_none() {
+        return;
+    }
     let path = dir().join("aelta.cube");
     let (origin, v) = header_vectors(&std::fs::read_to_string(&path).unwrap());
     let g = &load(&path).volumes[0];
@@ -168,6 +176,9 @@ fn non_orthogonal_voxels_sit_where_the_header_says() {
 
 #[test]
 fn angstrom_flagged_axis_is_converted() {
+    if common::refdata("refdata_cubes::angstrom_flagged_axis_is_converted").is_none() {
+        return;
+    }
     let g: VolumeGrid = load(&dir().join("grid20ang.cube")).volumes.remove(0);
     assert!((g.step(0) - DVec3::X * 1.151300 * BOHR_PER_ANGSTROM).length() < 1e-9, "{}", g.step(0));
     // Axes 2 and 3 carry positive counts: bohr.
@@ -177,6 +188,9 @@ fn angstrom_flagged_axis_is_converted() {
 
 #[test]
 fn cubegen_density_integrates_to_something_positive() {
+    if common::refdata("refdata_cubes::cubegen_density_integrates_to_something_positive").is_none() {
+        return;
+    }
     let g = load(&dir().join("cubegen_h2o_5points.cube")).volumes.remove(0);
     let integral: f64 = g.values.iter().map(|&v| v as f64).sum::<f64>() * g.voxel_volume();
     println!(

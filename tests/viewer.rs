@@ -1,6 +1,8 @@
 //! The viewer in egui_kittest on lavapipe: starts on the demo, reacts to controls and the mouse,
 //! and keeps what it shows when a file fails to load.
 
+mod common;
+
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use orbcloud::app::{OrbApp, wgpu_setup};
@@ -112,8 +114,10 @@ fn a_bad_file_reports_an_error_and_keeps_the_open_document() {
 #[test]
 fn a_molden_file_opens_on_its_homo_and_the_browser_switches_orbitals() {
     use orbcloud::model::orbitals::Quantity;
-    let path =
-        std::path::PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/refdata/real-world/nh3_orca.molden"));
+    let Some(dir) = common::refdata("viewer::a_molden_file_opens_on_its_homo_and_the_browser_switches_orbitals") else {
+        return;
+    };
+    let path = dir.join("nh3_orca.molden");
     assert!(path.exists(), "reference corpus missing: {}", path.display());
     let mut h = Harness::builder()
         .with_size([1200.0, 800.0])

@@ -331,11 +331,12 @@ impl OrbApp {
             "orbcloud-{}.png",
             std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map(|d| d.as_secs()).unwrap_or(0)
         );
-        let path = rfd::FileDialog::new()
-            .add_filter("PNG image", &["png"])
-            .set_file_name(&default_name)
-            .save_file()
-            .unwrap_or_else(|| PathBuf::from(&default_name));
+        // Cancelling the dialog means no file: nothing is written anywhere.
+        let Some(path) =
+            rfd::FileDialog::new().add_filter("PNG image", &["png"]).set_file_name(&default_name).save_file()
+        else {
+            return;
+        };
         let shot = match &mut self.scan {
             Some(scan) => {
                 let mut out = image::RgbaImage::new(size[0] * scan.views.len() as u32, size[1]);

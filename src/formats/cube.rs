@@ -26,7 +26,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::text::{Lines, excerpt, line_at, parse_real};
-use super::{LoadError, MAX_GRID_VALUES, ParseError};
+use super::{LoadError, MAX_GRID_VALUES, MAX_TRAILING_BYTES, MAX_Z, ParseError};
 use crate::model::units::BOHR_PER_ANGSTROM;
 use crate::model::{Atom, Document, Molecule, VolumeGrid};
 
@@ -159,6 +159,7 @@ impl CubeFile {
             }
             *axis = CubeAxis { count, step: read3(&t[1..4]).ok_or_else(bad)? };
         }
+        check_axes(file, &axes)?;
         let dims = axes.map(|a| a.count.unsigned_abs());
         let grid_points = dims.iter().try_fold(1u64, |p, &n| p.checked_mul(n));
         let per_point = if natoms >= 0 { nval.unwrap_or(1) as u64 } else { 1 };
@@ -200,8 +201,9 @@ impl CubeFile {
                 return Err(bad());
             }
             let z: i64 = t[0].parse().map_err(|_| bad())?;
-            let z = u32::try_from(z)
-                .map_err(|_| lines.error(&format!("a non-negative atomic number for atom {}", i + 1), t[0]))?;
+            let z = u32::try_from(z).ok().filter(|&z| z <= MAX_Z).ok_or_else(|| {
+                lines.error(&format!("an atomic number 0..={MAX_Z} (0 for a ghost) for atom {}", i + 1), t[0])
+            })?;
             let charge = parse_real(t[1]).ok_or_else(bad)?;
             atoms.push(CubeAtom { z, charge, position: read3(&t[2..5]).ok_or_else(bad)? });
         }
@@ -307,6 +309,157 @@ impl CubeFile {
 
         Document { source: source.to_string(), title, molecule, volumes, wavefunction: None }
     }
+}
+
+/// Refuses a singular grid: axis vectors that span no volume (zero, parallel or coplanar) would
+/// leave the grid without an inverse transform. |det| is compared with the product of the step
+/// lengths, so the test does not depend on the unit or the grid spacing.
+fn check_axes(file: &str, axes: &[CubeAxis; 3]) -> Result<(), ParseError> {
+    let [a, b, c] = axes.map(|a| DVec3::from_array(a.step));
+    let det = a.dot(b.cross(c));
+    let lengths = a.length() * b.length() * c.length();
+    if det.abs() > 1e-6 * lengths && det.is_finite() {
+        return Ok(());
+    }
+    Err(error(
+        file,
+        6,
+        "three linearly independent axis vectors (a grid that spans a volume)",
+        format!(
+            "axis vectors whose determinant is {det:e} (step lengths {:e}, {:e}, {:e})",
+            a.length(),
+            b.length(),
+            c.length()
+        ),
+    ))
+}
+
+/// Watches a cube arrive, so that reading stops as soon as the data exceed what the header
+/// declares (see [`super::read_bounded`]): it finds the header, then counts the tokens after it.
+#[derive(Debug, Default)]
+pub(crate) struct ValueGuard {
+    /// Where the data start and the most tokens they may hold, once the header is complete.
+    declared: Option<(usize, u64)>,
+    /// Bytes scanned so far, tokens seen, whether the last byte scanned was a space, and the
+    /// end of the last token.
+    pos: usize,
+    tokens: u64,
+    after_space: bool,
+    last_end: usize,
+}
+
+impl ValueGuard {
+    /// Looks at the bytes of `text` (the file so far) not seen yet; `Some(reason)` when reading
+    /// should stop.
+    pub(crate) fn scan(&mut self, text: &[u8]) -> Option<String> {
+        if self.declared.is_none() {
+            match declared(text) {
+                Declared::NeedMore => return None,
+                Declared::Broken => return Some("a header that does not declare a grid".into()),
+                Declared::Tokens { start, max } => {
+                    self.declared = Some((start, max));
+                    (self.pos, self.last_end, self.after_space) = (start, start, true);
+                }
+            }
+        }
+        let (_, max) = self.declared?;
+        let new = text.get(self.pos..).filter(|n| !n.is_empty())?;
+        // A token starts at a non-space after a space; counted pairwise, so that it vectorises.
+        let first = u64::from(self.after_space && !is_space(new[0]));
+        self.tokens += first + new.windows(2).filter(|w| is_space(w[0]) && !is_space(w[1])).count() as u64;
+        self.after_space = new.last().is_some_and(|&b| is_space(b));
+        if let Some(p) = new.iter().rposition(|&b| !is_space(b)) {
+            self.last_end = self.pos + p + 1;
+        }
+        self.pos = text.len();
+        if self.tokens > max {
+            return Some(format!("more than the {max} values it declares"));
+        }
+        (self.tokens == max && self.after_space && text.len() - self.last_end > MAX_TRAILING_BYTES)
+            .then(|| format!("more than {MAX_TRAILING_BYTES} bytes after the {max} values it declares"))
+    }
+}
+
+/// What the start of a cube declares.
+#[derive(Debug, PartialEq)]
+enum Declared {
+    /// The header is not complete yet.
+    NeedMore,
+    /// The header is malformed: the parser will say how.
+    Broken,
+    /// The data start at byte `start` and hold at most `max` tokens (a data-set line included).
+    Tokens { start: usize, max: u64 },
+}
+
+/// The next complete line (ending in a newline) from `*pos`, as text.
+fn complete_line<'a>(prefix: &'a [u8], pos: &mut usize) -> Option<&'a str> {
+    let n = prefix.get(*pos..)?.iter().position(|&b| b == b'\n')?;
+    let line = &prefix[*pos..*pos + n];
+    *pos += n + 1;
+    // Invalid UTF-8 cannot be a header: an empty "line" makes the caller report it broken.
+    Some(std::str::from_utf8(line).unwrap_or(""))
+}
+
+/// A light reading of a cube's header from the first bytes of the file, for [`ValueGuard`]; the
+/// parser checks everything again.
+fn declared(prefix: &[u8]) -> Declared {
+    let mut pos = 0;
+    for _ in 0..2 {
+        if complete_line(prefix, &mut pos).is_none() {
+            return Declared::NeedMore;
+        }
+    }
+    let ints = |l: &str| l.split_whitespace().map(|t| t.parse::<i64>().ok()).collect::<Vec<_>>();
+    let Some(line3) = complete_line(prefix, &mut pos) else { return Declared::NeedMore };
+    let t: Vec<&str> = line3.split_whitespace().collect();
+    let natoms = match t.first().map(|n| n.parse::<i64>()) {
+        Some(Ok(n)) => n,
+        _ => return Declared::Broken,
+    };
+    let nval = match t.get(4).map(|n| n.parse::<u64>()) {
+        None => 1,
+        Some(Ok(n)) if n >= 1 => n,
+        _ => return Declared::Broken,
+    };
+    let mut grid = 1u64;
+    for _ in 0..3 {
+        let Some(l) = complete_line(prefix, &mut pos) else { return Declared::NeedMore };
+        match ints(l).first() {
+            Some(Some(n)) if *n != 0 => grid = grid.saturating_mul(n.unsigned_abs()),
+            _ => return Declared::Broken,
+        }
+    }
+    if grid.saturating_mul(nval) > MAX_GRID_VALUES {
+        return Declared::Broken;
+    }
+    for _ in 0..natoms.unsigned_abs() {
+        if complete_line(prefix, &mut pos).is_none() {
+            return Declared::NeedMore;
+        }
+    }
+    let start = pos;
+    // The first non-blank line after the atoms may be a data-set line `m id1 … idm`.
+    let first = loop {
+        match complete_line(prefix, &mut pos) {
+            None => return Declared::NeedMore,
+            Some(l) if l.trim().is_empty() => continue,
+            Some(l) => break ints(l),
+        }
+    };
+    let m = match first.first() {
+        Some(Some(m)) if *m >= 1 => *m as u64,
+        _ if natoms < 0 => return Declared::Broken,
+        _ => 0,
+    };
+    let max = if natoms < 0 {
+        // The id line may wrap: only m is known to be on this line.
+        (m + 1).saturating_add(grid.saturating_mul(m))
+    } else if nval == 1 && m > 0 && first.len() as u64 == m + 1 && first.iter().all(Option::is_some) {
+        grid.max((m + 1).saturating_add(grid.saturating_mul(m)))
+    } else {
+        grid * nval
+    };
+    Declared::Tokens { start, max }
 }
 
 fn read3(t: &[&str]) -> Option<[f64; 3]> {
@@ -789,7 +942,7 @@ mod tests {
         let text = text.replacen("    0   0.0", "   -1   0.0", 1);
         let e = err(&text);
         assert_eq!(e.line, 8);
-        assert!(e.expected.contains("non-negative atomic number"), "{e}");
+        assert!(e.expected.contains("an atomic number 0..=118"), "{e}");
     }
 
     #[test]

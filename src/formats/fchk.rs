@@ -26,9 +26,9 @@ use std::collections::HashMap;
 
 use glam::DVec3;
 
-use super::ParseError;
 use super::text::{excerpt, parse_real};
 use super::wavefunction::{OverlapFn, powers, program_named_in, to_model_order, wavefunction_document};
+use super::{MAX_Z, ParseError};
 use crate::model::basis::{Basis, MAX_L, Shell, ShellKind, cartesian_powers};
 use crate::model::orbitals::{MolecularOrbital, Spin, Wavefunction};
 use crate::model::{Atom, Document};
@@ -341,8 +341,8 @@ impl FchkFile {
         };
         let mut atoms = Vec::with_capacity(n_atoms);
         for (i, &zi) in z.iter().enumerate() {
-            let zi = u32::try_from(zi).ok().filter(|&v| v <= 200).ok_or_else(|| {
-                error(file, self.line_of("Atomic numbers"), "atomic numbers 0..=200", format!("{zi}"))
+            let zi = u32::try_from(zi).ok().filter(|&v| v <= MAX_Z).ok_or_else(|| {
+                error(file, self.line_of("Atomic numbers"), format!("atomic numbers 0..={MAX_Z}"), format!("{zi}"))
             })?;
             let charge = charges.map_or(zi as f64, |c| c[i]);
             atoms.push(Atom {

@@ -33,6 +33,15 @@ pub const MAX_GRID_VALUES: u64 = 1 << 30;
 /// the analytic overlap of the functions as the file writes them.
 pub const DEFAULT_OVERLAP: Option<OverlapFn<'static>> = Some(&crate::model::overlap::overlap_matrix_as_written);
 
+/// Largest atomic number a file may give (oganesson); 0 is a ghost centre.
+pub const MAX_Z: u32 = 118;
+
+/// Longest line a reader accepts: a longer one is refused before it is buffered whole.
+pub const MAX_LINE_BYTES: usize = 1 << 20;
+
+/// Blank bytes a cube may carry after the values its header declares before reading stops.
+pub const MAX_TRAILING_BYTES: usize = 64 << 10;
+
 /// Reads a file from disk, picking the reader by extension: `.cube`, `.cub`, `.molden`,
 /// `.molden.input`, `.mold`, `.fchk`, `.fch`, each also gzipped (`.gz`).
 pub fn load(path: &Path) -> Result<Document, LoadError> {
@@ -41,9 +50,11 @@ pub fn load(path: &Path) -> Result<Document, LoadError> {
 
 /// [`load`] with the overlap function that checks (and selects repairs for) wavefunctions.
 pub fn load_with(path: &Path, overlap: Option<OverlapFn>) -> Result<Document, LoadError> {
-    reader_for(path)?;
-    let bytes = std::fs::read(path).map_err(|source| LoadError::Io { path: path.display().to_string(), source })?;
-    load_bytes_with(path, &bytes, overlap)
+    let reader = reader_for(path)?;
+    let name = path.display().to_string();
+    let file = std::fs::File::open(path).map_err(|source| LoadError::Io { path: name.clone(), source })?;
+    let text = read_bounded(&name, std::io::BufReader::new(file), Some(reader))?;
+    parse_text(&name, reader, text, overlap)
 }
 
 /// Parses a file's bytes already in memory; `path` picks the reader and names the file in errors.
@@ -54,16 +65,28 @@ pub fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Document, LoadError> {
 /// [`load_bytes`] with the overlap function that checks wavefunctions.
 pub fn load_bytes_with(path: &Path, bytes: &[u8], overlap: Option<OverlapFn>) -> Result<Document, LoadError> {
     let name = path.display().to_string();
-    let text = gunzip_text(&name, bytes)?;
-    let mut doc = match reader_for(path)? {
-        Reader::Cube => cube::parse(&name, &text)?,
-        Reader::Molden => molden::parse(&name, &text, overlap)?,
-        Reader::Fchk => fchk::parse(&name, &text, overlap)?,
+    let reader = reader_for(path)?;
+    let text = read_bounded(&name, bytes, Some(reader))?;
+    parse_text(&name, reader, text, overlap)
+}
+
+fn parse_text(name: &str, reader: Reader, text: Bounded, overlap: Option<OverlapFn>) -> Result<Document, LoadError> {
+    let parsed = match reader {
+        Reader::Cube => cube::parse(name, &text.text),
+        Reader::Molden => molden::parse(name, &text.text, overlap),
+        Reader::Fchk => fchk::parse(name, &text.text, overlap),
     };
-    doc.source = name;
+    // When reading stopped early the parser names the first fault in what was read, if it
+    // sees one; otherwise the reason reading stopped is the error.
+    let mut doc = match (parsed, text.stopped) {
+        (Err(e), _) | (Ok(_), Some(e)) => return Err(e.into()),
+        (Ok(doc), None) => doc,
+    };
+    doc.source = name.to_string();
     Ok(doc)
 }
 
+#[derive(Clone, Copy)]
 enum Reader {
     Cube,
     Molden,
@@ -84,24 +107,169 @@ fn reader_for(path: &Path) -> Result<Reader, LoadError> {
     }
 }
 
-/// Reads a whole file, transparently gunzipping `*.gz`.
+/// Reads a whole file, transparently gunzipping `*.gz`, within the bounds of [`read_bounded`].
 pub fn read_text(path: &Path) -> Result<String, LoadError> {
-    let bytes = std::fs::read(path).map_err(|source| LoadError::Io { path: path.display().to_string(), source })?;
-    gunzip_text(&path.display().to_string(), &bytes)
+    let name = path.display().to_string();
+    let file = std::fs::File::open(path).map_err(|source| LoadError::Io { path: name.clone(), source })?;
+    read_bounded(&name, std::io::BufReader::new(file), reader_for(path).ok())?.into_whole()
 }
 
 /// Bytes as text, gunzipped first when they start with the gzip magic number.
 pub fn gunzip_text(name: &str, bytes: &[u8]) -> Result<String, LoadError> {
-    let bytes = if bytes.starts_with(&[0x1f, 0x8b]) {
-        use std::io::Read;
-        let mut out = Vec::new();
-        flate2::read::MultiGzDecoder::new(bytes)
-            .read_to_end(&mut out)
-            .map_err(|source| LoadError::Io { path: name.to_string(), source })?;
-        out
+    read_bounded(name, bytes, None)?.into_whole()
+}
+
+/// Text read within bounds; `stopped` says why reading ended before the end of the input.
+struct Bounded {
+    text: String,
+    stopped: Option<ParseError>,
+}
+
+impl Bounded {
+    fn into_whole(self) -> Result<String, LoadError> {
+        match self.stopped {
+            Some(e) => Err(e.into()),
+            None => Ok(self.text),
+        }
+    }
+}
+
+/// Reads (and gunzips) `input` as text, refusing, as soon as it appears and before more is
+/// inflated: a control byte (a binary file), a line longer than [`MAX_LINE_BYTES`], and, for a
+/// cube, data beyond what its header declares. A decompression bomb thus costs no more memory
+/// than its header honestly implies.
+fn read_bounded(name: &str, mut input: impl std::io::BufRead, reader: Option<Reader>) -> Result<Bounded, LoadError> {
+    let io = |source| LoadError::Io { path: name.to_string(), source };
+    if input.fill_buf().map_err(io)?.starts_with(&[0x1f, 0x8b]) {
+        let consumed = std::cell::Cell::new(0u64);
+        let counted = Counted { inner: input, consumed: &consumed };
+        read_stream(name, flate2::bufread::MultiGzDecoder::new(counted), reader, Some(&consumed))
     } else {
-        bytes.to_vec()
-    };
-    String::from_utf8(bytes)
-        .map_err(|e| LoadError::NotText { path: name.to_string(), offset: e.utf8_error().valid_up_to() })
+        read_stream(name, input, reader, None)
+    }
+}
+
+/// Inflated text beyond this needs no more than [`MAX_INFLATION`] bytes per compressed byte.
+pub const INFLATION_FLOOR: u64 = 32 << 20;
+
+/// Deflate reaches ~1000:1 only on degenerate input (a decompression bomb); text compresses
+/// tenfold or so. Cubes are bounded by their header instead, so a cube of zeros may exceed it.
+pub const MAX_INFLATION: u64 = 200;
+
+/// A reader that counts the compressed bytes the decoder has consumed.
+struct Counted<'a, R> {
+    inner: R,
+    consumed: &'a std::cell::Cell<u64>,
+}
+
+impl<R: std::io::BufRead> std::io::Read for Counted<'_, R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        self.consumed.set(self.consumed.get() + n as u64);
+        Ok(n)
+    }
+}
+
+impl<R: std::io::BufRead> std::io::BufRead for Counted<'_, R> {
+    fn fill_buf(&mut self) -> std::io::Result<&[u8]> {
+        self.inner.fill_buf()
+    }
+    fn consume(&mut self, n: usize) {
+        self.consumed.set(self.consumed.get() + n as u64);
+        self.inner.consume(n);
+    }
+}
+
+fn read_stream(
+    name: &str,
+    mut input: impl std::io::Read,
+    reader: Option<Reader>,
+    compressed: Option<&std::cell::Cell<u64>>,
+) -> Result<Bounded, LoadError> {
+    let mut out = Vec::new();
+    let mut chunk = vec![0u8; 256 << 10];
+    let mut lines = LineGuard { line: 1, len: 0 };
+    let mut cube = matches!(reader, Some(Reader::Cube)).then(cube::ValueGuard::default);
+    let mut stopped = None;
+    loop {
+        let n = match input.read(&mut chunk) {
+            Ok(0) => break,
+            Ok(n) => n,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+            Err(source) => return Err(LoadError::Io { path: name.to_string(), source }),
+        };
+        out.extend_from_slice(&chunk[..n]);
+        if let Err(e) = lines.scan(name, &chunk[..n]) {
+            return Err(e.into());
+        }
+        let inflated = out.len() as u64;
+        if let Some(c) = compressed.map(|c| c.get())
+            && cube.is_none()
+            && inflated > INFLATION_FLOOR.max(c.saturating_mul(MAX_INFLATION))
+        {
+            return Err(ParseError {
+                file: name.to_string(),
+                line: lines.line,
+                expected: format!(
+                    "a gzip stream that inflates at most {MAX_INFLATION}-fold beyond {INFLATION_FLOOR} bytes"
+                ),
+                found: format!("{inflated} bytes from {c} compressed bytes (a decompression bomb)"),
+            }
+            .into());
+        }
+        if let Some(guard) = &mut cube
+            && let Some(found) = guard.scan(&out)
+        {
+            // Keep whole tokens only, so that the text stays valid UTF-8 and the parser sees
+            // no half value.
+            let keep = out.iter().rposition(|b| b.is_ascii_whitespace()).map_or(0, |p| p + 1);
+            out.truncate(keep);
+            stopped = Some(ParseError {
+                file: name.to_string(),
+                line: text::line_at(&out, out.len()),
+                expected: "the end of the file after the values its header declares".into(),
+                found,
+            });
+            break;
+        }
+    }
+    let text = String::from_utf8(out)
+        .map_err(|e| LoadError::NotText { path: name.to_string(), offset: e.utf8_error().valid_up_to() })?;
+    Ok(Bounded { text, stopped })
+}
+
+/// Counts lines as bytes arrive; refuses control bytes and over-long lines.
+struct LineGuard {
+    line: usize,
+    len: usize,
+}
+
+impl LineGuard {
+    fn scan(&mut self, name: &str, bytes: &[u8]) -> Result<(), ParseError> {
+        let error =
+            |line, expected: String, found: String| ParseError { file: name.to_string(), line, expected, found };
+        // Tab, vertical tab, form feed, carriage return and a DOS end-of-file mark occur in text
+        // files; any other control byte means binary data. (Fold, not `any`: it vectorises.)
+        let control = |b: u8| b < 0x20 && !matches!(b, b'\t' | b'\n' | 0x0b | 0x0c | b'\r' | 0x1a);
+        if bytes.iter().fold(false, |bad, &b| bad | control(b)) {
+            let i = bytes.iter().position(|&b| control(b)).unwrap_or(0);
+            let line = self.line + bytes[..i].iter().filter(|&&b| b == b'\n').count();
+            return Err(error(line, "text".into(), format!("the control byte 0x{:02x} (binary data)", bytes[i])));
+        }
+        for (k, segment) in bytes.split(|&b| b == b'\n').enumerate() {
+            if k > 0 {
+                self.line += 1;
+                self.len = 0;
+            }
+            self.len += segment.len();
+            if self.len > MAX_LINE_BYTES {
+                return Err(error(
+                    self.line,
+                    format!("a line of at most {MAX_LINE_BYTES} bytes"),
+                    "a longer line".into(),
+                ));
+            }
+        }
+        Ok(())
+    }
 }

@@ -25,9 +25,9 @@
 
 use glam::DVec3;
 
-use super::ParseError;
 use super::text::{excerpt, parse_real};
 use super::wavefunction::{OverlapFn, powers, program_named_in, to_model_order, wavefunction_document};
+use super::{MAX_Z, ParseError};
 use crate::model::basis::{Basis, MAX_L, Shell, ShellKind, cartesian_powers};
 use crate::model::elements::atomic_number;
 use crate::model::orbitals::{MolecularOrbital, Spin, Wavefunction};
@@ -354,8 +354,8 @@ fn parse_atoms(file: &str, lines: &[&str], start: usize, end: usize) -> Result<V
         }
         let index: i64 = t[1].parse().map_err(|_| bad())?;
         let charge = parse_real(t[2]).ok_or_else(bad)?;
-        if !(0.0..=200.0).contains(&charge) {
-            return Err(error(file, k + 1, "an atomic number 0..=200", t[2]));
+        if !(0.0..=f64::from(MAX_Z)).contains(&charge) {
+            return Err(error(file, k + 1, format!("an atomic number 0..={MAX_Z} (0 for a ghost)"), t[2]));
         }
         let position =
             [parse_real(t[3]).ok_or_else(bad)?, parse_real(t[4]).ok_or_else(bad)?, parse_real(t[5]).ok_or_else(bad)?];

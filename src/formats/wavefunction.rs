@@ -35,12 +35,13 @@ pub const REPAIRED_TOLERANCE: f64 = 1e-4;
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Repair {
     /// ORCA: primitive normalisation folded into the contraction coefficients (for pure shells
-    /// that of the xy, xyz, xxyz component), opposite signs for the f±3, g±3 and g±4 functions.
+    /// that of the xy, xyz, xxyz and, for h, the x⁵ component, as IOData reads ORCA), opposite
+    /// signs for the f±3, g±3, g±4, h±3 and h±4 functions.
     Orca,
     /// Psi4 before 1.0: primitive normalisation folded into the coefficients, pure d and f
     /// scaled like the xx and xxx components.
     Psi4Pre10,
-    /// Turbomole: cartesian d, f, g functions too small by √3, √15, √105.
+    /// Turbomole: cartesian d, f, g, h functions too small by √3, √15, √105, √945.
     Turbomole,
     /// CFOUR 2.1: cartesian components normalised without the (2a−1)!!(2b−1)!!(2c−1)!! factor.
     Cfour,
@@ -70,10 +71,10 @@ impl Repair {
     pub fn describe(self) -> &'static str {
         match self {
             Repair::Orca => {
-                "ORCA: primitive normalisation removed from the contraction coefficients, signs of f±3, g±3, g±4 flipped"
+                "ORCA: primitive normalisation removed from the contraction coefficients, signs of f±3, g±3, g±4, h±3, h±4 flipped"
             }
             Repair::Psi4Pre10 => "Psi4 < 1.0: primitive normalisation removed from the contraction coefficients",
-            Repair::Turbomole => "Turbomole: cartesian d, f, g functions scaled by √3, √15, √105",
+            Repair::Turbomole => "Turbomole: cartesian d, f, g, h functions scaled by √3, √15, √105, √945",
             Repair::Cfour => "CFOUR: cartesian components rescaled by √((2a−1)!!(2b−1)!!(2c−1)!!)",
             Repair::Contractions => "contractions normalised",
             Repair::Psi4Upto132 => {
@@ -99,6 +100,7 @@ impl Repair {
                         (2, true) => Some([1, 1, 0]),
                         (3, true) => Some([1, 1, 1]),
                         (4, true) if self == Repair::Orca => Some([2, 1, 1]),
+                        (5, true) if self == Repair::Orca => Some([5, 0, 0]),
                         _ => None,
                     };
                     if let Some(p) = powers {
@@ -111,21 +113,22 @@ impl Repair {
                             *c *= extra / cartesian_norm(a, p);
                         }
                     }
-                    if self == Repair::Orca && pure && (l == 3 || l == 4) {
-                        // m = ±3 (and ±4) sit after 0, ±1, ±2: positions 5.. in the shell.
-                        for f in &mut row_factor[first + 5..first + 2 * l as usize + 1] {
+                    if self == Repair::Orca && pure && (3..=5).contains(&l) {
+                        // m = ±3 and ±4 sit after 0, ±1, ±2: positions 5..9 in the shell (h±5 keep
+                        // their sign).
+                        for f in &mut row_factor[first + 5..first + (2 * l as usize + 1).min(9)] {
                             *f = -1.0;
                         }
                     }
                 }
                 Repair::Turbomole => {
-                    if !pure && (2..=4).contains(&l) {
+                    if !pure && (2..=5).contains(&l) {
                         let s = double_factorial(2 * l as i64 - 1).sqrt();
                         shell.coefficients.iter_mut().for_each(|c| *c *= s);
                     }
                 }
                 Repair::Cfour => {
-                    if !pure && (2..=4).contains(&l) {
+                    if !pure && (2..=5).contains(&l) {
                         for (k, p) in cartesian_powers(l).iter().enumerate() {
                             row_factor[first + k] = component_double_factorials(*p).sqrt();
                         }
@@ -136,7 +139,7 @@ impl Repair {
                     if n > 0.0 && n.is_finite() {
                         shell.coefficients.iter_mut().for_each(|c| *c /= n);
                     }
-                    if self == Repair::Psi4Upto132 && !pure && (2..=4).contains(&l) {
+                    if self == Repair::Psi4Upto132 && !pure && (2..=5).contains(&l) {
                         let dl = double_factorial(2 * l as i64 - 1);
                         for (k, p) in cartesian_powers(l).iter().enumerate() {
                             row_factor[first + k] = (component_double_factorials(*p) / dl).sqrt();
@@ -391,12 +394,18 @@ mod repair_tests {
     /// Two centres with s, p and a d (and f) shell each; orbitals orthonormal (Gram–Schmidt in
     /// the overlap metric), normalised contractions.
     fn correct(kind: ShellKind) -> Wavefunction {
+        correct_to(kind, 3)
+    }
+
+    /// [`correct`] with shells of every l from 2 to `max_l` (h at most) on each centre.
+    fn correct_to(kind: ShellKind, max_l: u32) -> Wavefunction {
         let mut shells = Vec::new();
         for (atom, z) in [(0, 0.0), (1, 1.6)] {
             shells.push(shell(atom, z, 0, ShellKind::Cartesian, &[3.0, 0.6], &[0.4, 0.7]));
             shells.push(shell(atom, z, 1, ShellKind::Cartesian, &[1.2, 0.3], &[0.5, 0.6]));
-            shells.push(shell(atom, z, 2, kind, &[0.9], &[1.0]));
-            shells.push(shell(atom, z, 3, kind, &[0.7], &[1.0]));
+            for l in 2..=max_l {
+                shells.push(shell(atom, z, l, kind, &[1.1 - 0.2 * (l - 2) as f64], &[1.0]));
+            }
         }
         let mut wf = Wavefunction { basis: Basis { shells }, restricted: true, ..Default::default() };
         normalize_contractions(&mut wf);
@@ -479,25 +488,46 @@ mod repair_tests {
         assert!(n.residual < 1e-10);
     }
 
-    /// What ORCA does to a correct file: primitive normalisation folded into the contraction
-    /// coefficients, and the signs of the pure f±3 functions flipped.
+    /// What ORCA does to a correct file with pure shells: primitive normalisation (of the x,
+    /// xy, xyz, xxyz, x⁵ component) folded into the contraction coefficients, and the signs of
+    /// the m = ±3 and ±4 functions of f, g and h flipped.
     fn orca_quirk(wf: &mut Wavefunction) {
         let offsets = wf.basis.shell_offsets();
         for (s, &first) in wf.basis.shells.iter_mut().zip(&offsets) {
-            let p = match s.l {
-                0 => [0, 0, 0],
-                1 => [1, 0, 0],
-                2 => [1, 1, 0],
-                _ => [1, 1, 1],
-            };
+            let p = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [1, 1, 1], [2, 1, 1], [5, 0, 0]][s.l as usize];
             for (c, &a) in s.coefficients.iter_mut().zip(&s.exponents) {
                 *c *= cartesian_norm(a, p);
             }
-            if s.l == 3 && s.kind == ShellKind::Pure {
+            if s.l >= 3 && s.kind == ShellKind::Pure {
                 for o in &mut wf.orbitals {
-                    o.coefficients[first + 5] *= -1.0;
-                    o.coefficients[first + 6] *= -1.0;
+                    for k in 5..(2 * s.l as usize + 1).min(9) {
+                        o.coefficients[first + k] *= -1.0;
+                    }
                 }
+            }
+        }
+    }
+
+    /// Every writer quirk on a basis with d, f, g and h shells is found and undone exactly.
+    #[test]
+    fn every_repair_covers_l_up_to_h() {
+        type Quirk = fn(&mut Wavefunction);
+        let turbomole: Quirk = |wf| scale_rows(wf, |_, l| 1.0 / double_factorial(2 * l as i64 - 1).sqrt());
+        let cfour: Quirk = |wf| scale_rows(wf, |p, _| 1.0 / component_double_factorials(p).sqrt());
+        let psi4: Quirk =
+            |wf| scale_rows(wf, |p, l| (double_factorial(2 * l as i64 - 1) / component_double_factorials(p)).sqrt());
+        for (kind, quirk, named, expected) in [
+            (ShellKind::Cartesian, turbomole, None, "Turbomole"),
+            (ShellKind::Cartesian, cfour, None, "CFOUR"),
+            (ShellKind::Cartesian, psi4, Some("Psi4"), "Psi4 <= 1.3.2"),
+            (ShellKind::Pure, orca_quirk as Quirk, None, "ORCA"),
+        ] {
+            for max_l in 2..=5 {
+                let mut wf = correct_to(kind, max_l);
+                quirk(&mut wf);
+                let n = run(wf, named);
+                assert_eq!(n.program, expected, "l ≤ {max_l}: {n:?}");
+                assert!(n.residual <= 1e-10, "l ≤ {max_l}: {n:?}");
             }
         }
     }
@@ -518,8 +548,11 @@ mod repair_tests {
         use crate::model::gto::PreparedBasis;
         let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/wavefunctions");
         let load = |name: &str| {
-            let text = std::fs::read_to_string(format!("{dir}/{name}"))
-                .unwrap_or_else(|e| panic!("{dir}/{name}: {e} (run scripts/make_wavefunction_fixtures.py)"));
+            let text = std::fs::read_to_string(format!("{dir}/{name}")).unwrap_or_else(|e| {
+                panic!(
+                    "{dir}/{name}: {e} (run scripts/make_wavefunction_fixtures.py and scripts/make_h_molden_fixture.py)"
+                )
+            });
             let doc = super::super::molden::parse(name, &text, Some(&reference_overlap)).expect("fixture parses");
             doc.wavefunction.expect("a wavefunction")
         };
@@ -545,6 +578,7 @@ mod repair_tests {
             ("h2o_cart_631gs.molden", cfour, None, "CFOUR"),
             ("h2o_cart_631gs.molden", psi4, Some("Psi4"), "Psi4 <= 1.3.2"),
             ("h2o_ccpvtz.molden", orca, None, "ORCA"),
+            ("h2_spdfgh.molden", orca, None, "ORCA"),
         ] {
             let good = load(name);
             assert_eq!(good.normalization.repair, "none", "{name}");
@@ -554,6 +588,11 @@ mod repair_tests {
             let fixed = check_and_repair(bad, named, Some(&reference_overlap));
             assert_eq!(fixed.normalization.program, expected, "{name}: {:?}", fixed.normalization);
             assert!(fixed.normalization.residual < 1e-8, "{name}: {:?}", fixed.normalization);
+            if name == "h2_spdfgh.molden" {
+                // h functions (l = 5): as read and repaired, orthonormal to 1e-10.
+                assert!(good.normalization.residual <= 1e-10, "{name}: {:?}", good.normalization);
+                assert!(fixed.normalization.residual <= 1e-10, "{name}: {:?}", fixed.normalization);
+            }
             let worst = values(&good).iter().zip(values(&fixed)).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
             assert!(worst < 1e-10, "{name} as {expected}: orbitals differ by {worst:e} after the repair");
         }

@@ -76,7 +76,7 @@ pub fn scene(with_volume: Option<VolumeGrid>) -> Document {
 pub fn assert_golden(name: &str, actual: &image::RgbaImage) {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/golden");
     let reference = dir.join(format!("{name}.png"));
-    if std::env::var_os("ORBCLOUD_BLESS").is_some() {
+    if blessing() {
         actual.save(&reference).unwrap();
         eprintln!("blessed {}", reference.display());
         return;
@@ -106,6 +106,45 @@ pub fn assert_golden(name: &str, actual: &image::RgbaImage) {
             "{name}: {bad} of {n} pixels differ by > 8/255, mean |diff| {mean:.3}/255; see tests/golden/{name}.actual.png and .diff.png"
         );
     }
+}
+
+/// Whether golden images are to be rewritten: `ORBCLOUD_BLESS=1` (or `true`); any other value,
+/// `0` included, compares.
+pub fn blessing() -> bool {
+    bless_value(std::env::var_os("ORBCLOUD_BLESS").as_deref())
+}
+
+pub fn bless_value(v: Option<&std::ffi::OsStr>) -> bool {
+    v.and_then(|v| v.to_str()).is_some_and(|v| matches!(v.trim().to_ascii_lowercase().as_str(), "1" | "true"))
+}
+
+/// The shared real-world corpus: `../shared/refdata/real-world` beside the checkout, or
+/// `ORBCLOUD_REFDATA`.
+pub fn refdata_dir() -> PathBuf {
+    std::env::var_os("ORBCLOUD_REFDATA")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/refdata/real-world"))
+}
+
+/// [`refdata_dir`] when it exists. `None` when it is absent: the test prints one line saying it
+/// did not run and why, and passes, unless `ORBCLOUD_REQUIRE_REFDATA=1` (CI), where a missing
+/// corpus fails.
+pub fn refdata(test: &str) -> Option<PathBuf> {
+    let dir = refdata_dir();
+    let required = std::env::var_os("ORBCLOUD_REQUIRE_REFDATA").is_some_and(|v| v == "1");
+    refdata_in(test, dir, required)
+}
+
+pub fn refdata_in(test: &str, dir: PathBuf, required: bool) -> Option<PathBuf> {
+    if dir.is_dir() {
+        return Some(dir);
+    }
+    let why = format!("{test}: not run: the reference corpus {} is absent", dir.display());
+    assert!(!required, "{why} and ORBCLOUD_REQUIRE_REFDATA=1 requires it");
+    // Straight to the stream: the test harness would hide a println! of a passing test.
+    use std::io::Write;
+    let _ = writeln!(std::io::stderr(), "{why}");
+    None
 }
 
 /// Fraction of pixels that differ from the background colour by more than a few counts.

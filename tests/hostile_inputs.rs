@@ -1,0 +1,318 @@
+//! Hostile and broken inputs: every one is refused with a typed error naming the file and line,
+//! quickly, and with memory bounded by what the file's header honestly implies. The hostile
+//! files (decompression bombs among them) are made here.
+
+use std::io::Write;
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+use orbcloud::formats::{self, LoadError, MAX_LINE_BYTES, MAX_TRAILING_BYTES, ParseError};
+
+const FIXTURES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/wavefunctions");
+
+/// A 2×2×3 bohr grid with one oxygen atom (line 7) and its 12 values (lines 8–9).
+fn cube(atom: &str, axes: [&str; 3], origin: &str) -> String {
+    format!(
+        "title\ndensity\n    1   {origin}\n    2   {}\n    2   {}\n    3   {}\n{atom}\n{TWELVE}",
+        axes[0], axes[1], axes[2]
+    )
+}
+
+const AXES: [&str; 3] = ["0.5 0.0 0.0", "0.0 0.4 0.0", "0.0 0.0 0.3"];
+const ORIGIN: &str = "-1.0 0.5 2.0";
+const OXYGEN: &str = "    8   8.0   0.0 0.0 0.1";
+const TWELVE: &str =
+    "  1.0E-01  2.0E-01  3.0E-01  4.0E-01  5.0E-01  6.0E-01\n  7.0E-01  8.0E-01  9.0E-01  1.0E+00  1.1E+00  1.2E+00\n";
+
+fn parse_error(e: LoadError) -> ParseError {
+    match e {
+        LoadError::Parse(p) => p,
+        other => panic!("expected a parse error, got {other}"),
+    }
+}
+
+/// Loads `bytes` as a file named `name` and returns the parse error, checking it came fast.
+fn refused(name: &str, bytes: &[u8]) -> ParseError {
+    let t = Instant::now();
+    let e = match formats::load_bytes(Path::new(name), bytes) {
+        Ok(_) => panic!("{name}: a hostile file was accepted"),
+        Err(e) => parse_error(e),
+    };
+    assert!(t.elapsed() < Duration::from_secs(5), "{name}: refused only after {:?}", t.elapsed());
+    assert_eq!(e.file, name);
+    e
+}
+
+fn gzip(data: &[u8]) -> Vec<u8> {
+    let mut gz = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
+    gz.write_all(data).unwrap();
+    gz.finish().unwrap()
+}
+
+/// A gzip file that starts with `head` and then inflates to `gib` GiB of `filler` repeated:
+/// one compressed 16 MiB member, concatenated (gzip allows members back to back).
+fn bomb(head: &str, filler: &[u8], gib: usize) -> Vec<u8> {
+    let block: Vec<u8> = filler.iter().copied().cycle().take(16 << 20).collect();
+    let member = gzip(&block);
+    let mut out = gzip(head.as_bytes());
+    for _ in 0..gib * 64 {
+        out.extend_from_slice(&member);
+    }
+    out
+}
+
+#[test]
+fn a_plain_cube_loads() {
+    let d = formats::load_bytes(Path::new("ok.cube"), cube(OXYGEN, AXES, ORIGIN).as_bytes()).unwrap();
+    assert_eq!(d.volumes[0].values.len(), 12);
+    // Z = 118 and a ghost (Z = 0) are atoms.
+    for z in ["118", "0"] {
+        let atom = OXYGEN.replacen("8   8.0", &format!("{z}   8.0"), 1);
+        formats::load_bytes(Path::new("ok.cube"), cube(&atom, AXES, ORIGIN).as_bytes()).unwrap();
+    }
+}
+
+#[test]
+fn impossible_atomic_numbers_are_refused() {
+    for z in ["999", "119", "-1", "-8", "4294967304"] {
+        let atom = OXYGEN.replacen("8   8.0", &format!("{z}   8.0"), 1);
+        let e = refused("z.cube", cube(&atom, AXES, ORIGIN).as_bytes());
+        assert_eq!(e.line, 7, "{z}: {e}");
+        assert!(e.expected.contains("0..=118"), "{z}: {e}");
+        assert_eq!(e.found, z);
+    }
+    let molden = std::fs::read_to_string(format!("{FIXTURES}/h2o_cart_631gs.molden")).unwrap();
+    for z in ["999", "119", "-1"] {
+        let bad = molden.replacen("O   1   8 ", &format!("O   1   {z} "), 1);
+        let e = refused("z.molden", bad.as_bytes());
+        assert_eq!(e.line, 4, "{z}: {e}");
+        assert!(e.expected.contains("0..=118"), "{z}: {e}");
+    }
+    let fchk = std::fs::read_to_string(format!("{FIXTURES}/h2o_cart_631gs.fchk")).unwrap();
+    let bad = fchk.replacen("           8           1           1", "         999           1           1", 1);
+    assert_ne!(bad, fchk);
+    let e = refused("z.fchk", bad.as_bytes());
+    assert!(e.expected.contains("0..=118"), "{e}");
+    assert_eq!(e.found, "999");
+}
+
+#[test]
+fn singular_and_non_finite_grids_are_refused() {
+    let singular = [
+        ["0 0 0", "0 0 0", "0 0 0"],
+        ["0.5 0 0", "0 0 0", "0 0 0.3"],
+        ["0.5 0 0", "1.0 0 0", "0 0 0.3"],
+        ["0.5 0 0", "0 0.4 0", "0.5 0.4 0"],
+        ["0.5 0 0", "0 0.4 0", "0.5 0.4 1e-9"],
+        ["1e200 0 0", "0 1e200 0", "0 0 1e200"],
+    ];
+    for axes in singular {
+        let e = refused("singular.cube", cube(OXYGEN, axes, ORIGIN).as_bytes());
+        assert_eq!(e.line, 6, "{axes:?}: {e}");
+        assert!(e.expected.contains("linearly independent"), "{axes:?}: {e}");
+    }
+    // Sheared but not singular.
+    let sheared = ["0.5 0.1 0", "0.2 0.4 0", "0 0.1 0.3"];
+    formats::load_bytes(Path::new("ok.cube"), cube(OXYGEN, sheared, ORIGIN).as_bytes()).unwrap();
+
+    for bad in ["NaN", "inf", "-Infinity", "1e999"] {
+        let e = refused("axis.cube", cube(OXYGEN, ["0.5 0 0", &format!("0 {bad} 0"), "0 0 0.3"], ORIGIN).as_bytes());
+        assert_eq!(e.line, 5, "{bad}: {e}");
+        let e = refused("origin.cube", cube(OXYGEN, AXES, &format!("-1.0 {bad} 2.0")).as_bytes());
+        assert_eq!(e.line, 3, "{bad}: {e}");
+        let e = refused("atom.cube", cube(&format!("    8   8.0   0.0 {bad} 0.1"), AXES, ORIGIN).as_bytes());
+        assert_eq!(e.line, 7, "{bad}: {e}");
+        let e = refused("charge.cube", cube(&format!("    8   {bad}   0.0 0.0 0.1"), AXES, ORIGIN).as_bytes());
+        assert_eq!(e.line, 7, "{bad}: {e}");
+    }
+}
+
+#[test]
+fn data_beyond_the_declared_values_are_refused() {
+    let text = cube(OXYGEN, AXES, ORIGIN);
+    for (name, bytes) in [
+        ("more.cube", format!("{text} 1.3E+00\n").into_bytes()),
+        ("more.cube.gz", gzip(format!("{text}0.0\n").as_bytes())),
+    ] {
+        let e = refused(name, &bytes);
+        assert_eq!(e.line, 10, "{e}");
+        assert!(e.found.contains("value 13"), "{e}");
+    }
+    // Trailing blank lines are fine.
+    formats::load_bytes(Path::new("ok.cube.gz"), &gzip(format!("{text}\n\n   \n").as_bytes())).unwrap();
+}
+
+#[test]
+fn gzip_bombs_are_refused_once_the_declared_values_are_read() {
+    let head = cube(OXYGEN, AXES, ORIGIN);
+    // 4 GiB of further values: refused at the first one.
+    let e = refused("values.cube.gz", &bomb(&head, b"0.0 ", 4));
+    assert_eq!(e.line, 10, "{e}");
+    assert!(e.found.contains("value 13"), "{e}");
+    // 4 GiB of blank space: refused after a bounded amount of it.
+    let e = refused("blank.cube.gz", &bomb(&head, b"  \n", 4));
+    assert!(e.found.contains(&format!("more than {MAX_TRAILING_BYTES} bytes")), "{e}");
+    // 4 GiB of NUL bytes, and of one endless line, after a valid header.
+    let e = refused("nul.cube.gz", &bomb(&head, b"\0", 4));
+    assert!(e.found.contains("control byte 0x00"), "{e}");
+    assert_eq!(e.line, 10);
+    // Endless digits are one more value; an endless comment line is refused at its length.
+    let e = refused("digits.cube.gz", &bomb(&head, b"1", 4));
+    assert!(e.found.contains("more than the 12 values"), "{e}");
+    let e = refused("line.cube.gz", &bomb("title ", b"x", 4));
+    assert!(e.expected.contains(&format!("at most {MAX_LINE_BYTES} bytes")), "{e}");
+    assert_eq!(e.line, 1);
+    // A header that declares a grid too large for any GPU: refused without reading the data.
+    let big =
+        head.replacen("    2   0.5", "    100000   0.5", 1).replacen("    2   0.0 0.4", "    100000   0.0 0.4", 1);
+    let e = refused("big.cube.gz", &bomb(&big, b"0.0 ", 4));
+    assert_eq!(e.line, 6, "{e}");
+    assert!(e.expected.contains("at most"), "{e}");
+}
+
+#[test]
+fn wavefunction_gzip_bombs_are_refused() {
+    let molden = std::fs::read_to_string(format!("{FIXTURES}/h2o_cart_631gs.molden")).unwrap();
+    let fchk = std::fs::read_to_string(format!("{FIXTURES}/h2o_cart_631gs.fchk")).unwrap();
+    for (name, head) in [("bomb.molden.gz", &molden), ("bomb.fchk.gz", &fchk)] {
+        let e = refused(name, &bomb(head, b"\n", 4));
+        assert!(e.found.contains("decompression bomb"), "{name}: {e}");
+    }
+}
+
+#[test]
+fn absurd_counts_are_refused() {
+    let e = refused(
+        "atoms.cube",
+        cube(OXYGEN, AXES, ORIGIN).replacen("    1   -1.0", "    99999999999   -1.0", 1).as_bytes(),
+    );
+    assert_eq!(e.line, 3, "{e}");
+    let molden = std::fs::read_to_string(format!("{FIXTURES}/h2o_cart_631gs.molden")).unwrap();
+    let e = refused("nprim.molden", molden.replacen(" s    6 1.00", " s    999999999999 1.00", 1).as_bytes());
+    assert_eq!(e.line, 9, "{e}");
+    assert!(e.expected.contains("primitive count"), "{e}");
+    let at = molden.find("[MO]").unwrap();
+    let line = 1 + molden[..at].matches('\n').count();
+    let index = at + molden[at..].find("\n   1 ").unwrap() + 1;
+    let bad = format!("{}99999999999999{}", &molden[..index], &molden[index + 4..]);
+    let e = refused("index.molden", bad.as_bytes());
+    assert!(e.line > line, "{e}");
+    assert!(e.expected.contains("coefficient indices"), "{e}");
+    let fchk = std::fs::read_to_string(format!("{FIXTURES}/h2o_cart_631gs.fchk")).unwrap();
+    let bad = regex_free_replace(&fchk, "Shell types", "N=", "N=  999999999999");
+    let e = refused("count.fchk", bad.as_bytes());
+    assert!(e.expected.contains("array length"), "{e}");
+}
+
+/// Replaces the first `key…` field on the line of `label` by `with` (the rest of the line goes).
+fn regex_free_replace(text: &str, label: &str, key: &str, with: &str) -> String {
+    let at = text.find(label).unwrap();
+    let k = at + text[at..].find(key).unwrap();
+    let end = k + text[k..].find('\n').unwrap();
+    format!("{}{with}{}", &text[..k], &text[end..])
+}
+
+#[test]
+fn empty_binary_and_endless_files_are_refused_in_every_format() {
+    // Deterministic pseudo-random bytes (a linear congruential generator).
+    let mut x = 0x2545_f491_4f6c_dd1du64;
+    let garbage: Vec<u8> = (0..1 << 16)
+        .map(|_| {
+            x = x.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (x >> 56) as u8
+        })
+        .collect();
+    let long_line = vec![b'7'; 3 * MAX_LINE_BYTES];
+    for ext in ["cube", "molden", "fchk", "cube.gz", "molden.gz", "fchk.gz"] {
+        let name = format!("hostile.{ext}");
+        let e = refused(&name, b"");
+        assert!(e.found.contains("empty file"), "{name}: {e}");
+        let e = refused(&name, b" \n\n\t\n");
+        assert!(e.found.contains("empty file") || e.found.contains("end of file"), "{name}: {e}");
+        // Binary garbage, plain and gzipped, never reaches a parser.
+        for bytes in [garbage.clone(), gzip(&garbage)] {
+            match formats::load_bytes(Path::new(&name), &bytes) {
+                Ok(_) => panic!("{name}: garbage accepted"),
+                Err(LoadError::Parse(e)) => assert!(e.found.contains("control byte"), "{name}: {e}"),
+                Err(LoadError::NotText { .. }) => {}
+                Err(e) => panic!("{name}: {e}"),
+            }
+        }
+        let e = refused(&name, &long_line);
+        assert!(e.expected.contains(&format!("at most {MAX_LINE_BYTES} bytes")), "{name}: {e}");
+        assert_eq!(e.line, 1);
+    }
+}
+
+#[test]
+fn truncated_files_never_panic() {
+    let cube = cube(OXYGEN, AXES, ORIGIN);
+    let molden = std::fs::read_to_string(format!("{FIXTURES}/h2o_cart_631gs.molden")).unwrap();
+    let fchk = std::fs::read_to_string(format!("{FIXTURES}/h2o_cart_631gs.fchk")).unwrap();
+    for (name, text) in [("t.cube", &cube), ("t.molden", &molden), ("t.fchk", &fchk)] {
+        let step = (text.len() / 97).max(1);
+        for cut in (0..text.len()).step_by(step) {
+            if let Ok(cut_text) = std::str::from_utf8(&text.as_bytes()[..cut]) {
+                let _ = formats::load_bytes(Path::new(name), cut_text.as_bytes());
+            }
+        }
+    }
+}
+
+/// `orbcloud info` on a 4 GiB gzip bomb (a valid header, then blank space, the case read
+/// furthest): refused with a message, within 5 s and 200 MB of resident memory.
+#[test]
+fn info_on_a_gzip_bomb_stays_small_and_fast() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("bomb.cube.gz");
+    std::fs::write(&path, bomb(&cube(OXYGEN, AXES, ORIGIN), b"  \n", 4)).unwrap();
+    let exe = env!("CARGO_BIN_EXE_orbcloud");
+    let (status, stderr, rss_kb, wall) = if Path::new("/usr/bin/time").exists() {
+        let t = Instant::now();
+        let out = std::process::Command::new("/usr/bin/time")
+            .arg("-v")
+            .args([exe, "info"])
+            .arg(&path)
+            .output()
+            .expect("run /usr/bin/time");
+        let wall = t.elapsed();
+        let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+        let rss = stderr
+            .lines()
+            .find_map(|l| l.trim().strip_prefix("Maximum resident set size (kbytes):"))
+            .and_then(|v| v.trim().parse::<u64>().ok())
+            .unwrap_or_else(|| panic!("no maximum RSS in /usr/bin/time's output:\n{stderr}"));
+        (out.status, stderr, rss, wall)
+    } else {
+        // Without GNU time: poll the child's high-water mark of resident memory.
+        let t = Instant::now();
+        let mut child = std::process::Command::new(exe)
+            .arg("info")
+            .arg(&path)
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        let mut rss = 0;
+        let status = loop {
+            if let Ok(s) = std::fs::read_to_string(format!("/proc/{}/status", child.id())) {
+                let hwm = s
+                    .lines()
+                    .find_map(|l| l.strip_prefix("VmHWM:"))
+                    .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<u64>().ok());
+                rss = rss.max(hwm.unwrap_or(0));
+            }
+            if let Some(s) = child.try_wait().unwrap() {
+                break s;
+            }
+            std::thread::sleep(Duration::from_millis(2));
+        };
+        let mut stderr = String::new();
+        std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut stderr).unwrap();
+        (status, stderr, rss, t.elapsed())
+    };
+    println!("orbcloud info on a 4 GiB gzip bomb: {wall:.2?}, max RSS {} MB", rss_kb / 1024);
+    assert!(!status.success(), "the bomb was accepted:\n{stderr}");
+    assert!(stderr.contains("bomb.cube.gz") && stderr.contains("more than"), "{stderr}");
+    assert!(rss_kb < 200 * 1024, "max RSS {rss_kb} kB");
+    assert!(wall < Duration::from_secs(5), "took {wall:?}");
+}
