@@ -267,7 +267,7 @@ fn isosurfaces_follow_the_slider_and_atoms_are_picked_and_measured() {
     let first = h.state().status.clone();
     assert!(first.starts_with("isosurfaces: ") && !first.starts_with("isosurfaces: 0 "), "{first}");
     // Dragging the iso value changes the surfaces.
-    let slider = h.get_by_label("value (a.u.)").rect();
+    let slider = h.get_by_role_and_label(egui::accesskit::Role::Slider, "value (a.u.)").rect();
     let from = slider.left_center() + egui::vec2(slider.width() * 0.3, 0.0);
     h.drag_at(from);
     h.run_steps(1);

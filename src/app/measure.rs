@@ -90,7 +90,7 @@ pub fn panel(ui: &mut egui::Ui, molecule: &Molecule, m: &mut Measurements) {
     let mut remove = None;
     for (n, measurement) in m.list.iter().enumerate() {
         ui.horizontal(|ui| {
-            if ui.small_button("✕").on_hover_text("remove").clicked() {
+            if ui.small_button("×").on_hover_text("remove").clicked() {
                 remove = Some(n);
             }
             ui.label(measurement.label(molecule));

@@ -225,7 +225,22 @@ impl Viewport {
             // The frame just drawn is the one on screen: read its id under the pointer.
             let rel = (pos - rect.min) / rect.size();
             let pixel = [(rel.x * size[0] as f32) as u32, (rel.y * size[1] as f32) as u32];
-            let shift = ui.input(|i| i.modifiers.shift);
+            // Shift as it was at the release (the frame's modifiers may already have moved on).
+            let shift = ui.input(|i| {
+                i.events
+                    .iter()
+                    .rev()
+                    .find_map(|e| match e {
+                        egui::Event::PointerButton {
+                            button: PointerButton::Primary,
+                            pressed: false,
+                            modifiers,
+                            ..
+                        } => Some(modifiers.shift),
+                        _ => None,
+                    })
+                    .unwrap_or(i.modifiers.shift)
+            });
             match self.renderer.pick(&self.ctx, pixel) {
                 Ok(picked) => self.click = Some(Click { picked, shift }),
                 Err(e) => log::warn!("picking failed: {e}"),
