@@ -287,6 +287,9 @@ fn isosurfaces_follow_the_slider_and_atoms_are_picked_and_measured() {
     click_at(&mut h, o, false);
     assert!(h.state().status.starts_with("atom 2 O"), "{}", h.state().status);
     let c = h.state().atom_on_screen(0).unwrap();
+    h.hover_at(c);
+    h.run_steps(2);
+    assert_eq!(h.state().hovered(), Some(orbcloud::gpu::frame::PickId::Atom { object: 0, index: 0 }), "hover");
     click_at(&mut h, c, true);
     let app = h.state();
     assert_eq!(app.measurements.selection, vec![1, 0]);

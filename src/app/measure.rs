@@ -1,6 +1,6 @@
-//! Picking atoms in the view and measuring between them: a click selects an atom, Shift-click
-//! adds to the selection, and 2, 3 or 4 selected atoms give a distance, an angle or a dihedral,
-//! kept in a list and drawn in the view.
+//! Picking atoms in the view and measuring between them: the atom under the pointer is ringed
+//! and named, a click selects an atom, Shift-click adds to the selection, and 2, 3 or 4 selected
+//! atoms give a distance, an angle or a dihedral, kept in a list and drawn in the view.
 
 use egui::{Color32, RichText, Stroke};
 
@@ -59,6 +59,18 @@ const COLOR: Color32 = Color32::from_rgb(255, 220, 90);
 pub fn overlay(ui: &egui::Ui, vp: &Viewport, camera: &Camera, molecule: &Molecule, m: &Measurements) {
     let painter = ui.painter();
     let screen = |i: usize| molecule.atoms.get(i).and_then(|a| vp.to_screen(camera, a.position.as_vec3()));
+    if let Some(PickId::Atom { index, .. }) = vp.hovered
+        && let (Some(p), Some(atom)) = (screen(index as usize), molecule.atoms.get(index as usize))
+    {
+        painter.circle_stroke(p, 11.0, Stroke::new(1.5, Color32::from_white_alpha(160)));
+        painter.text(
+            p + egui::vec2(12.0, 10.0),
+            egui::Align2::LEFT_TOP,
+            format!("{}{}", atom.element().symbol, index + 1),
+            egui::FontId::proportional(14.0),
+            Color32::WHITE,
+        );
+    }
     for &i in &m.selection {
         if let Some(p) = screen(i) {
             painter.circle_stroke(p, 9.0, Stroke::new(2.0, COLOR));

@@ -142,6 +142,11 @@ impl OrbApp {
         self.viewport.as_ref()?.to_screen(&self.view.camera, position)
     }
 
+    /// What is under the resting pointer in the single-file view.
+    pub fn hovered(&self) -> Option<crate::gpu::frame::PickId> {
+        self.viewport.as_ref()?.hovered
+    }
+
     /// Each view shown: (size on screen, size of its last frame), pixels. The frame is smaller
     /// while a drag or the animation runs on a CPU adapter ([`detail`]).
     pub fn view_sizes(&self) -> Vec<([u32; 2], [u32; 2])> {

@@ -49,6 +49,9 @@ pub struct Viewport {
     iso_grid: Option<VolumeGrid>,
     /// The last click, until the caller takes it.
     pub click: Option<Click>,
+    /// What is under the resting pointer (hover highlight), and where the pointer was.
+    pub hovered: Option<PickId>,
+    hovered_at: Option<egui::Pos2>,
     /// Where the view was laid out, and the size it was drawn at (for overlays).
     layout: Option<(egui::Rect, [u32; 2])>,
     /// Whether the current drag twists the dihedral.
@@ -71,6 +74,8 @@ impl Viewport {
             generation: 0,
             iso_grid: None,
             click: None,
+            hovered: None,
+            hovered_at: None,
             layout: None,
             twisting: false,
             scan_shown: None,
@@ -219,6 +224,16 @@ impl Viewport {
             ui.painter().image(*id, rect, uv, egui::Color32::WHITE);
         }
         self.layout = Some((rect, size));
+        // Hover: read the id under the pointer when it moved and no button is held.
+        let pointer = response.hover_pos().filter(|_| !ui.input(|i| i.pointer.any_down()));
+        if pointer != self.hovered_at {
+            self.hovered_at = pointer;
+            self.hovered = pointer.and_then(|pos| {
+                let rel = (pos - rect.min) / rect.size();
+                let pixel = [(rel.x * size[0] as f32) as u32, (rel.y * size[1] as f32) as u32];
+                self.renderer.pick(&self.ctx, pixel).ok().flatten()
+            });
+        }
         if response.clicked_by(PointerButton::Primary)
             && let Some(pos) = response.interact_pointer_pos()
         {
