@@ -49,11 +49,8 @@ fn orbitals_and_densities_decay_inside_their_box() {
             };
             let (lo, hi) = quantity_box(wf, &doc.molecule, q).unwrap();
             let (face, max) = face_and_max(&eval(lo, hi), n);
-            assert!(
-                face <= FACE_FRACTION * max,
-                "{file} {q:?}: faces reach {:.2} % of the maximum",
-                100.0 * face / max
-            );
+            let limit = if q == Quantity::Density { DENSITY_FACE } else { FACE_FRACTION * max };
+            assert!(face <= limit, "{file} {q:?}: faces reach {face:.2e} (max {max:.2e})");
             // The old box: the atoms plus 4.5 bohr.
             let (alo, ahi) = doc.molecule.bounds().unwrap();
             let (old_face, old_max) = face_and_max(&eval(alo - DVec3::splat(4.5), ahi + DVec3::splat(4.5)), n);
