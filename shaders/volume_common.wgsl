@@ -12,20 +12,33 @@ struct VolumeUniforms {
     plane: vec4<f32>,
     positive_color: vec4<f32>,
     negative_color: vec4<f32>,
-    // x: k1, y: k2, z: 1 / max|value|, w: reference step (bohr) the opacity k1 refers to
-    params: vec4<f32>,
-    // x: 1 for a signed field (orbital), 0 for a density
-    flags: vec4<u32>,
-    // x: the smallest |value| / max|value| that can be seen at these k1, k2
-    flags_f: vec4<f32>,
-    // y/z: shape of the positive/negative lobe, w: bit 0 shading (x unused: the power law,
-    // the gradient and clipping are pipeline overrides)
-    tf: vec4<u32>,
+    // Opacity k1·ρ^k2 per `ref_step` (bohr) of travel, ρ scaled by `inv_max` = 1 / max|value|.
+    k1: f32,
+    k2: f32,
+    inv_max: f32,
+    ref_step: f32,
+    // 1 for a signed field (an orbital), 0 for a density.
+    signed_field: u32,
+    // Shapes of the positive and negative lobes (the power law, the gradient and clipping are
+    // pipeline overrides).
+    shape_positive: u32,
+    shape_negative: u32,
+    // Bit 0: shading from the gradient.
+    tf_bits: u32,
+    // The smallest scaled |value| that can be seen at these k1, k2.
+    visible_min: f32,
+    // A scan frame's mix ratio k between its key volumes A and B.
+    morph_k: f32,
+    _pad0: f32,
+    _pad1: f32,
     // centre, width, peak opacity (fractions of max|value|), unused
     tf_positive: vec4<f32>,
     tf_negative: vec4<f32>,
-    // x: gradient power (2D transfer function), y: boundary enhancement, z: 1 / max|∇value|
-    tf_gradient: vec4<f32>,
+    // The 2D transfer function's gradient power, boundary enhancement, and 1 / max|∇value|.
+    gradient_power: f32,
+    boundary: f32,
+    inv_max_grad: f32,
+    _pad2: f32,
     // xyz: unit normal, w: offset; fragments with n·p > offset are cut away
     clip: vec4<f32>,
     // xyz: unit direction towards the light
@@ -90,26 +103,26 @@ fn needs_gradient() -> bool {
 // transfer function needs it); alpha < 0 means invisible (the caller discards, which skips the
 // frame buffer's read-modify-write).
 fn shade(value: f32, grad: vec3<f32>, from_eye: vec3<f32>) -> vec4<f32> {
-    let scaled = value * u.params.z;
+    let scaled = value * u.inv_max;
     var extinction: f32;
     var color: vec3<f32>;
     if (!SHAPED) {
         // Below this magnitude a sample is invisible (computed on the CPU from k1, k2).
-        if (abs(scaled) < u.flags_f.x) {
+        if (abs(scaled) < u.visible_min) {
             return vec4<f32>(-1.0);
         }
-        if (u.flags.x == 1u) {
+        if (u.signed_field == 1u) {
             // rho = psi^2, so rho^k2 = |psi|^(2 k2).
-            extinction = u.params.x * pow(abs(scaled), 2.0 * u.params.y);
+            extinction = u.k1 * pow(abs(scaled), 2.0 * u.k2);
             color = select(u.negative_color.rgb, u.positive_color.rgb, value >= 0.0);
         } else {
-            extinction = u.params.x * pow(max(scaled, 0.0), u.params.y);
+            extinction = u.k1 * pow(max(scaled, 0.0), u.k2);
             color = mix(u.negative_color.rgb, u.positive_color.rgb, sqrt(min(scaled, 1.0)));
         }
     } else {
-        let positive = value >= 0.0 || u.flags.x == 0u;
+        let positive = value >= 0.0 || u.signed_field == 0u;
         let lobe = select(u.tf_negative, u.tf_positive, positive);
-        let shape = select(u.tf.z, u.tf.y, positive);
+        let shape = select(u.shape_negative, u.shape_positive, positive);
         extinction = lobe.z * shape_factor(shape, abs(scaled), lobe.x, lobe.y);
         if (extinction < 1e-5) {
             return vec4<f32>(-1.0);
@@ -117,12 +130,12 @@ fn shade(value: f32, grad: vec3<f32>, from_eye: vec3<f32>) -> vec4<f32> {
         color = select(u.negative_color.rgb, u.positive_color.rgb, positive);
     }
     if (needs_gradient()) {
-        let g = min(length(grad) * u.tf_gradient.z, 1.0);
-        if (u.tf_gradient.x > 0.0) {
-            extinction *= pow(g, u.tf_gradient.x);
+        let g = min(length(grad) * u.inv_max_grad, 1.0);
+        if (u.gradient_power > 0.0) {
+            extinction *= pow(g, u.gradient_power);
         }
-        extinction *= 1.0 - u.tf_gradient.y + u.tf_gradient.y * sqrt(g);
-        if ((u.tf.w & 1u) != 0u && length(grad) > 0.0) {
+        extinction *= 1.0 - u.boundary + u.boundary * sqrt(g);
+        if ((u.tf_bits & 1u) != 0u && length(grad) > 0.0) {
             // Two-sided lighting: a translucent shell is seen from both sides.
             let n = normalize(grad);
             let v = -normalize(from_eye);
@@ -138,7 +151,7 @@ fn shade(value: f32, grad: vec3<f32>, from_eye: vec3<f32>) -> vec4<f32> {
     // alpha = 1 - exp(-extinction * path / step).
     let ray = normalize(from_eye);
     let path = u.plane.w / max(abs(dot(ray, u.plane.xyz)), 0.05);
-    let x = extinction * path / u.params.w;
+    let x = extinction * path / u.ref_step;
     // 1 − e^−x loses its digits to cancellation for small x: use the series there.
     let alpha = select(1.0 - exp2(-1.442695 * x), x * (1.0 - x * (0.5 - x / 6.0)), x < 0.03);
     return vec4<f32>(color * alpha, alpha);

@@ -1,5 +1,5 @@
 // Seed 000's interpolation between two key volumes A and B on one grid, θ between their
-// angles with ratio k = u.flags_f.y (`volume` is A).
+// angles with ratio k = u.morph_k (`volume` is A).
 //
 // exact (fs_exact): the two volumes sampled and mixed per sample, ψ = (1−k)ψA + kψB, then one
 // premultiplied "over" blend.
@@ -35,7 +35,7 @@ fn shade_mix(in: VertexOut, w: vec2<f32>) -> vec4<f32> {
 }
 
 fn k() -> f32 {
-    return u.flags_f.y;
+    return u.morph_k;
 }
 
 @fragment

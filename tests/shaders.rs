@@ -45,3 +45,71 @@ fn every_prerequisite_is_registered() {
         assert!(names.contains(&p), "{p} is a prerequisite but not in gpu::SHADERS");
     }
 }
+
+/// A Rust mirror of a WGSL struct: the module that declares it, the WGSL name, the Rust size and
+/// each field's name and offset, in order.
+macro_rules! mirror {
+    ($module:expr, $wgsl:expr, $ty:ty, [$($field:ident),* $(,)?]) => {
+        ($module, $wgsl, std::mem::size_of::<$ty>(), vec![$((stringify!($field), std::mem::offset_of!($ty, $field))),*])
+    };
+}
+
+#[test]
+fn rust_mirrors_match_the_wgsl_layouts() {
+    use orbcloud::gpu::{
+        atoms::AtomGlobals, gto::FillParams, gto::GpuShell, isosurface::SurfaceUniforms, volume::VolumeUniforms,
+    };
+    let mirrors = [
+        mirror!(
+            "volume_slices.wgsl",
+            "VolumeUniforms",
+            VolumeUniforms,
+            [
+                clip_from_world,
+                tex_from_world,
+                eye,
+                plane,
+                positive_color,
+                negative_color,
+                k1,
+                k2,
+                inv_max,
+                ref_step,
+                signed_field,
+                shape_positive,
+                shape_negative,
+                tf_bits,
+                visible_min,
+                morph_k,
+                _pad0,
+                _pad1,
+                tf_positive,
+                tf_negative,
+                gradient_power,
+                boundary,
+                inv_max_grad,
+                _pad2,
+                clip,
+                light,
+            ]
+        ),
+        mirror!("atoms.wgsl", "Globals", AtomGlobals, [clip_from_world, eye, light, up, pick]),
+        mirror!("isosurface.wgsl", "SurfaceUniforms", SurfaceUniforms, [clip_from_world, eye, light, color, pick]),
+        mirror!("gto_fill.wgsl", "FillParams", FillParams, [world_from_grid, dims]),
+        mirror!("gto_fill.wgsl", "GtoShell", GpuShell, [center, cutoff2, l, prim_offset, prim_count, weight_offset]),
+    ];
+    for (module_name, wgsl, size, fields) in mirrors {
+        let source = module_source(module_name);
+        let module = naga::front::wgsl::parse_str(&source).unwrap();
+        let (_, ty) = module
+            .types
+            .iter()
+            .find(|(_, t)| t.name.as_deref() == Some(wgsl))
+            .unwrap_or_else(|| panic!("{module_name} declares no struct {wgsl}"));
+        let naga::TypeInner::Struct { members, span } = &ty.inner else { panic!("{wgsl} is not a struct") };
+        let wgsl_fields: Vec<(&str, usize)> =
+            members.iter().map(|m| (m.name.as_deref().unwrap_or("?"), m.offset as usize)).collect();
+        assert_eq!(wgsl_fields, fields, "{wgsl} in {module_name}: members and offsets differ from the Rust mirror");
+        assert_eq!(*span as usize, size, "{wgsl} in {module_name}: size differs from the Rust mirror");
+    }
+}

@@ -26,9 +26,9 @@ const _: () = assert!(std::mem::size_of::<GpuShell>() == 32);
 /// Mirror of `FillParams` in gto_fill.wgsl.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
-struct FillParams {
-    world_from_grid: [[f32; 4]; 4],
-    dims: [u32; 4],
+pub struct FillParams {
+    pub world_from_grid: [[f32; 4]; 4],
+    pub dims: [u32; 4],
 }
 const _: () = assert!(std::mem::size_of::<FillParams>() == 80);
 
