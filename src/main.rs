@@ -10,8 +10,9 @@ use orbcloud::formats::cube_write;
 use orbcloud::gpu::{AdapterPreference, GpuContext};
 use orbcloud::headless::{Headless, WavefunctionView, default_camera, show_wavefunction};
 use orbcloud::model::Document;
+use orbcloud::model::GridSpec;
 use orbcloud::model::VolumeGrid;
-use orbcloud::model::gto::{GridSpec, PreparedBasis};
+use orbcloud::model::gto::PreparedBasis;
 use orbcloud::model::orbitals::{OrbitalSpec, Quantity, Spin, Wavefunction};
 use orbcloud::scene::transfer::PRESETS;
 use orbcloud::scene::{AtomStyle, Camera, ClipPlane, RenderSettings, Shape, SliceMode, TransferKind};
@@ -513,24 +514,16 @@ fn main() -> Result<()> {
                 None => orbcloud::model::extent::quantity_box(wf, &doc.molecule, q),
             }
             .ok_or_else(|| anyhow::anyhow!("{}: no atoms", doc.source))?;
-            let dims = match spacing {
-                Some(h) if h > 0.0 => ((hi - lo) / h).ceil().as_uvec3().to_array().map(|n| n as usize + 1),
+            let spec = match spacing {
+                Some(h) if h > 0.0 => GridSpec::spaced(lo, hi, h),
                 Some(h) => bail!("--spacing must be positive, got {h}"),
-                None => [grid.max(2); 3],
+                // cubegen's convention: the grid spans the box exactly, spacing = extent / (n − 1).
+                None => GridSpec::cube(lo, hi, grid),
             };
+            let dims = spec.dims;
             if dims.iter().map(|&d| d as u64).product::<u64>() > formats::MAX_GRID_VALUES {
                 bail!("a {dims:?} grid is too large");
             }
-            // cubegen's convention: the grid spans the box exactly, spacing = extent / (n − 1).
-            let step = match spacing {
-                Some(h) => DVec3::splat(h),
-                None => (hi - lo) / (dims[0] - 1) as f64,
-            };
-            let spec = GridSpec::new(
-                lo,
-                [DVec3::new(step.x, 0.0, 0.0), DVec3::new(0.0, step.y, 0.0), DVec3::new(0.0, 0.0, step.z)],
-                dims,
-            );
             let prepared = PreparedBasis::new(&wf.basis);
             let t = Instant::now();
             let values: Vec<f32> = match q {
@@ -539,9 +532,8 @@ fn main() -> Result<()> {
                 Quantity::SpinDensity => prepared.spin_density_grid(wf, &spec).iter().map(|&v| v as f32).collect(),
             };
             let seconds = t.elapsed().as_secs_f64();
-            let world = VolumeGrid::affine(spec.origin, spec.steps);
             let label = what.label(&q, wf);
-            let grid = VolumeGrid::new(&label, dims, world, values);
+            let grid = VolumeGrid::new(&label, dims, spec.world_from_grid, values);
             let id = match q {
                 Quantity::Orbital(i) => wf.of_spin(wf.orbitals[i].spin).position(|(j, _)| j == i).map_or(0, |p| p + 1),
                 _ => 0,

@@ -3,7 +3,8 @@
 mod common;
 
 use glam::DVec3;
-use orbcloud::gpu::gto::{GridGeometry, GtoFillPass, read_volume};
+use orbcloud::gpu::gto::{GtoFillPass, read_volume};
+use orbcloud::model::GridSpec;
 use orbcloud::model::VolumeGrid;
 use orbcloud::model::basis::n_cartesian;
 use orbcloud::model::cartesian::{CartesianExpansion, CartesianShell};
@@ -40,7 +41,7 @@ fn gpu_fill_matches_the_cpu_reference() {
         DVec3::new(-3.0, -2.5, -2.0),
         [DVec3::new(0.3, 0.0, 0.0), DVec3::new(0.05, 0.31, 0.0), DVec3::new(0.0, 0.02, 0.33)],
     );
-    let grid = GridGeometry { dims, world_from_grid };
+    let grid = GridSpec { dims, world_from_grid };
     let texture = GtoFillPass::new(&ctx).fill(&ctx, &e, &grid).unwrap();
     let gpu = read_volume(&ctx, &texture).unwrap();
     assert_eq!(gpu.len(), dims.iter().product::<usize>());
@@ -63,7 +64,7 @@ fn gpu_fill_matches_the_cpu_reference() {
 #[test]
 fn an_empty_expansion_fills_zeros() {
     let ctx = common::lavapipe();
-    let grid = GridGeometry::cube(DVec3::splat(-1.0), DVec3::splat(1.0), 5);
+    let grid = GridSpec::cube(DVec3::splat(-1.0), DVec3::splat(1.0), 5);
     let texture = GtoFillPass::new(&ctx).fill(&ctx, &CartesianExpansion::default(), &grid).unwrap();
     assert!(read_volume(&ctx, &texture).unwrap().iter().all(|&v| v == 0.0));
 }
@@ -77,7 +78,7 @@ fn direct_mode_matches_slicing_the_filled_grid() {
 
     let ctx = common::lavapipe();
     let e = expansion();
-    let grid = GridGeometry::cube(DVec3::new(-4.0, -4.0, -3.5), DVec3::new(4.0, 4.0, 3.5), 48);
+    let grid = GridSpec::cube(DVec3::new(-4.0, -4.0, -3.5), DVec3::new(4.0, 4.0, 3.5), 48);
     let texture = GtoFillPass::new(&ctx).fill(&ctx, &e, &grid).unwrap();
     let values = read_volume(&ctx, &texture).unwrap();
     let max_abs = values.iter().fold(0.0f64, |m, v| m.max(v.abs() as f64));
@@ -112,7 +113,7 @@ fn gpu_fill_of_real_orbitals_matches_the_cpu_evaluator() {
     let Some(dir) = common::refdata("gto_gpu::gpu_fill_of_real_orbitals_matches_the_cpu_evaluator") else {
         return;
     };
-    use orbcloud::model::gto::{GridSpec, PreparedBasis};
+    use orbcloud::model::gto::PreparedBasis;
     let ctx = common::lavapipe();
     let fill = GtoFillPass::new(&ctx);
     // ORCA (pure d and f after its repair), Gaussian cartesian d/f, a ghost basis.
@@ -123,11 +124,7 @@ fn gpu_fill_of_real_orbitals_matches_the_cpu_evaluator() {
         for i in [wf.homo(orbcloud::model::Spin::Alpha).unwrap(), wf.lumo(orbcloud::model::Spin::Alpha).unwrap()] {
             let quantity = orbcloud::model::orbitals::Quantity::Orbital(i);
             let geometry = orbcloud::headless::orbital_geometry(&doc, quantity, 28).unwrap();
-            let spec = GridSpec::new(
-                geometry.world_from_grid.w_axis.truncate(),
-                std::array::from_fn(|a| geometry.world_from_grid.col(a).truncate()),
-                geometry.dims,
-            );
+            let spec = geometry;
             let c = &wf.orbitals[i].coefficients;
             let e = CartesianExpansion::from_coefficients(&prepared, c);
             let gpu = read_volume(&ctx, &fill.fill(&ctx, &e, &geometry).unwrap()).unwrap();

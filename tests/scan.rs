@@ -96,7 +96,7 @@ fn the_skeleton_follows_theta_and_the_charge_moves_at_minus_90() {
     let f = scan.frames.iter().position(|f| f.angle == -90.0).unwrap();
     let atoms = &scan.frames[f].molecule.atoms;
     let moving: Vec<bool> = (0..atoms.len()).map(|i| scan.moving.contains(&i)).collect();
-    let spec = grid.spec();
+    let spec = grid;
     let fraction_moving = |slot: usize| {
         let v = scan.key_values(&tracks, slot, f, &grid);
         let (mut on, mut all) = (0.0, 0.0);

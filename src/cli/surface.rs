@@ -10,7 +10,7 @@ use orbcloud::formats::mesh_write::{self, MeshFormat, NamedMesh};
 use orbcloud::gpu::frame::PickId;
 use orbcloud::gpu::{GpuContext, Renderer};
 use orbcloud::headless::{isosurfaces, orbital_geometry};
-use orbcloud::model::gto::{GridSpec, PreparedBasis};
+use orbcloud::model::gto::PreparedBasis;
 use orbcloud::model::isosurface::{self, Level, Mesh};
 use orbcloud::model::orbitals::Quantity;
 use orbcloud::model::units::BOHR_PER_ANGSTROM;
@@ -129,11 +129,7 @@ impl GridArgs {
         let wf = wavefunction_of(doc)?;
         let q = self.what.resolve(wf)?;
         let g = orbital_geometry(doc, q, self.grid_points.clamp(8, 512)).context("the file has no atoms")?;
-        let spec = GridSpec::new(
-            g.world_from_grid.w_axis.truncate(),
-            std::array::from_fn(|a| g.world_from_grid.col(a).truncate()),
-            g.dims,
-        );
+        let spec = g;
         let prepared = PreparedBasis::new(&wf.basis);
         let values: Vec<f32> = match q {
             Quantity::Orbital(i) => prepared.eval_grid_f32(&wf.orbitals[i].coefficients, &spec),

@@ -2,13 +2,13 @@
 //! texture for the slice renderer (seed 004's exact orbitals, switched without resampling files).
 
 use bytemuck::{Pod, Zeroable};
-use glam::{DMat4, DVec3};
+
 use wgpu::util::DeviceExt;
 
 use super::volume::VolumeTexture;
 use super::{GpuContext, GpuError};
 use crate::model::cartesian::CartesianExpansion;
-use crate::model::grid::ValueKind;
+use crate::model::grid::{GridSpec, ValueKind};
 
 /// Mirror of `GtoShell` in gto_common.wgsl.
 #[repr(C)]
@@ -109,26 +109,6 @@ pub struct GtoFillPass {
     gto_layout: wgpu::BindGroupLayout,
 }
 
-/// Where to evaluate: a grid's shape and placement, without values.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct GridGeometry {
-    pub dims: [usize; 3],
-    pub world_from_grid: DMat4,
-}
-
-impl GridGeometry {
-    /// A grid of `n` points per axis over the box `lo..hi` (bohr).
-    pub fn cube(lo: DVec3, hi: DVec3, n: usize) -> Self {
-        let n = n.max(2);
-        let step = (hi - lo) / (n - 1) as f64;
-        let world_from_grid = crate::model::VolumeGrid::affine(
-            lo,
-            [DVec3::new(step.x, 0.0, 0.0), DVec3::new(0.0, step.y, 0.0), DVec3::new(0.0, 0.0, step.z)],
-        );
-        Self { dims: [n; 3], world_from_grid }
-    }
-}
-
 impl GtoFillPass {
     pub fn new(ctx: &GpuContext) -> Self {
         let device = &ctx.device;
@@ -171,7 +151,7 @@ impl GtoFillPass {
         &self,
         ctx: &GpuContext,
         expansion: &CartesianExpansion,
-        grid: &GridGeometry,
+        grid: &GridSpec,
     ) -> Result<wgpu::Texture, GpuError> {
         let device = &ctx.device;
         let [nx, ny, nz] = grid.dims;
@@ -226,7 +206,7 @@ impl GtoFillPass {
 
 /// A filled texture made ready for the slice renderer. `max_abs` scales the opacity (the CPU
 /// knows it from the evaluator or a coarse estimate).
-pub fn volume_from_texture(texture: wgpu::Texture, grid: &GridGeometry, max_abs: f64) -> VolumeTexture {
+pub fn volume_from_texture(texture: wgpu::Texture, grid: &GridSpec, max_abs: f64) -> VolumeTexture {
     VolumeTexture::from_texture(texture, grid.dims, grid.world_from_grid, ValueKind::Signed, max_abs)
 }
 

@@ -4,11 +4,11 @@ use glam::Vec3;
 
 use super::atoms::AtomsPass;
 use super::frame::{Draw, FrameTargets, Phase, PhaseNode, PickId, STANDARD_FRAME};
-use super::gto::GridGeometry;
 use super::isosurface::IsosurfacePass;
 use super::resolve::ResolvePass;
 use super::volume::{VolumePass, VolumeTexture};
 use super::{GpuContext, GpuError};
+use crate::model::GridSpec;
 use crate::model::cartesian::CartesianExpansion;
 use crate::model::{Molecule, VolumeGrid};
 use crate::scene::{AtomStyle, Camera, RenderSettings};
@@ -84,13 +84,7 @@ impl Renderer {
     }
 
     /// Shows an orbital evaluated per fragment from its basis functions (seed 004's direct mode).
-    pub fn set_direct(
-        &mut self,
-        ctx: &GpuContext,
-        expansion: &CartesianExpansion,
-        geometry: &GridGeometry,
-        max_abs: f64,
-    ) {
+    pub fn set_direct(&mut self, ctx: &GpuContext, expansion: &CartesianExpansion, geometry: &GridSpec, max_abs: f64) {
         self.volume.set_direct(ctx, expansion, geometry, max_abs);
         self.update_bounds();
     }

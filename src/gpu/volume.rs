@@ -4,8 +4,9 @@ use bytemuck::{Pod, Zeroable};
 use glam::{DMat4, DVec3, Mat4, Vec3, Vec4};
 use wgpu::util::DeviceExt;
 
-use super::gto::{GridGeometry, GtoArrays, GtoBuffers, gto_layout};
+use super::gto::{GtoArrays, GtoBuffers, gto_layout};
 use super::{DEPTH_FORMAT, GpuContext, GpuError, SCENE_FORMAT};
+use crate::model::GridSpec;
 use crate::model::cartesian::CartesianExpansion;
 use crate::model::{VolumeGrid, grid::ValueKind};
 use crate::scene::slicing::{GridBox, Slices};
@@ -429,13 +430,7 @@ impl VolumePass {
     /// Seed 004's direct mode: the slices through `geometry`'s box evaluate `expansion` per
     /// fragment. `max_abs` scales the opacity like a grid's maximum; the grid spacing of
     /// `geometry` is the reference step of k1.
-    pub fn set_direct(
-        &mut self,
-        ctx: &GpuContext,
-        expansion: &CartesianExpansion,
-        geometry: &GridGeometry,
-        max_abs: f64,
-    ) {
+    pub fn set_direct(&mut self, ctx: &GpuContext, expansion: &CartesianExpansion, geometry: &GridSpec, max_abs: f64) {
         // The texture binding is unused by the direct shader but part of the shared layout.
         let placeholder = ctx.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("direct-mode placeholder volume"),

@@ -5,7 +5,7 @@ pub mod scan;
 
 use glam::DVec3;
 
-use crate::gpu::gto::{GridGeometry, GtoFillPass, read_volume, volume_from_texture};
+use crate::gpu::gto::{GtoFillPass, read_volume, volume_from_texture};
 use crate::gpu::{FrameInput, GpuContext, GpuError, OffscreenTarget, Renderer};
 use crate::model::cartesian::CartesianExpansion;
 use crate::model::extent::quantity_box;
@@ -34,9 +34,9 @@ pub fn default_camera(doc: &Document) -> Camera {
 
 /// The grid a wavefunction's `quantity` is evaluated on, `points` per axis: the box where it
 /// decays to 1 % of its largest |value| ([`crate::model::extent::quantity_box`]).
-pub fn orbital_geometry(doc: &Document, quantity: Quantity, points: usize) -> Option<GridGeometry> {
+pub fn orbital_geometry(doc: &Document, quantity: Quantity, points: usize) -> Option<GridSpec> {
     let (lo, hi) = quantity_box(doc.wavefunction.as_ref()?, &doc.molecule, quantity)?;
-    Some(GridGeometry::cube(lo, hi, points))
+    Some(GridSpec::cube(lo, hi, points))
 }
 
 /// How to show a quantity of a wavefunction.
@@ -91,15 +91,10 @@ pub fn show_wavefunction(
             Ok(Some(grid))
         }
         Quantity::Density | Quantity::SpinDensity => {
-            let spec = GridSpec::new(
-                geometry.world_from_grid.w_axis.truncate(),
-                std::array::from_fn(|a| geometry.world_from_grid.col(a).truncate()),
-                geometry.dims,
-            );
             let (values, label) = if view.quantity == Quantity::Density {
-                (prepared.density_grid(wf, &spec), "total density")
+                (prepared.density_grid(wf, &geometry), "total density")
             } else {
-                (prepared.spin_density_grid(wf, &spec), "spin density")
+                (prepared.spin_density_grid(wf, &geometry), "spin density")
             };
             let values = values.iter().map(|&v| v as f32).collect();
             let grid = VolumeGrid::new(label, geometry.dims, geometry.world_from_grid, values);

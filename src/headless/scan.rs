@@ -8,8 +8,9 @@ use super::ORBITAL_MARGIN;
 use crate::gpu::gto::{GtoFillPass, read_volume};
 use crate::gpu::volume::{VolumeTexture, residency_budget, texel_bytes};
 use crate::gpu::{FrameInput, GpuContext, GpuError, OffscreenTarget, Renderer};
+use crate::model::GridSpec;
 use crate::model::cartesian::CartesianExpansion;
-use crate::model::scan::{Bracket, Follow, Scan, ScanError, ScanGrid, Tracks};
+use crate::model::scan::{Bracket, Follow, Scan, ScanError, Tracks};
 use crate::model::units::EV_PER_HARTREE;
 use crate::model::{PreparedBasis, VolumeGrid};
 use crate::scene::{AtomStyle, Camera, Interpolation, RenderSettings};
@@ -54,7 +55,7 @@ impl Default for KeyOptions {
 pub struct ScanScene {
     pub scan: Scan,
     pub tracks: Tracks,
-    pub grid: ScanGrid,
+    pub grid: GridSpec,
     /// `keys[slot][frame]`, phase-aligned, each with the slot's common opacity scale.
     keys: Vec<Vec<VolumeTexture>>,
     /// Largest |ψ| per slot over all frames: one opacity scale for the whole scan, so the
@@ -107,8 +108,7 @@ impl ScanScene {
                     (Some(wf), Some(c)) => {
                         let prepared = PreparedBasis::new(&wf.basis);
                         let fill = fill.get_or_insert_with(|| GtoFillPass::new(ctx));
-                        let geometry =
-                            crate::gpu::gto::GridGeometry { dims: grid.dims, world_from_grid: grid.world_from_grid };
+                        let geometry = grid;
                         let texture =
                             fill.fill(ctx, &CartesianExpansion::from_coefficients(&prepared, &c), &geometry)?;
                         read_volume(ctx, &texture)?

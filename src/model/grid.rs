@@ -34,6 +34,64 @@ impl GridStats {
     }
 }
 
+/// The shape and placement of a regular grid, the one type every grid path shares (evaluation
+/// on the CPU, GPU fills, scans' common grids, cube files): `dims` points, point (i, j, k) at
+/// `world_from_grid`·(i, j, k) in bohr; values stored x slowest, z fastest (cube order).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GridSpec {
+    pub dims: [usize; 3],
+    pub world_from_grid: DMat4,
+}
+
+impl GridSpec {
+    /// From an origin and the three step vectors (bohr).
+    pub fn new(origin: DVec3, steps: [DVec3; 3], dims: [usize; 3]) -> Self {
+        Self { dims, world_from_grid: VolumeGrid::affine(origin, steps) }
+    }
+
+    /// `n` points per axis spanning the box `lo..hi` exactly (spacing = extent / (n − 1), as
+    /// cubegen does).
+    pub fn cube(lo: DVec3, hi: DVec3, n: usize) -> Self {
+        let n = n.max(2);
+        let step = (hi - lo) / (n - 1) as f64;
+        Self::new(lo, [DVec3::X * step.x, DVec3::Y * step.y, DVec3::Z * step.z], [n; 3])
+    }
+
+    /// Points `spacing` apart (bohr) from `lo`, enough to reach `hi` on every axis.
+    pub fn spaced(lo: DVec3, hi: DVec3, spacing: f64) -> Self {
+        let dims = ((hi - lo) / spacing).ceil().to_array().map(|n| n.max(1.0) as usize + 1);
+        Self::new(lo, [DVec3::X * spacing, DVec3::Y * spacing, DVec3::Z * spacing], dims)
+    }
+
+    pub fn origin(&self) -> DVec3 {
+        self.world_from_grid.w_axis.truncate()
+    }
+
+    /// The step vector along grid axis `axis` (bohr).
+    pub fn step(&self, axis: usize) -> DVec3 {
+        self.world_from_grid.col(axis).truncate()
+    }
+
+    pub fn point(&self, i: usize, j: usize, k: usize) -> DVec3 {
+        self.origin() + i as f64 * self.step(0) + j as f64 * self.step(1) + k as f64 * self.step(2)
+    }
+
+    pub fn len(&self) -> usize {
+        self.dims[0] * self.dims[1] * self.dims[2]
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The lowest and highest corner of the grid's box (axis-aligned steps), bohr.
+    pub fn bounds(&self) -> (DVec3, DVec3) {
+        let [a, b, c] = self.dims.map(|d| d.max(1) - 1);
+        let (lo, hi) = (self.origin(), self.point(a, b, c));
+        (lo.min(hi), lo.max(hi))
+    }
+}
+
 /// What the values mean, which decides how they are coloured.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 pub enum ValueKind {
@@ -254,6 +312,24 @@ mod tests {
         let j = DMat3::from_cols(g.step(0), g.step(1), g.step(2));
         let expected = (j.inverse().transpose() * DVec3::new(1.0, 10.0, -3.0)).length();
         assert!((g.max_gradient() - expected).abs() < 1e-4 * expected);
+    }
+
+    #[test]
+    fn grid_specs_span_their_boxes() {
+        let (lo, hi) = (DVec3::new(-1.0, -2.0, 0.5), DVec3::new(3.0, 2.0, 1.5));
+        let cube = GridSpec::cube(lo, hi, 5);
+        assert_eq!(cube.dims, [5; 3]);
+        assert_eq!(cube.bounds(), (lo, hi));
+        assert!((cube.point(2, 2, 2) - 0.5 * (lo + hi)).length() < 1e-12);
+        let spaced = GridSpec::spaced(lo, hi, 0.3);
+        assert_eq!(spaced.dims, [15, 15, 5]);
+        let (_, top) = spaced.bounds();
+        assert!(top.cmpge(hi).all() && (top - hi).max_element() < 0.3);
+        // The same shape as a VolumeGrid built on it.
+        let g = linear_grid();
+        let spec = GridSpec { dims: g.dims, world_from_grid: g.world_from_grid };
+        assert_eq!(spec.point(2, 1, 3), g.point(2, 1, 3));
+        assert_eq!(spec.len(), g.values.len());
     }
 
     #[test]

@@ -99,32 +99,7 @@ pub struct PreparedBasis {
     n_cartesians: usize,
 }
 
-/// A regular grid of points: point (i, j, k) = origin + i·steps[0] + j·steps[1] + k·steps[2];
-/// values are stored x slowest, z fastest (cube order).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct GridSpec {
-    pub origin: DVec3,
-    pub steps: [DVec3; 3],
-    pub dims: [usize; 3],
-}
-
-impl GridSpec {
-    pub fn new(origin: DVec3, steps: [DVec3; 3], dims: [usize; 3]) -> Self {
-        Self { origin, steps, dims }
-    }
-
-    pub fn point(&self, i: usize, j: usize, k: usize) -> DVec3 {
-        self.origin + i as f64 * self.steps[0] + j as f64 * self.steps[1] + k as f64 * self.steps[2]
-    }
-
-    pub fn len(&self) -> usize {
-        self.dims[0] * self.dims[1] * self.dims[2]
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-}
+pub use super::grid::GridSpec;
 
 /// Normalisation of a primitive x^l exp(−α r²).
 fn primitive_norm(alpha: f64, l: u32) -> f64 {
@@ -498,7 +473,7 @@ impl PreparedBasis {
             .collect();
         let any_active: Vec<bool> = (0..self.shells.len()).map(|s| prepared.iter().any(|p| p.1[s])).collect();
         const BLOCK: usize = 8;
-        let v = grid.steps[2];
+        let v = grid.step(2);
         let _ = nx;
         out.par_chunks_mut(ny * nz).enumerate().for_each(|(ix, slab)| {
             let mut scratch = RowScratch::new(nz, prepared.len());
@@ -507,7 +482,7 @@ impl PreparedBasis {
                 let iy1 = (iy0 + BLOCK).min(ny);
                 // Bounding sphere of the block's points.
                 let corner = grid.point(ix, iy0, 0);
-                let ey = (iy1 - iy0 - 1) as f64 * grid.steps[1];
+                let ey = (iy1 - iy0 - 1) as f64 * grid.step(1);
                 let ez = (nz - 1) as f64 * v;
                 let centre = corner + 0.5 * (ey + ez);
                 let radius = (0.5 * (ey + ez)).length().max((0.5 * (ey - ez)).length());

@@ -22,7 +22,7 @@ pub mod solid_harmonics;
 pub mod units;
 
 pub use document::Document;
-pub use grid::{GridStats, VolumeGrid};
-pub use gto::{GridSpec, PreparedBasis};
+pub use grid::{GridSpec, GridStats, VolumeGrid};
+pub use gto::PreparedBasis;
 pub use molecule::{Atom, Bond, Molecule};
 pub use orbitals::{MolecularOrbital, Spin, Wavefunction};

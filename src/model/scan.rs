@@ -6,7 +6,7 @@
 //! its sign is flipped when the overlap is negative, and a different orbital is reported (or
 //! followed) when it overlaps the previous one better than the one of the same name.
 
-use glam::{DMat4, DQuat, DVec3};
+use glam::{DQuat, DVec3};
 use thiserror::Error;
 
 use super::gto::{GridSpec, PreparedBasis};
@@ -455,47 +455,15 @@ pub fn grid_overlap(a: &VolumeGrid, b: &VolumeGrid) -> f64 {
     a.values.iter().zip(&b.values).map(|(&x, &y)| x as f64 * y as f64).sum::<f64>() * a.voxel_volume()
 }
 
-/// Where key volumes live: a grid's placement and shape.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ScanGrid {
-    pub world_from_grid: DMat4,
-    pub dims: [usize; 3],
-}
-
-impl ScanGrid {
-    pub fn spec(&self) -> GridSpec {
-        GridSpec::new(
-            self.world_from_grid.w_axis.truncate(),
-            std::array::from_fn(|a| self.world_from_grid.col(a).truncate()),
-            self.dims,
-        )
-    }
-
-    pub fn len(&self) -> usize {
-        self.dims.iter().product()
-    }
-
-    /// The corners of the (axis-aligned) grid box: lowest and highest point, bohr.
-    pub fn bounds(&self) -> (DVec3, DVec3) {
-        let far = DVec3::new(self.dims[0] as f64 - 1.0, self.dims[1] as f64 - 1.0, self.dims[2] as f64 - 1.0);
-        let (a, b) = (self.world_from_grid.w_axis.truncate(), self.world_from_grid.transform_point3(far));
-        (a.min(b), a.max(b))
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-}
-
 impl Scan {
     /// The grid all key volumes share: for cube series the cubes' grid; otherwise the box
     /// holding every frame's atoms plus `margin` (bohr), cubic voxels, `points` along its
     /// longest side.
-    pub fn common_grid(&self, margin: f64, points: usize) -> ScanGrid {
+    pub fn common_grid(&self, margin: f64, points: usize) -> GridSpec {
         if let FrameContent::Volumes(v) = &self.frames[0].content
             && let Some(g) = v.first()
         {
-            return ScanGrid { world_from_grid: g.world_from_grid, dims: g.dims };
+            return GridSpec { world_from_grid: g.world_from_grid, dims: g.dims };
         }
         let (lo, hi) = self
             .frames
@@ -511,7 +479,7 @@ impl Scan {
         let span = DVec3::new(dims[0] as f64 - 1.0, dims[1] as f64 - 1.0, dims[2] as f64 - 1.0) * step;
         let origin = lo - 0.5 * (span - extent);
         let steps = [DVec3::X * step, DVec3::Y * step, DVec3::Z * step];
-        ScanGrid { world_from_grid: VolumeGrid::affine(origin, steps), dims }
+        GridSpec::new(origin, steps, dims)
     }
 
     /// A slot's coefficient vector in `frame`, sign-aligned (wavefunction frames).
@@ -523,12 +491,12 @@ impl Scan {
 
     /// A slot's key volume in `frame` on `grid`, sign-aligned: evaluated on the CPU for
     /// wavefunction frames, the cube's values for cube frames.
-    pub fn key_values(&self, tracks: &Tracks, slot: usize, frame: usize, grid: &ScanGrid) -> Vec<f32> {
+    pub fn key_values(&self, tracks: &Tracks, slot: usize, frame: usize, grid: &GridSpec) -> Vec<f32> {
         let p = tracks.points[slot][frame];
         match (&self.frames[frame].content, self.frames[frame].wavefunction(slot)) {
             (_, Some(wf)) => {
                 let c = self.aligned_coefficients(tracks, slot, frame).unwrap_or_default();
-                PreparedBasis::new(&wf.basis).eval_grid_f32(&c, &grid.spec())
+                PreparedBasis::new(&wf.basis).eval_grid_f32(&c, grid)
             }
             (FrameContent::Volumes(v), _) => v[p.index].values.iter().map(|&x| x * p.sign as f32).collect(),
             _ => vec![0.0; grid.len()],
@@ -536,7 +504,7 @@ impl Scan {
     }
 
     /// The exactly interpolated volume at θ: (1−k)·ψa + k·ψb of the two bracketing key frames.
-    pub fn interpolated_values(&self, tracks: &Tracks, slot: usize, theta: f64, grid: &ScanGrid) -> Vec<f32> {
+    pub fn interpolated_values(&self, tracks: &Tracks, slot: usize, theta: f64, grid: &GridSpec) -> Vec<f32> {
         let Bracket { a, b, k } = self.bracket(theta);
         let (va, vb) = (self.key_values(tracks, slot, a, grid), self.key_values(tracks, slot, b, grid));
         let (wa, wb) = ((1.0 - k) as f32, k as f32);
@@ -549,7 +517,7 @@ impl Scan {
         tracks: &Tracks,
         slot: usize,
         theta: f64,
-        grid: &ScanGrid,
+        grid: &GridSpec,
         label: impl Into<String>,
     ) -> VolumeGrid {
         let values = self.interpolated_values(tracks, slot, theta, grid);
