@@ -75,8 +75,8 @@ enum Command {
         /// Grid spacing in bohr (same on every axis).
         #[arg(long)]
         spacing: Option<f64>,
-        /// Space around the atoms, bohr (default: the box where the orbital or density decays
-        /// to 1 % of its largest value).
+        /// Space around the atoms, bohr (default: the box where the orbital decays to 1 % of
+        /// its largest value, a density to 1e-4 a.u.).
         #[arg(long)]
         margin: Option<f64>,
         #[arg(short, long)]
