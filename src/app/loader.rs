@@ -5,8 +5,8 @@ use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::mpsc::{Receiver, channel};
 
+use super::jobs::{Pending, spawn};
 use crate::formats::{self, LoadError};
 use crate::model::Document;
 
@@ -15,19 +15,21 @@ pub struct LoadJob {
     /// Bytes read so far and the file's size; parsing starts when they are equal.
     read: Arc<AtomicU64>,
     total: u64,
-    result: Receiver<Result<Document, LoadError>>,
+    result: Pending<Result<Document, LoadError>>,
 }
 
 impl LoadJob {
-    pub fn start(path: PathBuf, repaint: impl Fn() + Send + 'static) -> Self {
+    pub fn start(path: PathBuf, repaint: impl Fn() + Send + Sync + 'static) -> Self {
         let total = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
         let read = Arc::new(AtomicU64::new(0));
-        let (tx, result) = channel();
         let (p, counter) = (path.clone(), read.clone());
-        std::thread::spawn(move || {
-            let _ = tx.send(load_with_progress(&p, &counter, &repaint));
-            repaint();
-        });
+        let repaint = Arc::new(repaint);
+        let progress = repaint.clone();
+        let result = spawn(
+            &format!("loading {}", path.display()),
+            move || load_with_progress(&p, &counter, &*progress),
+            move || repaint(),
+        );
         Self { path, read, total, result }
     }
 
@@ -38,8 +40,9 @@ impl LoadJob {
         (f.min(1.0), self.total > 0 && read >= self.total)
     }
 
-    pub fn poll(&self) -> Option<Result<Document, LoadError>> {
-        self.result.try_recv().ok()
+    /// The document, or why it did not load (a reader's error, or a failure of the job).
+    pub fn poll(&self) -> Option<Result<Document, String>> {
+        self.result.poll().map(|r| r.and_then(|loaded| loaded.map_err(|e| e.to_string())))
     }
 }
 

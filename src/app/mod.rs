@@ -1,6 +1,7 @@
 //! The eframe viewer: the only module that uses egui and rfd.
 
 pub mod detail;
+pub mod jobs;
 mod loader;
 pub mod measure;
 mod orbitals;

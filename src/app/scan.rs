@@ -1,10 +1,10 @@
 //! Dihedral scans in the window: HOMO and LUMO side by side with linked cameras and θ, a θ
 //! slider with the key angles as ticks, play/loop, and the orbital energies against θ.
 
+use super::jobs::{Pending, spawn};
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::sync::mpsc::{Receiver, channel};
 
 use egui::{Key, RichText};
 use egui_plot::{Legend, Line, Plot, VLine};
@@ -35,7 +35,7 @@ pub struct ScanJob {
     done: Arc<AtomicUsize>,
     total: Arc<AtomicUsize>,
     cancel: Arc<AtomicBool>,
-    result: Receiver<Result<ScanScene, ScanFailure>>,
+    result: Pending<Result<ScanScene, ScanFailure>>,
 }
 
 /// Why a scan did not open.
@@ -57,7 +57,7 @@ impl ScanJob {
         source: ScanSource,
         options: KeyOptions,
         follow: Option<Follow>,
-        repaint: impl Fn() + Send + 'static,
+        repaint: impl Fn() + Send + Sync + 'static,
     ) -> Self {
         let name = match &source {
             ScanSource::File(p) => p.display().to_string(),
@@ -65,10 +65,11 @@ impl ScanJob {
         };
         let (done, total, cancel) =
             (Arc::new(AtomicUsize::new(0)), Arc::new(AtomicUsize::new(0)), Arc::new(AtomicBool::new(false)));
-        let (tx, result) = channel();
         let (d, t, c) = (done.clone(), total.clone(), cancel.clone());
         let job_source = source.clone();
-        std::thread::spawn(move || {
+        let repaint = Arc::new(repaint);
+        let progress = repaint.clone();
+        let work = move || {
             let run = || -> Result<ScanScene, ScanFailure> {
                 let file: ScanFile = match &source {
                     ScanSource::File(p) => load_scan(p),
@@ -79,7 +80,7 @@ impl ScanJob {
                 ScanScene::build(&ctx, file.scan, &options, &mut |n, of| {
                     d.store(n, Ordering::Relaxed);
                     t.store(of, Ordering::Relaxed);
-                    repaint();
+                    progress();
                     !c.load(Ordering::Relaxed)
                 })
                 .map_err(|e| match e {
@@ -88,9 +89,9 @@ impl ScanJob {
                     e => ScanFailure::Other(e.to_string()),
                 })
             };
-            let _ = tx.send(run());
-            repaint();
-        });
+            run()
+        };
+        let result = spawn(&format!("opening the scan {name}"), work, move || repaint());
         Self { name, source: job_source, done, total, cancel, result }
     }
 
@@ -104,7 +105,7 @@ impl ScanJob {
     }
 
     pub fn poll(&self) -> Option<Result<ScanScene, ScanFailure>> {
-        self.result.try_recv().ok()
+        self.result.poll().map(|r| r.unwrap_or_else(|e| Err(ScanFailure::Other(e))))
     }
 }
 
