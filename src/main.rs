@@ -526,11 +526,7 @@ fn main() -> Result<()> {
             }
             let prepared = PreparedBasis::new(&wf.basis);
             let t = Instant::now();
-            let values: Vec<f32> = match q {
-                Quantity::Orbital(i) => prepared.eval_grid_f32(&wf.orbitals[i].coefficients, &spec),
-                Quantity::Density => prepared.density_grid(wf, &spec).iter().map(|&v| v as f32).collect(),
-                Quantity::SpinDensity => prepared.spin_density_grid(wf, &spec).iter().map(|&v| v as f32).collect(),
-            };
+            let values = prepared.quantity_grid_f32(wf, q, &spec);
             let seconds = t.elapsed().as_secs_f64();
             let label = what.label(&q, wf);
             let grid = VolumeGrid::new(&label, dims, spec.world_from_grid, values);

@@ -228,18 +228,11 @@ impl Viewport {
         let pointer = response.hover_pos().filter(|_| !ui.input(|i| i.pointer.any_down()));
         if pointer != self.hovered_at {
             self.hovered_at = pointer;
-            self.hovered = pointer.and_then(|pos| {
-                let rel = (pos - rect.min) / rect.size();
-                let pixel = [(rel.x * size[0] as f32) as u32, (rel.y * size[1] as f32) as u32];
-                self.renderer.pick(&self.ctx, pixel).ok().flatten()
-            });
+            self.hovered = pointer.and_then(|pos| self.pick_at(pos).ok().flatten());
         }
         if response.clicked_by(PointerButton::Primary)
             && let Some(pos) = response.interact_pointer_pos()
         {
-            // The frame just drawn is the one on screen: read its id under the pointer.
-            let rel = (pos - rect.min) / rect.size();
-            let pixel = [(rel.x * size[0] as f32) as u32, (rel.y * size[1] as f32) as u32];
             // Shift as it was at the release (the frame's modifiers may already have moved on).
             let shift = ui.input(|i| {
                 i.events
@@ -256,12 +249,19 @@ impl Viewport {
                     })
                     .unwrap_or(i.modifiers.shift)
             });
-            match self.renderer.pick(&self.ctx, pixel) {
+            match self.pick_at(pos) {
                 Ok(picked) => self.click = Some(Click { picked, shift }),
                 Err(e) => log::warn!("picking failed: {e}"),
             }
         }
         twisted
+    }
+
+    /// What the frame on screen (the one just drawn) shows at window position `pos`.
+    fn pick_at(&self, pos: egui::Pos2) -> Result<Option<PickId>, GpuError> {
+        let Some((rect, size)) = self.layout else { return Ok(None) };
+        let rel = (pos - rect.min) / rect.size();
+        self.renderer.pick(&self.ctx, [(rel.x * size[0] as f32) as u32, (rel.y * size[1] as f32) as u32])
     }
 
     /// Where world point `p` (bohr) lies on screen in the last frame laid out.

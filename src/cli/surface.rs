@@ -9,10 +9,9 @@ use clap::Args;
 use orbcloud::formats::mesh_write::{self, MeshFormat, NamedMesh};
 use orbcloud::gpu::frame::PickId;
 use orbcloud::gpu::{GpuContext, Renderer};
-use orbcloud::headless::{isosurfaces, orbital_geometry};
+use orbcloud::headless::{isosurfaces, orbital_geometry, show_meshes};
 use orbcloud::model::gto::PreparedBasis;
 use orbcloud::model::isosurface::{self, Level, Mesh};
-use orbcloud::model::orbitals::Quantity;
 use orbcloud::model::units::BOHR_PER_ANGSTROM;
 use orbcloud::model::{Document, VolumeGrid};
 use orbcloud::scene::{IsoLevel, IsosurfaceSettings};
@@ -61,9 +60,7 @@ pub fn show(ctx: &GpuContext, renderer: &mut Renderer, grid: &VolumeGrid, iso: &
         return;
     }
     let meshes = iso.meshes(grid, &IsosurfaceSettings::default());
-    let refs: Vec<(&Mesh, [f32; 3])> = meshes.iter().map(|(m, c)| (m, *c)).collect();
-    renderer.surfaces.set_meshes(ctx, 0, &refs);
-    let triangles: usize = meshes.iter().map(|(m, _)| m.triangle_count()).sum();
+    let triangles = show_meshes(ctx, renderer, &meshes);
     eprintln!("isosurfaces: {} surface(s), {triangles} triangles", meshes.len());
 }
 
@@ -131,11 +128,7 @@ impl GridArgs {
         let g = orbital_geometry(doc, q, self.grid_points.clamp(8, 512)).context("the file has no atoms")?;
         let spec = g;
         let prepared = PreparedBasis::new(&wf.basis);
-        let values: Vec<f32> = match q {
-            Quantity::Orbital(i) => prepared.eval_grid_f32(&wf.orbitals[i].coefficients, &spec),
-            Quantity::Density => prepared.density_grid(wf, &spec).iter().map(|&v| v as f32).collect(),
-            Quantity::SpinDensity => prepared.spin_density_grid(wf, &spec).iter().map(|&v| v as f32).collect(),
-        };
+        let values = prepared.quantity_grid_f32(wf, q, &spec);
         Ok(VolumeGrid::new(self.what.label(&q, wf), g.dims, g.world_from_grid, values))
     }
 }

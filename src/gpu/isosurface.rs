@@ -81,7 +81,7 @@ impl IsosurfacePass {
 
     /// Replaces the surfaces shown: each mesh with its linear RGB colour. Surface `n` picks as
     /// `PickId::Surface { object, index: n }`.
-    pub fn set_meshes(&mut self, ctx: &GpuContext, object: u32, meshes: &[(&Mesh, [f32; 3])]) {
+    pub fn set_meshes(&mut self, ctx: &GpuContext, object: u32, meshes: &[(Mesh, [f32; 3])]) {
         let device = &ctx.device;
         self.surfaces = meshes
             .iter()

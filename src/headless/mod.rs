@@ -91,12 +91,8 @@ pub fn show_wavefunction(
             Ok(Some(grid))
         }
         Quantity::Density | Quantity::SpinDensity => {
-            let (values, label) = if view.quantity == Quantity::Density {
-                (prepared.density_grid(wf, &geometry), "total density")
-            } else {
-                (prepared.spin_density_grid(wf, &geometry), "spin density")
-            };
-            let values = values.iter().map(|&v| v as f32).collect();
+            let label = if view.quantity == Quantity::Density { "total density" } else { "spin density" };
+            let values = prepared.quantity_grid_f32(wf, view.quantity, &geometry);
             let grid = VolumeGrid::new(label, geometry.dims, geometry.world_from_grid, values);
             renderer.set_volume(ctx, Some(&grid))?;
             Ok(Some(grid))
@@ -124,9 +120,12 @@ pub fn show_isosurfaces(
     grid: &VolumeGrid,
     iso: &IsosurfaceSettings,
 ) -> usize {
-    let meshes = isosurfaces(grid, iso);
-    let refs: Vec<(&Mesh, [f32; 3])> = meshes.iter().map(|(m, c)| (m, *c)).collect();
-    renderer.surfaces.set_meshes(ctx, 0, &refs);
+    show_meshes(ctx, renderer, &isosurfaces(grid, iso))
+}
+
+/// Shows `meshes`, each in its colour, as the renderer's isosurfaces; returns the triangle count.
+pub fn show_meshes(ctx: &GpuContext, renderer: &mut Renderer, meshes: &[(Mesh, [f32; 3])]) -> usize {
+    renderer.surfaces.set_meshes(ctx, 0, meshes);
     meshes.iter().map(|(m, _)| m.triangle_count()).sum()
 }
 

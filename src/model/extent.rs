@@ -99,11 +99,7 @@ pub fn quantity_box(wf: &Wavefunction, molecule: &Molecule, quantity: Quantity) 
         Quantity::Orbital(_) => Decay::Relative(FACE_FRACTION),
         Quantity::Density | Quantity::SpinDensity => Decay::Absolute(DENSITY_FACE),
     };
-    Some(decay_box(lo, hi, START_REACH, decay, |spec| match quantity {
-        Quantity::Orbital(i) => prepared.eval_grid(&wf.orbitals[i].coefficients, spec),
-        Quantity::Density => prepared.density_grid(wf, spec),
-        Quantity::SpinDensity => prepared.spin_density_grid(wf, spec),
-    }))
+    Some(decay_box(lo, hi, START_REACH, decay, |spec| prepared.quantity_grid(wf, quantity, spec)))
 }
 
 #[cfg(test)]

@@ -27,7 +27,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::basis::{Basis, ShellKind, cartesian_powers, n_cartesian};
-use super::orbitals::{Spin, Wavefunction};
+use super::orbitals::{Quantity, Spin, Wavefunction};
 use super::solid_harmonics::{cart_to_pure, component_factor, double_factorial_m1};
 
 /// Default absolute cutoff threshold for basis-function values (bohr^−3/2).
@@ -444,6 +444,23 @@ impl PreparedBasis {
             .map(|o| (o.coefficients.as_slice(), o.occupation))
             .collect();
         self.grid_sum(&sets, true, grid)
+    }
+
+    /// An orbital, the total density or the spin density of `wf` on a grid.
+    pub fn quantity_grid(&self, wf: &Wavefunction, quantity: Quantity, grid: &GridSpec) -> Vec<f64> {
+        match quantity {
+            Quantity::Orbital(i) => self.eval_grid(&wf.orbitals[i].coefficients, grid),
+            Quantity::Density => self.density_grid(wf, grid),
+            Quantity::SpinDensity => self.spin_density_grid(wf, grid),
+        }
+    }
+
+    /// [`Self::quantity_grid`] in single precision (an orbital evaluated straight to f32).
+    pub fn quantity_grid_f32(&self, wf: &Wavefunction, quantity: Quantity, grid: &GridSpec) -> Vec<f32> {
+        match quantity {
+            Quantity::Orbital(i) => self.eval_grid_f32(&wf.orbitals[i].coefficients, grid),
+            _ => self.quantity_grid(wf, quantity, grid).iter().map(|&v| v as f32).collect(),
+        }
     }
 
     /// Spin density on a grid.
