@@ -141,7 +141,7 @@ impl WavefunctionArgs {
             shells: None,
         };
         let mut fill = None;
-        let grid = show_wavefunction(ctx, &mut h.renderer, &mut fill, doc, &view)?;
+        let grid = show_wavefunction(ctx, h.renderer.main(), &mut fill, doc, &view)?;
         Ok(grid.map(|g| (start.elapsed().as_secs_f64(), g)))
     }
 }
@@ -263,6 +263,7 @@ enum ModeArg {
 enum AtomsArg {
     BallAndStick,
     SpaceFilling,
+    Sticks,
     Hidden,
 }
 
@@ -416,6 +417,7 @@ impl ViewArgs {
         s.atoms = match self.atoms {
             AtomsArg::BallAndStick => AtomStyle::BallAndStick,
             AtomsArg::SpaceFilling => AtomStyle::SpaceFilling,
+            AtomsArg::Sticks => AtomStyle::Sticks,
             AtomsArg::Hidden => AtomStyle::Hidden,
         };
         s
@@ -603,7 +605,7 @@ fn main() -> Result<()> {
                 camera.target.z,
                 camera.fov_y.to_degrees()
             );
-            if let Some(v) = h.renderer.volume.volume() {
+            if let Some(v) = h.renderer.main().volume.volume() {
                 let s = v.grid_box.slices(settings.volume.mode, settings.volume.slices, eye, -camera.backward());
                 println!("slice_spacing_bohr={:.5}", s.spacing);
             }

@@ -88,9 +88,9 @@ fn direct_mode_matches_slicing_the_filled_grid() {
     camera.orbit(0.6, 0.3);
     let mut h = Headless::new(&ctx, &doc, None, &settings, [96, 72]).unwrap();
 
-    h.renderer.set_volume_texture(&ctx, volume_from_texture(texture, &grid, max_abs));
+    h.renderer.main().set_volume_texture(&ctx, volume_from_texture(texture, &grid, max_abs));
     let sliced = h.render(&ctx, &camera, &settings).unwrap();
-    h.renderer.set_direct(&ctx, &e, &grid, max_abs);
+    h.renderer.main().set_direct(&ctx, &e, &grid, max_abs);
     let direct = h.render(&ctx, &camera, &settings).unwrap();
 
     let covered = direct.pixels().filter(|p| p[0].abs_diff(p[2]) > 20).count();

@@ -81,7 +81,7 @@ fn a_density_has_one_surface_and_sigma_levels_resolve() {
     assert!(coverage(&img, [3, 3, 4]) > 0.2);
     let (red, blue) = red_blue(&img);
     assert!(red < 50 && blue < 50, "a density is not coloured by sign: red {red}, blue {blue}");
-    assert!(!h.renderer.surfaces.is_empty());
+    assert!(!h.renderer.layer(0).expect("one layer").surfaces.is_empty());
     assert!((IsoLevel::Sigma(2.0).value(sigma) as f64 - 2.0 * sigma).abs() < 1e-6);
     assert_golden("iso_density", &img);
 }
@@ -212,7 +212,7 @@ fn picking_finds_a_surface_in_front_of_the_atoms() {
     let s = iso_settings(IsoLevel::Absolute(0.2), false);
     let ctx = lavapipe();
     let mut h = Headless::new(&ctx, &doc, None, &s, SIZE).unwrap();
-    let triangles = show_isosurfaces(&ctx, &mut h.renderer, &doc.volumes[0], &s.iso);
+    let triangles = show_isosurfaces(&ctx, h.renderer.main(), &doc.volumes[0], &s.iso);
     assert!(triangles > 500);
     // The default camera looks down −z: the +z lobe hides the atoms in the molecular plane.
     let cam = default_camera(&doc);

@@ -246,11 +246,12 @@ fn the_gpu_mix_matches_the_cpu_interpolated_grid() {
         volume.max_grad = key.max_grad;
         volume.grid_box = key.grid_box;
         let mut renderer = Renderer::new(&ctx);
-        renderer.set_molecule(&ctx, &scene.scan.geometry_at(theta), s.atoms);
-        renderer.set_volume_texture(&ctx, volume);
+        let layer = renderer.main();
+        layer.set_molecule(&ctx, &scene.scan.geometry_at(theta), s.atoms);
+        layer.set_volume_texture(&ctx, volume);
         let target = OffscreenTarget::new(&ctx.device, size);
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        renderer.render(&ctx, &mut encoder, &target.color_view, &FrameInput { camera: &camera, settings: &s, size });
+        renderer.render(&ctx, &mut encoder, &target.color_view, &FrameInput::single(&camera, &s, size));
         ctx.queue.submit([encoder.finish()]);
         let reference = target.read_rgba(&ctx.device, &ctx.queue).unwrap();
         let (mean, max) = mean_max_diff(&mixed, &reference);

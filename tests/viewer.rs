@@ -55,8 +55,8 @@ fn starts_on_the_demo_and_changes_controls() {
     let mut h = harness();
     h.run_steps(2);
     let app = h.state();
-    assert_eq!(app.doc.volumes.len(), 1, "the demo cube has one orbital");
-    assert_eq!(app.doc.molecule.atoms.len(), 4, "formaldehyde");
+    assert_eq!(app.doc().volumes.len(), 1, "the demo cube has one orbital");
+    assert_eq!(app.doc().molecule.atoms.len(), 4, "formaldehyde");
     assert_eq!(app.view.settings.volume.mode, SliceMode::ViewAligned);
 
     h.get_by_label("axis stacks").click();
@@ -105,7 +105,7 @@ fn a_bad_file_reports_an_error_and_keeps_the_open_document() {
     let app = h.state();
     let err = app.error.as_deref().expect("an error is shown");
     assert!(err.contains("broken.cube") && err.contains(":4"), "{err}");
-    assert_eq!(app.doc.molecule.atoms.len(), 4, "the demo stays open");
+    assert_eq!(app.doc().molecule.atoms.len(), 4, "the demo stays open");
     h.get_by_label("Dismiss").click();
     h.run_steps(2);
     assert!(h.state().error.is_none());
@@ -125,7 +125,7 @@ fn a_molden_file_opens_on_its_homo_and_the_browser_switches_orbitals() {
         .build_eframe(|cc| OrbApp::new(cc, vec![path]));
     for _ in 0..300 {
         h.run_steps(1);
-        if !h.state().is_loading() && h.state().doc.wavefunction.is_some() {
+        if !h.state().is_loading() && h.state().doc().wavefunction.is_some() {
             break;
         }
         std::thread::sleep(std::time::Duration::from_millis(10));
@@ -133,7 +133,7 @@ fn a_molden_file_opens_on_its_homo_and_the_browser_switches_orbitals() {
     h.run_steps(2);
     let app = h.state();
     assert!(app.error.is_none(), "{:?}", app.error);
-    let wf = app.doc.wavefunction.as_ref().expect("the Molden file loaded");
+    let wf = app.doc().wavefunction.as_ref().expect("the Molden file loaded");
     let homo = wf.homo(orbcloud::model::Spin::Alpha).unwrap();
     assert_eq!(app.orbitals.shown, Quantity::Orbital(homo), "opens on the HOMO");
     let lumo = wf.lumo(orbcloud::model::Spin::Alpha).unwrap();

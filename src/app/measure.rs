@@ -6,6 +6,7 @@ use egui::{Color32, RichText, Stroke};
 
 use super::viewport::{Click, Viewport};
 use crate::gpu::frame::PickId;
+use super::World;
 use crate::model::Molecule;
 use crate::model::measure::Measurement;
 use crate::model::units::ANGSTROM_PER_BOHR;
@@ -21,8 +22,9 @@ pub struct Measurements {
 
 impl Measurements {
     /// Applies a click; returns a status line describing what was picked.
-    pub fn click(&mut self, click: Click, molecule: &Molecule) -> String {
-        let Some(PickId::Atom { index, .. }) = click.picked else {
+    pub fn click(&mut self, click: Click, world: &World) -> String {
+        let molecule = &world.molecule;
+        let Some(PickId::Atom { object, index }) = click.picked else {
             if click.picked.is_none() && !click.shift {
                 self.selection.clear();
             }
@@ -31,7 +33,7 @@ impl Measurements {
                 _ => String::new(),
             };
         };
-        let atom = index as usize;
+        let Some(atom) = world.atom(object as usize, index as usize) else { return String::new() };
         let Some(a) = molecule.atoms.get(atom) else { return String::new() };
         let extends = click.shift && self.selection.len() < 4 && !self.selection.contains(&atom);
         if !extends {
@@ -56,11 +58,13 @@ impl Measurements {
 const COLOR: Color32 = Color32::from_rgb(255, 220, 90);
 
 /// Draws the selection and the measurements over the view.
-pub fn overlay(ui: &egui::Ui, vp: &Viewport, camera: &Camera, molecule: &Molecule, m: &Measurements) {
+pub fn overlay(ui: &egui::Ui, vp: &Viewport, camera: &Camera, world: &World, m: &Measurements) {
     let painter = ui.painter();
+    let molecule = &world.molecule;
     let screen = |i: usize| molecule.atoms.get(i).and_then(|a| vp.to_screen(camera, a.position.as_vec3()));
-    if let Some(PickId::Atom { index, .. }) = vp.hovered
-        && let (Some(p), Some(atom)) = (screen(index as usize), molecule.atoms.get(index as usize))
+    if let Some(PickId::Atom { object, index }) = vp.hovered
+        && let Some(index) = world.atom(object as usize, index as usize)
+        && let (Some(p), Some(atom)) = (screen(index), molecule.atoms.get(index))
     {
         painter.circle_stroke(p, 11.0, Stroke::new(1.5, Color32::from_white_alpha(160)));
         painter.text(
@@ -124,6 +128,7 @@ mod tests {
         let atom = |x: f64, y: f64, z: f64| Atom { z: 6, charge: 6.0, position: DVec3::new(x, y, z), ghost: false };
         let mol =
             Molecule::new(vec![atom(0.0, 2.0, 0.0), atom(0.0, 0.0, 0.0), atom(2.8, 0.0, 0.0), atom(2.8, 0.0, 2.0)]);
+        let mol = World { molecule: mol, offsets: vec![0] };
         let mut m = Measurements::default();
         let pick = |i: u32, shift| Click { picked: Some(PickId::Atom { object: 0, index: i }), shift };
         assert!(m.click(pick(0, false), &mol).starts_with("atom 1 C"));
@@ -139,5 +144,17 @@ mod tests {
         assert_eq!(m.list.len(), 2);
         m.click(Click { picked: None, shift: false }, &mol);
         assert!(m.selection.is_empty());
+    }
+
+    #[test]
+    fn picks_in_a_second_object_number_through_the_scene() {
+        let atom = |x: f64| Atom { z: 8, charge: 8.0, position: DVec3::new(x, 0.0, 0.0), ghost: false };
+        let world = World { molecule: Molecule { atoms: vec![atom(0.0), atom(2.0), atom(10.0)], bonds: vec![] }, offsets: vec![0, 2] };
+        let mut m = Measurements::default();
+        let pick = |object, index, shift| Click { picked: Some(PickId::Atom { object, index }), shift };
+        assert!(m.click(pick(1, 0, false), &world).starts_with("atom 3 O"), "object 1's first atom is atom 3");
+        let label = m.click(pick(0, 1, true), &world);
+        assert!(label.ends_with(&format!("{:.3} Å", 8.0 * crate::model::units::ANGSTROM_PER_BOHR)), "{label}");
+        assert_eq!(m.click(pick(1, 5, false), &world), "", "no such atom");
     }
 }

@@ -7,6 +7,8 @@ pub mod measure;
 mod orbitals;
 mod panels;
 pub mod scan;
+mod scene_panel;
+pub mod session;
 pub mod state;
 pub mod viewport;
 
@@ -16,7 +18,8 @@ use std::sync::Arc;
 use crate::gpu::{GpuContext, context::device_descriptor};
 use crate::headless::WavefunctionView;
 use crate::headless::default_camera;
-use crate::model::Document;
+use crate::model::{Atom, Document, Molecule};
+use crate::scene::{ObjectState, RenderSettings};
 use loader::LoadJob;
 use scan::{ScanFailure, ScanJob, ScanSource, ScanView};
 pub use state::{OrbitalView, ViewState};
@@ -32,7 +35,17 @@ pub fn run(files: Vec<PathBuf>) -> eframe::Result<()> {
         wgpu_options: egui_wgpu::WgpuConfiguration { wgpu_setup: wgpu_setup(false), ..Default::default() },
         ..Default::default()
     };
-    eframe::run_native("orbcloud", options, Box::new(|cc| Ok(Box::new(OrbApp::new(cc, files)))))
+    eframe::run_native(
+        "orbcloud",
+        options,
+        Box::new(|cc| {
+            let mut app = OrbApp::new(cc, files);
+            if let Some(path) = session::last_session_path() {
+                app.keep_session_in(path);
+            }
+            Ok(Box::new(app))
+        }),
+    )
 }
 
 /// The window's device: the renderer's features and the adapter's limits. `lavapipe` picks
@@ -53,19 +66,48 @@ pub fn wgpu_setup(lavapipe: bool) -> egui_wgpu::WgpuSetup {
     egui_wgpu::WgpuSetup::CreateNew(setup)
 }
 
-pub struct OrbApp {
+/// One object of the scene: a document and what the user set for it.
+pub struct SceneObject {
     pub doc: Document,
-    pub view: ViewState,
+    pub state: ObjectState,
     /// The orbital browser's choices (documents with a wavefunction).
     pub orbitals: OrbitalView,
+}
+
+/// How a file being loaded joins the scene.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Opening {
+    /// Added beside what is open.
+    Add,
+    /// Replaces every object.
+    Replace,
+    /// Restored from a session, as it was saved.
+    Restore(Box<ObjectState>),
+}
+
+pub struct OrbApp {
+    /// The scene: every open file, in the order opened (object `n` is the renderer's layer `n`).
+    pub objects: Vec<SceneObject>,
+    /// The object the side panel and the orbital browser edit.
+    pub active: usize,
+    /// The camera, and the active object's settings as the side panel edits them (written back
+    /// to the object every frame).
+    pub view: ViewState,
+    /// The active object's orbital browser.
+    pub orbitals: OrbitalView,
+    /// What a newly opened object starts with (kept between runs).
+    pub defaults: RenderSettings,
+    /// Whether *Open…* and dropped files replace the scene instead of adding to it.
+    pub open_replaces: bool,
     scroll_to_frontier: bool,
     viewport: Option<Viewport>,
-    job: Option<LoadJob>,
-    /// Files given on the command line or dropped, waiting to be loaded one after another.
-    queue: Vec<PathBuf>,
+    job: Option<(LoadJob, Opening)>,
+    /// Files given on the command line, dropped or named by a session, waiting to be loaded one
+    /// after another (last first).
+    queue: Vec<(PathBuf, Opening)>,
     pub error: Option<String>,
     pub status: String,
-    /// An open dihedral scan (shown instead of `doc`), and one being prepared.
+    /// An open dihedral scan (shown instead of the scene), and one being prepared.
     pub scan: Option<ScanView>,
     scan_job: Option<ScanJob>,
     /// Points along the longest side of a scan's common grid.
@@ -74,8 +116,40 @@ pub struct OrbApp {
     pub scan_budget: Option<u64>,
     /// A scan that did not fit the GPU's memory, and the grid that would.
     pub scan_retry: Option<(ScanSource, usize)>,
-    /// Picked atoms and measurements between them.
+    /// Picked atoms and measurements between them; atoms are numbered through the scene
+    /// ([`Self::world`]).
     pub measurements: measure::Measurements,
+    /// Every object's atoms where they are placed, one numbering through the scene.
+    world: World,
+    /// Where the session is saved between runs (`None`: not kept, as in tests).
+    pub last_session: Option<PathBuf>,
+}
+
+/// The scene's atoms in world space, numbered object after object: what measurements index.
+#[derive(Debug, Clone, Default)]
+pub struct World {
+    pub molecule: Molecule,
+    /// Index of each object's first atom.
+    pub offsets: Vec<usize>,
+}
+
+impl World {
+    fn of(objects: &[SceneObject]) -> Self {
+        let mut world = Self::default();
+        for o in objects {
+            world.offsets.push(world.molecule.atoms.len());
+            let m = o.state.placement.world_from_object().as_dmat4();
+            world.molecule.atoms.extend(
+                o.doc.molecule.atoms.iter().map(|a| Atom { position: m.transform_point3(a.position), ..a.clone() }),
+            );
+        }
+        world
+    }
+
+    /// The scene-wide number of atom `index` of object `object`.
+    pub fn atom(&self, object: usize, index: usize) -> Option<usize> {
+        Some(self.offsets.get(object)? + index).filter(|&i| i < self.molecule.atoms.len())
+    }
 }
 
 impl OrbApp {
@@ -93,7 +167,7 @@ impl OrbApp {
     pub fn cube_demo(cc: &eframe::CreationContext<'_>) -> Self {
         let mut app = Self::empty(cc, Vec::new());
         match crate::demo::document() {
-            Ok(doc) => app.show_document(doc),
+            Ok(doc) => app.add_object(doc, Opening::Replace),
             Err(e) => app.error = Some(e.to_string()),
         }
         app
@@ -105,13 +179,16 @@ impl OrbApp {
             .as_ref()
             .map(|rs| Viewport::new(GpuContext::from_parts(rs.adapter.clone(), rs.device.clone(), rs.queue.clone())));
         let mut app = Self {
-            doc: Document::default(),
+            objects: Vec::new(),
+            active: 0,
             view: ViewState::default(),
             orbitals: OrbitalView::default(),
+            defaults: RenderSettings::default(),
+            open_replaces: false,
             scroll_to_frontier: false,
             viewport,
             job: None,
-            queue: files.into_iter().rev().collect(),
+            queue: files.into_iter().rev().map(|p| (p, Opening::Add)).collect(),
             error: None,
             status: String::new(),
             scan: None,
@@ -120,6 +197,8 @@ impl OrbApp {
             scan_retry: None,
             scan_budget: None,
             measurements: measure::Measurements::default(),
+            world: World::default(),
+            last_session: None,
         };
         if app.viewport.is_none() {
             app.error = Some("no wgpu render state: the viewer needs eframe's wgpu backend".into());
@@ -127,19 +206,31 @@ impl OrbApp {
         app
     }
 
-    /// The σ of the grid shown (what isosurface levels in σ refer to) and whether its values
-    /// are signed (an orbital: two surfaces).
+    /// The active object's document (an empty one when the scene is empty).
+    pub fn doc(&self) -> &Document {
+        static EMPTY: std::sync::LazyLock<Document> = std::sync::LazyLock::new(Document::default);
+        self.objects.get(self.active).map_or(&EMPTY, |o| &o.doc)
+    }
+
+    /// Every object's atoms where they are placed (what measurements and picks number).
+    pub fn world(&self) -> &World {
+        &self.world
+    }
+
+    /// The σ of the grid the active object shows (what isosurface levels in σ refer to) and
+    /// whether its values are signed (an orbital: two surfaces).
     pub fn shown_grid(&self) -> (Option<f64>, bool) {
-        let computed = self.viewport.as_ref().and_then(|vp| vp.computed_grid());
-        match computed.or(self.doc.volumes.get(self.view.volume)) {
+        let computed = self.viewport.as_ref().and_then(|vp| vp.computed_grid(self.active));
+        match computed.or(self.doc().volumes.get(self.view.volume)) {
             Some(g) => (Some(g.stats.sigma), g.kind == crate::model::grid::ValueKind::Signed),
             None => (None, true),
         }
     }
 
-    /// Where atom `atom` of the open document is drawn in the window (for tests and overlays).
+    /// Where atom `atom` of the scene (numbered through every object, [`World`]) is drawn in
+    /// the window (for tests and overlays).
     pub fn atom_on_screen(&self, atom: usize) -> Option<egui::Pos2> {
-        let position = self.doc.molecule.atoms.get(atom)?.position.as_vec3();
+        let position = self.world.molecule.atoms.get(atom)?.position.as_vec3();
         self.viewport.as_ref()?.to_screen(&self.view.camera, position)
     }
 
@@ -164,15 +255,27 @@ impl OrbApp {
         Some(GpuContext::from_parts(c.adapter.clone(), c.device.clone(), c.queue.clone()))
     }
 
-    /// Starts loading a file in the background (a `.scan.toml` opens as a scan); what is shown
-    /// stays until it has loaded.
+    /// Starts loading a file in the background, added to the scene or replacing it as
+    /// [`Self::open_replaces`] says (a `.scan.toml` opens as a scan, a `.orbcloud.toml` as a
+    /// session); what is shown stays until it has loaded.
     pub fn open(&mut self, path: PathBuf, ctx: &egui::Context) {
-        if path.to_string_lossy().to_ascii_lowercase().ends_with(".scan.toml") {
+        let how = if self.open_replaces { Opening::Replace } else { Opening::Add };
+        self.open_as(path, how, ctx);
+    }
+
+    /// [`Self::open`], joining the scene as `how` says.
+    pub fn open_as(&mut self, path: PathBuf, how: Opening, ctx: &egui::Context) {
+        let name = path.to_string_lossy().to_ascii_lowercase();
+        if name.ends_with(".scan.toml") {
             self.open_scan(ScanSource::File(path), ctx);
             return;
         }
-        let ctx = ctx.clone();
-        self.job = Some(LoadJob::start(path, move || ctx.request_repaint()));
+        if name.ends_with(crate::scene::objects::SESSION_SUFFIX) {
+            self.open_session(&path, ctx);
+            return;
+        }
+        let repaint = ctx.clone();
+        self.job = Some((LoadJob::start(path, move || repaint.request_repaint()), how));
     }
 
     /// Loads a scan and makes its key volumes in the background, following orbitals as its
@@ -205,29 +308,171 @@ impl OrbApp {
         self.job.is_some() || !self.queue.is_empty() || self.scan_job.is_some()
     }
 
-    fn show_document(&mut self, doc: Document) {
-        let mut view = self.view;
-        view.camera = default_camera(&doc);
-        view.volume = 0;
-        if let Some(vp) = &mut self.viewport
-            && let Err(e) = vp.set_document(&doc, &view)
-        {
+    /// Adds a loaded document to the scene as `how` says: beside the others, instead of them,
+    /// or as a session saved it. It becomes the active object.
+    fn add_object(&mut self, doc: Document, how: Opening) {
+        let restoring = matches!(how, Opening::Restore(_));
+        let replace = how == Opening::Replace;
+        let mut state = match how {
+            Opening::Restore(state) => *state,
+            _ => ObjectState {
+                path: (!doc.source.is_empty()).then(|| PathBuf::from(&doc.source)).filter(|p| p.exists()),
+                settings: RenderSettings { background: self.view.settings.background, ..self.defaults },
+                ..ObjectState::default()
+            },
+        };
+        let keep = if replace { 0 } else { self.objects.len() };
+        if !restoring && keep > 0 {
+            // Beside the scene: 4 bohr past its largest x.
+            let right = self.world.molecule.bounds().map_or(0.0, |(_, hi)| hi.x as f32);
+            let lo = doc.bounds().map_or(glam::Vec3::ZERO, |(lo, _)| lo.as_vec3());
+            state.placement = crate::scene::Placement::beside(right, lo, 4.0);
+        }
+        if keep >= crate::gpu::renderer::MAX_LAYERS {
+            self.error = Some(format!("{}: a scene holds at most {} objects", doc.source, keep));
+            return;
+        }
+        let Some(vp) = &mut self.viewport else { return };
+        if let Err(e) = vp.set_object(keep, &doc, &state) {
             self.error = Some(format!("{}: {e}", doc.source));
             return;
         }
-        self.status = format!("opened {}", doc.source);
+        if replace {
+            vp.truncate(1);
+        }
+        self.commit_active();
+        if replace {
+            self.objects.clear();
+            self.measurements = measure::Measurements::default();
+        }
         self.scan = None;
-        self.orbitals = doc.wavefunction.as_ref().map(OrbitalView::for_wavefunction).unwrap_or_default();
+        self.status = format!("opened {}", doc.source);
+        let mut orbitals = doc.wavefunction.as_ref().map(OrbitalView::for_wavefunction).unwrap_or_default();
+        if let Some(q) = state.quantity {
+            orbitals.shown = q;
+        }
+        self.objects.push(SceneObject { doc, state, orbitals });
+        self.select(self.objects.len() - 1);
+        self.world = World::of(&self.objects);
+        if !restoring {
+            self.view.camera = self.scene_camera();
+        }
         self.scroll_to_frontier = true;
-        self.measurements = measure::Measurements::default();
-        self.doc = doc;
-        self.view = view;
         self.show_wavefunction();
     }
 
-    /// Computes what the orbital browser asks for and hands it to the viewport.
+    /// A camera that frames every object where it is placed.
+    pub fn scene_camera(&self) -> crate::scene::Camera {
+        match self.objects.as_slice() {
+            [] => crate::scene::Camera::default(),
+            [only] if only.state.placement.is_identity() => default_camera(&only.doc),
+            objects => {
+                let boxes = objects.iter().filter_map(|o| {
+                    let (lo, hi) = crate::headless::framing_box(&o.doc)?;
+                    let m = o.state.placement.world_from_object();
+                    let corners = [lo, hi];
+                    let points: Vec<glam::Vec3> = (0..8)
+                        .map(|i| {
+                            let c = glam::Vec3::new(corners[i & 1].x, corners[(i >> 1) & 1].y, corners[i >> 2].z);
+                            m.transform_point3(c)
+                        })
+                        .collect();
+                    points.iter().copied().reduce(|a, b| a.min(b)).zip(points.iter().copied().reduce(|a, b| a.max(b)))
+                });
+                match boxes.reduce(|a, b| (a.0.min(b.0), a.1.max(b.1))) {
+                    Some((lo, hi)) => crate::scene::Camera::framing(lo, hi),
+                    None => crate::scene::Camera::default(),
+                }
+            }
+        }
+    }
+
+    /// Writes the panels' working copies (settings, volume, orbital choice) into the active
+    /// object.
+    fn commit_active(&mut self) {
+        if let Some(o) = self.objects.get_mut(self.active) {
+            o.state.settings = RenderSettings { background: self.view.settings.background, ..self.view.settings };
+            o.state.volume = self.view.volume;
+            o.state.quantity = Some(self.orbitals.shown);
+            o.orbitals = self.orbitals.clone();
+        }
+    }
+
+    /// Makes object `n` the one the panels edit.
+    pub fn select(&mut self, n: usize) {
+        if n >= self.objects.len() {
+            return;
+        }
+        self.commit_active();
+        self.active = n;
+        let o = &self.objects[n];
+        self.view.settings = RenderSettings { background: self.view.settings.background, ..o.state.settings };
+        self.view.volume = o.state.volume;
+        self.orbitals = o.orbitals.clone();
+    }
+
+    /// Removes object `n` from the scene (measurements, which number the scene's atoms, go too).
+    pub fn remove_object(&mut self, n: usize) {
+        if n >= self.objects.len() {
+            return;
+        }
+        self.commit_active();
+        self.objects.remove(n);
+        if let Some(vp) = &mut self.viewport {
+            vp.remove_object(n);
+        }
+        self.measurements = measure::Measurements::default();
+        self.world = World::of(&self.objects);
+        self.active = self.active.min(self.objects.len().saturating_sub(1));
+        if let Some(o) = self.objects.get(self.active) {
+            self.view.settings = RenderSettings { background: self.view.settings.background, ..o.state.settings };
+            self.view.volume = o.state.volume;
+            self.orbitals = o.orbitals.clone();
+        }
+    }
+
+    /// Moves object `n` to `placement`.
+    pub fn place(&mut self, n: usize, placement: crate::scene::Placement) {
+        let Some(o) = self.objects.get_mut(n) else { return };
+        o.state.placement = placement;
+        if let Some(vp) = &mut self.viewport {
+            vp.set_placement(n, &placement);
+        }
+        self.world = World::of(&self.objects);
+    }
+
+    /// Shows or hides object `n` whole.
+    pub fn set_visible(&mut self, n: usize, visible: bool) {
+        let Some(o) = self.objects.get_mut(n) else { return };
+        o.state.visible = visible;
+        if let Some(vp) = &mut self.viewport {
+            vp.set_visible(n, visible);
+        }
+    }
+
+    /// Redraws object `n`'s isosurfaces from its state (after an edit in the scene panel).
+    pub fn refresh_isosurfaces(&mut self, n: usize) {
+        if n == self.active {
+            self.commit_active();
+        }
+        let (Some(vp), Some(o)) = (&mut self.viewport, self.objects.get(n)) else { return };
+        let triangles = vp.update_isosurfaces(n, &o.doc, &o.state);
+        self.status = format!("isosurfaces: {triangles} triangles");
+    }
+
+    /// Shows object `n`'s atoms in its state's style.
+    pub fn restyle_atoms(&mut self, n: usize) {
+        if n == self.active {
+            self.commit_active();
+        }
+        let (Some(vp), Some(o)) = (&mut self.viewport, self.objects.get(n)) else { return };
+        vp.set_atom_style(n, &o.doc, o.state.settings.atoms);
+    }
+
+    /// Computes what the active object's orbital browser asks for and hands it to the viewport.
     fn show_wavefunction(&mut self) {
-        let Some(vp) = &mut self.viewport else { return };
+        self.commit_active();
+        let (Some(vp), Some(o)) = (&mut self.viewport, self.objects.get(self.active)) else { return };
         let ov = &self.orbitals;
         let view = WavefunctionView {
             quantity: ov.shown,
@@ -235,18 +480,18 @@ impl OrbApp {
             points: ov.grid_points,
             shells: ov.ao_filter.then_some(ov.shell_mask.as_slice()),
         };
-        if let Err(e) = vp.show_wavefunction(&self.doc, &view, &self.view) {
+        if let Err(e) = vp.show_wavefunction(self.active, &o.doc, &view, &o.state) {
             self.error = Some(e.to_string());
         }
     }
 
     fn poll_job(&mut self, ctx: &egui::Context) {
-        if let Some(job) = &self.job
+        if let Some((job, _)) = &self.job
             && let Some(result) = job.poll()
         {
-            self.job = None;
+            let Some((_, how)) = self.job.take() else { return };
             match result {
-                Ok(doc) => self.show_document(doc),
+                Ok(doc) => self.add_object(doc, how),
                 Err(e) => self.error = Some(e.to_string()),
             }
         }
@@ -292,33 +537,45 @@ impl OrbApp {
             }
         }
         if self.job.is_none()
-            && let Some(next) = self.queue.pop()
+            && let Some((next, how)) = self.queue.pop()
         {
-            self.open(next, ctx);
+            self.open_as(next, how, ctx);
         }
         let dropped: Vec<PathBuf> = ctx.input(|i| {
             i.raw.dropped_files.iter().map(|f| f.path().to_path_buf()).filter(|p| !p.as_os_str().is_empty()).collect()
         });
-        for path in dropped.into_iter().rev() {
-            self.queue.push(path);
+        // Several files dropped at once: the first replaces (when asked), the rest are added.
+        let first = if self.open_replaces { Opening::Replace } else { Opening::Add };
+        let count = dropped.len();
+        for (n, path) in dropped.into_iter().enumerate().rev() {
+            self.queue.push((path, if n == 0 && count > 0 { first.clone() } else { Opening::Add }));
         }
     }
 
-    /// Applies a change of the shown volume or atom style made in the panels.
+    /// Applies a change the side panel made to the active object, and writes it back.
     fn apply(&mut self, before: &ViewState) {
-        let Some(vp) = &mut self.viewport else { return };
+        self.commit_active();
+        let n = self.active;
+        let (Some(vp), Some(o)) = (&mut self.viewport, self.objects.get(n)) else {
+            if before.settings.atoms != self.view.settings.atoms
+                && let Some(scan) = &mut self.scan
+            {
+                scan::restyle(scan);
+            }
+            return;
+        };
         if before.volume != self.view.volume {
-            if let Err(e) = vp.set_volume(&self.doc, &self.view) {
+            if let Err(e) = vp.set_volume(n, &o.doc, &o.state) {
                 self.error = Some(e.to_string());
             }
         } else if before.settings.iso != self.view.settings.iso {
-            let triangles = vp.update_isosurfaces(&self.doc, &self.view);
+            let triangles = vp.update_isosurfaces(n, &o.doc, &o.state);
             if self.view.settings.iso.visible {
                 self.status = format!("isosurfaces: {triangles} triangles");
             }
         }
         if before.settings.atoms != self.view.settings.atoms {
-            vp.set_atom_style(&self.doc, &self.view);
+            vp.set_atom_style(n, &o.doc, self.view.settings.atoms);
             if let Some(scan) = &mut self.scan {
                 scan::restyle(scan);
             }
@@ -366,6 +623,10 @@ impl OrbApp {
 }
 
 impl eframe::App for OrbApp {
+    fn on_exit(&mut self) {
+        self.save_last_session();
+    }
+
     fn ui(&mut self, ui: &mut egui::Ui, frame: &mut eframe::Frame) {
         let ctx = ui.ctx().clone();
         self.poll_job(&ctx);
@@ -374,7 +635,9 @@ impl eframe::App for OrbApp {
         panels::status_bar(ui, self);
         panels::side_panel(ui, self);
         let orbitals_before = self.orbitals.clone();
-        orbitals::panel(ui, &self.doc, &mut self.orbitals, &mut self.scroll_to_frontier);
+        if let Some(o) = self.objects.get(self.active) {
+            orbitals::panel(ui, &o.doc, &mut self.orbitals, &mut self.scroll_to_frontier);
+        }
         if self.orbitals != orbitals_before {
             self.show_wavefunction();
         }
@@ -383,7 +646,7 @@ impl eframe::App for OrbApp {
             panels::Action::Open => {
                 if let Some(path) = rfd::FileDialog::new()
                     .add_filter(
-                        "Cube, Molden, fchk, scan",
+                        "Cube, Molden, fchk, scan, session",
                         &["cube", "cub", "molden", "mold", "fchk", "fch", "toml", "gz"],
                     )
                     .pick_file()
@@ -393,11 +656,25 @@ impl eframe::App for OrbApp {
                     self.status = "no file chosen (open files from the command line or drop them on the window)".into();
                 }
             }
+            panels::Action::SaveSession => {
+                if let Some(path) = rfd::FileDialog::new()
+                    .add_filter("orbcloud session", &["toml"])
+                    .set_file_name("scene.orbcloud.toml")
+                    .save_file()
+                {
+                    self.save_session(&session::with_suffix(path));
+                }
+            }
+            panels::Action::ReopenLast => {
+                if let Some(path) = self.last_session.clone() {
+                    self.open_session(&path, &ctx);
+                }
+            }
             panels::Action::Screenshot => self.screenshot(),
             panels::Action::ResetView => {
                 self.view.camera = match &self.scan {
                     Some(scan) => scan.scene.camera(),
-                    None => default_camera(&self.doc),
+                    None => self.scene_camera(),
                 }
             }
             panels::Action::None => {}
@@ -414,14 +691,15 @@ impl eframe::App for OrbApp {
                 (None, Some(vp)) => {
                     vp.detail =
                         detail::Detail::for_frame(detail::interacting(ui.ctx(), false), vp.ctx.info.device_type, 1);
+                    vp.clouds = self.objects.iter().map(|o| o.state.settings.volume).collect();
                     vp.show(ui, rs, &mut self.view);
                     if let Some(click) = vp.click.take() {
-                        let said = self.measurements.click(click, &self.doc.molecule);
+                        let said = self.measurements.click(click, &self.world);
                         if !said.is_empty() {
                             self.status = said;
                         }
                     }
-                    measure::overlay(ui, vp, &self.view.camera, &self.doc.molecule, &self.measurements);
+                    measure::overlay(ui, vp, &self.view.camera, &self.world, &self.measurements);
                 }
                 (None, None) => {}
             }

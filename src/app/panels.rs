@@ -11,18 +11,30 @@ use crate::scene::{AtomStyle, ClipPlane, IsoLevel, IsosurfaceSettings, Shape, Sl
 pub enum Action {
     None,
     Open,
+    SaveSession,
+    ReopenLast,
     Screenshot,
     ResetView,
 }
 
-pub fn top_bar(ui: &mut egui::Ui, app: &OrbApp) -> Action {
+pub fn top_bar(ui: &mut egui::Ui, app: &mut OrbApp) -> Action {
     let mut action = Action::None;
     egui::Panel::top("top bar").show(ui, |ui| {
         ui.horizontal(|ui| {
             ui.strong("orbcloud");
             ui.separator();
-            if ui.button("Open…").clicked() {
+            if ui.button("Open…").on_hover_text("cube, Molden, fchk, a scan or a saved session").clicked() {
                 action = Action::Open;
+            }
+            ui.checkbox(&mut app.open_replaces, "replace")
+                .on_hover_text("opened and dropped files replace the scene instead of joining it");
+            if ui.button("Save session…").on_hover_text("files, representations and camera").clicked() {
+                action = Action::SaveSession;
+            }
+            if app.last_session.as_ref().is_some_and(|p| p.exists())
+                && ui.button("Last session").on_hover_text("reopen what was open when orbcloud last closed").clicked()
+            {
+                action = Action::ReopenLast;
             }
             if ui.button("Save PNG").clicked() {
                 action = Action::Screenshot;
@@ -31,7 +43,11 @@ pub fn top_bar(ui: &mut egui::Ui, app: &OrbApp) -> Action {
                 action = Action::ResetView;
             }
             ui.separator();
-            let source = app.scan.as_ref().map_or(app.doc.source.as_str(), |s| s.scene.scan.title.as_str());
+            let source = match &app.scan {
+                Some(s) => s.scene.scan.title.clone(),
+                None if app.objects.len() > 1 => format!("{} objects", app.objects.len()),
+                None => app.doc().source.clone(),
+            };
             ui.label(RichText::new(source).weak());
         });
     });
@@ -42,10 +58,10 @@ pub fn status_bar(ui: &mut egui::Ui, app: &OrbApp) {
     egui::Panel::bottom("status").show(ui, |ui| {
         ui.horizontal(|ui| {
             if let Some(job) = &app.job {
-                let (f, parsing) = job.progress();
+                let (f, parsing) = job.0.progress();
                 let text = if parsing { "parsing…".to_string() } else { format!("reading {:.0}%", 100.0 * f) };
                 ui.add(egui::ProgressBar::new(f).desired_width(160.0).text(text));
-                ui.label(job.path.display().to_string());
+                ui.label(job.0.path.display().to_string());
                 ui.separator();
             }
             if let Some(job) = &app.scan_job {
@@ -74,9 +90,9 @@ pub fn status_bar(ui: &mut egui::Ui, app: &OrbApp) {
                 }
                 return;
             }
-            let m = &app.doc.molecule;
+            let m = &app.doc().molecule;
             ui.label(format!("{} atoms ({}), {} bonds", m.atoms.len(), m.formula(), m.bonds.len()));
-            if let (Some(wf), Quantity::Orbital(i)) = (&app.doc.wavefunction, app.orbitals.shown) {
+            if let (Some(wf), Quantity::Orbital(i)) = (&app.doc().wavefunction, app.orbitals.shown) {
                 let o = &wf.orbitals[i];
                 ui.separator();
                 ui.label(format!(
@@ -89,7 +105,7 @@ pub fn status_bar(ui: &mut egui::Ui, app: &OrbApp) {
                     o.occupation
                 ));
             }
-            if let Some(g) = app.doc.volumes.get(app.view.volume) {
+            if let Some(g) = app.doc().volumes.get(app.view.volume) {
                 ui.separator();
                 let h: Vec<String> = (0..3).map(|a| format!("{:.3}", g.step(a).length())).collect();
                 ui.label(format!(
@@ -113,7 +129,13 @@ pub fn status_bar(ui: &mut egui::Ui, app: &OrbApp) {
 pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
     egui::Panel::left("controls").default_size(250.0).show(ui, |ui| {
         egui::ScrollArea::vertical().show(ui, |ui| {
+            super::scene_panel::section(ui, app);
+            if app.scan.is_none() && !app.objects.is_empty() {
+                ui.separator();
+            }
             let (grid_sigma, grid_signed) = app.shown_grid();
+            let no_document = crate::model::Document::default();
+            let doc = app.objects.get(app.active).map_or(&no_document, |o| &o.doc);
             let view = &mut app.view;
             ui.heading("Volume");
             if let Some(scan) = &app.scan {
@@ -126,8 +148,8 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
                     g[2],
                     scan.scene.bytes as f64 / 1048576.0
                 ));
-            } else if app.doc.volumes.is_empty() {
-                ui.label(if app.doc.wavefunction.is_some() {
+            } else if doc.volumes.is_empty() {
+                ui.label(if doc.wavefunction.is_some() {
                     "computed from the basis set: choose it under Orbitals"
                 } else {
                     "no volume in this file"
@@ -136,9 +158,9 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
                 let label = ui.label("data set");
                 ComboBox::from_id_salt("data set")
                     .width(220.0)
-                    .selected_text(app.doc.volumes.get(view.volume).map(|v| v.label.as_str()).unwrap_or("?"))
+                    .selected_text(doc.volumes.get(view.volume).map(|v| v.label.as_str()).unwrap_or("?"))
                     .show_ui(ui, |ui| {
-                        for (i, v) in app.doc.volumes.iter().enumerate() {
+                        for (i, v) in doc.volumes.iter().enumerate() {
                             ui.selectable_value(&mut view.volume, i, &v.label);
                         }
                     })
@@ -155,7 +177,7 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
             ui.add(Slider::new(&mut vs.slices, 16..=512).text("slice count"));
             ui.add(Slider::new(&mut vs.k1, 0.0..=1.0).text("k1 (opacity)"));
             ui.add(Slider::new(&mut vs.k2, 0.1..=3.0).text("k2 (shape)"));
-            let signed = app.doc.volumes.get(view.volume).is_none_or(|v| v.kind == ValueKind::Signed);
+            let signed = doc.volumes.get(view.volume).is_none_or(|v| v.kind == ValueKind::Signed);
             let (pos, neg) = if signed { ("ψ > 0", "ψ < 0") } else { ("dense", "thin") };
             ui.horizontal(|ui| {
                 ui.color_edit_button_rgb(&mut vs.positive_color);
@@ -182,17 +204,11 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
 
             ui.separator();
             ui.heading("Atoms");
-            ComboBox::from_label("style")
-                .selected_text(match view.settings.atoms {
-                    AtomStyle::BallAndStick => "ball and stick",
-                    AtomStyle::SpaceFilling => "space filling",
-                    AtomStyle::Hidden => "hidden",
-                })
-                .show_ui(ui, |ui| {
-                    ui.selectable_value(&mut view.settings.atoms, AtomStyle::BallAndStick, "ball and stick");
-                    ui.selectable_value(&mut view.settings.atoms, AtomStyle::SpaceFilling, "space filling");
-                    ui.selectable_value(&mut view.settings.atoms, AtomStyle::Hidden, "hidden");
-                });
+            ComboBox::from_label("style").selected_text(view.settings.atoms.name()).show_ui(ui, |ui| {
+                for style in AtomStyle::ALL {
+                    ui.selectable_value(&mut view.settings.atoms, style, style.name());
+                }
+            });
             ui.horizontal(|ui| {
                 ui.color_edit_button_rgb(&mut view.settings.background);
                 ui.label("background");
@@ -200,14 +216,14 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
 
             if app.scan.is_none() {
                 ui.separator();
-                super::measure::panel(ui, &app.doc.molecule, &mut app.measurements);
+                super::measure::panel(ui, &app.world.molecule, &mut app.measurements);
             }
 
             ui.separator();
             ui.collapsing("Atoms in file", |ui| {
                 // A scan's atoms where they are at θ.
                 let twisted = app.scan.as_ref().map(|s| s.scene.scan.geometry_at(s.theta));
-                let molecule = twisted.as_ref().unwrap_or(&app.doc.molecule);
+                let molecule = twisted.as_ref().unwrap_or(&app.doc().molecule);
                 egui::Grid::new("atoms").striped(true).show(ui, |ui| {
                     for (i, a) in molecule.atoms.iter().enumerate().take(500) {
                         let p = a.position * ANGSTROM_PER_BOHR;

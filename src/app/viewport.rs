@@ -9,8 +9,9 @@ use crate::gpu::frame::PickId;
 use crate::gpu::gto::GtoFillPass;
 use crate::gpu::{FrameInput, GpuContext, GpuError, OffscreenTarget, Renderer};
 use crate::headless::scan::ScanScene;
-use crate::headless::{WavefunctionView, show_isosurfaces};
+use crate::headless::{WavefunctionView, isosurfaces, show_meshes};
 use crate::model::{Document, VolumeGrid};
+use crate::scene::{ObjectState, RenderSettings, VolumeSettings};
 
 /// A click in the view: what the frame showed under the pointer, and whether Shift was held.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -41,12 +42,15 @@ pub struct Viewport {
     /// What the next frames draw: set each frame by the caller.
     pub detail: Detail,
     /// The state the texture currently shows; a frame is drawn only when this changes.
-    drawn: Option<(ViewState, [u32; 2], u64)>,
+    drawn: Option<(ViewState, Vec<VolumeSettings>, [u32; 2], u64)>,
     /// Bumped whenever the renderer's data changes.
     generation: u64,
-    /// A wavefunction's values on the grid shown (cube files' grids stay in the document):
-    /// isosurfaces are cut from it.
-    iso_grid: Option<VolumeGrid>,
+    /// Per object, its values on the grid shown when computed from a basis (cube files' grids
+    /// stay in the document): isosurfaces are cut from it.
+    computed: Vec<Option<VolumeGrid>>,
+    /// Each object's cloud settings (set by the caller each frame); empty: one layer drawn with
+    /// the view's settings (scan views).
+    pub clouds: Vec<VolumeSettings>,
     /// The last click, until the caller takes it.
     pub click: Option<Click>,
     /// What is under the resting pointer (hover highlight), and where the pointer was.
@@ -72,7 +76,8 @@ impl Viewport {
             detail: Detail::FULL,
             drawn: None,
             generation: 0,
-            iso_grid: None,
+            computed: Vec::new(),
+            clouds: Vec::new(),
             click: None,
             hovered: None,
             hovered_at: None,
@@ -82,49 +87,98 @@ impl Viewport {
         }
     }
 
-    /// Uploads a document's molecule and chosen volume.
-    pub fn set_document(&mut self, doc: &Document, view: &ViewState) -> Result<(), GpuError> {
-        self.renderer.set_volume(&self.ctx, doc.volumes.get(view.volume))?;
-        self.renderer.set_molecule(&self.ctx, &doc.molecule, view.settings.atoms);
-        self.iso_grid = None;
-        self.update_isosurfaces(doc, view);
+    /// Uploads object `n` of the scene: its molecule, the volume its state chooses, its
+    /// isosurfaces and its placement.
+    pub fn set_object(&mut self, n: usize, doc: &Document, state: &ObjectState) -> Result<(), GpuError> {
+        crate::headless::show_object(&self.ctx, self.renderer.layer_mut(&self.ctx, n), doc, state)?;
+        self.grid_slot(n).take();
+        self.generation += 1;
         Ok(())
     }
 
-    pub fn set_volume(&mut self, doc: &Document, view: &ViewState) -> Result<(), GpuError> {
-        self.renderer.set_volume(&self.ctx, doc.volumes.get(view.volume))?;
-        self.update_isosurfaces(doc, view);
+    /// Shows the volume object `n`'s state chooses.
+    pub fn set_volume(&mut self, n: usize, doc: &Document, state: &ObjectState) -> Result<(), GpuError> {
+        self.renderer.layer_mut(&self.ctx, n).set_volume(&self.ctx, doc.volumes.get(state.volume))?;
+        self.update_isosurfaces(n, doc, state);
         Ok(())
     }
 
-    /// Shows a wavefunction's orbital or density (see [`crate::headless::show_wavefunction`]).
+    /// Shows a wavefunction's orbital or density for object `n` (see
+    /// [`crate::headless::show_wavefunction`]).
     pub fn show_wavefunction(
         &mut self,
+        n: usize,
         doc: &Document,
         wavefunction: &WavefunctionView,
-        view: &ViewState,
+        state: &ObjectState,
     ) -> Result<(), GpuError> {
-        self.iso_grid =
-            crate::headless::show_wavefunction(&self.ctx, &mut self.renderer, &mut self.fill, doc, wavefunction)?;
-        self.update_isosurfaces(doc, view);
+        let layer = self.renderer.layer_mut(&self.ctx, n);
+        let grid = crate::headless::show_wavefunction(&self.ctx, layer, &mut self.fill, doc, wavefunction)?;
+        *self.grid_slot(n) = grid;
+        self.update_isosurfaces(n, doc, state);
         Ok(())
     }
 
-    /// Cuts the isosurfaces `view` asks for from the grid shown; returns their triangle count.
-    pub fn update_isosurfaces(&mut self, doc: &Document, view: &ViewState) -> usize {
+    /// Cuts every isosurface object `n`'s state asks for from the grid it shows; returns their
+    /// triangle count.
+    pub fn update_isosurfaces(&mut self, n: usize, doc: &Document, state: &ObjectState) -> usize {
         self.generation += 1;
-        match self.iso_grid.as_ref().or(doc.volumes.get(view.volume)) {
-            Some(grid) => show_isosurfaces(&self.ctx, &mut self.renderer, grid, &view.settings.iso),
-            None => {
-                self.renderer.surfaces.clear();
-                0
-            }
-        }
+        let grid = self.computed_grid(n).or(doc.volumes.get(state.volume));
+        let meshes: Vec<_> = match grid {
+            Some(grid) => state.all_isosurfaces().flat_map(|iso| isosurfaces(grid, iso)).collect(),
+            None => Vec::new(),
+        };
+        show_meshes(&self.ctx, self.renderer.layer_mut(&self.ctx, n), &meshes)
     }
 
-    /// The grid isosurfaces are cut from, when it is not one of the document's.
-    pub fn computed_grid(&self) -> Option<&VolumeGrid> {
-        self.iso_grid.as_ref()
+    /// Object `n`'s values on the grid it shows, when they are not one of its document's (an
+    /// orbital or density computed from a basis): isosurfaces are cut from it.
+    pub fn computed_grid(&self, n: usize) -> Option<&VolumeGrid> {
+        self.computed.get(n)?.as_ref()
+    }
+
+    fn grid_slot(&mut self, n: usize) -> &mut Option<VolumeGrid> {
+        if self.computed.len() <= n {
+            self.computed.resize_with(n + 1, || None);
+        }
+        &mut self.computed[n]
+    }
+
+    pub fn set_atom_style(&mut self, n: usize, doc: &Document, style: crate::scene::AtomStyle) {
+        self.renderer.layer_mut(&self.ctx, n).set_molecule(&self.ctx, &doc.molecule, style);
+        self.generation += 1;
+    }
+
+    /// Moves object `n` to `placement`.
+    pub fn set_placement(&mut self, n: usize, placement: &crate::scene::Placement) {
+        self.renderer.layer_mut(&self.ctx, n).world_from_object = placement.world_from_object();
+        self.generation += 1;
+    }
+
+    /// Shows or hides object `n` whole.
+    pub fn set_visible(&mut self, n: usize, visible: bool) {
+        self.renderer.layer_mut(&self.ctx, n).visible = visible;
+        self.generation += 1;
+    }
+
+    /// Keeps the first `n` objects, dropping the GPU data of the rest (the first layer is
+    /// emptied when `n` is 0).
+    pub fn truncate(&mut self, n: usize) {
+        self.renderer.truncate(n);
+        self.computed.truncate(n);
+        if n == 0 {
+            self.renderer.main().clear(&self.ctx);
+        }
+        self.generation += 1;
+    }
+
+    /// Removes object `n`; the objects after it move down by one.
+    pub fn remove_object(&mut self, n: usize) {
+        self.renderer.remove(&self.ctx, n);
+        if n < self.computed.len() {
+            self.computed.remove(n);
+        }
+        self.generation += 1;
     }
 
     /// Shows slot `slot` of a scan at θ (both key volumes and the twisted skeleton).
@@ -141,10 +195,6 @@ impl Viewport {
         self.generation += 1;
     }
 
-    pub fn set_atom_style(&mut self, doc: &Document, view: &ViewState) {
-        self.renderer.set_molecule(&self.ctx, &doc.molecule, view.settings.atoms);
-        self.generation += 1;
-    }
 
     /// Shows the view in the remaining space of `ui`, applying mouse and keyboard input to
     /// `view.camera`.
@@ -210,12 +260,17 @@ impl Viewport {
             self.target = Some((target, id));
             self.drawn = None;
         }
-        let key = (drawn, size, self.generation);
+        let clouds: Vec<VolumeSettings> = if self.clouds.is_empty() {
+            vec![drawn.settings.volume]
+        } else {
+            self.clouds.iter().map(|&volume| self.detail.apply(RenderSettings { volume, ..drawn.settings }).volume).collect()
+        };
+        let key = (drawn, clouds, size, self.generation);
         if let Some((target, id)) = &self.target {
-            if self.drawn != Some(key) {
+            if self.drawn.as_ref() != Some(&key) {
                 let mut encoder =
                     self.ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("viewport") });
-                let frame = FrameInput { camera: &drawn.camera, settings: &drawn.settings, size };
+                let frame = FrameInput { camera: &drawn.camera, background: drawn.settings.background, clouds: &key.1, size };
                 self.renderer.render(&self.ctx, &mut encoder, &target.color_view, &frame);
                 self.ctx.queue.submit([encoder.finish()]);
                 self.drawn = Some(key);
@@ -279,7 +334,8 @@ impl Viewport {
         let target = OffscreenTarget::new(&self.ctx.device, size);
         let mut encoder =
             self.ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("snapshot") });
-        let frame = FrameInput { camera: &view.camera, settings: &view.settings, size };
+        let clouds = if self.clouds.is_empty() { vec![view.settings.volume] } else { self.clouds.clone() };
+        let frame = FrameInput { camera: &view.camera, background: view.settings.background, clouds: &clouds, size };
         self.renderer.render(&self.ctx, &mut encoder, &target.color_view, &frame);
         self.ctx.queue.submit([encoder.finish()]);
         // The viewport's own frame must be redrawn: the renderer's buffers changed size.

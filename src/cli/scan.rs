@@ -347,7 +347,7 @@ pub fn bench_keyvolumes(args: KeyVolumeBench) -> Result<()> {
         ctx.device.poll(wgpu::PollType::wait_indefinitely())?;
         let upload = t.elapsed().as_secs_f64();
         let mut renderer = Renderer::new(&ctx);
-        renderer.set_molecule(&ctx, &molecule, settings.atoms);
+        renderer.main().set_molecule(&ctx, &molecule, settings.atoms);
         let mut medians = Vec::new();
         for mode in [Interpolation::Exact, Interpolation::ThreePass] {
             let mut times = Vec::new();
@@ -355,11 +355,11 @@ pub fn bench_keyvolumes(args: KeyVolumeBench) -> Result<()> {
                 // Spread the frames over all K volumes, as a drag across the whole range would.
                 let i = (f * (k - 1)) / args.frames.max(1);
                 let (a, b) = (i.min(k - 2), i.min(k - 2) + 1);
-                renderer.set_morph(&ctx, keys[a].clone(), keys[b].clone(), 0.37, mode);
+                renderer.main().set_morph(&ctx, keys[a].clone(), keys[b].clone(), 0.37, mode);
                 let t = Instant::now();
                 let mut encoder =
                     ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("bench") });
-                let frame = orbcloud::gpu::FrameInput { camera: &camera, settings: &settings, size: args.size };
+                let frame = orbcloud::gpu::FrameInput::single(&camera, &settings, args.size);
                 renderer.render(&ctx, &mut encoder, &target.color_view, &frame);
                 ctx.queue.submit([encoder.finish()]);
                 ctx.device.poll(wgpu::PollType::wait_indefinitely())?;

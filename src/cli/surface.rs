@@ -60,7 +60,7 @@ pub fn show(ctx: &GpuContext, renderer: &mut Renderer, grid: &VolumeGrid, iso: &
         return;
     }
     let meshes = iso.meshes(grid, &IsosurfaceSettings::default());
-    let triangles = show_meshes(ctx, renderer, &meshes);
+    let triangles = show_meshes(ctx, renderer.main(), &meshes);
     eprintln!("isosurfaces: {} surface(s), {triangles} triangles", meshes.len());
 }
 

@@ -2,10 +2,10 @@
 //! done as instanced quads with exact per-pixel intersection and depth).
 
 use bytemuck::{Pod, Zeroable};
-use glam::{Mat4, Vec3};
+use glam::Vec3;
 
 use super::GpuContext;
-use super::frame::{Draw, Phase, PickId, opaque_depth, opaque_targets};
+use super::frame::{Draw, ObjectView, Phase, PickId, opaque_depth, opaque_targets};
 use crate::model::{Molecule, units::BOHR_PER_ANGSTROM};
 use crate::scene::AtomStyle;
 
@@ -72,6 +72,7 @@ pub fn instances(molecule: &Molecule, style: AtomStyle) -> (Vec<SphereInstance>,
                 let e = a.element();
                 let mut radius = match style {
                     AtomStyle::SpaceFilling => e.vdw_radius,
+                    AtomStyle::Sticks => STICK_RADIUS_ANG,
                     _ => e.vdw_radius * BALL_FRACTION,
                 } * bohr;
                 let mut color = linear_color(e.color);
@@ -84,7 +85,7 @@ pub fn instances(molecule: &Molecule, style: AtomStyle) -> (Vec<SphereInstance>,
             .collect(),
     };
     let cylinders = match style {
-        AtomStyle::BallAndStick => molecule
+        AtomStyle::BallAndStick | AtomStyle::Sticks => molecule
             .bonds
             .iter()
             .flat_map(|b| {
@@ -109,6 +110,7 @@ pub fn instances(molecule: &Molecule, style: AtomStyle) -> (Vec<SphereInstance>,
 pub struct AtomsPass {
     spheres_pipeline: wgpu::RenderPipeline,
     cylinders_pipeline: wgpu::RenderPipeline,
+    layout: wgpu::BindGroupLayout,
     globals: wgpu::Buffer,
     bind_group: wgpu::BindGroup,
     spheres: Option<(wgpu::Buffer, u32)>,
@@ -174,7 +176,7 @@ impl AtomsPass {
             layout: &layout,
             entries: &[wgpu::BindGroupEntry { binding: 0, resource: globals.as_entire_binding() }],
         });
-        Self { spheres_pipeline, cylinders_pipeline, globals, bind_group, spheres: None, cylinders: None }
+        Self { spheres_pipeline, cylinders_pipeline, layout, globals, bind_group, spheres: None, cylinders: None }
     }
 
     /// Uploads the impostor instances of a molecule in a style.
@@ -195,14 +197,34 @@ impl AtomsPass {
         self.cylinders = upload("cylinder instances", bytemuck::cast_slice(&cylinders), cylinders.len());
     }
 
-    pub fn prepare(&self, queue: &wgpu::Queue, clip_from_world: Mat4, eye: Vec3, target: Vec3) {
-        let (light, up) = headlight(eye, target);
+    /// Another set of atoms drawn with this one's pipelines.
+    pub fn instance(&self, ctx: &GpuContext) -> Self {
+        let globals = super::uniform_buffer(&ctx.device, "atoms globals", std::mem::size_of::<AtomGlobals>());
+        let bind_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("atoms bind group"),
+            layout: &self.layout,
+            entries: &[wgpu::BindGroupEntry { binding: 0, resource: globals.as_entire_binding() }],
+        });
+        Self {
+            spheres_pipeline: self.spheres_pipeline.clone(),
+            cylinders_pipeline: self.cylinders_pipeline.clone(),
+            layout: self.layout.clone(),
+            globals,
+            bind_group,
+            spheres: None,
+            cylinders: None,
+        }
+    }
+
+    /// This frame's camera, in the frame of the object the atoms belong to; their pick ids name
+    /// `object`.
+    pub fn prepare(&self, queue: &wgpu::Queue, view: &ObjectView, object: u32) {
         let g = AtomGlobals {
-            clip_from_world: clip_from_world.to_cols_array_2d(),
-            eye: eye.extend(1.0).to_array(),
-            light: light.extend(0.0).to_array(),
-            up: up.extend(0.0).to_array(),
-            pick: [PickId::atom_base(0), 0, 0, 0],
+            clip_from_world: view.clip_from_object.to_cols_array_2d(),
+            eye: view.eye.extend(1.0).to_array(),
+            light: view.light.extend(0.0).to_array(),
+            up: view.up.extend(0.0).to_array(),
+            pick: [PickId::atom_base(object), 0, 0, 0],
         };
         queue.write_buffer(&self.globals, 0, bytemuck::bytes_of(&g));
     }
@@ -254,5 +276,8 @@ mod tests {
         let (s2, c2) = instances(&m, AtomStyle::SpaceFilling);
         assert!(c2.is_empty() && s2[0].radius > 3.0 * s[0].radius);
         assert!(instances(&m, AtomStyle::Hidden).0.is_empty());
+        let (s3, c3) = instances(&m, AtomStyle::Sticks);
+        assert_eq!(c3.len(), 2);
+        assert!(s3.iter().all(|s| (s.radius - c3[0].radius).abs() < 1e-6), "caps as wide as the sticks");
     }
 }

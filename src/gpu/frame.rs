@@ -77,6 +77,36 @@ pub trait Draw {
     fn draw(&self, phase: Phase, pass: &mut wgpu::RenderPass<'_>);
 }
 
+/// The frame's camera as one object sees it: every vector in the object's own frame, so a
+/// placed object's passes draw its data as uploaded. Placements are rigid, so distances (and
+/// the clouds' per-step opacity) are the same in both frames.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ObjectView {
+    pub clip_from_object: glam::Mat4,
+    pub eye: glam::Vec3,
+    /// Unit vector from the eye towards the camera's target.
+    pub view_dir: glam::Vec3,
+    /// Unit vector towards the light.
+    pub light: glam::Vec3,
+    /// The camera's up vector.
+    pub up: glam::Vec3,
+}
+
+impl ObjectView {
+    /// The camera (`clip_from_world`, `eye`, `view_dir`, `light`, `up` in world space) seen
+    /// from an object placed at `world_from_object`.
+    pub fn new(world: &ObjectView, world_from_object: glam::Mat4) -> Self {
+        let object_from_world = world_from_object.inverse();
+        Self {
+            clip_from_object: world.clip_from_object * world_from_object,
+            eye: object_from_world.transform_point3(world.eye),
+            view_dir: object_from_world.transform_vector3(world.view_dir).normalize_or(glam::Vec3::NEG_Z),
+            light: object_from_world.transform_vector3(world.light).normalize_or(glam::Vec3::Z),
+            up: object_from_world.transform_vector3(world.up).normalize_or(glam::Vec3::Y),
+        }
+    }
+}
+
 /// What an id in the [`Target::Ids`] target names. Bits 30–31: the kind; 24–29: the object;
 /// 0–23: the atom or surface within it (enough for 16 million atoms).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -2,11 +2,10 @@
 //! one), drawn in the opaque phase with depth and pick ids.
 
 use bytemuck::{Pod, Zeroable};
-use glam::{Mat4, Vec3};
 use wgpu::util::DeviceExt;
 
 use super::GpuContext;
-use super::frame::{Draw, Phase, PickId, opaque_depth, opaque_targets};
+use super::frame::{Draw, ObjectView, Phase, PickId, opaque_depth, opaque_targets};
 use crate::model::isosurface::Mesh;
 
 /// Mirror of `SurfaceUniforms` in isosurface.wgsl.
@@ -36,6 +35,7 @@ struct GpuSurface {
     uniforms: wgpu::Buffer,
     bind_group: wgpu::BindGroup,
     color: [f32; 3],
+    /// The surface's index in its layer.
     pick: u32,
 }
 
@@ -80,8 +80,8 @@ impl IsosurfacePass {
     }
 
     /// Replaces the surfaces shown: each mesh with its linear RGB colour. Surface `n` picks as
-    /// `PickId::Surface { object, index: n }`.
-    pub fn set_meshes(&mut self, ctx: &GpuContext, object: u32, meshes: &[(Mesh, [f32; 3])]) {
+    /// `PickId::Surface { object, index: n }`, the object given each frame.
+    pub fn set_meshes(&mut self, ctx: &GpuContext, meshes: &[(Mesh, [f32; 3])]) {
         let device = &ctx.device;
         self.surfaces = meshes
             .iter()
@@ -110,7 +110,7 @@ impl IsosurfacePass {
                     layout: &self.layout,
                     entries: &[wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() }],
                 });
-                let pick = PickId::Surface { object, index: n as u32 }.encode();
+                let pick = n as u32;
                 GpuSurface {
                     vertices,
                     indices,
@@ -132,14 +132,21 @@ impl IsosurfacePass {
         self.surfaces.is_empty()
     }
 
-    pub fn prepare(&self, queue: &wgpu::Queue, clip_from_world: Mat4, eye: Vec3, light: Vec3) {
+    /// Another set of surfaces drawn with this one's pipeline.
+    pub fn instance(&self) -> Self {
+        Self { pipeline: self.pipeline.clone(), layout: self.layout.clone(), surfaces: Vec::new() }
+    }
+
+    /// This frame's camera, in the frame of the object the surfaces belong to; their pick ids
+    /// name `object`.
+    pub fn prepare(&self, queue: &wgpu::Queue, view: &ObjectView, object: u32) {
         for s in &self.surfaces {
             let u = SurfaceUniforms {
-                clip_from_world: clip_from_world.to_cols_array_2d(),
-                eye: eye.extend(1.0).to_array(),
-                light: light.extend(0.0).to_array(),
+                clip_from_world: view.clip_from_object.to_cols_array_2d(),
+                eye: view.eye.extend(1.0).to_array(),
+                light: view.light.extend(0.0).to_array(),
                 color: [s.color[0], s.color[1], s.color[2], 1.0],
-                pick: [s.pick, 0, 0, 0],
+                pick: [PickId::Surface { object, index: s.pick }.encode(), 0, 0, 0],
             };
             queue.write_buffer(&s.uniforms, 0, bytemuck::bytes_of(&u));
         }

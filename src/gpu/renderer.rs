@@ -1,9 +1,9 @@
 //! One renderer for every host: the window, the CLI and the tests draw through it.
 
-use glam::Vec3;
+use glam::{Mat4, Vec3};
 
 use super::atoms::AtomsPass;
-use super::frame::{Draw, FrameTargets, Phase, PhaseNode, PickId, STANDARD_FRAME};
+use super::frame::{Draw, FrameTargets, ObjectView, Phase, PhaseNode, PickId, STANDARD_FRAME};
 use super::isosurface::IsosurfacePass;
 use super::resolve::ResolvePass;
 use super::volume::{VolumePass, VolumeTexture};
@@ -11,63 +11,56 @@ use super::{GpuContext, GpuError};
 use crate::model::GridSpec;
 use crate::model::cartesian::CartesianExpansion;
 use crate::model::{Molecule, VolumeGrid};
-use crate::scene::{AtomStyle, Camera, RenderSettings};
+use crate::scene::{AtomStyle, Camera, RenderSettings, VolumeSettings};
 
 /// What one frame needs besides the long-lived GPU state.
 #[derive(Debug, Clone, Copy)]
 pub struct FrameInput<'a> {
     pub camera: &'a Camera,
-    pub settings: &'a RenderSettings,
+    /// Linear RGB.
+    pub background: [f32; 3],
+    /// Each layer's cloud settings, by layer index; a layer past the end draws no cloud.
+    pub clouds: &'a [VolumeSettings],
     /// Target size in pixels.
     pub size: [u32; 2],
 }
 
-/// Draws a frame as [`STANDARD_FRAME`] describes it: each phase one render pass over the shared
-/// [`FrameTargets`], each drawer drawing in the phases it names.
-pub struct Renderer {
-    pub volume: VolumePass,
+impl<'a> FrameInput<'a> {
+    /// A frame of one layer drawn with `settings` (the CLI, scan views, tests).
+    pub fn single(camera: &'a Camera, settings: &'a RenderSettings, size: [u32; 2]) -> Self {
+        Self { camera, background: settings.background, clouds: std::slice::from_ref(&settings.volume), size }
+    }
+}
+
+/// One object of the scene on the GPU: its atoms, isosurfaces and cloud, each a long-lived
+/// instance of its pass, drawn where `world_from_object` places them. Its index in the
+/// renderer is the object number its pick ids carry.
+pub struct Layer {
     pub atoms: AtomsPass,
     pub surfaces: IsosurfacePass,
-    resolve: ResolvePass,
-    frame: &'static [PhaseNode],
-    /// The targets at the last frame's size, and the resolve pass's view of their colour.
-    targets: Option<(FrameTargets, wgpu::BindGroup)>,
-    /// Bounds of everything drawn (bohr), for the depth range.
-    bounds: Option<(Vec3, Vec3)>,
+    pub volume: VolumePass,
+    /// A rigid placement (rotation and translation).
+    pub world_from_object: Mat4,
+    /// Whether the layer is drawn at all.
+    pub visible: bool,
+    /// The molecule's bounds in the object's frame, padded by the largest atom.
     molecule_bounds: Option<(Vec3, Vec3)>,
 }
 
-impl Renderer {
-    pub fn new(ctx: &GpuContext) -> Self {
-        Self {
-            volume: VolumePass::new(ctx),
-            atoms: AtomsPass::new(ctx),
-            surfaces: IsosurfacePass::new(ctx),
-            resolve: ResolvePass::new(ctx),
-            frame: STANDARD_FRAME,
-            targets: None,
-            bounds: None,
-            molecule_bounds: None,
-        }
-    }
-
+impl Layer {
     pub fn set_molecule(&mut self, ctx: &GpuContext, molecule: &Molecule, style: AtomStyle) {
         self.atoms.set_molecule(ctx, molecule, style);
         // Pad by the largest space-filling radius so near/far planes never clip an atom.
         self.molecule_bounds = molecule.bounds().map(|(lo, hi)| (lo.as_vec3() - 4.5, hi.as_vec3() + 4.5));
-        self.update_bounds();
     }
 
     pub fn set_volume(&mut self, ctx: &GpuContext, grid: Option<&VolumeGrid>) -> Result<(), GpuError> {
-        self.volume.set_volume(ctx, grid)?;
-        self.update_bounds();
-        Ok(())
+        self.volume.set_volume(ctx, grid)
     }
 
     /// Shows a volume already on the GPU (a filled GTO grid).
     pub fn set_volume_texture(&mut self, ctx: &GpuContext, volume: VolumeTexture) {
         self.volume.set_texture(ctx, Some(volume));
-        self.update_bounds();
     }
 
     /// Shows θ between two key volumes of a scan (seed 000), mixed (1−k):k.
@@ -80,39 +73,130 @@ impl Renderer {
         mode: crate::scene::Interpolation,
     ) {
         self.volume.set_morph(ctx, a, b, k, mode);
-        self.update_bounds();
     }
 
     /// Shows an orbital evaluated per fragment from its basis functions (seed 004's direct mode).
     pub fn set_direct(&mut self, ctx: &GpuContext, expansion: &CartesianExpansion, geometry: &GridSpec, max_abs: f64) {
         self.volume.set_direct(ctx, expansion, geometry, max_abs);
-        self.update_bounds();
     }
 
-    fn update_bounds(&mut self) {
-        let volume = self.volume.volume().map(|v| {
-            let c = v.grid_box.corners();
-            c.iter().fold((c[0], c[0]), |(lo, hi), &p| (lo.min(p), hi.max(p)))
-        });
-        self.bounds = match (self.molecule_bounds, volume) {
-            (Some(a), Some(b)) => Some((a.0.min(b.0), a.1.max(b.1))),
-            (a, b) => a.or(b),
+    /// Empties the layer (no atoms, surfaces or cloud), keeping its pipelines.
+    pub fn clear(&mut self, ctx: &GpuContext) {
+        self.set_molecule(ctx, &Molecule::default(), AtomStyle::Hidden);
+        self.volume.set_texture(ctx, None);
+        self.surfaces.clear();
+    }
+
+    /// The world-space box around everything the layer draws.
+    fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        let volume = self.volume.volume().map(|v| v.grid_box.corners().to_vec()).unwrap_or_default();
+        let atoms = self.molecule_bounds.map(|(lo, hi)| corners(lo, hi)).unwrap_or_default();
+        let points: Vec<Vec3> =
+            volume.into_iter().chain(atoms).map(|p| self.world_from_object.transform_point3(p)).collect();
+        let first = *points.first()?;
+        Some(points.iter().fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p))))
+    }
+
+    /// The representations, in the order they draw within a phase.
+    fn drawers(&self) -> [&dyn Draw; 3] {
+        [&self.atoms, &self.surfaces, &self.volume]
+    }
+}
+
+fn corners(lo: Vec3, hi: Vec3) -> Vec<Vec3> {
+    (0..8).map(|i| Vec3::new([lo.x, hi.x][i & 1], [lo.y, hi.y][(i >> 1) & 1], [lo.z, hi.z][i >> 2])).collect()
+}
+
+/// Most objects one scene draws: the object field of a [`PickId`] has 6 bits.
+pub const MAX_LAYERS: usize = 64;
+
+/// Draws a frame as [`STANDARD_FRAME`] describes it: each phase one render pass over the shared
+/// [`FrameTargets`]; in each, every layer's drawers that draw in that phase, layer by layer.
+pub struct Renderer {
+    /// At least one; layer `n` is object `n` of the scene.
+    layers: Vec<Layer>,
+    resolve: ResolvePass,
+    frame: &'static [PhaseNode],
+    /// The targets at the last frame's size, and the resolve pass's view of their colour.
+    targets: Option<(FrameTargets, wgpu::BindGroup)>,
+}
+
+impl Renderer {
+    pub fn new(ctx: &GpuContext) -> Self {
+        let layer = Layer {
+            atoms: AtomsPass::new(ctx),
+            surfaces: IsosurfacePass::new(ctx),
+            volume: VolumePass::new(ctx),
+            world_from_object: Mat4::IDENTITY,
+            visible: true,
+            molecule_bounds: None,
         };
+        Self { layers: vec![layer], resolve: ResolvePass::new(ctx), frame: STANDARD_FRAME, targets: None }
+    }
+
+    /// Layer `n` (object `n`); layer 0 always exists.
+    pub fn layer(&self, n: usize) -> Option<&Layer> {
+        self.layers.get(n)
+    }
+
+    /// Layer `n`, made (empty, sharing the first layer's pipelines) if the scene had fewer.
+    /// `n` is clamped to [`MAX_LAYERS`] − 1.
+    pub fn layer_mut(&mut self, ctx: &GpuContext, n: usize) -> &mut Layer {
+        let n = n.min(MAX_LAYERS - 1);
+        while self.layers.len() <= n {
+            let first = &self.layers[0];
+            let layer = Layer {
+                atoms: first.atoms.instance(ctx),
+                surfaces: first.surfaces.instance(),
+                volume: first.volume.instance(ctx),
+                world_from_object: Mat4::IDENTITY,
+                visible: true,
+                molecule_bounds: None,
+            };
+            self.layers.push(layer);
+        }
+        &mut self.layers[n]
+    }
+
+    /// The first layer: the whole scene of a single-document host.
+    pub fn main(&mut self) -> &mut Layer {
+        &mut self.layers[0]
+    }
+
+    /// Keeps the first `n` layers (at least one), dropping the GPU data of the rest.
+    pub fn truncate(&mut self, n: usize) {
+        self.layers.truncate(n.max(1));
+    }
+
+    /// Removes layer `n`; the layers after it move down by one. Removing the only layer empties
+    /// it instead.
+    pub fn remove(&mut self, ctx: &GpuContext, n: usize) {
+        if self.layers.len() == 1 {
+            self.layers[0].clear(ctx);
+            self.layers[0].world_from_object = Mat4::IDENTITY;
+            self.layers[0].visible = true;
+        } else if n < self.layers.len() {
+            self.layers.remove(n);
+        }
+    }
+
+    pub fn layer_count(&self) -> usize {
+        self.layers.len()
+    }
+
+    /// Bounds of everything drawn (world, bohr), for the depth range.
+    fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        self.layers.iter().filter(|l| l.visible).filter_map(Layer::bounds).reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)))
     }
 
     /// The projection a frame of `size` pixels uses: the depth range holds everything drawn.
     pub fn clip_from_world(&self, camera: &Camera, size: [u32; 2]) -> glam::Mat4 {
         let aspect = size[0].max(1) as f32 / size[1].max(1) as f32;
         let radius = self
-            .bounds
+            .bounds()
             .map(|(lo, hi)| (hi - camera.target).abs().max((camera.target - lo).abs()).length())
             .unwrap_or(10.0);
         camera.clip_from_world(aspect, radius)
-    }
-
-    /// The representations, in the order they draw within a phase.
-    fn drawers(&self) -> [&dyn Draw; 3] {
-        [&self.atoms, &self.surfaces, &self.volume]
     }
 
     /// Records the frame into `encoder`, phase by phase as the frame description orders them;
@@ -131,21 +215,34 @@ impl Renderer {
             self.targets = Some((targets, bind));
         }
         let cam = frame.camera;
-        let clip_from_world = self.clip_from_world(cam, frame.size);
         let eye = cam.eye();
-        let view_dir = (cam.target - eye).normalize_or(Vec3::NEG_Z);
-        self.atoms.prepare(&ctx.queue, clip_from_world, eye, cam.target);
-        self.surfaces.prepare(&ctx.queue, clip_from_world, eye, super::atoms::headlight(eye, cam.target).0);
-        self.volume.prepare(&ctx.device, &ctx.queue, clip_from_world, eye, view_dir, &frame.settings.volume);
+        let (light, up) = super::atoms::headlight(eye, cam.target);
+        let world = ObjectView {
+            clip_from_object: self.clip_from_world(cam, frame.size),
+            eye,
+            view_dir: (cam.target - eye).normalize_or(Vec3::NEG_Z),
+            light,
+            up,
+        };
+        let hidden = VolumeSettings { visible: false, ..VolumeSettings::default() };
+        for (n, layer) in self.layers.iter_mut().enumerate() {
+            let view = ObjectView::new(&world, layer.world_from_object);
+            layer.atoms.prepare(&ctx.queue, &view, n as u32);
+            layer.surfaces.prepare(&ctx.queue, &view, n as u32);
+            let cloud = frame.clouds.get(n).unwrap_or(&hidden);
+            layer.volume.prepare(&ctx.device, &ctx.queue, view.clip_from_object, view.eye, view.view_dir, cloud);
+        }
         let Some((targets, resolve)) = &self.targets else { return };
         for node in self.frame {
             if node.phase == Phase::Resolve {
                 self.resolve.draw(encoder, resolve, output);
                 continue;
             }
-            let mut pass = targets.begin(encoder, node, frame.settings.background);
-            for drawer in self.drawers().into_iter().filter(|d| d.phases().contains(&node.phase)) {
-                drawer.draw(node.phase, &mut pass);
+            let mut pass = targets.begin(encoder, node, frame.background);
+            for layer in self.layers.iter().filter(|l| l.visible) {
+                for drawer in layer.drawers().into_iter().filter(|d| d.phases().contains(&node.phase)) {
+                    drawer.draw(node.phase, &mut pass);
+                }
             }
         }
     }

@@ -1,5 +1,8 @@
 //! The volume pass: a grid as a 3D texture, drawn as translucent slices back to front.
 
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex};
+
 use bytemuck::{Pod, Zeroable};
 use glam::{DMat4, DVec3, Mat4, Vec3, Vec4};
 use wgpu::util::DeviceExt;
@@ -261,26 +264,47 @@ struct Morph {
     mode: Interpolation,
 }
 
-pub struct VolumePass {
+/// What every cloud shares: shader modules, layouts, the sampler and the pipelines built so far
+/// (one per [`Variant`], built the first time a frame needs it).
+struct VolumeShaders {
     slices: SliceShader,
-    direct_shader: SliceShader,
-    morph_shader: SliceShader,
-    pipelines: std::collections::HashMap<Variant, wgpu::RenderPipeline>,
+    direct: SliceShader,
+    morph: SliceShader,
+    layout: wgpu::BindGroupLayout,
+    morph_layout: wgpu::BindGroupLayout,
+    gto_layout: wgpu::BindGroupLayout,
+    sampler: wgpu::Sampler,
+    pipelines: Mutex<HashMap<Variant, wgpu::RenderPipeline>>,
+}
+
+impl VolumeShaders {
+    /// The pipeline of `variant`, built now if no cloud has needed it before.
+    fn pipeline(&self, device: &wgpu::Device, variant: Variant) -> wgpu::RenderPipeline {
+        let mut pipelines = self.pipelines.lock().unwrap_or_else(|e| e.into_inner());
+        pipelines
+            .entry(variant)
+            .or_insert_with(|| make_pipeline(device, (&self.slices, &self.direct, &self.morph), variant))
+            .clone()
+    }
+}
+
+/// One cloud: its volume, uniforms and slices. Clouds made with [`VolumePass::instance`] share
+/// the first one's shaders and pipelines.
+pub struct VolumePass {
+    shared: Arc<VolumeShaders>,
     /// The variant this frame draws with (set in `prepare`); three-pass frames draw each slice
     /// with the three programs in turn.
     variant: Variant,
+    /// This frame's pipelines, one per program, in the order each slice is drawn with them.
+    frame_pipelines: Vec<wgpu::RenderPipeline>,
     /// This frame's slices (vertex ranges, back to front).
     ranges: Vec<std::ops::Range<u32>>,
-    morph_layout: wgpu::BindGroupLayout,
     morph: Option<Morph>,
-    layout: wgpu::BindGroupLayout,
-    sampler: wgpu::Sampler,
     uniforms: wgpu::Buffer,
     vertices: wgpu::Buffer,
     vertex_count: u32,
     bind_group: Option<wgpu::BindGroup>,
     volume: Option<VolumeTexture>,
-    gto_layout: wgpu::BindGroupLayout,
     /// Basis functions of the orbital shown in direct mode (then `volume` holds only its box).
     direct: Option<GtoBuffers>,
 }
@@ -374,11 +398,8 @@ impl VolumePass {
             entries: &[volume_entry(0)],
         });
         let slices = SliceShader::new(device, "volume_slices.wgsl", &[Some(&layout)]);
-        let direct_shader = SliceShader::new(device, "volume_direct.wgsl", &[Some(&layout), Some(&gto_layout)]);
-        let morph_shader = SliceShader::new(device, "volume_morph.wgsl", &[Some(&layout), Some(&morph_layout)]);
-        let variant = Variant { program: Program::Slices, gradient: false, shaped: false, clip: false };
-        let pipelines =
-            [(variant, make_pipeline(device, (&slices, &direct_shader, &morph_shader), variant))].into_iter().collect();
+        let direct = SliceShader::new(device, "volume_direct.wgsl", &[Some(&layout), Some(&gto_layout)]);
+        let morph = SliceShader::new(device, "volume_morph.wgsl", &[Some(&layout), Some(&morph_layout)]);
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("volume sampler"),
             address_mode_u: wgpu::AddressMode::ClampToEdge,
@@ -388,25 +409,38 @@ impl VolumePass {
             min_filter: wgpu::FilterMode::Linear,
             ..Default::default()
         });
-        let uniforms = super::uniform_buffer(device, "volume uniforms", std::mem::size_of::<VolumeUniforms>());
-        let vertices = Self::vertex_buffer(device, 1024);
-        Self {
+        let shared = VolumeShaders {
             slices,
-            direct_shader,
-            morph_shader,
-            pipelines,
-            variant,
-            ranges: Vec::new(),
-            morph_layout,
-            morph: None,
+            direct,
+            morph,
             layout,
+            morph_layout,
+            gto_layout,
             sampler,
-            uniforms,
-            vertices,
+            pipelines: Mutex::new(HashMap::new()),
+        };
+        let variant = Variant { program: Program::Slices, gradient: false, shaped: false, clip: false };
+        shared.pipeline(device, variant);
+        Self::with_shared(device, Arc::new(shared))
+    }
+
+    /// Another cloud drawn with this one's shaders and pipelines.
+    pub fn instance(&self, ctx: &GpuContext) -> Self {
+        Self::with_shared(&ctx.device, self.shared.clone())
+    }
+
+    fn with_shared(device: &wgpu::Device, shared: Arc<VolumeShaders>) -> Self {
+        Self {
+            shared,
+            variant: Variant { program: Program::Slices, gradient: false, shaped: false, clip: false },
+            frame_pipelines: Vec::new(),
+            ranges: Vec::new(),
+            morph: None,
+            uniforms: super::uniform_buffer(device, "volume uniforms", std::mem::size_of::<VolumeUniforms>()),
+            vertices: Self::vertex_buffer(device, 1024),
             vertex_count: 0,
             bind_group: None,
             volume: None,
-            gto_layout,
             direct: None,
         }
     }
@@ -450,7 +484,7 @@ impl VolumePass {
             max_abs,
         );
         self.set_texture(ctx, Some(shape));
-        self.direct = Some(GtoBuffers::new(&ctx.device, &self.gto_layout, &GtoArrays::new(expansion)));
+        self.direct = Some(GtoBuffers::new(&ctx.device, &self.shared.gto_layout, &GtoArrays::new(expansion)));
     }
 
     /// Shows a volume already on the GPU (None shows none).
@@ -461,11 +495,11 @@ impl VolumePass {
         self.bind_group = self.volume.as_ref().map(|v| {
             ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("volume bind group"),
-                layout: &self.layout,
+                layout: &self.shared.layout,
                 entries: &[
                     wgpu::BindGroupEntry { binding: 0, resource: self.uniforms.as_entire_binding() },
                     wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&v.view) },
-                    wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&self.sampler) },
+                    wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&self.shared.sampler) },
                 ],
             })
         });
@@ -477,7 +511,7 @@ impl VolumePass {
         self.set_texture(ctx, Some(a));
         let bind_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("key volume B"),
-            layout: &self.morph_layout,
+            layout: &self.shared.morph_layout,
             entries: &[wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&b.view) }],
         });
         self.morph = Some(Morph { _partner: b, bind_group, k: k.clamp(0.0, 1.0), mode });
@@ -527,13 +561,8 @@ impl VolumePass {
             shaped: t.kind == TransferKind::Shaped,
             clip: settings.clip.enabled,
         };
-        for variant in self.programs().map(|program| Variant { program, ..self.variant }) {
-            if !self.pipelines.contains_key(&variant) {
-                let shaders = (&self.slices, &self.direct_shader, &self.morph_shader);
-                let pipeline = make_pipeline(device, shaders, variant);
-                self.pipelines.insert(variant, pipeline);
-            }
-        }
+        self.frame_pipelines =
+            self.programs().map(|program| self.shared.pipeline(device, Variant { program, ..self.variant })).collect();
         let lobe = |l: &crate::scene::transfer::Lobe| [l.center, l.width, l.opacity, 0.0];
         let bits = u32::from(t.shading);
         let clip_normal = Vec3::from(settings.clip.normal).normalize_or(Vec3::Z);
@@ -598,9 +627,7 @@ impl super::frame::Draw for VolumePass {
         if self.vertex_count == 0 {
             return;
         }
-        let pipelines: Option<Vec<&wgpu::RenderPipeline>> =
-            self.programs().map(|program| self.pipelines.get(&Variant { program, ..self.variant })).collect();
-        let Some(pipelines) = pipelines else { return };
+        let pipelines = &self.frame_pipelines;
         pass.set_bind_group(0, bind_group, &[]);
         if let Some(gto) = &self.direct {
             pass.set_bind_group(1, &gto.bind_group, &[]);
@@ -616,7 +643,7 @@ impl super::frame::Draw for VolumePass {
         }
         // Seed 000's three passes: each slice is finished before the next one starts.
         for range in &self.ranges {
-            for pipeline in &pipelines {
+            for pipeline in pipelines {
                 pass.set_pipeline(pipeline);
                 pass.draw(range.clone(), 0..1);
             }

@@ -6,6 +6,7 @@ pub mod scan;
 use glam::DVec3;
 
 use crate::gpu::gto::{GtoFillPass, read_volume, volume_from_texture};
+use crate::gpu::renderer::Layer;
 use crate::gpu::{FrameInput, GpuContext, GpuError, OffscreenTarget, Renderer};
 use crate::model::cartesian::CartesianExpansion;
 use crate::model::extent::quantity_box;
@@ -14,7 +15,7 @@ use crate::model::gto::{GridSpec, PreparedBasis};
 use crate::model::isosurface::{self, Level, Mesh};
 use crate::model::orbitals::Quantity;
 use crate::model::{Document, VolumeGrid};
-use crate::scene::{Camera, IsosurfaceSettings, RenderSettings};
+use crate::scene::{Camera, IsosurfaceSettings, ObjectState, RenderSettings};
 
 /// Space (bohr) around the atoms in which orbitals are evaluated.
 pub const ORBITAL_MARGIN: f64 = 4.5;
@@ -22,14 +23,19 @@ pub const ORBITAL_MARGIN: f64 = 4.5;
 /// A camera that frames everything in the document from the default direction: its grids, or
 /// for a wavefunction the box its orbitals are evaluated in.
 pub fn default_camera(doc: &Document) -> Camera {
+    match framing_box(doc) {
+        Some((lo, hi)) => Camera::framing(lo, hi),
+        None => Camera::default(),
+    }
+}
+
+/// The box a camera frames to show `doc` whole (bohr, the document's own frame).
+pub fn framing_box(doc: &Document) -> Option<(glam::Vec3, glam::Vec3)> {
     let bounds = match (&doc.wavefunction, doc.molecule.bounds()) {
         (Some(_), Some((lo, hi))) => Some((lo - DVec3::splat(ORBITAL_MARGIN), hi + DVec3::splat(ORBITAL_MARGIN))),
         _ => doc.bounds(),
     };
-    match bounds {
-        Some((lo, hi)) => Camera::framing(lo.as_vec3(), hi.as_vec3()),
-        None => Camera::default(),
-    }
+    bounds.map(|(lo, hi)| (lo.as_vec3(), hi.as_vec3()))
 }
 
 /// The grid a wavefunction's `quantity` is evaluated on, `points` per axis: the box where it
@@ -51,13 +57,13 @@ pub struct WavefunctionView<'a> {
     pub shells: Option<&'a [bool]>,
 }
 
-/// Puts a wavefunction's orbital or density into `renderer`: orbitals through the GPU (a filled
+/// Puts a wavefunction's orbital or density into `layer`: orbitals through the GPU (a filled
 /// texture, or direct evaluation per sample), densities evaluated on the CPU. `fill` caches the
 /// compute pipeline between calls. Returns the values on the grid (what isosurfaces are cut
 /// from), or `None` when the document has no wavefunction.
 pub fn show_wavefunction(
     ctx: &GpuContext,
-    renderer: &mut Renderer,
+    layer: &mut Layer,
     fill: &mut Option<GtoFillPass>,
     doc: &Document,
     view: &WavefunctionView,
@@ -82,11 +88,11 @@ pub fn show_wavefunction(
             // The filled values give the range that scales the opacity (and the gradient scale).
             let grid = VolumeGrid::new("orbital", geometry.dims, geometry.world_from_grid, read_volume(ctx, &texture)?);
             if view.direct {
-                renderer.set_direct(ctx, &expansion, &geometry, grid.stats.max_abs);
+                layer.set_direct(ctx, &expansion, &geometry, grid.stats.max_abs);
             } else {
                 let mut volume = volume_from_texture(texture, &geometry, grid.stats.max_abs);
                 volume.max_grad = grid.max_gradient().max(1e-30) as f32;
-                renderer.set_volume_texture(ctx, volume);
+                layer.set_volume_texture(ctx, volume);
             }
             Ok(Some(grid))
         }
@@ -94,7 +100,7 @@ pub fn show_wavefunction(
             let label = if view.quantity == Quantity::Density { "total density" } else { "spin density" };
             let values = prepared.quantity_grid_f32(wf, view.quantity, &geometry);
             let grid = VolumeGrid::new(label, geometry.dims, geometry.world_from_grid, values);
-            renderer.set_volume(ctx, Some(&grid))?;
+            layer.set_volume(ctx, Some(&grid))?;
             Ok(Some(grid))
         }
     }
@@ -112,21 +118,32 @@ pub fn isosurfaces(grid: &VolumeGrid, iso: &IsosurfaceSettings) -> Vec<(Mesh, [f
     isosurface::extract(grid, &levels).into_iter().zip(colors).collect()
 }
 
-/// Extracts the isosurfaces of `grid` and shows them in `renderer` (none when `iso` is hidden).
+/// Extracts the isosurfaces of `grid` and shows them in `layer` (none when `iso` is hidden).
 /// Returns the number of triangles.
-pub fn show_isosurfaces(
-    ctx: &GpuContext,
-    renderer: &mut Renderer,
-    grid: &VolumeGrid,
-    iso: &IsosurfaceSettings,
-) -> usize {
-    show_meshes(ctx, renderer, &isosurfaces(grid, iso))
+pub fn show_isosurfaces(ctx: &GpuContext, layer: &mut Layer, grid: &VolumeGrid, iso: &IsosurfaceSettings) -> usize {
+    show_meshes(ctx, layer, &isosurfaces(grid, iso))
 }
 
-/// Shows `meshes`, each in its colour, as the renderer's isosurfaces; returns the triangle count.
-pub fn show_meshes(ctx: &GpuContext, renderer: &mut Renderer, meshes: &[(Mesh, [f32; 3])]) -> usize {
-    renderer.surfaces.set_meshes(ctx, 0, meshes);
+/// Shows `meshes`, each in its colour, as the layer's isosurfaces; returns the triangle count.
+pub fn show_meshes(ctx: &GpuContext, layer: &mut Layer, meshes: &[(Mesh, [f32; 3])]) -> usize {
+    layer.surfaces.set_meshes(ctx, meshes);
     meshes.iter().map(|(m, _)| m.triangle_count()).sum()
+}
+
+/// Puts `doc` into `layer` as `state` shows it: its molecule in the state's atom style, the
+/// volume it chooses (none past the document's volumes) with every isosurface of it, its
+/// placement and visibility. Returns the isosurfaces' triangle count.
+pub fn show_object(ctx: &GpuContext, layer: &mut Layer, doc: &Document, state: &ObjectState) -> Result<usize, GpuError> {
+    let grid = doc.volumes.get(state.volume);
+    layer.set_volume(ctx, grid)?;
+    layer.set_molecule(ctx, &doc.molecule, state.settings.atoms);
+    layer.world_from_object = state.placement.world_from_object();
+    layer.visible = state.visible;
+    let meshes: Vec<_> = match grid {
+        Some(grid) => state.all_isosurfaces().flat_map(|iso| isosurfaces(grid, iso)).collect(),
+        None => Vec::new(),
+    };
+    Ok(show_meshes(ctx, layer, &meshes))
 }
 
 /// A renderer with an offscreen target of a fixed size.
@@ -145,11 +162,12 @@ impl Headless {
         size: [u32; 2],
     ) -> Result<Self, GpuError> {
         let mut renderer = Renderer::new(ctx);
-        renderer.set_molecule(ctx, &doc.molecule, settings.atoms);
+        let layer = renderer.main();
+        layer.set_molecule(ctx, &doc.molecule, settings.atoms);
         let grid = volume_index.and_then(|i| doc.volumes.get(i));
-        renderer.set_volume(ctx, grid)?;
+        layer.set_volume(ctx, grid)?;
         if let Some(grid) = grid {
-            show_isosurfaces(ctx, &mut renderer, grid, &settings.iso);
+            show_isosurfaces(ctx, layer, grid, &settings.iso);
         }
         Ok(Self { renderer, target: OffscreenTarget::new(&ctx.device, size) })
     }
@@ -157,7 +175,7 @@ impl Headless {
     /// Records and submits one frame (does not wait for it).
     pub fn draw(&mut self, ctx: &GpuContext, camera: &Camera, settings: &RenderSettings) {
         let mut encoder = ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
-        let frame = FrameInput { camera, settings, size: self.target.size };
+        let frame = FrameInput::single(camera, settings, self.target.size);
         self.renderer.render(ctx, &mut encoder, &self.target.color_view, &frame);
         ctx.queue.submit([encoder.finish()]);
     }

@@ -163,8 +163,9 @@ impl ScanScene {
     ) {
         let Bracket { a, b, k } = self.scan.bracket(theta);
         let keys = &self.keys[slot];
-        renderer.set_morph(ctx, keys[a].clone(), keys[b].clone(), k as f32, mode);
-        renderer.set_molecule(ctx, &self.scan.geometry_at(theta), style);
+        let layer = renderer.main();
+        layer.set_morph(ctx, keys[a].clone(), keys[b].clone(), k as f32, mode);
+        layer.set_molecule(ctx, &self.scan.geometry_at(theta), style);
     }
 
     /// A camera framing the common grid from the default direction.
@@ -192,7 +193,7 @@ impl ScanScene {
             self.show(ctx, &mut renderer, slot, theta, mode, settings.atoms);
             let mut encoder =
                 ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("scan frame") });
-            renderer.render(ctx, &mut encoder, &target.color_view, &FrameInput { camera, settings, size });
+            renderer.render(ctx, &mut encoder, &target.color_view, &FrameInput::single(camera, settings, size));
             ctx.queue.submit([encoder.finish()]);
             let view = target.read_rgba(&ctx.device, &ctx.queue)?;
             image::imageops::replace(&mut out, &view, (n as u32 * size[0]) as i64, 0);

@@ -1,10 +1,12 @@
 //! What to draw and how: camera and render settings. Plain, serialisable data; no wgpu.
 
 pub mod camera;
+pub mod objects;
 pub mod settings;
 pub mod slicing;
 pub mod transfer;
 
 pub use camera::Camera;
+pub use objects::{ObjectState, Placement, Session};
 pub use settings::{AtomStyle, Interpolation, IsoLevel, IsosurfaceSettings, RenderSettings, SliceMode, VolumeSettings};
 pub use transfer::{ClipPlane, Shape, Transfer, TransferKind};

@@ -66,7 +66,22 @@ pub enum AtomStyle {
     #[default]
     BallAndStick,
     SpaceFilling,
+    /// Bonds as sticks, atoms as caps of the same radius.
+    Sticks,
     Hidden,
+}
+
+impl AtomStyle {
+    pub const ALL: [AtomStyle; 4] = [AtomStyle::BallAndStick, AtomStyle::SpaceFilling, AtomStyle::Sticks, AtomStyle::Hidden];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            AtomStyle::BallAndStick => "ball and stick",
+            AtomStyle::SpaceFilling => "space filling",
+            AtomStyle::Sticks => "sticks",
+            AtomStyle::Hidden => "hidden",
+        }
+    }
 }
 
 /// Where an isosurface lies: an absolute value (atomic units: ψ in bohr^−3/2, ρ in bohr^−3) or

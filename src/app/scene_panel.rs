@@ -1,0 +1,152 @@
+//! The scene panel: every object with its representations (atoms, cloud, isosurfaces), shown
+//! or hidden, added and removed, and its placement. The active object's atoms, cloud and first
+//! isosurface are the side panel's working copy (`app.view.settings`); its further isosurfaces
+//! and every placement are edited here directly.
+
+use egui::{ComboBox, DragValue, RichText, Slider};
+
+use super::OrbApp;
+use crate::model::units::{ANGSTROM_PER_BOHR, BOHR_PER_ANGSTROM};
+use crate::scene::{AtomStyle, IsoLevel, IsosurfaceSettings, Placement};
+
+/// What the user asked for in the panel this frame, applied after it is drawn.
+enum Edit {
+    Select(usize),
+    Remove(usize),
+    Visible(usize, bool),
+    Place(usize, Placement),
+    Isosurfaces,
+}
+
+pub fn section(ui: &mut egui::Ui, app: &mut OrbApp) {
+    if app.scan.is_some() || app.objects.is_empty() {
+        return;
+    }
+    ui.heading("Scene");
+    let mut edits = Vec::new();
+    for (n, object) in app.objects.iter().enumerate() {
+        ui.horizontal(|ui| {
+            let mut visible = object.state.visible;
+            if ui.checkbox(&mut visible, "").on_hover_text("show or hide the whole object").changed() {
+                edits.push(Edit::Visible(n, visible));
+            }
+            let name = object.doc.source.rsplit(['/', '\\']).next().unwrap_or("object");
+            if ui.selectable_label(n == app.active, format!("{} {name}", n + 1)).clicked() && n != app.active {
+                edits.push(Edit::Select(n));
+            }
+            if ui.small_button("×").on_hover_text("remove from the scene").clicked() {
+                edits.push(Edit::Remove(n));
+            }
+        });
+    }
+    let n = app.active;
+    if let Some(object) = app.objects.get_mut(n) {
+        ui.indent("representations", |ui| {
+            let s = &mut app.view.settings;
+            ui.horizontal(|ui| {
+                let mut shown = s.atoms != AtomStyle::Hidden;
+                if ui.checkbox(&mut shown, "atoms").changed() {
+                    s.atoms = if shown { AtomStyle::BallAndStick } else { AtomStyle::Hidden };
+                }
+                atom_style(ui, &mut s.atoms);
+            });
+            ui.checkbox(&mut s.volume.visible, "cloud");
+            ui.checkbox(&mut s.iso.visible, format!("isosurface {}", level_text(s.iso.level)));
+            let mut remove = None;
+            let mut changed = false;
+            for (k, iso) in object.state.isosurfaces.iter_mut().enumerate() {
+                ui.horizontal(|ui| {
+                    changed |= ui.checkbox(&mut iso.visible, "").changed();
+                    changed |= level_slider(ui, &mut iso.level);
+                    changed |= ui.color_edit_button_rgb(&mut iso.positive_color).changed();
+                    changed |= ui.color_edit_button_rgb(&mut iso.negative_color).changed();
+                    if ui.small_button("×").on_hover_text("remove this isosurface").clicked() {
+                        remove = Some(k);
+                    }
+                });
+            }
+            if let Some(k) = remove {
+                object.state.isosurfaces.remove(k);
+                changed = true;
+            }
+            if ui.button("+ isosurface").on_hover_text("another value of the same volume (nested shells)").clicked() {
+                object.state.isosurfaces.push(another_isosurface(s.iso, &object.state.isosurfaces));
+                changed = true;
+            }
+            if changed {
+                edits.push(Edit::Isosurfaces);
+            }
+            if let Some(p) = placement_editor(ui, object.state.placement) {
+                edits.push(Edit::Place(n, p));
+            }
+        });
+    }
+    ui.label(RichText::new("opened files join the scene beside it (tick “replace” to swap)").small().weak());
+    for edit in edits {
+        match edit {
+            Edit::Select(k) => app.select(k),
+            Edit::Remove(k) => app.remove_object(k),
+            Edit::Visible(k, v) => app.set_visible(k, v),
+            Edit::Place(k, p) => app.place(k, p),
+            Edit::Isosurfaces => app.refresh_isosurfaces(n),
+        }
+    }
+}
+
+fn atom_style(ui: &mut egui::Ui, style: &mut AtomStyle) {
+    ComboBox::from_id_salt("scene atom style").selected_text(style.name()).show_ui(ui, |ui| {
+        for s in AtomStyle::ALL {
+            ui.selectable_value(style, s, s.name());
+        }
+    });
+}
+
+fn level_text(level: IsoLevel) -> String {
+    match level {
+        IsoLevel::Absolute(v) => format!("{v:.3} a.u."),
+        IsoLevel::Sigma(s) => format!("{s:.2} σ"),
+    }
+}
+
+fn level_slider(ui: &mut egui::Ui, level: &mut IsoLevel) -> bool {
+    match level {
+        IsoLevel::Absolute(v) => ui.add(Slider::new(v, 1e-4..=0.5).logarithmic(true).text("a.u.")).changed(),
+        IsoLevel::Sigma(s) => ui.add(Slider::new(s, 0.1..=20.0).logarithmic(true).text("σ")).changed(),
+    }
+}
+
+/// A new isosurface at half the value of the last one (the next shell out), shown.
+fn another_isosurface(first: IsosurfaceSettings, more: &[IsosurfaceSettings]) -> IsosurfaceSettings {
+    let last = more.last().copied().unwrap_or(first);
+    let level = match last.level {
+        IsoLevel::Absolute(v) => IsoLevel::Absolute(v * 0.5),
+        IsoLevel::Sigma(s) => IsoLevel::Sigma(s * 0.5),
+    };
+    IsosurfaceSettings { visible: true, level, ..last }
+}
+
+/// Offset (Å) and rotation (degrees) of an object; the new placement when it was edited.
+fn placement_editor(ui: &mut egui::Ui, mut p: Placement) -> Option<Placement> {
+    let before = p;
+    ui.collapsing("placement", |ui| {
+        ui.horizontal(|ui| {
+            ui.label("move Å");
+            for (c, axis) in p.offset.iter_mut().zip(["x ", "y ", "z "]) {
+                let mut a = *c * ANGSTROM_PER_BOHR as f32;
+                if ui.add(DragValue::new(&mut a).speed(0.05).prefix(axis).max_decimals(2)).changed() {
+                    *c = a * BOHR_PER_ANGSTROM as f32;
+                }
+            }
+        });
+        ui.horizontal(|ui| {
+            ui.label("turn °");
+            for (c, axis) in p.rotation_deg.iter_mut().zip(["x ", "y ", "z "]) {
+                ui.add(DragValue::new(c).speed(1.0).range(-180.0..=180.0).prefix(axis).max_decimals(1));
+            }
+        });
+        if ui.button("back to where it was read").clicked() {
+            p = Placement::default();
+        }
+    });
+    (p != before).then_some(p)
+}

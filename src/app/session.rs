@@ -1,0 +1,162 @@
+//! Saving and reopening what the user had open (`*.orbcloud.toml`: files, representations,
+//! placements, camera), and the session kept between runs.
+
+use std::path::{Path, PathBuf};
+
+use super::{OrbApp, Opening};
+use crate::scene::objects::SESSION_SUFFIX;
+use crate::scene::{RenderSettings, Session};
+
+/// `path` ending in `.orbcloud.toml` (a dialog may have dropped the double suffix).
+pub fn with_suffix(path: PathBuf) -> PathBuf {
+    let name = path.to_string_lossy();
+    if name.ends_with(SESSION_SUFFIX) {
+        return path;
+    }
+    let stem = name.strip_suffix(".toml").unwrap_or(&name);
+    PathBuf::from(format!("{stem}{SESSION_SUFFIX}"))
+}
+
+/// Where the session is kept between runs: `$XDG_CONFIG_HOME/orbcloud` or `~/.config/orbcloud`.
+pub fn last_session_path() -> Option<PathBuf> {
+    let config = std::env::var_os("XDG_CONFIG_HOME")
+        .map(PathBuf::from)
+        .filter(|p| p.is_absolute())
+        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".config")))?;
+    Some(config.join("orbcloud").join(format!("last{SESSION_SUFFIX}")))
+}
+
+/// Reads a session file; the error names the file (and the line, for TOML errors).
+pub fn read(path: &Path) -> Result<Session, String> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    toml::from_str(&text).map_err(|e| format!("{}: not an orbcloud session: {e}", path.display()))
+}
+
+/// Writes a session file.
+pub fn write(path: &Path, session: &Session) -> Result<(), String> {
+    let text = toml::to_string_pretty(session).map_err(|e| format!("{}: {e}", path.display()))?;
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    }
+    std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+impl OrbApp {
+    /// The scene as a session: every object read from a file (the bundled demo is left out),
+    /// the camera and the background.
+    pub fn session(&mut self) -> Session {
+        self.commit_active();
+        Session {
+            camera: self.view.camera,
+            background: Some(self.view.settings.background),
+            objects: self.objects.iter().filter(|o| o.state.path.is_some()).map(|o| o.state.clone()).collect(),
+        }
+    }
+
+    /// Saves the scene to `path`, saying so in the status line (or the error window).
+    pub fn save_session(&mut self, path: &Path) {
+        let session = self.session();
+        match write(path, &session) {
+            Ok(()) => self.status = format!("saved {} ({} objects)", path.display(), session.objects.len()),
+            Err(e) => self.error = Some(e),
+        }
+    }
+
+    /// Replaces the scene with a saved one: its files load one after another, each restored
+    /// with its representations and placement; the camera is the saved one. A session that
+    /// cannot be read leaves the scene as it was.
+    pub fn open_session(&mut self, path: &Path, ctx: &egui::Context) {
+        let session = match read(path) {
+            Ok(s) => s,
+            Err(e) => {
+                self.error = Some(e);
+                return;
+            }
+        };
+        let files: Vec<(PathBuf, Opening)> = session
+            .objects
+            .into_iter()
+            .filter_map(|state| Some((state.path.clone()?, Opening::Restore(Box::new(state)))))
+            .collect();
+        if files.is_empty() {
+            self.error = Some(format!("{}: the session names no file", path.display()));
+            return;
+        }
+        self.clear_scene();
+        self.view.camera = session.camera;
+        if let Some(bg) = session.background {
+            self.view.settings.background = bg;
+        }
+        self.queue.extend(files.into_iter().rev());
+        self.status = format!("opening session {}", path.display());
+        ctx.request_repaint();
+    }
+
+    /// Empties the scene (what is loading still arrives).
+    pub fn clear_scene(&mut self) {
+        self.objects.clear();
+        self.active = 0;
+        self.scan = None;
+        self.measurements = Default::default();
+        if let Some(vp) = &mut self.viewport {
+            vp.truncate(0);
+        }
+        self.world = super::World::default();
+    }
+
+    /// Starts keeping the session between runs in `path`: the settings new objects start with
+    /// come from the session saved there (its last object's), and the scene is saved there when
+    /// the window closes.
+    pub fn keep_session_in(&mut self, path: PathBuf) {
+        if let Ok(session) = read(&path) {
+            if let Some(last) = session.objects.last() {
+                self.defaults = RenderSettings { background: self.defaults.background, ..last.settings };
+                // New files open without the last file's isosurfaces or hidden cloud.
+                self.defaults.iso.visible = false;
+                self.defaults.volume.visible = true;
+            }
+            if let Some(bg) = session.background {
+                self.view.settings.background = bg;
+                self.defaults.background = bg;
+            }
+        }
+        self.last_session = Some(path);
+    }
+
+    /// Saves the scene where [`Self::keep_session_in`] said (on closing the window).
+    pub fn save_last_session(&mut self) {
+        let Some(path) = self.last_session.clone() else { return };
+        let session = self.session();
+        if let Err(e) = write(&path, &session) {
+            log::warn!("could not keep the session: {e}");
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{IsoLevel, ObjectState, Placement};
+
+    #[test]
+    fn sessions_round_trip_through_toml() {
+        let mut object = ObjectState { path: Some("/data/water.molden".into()), ..Default::default() };
+        object.placement = Placement { offset: [8.0, 0.0, -1.5], rotation_deg: [0.0, 90.0, 0.0] };
+        object.settings.iso.visible = true;
+        object.settings.iso.level = IsoLevel::Sigma(2.5);
+        object.isosurfaces.push(Default::default());
+        object.quantity = Some(crate::model::orbitals::Quantity::Orbital(4));
+        let session = Session { background: Some([1.0, 1.0, 1.0]), objects: vec![object], ..Default::default() };
+        let dir = std::env::temp_dir().join(format!("orbcloud-session-{}", std::process::id()));
+        let path = dir.join(format!("scene{SESSION_SUFFIX}"));
+        write(&path, &session).unwrap();
+        assert_eq!(read(&path).unwrap(), session);
+        std::fs::write(&path, "objects = 3").unwrap();
+        let e = read(&path).unwrap_err();
+        assert!(e.contains("scene.orbcloud.toml") && e.contains("line 1"), "{e}");
+        std::fs::remove_dir_all(dir).ok();
+        assert_eq!(with_suffix("a/b.toml".into()), PathBuf::from("a/b.orbcloud.toml"));
+        assert_eq!(with_suffix("b".into()), PathBuf::from("b.orbcloud.toml"));
+        assert_eq!(with_suffix("b.orbcloud.toml".into()), PathBuf::from("b.orbcloud.toml"));
+    }
+}
