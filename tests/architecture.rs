@@ -26,7 +26,7 @@ const CRATE_RULES: &[(&str, &[&str])] = &[
     ("headless", &["glam", "thiserror", "wgpu", "image"]),
     ("info.rs", &["glam", "serde", "serde_json"]),
     ("demo.rs", &["flate2"]),
-    ("app", &["glam", "serde", "wgpu", "image", "log", "egui", "eframe", "egui_wgpu", "egui_plot", "rfd"]),
+    ("app", &["glam", "serde", "toml", "wgpu", "image", "log", "egui", "eframe", "egui_wgpu", "egui_plot", "rfd"]),
     // The binary: main.rs and its subcommands.
     ("cli", &["wgpu", "glam", "rayon", "clap", "anyhow"]),
     ("main.rs", &["wgpu", "glam", "rayon", "clap", "anyhow", "serde_json", "env_logger"]),

@@ -142,8 +142,38 @@ fn a_placed_cloud_matches_the_same_cloud_moved_in_its_grid() {
     show_object(&ctx, moved.main(), &shifted_doc, &plain).unwrap();
     let clouds = [states[1].settings.volume];
     let (a, b) = (draw(&ctx, &mut placed, &clouds), draw(&ctx, &mut moved, &clouds));
-    let diff: f64 = a.pixels().zip(b.pixels()).map(|(p, q)| (0..3).map(|c| p[c].abs_diff(q[c]) as f64).sum::<f64>()).sum::<f64>()
-        / (3.0 * a.len() as f64 / 4.0);
+    let diff: f64 =
+        a.pixels().zip(b.pixels()).map(|(p, q)| (0..3).map(|c| p[c].abs_diff(q[c]) as f64).sum::<f64>()).sum::<f64>()
+            / (3.0 * a.len() as f64 / 4.0);
     assert!(diff < 1.0, "mean difference {diff:.3}/255");
     assert!(halves(&a).0 + halves(&a).1 > 2000, "the cloud is drawn");
+}
+
+#[test]
+fn gpu_errors_inside_a_guard_become_messages() {
+    use orbcloud::gpu::GpuError;
+    use orbcloud::gpu::context::guarded;
+    let ctx = lavapipe();
+    let too_wide = ctx.device.limits().max_texture_dimension_2d + 1;
+    let result = guarded(&ctx.device, || {
+        let _texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("over the limit"),
+            size: wgpu::Extent3d { width: too_wide, height: 1, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba8Unorm,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        });
+        Ok(())
+    });
+    match result {
+        Err(GpuError::Rejected(message)) => {
+            assert!(message.contains("over the limit") || message.contains("imension"), "{message}")
+        }
+        other => panic!("the texture over the limit was not caught: {other:?}"),
+    }
+    // The device goes on working after the caught error.
+    assert!(guarded(&ctx.device, || Ok(Renderer::new(&ctx).layer_count())).is_ok());
 }

@@ -262,7 +262,7 @@ fn isosurfaces_follow_the_slider_and_atoms_are_picked_and_measured() {
     let mut h = harness();
     h.run_steps(2);
     h.get_by_label("show ψ = ±value").click();
-    h.run_steps(2);
+    wait_loaded(&mut h);
     assert!(h.state().view.settings.iso.visible);
     let first = h.state().status.clone();
     assert!(first.starts_with("isosurfaces: ") && !first.starts_with("isosurfaces: 0 "), "{first}");
@@ -274,7 +274,7 @@ fn isosurfaces_follow_the_slider_and_atoms_are_picked_and_measured() {
     h.hover_at(from + egui::vec2(slider.width() * 0.2, 0.0));
     h.run_steps(1);
     h.drop_at(from + egui::vec2(slider.width() * 0.2, 0.0));
-    h.run_steps(2);
+    wait_loaded(&mut h);
     let level = h.state().view.settings.iso.level;
     assert_ne!(level, orbcloud::scene::IsoLevel::Absolute(0.05), "the slider moved");
     assert_ne!(h.state().status, first, "the surfaces were cut anew: {}", h.state().status);
@@ -299,4 +299,83 @@ fn isosurfaces_follow_the_slider_and_atoms_are_picked_and_measured() {
     click_at(&mut h, egui::pos2(985.0, 100.0), false);
     assert!(h.state().measurements.selection.is_empty());
     assert_eq!(h.state().measurements.list.len(), 1);
+}
+
+/// Steps the app until nothing is loading (failing after a minute).
+fn wait_loaded(h: &mut Harness<'static, OrbApp>) {
+    let start = std::time::Instant::now();
+    h.run_steps(1);
+    while h.state().is_loading() {
+        assert!(start.elapsed().as_secs() < 60, "still loading after a minute");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+        h.run_steps(1);
+    }
+    h.run_steps(2);
+    assert!(h.state().error.is_none(), "{:?}", h.state().error);
+}
+
+#[test]
+fn files_join_the_scene_are_measured_across_and_a_session_reopens_them() {
+    use orbcloud::app::Opening;
+    let demo = orbcloud::demo::document().unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let files: Vec<_> = ["a.cube", "b.cube"].iter().map(|n| dir.path().join(n)).collect();
+    let text = orbcloud::formats::cube_write::write("demo", "copy", &demo.molecule, &[(&demo.volumes[0], 1)]);
+    for f in &files {
+        std::fs::write(f, &text).unwrap();
+    }
+    let mut h = harness();
+    h.run_steps(1);
+    let ctx = h.ctx.clone();
+    // The first replaces the demo; the second joins beside it.
+    h.state_mut().open_as(files[0].clone(), Opening::Replace, &ctx);
+    wait_loaded(&mut h);
+    h.state_mut().open(files[1].clone(), &ctx);
+    wait_loaded(&mut h);
+    let app = h.state();
+    assert_eq!(app.objects.len(), 2);
+    assert_eq!(app.active, 1, "the new file is the one the panels edit");
+    let offset = app.objects[1].state.placement.offset;
+    let (_, hi) = demo.molecule.bounds().unwrap();
+    let (lo, _) = demo.bounds().unwrap();
+    assert!(offset[0] as f64 + lo.x > hi.x, "placed beside the first: {offset:?}");
+    assert_eq!(app.world().molecule.atoms.len(), 8);
+
+    // Hide the active object's cloud from the scene panel; the other keeps its own.
+    h.get_by_label("cloud").click();
+    h.run_steps(2);
+    assert!(!h.state().objects[1].state.settings.volume.visible);
+    assert!(h.state().objects[0].state.settings.volume.visible);
+    // A second isosurface for object 2.
+    h.get_by_label("+ isosurface").click();
+    wait_loaded(&mut h);
+    assert_eq!(h.state().objects[1].state.isosurfaces.len(), 1);
+    assert!(h.state().status.starts_with("isosurfaces: "), "{}", h.state().status);
+
+    // An oxygen of each molecule: the distance between them is the placement's offset.
+    let (o1, o2) = (h.state().atom_on_screen(1).unwrap(), h.state().atom_on_screen(5).unwrap());
+    click_at(&mut h, o1, false);
+    assert!(h.state().status.starts_with("atom 2 O"), "{}", h.state().status);
+    click_at(&mut h, o2, true);
+    let expected = offset[0] as f64 * orbcloud::model::units::ANGSTROM_PER_BOHR;
+    assert!(h.state().status.ends_with(&format!("{expected:.3} Å")), "{} (expected {expected:.3})", h.state().status);
+
+    // Move object 2 and turn it; save; replace the scene with the demo file; reopen.
+    let moved = orbcloud::scene::Placement { offset: [20.0, 1.0, 0.0], rotation_deg: [0.0, 0.0, 45.0] };
+    h.state_mut().place(1, moved);
+    h.run_steps(1);
+    let session = dir.path().join("scene.orbcloud.toml");
+    h.state_mut().save_session(&session);
+    let saved: Vec<_> = h.state().objects.iter().map(|o| o.state.clone()).collect();
+    let camera = h.state().view.camera;
+    h.state_mut().open_as(files[0].clone(), Opening::Replace, &ctx);
+    wait_loaded(&mut h);
+    assert_eq!(h.state().objects.len(), 1);
+    h.state_mut().open(session, &ctx);
+    wait_loaded(&mut h);
+    let app = h.state();
+    let reopened: Vec<_> = app.objects.iter().map(|o| o.state.clone()).collect();
+    assert_eq!(reopened, saved, "files, representations and placements as saved");
+    assert_eq!(app.view.camera, camera);
+    assert_eq!(app.world().molecule.atoms.len(), 8);
 }

@@ -4,9 +4,9 @@
 
 use egui::{Color32, RichText, Stroke};
 
+use super::World;
 use super::viewport::{Click, Viewport};
 use crate::gpu::frame::PickId;
-use super::World;
 use crate::model::Molecule;
 use crate::model::measure::Measurement;
 use crate::model::units::ANGSTROM_PER_BOHR;
@@ -149,7 +149,10 @@ mod tests {
     #[test]
     fn picks_in_a_second_object_number_through_the_scene() {
         let atom = |x: f64| Atom { z: 8, charge: 8.0, position: DVec3::new(x, 0.0, 0.0), ghost: false };
-        let world = World { molecule: Molecule { atoms: vec![atom(0.0), atom(2.0), atom(10.0)], bonds: vec![] }, offsets: vec![0, 2] };
+        let world = World {
+            molecule: Molecule { atoms: vec![atom(0.0), atom(2.0), atom(10.0)], bonds: vec![] },
+            offsets: vec![0, 2],
+        };
         let mut m = Measurements::default();
         let pick = |object, index, shift| Click { picked: Some(PickId::Atom { object, index }), shift };
         assert!(m.click(pick(1, 0, false), &world).starts_with("atom 3 O"), "object 1's first atom is atom 3");

@@ -68,7 +68,8 @@ pub fn wgpu_setup(lavapipe: bool) -> egui_wgpu::WgpuSetup {
 
 /// One object of the scene: a document and what the user set for it.
 pub struct SceneObject {
-    pub doc: Document,
+    /// Shared with the background jobs that evaluate and cut it.
+    pub doc: Arc<Document>,
     pub state: ObjectState,
     /// The orbital browser's choices (documents with a wavefunction).
     pub orbitals: OrbitalView,
@@ -123,6 +124,8 @@ pub struct OrbApp {
     world: World,
     /// Where the session is saved between runs (`None`: not kept, as in tests).
     pub last_session: Option<PathBuf>,
+    /// GPU errors outside any error scope, reported by the device's handler.
+    gpu_errors: Arc<std::sync::Mutex<Vec<String>>>,
 }
 
 /// The scene's atoms in world space, numbered object after object: what measurements index.
@@ -177,7 +180,21 @@ impl OrbApp {
         let viewport = cc
             .wgpu_render_state
             .as_ref()
-            .map(|rs| Viewport::new(GpuContext::from_parts(rs.adapter.clone(), rs.device.clone(), rs.queue.clone())));
+            .map(|rs| Viewport::new(GpuContext::from_parts(rs.adapter.clone(), rs.device.clone(), rs.queue.clone())))
+            .map(|mut vp| {
+                vp.set_repaint(cc.egui_ctx.clone());
+                vp
+            });
+        // An error no scope caught (wgpu's default is to panic) is shown, and the viewer goes on.
+        let gpu_errors: Arc<std::sync::Mutex<Vec<String>>> = Arc::default();
+        if let Some(vp) = &viewport {
+            let (errors, repaint) = (gpu_errors.clone(), cc.egui_ctx.clone());
+            vp.ctx.device.on_uncaptured_error(Arc::new(move |e| {
+                log::error!("GPU: {e}");
+                errors.lock().unwrap_or_else(|p| p.into_inner()).push(e.to_string());
+                repaint.request_repaint();
+            }));
+        }
         let mut app = Self {
             objects: Vec::new(),
             active: 0,
@@ -199,6 +216,7 @@ impl OrbApp {
             measurements: measure::Measurements::default(),
             world: World::default(),
             last_session: None,
+            gpu_errors,
         };
         if app.viewport.is_none() {
             app.error = Some("no wgpu render state: the viewer needs eframe's wgpu backend".into());
@@ -251,8 +269,7 @@ impl OrbApp {
 
     /// A new handle on the window's device (for scan views and the key-volume job).
     fn gpu_context(&self) -> Option<GpuContext> {
-        let c = &self.viewport.as_ref()?.ctx;
-        Some(GpuContext::from_parts(c.adapter.clone(), c.device.clone(), c.queue.clone()))
+        Some(self.viewport.as_ref()?.ctx.clone())
     }
 
     /// Starts loading a file in the background, added to the scene or replacing it as
@@ -304,13 +321,15 @@ impl OrbApp {
         self.scan_job = Some(ScanJob::start(gpu, source, options, follow, move || ctx.request_repaint()));
     }
 
+    /// Whether a file, a scan or a job of the scene is still being worked on.
     pub fn is_loading(&self) -> bool {
-        self.job.is_some() || !self.queue.is_empty() || self.scan_job.is_some()
+        self.job.is_some() || !self.queue.is_empty() || self.scan_job.is_some() || self.busy().is_some()
     }
 
     /// Adds a loaded document to the scene as `how` says: beside the others, instead of them,
     /// or as a session saved it. It becomes the active object.
     fn add_object(&mut self, doc: Document, how: Opening) {
+        let doc = Arc::new(doc);
         let restoring = matches!(how, Opening::Restore(_));
         let replace = how == Opening::Replace;
         let mut state = match how {
@@ -352,7 +371,7 @@ impl OrbApp {
             orbitals.shown = q;
         }
         self.objects.push(SceneObject { doc, state, orbitals });
-        self.select(self.objects.len() - 1);
+        self.load_active(self.objects.len() - 1);
         self.world = World::of(&self.objects);
         if !restoring {
             self.view.camera = self.scene_camera();
@@ -400,15 +419,20 @@ impl OrbApp {
 
     /// Makes object `n` the one the panels edit.
     pub fn select(&mut self, n: usize) {
-        if n >= self.objects.len() {
-            return;
+        if n < self.objects.len() {
+            self.commit_active();
+            self.load_active(n);
         }
-        self.commit_active();
-        self.active = n;
-        let o = &self.objects[n];
-        self.view.settings = RenderSettings { background: self.view.settings.background, ..o.state.settings };
-        self.view.volume = o.state.volume;
-        self.orbitals = o.orbitals.clone();
+    }
+
+    /// Points the panels' working copies at object `n` (without writing the old ones back).
+    fn load_active(&mut self, n: usize) {
+        self.active = n.min(self.objects.len().saturating_sub(1));
+        if let Some(o) = self.objects.get(self.active) {
+            self.view.settings = RenderSettings { background: self.view.settings.background, ..o.state.settings };
+            self.view.volume = o.state.volume;
+            self.orbitals = o.orbitals.clone();
+        }
     }
 
     /// Removes object `n` from the scene (measurements, which number the scene's atoms, go too).
@@ -423,12 +447,8 @@ impl OrbApp {
         }
         self.measurements = measure::Measurements::default();
         self.world = World::of(&self.objects);
-        self.active = self.active.min(self.objects.len().saturating_sub(1));
-        if let Some(o) = self.objects.get(self.active) {
-            self.view.settings = RenderSettings { background: self.view.settings.background, ..o.state.settings };
-            self.view.volume = o.state.volume;
-            self.orbitals = o.orbitals.clone();
-        }
+        let active = if n < self.active { self.active - 1 } else { self.active };
+        self.load_active(active);
     }
 
     /// Moves object `n` to `placement`.
@@ -456,8 +476,7 @@ impl OrbApp {
             self.commit_active();
         }
         let (Some(vp), Some(o)) = (&mut self.viewport, self.objects.get(n)) else { return };
-        let triangles = vp.update_isosurfaces(n, &o.doc, &o.state);
-        self.status = format!("isosurfaces: {triangles} triangles");
+        vp.update_isosurfaces(n, &o.doc, &o.state);
     }
 
     /// Shows object `n`'s atoms in its state's style.
@@ -478,14 +497,43 @@ impl OrbApp {
             quantity: ov.shown,
             direct: ov.direct,
             points: ov.grid_points,
-            shells: ov.ao_filter.then_some(ov.shell_mask.as_slice()),
+            shells: ov.ao_filter.then(|| ov.shell_mask.clone()),
         };
-        if let Err(e) = vp.show_wavefunction(self.active, &o.doc, &view, &o.state) {
-            self.error = Some(e.to_string());
+        vp.show_wavefunction(self.active, &o.doc, view);
+    }
+
+    /// Shows what the objects' background jobs (orbitals, densities, isosurfaces) finished.
+    fn poll_object_jobs(&mut self) {
+        let Some(vp) = &mut self.viewport else { return };
+        for (n, o) in self.objects.iter().enumerate() {
+            for said in vp.poll(n, &o.doc, &o.state) {
+                match said {
+                    Ok(status) => self.status = status,
+                    Err(e) => self.error = Some(e),
+                }
+            }
+        }
+    }
+
+    /// What the scene's background jobs are doing, in words (`None`: nothing).
+    pub fn busy(&self) -> Option<&'static str> {
+        self.viewport.as_ref()?.busy()
+    }
+
+    /// Stops the scene's background jobs (evaluations, isosurfaces).
+    pub fn cancel_jobs(&mut self) {
+        if let Some(vp) = &mut self.viewport {
+            vp.cancel_jobs();
+            self.status = "cancelled".into();
         }
     }
 
     fn poll_job(&mut self, ctx: &egui::Context) {
+        self.poll_object_jobs();
+        let reported: Vec<String> = std::mem::take(&mut *self.gpu_errors.lock().unwrap_or_else(|p| p.into_inner()));
+        if let Some(last) = reported.last() {
+            self.error = Some(format!("the GPU reported an error (the view may be incomplete): {last}"));
+        }
         if let Some((job, _)) = &self.job
             && let Some(result) = job.poll()
         {
@@ -569,10 +617,7 @@ impl OrbApp {
                 self.error = Some(e.to_string());
             }
         } else if before.settings.iso != self.view.settings.iso {
-            let triangles = vp.update_isosurfaces(n, &o.doc, &o.state);
-            if self.view.settings.iso.visible {
-                self.status = format!("isosurfaces: {triangles} triangles");
-            }
+            vp.update_isosurfaces(n, &o.doc, &o.state);
         }
         if before.settings.atoms != self.view.settings.atoms {
             vp.set_atom_style(n, &o.doc, self.view.settings.atoms);

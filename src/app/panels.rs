@@ -54,7 +54,15 @@ pub fn top_bar(ui: &mut egui::Ui, app: &mut OrbApp) -> Action {
     action
 }
 
-pub fn status_bar(ui: &mut egui::Ui, app: &OrbApp) {
+pub fn status_bar(ui: &mut egui::Ui, app: &mut OrbApp) {
+    let mut cancel = false;
+    status_line(ui, app, &mut cancel);
+    if cancel {
+        app.cancel_jobs();
+    }
+}
+
+fn status_line(ui: &mut egui::Ui, app: &OrbApp, cancel: &mut bool) {
     egui::Panel::bottom("status").show(ui, |ui| {
         ui.horizontal(|ui| {
             if let Some(job) = &app.job {
@@ -62,6 +70,14 @@ pub fn status_bar(ui: &mut egui::Ui, app: &OrbApp) {
                 let text = if parsing { "parsing…".to_string() } else { format!("reading {:.0}%", 100.0 * f) };
                 ui.add(egui::ProgressBar::new(f).desired_width(160.0).text(text));
                 ui.label(job.0.path.display().to_string());
+                ui.separator();
+            }
+            if let Some(what) = app.busy() {
+                ui.spinner();
+                ui.label(what);
+                if ui.button("Cancel").on_hover_text("stop it; what is shown stays").clicked() {
+                    *cancel = true;
+                }
                 ui.separator();
             }
             if let Some(job) = &app.scan_job {

@@ -45,10 +45,11 @@ pub fn section(ui: &mut egui::Ui, app: &mut OrbApp) {
             let s = &mut app.view.settings;
             ui.horizontal(|ui| {
                 let mut shown = s.atoms != AtomStyle::Hidden;
-                if ui.checkbox(&mut shown, "atoms").changed() {
+                let checkbox = ui.checkbox(&mut shown, "atoms");
+                if checkbox.changed() {
                     s.atoms = if shown { AtomStyle::BallAndStick } else { AtomStyle::Hidden };
                 }
-                atom_style(ui, &mut s.atoms);
+                atom_style(ui, &mut s.atoms, checkbox.id);
             });
             ui.checkbox(&mut s.volume.visible, "cloud");
             ui.checkbox(&mut s.iso.visible, format!("isosurface {}", level_text(s.iso.level)));
@@ -93,12 +94,16 @@ pub fn section(ui: &mut egui::Ui, app: &mut OrbApp) {
     }
 }
 
-fn atom_style(ui: &mut egui::Ui, style: &mut AtomStyle) {
-    ComboBox::from_id_salt("scene atom style").selected_text(style.name()).show_ui(ui, |ui| {
-        for s in AtomStyle::ALL {
-            ui.selectable_value(style, s, s.name());
-        }
-    });
+fn atom_style(ui: &mut egui::Ui, style: &mut AtomStyle, label: egui::Id) {
+    ComboBox::from_id_salt("scene atom style")
+        .selected_text(style.name())
+        .show_ui(ui, |ui| {
+            for s in AtomStyle::ALL {
+                ui.selectable_value(style, s, s.name());
+            }
+        })
+        .response
+        .labelled_by(label);
 }
 
 fn level_text(level: IsoLevel) -> String {

@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use super::{OrbApp, Opening};
+use super::{Opening, OrbApp};
 use crate::scene::objects::SESSION_SUFFIX;
 use crate::scene::{RenderSettings, Session};
 

@@ -4,14 +4,18 @@
 use egui::{Key, PointerButton, Sense};
 
 use super::detail::Detail;
+use super::jobs::Latest;
 use super::state::{DRAG_ROTATE, KEY_ROTATE, KEY_ZOOM, ViewState};
+use crate::gpu::context::guarded;
 use crate::gpu::frame::PickId;
 use crate::gpu::gto::GtoFillPass;
 use crate::gpu::{FrameInput, GpuContext, GpuError, OffscreenTarget, Renderer};
 use crate::headless::scan::ScanScene;
-use crate::headless::{WavefunctionView, isosurfaces, show_meshes};
+use crate::headless::{Evaluated, WavefunctionView, evaluate_wavefunction, isosurfaces, show_meshes};
+use crate::model::isosurface::Mesh;
 use crate::model::{Document, VolumeGrid};
-use crate::scene::{ObjectState, RenderSettings, VolumeSettings};
+use crate::scene::{IsosurfaceSettings, ObjectState, RenderSettings, VolumeSettings};
+use std::sync::Arc;
 
 /// A click in the view: what the frame showed under the pointer, and whether Shift was held.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -32,10 +36,21 @@ pub struct TwistInput {
 /// Screen distance (points) within which a press grabs the rotatable bond.
 const BOND_GRAB: f32 = 10.0;
 
+/// What the viewport keeps per object besides its renderer layer.
+struct ObjectJobs {
+    /// Values on the grid shown when computed from a basis (cube files' grids stay in the
+    /// document): isosurfaces are cut from it.
+    computed: Option<Arc<VolumeGrid>>,
+    /// Orbitals filled on the GPU and densities evaluated on the CPU.
+    evaluation: Latest<Result<Option<Evaluated>, GpuError>>,
+    /// Marching cubes over the grid shown.
+    extraction: Latest<Vec<(Mesh, [f32; 3])>>,
+}
+
 pub struct Viewport {
     pub ctx: GpuContext,
     renderer: Renderer,
-    fill: Option<GtoFillPass>,
+    fill: Option<Arc<GtoFillPass>>,
     target: Option<(OffscreenTarget, egui::TextureId)>,
     /// The view's size on screen, pixels (the target may be smaller while interacting).
     shown_size: Option<[u32; 2]>,
@@ -45,9 +60,10 @@ pub struct Viewport {
     drawn: Option<(ViewState, Vec<VolumeSettings>, [u32; 2], u64)>,
     /// Bumped whenever the renderer's data changes.
     generation: u64,
-    /// Per object, its values on the grid shown when computed from a basis (cube files' grids
-    /// stay in the document): isosurfaces are cut from it.
-    computed: Vec<Option<VolumeGrid>>,
+    /// Per object: its computed grid and its background jobs.
+    slots: Vec<ObjectJobs>,
+    /// Wakes the window when a job ends.
+    repaint: Arc<dyn Fn() + Send + Sync>,
     /// Each object's cloud settings (set by the caller each frame); empty: one layer drawn with
     /// the view's settings (scan views).
     pub clouds: Vec<VolumeSettings>,
@@ -65,6 +81,11 @@ pub struct Viewport {
 }
 
 impl Viewport {
+    /// Wakes `ctx`'s window whenever a background job of the view ends.
+    pub fn set_repaint(&mut self, ctx: egui::Context) {
+        self.repaint = Arc::new(move || ctx.request_repaint());
+    }
+
     pub fn new(ctx: GpuContext) -> Self {
         let renderer = Renderer::new(&ctx);
         Self {
@@ -76,7 +97,8 @@ impl Viewport {
             detail: Detail::FULL,
             drawn: None,
             generation: 0,
-            computed: Vec::new(),
+            slots: Vec::new(),
+            repaint: Arc::new(|| {}),
             clouds: Vec::new(),
             click: None,
             hovered: None,
@@ -87,61 +109,135 @@ impl Viewport {
         }
     }
 
-    /// Uploads object `n` of the scene: its molecule, the volume its state chooses, its
-    /// isosurfaces and its placement.
-    pub fn set_object(&mut self, n: usize, doc: &Document, state: &ObjectState) -> Result<(), GpuError> {
-        crate::headless::show_object(&self.ctx, self.renderer.layer_mut(&self.ctx, n), doc, state)?;
-        self.grid_slot(n).take();
+    /// Uploads object `n` of the scene: its molecule, the volume its state chooses and its
+    /// placement; its isosurfaces are cut in the background.
+    pub fn set_object(&mut self, n: usize, doc: &Arc<Document>, state: &ObjectState) -> Result<(), GpuError> {
+        let (ctx, layer) = (&self.ctx, self.renderer.layer_mut(&self.ctx, n));
+        guarded(&ctx.device, || {
+            layer.set_volume(ctx, doc.volumes.get(state.volume))?;
+            layer.set_molecule(ctx, &doc.molecule, state.settings.atoms);
+            layer.surfaces.clear();
+            Ok(())
+        })?;
+        layer.world_from_object = state.placement.world_from_object();
+        layer.visible = state.visible;
+        let slot = self.slot(n);
+        slot.evaluation.cancel();
+        slot.computed = None;
         self.generation += 1;
+        self.update_isosurfaces(n, doc, state);
         Ok(())
     }
 
     /// Shows the volume object `n`'s state chooses.
-    pub fn set_volume(&mut self, n: usize, doc: &Document, state: &ObjectState) -> Result<(), GpuError> {
-        self.renderer.layer_mut(&self.ctx, n).set_volume(&self.ctx, doc.volumes.get(state.volume))?;
-        self.update_isosurfaces(n, doc, state);
-        Ok(())
-    }
-
-    /// Shows a wavefunction's orbital or density for object `n` (see
-    /// [`crate::headless::show_wavefunction`]).
-    pub fn show_wavefunction(
-        &mut self,
-        n: usize,
-        doc: &Document,
-        wavefunction: &WavefunctionView,
-        state: &ObjectState,
-    ) -> Result<(), GpuError> {
-        let layer = self.renderer.layer_mut(&self.ctx, n);
-        let grid = crate::headless::show_wavefunction(&self.ctx, layer, &mut self.fill, doc, wavefunction)?;
-        *self.grid_slot(n) = grid;
-        self.update_isosurfaces(n, doc, state);
-        Ok(())
-    }
-
-    /// Cuts every isosurface object `n`'s state asks for from the grid it shows; returns their
-    /// triangle count.
-    pub fn update_isosurfaces(&mut self, n: usize, doc: &Document, state: &ObjectState) -> usize {
+    pub fn set_volume(&mut self, n: usize, doc: &Arc<Document>, state: &ObjectState) -> Result<(), GpuError> {
+        let (ctx, layer) = (&self.ctx, self.renderer.layer_mut(&self.ctx, n));
+        guarded(&ctx.device, || layer.set_volume(ctx, doc.volumes.get(state.volume)))?;
         self.generation += 1;
-        let grid = self.computed_grid(n).or(doc.volumes.get(state.volume));
-        let meshes: Vec<_> = match grid {
-            Some(grid) => state.all_isosurfaces().flat_map(|iso| isosurfaces(grid, iso)).collect(),
-            None => Vec::new(),
-        };
-        show_meshes(&self.ctx, self.renderer.layer_mut(&self.ctx, n), &meshes)
+        self.update_isosurfaces(n, doc, state);
+        Ok(())
+    }
+
+    /// Evaluates a wavefunction's orbital or density for object `n` in the background
+    /// ([`crate::headless::evaluate_wavefunction`]); [`Self::poll`] shows it when it is done.
+    pub fn show_wavefunction(&mut self, n: usize, doc: &Arc<Document>, view: WavefunctionView) {
+        if doc.wavefunction.is_none() {
+            return;
+        }
+        let ctx = self.ctx.clone();
+        let fill = self.fill.get_or_insert_with(|| Arc::new(GtoFillPass::new(&ctx))).clone();
+        let doc = doc.clone();
+        self.slot(n)
+            .evaluation
+            .request(move |_| guarded(&ctx.device, || evaluate_wavefunction(&ctx, &fill, &doc, &view)));
+    }
+
+    /// Cuts every isosurface object `n`'s state asks for, from the grid it shows, in the
+    /// background; [`Self::poll`] shows them when they are done.
+    pub fn update_isosurfaces(&mut self, n: usize, doc: &Arc<Document>, state: &ObjectState) {
+        let computed = self.slot(n).computed.clone();
+        let (doc, volume) = (doc.clone(), state.volume);
+        let levels: Vec<IsosurfaceSettings> = state.all_isosurfaces().copied().collect();
+        self.slot(n).extraction.request(move |_| {
+            let grid = computed.as_deref().or(doc.volumes.get(volume));
+            grid.map(|g| levels.iter().flat_map(|iso| isosurfaces(g, iso)).collect()).unwrap_or_default()
+        });
+    }
+
+    /// Shows what object `n`'s finished jobs made; returns what to tell the user (`Err`: a
+    /// failure).
+    pub fn poll(&mut self, n: usize, doc: &Arc<Document>, state: &ObjectState) -> Vec<Result<String, String>> {
+        let mut said = Vec::new();
+        if let Some(result) = self.slot(n).evaluation.poll() {
+            let shown = result.and_then(|r| r.map_err(|e| e.to_string())).and_then(|evaluated| {
+                let Some(evaluated) = evaluated else { return Ok(None) };
+                let (ctx, layer) = (&self.ctx, self.renderer.layer_mut(&self.ctx, n));
+                guarded(&ctx.device, || evaluated.show(ctx, layer)).map(Some).map_err(|e| e.to_string())
+            });
+            match shown {
+                Ok(grid) => {
+                    self.slot(n).computed = grid.map(Arc::new);
+                    self.generation += 1;
+                    self.update_isosurfaces(n, doc, state);
+                }
+                Err(e) => said.push(Err(format!("{}: {e}", doc.source))),
+            }
+        }
+        if let Some(result) = self.slot(n).extraction.poll() {
+            match result {
+                Ok(meshes) => {
+                    let (ctx, layer) = (&self.ctx, self.renderer.layer_mut(&self.ctx, n));
+                    match guarded(&ctx.device, || Ok(show_meshes(ctx, layer, &meshes))) {
+                        Ok(triangles) if !meshes.is_empty() => {
+                            said.push(Ok(format!("isosurfaces: {triangles} triangles")))
+                        }
+                        Ok(_) => {}
+                        Err(e) => said.push(Err(format!("{}: isosurfaces: {e}", doc.source))),
+                    }
+                    self.generation += 1;
+                }
+                Err(e) => said.push(Err(e)),
+            }
+        }
+        said
+    }
+
+    /// What runs in the background for the scene, in words (`None`: nothing).
+    pub fn busy(&self) -> Option<&'static str> {
+        if self.slots.iter().any(|s| s.evaluation.is_busy()) {
+            Some("evaluating on the grid…")
+        } else if self.slots.iter().any(|s| s.extraction.is_busy()) {
+            Some("cutting isosurfaces…")
+        } else {
+            None
+        }
+    }
+
+    /// Stops every background job of the scene (what they would have shown is dropped).
+    pub fn cancel_jobs(&mut self) {
+        for s in &mut self.slots {
+            s.evaluation.cancel();
+            s.extraction.cancel();
+        }
     }
 
     /// Object `n`'s values on the grid it shows, when they are not one of its document's (an
     /// orbital or density computed from a basis): isosurfaces are cut from it.
     pub fn computed_grid(&self, n: usize) -> Option<&VolumeGrid> {
-        self.computed.get(n)?.as_ref()
+        self.slots.get(n)?.computed.as_deref()
     }
 
-    fn grid_slot(&mut self, n: usize) -> &mut Option<VolumeGrid> {
-        if self.computed.len() <= n {
-            self.computed.resize_with(n + 1, || None);
+    fn slot(&mut self, n: usize) -> &mut ObjectJobs {
+        while self.slots.len() <= n {
+            let repaint = self.repaint.clone();
+            let again = self.repaint.clone();
+            self.slots.push(ObjectJobs {
+                computed: None,
+                evaluation: Latest::new("evaluating the orbital", move || repaint()),
+                extraction: Latest::new("cutting isosurfaces", move || again()),
+            });
         }
-        &mut self.computed[n]
+        &mut self.slots[n]
     }
 
     pub fn set_atom_style(&mut self, n: usize, doc: &Document, style: crate::scene::AtomStyle) {
@@ -161,11 +257,11 @@ impl Viewport {
         self.generation += 1;
     }
 
-    /// Keeps the first `n` objects, dropping the GPU data of the rest (the first layer is
-    /// emptied when `n` is 0).
+    /// Keeps the first `n` objects, dropping the GPU data and jobs of the rest (the first
+    /// layer is emptied when `n` is 0).
     pub fn truncate(&mut self, n: usize) {
         self.renderer.truncate(n);
-        self.computed.truncate(n);
+        self.slots.truncate(n);
         if n == 0 {
             self.renderer.main().clear(&self.ctx);
         }
@@ -175,8 +271,8 @@ impl Viewport {
     /// Removes object `n`; the objects after it move down by one.
     pub fn remove_object(&mut self, n: usize) {
         self.renderer.remove(&self.ctx, n);
-        if n < self.computed.len() {
-            self.computed.remove(n);
+        if n < self.slots.len() {
+            self.slots.remove(n);
         }
         self.generation += 1;
     }
@@ -194,7 +290,6 @@ impl Viewport {
         self.scan_shown = Some((theta, mode));
         self.generation += 1;
     }
-
 
     /// Shows the view in the remaining space of `ui`, applying mouse and keyboard input to
     /// `view.camera`.
@@ -263,14 +358,18 @@ impl Viewport {
         let clouds: Vec<VolumeSettings> = if self.clouds.is_empty() {
             vec![drawn.settings.volume]
         } else {
-            self.clouds.iter().map(|&volume| self.detail.apply(RenderSettings { volume, ..drawn.settings }).volume).collect()
+            self.clouds
+                .iter()
+                .map(|&volume| self.detail.apply(RenderSettings { volume, ..drawn.settings }).volume)
+                .collect()
         };
         let key = (drawn, clouds, size, self.generation);
         if let Some((target, id)) = &self.target {
             if self.drawn.as_ref() != Some(&key) {
                 let mut encoder =
                     self.ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("viewport") });
-                let frame = FrameInput { camera: &drawn.camera, background: drawn.settings.background, clouds: &key.1, size };
+                let frame =
+                    FrameInput { camera: &drawn.camera, background: drawn.settings.background, clouds: &key.1, size };
                 self.renderer.render(&self.ctx, &mut encoder, &target.color_view, &frame);
                 self.ctx.queue.submit([encoder.finish()]);
                 self.drawn = Some(key);

@@ -18,6 +18,25 @@ pub enum GpuError {
     VolumeTooLarge { dims: [usize; 3], max: u32 },
     #[error("reading back the frame failed: {0}")]
     Readback(String),
+    /// Validation or out-of-memory, caught by [`guarded`] instead of wgpu's default panic.
+    #[error("the GPU refused the work: {0}")]
+    Rejected(String),
+}
+
+/// Runs `work`, catching the validation and out-of-memory errors it causes on `device` (error
+/// scopes) as [`GpuError::Rejected`], so a texture over a limit or a full GPU becomes a message
+/// in the window instead of a crash. Scopes are per thread: `work` must not hand the device to
+/// another thread.
+pub fn guarded<T>(device: &wgpu::Device, work: impl FnOnce() -> Result<T, GpuError>) -> Result<T, GpuError> {
+    let memory = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+    let validation = device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let result = work();
+    let invalid = pollster::block_on(validation.pop());
+    let full = pollster::block_on(memory.pop());
+    match invalid.or(full) {
+        Some(e) => Err(GpuError::Rejected(e.to_string())),
+        None => result,
+    }
 }
 
 /// Which adapter to open.
@@ -30,6 +49,9 @@ pub enum AdapterPreference {
     LavapipeOnly,
 }
 
+/// Handles on one device; cloning gives another handle on the same device (for a background
+/// job or a second view).
+#[derive(Clone)]
 pub struct GpuContext {
     pub adapter: wgpu::Adapter,
     pub device: wgpu::Device,

@@ -7,6 +7,7 @@ use glam::DVec3;
 
 use crate::gpu::gto::{GtoFillPass, read_volume, volume_from_texture};
 use crate::gpu::renderer::Layer;
+use crate::gpu::volume::VolumeTexture;
 use crate::gpu::{FrameInput, GpuContext, GpuError, OffscreenTarget, Renderer};
 use crate::model::cartesian::CartesianExpansion;
 use crate::model::extent::quantity_box;
@@ -47,27 +48,44 @@ pub fn orbital_geometry(doc: &Document, quantity: Quantity, points: usize) -> Op
 
 /// How to show a quantity of a wavefunction.
 #[derive(Debug, Clone, PartialEq)]
-pub struct WavefunctionView<'a> {
+pub struct WavefunctionView {
     pub quantity: Quantity,
     /// Seed 004's direct mode (orbitals only): evaluate per slice sample, no grid.
     pub direct: bool,
     /// Points per axis of the evaluation grid.
     pub points: usize,
     /// Per shell, whether it contributes (the atomic-orbital selector); `None`: all.
-    pub shells: Option<&'a [bool]>,
+    pub shells: Option<Vec<bool>>,
 }
 
-/// Puts a wavefunction's orbital or density into `layer`: orbitals through the GPU (a filled
-/// texture, or direct evaluation per sample), densities evaluated on the CPU. `fill` caches the
-/// compute pipeline between calls. Returns the values on the grid (what isosurfaces are cut
-/// from), or `None` when the document has no wavefunction.
-pub fn show_wavefunction(
+/// A wavefunction's quantity evaluated for display, ready for a layer. Made by
+/// [`evaluate_wavefunction`], which may run on any thread (the viewer's jobs); shown with
+/// [`Evaluated::show`] on the thread that owns the renderer.
+pub struct Evaluated {
+    /// The values on the evaluation grid: what isosurfaces are cut from and what scales the
+    /// opacity.
+    pub grid: VolumeGrid,
+    cloud: Cloud,
+}
+
+enum Cloud {
+    /// An orbital filled on the GPU, already a texture.
+    Texture(VolumeTexture),
+    /// Seed 004's direct mode: the orbital evaluated per slice sample.
+    Direct(CartesianExpansion, GridSpec),
+    /// Values computed on the CPU (densities), uploaded when shown.
+    Values,
+}
+
+/// Evaluates what `view` asks for of `doc`'s wavefunction: orbitals on the GPU (a filled
+/// texture, read back once for the grid's values), densities on the CPU. `None` when the
+/// document has no wavefunction.
+pub fn evaluate_wavefunction(
     ctx: &GpuContext,
-    layer: &mut Layer,
-    fill: &mut Option<GtoFillPass>,
+    fill: &GtoFillPass,
     doc: &Document,
     view: &WavefunctionView,
-) -> Result<Option<VolumeGrid>, GpuError> {
+) -> Result<Option<Evaluated>, GpuError> {
     let (Some(wf), Some(geometry)) = (&doc.wavefunction, orbital_geometry(doc, view.quantity, view.points)) else {
         return Ok(None);
     };
@@ -75,7 +93,7 @@ pub fn show_wavefunction(
     match view.quantity {
         Quantity::Orbital(i) => {
             let mut coefficients = wf.orbitals[i].coefficients.clone();
-            if let Some(mask) = view.shells {
+            if let Some(mask) = &view.shells {
                 for ((shell, offset), &keep) in wf.basis.shells.iter().zip(wf.basis.shell_offsets()).zip(mask) {
                     if !keep {
                         coefficients[offset..offset + shell.n_functions()].fill(0.0);
@@ -83,27 +101,51 @@ pub fn show_wavefunction(
                 }
             }
             let expansion = CartesianExpansion::from_coefficients(&prepared, &coefficients);
-            let fill = fill.get_or_insert_with(|| GtoFillPass::new(ctx));
             let texture = fill.fill(ctx, &expansion, &geometry)?;
             // The filled values give the range that scales the opacity (and the gradient scale).
             let grid = VolumeGrid::new("orbital", geometry.dims, geometry.world_from_grid, read_volume(ctx, &texture)?);
-            if view.direct {
-                layer.set_direct(ctx, &expansion, &geometry, grid.stats.max_abs);
+            let cloud = if view.direct {
+                Cloud::Direct(expansion, geometry)
             } else {
                 let mut volume = volume_from_texture(texture, &geometry, grid.stats.max_abs);
                 volume.max_grad = grid.max_gradient().max(1e-30) as f32;
-                layer.set_volume_texture(ctx, volume);
-            }
-            Ok(Some(grid))
+                Cloud::Texture(volume)
+            };
+            Ok(Some(Evaluated { grid, cloud }))
         }
         Quantity::Density | Quantity::SpinDensity => {
             let label = if view.quantity == Quantity::Density { "total density" } else { "spin density" };
             let values = prepared.quantity_grid_f32(wf, view.quantity, &geometry);
             let grid = VolumeGrid::new(label, geometry.dims, geometry.world_from_grid, values);
-            layer.set_volume(ctx, Some(&grid))?;
-            Ok(Some(grid))
+            Ok(Some(Evaluated { grid, cloud: Cloud::Values }))
         }
     }
+}
+
+impl Evaluated {
+    /// Shows the cloud in `layer`; returns the values on the grid.
+    pub fn show(self, ctx: &GpuContext, layer: &mut Layer) -> Result<VolumeGrid, GpuError> {
+        match self.cloud {
+            Cloud::Texture(volume) => layer.set_volume_texture(ctx, volume),
+            Cloud::Direct(expansion, geometry) => layer.set_direct(ctx, &expansion, &geometry, self.grid.stats.max_abs),
+            Cloud::Values => layer.set_volume(ctx, Some(&self.grid))?,
+        }
+        Ok(self.grid)
+    }
+}
+
+/// Puts a wavefunction's orbital or density into `layer` ([`evaluate_wavefunction`], then
+/// [`Evaluated::show`]). `fill` caches the compute pipeline between calls. Returns the values on
+/// the grid (what isosurfaces are cut from), or `None` when the document has no wavefunction.
+pub fn show_wavefunction(
+    ctx: &GpuContext,
+    layer: &mut Layer,
+    fill: &mut Option<GtoFillPass>,
+    doc: &Document,
+    view: &WavefunctionView,
+) -> Result<Option<VolumeGrid>, GpuError> {
+    let fill = fill.get_or_insert_with(|| GtoFillPass::new(ctx));
+    evaluate_wavefunction(ctx, fill, doc, view)?.map(|e| e.show(ctx, layer)).transpose()
 }
 
 /// The isosurfaces `iso` asks for on `grid`, each with its colour: ψ = +v and ψ = −v for a
@@ -133,7 +175,12 @@ pub fn show_meshes(ctx: &GpuContext, layer: &mut Layer, meshes: &[(Mesh, [f32; 3
 /// Puts `doc` into `layer` as `state` shows it: its molecule in the state's atom style, the
 /// volume it chooses (none past the document's volumes) with every isosurface of it, its
 /// placement and visibility. Returns the isosurfaces' triangle count.
-pub fn show_object(ctx: &GpuContext, layer: &mut Layer, doc: &Document, state: &ObjectState) -> Result<usize, GpuError> {
+pub fn show_object(
+    ctx: &GpuContext,
+    layer: &mut Layer,
+    doc: &Document,
+    state: &ObjectState,
+) -> Result<usize, GpuError> {
     let grid = doc.volumes.get(state.volume);
     layer.set_volume(ctx, grid)?;
     layer.set_molecule(ctx, &doc.molecule, state.settings.atoms);

@@ -72,7 +72,8 @@ pub enum AtomStyle {
 }
 
 impl AtomStyle {
-    pub const ALL: [AtomStyle; 4] = [AtomStyle::BallAndStick, AtomStyle::SpaceFilling, AtomStyle::Sticks, AtomStyle::Hidden];
+    pub const ALL: [AtomStyle; 4] =
+        [AtomStyle::BallAndStick, AtomStyle::SpaceFilling, AtomStyle::Sticks, AtomStyle::Hidden];
 
     pub fn name(self) -> &'static str {
         match self {
