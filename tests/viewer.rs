@@ -379,3 +379,54 @@ fn files_join_the_scene_are_measured_across_and_a_session_reopens_them() {
     assert_eq!(app.view.camera, camera);
     assert_eq!(app.world().molecule.atoms.len(), 8);
 }
+
+#[test]
+fn a_scan_shows_isosurfaces_at_theta_and_its_measured_dihedral_follows_theta() {
+    use orbcloud::model::measure::Measurement;
+    let mut h = Harness::builder()
+        .with_size([1100.0, 720.0])
+        .wgpu_setup(wgpu_setup(true))
+        .build_eframe(|cc| OrbApp::new(cc, Vec::new()));
+    wait_for_scan(&mut h, |_| true);
+    h.get_by_label("show ψ = ±value").click();
+    let start = std::time::Instant::now();
+    while !h.state().status.starts_with("isosurfaces at θ") {
+        assert!(start.elapsed().as_secs() < 60, "no isosurfaces: {}", h.state().status);
+        std::thread::sleep(std::time::Duration::from_millis(20));
+        h.run_steps(1);
+    }
+    let status = h.state().status.clone();
+    assert!(status.contains("θ = -90.0°") || status.contains("θ = −90.0°"), "{status}");
+    h.get_by_label("show ψ = ±value").click();
+    h.get_by_label("show cloud").click();
+    h.run_steps(3);
+
+    // Pick the four atoms of the scanned dihedral in the left view, Shift held after the first.
+    let dihedral = h.state().scan.as_ref().unwrap().scene.scan.dihedral;
+    for (n, &atom) in dihedral.iter().enumerate() {
+        let app = h.state();
+        let p = app.scan.as_ref().unwrap().atom_on_screen(0, atom, &app.view.camera).expect("on screen");
+        click_at(&mut h, p, n > 0);
+    }
+    // An atom of the moving end may sit in front of the one aimed at; any dihedral about the
+    // scanned bond j–k follows θ.
+    let app = h.state();
+    let m: &Measurement = app.measurements.list.first().expect("a measurement");
+    assert_eq!(app.measurements.list.len(), 1, "{}", app.status);
+    assert!(m.atoms.len() == 4 && m.atoms[1..3] == dihedral[1..3], "{:?} about {dihedral:?}", m.atoms);
+    assert!(app.status.ends_with('°'), "{}", app.status);
+    let value_at = |app: &OrbApp| {
+        let scan = app.scan.as_ref().unwrap();
+        app.measurements.list[0].value(&scan.scene.scan.geometry_at(scan.theta)).unwrap()
+    };
+    let before = value_at(app);
+    // Step θ to the next key angle: the measured dihedral turns by as much.
+    let theta = app.scan.as_ref().unwrap().theta;
+    h.key_press(egui::Key::CloseBracket);
+    h.run_steps(2);
+    let app = h.state();
+    let turned = app.scan.as_ref().unwrap().theta - theta;
+    assert!(turned > 1.0, "θ moved: {turned}");
+    let change = (value_at(app) - before + 540.0).rem_euclid(360.0) - 180.0;
+    assert!((change.abs() - turned).abs() < 1.0, "dihedral changed by {change:.2}°, θ by {turned:.2}°");
+}

@@ -149,6 +149,11 @@ impl World {
         world
     }
 
+    /// One molecule as the whole scene (a scan's skeleton at θ).
+    pub fn single(molecule: Molecule) -> Self {
+        Self { molecule, offsets: vec![0] }
+    }
+
     /// The scene-wide number of atom `index` of object `object`.
     pub fn atom(&self, object: usize, index: usize) -> Option<usize> {
         Some(self.offsets.get(object)? + index).filter(|&i| i < self.molecule.atoms.len())
@@ -556,6 +561,8 @@ impl OrbApp {
                         let reopened = self.scan.take().filter(|old| old.source == source);
                         if reopened.is_none() {
                             self.view.camera = scene.camera();
+                            // Picks number the scan's atoms now.
+                            self.measurements = measure::Measurements::default();
                         }
                         self.status = format!(
                             "opened {name}: {} key volumes, {:.1} MiB of {:.0} MiB",
@@ -732,7 +739,11 @@ impl eframe::App for OrbApp {
         egui::CentralPanel::no_frame().show(ui, |ui| {
             let Some(rs) = frame.wgpu_render_state() else { return };
             match (&mut self.scan, &mut self.viewport) {
-                (Some(scan), _) => scan::views(ui, rs, scan, &mut self.view),
+                (Some(scan), _) => {
+                    if let Some(said) = scan::views(ui, rs, scan, &mut self.view, &mut self.measurements) {
+                        self.status = said;
+                    }
+                }
                 (None, Some(vp)) => {
                     vp.detail =
                         detail::Detail::for_frame(detail::interacting(ui.ctx(), false), vp.ctx.info.device_type, 1);

@@ -213,10 +213,10 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
             transfer_editor(ui, &mut vs.transfer);
             clip_editor(ui, &mut vs.clip);
 
-            if app.scan.is_none() {
-                ui.separator();
-                isosurface_editor(ui, &mut view.settings.iso, grid_signed, grid_sigma);
-            }
+            ui.separator();
+            // A scan's isosurfaces are cut from the orbital at θ; levels are absolute there.
+            let sigma = if app.scan.is_none() { grid_sigma } else { None };
+            isosurface_editor(ui, &mut view.settings.iso, grid_signed, sigma);
 
             ui.separator();
             ui.heading("Atoms");
@@ -230,9 +230,11 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
                 ui.label("background");
             });
 
-            if app.scan.is_none() {
-                ui.separator();
-                super::measure::panel(ui, &app.world.molecule, &mut app.measurements);
+            ui.separator();
+            match &app.scan {
+                // The measured values follow θ.
+                Some(s) => super::measure::panel(ui, &s.scene.scan.geometry_at(s.theta), &mut app.measurements),
+                None => super::measure::panel(ui, &app.world.molecule, &mut app.measurements),
             }
 
             ui.separator();

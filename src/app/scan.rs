@@ -9,12 +9,15 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use egui::{Key, RichText};
 use egui_plot::{Legend, Line, Plot, VLine};
 
+use super::World;
 use super::detail::{Detail, interacting};
+use super::measure::{self, Measurements};
 use super::state::ViewState;
 use super::viewport::{TwistInput, Viewport};
 use crate::formats::scan::{ScanFile, load_scan};
 use crate::gpu::GpuContext;
-use crate::headless::scan::{KeyOptions, ScanScene, ScanSceneError};
+use crate::headless::isosurfaces;
+use crate::headless::scan::{KeyOptions, ScanScene, ScanSceneError, mix};
 use crate::model::scan::Follow;
 use crate::model::units::EV_PER_HARTREE;
 use crate::scene::Interpolation;
@@ -157,6 +160,12 @@ impl ScanView {
         self.looping = old.looping;
         self.speed = old.speed;
         self.drag_twists = old.drag_twists;
+    }
+
+    /// Where atom `atom` of the skeleton at θ is drawn in view `view` (for tests and overlays).
+    pub fn atom_on_screen(&self, view: usize, atom: usize, camera: &crate::scene::Camera) -> Option<egui::Pos2> {
+        let p = self.scene.scan.geometry_at(self.theta).atoms.get(atom)?.position.as_vec3();
+        self.views.get(view)?.to_screen(camera, p)
     }
 
     /// The θ and interpolation each view last drew (None before its first frame).
@@ -311,7 +320,16 @@ fn energy_plot(ui: &mut egui::Ui, scan: &ScanView) {
 
 /// The orbital views side by side, each labelled with its orbital and energy at θ; drags and
 /// keys change θ; both views share `view` (camera and settings).
-pub fn views(ui: &mut egui::Ui, render_state: &egui_wgpu::RenderState, scan: &mut ScanView, view: &mut ViewState) {
+/// The scan's views side by side, each with its orbital at θ (cloud, isosurfaces at θ when
+/// shown, atoms), picking and measurements on the skeleton at θ. Returns what to tell the user.
+pub fn views(
+    ui: &mut egui::Ui,
+    render_state: &egui_wgpu::RenderState,
+    scan: &mut ScanView,
+    view: &mut ViewState,
+    measurements: &mut Measurements,
+) -> Option<String> {
+    let mut said = None;
     let dt = ui.input(|i| i.stable_dt) as f64;
     if !ui.ctx().egui_wants_keyboard_input() {
         let (space, prev, next) = ui
@@ -351,14 +369,36 @@ pub fn views(ui: &mut egui::Ui, render_state: &egui_wgpu::RenderState, scan: &mu
                 ui.strong(scan.scene.label(slot, scan.theta));
                 ui.label(RichText::new(format!("θ = {:.1}°", scan.theta)).weak());
             });
+            // Isosurfaces of the orbital at θ, cut in the background from the two key volumes.
+            let wanted = view.settings.iso.visible.then_some((scan.theta, view.settings.iso));
+            if vp.scan_iso != wanted {
+                vp.scan_iso = wanted;
+                let (a, b, k) = scan.scene.bracket_grids(slot, scan.theta);
+                let iso = view.settings.iso;
+                vp.request_meshes(0, move || isosurfaces(&mix(&a, &b, k), &iso));
+            }
+            match vp.poll_meshes(0) {
+                Some(Ok(n)) if n > 0 => said = Some(format!("isosurfaces at θ = {:.1}°: {n} triangles", scan.theta)),
+                Some(Err(e)) => said = Some(e),
+                _ => {}
+            }
             vp.detail = detail;
             dragged += vp.show_twistable(ui, render_state, view, Some(twist));
+            let world = World::single(scan.scene.scan.geometry_at(scan.theta));
+            if let Some(click) = vp.click.take() {
+                let text = measurements.click(click, &world);
+                if !text.is_empty() {
+                    said = Some(text);
+                }
+            }
+            measure::overlay(ui, vp, &view.camera, &world, measurements);
         }
     });
     if dragged != 0.0 {
         scan.set_theta(scan.theta + dragged as f64 * (hi - lo));
         ui.ctx().request_repaint();
     }
+    said
 }
 
 /// Re-applies the atom style to every view (after the side panel changed it).

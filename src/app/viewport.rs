@@ -78,6 +78,8 @@ pub struct Viewport {
     twisting: bool,
     /// The scan frame shown: (θ, interpolation), for tests and redraws.
     pub scan_shown: Option<(f64, crate::scene::Interpolation)>,
+    /// The θ and settings a scan view's isosurfaces were last asked for (`None`: hidden).
+    pub scan_iso: Option<(f64, IsosurfaceSettings)>,
 }
 
 impl Viewport {
@@ -106,6 +108,7 @@ impl Viewport {
             layout: None,
             twisting: false,
             scan_shown: None,
+            scan_iso: None,
         }
     }
 
@@ -158,10 +161,27 @@ impl Viewport {
         let computed = self.slot(n).computed.clone();
         let (doc, volume) = (doc.clone(), state.volume);
         let levels: Vec<IsosurfaceSettings> = state.all_isosurfaces().copied().collect();
-        self.slot(n).extraction.request(move |_| {
+        self.request_meshes(n, move || {
             let grid = computed.as_deref().or(doc.volumes.get(volume));
             grid.map(|g| levels.iter().flat_map(|iso| isosurfaces(g, iso)).collect()).unwrap_or_default()
         });
+    }
+
+    /// Makes object `n`'s isosurfaces with `make` in the background (the newest request wins);
+    /// [`Self::poll_meshes`] shows them when they are done.
+    pub fn request_meshes(&mut self, n: usize, make: impl FnOnce() -> Vec<(Mesh, [f32; 3])> + Send + 'static) {
+        self.slot(n).extraction.request(move |_| make());
+    }
+
+    /// Shows object `n`'s isosurfaces if their job finished: `Ok` with the triangle count, or
+    /// the failure.
+    pub fn poll_meshes(&mut self, n: usize) -> Option<Result<usize, String>> {
+        let result = self.slot(n).extraction.poll()?;
+        self.generation += 1;
+        Some(result.and_then(|meshes| {
+            let (ctx, layer) = (&self.ctx, self.renderer.layer_mut(&self.ctx, n));
+            guarded(&ctx.device, || Ok(show_meshes(ctx, layer, &meshes))).map_err(|e| e.to_string())
+        }))
     }
 
     /// Shows what object `n`'s finished jobs made; returns what to tell the user (`Err`: a
@@ -183,21 +203,10 @@ impl Viewport {
                 Err(e) => said.push(Err(format!("{}: {e}", doc.source))),
             }
         }
-        if let Some(result) = self.slot(n).extraction.poll() {
-            match result {
-                Ok(meshes) => {
-                    let (ctx, layer) = (&self.ctx, self.renderer.layer_mut(&self.ctx, n));
-                    match guarded(&ctx.device, || Ok(show_meshes(ctx, layer, &meshes))) {
-                        Ok(triangles) if !meshes.is_empty() => {
-                            said.push(Ok(format!("isosurfaces: {triangles} triangles")))
-                        }
-                        Ok(_) => {}
-                        Err(e) => said.push(Err(format!("{}: isosurfaces: {e}", doc.source))),
-                    }
-                    self.generation += 1;
-                }
-                Err(e) => said.push(Err(e)),
-            }
+        match self.poll_meshes(n) {
+            Some(Ok(0)) | None => {}
+            Some(Ok(triangles)) => said.push(Ok(format!("isosurfaces: {triangles} triangles"))),
+            Some(Err(e)) => said.push(Err(format!("{}: isosurfaces: {e}", doc.source))),
         }
         said
     }

@@ -2,6 +2,8 @@
 //! one common grid and kept resident as a 3D texture, so any θ is drawn by mixing the two key
 //! volumes around it, with the skeleton turned to θ.
 
+use std::sync::Arc;
+
 use thiserror::Error;
 
 use super::ORBITAL_MARGIN;
@@ -58,6 +60,8 @@ pub struct ScanScene {
     pub grid: GridSpec,
     /// `keys[slot][frame]`, phase-aligned, each with the slot's common opacity scale.
     keys: Vec<Vec<VolumeTexture>>,
+    /// The same key volumes' values (what isosurfaces at θ are mixed from).
+    key_grids: Vec<Vec<Arc<VolumeGrid>>>,
     /// Largest |ψ| per slot over all frames: one opacity scale for the whole scan, so the
     /// cloud does not brighten or fade between frames for nothing.
     pub scale: Vec<f64>,
@@ -143,7 +147,8 @@ impl ScanScene {
             keys.push(textures);
             scale.push(max_abs);
         }
-        Ok(Self { scan, tracks, grid, keys, scale, bytes: needed, budget })
+        let key_grids = grids.into_iter().map(|g| g.into_iter().map(Arc::new).collect()).collect();
+        Ok(Self { scan, tracks, grid, keys, key_grids, scale, bytes: needed, budget })
     }
 
     pub fn slots(&self) -> usize {
@@ -218,9 +223,26 @@ impl ScanScene {
         }
     }
 
+    /// The two key volumes' values around θ and the weight k of the second: slot `slot` at θ
+    /// is (1−k)·a + k·b ([`mix`]).
+    pub fn bracket_grids(&self, slot: usize, theta: f64) -> (Arc<VolumeGrid>, Arc<VolumeGrid>, f32) {
+        let Bracket { a, b, k } = self.scan.bracket(theta);
+        let keys = &self.key_grids[slot];
+        (keys[a].clone(), keys[b].clone(), k as f32)
+    }
+
     /// The exactly interpolated volume of a slot at θ, evaluated on the CPU (for export).
     pub fn interpolated_grid(&self, slot: usize, theta: f64) -> VolumeGrid {
         let label = format!("{} at {theta}° (interpolated)", self.scan.orbitals[slot]);
         self.scan.interpolated_grid(&self.tracks, slot, theta, &self.grid, label)
     }
+}
+
+/// (1−k)·a + k·b on their common grid: a scan's orbital between two key volumes, as the exact
+/// interpolation mode draws it.
+pub fn mix(a: &VolumeGrid, b: &VolumeGrid, k: f32) -> VolumeGrid {
+    let values = a.values.iter().zip(&b.values).map(|(&x, &y)| (1.0 - k) * x + k * y).collect();
+    let mut g = VolumeGrid::new("interpolated", a.dims, a.world_from_grid, values);
+    g.kind = crate::model::grid::ValueKind::Signed;
+    g
 }
