@@ -11,13 +11,18 @@ const FIXTURES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/wave
 
 /// The largest |value| on the box's faces and inside it, on an `n`³ grid.
 fn face_and_max(values: &[f64], n: usize) -> (f64, f64) {
+    face_and_max_of(values, [n; 3])
+}
+
+/// The largest |value| on the faces of a grid of `dims` and inside it.
+fn face_and_max_of(values: &[f64], dims: [usize; 3]) -> (f64, f64) {
     let (mut face, mut max) = (0.0f64, 0.0f64);
-    for i in 0..n {
-        for j in 0..n {
-            for k in 0..n {
-                let v = values[(i * n + j) * n + k].abs();
+    for i in 0..dims[0] {
+        for j in 0..dims[1] {
+            for k in 0..dims[2] {
+                let v = values[(i * dims[1] + j) * dims[2] + k].abs();
                 max = max.max(v);
-                if [i, j, k].iter().any(|&x| x == 0 || x == n - 1) {
+                if [i, j, k].iter().zip(dims).any(|(&x, n)| x == 0 || x == n - 1) {
                     face = face.max(v);
                 }
             }
@@ -66,4 +71,23 @@ fn orbitals_and_densities_decay_inside_their_box() {
         }
     }
     assert!(cut_by_a_fixed_margin > 0, "no orbital here needs more than a fixed margin: the test shows nothing");
+}
+
+#[test]
+fn a_scans_key_grid_holds_every_key_orbital() {
+    use orbcloud::model::scan::Follow;
+    let file = orbcloud::demo::scan().unwrap();
+    let scan = &file.scan;
+    let tracks = scan.track(Follow::Index).unwrap();
+    let grid = scan.key_grid(&tracks, orbcloud::headless::ORBITAL_MARGIN, 40);
+    let mut worst: f64 = 0.0;
+    for slot in 0..scan.orbitals.len() {
+        for frame in 0..scan.frames.len() {
+            let values: Vec<f64> = scan.key_values(&tracks, slot, frame, &grid).into_iter().map(f64::from).collect();
+            let (face, max) = face_and_max_of(&values, grid.dims);
+            worst = worst.max(face / max);
+        }
+    }
+    eprintln!("PSB3 key grid {:?}: faces at most {:.2} % of max |ψ|", grid.dims, 100.0 * worst);
+    assert!(worst <= FACE_FRACTION, "faces reach {:.2} % of max |ψ|", 100.0 * worst);
 }

@@ -427,6 +427,7 @@ impl OrbApp {
         if n < self.objects.len() {
             self.commit_active();
             self.load_active(n);
+            self.scroll_to_frontier = true;
         }
     }
 

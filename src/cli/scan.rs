@@ -260,7 +260,7 @@ pub fn run(command: ScanCommand) -> Result<()> {
                 bail!("--angle {angle} is outside the scan's {lo}°..{hi}°");
             }
             let tracks = s.track(follow)?;
-            let grid = s.common_grid(orbcloud::headless::ORBITAL_MARGIN, keys.points.clamp(8, 512));
+            let grid = s.key_grid(&tracks, orbcloud::headless::ORBITAL_MARGIN, keys.points.clamp(8, 512));
             let label = format!("{orbital} at {angle} deg (interpolated)");
             let volume = s.interpolated_grid(&tracks, slot, angle, &grid, &label);
             let molecule = s.geometry_at(angle);
@@ -305,7 +305,7 @@ pub fn bench_keyvolumes(args: KeyVolumeBench) -> Result<()> {
     };
     let s = &file.scan;
     let tracks = s.track(file.follow)?;
-    let grid = s.common_grid(orbcloud::headless::ORBITAL_MARGIN, args.points.clamp(8, 512));
+    let grid = s.key_grid(&tracks, orbcloud::headless::ORBITAL_MARGIN, args.points.clamp(8, 512));
     // The real key volumes of the first orbital, cycled to make K distinct textures.
     let sources: Vec<VolumeGrid> = (0..s.frames.len())
         .map(|f| {

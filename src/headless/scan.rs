@@ -81,7 +81,14 @@ impl ScanScene {
         progress: &mut dyn FnMut(usize, usize) -> bool,
     ) -> Result<Self, ScanSceneError> {
         let tracks = scan.track(options.follow)?;
-        let grid = scan.common_grid(ORBITAL_MARGIN, options.points);
+        // Wavefunctions: the box where every slot's orbital decays in every frame; cube series:
+        // their own grid.
+        let decay = scan.decay_box(&tracks);
+        let grid_of = |points| match decay {
+            Some((lo, hi)) => GridSpec::cubic_voxels(lo, hi, points),
+            None => scan.common_grid(ORBITAL_MARGIN, points),
+        };
+        let grid = grid_of(options.points);
         let slots = scan.orbitals.len();
         let count = slots * scan.frames.len();
         let per_volume = grid.len() as u64 * texel_bytes(options.format);
@@ -92,10 +99,7 @@ impl ScanScene {
             // (dimensions round up, so the estimate may still be too large).
             let texel = texel_bytes(options.format) * count as u64;
             let estimate = (options.points as f64 * (budget as f64 / needed as f64).cbrt()).floor() as usize;
-            let fits = (2..=estimate.max(2))
-                .rev()
-                .find(|&p| scan.common_grid(ORBITAL_MARGIN, p).len() as u64 * texel <= budget)
-                .unwrap_or(2);
+            let fits = (2..=estimate.max(2)).rev().find(|&p| grid_of(p).len() as u64 * texel <= budget).unwrap_or(2);
             return Err(ScanSceneError::OverBudget {
                 count,
                 dims: grid.dims,

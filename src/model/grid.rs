@@ -57,6 +57,18 @@ impl GridSpec {
         Self::new(lo, [DVec3::X * step.x, DVec3::Y * step.y, DVec3::Z * step.z], [n; 3])
     }
 
+    /// Cubic voxels over the box `lo..hi`, `points` along its longest side, the (slightly
+    /// larger) grid centred on the box.
+    pub fn cubic_voxels(lo: DVec3, hi: DVec3, points: usize) -> Self {
+        let extent = (hi - lo).max(DVec3::splat(1e-6));
+        let points = points.max(2);
+        let step = extent.max_element() / (points - 1) as f64;
+        let dims = extent.to_array().map(|e| ((e / step - 1e-9).ceil() as usize + 1).clamp(2, points));
+        let span = DVec3::new(dims[0] as f64 - 1.0, dims[1] as f64 - 1.0, dims[2] as f64 - 1.0) * step;
+        let origin = lo - 0.5 * (span - extent);
+        Self::new(origin, [DVec3::X * step, DVec3::Y * step, DVec3::Z * step], dims)
+    }
+
     /// Points `spacing` apart (bohr) from `lo`, enough to reach `hi` on every axis.
     pub fn spaced(lo: DVec3, hi: DVec3, spacing: f64) -> Self {
         let dims = ((hi - lo) / spacing).ceil().to_array().map(|n| n.max(1.0) as usize + 1);

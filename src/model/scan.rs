@@ -470,16 +470,32 @@ impl Scan {
             .iter()
             .filter_map(|f| f.molecule.bounds())
             .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), (a, b)| (lo.min(a), hi.max(b)));
-        let (lo, hi) = (lo - DVec3::splat(margin), hi + DVec3::splat(margin));
-        let extent = (hi - lo).max(DVec3::splat(1e-6));
-        let points = points.max(2);
-        let step = extent.max_element() / (points - 1) as f64;
-        let dims = extent.to_array().map(|e| ((e / step - 1e-9).ceil() as usize + 1).clamp(2, points));
-        // Centre the (slightly larger) grid on the box.
-        let span = DVec3::new(dims[0] as f64 - 1.0, dims[1] as f64 - 1.0, dims[2] as f64 - 1.0) * step;
-        let origin = lo - 0.5 * (span - extent);
-        let steps = [DVec3::X * step, DVec3::Y * step, DVec3::Z * step];
-        GridSpec::new(origin, steps, dims)
+        GridSpec::cubic_voxels(lo - DVec3::splat(margin), hi + DVec3::splat(margin), points)
+    }
+
+    /// The grid key volumes are evaluated on, `points` along its longest side: the
+    /// [`Self::decay_box`] of the tracked orbitals, or (cube series, no atoms)
+    /// [`Self::common_grid`] with `margin`.
+    pub fn key_grid(&self, tracks: &Tracks, margin: f64, points: usize) -> GridSpec {
+        match self.decay_box(tracks) {
+            Some((lo, hi)) => GridSpec::cubic_voxels(lo, hi, points),
+            None => self.common_grid(margin, points),
+        }
+    }
+
+    /// The box (bohr) that holds every slot's orbital in every key frame: the union of the
+    /// boxes where each decays to 1 % of its largest |ψ| ([`super::extent::quantity_box`]).
+    /// `None` for cube series (their grid is given) or frames without atoms.
+    pub fn decay_box(&self, tracks: &Tracks) -> Option<(DVec3, DVec3)> {
+        let mut boxes = Vec::new();
+        for (f, frame) in self.frames.iter().enumerate() {
+            for (slot, points) in tracks.points.iter().enumerate() {
+                let wf = frame.wavefunction(slot)?;
+                let orbital = super::orbitals::Quantity::Orbital(points[f].index);
+                boxes.push(super::extent::quantity_box(wf, &frame.molecule, orbital)?);
+            }
+        }
+        boxes.into_iter().reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)))
     }
 
     /// A slot's coefficient vector in `frame`, sign-aligned (wavefunction frames).
