@@ -162,6 +162,17 @@ fn wait_for_scan(h: &mut Harness<'static, OrbApp>, ready: impl Fn(&orbcloud::app
     h.run_steps(2);
 }
 
+/// The viewer as `cargo run` opens it: the bundled scan, once its key volumes are made (on a
+/// background thread).
+fn scan_demo() -> Harness<'static, OrbApp> {
+    let mut h = Harness::builder()
+        .with_size([1100.0, 720.0])
+        .wgpu_setup(wgpu_setup(true))
+        .build_eframe(|cc| OrbApp::new(cc, Vec::new()));
+    wait_for_scan(&mut h, |_| true);
+    h
+}
+
 /// Opens `path` and steps the app until it reports an error (failing after a minute).
 fn open_expecting_error(h: &mut Harness<'static, OrbApp>, path: std::path::PathBuf) -> String {
     let ctx = h.ctx.clone();
@@ -177,12 +188,7 @@ fn open_expecting_error(h: &mut Harness<'static, OrbApp>, path: std::path::PathB
 
 #[test]
 fn the_scan_demo_opens_side_by_side_and_a_drag_twists_both_views() {
-    let mut h = Harness::builder()
-        .with_size([1100.0, 720.0])
-        .wgpu_setup(wgpu_setup(true))
-        .build_eframe(|cc| OrbApp::new(cc, Vec::new()));
-    // The key volumes are made on a background thread.
-    wait_for_scan(&mut h, |_| true);
+    let mut h = scan_demo();
     let scan = h.state().scan.as_ref().unwrap();
     assert_eq!(scan.theta, -90.0, "opens at the twisted geometry");
     assert_eq!(scan.shown().len(), 2, "HOMO and LUMO side by side");
@@ -383,11 +389,7 @@ fn files_join_the_scene_are_measured_across_and_a_session_reopens_them() {
 #[test]
 fn a_scan_shows_isosurfaces_at_theta_and_its_measured_dihedral_follows_theta() {
     use orbcloud::model::measure::Measurement;
-    let mut h = Harness::builder()
-        .with_size([1100.0, 720.0])
-        .wgpu_setup(wgpu_setup(true))
-        .build_eframe(|cc| OrbApp::new(cc, Vec::new()));
-    wait_for_scan(&mut h, |_| true);
+    let mut h = scan_demo();
     h.get_by_label("show ψ = ±value").click();
     let start = std::time::Instant::now();
     while !h.state().status.starts_with("isosurfaces at θ") {
