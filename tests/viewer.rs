@@ -384,6 +384,23 @@ fn files_join_the_scene_are_measured_across_and_a_session_reopens_them() {
     assert_eq!(reopened, saved, "files, representations and placements as saved");
     assert_eq!(app.view.camera, camera);
     assert_eq!(app.world().molecule.atoms.len(), 8);
+
+    // Closing keeps the scene; the next start takes its settings for new files and offers it.
+    let last = dir.path().join("config/last.orbcloud.toml");
+    h.state_mut().view.settings.background = [0.9, 0.9, 0.9];
+    h.state_mut().view.settings.volume.k1 = 0.55;
+    h.state_mut().keep_session_in(last.clone());
+    h.state_mut().save_last_session();
+    let mut next = harness();
+    next.state_mut().keep_session_in(last.clone());
+    let app = next.state();
+    assert_eq!(app.view.settings.background, [0.9, 0.9, 0.9]);
+    assert_eq!(app.defaults.volume.k1, 0.55, "new files start with the last settings");
+    assert_eq!(orbcloud::app::session::read(&last).unwrap().objects.len(), 2);
+    next.run_steps(2);
+    next.get_by_label("Last session").click();
+    wait_loaded(&mut next);
+    assert_eq!(next.state().objects.len(), 2, "the last session reopened");
 }
 
 #[test]
