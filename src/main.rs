@@ -8,14 +8,14 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 use glam::DVec3;
 use orbcloud::formats::cube_write;
 use orbcloud::gpu::{AdapterPreference, GpuContext};
-use orbcloud::headless::{Headless, WavefunctionView, default_camera, show_wavefunction};
+use orbcloud::headless::{Headless, WavefunctionView, camera_for, show_wavefunction};
 use orbcloud::model::Document;
 use orbcloud::model::GridSpec;
 use orbcloud::model::VolumeGrid;
 use orbcloud::model::gto::PreparedBasis;
 use orbcloud::model::orbitals::{OrbitalSpec, Quantity, Spin, Wavefunction};
 use orbcloud::scene::transfer::PRESETS;
-use orbcloud::scene::{AtomStyle, Camera, ClipPlane, RenderSettings, Shape, SliceMode, TransferKind};
+use orbcloud::scene::{AtomStyle, Camera, ClipPlane, RenderSettings, Shape, SliceMode, TransferKind, ViewPreset};
 use orbcloud::{demo, formats, info};
 use rayon::prelude::*;
 
@@ -275,7 +275,12 @@ struct ViewArgs {
     /// Which volume of a multi-orbital cube (0-based, in file order; see `info`).
     #[arg(long, default_value_t = 0)]
     volume: usize,
-    /// Camera rotation about the vertical axis, degrees.
+    /// Which way to look: `auto` (the molecule's principal axes, tilted so no bond points at
+    /// the viewer), `x`, `y`, `z` (along the file's axis), `bond:I,J` (from atom I down the bond
+    /// to J) or `plane:I,J,K` (perpendicular to three atoms' plane); atoms count from 1.
+    #[arg(long, default_value = "auto", value_parser = ViewPreset::parse)]
+    view: ViewPreset,
+    /// Camera rotation about the vertical axis, degrees (after `--view`).
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     yaw: f32,
     /// Camera elevation, degrees.
@@ -423,11 +428,11 @@ impl ViewArgs {
         s
     }
 
-    fn camera(&self, doc: &Document) -> Camera {
-        let mut cam = default_camera(doc);
+    fn camera(&self, doc: &Document) -> Result<Camera> {
+        let mut cam = camera_for(doc, self.view).map_err(|e| anyhow::anyhow!("--view {e}"))?;
         cam.orbit(self.yaw.to_radians(), self.pitch.to_radians());
         cam.zoom(1.0 / self.zoom.max(1e-3));
-        cam
+        Ok(cam)
     }
 
     fn volume_index(&self, doc: &Document) -> Result<Option<usize>> {
@@ -461,15 +466,17 @@ fn main() -> Result<()> {
         Some(Command::Viewer { files }) => Ok(orbcloud::app::run(files)?),
         Some(Command::Render(args)) => {
             let doc = load(args.file.as_deref())?;
+            // Arguments that depend on the file are checked before any GPU work.
+            let camera = args.view.camera(&doc)?;
+            let volume = args.view.volume_index(&doc)?;
             let ctx = gpu(args.lavapipe)?;
             let settings = args.view.settings();
-            let volume = args.view.volume_index(&doc)?;
             let mut h = Headless::new(&ctx, &doc, volume, &settings, args.view.size)?;
             let computed = args.wavefunction.apply(&ctx, &mut h, &doc)?.map(|(_, g)| g);
             if let Some(grid) = computed.as_ref().or(volume.and_then(|i| doc.volumes.get(i))) {
                 surface_cli::show(&ctx, &mut h.renderer, grid, &args.iso);
             }
-            let img = h.render(&ctx, &args.view.camera(&doc), &settings)?;
+            let img = h.render(&ctx, &camera, &settings)?;
             img.save(&args.output).with_context(|| format!("writing {}", args.output.display()))?;
             eprintln!("wrote {} ({}x{}, {})", args.output.display(), img.width(), img.height(), ctx.describe());
             if let Some(pixel) = args.pick {
@@ -556,9 +563,9 @@ fn main() -> Result<()> {
         Some(Command::Bench(BenchCommand::Isosurface(args))) => surface_cli::bench(&args),
         Some(Command::Bench(BenchCommand::Render { file, view, frames, lavapipe, wavefunction })) => {
             let doc = load(file.as_deref())?;
+            let camera = view.camera(&doc)?;
             let ctx = gpu(lavapipe)?;
             let settings = view.settings();
-            let camera = view.camera(&doc);
             let mut h = Headless::new(&ctx, &doc, view.volume_index(&doc)?, &settings, view.size)?;
             if let Some((seconds, _)) = wavefunction.apply(&ctx, &mut h, &doc)? {
                 let n = wavefunction.grid_points;

@@ -259,3 +259,33 @@ fn help_names_every_format_read() {
         assert_eq!(help.contains(".scan.toml"), viewer, "`orbcloud {}`:\n{help}", args.join(" "));
     }
 }
+
+#[test]
+fn render_views_along_presets_and_refuses_bad_ones_before_any_gpu_work() {
+    let dir = tempfile::tempdir().unwrap();
+    // The bundled formaldehyde: atoms 1 (C) and 2 (O) make the C=O bond.
+    let along_bond = dir.path().join("bond.png");
+    let out = orbcloud(&[
+        "render",
+        "--view",
+        "bond:1,2",
+        "--size",
+        "96x64",
+        "--lavapipe",
+        "-o",
+        along_bond.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let side = dir.path().join("auto.png");
+    let out = orbcloud(&["render", "--size", "96x64", "--lavapipe", "-o", side.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let (a, b) = (image::open(&along_bond).unwrap().to_rgba8(), image::open(&side).unwrap().to_rgba8());
+    assert_ne!(a.as_raw(), b.as_raw(), "down the bond differs from the first view");
+    for (view, says) in [("bond:1,99", "atom 99"), ("plane:1,2", "3 atom numbers"), ("sideways", "expected auto")] {
+        let start = std::time::Instant::now();
+        let out = orbcloud(&["render", "--view", view, "--lavapipe", "-o", "/dev/null"]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success() && err.contains(says), "--view {view}: {err}");
+        assert!(start.elapsed().as_secs_f64() < 5.0, "--view {view} took {:?}", start.elapsed());
+    }
+}

@@ -352,12 +352,6 @@ fn files_join_the_scene_are_measured_across_and_a_session_reopens_them() {
     h.run_steps(2);
     assert!(!h.state().objects[1].state.settings.volume.visible);
     assert!(h.state().objects[0].state.settings.volume.visible);
-    // A second isosurface for object 2.
-    h.get_by_label("+ isosurface").click();
-    wait_loaded(&mut h);
-    assert_eq!(h.state().objects[1].state.isosurfaces.len(), 1);
-    assert!(h.state().status.starts_with("isosurfaces: "), "{}", h.state().status);
-
     // An oxygen of each molecule: the distance between them is the placement's offset.
     let (o1, o2) = (h.state().atom_on_screen(1).unwrap(), h.state().atom_on_screen(5).unwrap());
     click_at(&mut h, o1, false);
@@ -365,6 +359,11 @@ fn files_join_the_scene_are_measured_across_and_a_session_reopens_them() {
     click_at(&mut h, o2, true);
     let expected = offset[0] as f64 * orbcloud::model::units::ANGSTROM_PER_BOHR;
     assert!(h.state().status.ends_with(&format!("{expected:.3} Å")), "{} (expected {expected:.3})", h.state().status);
+    // A second isosurface for object 2.
+    h.get_by_label("+ isosurface").click();
+    wait_loaded(&mut h);
+    assert_eq!(h.state().objects[1].state.isosurfaces.len(), 1);
+    assert!(h.state().status.starts_with("isosurfaces: "), "{}", h.state().status);
 
     // Move object 2 and turn it; save; replace the scene with the demo file; reopen.
     let moved = orbcloud::scene::Placement { offset: [20.0, 1.0, 0.0], rotation_deg: [0.0, 0.0, 45.0] };
@@ -448,4 +447,53 @@ fn a_scan_shows_isosurfaces_at_theta_and_its_measured_dihedral_follows_theta() {
     assert!(turned > 1.0, "θ moved: {turned}");
     let change = (value_at(app) - before + 540.0).rem_euclid(360.0) - 180.0;
     assert!((change.abs() - turned).abs() < 1.0, "dihedral changed by {change:.2}°, θ by {turned:.2}°");
+}
+
+#[test]
+fn files_open_without_a_system_dialog_and_a_failed_file_leaves_the_demo() {
+    let demo = orbcloud::demo::document().unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("copy.cube");
+    std::fs::write(
+        &file,
+        orbcloud::formats::cube_write::write("demo", "copy", &demo.molecule, &[(&demo.volumes[0], 1)]),
+    )
+    .unwrap();
+    let mut h = harness();
+    // As on a bare X server: no dialog backend.
+    h.state_mut().native_dialogs = false;
+    h.get_by_label("Open…").click();
+    h.run_steps(2);
+    assert!(h.state().browser.is_some(), "the in-window chooser opens");
+    h.get_by_role(egui::accesskit::Role::TextInput).click();
+    h.run_steps(1);
+    h.get_by_role(egui::accesskit::Role::TextInput).type_text(file.to_str().unwrap());
+    h.run_steps(1);
+    h.key_press(egui::Key::Enter);
+    wait_loaded(&mut h);
+    assert!(h.state().browser.is_none());
+    assert_eq!(h.state().objects.len(), 2, "the file joined the scene");
+    let canonical = std::fs::canonicalize(&file).unwrap();
+    assert_eq!(h.state().recent.first(), Some(&canonical), "and is the first recent file");
+    // The recent list opens it again from the chooser.
+    h.get_by_label("Open…").click();
+    h.run_steps(2);
+    h.get_by_label(&canonical.display().to_string()).click();
+    wait_loaded(&mut h);
+    assert_eq!(h.state().objects.len(), 3);
+
+    // A file that fails to open, with nothing else open: the demo shows instead of nothing.
+    let bad = dir.path().join("broken.molden");
+    std::fs::write(&bad, "[Molden Format]\n[Atoms] AU\nC 1 6 0.0 0.0\n").unwrap();
+    let mut h = Harness::builder()
+        .with_size([1100.0, 720.0])
+        .wgpu_setup(wgpu_setup(true))
+        .build_eframe(move |cc| OrbApp::new(cc, vec![bad.clone()]));
+    let start = std::time::Instant::now();
+    while h.state().error.is_none() || h.state().scan.is_none() {
+        assert!(start.elapsed().as_secs() < 300, "no error and demo: {:?}", h.state().error);
+        std::thread::sleep(std::time::Duration::from_millis(50));
+        h.run_steps(1);
+    }
+    assert!(h.state().error.as_deref().unwrap().contains("broken.molden"));
 }

@@ -56,12 +56,28 @@ impl Measurements {
 }
 
 const COLOR: Color32 = Color32::from_rgb(255, 220, 90);
+/// Atoms labelled at most (beyond that the labels are unreadable anyway).
+const MAX_LABELS: usize = 2000;
 
-/// Draws the selection and the measurements over the view.
-pub fn overlay(ui: &egui::Ui, vp: &Viewport, camera: &Camera, world: &World, m: &Measurements) {
+/// Draws the selection and the measurements over the view, and with `labels` every atom's
+/// element and number.
+pub fn overlay(ui: &egui::Ui, vp: &Viewport, camera: &Camera, world: &World, m: &Measurements, labels: bool) {
     let painter = ui.painter();
     let molecule = &world.molecule;
     let screen = |i: usize| molecule.atoms.get(i).and_then(|a| vp.to_screen(camera, a.position.as_vec3()));
+    if labels {
+        for (i, atom) in molecule.atoms.iter().enumerate().take(MAX_LABELS) {
+            if let Some(p) = screen(i) {
+                painter.text(
+                    p + egui::vec2(7.0, -7.0),
+                    egui::Align2::LEFT_BOTTOM,
+                    format!("{}{}", atom.element().symbol, i + 1),
+                    egui::FontId::proportional(13.0),
+                    Color32::from_white_alpha(220),
+                );
+            }
+        }
+    }
     if let Some(PickId::Atom { object, index }) = vp.hovered
         && let Some(index) = world.atom(object as usize, index as usize)
         && let (Some(p), Some(atom)) = (screen(index), molecule.atoms.get(index))

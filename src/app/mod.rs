@@ -1,6 +1,7 @@
 //! The eframe viewer: the only module that uses egui and rfd.
 
 pub mod detail;
+pub mod files;
 pub mod jobs;
 mod loader;
 pub mod measure;
@@ -12,14 +13,14 @@ pub mod session;
 pub mod state;
 pub mod viewport;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use crate::gpu::{GpuContext, context::device_descriptor};
 use crate::headless::WavefunctionView;
 use crate::headless::default_camera;
 use crate::model::{Atom, Document, Molecule};
-use crate::scene::{ObjectState, RenderSettings};
+use crate::scene::{ObjectState, RenderSettings, ViewPreset};
 use loader::LoadJob;
 use scan::{ScanFailure, ScanJob, ScanSource, ScanView};
 pub use state::{OrbitalView, ViewState};
@@ -86,6 +87,9 @@ pub enum Opening {
     Restore(Box<ObjectState>),
 }
 
+/// Recent files kept.
+const RECENT_FILES: usize = 10;
+
 pub struct OrbApp {
     /// The scene: every open file, in the order opened (object `n` is the renderer's layer `n`).
     pub objects: Vec<SceneObject>,
@@ -126,6 +130,12 @@ pub struct OrbApp {
     pub last_session: Option<PathBuf>,
     /// GPU errors outside any error scope, reported by the device's handler.
     gpu_errors: Arc<std::sync::Mutex<Vec<String>>>,
+    /// Whether to ask the system's file dialog first (cleared once it turns out there is none).
+    pub native_dialogs: bool,
+    /// The in-window file chooser, when open.
+    pub browser: Option<files::FileBrowser>,
+    /// Files opened recently, newest first (kept with the last session).
+    pub recent: Vec<PathBuf>,
 }
 
 /// The scene's atoms in world space, numbered object after object: what measurements index.
@@ -222,6 +232,9 @@ impl OrbApp {
             world: World::default(),
             last_session: None,
             gpu_errors,
+            native_dialogs: true,
+            browser: None,
+            recent: Vec::new(),
         };
         if app.viewport.is_none() {
             app.error = Some("no wgpu render state: the viewer needs eframe's wgpu backend".into());
@@ -375,6 +388,9 @@ impl OrbApp {
         if let Some(q) = state.quantity {
             orbitals.shown = q;
         }
+        if let Some(path) = &state.path {
+            files::remember(&mut self.recent, path, RECENT_FILES);
+        }
         self.objects.push(SceneObject { doc, state, orbitals });
         self.load_active(self.objects.len() - 1);
         self.world = World::of(&self.objects);
@@ -385,8 +401,39 @@ impl OrbApp {
         self.show_wavefunction();
     }
 
-    /// A camera that frames every object where it is placed.
+    /// A camera that frames every object where it is placed, looking at the first one as a new
+    /// file opens ([`ViewPreset::Auto`]: its principal axes, tilted).
     pub fn scene_camera(&self) -> crate::scene::Camera {
+        let mut camera = self.framing_camera();
+        if let Some(first) = self.objects.first() {
+            let view = crate::scene::view::first_view(&first.doc.molecule);
+            let m = first.state.placement.world_from_object();
+            camera.look_along(m.transform_vector3(view.direction), m.transform_vector3(view.up));
+        }
+        camera
+    }
+
+    /// Turns the camera to `preset`: `Auto` as a new file opens, x/y/z along the scene's axes,
+    /// a bond or a plane of the selected atoms (numbered through the scene).
+    pub fn look(&mut self, preset: ViewPreset) {
+        let view = match preset {
+            ViewPreset::Auto => {
+                let target = self.view.camera.target;
+                let distance = self.view.camera.distance;
+                self.view.camera = self.scene_camera();
+                (self.view.camera.target, self.view.camera.distance) = (target, distance);
+                return;
+            }
+            _ => preset.direction(&self.world.molecule),
+        };
+        match view {
+            Ok(v) => self.view.camera.look_along(v.direction, v.up),
+            Err(e) => self.status = e,
+        }
+    }
+
+    /// A camera that frames every object where it is placed, from the default direction.
+    fn framing_camera(&self) -> crate::scene::Camera {
         match self.objects.as_slice() {
             [] => crate::scene::Camera::default(),
             [only] if only.state.placement.is_identity() => default_camera(&only.doc),
@@ -508,6 +555,58 @@ impl OrbApp {
         vp.show_wavefunction(self.active, &o.doc, view);
     }
 
+    /// After a failed load with nothing open and nothing else coming, opens the bundled demo:
+    /// the window never stays empty because a file did not open.
+    fn show_demo_if_empty(&mut self, ctx: &egui::Context) {
+        let nothing = self.objects.is_empty() && self.scan.is_none() && self.scan_job.is_none();
+        if nothing && self.queue.is_empty() && self.job.is_none() {
+            self.open_scan(ScanSource::Demo, ctx);
+        }
+    }
+
+    /// A path for `purpose` from the system's file dialog; where there is none, opens the
+    /// in-window chooser instead (its choice is acted on when made) and returns `None`.
+    fn choose(&mut self, purpose: files::Purpose, file_name: &str) -> Option<PathBuf> {
+        if self.native_dialogs {
+            match files::native(purpose, file_name) {
+                files::Native::Answered(chosen) => return chosen,
+                files::Native::Missing => self.native_dialogs = false,
+            }
+        }
+        let dir = self
+            .recent
+            .first()
+            .and_then(|p| p.parent())
+            .map(Path::to_path_buf)
+            .or_else(|| std::env::current_dir().ok())
+            .unwrap_or_else(|| PathBuf::from("/"));
+        self.browser = Some(files::FileBrowser::new(purpose, dir, file_name));
+        None
+    }
+
+    /// Does what a path chosen for `purpose` is for.
+    fn chosen(&mut self, purpose: files::Purpose, path: PathBuf, ctx: &egui::Context) {
+        match purpose {
+            files::Purpose::Open => self.open(path, ctx),
+            files::Purpose::SaveSession => self.save_session(&session::with_suffix(path)),
+            files::Purpose::SavePng => self.save_png(&path),
+        }
+    }
+
+    /// Shows the in-window chooser, when open, and acts on its choice.
+    fn file_browser(&mut self, ctx: &egui::Context) {
+        let Some(browser) = &mut self.browser else { return };
+        let purpose = browser.purpose;
+        match browser.show(ctx, &self.recent) {
+            files::Choice::None => {}
+            files::Choice::Closed => self.browser = None,
+            files::Choice::Chosen(path) => {
+                self.browser = None;
+                self.chosen(purpose, path, ctx);
+            }
+        }
+    }
+
     /// Shows what the objects' background jobs (orbitals, densities, isosurfaces) finished.
     fn poll_object_jobs(&mut self) {
         let Some(vp) = &mut self.viewport else { return };
@@ -546,7 +645,10 @@ impl OrbApp {
             let Some((_, how)) = self.job.take() else { return };
             match result {
                 Ok(doc) => self.add_object(doc, how),
-                Err(e) => self.error = Some(e.to_string()),
+                Err(e) => {
+                    self.error = Some(e.to_string());
+                    self.show_demo_if_empty(ctx);
+                }
             }
         }
         if let Some(job) = &self.scan_job
@@ -589,7 +691,10 @@ impl OrbApp {
                     self.error = Some(format!("{name}: {message}"));
                     self.scan_retry = Some((source, fits));
                 }
-                Err(ScanFailure::Other(e)) => self.error = Some(e),
+                Err(ScanFailure::Other(e)) => {
+                    self.error = Some(e);
+                    self.show_demo_if_empty(ctx);
+                }
             }
         }
         if self.job.is_none()
@@ -635,24 +740,13 @@ impl OrbApp {
         }
     }
 
-    /// Saves the current view as a PNG: where the user chooses, or in the working directory
-    /// when no file dialog is available.
-    fn screenshot(&mut self) {
+    /// Renders the current view (each scan view side by side) and writes it to `path` as PNG.
+    pub fn save_png(&mut self, path: &Path) {
         let Some(vp) = &mut self.viewport else { return };
         let mut size = vp.size().unwrap_or([1280, 800]);
         if let Some(scan) = &self.scan {
             size = scan.views.first().and_then(|v| v.size()).unwrap_or([640, 600]);
         }
-        let default_name = format!(
-            "orbcloud-{}.png",
-            std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map(|d| d.as_secs()).unwrap_or(0)
-        );
-        // Cancelling the dialog means no file: nothing is written anywhere.
-        let Some(path) =
-            rfd::FileDialog::new().add_filter("PNG image", &["png"]).set_file_name(&default_name).save_file()
-        else {
-            return;
-        };
         let shot = match &mut self.scan {
             Some(scan) => {
                 let mut out = image::RgbaImage::new(size[0] * scan.views.len() as u32, size[1]);
@@ -667,7 +761,7 @@ impl OrbApp {
             }
             None => vp.snapshot(&self.view, size),
         };
-        match shot.map(|img| img.save(&path)) {
+        match shot.map(|img| img.save(path)) {
             Ok(Ok(())) => self.status = format!("saved {}", path.display()),
             Ok(Err(e)) => self.error = Some(format!("{}: {e}", path.display())),
             Err(e) => self.error = Some(e.to_string()),
@@ -697,24 +791,12 @@ impl eframe::App for OrbApp {
         self.apply(&before);
         match action {
             panels::Action::Open => {
-                if let Some(path) = rfd::FileDialog::new()
-                    .add_filter(
-                        "Cube, Molden, fchk, scan, session",
-                        &["cube", "cub", "molden", "mold", "fchk", "fch", "toml", "gz"],
-                    )
-                    .pick_file()
-                {
+                if let Some(path) = self.choose(files::Purpose::Open, "") {
                     self.open(path, &ctx);
-                } else {
-                    self.status = "no file chosen (open files from the command line or drop them on the window)".into();
                 }
             }
             panels::Action::SaveSession => {
-                if let Some(path) = rfd::FileDialog::new()
-                    .add_filter("orbcloud session", &["toml"])
-                    .set_file_name("scene.orbcloud.toml")
-                    .save_file()
-                {
+                if let Some(path) = self.choose(files::Purpose::SaveSession, "scene.orbcloud.toml") {
                     self.save_session(&session::with_suffix(path));
                 }
             }
@@ -723,7 +805,16 @@ impl eframe::App for OrbApp {
                     self.open_session(&path, &ctx);
                 }
             }
-            panels::Action::Screenshot => self.screenshot(),
+            panels::Action::Screenshot => {
+                let name = format!(
+                    "orbcloud-{}.png",
+                    std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_secs())
+                );
+                // Cancelling the dialog means no file: nothing is written anywhere.
+                if let Some(path) = self.choose(files::Purpose::SavePng, &name) {
+                    self.save_png(&path);
+                }
+            }
             panels::Action::ResetView => {
                 self.view.camera = match &self.scan {
                     Some(scan) => scan.scene.camera(),
@@ -733,6 +824,7 @@ impl eframe::App for OrbApp {
             panels::Action::None => {}
         }
         panels::error_window(ui, self);
+        self.file_browser(&ctx);
         let refollow = self.scan.as_mut().and_then(|scan| scan::controls(ui, scan).map(|f| (scan.source.clone(), f)));
         if let Some((source, follow)) = refollow {
             self.open_scan_following(source, Some(follow), &ctx);
@@ -756,7 +848,7 @@ impl eframe::App for OrbApp {
                             self.status = said;
                         }
                     }
-                    measure::overlay(ui, vp, &self.view.camera, &self.world, &self.measurements);
+                    measure::overlay(ui, vp, &self.view.camera, &self.world, &self.measurements, self.view.labels);
                 }
                 (None, None) => {}
             }

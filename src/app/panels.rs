@@ -6,7 +6,9 @@ use super::OrbApp;
 use crate::model::orbitals::Quantity;
 use crate::model::{grid::ValueKind, units::ANGSTROM_PER_BOHR};
 use crate::scene::transfer::{Lobe, PRESETS};
-use crate::scene::{AtomStyle, ClipPlane, IsoLevel, IsosurfaceSettings, Shape, SliceMode, Transfer, TransferKind};
+use crate::scene::{
+    AtomStyle, ClipPlane, IsoLevel, IsosurfaceSettings, Shape, SliceMode, Transfer, TransferKind, ViewPreset,
+};
 
 pub enum Action {
     None,
@@ -229,6 +231,10 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
                 ui.color_edit_button_rgb(&mut view.settings.background);
                 ui.label("background");
             });
+            ui.checkbox(&mut view.labels, "atom labels");
+            if app.scan.is_none() {
+                view_presets(ui, app);
+            }
 
             ui.separator();
             match &app.scan {
@@ -263,6 +269,37 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
             ui.label(RichText::new(help).small().weak());
         });
     });
+}
+
+/// The view presets: as a new file opens, along the axes, down a bond or onto a plane of the
+/// selected atoms.
+fn view_presets(ui: &mut egui::Ui, app: &mut OrbApp) {
+    let selected = app.measurements.selection.clone();
+    let mut preset = None;
+    ui.horizontal_wrapped(|ui| {
+        ui.label("view");
+        for (name, p, hint) in [
+            ("auto", ViewPreset::Auto, "the principal axes, tilted so no bond points at you"),
+            ("x", ViewPreset::AlongX, "along the x axis"),
+            ("y", ViewPreset::AlongY, "along the y axis"),
+            ("z", ViewPreset::AlongZ, "along the z axis"),
+        ] {
+            if ui.button(name).on_hover_text(hint).clicked() {
+                preset = Some(p);
+            }
+        }
+        let bond = ui.add_enabled(selected.len() >= 2, egui::Button::new("down bond"));
+        if bond.on_hover_text("from the first selected atom down its bond to the second").clicked() {
+            preset = Some(ViewPreset::Bond(selected[0], selected[1]));
+        }
+        let plane = ui.add_enabled(selected.len() >= 3, egui::Button::new("onto plane"));
+        if plane.on_hover_text("perpendicular to the plane of the three selected atoms").clicked() {
+            preset = Some(ViewPreset::Plane(selected[0], selected[1], selected[2]));
+        }
+    });
+    if let Some(p) = preset {
+        app.look(p);
+    }
 }
 
 pub fn error_window(ui: &mut egui::Ui, app: &mut OrbApp) {

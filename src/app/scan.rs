@@ -391,7 +391,7 @@ pub fn views(
                     said = Some(text);
                 }
             }
-            measure::overlay(ui, vp, &view.camera, &world, measurements);
+            measure::overlay(ui, vp, &view.camera, &world, measurements, view.labels);
         }
     });
     if dragged != 0.0 {

@@ -50,6 +50,7 @@ impl OrbApp {
             camera: self.view.camera,
             background: Some(self.view.settings.background),
             objects: self.objects.iter().filter(|o| o.state.path.is_some()).map(|o| o.state.clone()).collect(),
+            recent: self.recent.clone(),
         }
     }
 
@@ -87,6 +88,7 @@ impl OrbApp {
         if let Some(bg) = session.background {
             self.view.settings.background = bg;
         }
+        super::files::remember(&mut self.recent, path, super::RECENT_FILES);
         self.queue.extend(files.into_iter().rev());
         self.status = format!("opening session {}", path.display());
         ctx.request_repaint();
@@ -119,6 +121,7 @@ impl OrbApp {
                 self.view.settings.background = bg;
                 self.defaults.background = bg;
             }
+            self.recent = session.recent;
         }
         self.last_session = Some(path);
     }

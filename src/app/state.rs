@@ -11,6 +11,9 @@ pub struct ViewState {
     pub settings: RenderSettings,
     /// Which volume of the document is shown.
     pub volume: usize,
+    /// Element and number beside every atom.
+    #[serde(default)]
+    pub labels: bool,
 }
 
 /// Keyboard rotation step, radians.

@@ -231,9 +231,9 @@ impl AtomsPass {
 }
 
 /// A light above-left of the viewer, moving with the camera, and the camera's up vector.
-pub fn headlight(eye: Vec3, target: Vec3) -> (Vec3, Vec3) {
+pub fn headlight(eye: Vec3, target: Vec3, camera_up: Vec3) -> (Vec3, Vec3) {
     let back = (eye - target).normalize_or(Vec3::Z);
-    let right = Vec3::Y.cross(back).normalize_or(Vec3::X);
+    let right = camera_up.cross(back).normalize_or(Vec3::X);
     let up = back.cross(right);
     ((back + 0.6 * up - 0.4 * right).normalize(), up)
 }

@@ -216,7 +216,7 @@ impl Renderer {
         }
         let cam = frame.camera;
         let eye = cam.eye();
-        let (light, up) = super::atoms::headlight(eye, cam.target);
+        let (light, up) = super::atoms::headlight(eye, cam.target, cam.up());
         let world = ObjectView {
             clip_from_object: self.clip_from_world(cam, frame.size),
             eye,
@@ -230,7 +230,7 @@ impl Renderer {
             layer.atoms.prepare(&ctx.queue, &view, n as u32);
             layer.surfaces.prepare(&ctx.queue, &view, n as u32);
             let cloud = frame.clouds.get(n).unwrap_or(&hidden);
-            layer.volume.prepare(&ctx.device, &ctx.queue, view.clip_from_object, view.eye, view.view_dir, cloud);
+            layer.volume.prepare(&ctx.device, &ctx.queue, &view, cloud);
         }
         let Some((targets, resolve)) = &self.targets else { return };
         for node in self.frame {

@@ -526,11 +526,10 @@ impl VolumePass {
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
-        clip_from_world: Mat4,
-        eye: Vec3,
-        view_dir: Vec3,
+        view: &super::frame::ObjectView,
         settings: &VolumeSettings,
     ) {
+        let (eye, view_dir) = (view.eye, view.view_dir);
         self.vertex_count = 0;
         let Some(vol) = &self.volume else { return };
         if !settings.visible {
@@ -568,12 +567,9 @@ impl VolumePass {
         let clip_normal = Vec3::from(settings.clip.normal).normalize_or(Vec3::Z);
         let box_centre =
             vol.grid_box.origin + 0.5 * (vol.grid_box.edges[0] + vol.grid_box.edges[1] + vol.grid_box.edges[2]);
-        let back = -view_dir;
-        let right = Vec3::Y.cross(back).normalize_or(Vec3::X);
-        let light = (back + 0.6 * back.cross(right) - 0.4 * right).normalize();
         let rgb = |c: [f32; 3]| Vec4::new(c[0], c[1], c[2], 1.0).to_array();
         let u = VolumeUniforms {
-            clip_from_world: clip_from_world.to_cols_array_2d(),
+            clip_from_world: view.clip_from_object.to_cols_array_2d(),
             tex_from_world: vol.tex_from_world.to_cols_array_2d(),
             eye: eye.extend(1.0).to_array(),
             plane: normal.extend(spacing).to_array(),
@@ -598,7 +594,7 @@ impl VolumePass {
             inv_max_grad: 1.0 / vol.max_grad,
             _pad2: 0.0,
             clip: clip_normal.extend(clip_normal.dot(box_centre) + settings.clip.offset).to_array(),
-            light: light.extend(0.0).to_array(),
+            light: view.light.extend(0.0).to_array(),
         };
         queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
     }

@@ -16,7 +16,7 @@ use crate::model::gto::{GridSpec, PreparedBasis};
 use crate::model::isosurface::{self, Level, Mesh};
 use crate::model::orbitals::Quantity;
 use crate::model::{Document, VolumeGrid};
-use crate::scene::{Camera, IsosurfaceSettings, ObjectState, RenderSettings};
+use crate::scene::{Camera, IsosurfaceSettings, ObjectState, RenderSettings, ViewPreset};
 
 /// Space (bohr) around the atoms in which orbitals are evaluated.
 pub const ORBITAL_MARGIN: f64 = 4.5;
@@ -28,6 +28,15 @@ pub fn default_camera(doc: &Document) -> Camera {
         Some((lo, hi)) => Camera::framing(lo, hi),
         None => Camera::default(),
     }
+}
+
+/// The camera a new file opens with: [`default_camera`]'s framing, looking along `preset`'s
+/// direction (the principal axes, tilted, for [`ViewPreset::Auto`]).
+pub fn camera_for(doc: &Document, preset: ViewPreset) -> Result<Camera, String> {
+    let view = preset.direction(&doc.molecule)?;
+    let mut camera = default_camera(doc);
+    camera.look_along(view.direction, view.up);
+    Ok(camera)
 }
 
 /// The box a camera frames to show `doc` whole (bohr, the document's own frame).

@@ -177,10 +177,16 @@ impl ScanScene {
         layer.set_molecule(ctx, &self.scan.geometry_at(theta), style);
     }
 
-    /// A camera framing the common grid from the default direction.
+    /// A camera framing the common grid, looking at the first key frame's skeleton along its
+    /// principal axes, tilted ([`crate::scene::view::first_view`]).
     pub fn camera(&self) -> Camera {
         let (lo, hi) = self.grid.bounds();
-        Camera::framing(lo.as_vec3(), hi.as_vec3())
+        let mut camera = Camera::framing(lo.as_vec3(), hi.as_vec3());
+        if let Some(frame) = self.scan.frames.first() {
+            let view = crate::scene::view::first_view(&frame.molecule);
+            camera.look_along(view.direction, view.up);
+        }
+        camera
     }
 
     /// Renders `slots` at θ side by side (left to right), each `size`, into one image.

@@ -1,6 +1,6 @@
 //! An orbit camera around a target point. World units are bohr.
 
-use glam::{Mat4, Vec3};
+use glam::{Mat3, Mat4, Quat, Vec3};
 use serde::{Deserialize, Serialize};
 
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -15,11 +15,22 @@ pub struct Camera {
     pub distance: f32,
     /// Vertical field of view, radians.
     pub fov_y: f32,
+    /// The frame yaw and pitch are measured in (world from orbit frame): its Y is the axis the
+    /// camera orbits about and the screen's up at zero pitch. Identity: world Y up.
+    #[serde(default)]
+    pub orientation: Quat,
 }
 
 impl Default for Camera {
     fn default() -> Self {
-        Self { target: Vec3::ZERO, yaw: 0.0, pitch: 0.0, distance: 20.0, fov_y: 30f32.to_radians() }
+        Self {
+            target: Vec3::ZERO,
+            yaw: 0.0,
+            pitch: 0.0,
+            distance: 20.0,
+            fov_y: 30f32.to_radians(),
+            orientation: Quat::IDENTITY,
+        }
     }
 }
 
@@ -46,7 +57,19 @@ impl Camera {
     pub fn backward(&self) -> Vec3 {
         let (sy, cy) = self.yaw.sin_cos();
         let (sp, cp) = self.pitch.sin_cos();
-        Vec3::new(sy * cp, sp, cy * cp)
+        self.orientation * Vec3::new(sy * cp, sp, cy * cp)
+    }
+
+    /// The orbit axis (the screen's up at zero pitch).
+    pub fn up(&self) -> Vec3 {
+        self.orientation * Vec3::Y
+    }
+
+    /// The screen's right and up directions in world space.
+    pub fn screen_axes(&self) -> (Vec3, Vec3) {
+        let back = self.backward();
+        let right = self.up().cross(back).normalize_or(self.orientation * Vec3::X);
+        (right, back.cross(right))
     }
 
     pub fn eye(&self) -> Vec3 {
@@ -54,7 +77,18 @@ impl Camera {
     }
 
     pub fn view_from_world(&self) -> Mat4 {
-        glam::camera::rh::view::look_at_mat4(self.eye(), self.target, Vec3::Y)
+        glam::camera::rh::view::look_at_mat4(self.eye(), self.target, self.up())
+    }
+
+    /// Looks along `direction` (from the eye towards the target) with `up` as the screen's up
+    /// (made perpendicular to `direction`); target and distance stay.
+    pub fn look_along(&mut self, direction: Vec3, up: Vec3) {
+        let back = -direction.normalize_or(Vec3::NEG_Z);
+        let up = (up - up.dot(back) * back).try_normalize().unwrap_or_else(|| back.any_orthonormal_vector());
+        let right = up.cross(back);
+        self.orientation = Quat::from_mat3(&Mat3::from_cols(right, up, back)).normalize();
+        self.yaw = 0.0;
+        self.pitch = 0.0;
     }
 
     /// Near and far planes that bracket everything within `scene_radius` of the target.
@@ -84,9 +118,7 @@ impl Camera {
 
     /// Moves the target in the view plane; `dx`, `dy` are fractions of the view height.
     pub fn pan(&mut self, dx: f32, dy: f32) {
-        let back = self.backward();
-        let right = Vec3::Y.cross(back).normalize_or(Vec3::X);
-        let up = back.cross(right);
+        let (right, up) = self.screen_axes();
         let height = 2.0 * self.distance * (0.5 * self.fov_y).tan();
         self.target += (-dx * right + dy * up) * height;
     }
@@ -106,6 +138,27 @@ mod tests {
         assert!(ndc.x.abs() < 1e-5 && ndc.y.abs() < 1e-5);
         assert!(ndc.z > 0.0 && ndc.z < 1.0);
         assert!((cam.eye() - cam.target).length() - cam.distance < 1e-4);
+    }
+
+    #[test]
+    fn looking_along_a_direction_puts_up_on_top() {
+        let mut cam = Camera::framing(Vec3::splat(-2.0), Vec3::splat(2.0));
+        let (dir, up) = (Vec3::new(1.0, -2.0, 0.5).normalize(), Vec3::new(0.0, 0.0, 1.0));
+        cam.look_along(dir, up);
+        assert!((cam.backward() + dir).length() < 1e-5, "the eye looks along the direction");
+        let m = cam.clip_from_world(1.0, 5.0);
+        let project = |p: Vec3| {
+            let c = m * p.extend(1.0);
+            c.truncate() / c.w
+        };
+        let above = project(cam.target + up);
+        assert!(above.y > 0.1 && above.x.abs() < 1e-4, "up projects straight up: {above}");
+        // Orbiting turns about the new up axis, as the default camera turns about world Y.
+        let before = cam.backward();
+        cam.orbit(0.3, 0.0);
+        assert!((cam.backward().dot(cam.up()) - before.dot(cam.up())).abs() < 1e-5);
+        let (right, screen_up) = cam.screen_axes();
+        assert!(right.dot(cam.backward()).abs() < 1e-5 && screen_up.dot(cam.backward()).abs() < 1e-5);
     }
 
     #[test]

@@ -5,8 +5,10 @@ pub mod objects;
 pub mod settings;
 pub mod slicing;
 pub mod transfer;
+pub mod view;
 
 pub use camera::Camera;
 pub use objects::{ObjectState, Placement, Session};
 pub use settings::{AtomStyle, Interpolation, IsoLevel, IsosurfaceSettings, RenderSettings, SliceMode, VolumeSettings};
 pub use transfer::{ClipPlane, Shape, Transfer, TransferKind};
+pub use view::{ViewDirection, ViewPreset};

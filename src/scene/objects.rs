@@ -87,6 +87,8 @@ pub struct Session {
     /// Linear RGB.
     pub background: Option<[f32; 3]>,
     pub objects: Vec<ObjectState>,
+    /// Files opened recently, newest first (the session kept between runs).
+    pub recent: Vec<std::path::PathBuf>,
 }
 
 /// What a session file is called.
