@@ -17,7 +17,8 @@ struct VolumeUniforms {
     k2: f32,
     inv_max: f32,
     ref_step: f32,
-    // 1 for a signed field (an orbital), 0 for a density.
+    // 1 for a signed field (an orbital), 0 for a density scaled to its maximum, 2 for a density
+    // on a log scale.
     signed_field: u32,
     // Shapes of the positive and negative lobes (the power law, the gradient and clipping are
     // pipeline overrides).
@@ -29,8 +30,9 @@ struct VolumeUniforms {
     visible_min: f32,
     // A scan frame's mix ratio k between its key volumes A and B.
     morph_k: f32,
-    _pad0: f32,
-    _pad1: f32,
+    // A density on a log scale (signed_field 2): t = (log10 ρ − log_lo) · inv_log_span.
+    log_lo: f32,
+    inv_log_span: f32,
     // centre, width, peak opacity (fractions of max|value|), unused
     tf_positive: vec4<f32>,
     tf_negative: vec4<f32>,
@@ -102,8 +104,20 @@ fn needs_gradient() -> bool {
 // Premultiplied colour of one sample with gradient `grad` (world units; ignored unless the
 // transfer function needs it); alpha < 0 means invisible (the caller discards, which skips the
 // frame buffer's read-modify-write).
+// The value as the transfer function sees it: ψ / max|ψ| (sign kept), ρ / max ρ, or log ρ
+// between the bounds (scene::opacity::DensityScale::t is the CPU reference).
+fn transfer_value(value: f32) -> f32 {
+    if (u.signed_field == 2u) {
+        if (value <= 0.0) {
+            return 0.0;
+        }
+        return clamp((log2(value) * 0.30103 - u.log_lo) * u.inv_log_span, 0.0, 1.0);
+    }
+    return value * u.inv_max;
+}
+
 fn shade(value: f32, grad: vec3<f32>, from_eye: vec3<f32>) -> vec4<f32> {
-    let scaled = value * u.inv_max;
+    let scaled = transfer_value(value);
     var extinction: f32;
     var color: vec3<f32>;
     if (!SHAPED) {
@@ -120,7 +134,7 @@ fn shade(value: f32, grad: vec3<f32>, from_eye: vec3<f32>) -> vec4<f32> {
             color = mix(u.negative_color.rgb, u.positive_color.rgb, sqrt(min(scaled, 1.0)));
         }
     } else {
-        let positive = value >= 0.0 || u.signed_field == 0u;
+        let positive = value >= 0.0 || u.signed_field != 1u;
         let lobe = select(u.tf_negative, u.tf_positive, positive);
         let shape = select(u.shape_negative, u.shape_positive, positive);
         extinction = lobe.z * shape_factor(shape, abs(scaled), lobe.x, lobe.y);

@@ -294,7 +294,8 @@ struct ViewArgs {
     /// Number of slices.
     #[arg(long)]
     slices: Option<u32>,
-    /// Opacity scale k1 in α = k1·ρ^k2.
+    /// Opacity scale k1 in α = k1·ρ^k2 (default: chosen from the grid so its densest lines of
+    /// sight reach an optical depth of 2.5).
     #[arg(long)]
     k1: Option<f32>,
     /// Opacity exponent k2 in α = k1·ρ^k2.
@@ -385,6 +386,7 @@ impl ViewArgs {
         if let Some(n) = self.slices {
             s.volume.slices = n.clamp(1, 4096);
         }
+        s.volume.auto_k1 = self.k1.is_none();
         if let Some(k1) = self.k1 {
             s.volume.k1 = k1;
         }
@@ -470,10 +472,11 @@ fn main() -> Result<()> {
             let camera = args.view.camera(&doc)?;
             let volume = args.view.volume_index(&doc)?;
             let ctx = gpu(args.lavapipe)?;
-            let settings = args.view.settings();
+            let mut settings = args.view.settings();
             let mut h = Headless::new(&ctx, &doc, volume, &settings, args.view.size)?;
             let computed = args.wavefunction.apply(&ctx, &mut h, &doc)?.map(|(_, g)| g);
             if let Some(grid) = computed.as_ref().or(volume.and_then(|i| doc.volumes.get(i))) {
+                orbcloud::headless::auto_opacity(&mut settings.volume, grid);
                 surface_cli::show(&ctx, &mut h.renderer, grid, &args.iso);
             }
             let img = h.render(&ctx, &camera, &settings)?;

@@ -8,6 +8,7 @@ use common::{lavapipe, p_orbital, scene};
 use glam::{DVec3, Vec3};
 use orbcloud::headless::{default_camera, render_document};
 use orbcloud::model::VolumeGrid;
+use orbcloud::model::grid::ValueKind;
 use orbcloud::scene::slicing::GridBox;
 use orbcloud::scene::{AtomStyle, Camera, RenderSettings, Shape, SliceMode, TransferKind};
 
@@ -57,11 +58,15 @@ fn reference(grid: &VolumeGrid, cam: &Camera, s: &RenderSettings) -> image::Rgba
     let clip_n = Vec3::from(vs.clip.normal).normalize().as_dvec3();
     let centre = (gbox.origin + 0.5 * (gbox.edges[0] + gbox.edges[1] + gbox.edges[2])).as_dvec3();
     let clip_offset = clip_n.dot(centre) + vs.clip.offset as f64;
+    // A density's t: on its scale (log by default), the shader's `transfer_value`.
+    let signed = grid.kind == ValueKind::Signed;
+    let density_t = |v: f64| vs.density_scale.t(v as f32, grid.stats.max_abs as f32) as f64;
     // Extinction of one reference step for a value: seed 000's k1·ρ^k2 or seed 004's shapes.
     let extinction = |v: f64| -> f64 {
-        let t = (v * inv).abs();
+        let t = if signed { (v * inv).abs() } else { density_t(v) };
         match vs.transfer.kind {
-            TransferKind::PowerLaw => k1 * (t * t).powf(k2),
+            TransferKind::PowerLaw if signed => k1 * (t * t).powf(k2),
+            TransferKind::PowerLaw => k1 * t.powf(k2),
             TransferKind::Shaped => {
                 let lobe = if v >= 0.0 { vs.transfer.positive } else { vs.transfer.negative };
                 lobe.opacity as f64 * lobe.shape.factor(t as f32, lobe.center, lobe.width) as f64
@@ -84,7 +89,15 @@ fn reference(grid: &VolumeGrid, cam: &Camera, s: &RenderSettings) -> image::Rgba
             let v = grid.sample(grid_from_world.transform_point3(p));
             let path = slices.spacing as f64 / d.dot(slices.normal.as_dvec3()).abs().max(0.05);
             let alpha = 1.0 - (-extinction(v) * path / step).exp();
-            let col = if v >= 0.0 { pos } else { neg };
+            let col = match (signed, v >= 0.0) {
+                (true, true) => pos,
+                (true, false) => neg,
+                // A density's colour runs from the thin to the dense end.
+                (false, _) => {
+                    let w = density_t(v).min(1.0).sqrt();
+                    [0, 1, 2].map(|i| neg[i] + (pos[i] - neg[i]) * w)
+                }
+            };
             for i in 0..3 {
                 c[i] = col[i] * alpha + c[i] * (1.0 - alpha);
             }
@@ -94,7 +107,10 @@ fn reference(grid: &VolumeGrid, cam: &Camera, s: &RenderSettings) -> image::Rgba
 }
 
 fn compare(mode: SliceMode, adjust: impl Fn(&mut RenderSettings)) {
-    let grid = p_orbital(24, true);
+    compare_grid(p_orbital(24, true), mode, adjust);
+}
+
+fn compare_grid(grid: VolumeGrid, mode: SliceMode, adjust: impl Fn(&mut RenderSettings)) {
     let doc = scene(Some(grid.clone()));
     let mut s = RenderSettings { atoms: AtomStyle::Hidden, ..Default::default() };
     s.volume.mode = mode;
@@ -156,6 +172,22 @@ fn shaped_transfer_functions_match_the_cpu_compositor() {
         t.negative.shape = Shape::RightHalfGaussian;
         t.negative.center = 0.2;
     });
+}
+
+#[test]
+fn a_density_on_its_log_scale_matches_the_cpu_compositor() {
+    // ρ = 50·exp(−2r): six decades inside the box, as a molecule's density has.
+    let p = p_orbital(24, false);
+    let values = (0..p.values.len())
+        .map(|n| {
+            let (i, j, k) = (n / (24 * 24), (n / 24) % 24, n % 24);
+            let r = p.world_from_grid.transform_point3(DVec3::new(i as f64, j as f64, k as f64)).length();
+            (50.0 * (-2.0 * r).exp()) as f32
+        })
+        .collect();
+    let density = VolumeGrid::new("density", p.dims, p.world_from_grid, values);
+    assert_eq!(density.kind, ValueKind::Density);
+    compare_grid(density, SliceMode::ViewAligned, |s| s.volume.k1 = 0.3);
 }
 
 #[test]

@@ -393,6 +393,7 @@ impl OrbApp {
         }
         self.objects.push(SceneObject { doc, state, orbitals });
         self.load_active(self.objects.len() - 1);
+        self.auto_opacity(self.objects.len() - 1);
         self.world = World::of(&self.objects);
         if !restoring {
             self.view.camera = self.scene_camera();
@@ -610,13 +611,35 @@ impl OrbApp {
     /// Shows what the objects' background jobs (orbitals, densities, isosurfaces) finished.
     fn poll_object_jobs(&mut self) {
         let Some(vp) = &mut self.viewport else { return };
+        let mut evaluated = Vec::new();
         for (n, o) in self.objects.iter().enumerate() {
-            for said in vp.poll(n, &o.doc, &o.state) {
+            let (said, shown) = vp.poll(n, &o.doc, &o.state);
+            for said in said {
                 match said {
                     Ok(status) => self.status = status,
                     Err(e) => self.error = Some(e),
                 }
             }
+            if shown {
+                evaluated.push(n);
+            }
+        }
+        for n in evaluated {
+            self.auto_opacity(n);
+        }
+    }
+
+    /// Chooses object `n`'s k1 from the grid it shows, when its cloud asks for that.
+    fn auto_opacity(&mut self, n: usize) {
+        if n == self.active {
+            self.commit_active();
+        }
+        let (Some(vp), Some(o)) = (&self.viewport, self.objects.get_mut(n)) else { return };
+        if let Some(grid) = vp.computed_grid(n).or(o.doc.volumes.get(o.state.volume)) {
+            crate::headless::auto_opacity(&mut o.state.settings.volume, grid);
+        }
+        if n == self.active {
+            self.view.settings.volume.k1 = self.objects[n].state.settings.volume.k1;
         }
     }
 
@@ -725,11 +748,18 @@ impl OrbApp {
             }
             return;
         };
+        let (was, now) = (&before.settings.volume, &self.view.settings.volume);
+        let law_changed = was.k2 != now.k2 || was.density_scale != now.density_scale || (now.auto_k1 && !was.auto_k1);
         if before.volume != self.view.volume {
             if let Err(e) = vp.set_volume(n, &o.doc, &o.state) {
                 self.error = Some(e.to_string());
             }
-        } else if before.settings.iso != self.view.settings.iso {
+            self.auto_opacity(n);
+        } else if law_changed {
+            self.auto_opacity(n);
+        }
+        let (Some(vp), Some(o)) = (&mut self.viewport, self.objects.get(n)) else { return };
+        if before.settings.iso != self.view.settings.iso {
             vp.update_isosurfaces(n, &o.doc, &o.state);
         }
         if before.settings.atoms != self.view.settings.atoms {

@@ -4,10 +4,11 @@ use egui::{ComboBox, RichText, Slider};
 
 use super::OrbApp;
 use crate::model::orbitals::Quantity;
-use crate::model::{grid::ValueKind, units::ANGSTROM_PER_BOHR};
+use crate::model::units::ANGSTROM_PER_BOHR;
 use crate::scene::transfer::{Lobe, PRESETS};
 use crate::scene::{
-    AtomStyle, ClipPlane, IsoLevel, IsosurfaceSettings, Shape, SliceMode, Transfer, TransferKind, ViewPreset,
+    AtomStyle, ClipPlane, DensityScale, IsoLevel, IsosurfaceSettings, Shape, SliceMode, Transfer, TransferKind,
+    ViewPreset,
 };
 
 pub enum Action {
@@ -193,9 +194,19 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
                 ui.selectable_value(&mut vs.mode, SliceMode::AxisAligned, "axis stacks");
             });
             ui.add(Slider::new(&mut vs.slices, 16..=512).text("slice count"));
-            ui.add(Slider::new(&mut vs.k1, 0.0..=1.0).text("k1 (opacity)"));
+            ui.horizontal(|ui| {
+                let k1 = ui.add(Slider::new(&mut vs.k1, 0.0..=2.0).logarithmic(true).text("k1 (opacity)"));
+                if k1.changed() {
+                    vs.auto_k1 = false;
+                }
+                ui.checkbox(&mut vs.auto_k1, "auto")
+                    .on_hover_text("k1 from the grid: its densest lines of sight reach an optical depth of 2.5");
+            });
             ui.add(Slider::new(&mut vs.k2, 0.1..=3.0).text("k2 (shape)"));
-            let signed = doc.volumes.get(view.volume).is_none_or(|v| v.kind == ValueKind::Signed);
+            let signed = grid_signed;
+            if !signed {
+                density_scale_editor(ui, &mut vs.density_scale);
+            }
             let (pos, neg) = if signed { ("ψ > 0", "ψ < 0") } else { ("dense", "thin") };
             ui.horizontal(|ui| {
                 ui.color_edit_button_rgb(&mut vs.positive_color);
@@ -203,7 +214,12 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
                 ui.color_edit_button_rgb(&mut vs.negative_color);
                 ui.label(neg);
             });
-            ui.label(RichText::new("α = k1·ρ^k2, ρ = ψ² (orbital) or density, scaled to its maximum").small().weak());
+            let law = if signed {
+                "α = k1·ρ^k2 per grid step, ρ = ψ² scaled to its maximum"
+            } else {
+                "α = k1·t^k2 per grid step, t = the density on the scale above"
+            };
+            ui.label(RichText::new(law).small().weak());
             ComboBox::from_label("colour preset").selected_text("choose…").show_ui(ui, |ui| {
                 for (name, pos, neg) in PRESETS {
                     if ui.selectable_label(false, *name).clicked() {
@@ -212,7 +228,7 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
                     }
                 }
             });
-            transfer_editor(ui, &mut vs.transfer);
+            transfer_editor(ui, &mut vs.transfer, signed);
             clip_editor(ui, &mut vs.clip);
 
             ui.separator();
@@ -357,15 +373,40 @@ fn lobe_editor(ui: &mut egui::Ui, label: &str, lobe: &mut Lobe) {
     painter.add(egui::Shape::line(points, egui::Stroke::new(1.5, ui.visuals().strong_text_color())));
 }
 
-fn transfer_editor(ui: &mut egui::Ui, t: &mut Transfer) {
+/// How a density maps onto the transfer function: log between bounds (a.u.) or its maximum.
+fn density_scale_editor(ui: &mut egui::Ui, scale: &mut DensityScale) {
+    ui.horizontal(|ui| {
+        ui.label("density scale");
+        let log = matches!(scale, DensityScale::Log { .. });
+        if ui.selectable_label(log, "log").on_hover_text("shows the valence shell and the molecule's surface").clicked()
+        {
+            *scale = DensityScale::default();
+        }
+        if ui.selectable_label(!log, "linear").on_hover_text("ρ / max ρ: the nuclear cusps dominate").clicked() {
+            *scale = DensityScale::Linear;
+        }
+    });
+    if let DensityScale::Log { lo, hi } = scale {
+        ui.horizontal(|ui| {
+            ui.add(egui::DragValue::new(lo).speed(0.0001).range(1e-8..=1.0).prefix("from ").suffix(" a.u."));
+            ui.add(egui::DragValue::new(hi).speed(0.01).range(1e-6..=1e4).prefix("to ").suffix(" a.u."));
+        });
+    }
+}
+
+fn transfer_editor(ui: &mut egui::Ui, t: &mut Transfer, signed: bool) {
     ui.collapsing("Transfer function", |ui| {
         ui.horizontal(|ui| {
             ui.selectable_value(&mut t.kind, TransferKind::PowerLaw, "power law (k1, k2)");
             ui.selectable_value(&mut t.kind, TransferKind::Shaped, "shapes");
         });
         if t.kind == TransferKind::Shaped {
-            lobe_editor(ui, "ψ > 0", &mut t.positive);
-            lobe_editor(ui, "ψ < 0", &mut t.negative);
+            if signed {
+                lobe_editor(ui, "ψ > 0", &mut t.positive);
+                lobe_editor(ui, "ψ < 0", &mut t.negative);
+            } else {
+                lobe_editor(ui, "density", &mut t.positive);
+            }
         }
         ui.checkbox(&mut t.shading, "shading from the gradient");
         ui.add(Slider::new(&mut t.boundary, 0.0..=1.0).text("boundary enhancement"));

@@ -185,9 +185,10 @@ impl Viewport {
     }
 
     /// Shows what object `n`'s finished jobs made; returns what to tell the user (`Err`: a
-    /// failure).
-    pub fn poll(&mut self, n: usize, doc: &Arc<Document>, state: &ObjectState) -> Vec<Result<String, String>> {
+    /// failure) and whether a newly evaluated grid is shown.
+    pub fn poll(&mut self, n: usize, doc: &Arc<Document>, state: &ObjectState) -> (Vec<Result<String, String>>, bool) {
         let mut said = Vec::new();
+        let mut evaluated = false;
         if let Some(result) = self.slot(n).evaluation.poll() {
             let shown = result.and_then(|r| r.map_err(|e| e.to_string())).and_then(|evaluated| {
                 let Some(evaluated) = evaluated else { return Ok(None) };
@@ -196,6 +197,7 @@ impl Viewport {
             });
             match shown {
                 Ok(grid) => {
+                    evaluated = grid.is_some();
                     self.slot(n).computed = grid.map(Arc::new);
                     self.generation += 1;
                     self.update_isosurfaces(n, doc, state);
@@ -208,7 +210,7 @@ impl Viewport {
             Some(Ok(triangles)) => said.push(Ok(format!("isosurfaces: {triangles} triangles"))),
             Some(Err(e)) => said.push(Err(format!("{}: isosurfaces: {e}", doc.source))),
         }
-        said
+        (said, evaluated)
     }
 
     /// What runs in the background for the scene, in words (`None`: nothing).

@@ -13,7 +13,7 @@ use crate::model::GridSpec;
 use crate::model::cartesian::CartesianExpansion;
 use crate::model::{VolumeGrid, grid::ValueKind};
 use crate::scene::slicing::{GridBox, Slices};
-use crate::scene::{Interpolation, TransferKind, VolumeSettings};
+use crate::scene::{DensityScale, Interpolation, TransferKind, VolumeSettings};
 
 /// Mirror of `VolumeUniforms` in volume_slices.wgsl.
 #[repr(C)]
@@ -35,8 +35,8 @@ pub struct VolumeUniforms {
     pub tf_bits: u32,
     pub visible_min: f32,
     pub morph_k: f32,
-    pub _pad0: f32,
-    pub _pad1: f32,
+    pub log_lo: f32,
+    pub inv_log_span: f32,
     pub tf_positive: [f32; 4],
     pub tf_negative: [f32; 4],
     pub gradient_power: f32,
@@ -547,6 +547,7 @@ impl VolumePass {
         queue.write_buffer(&self.vertices, 0, bytemuck::cast_slice(&vertices));
         self.vertex_count = vertices.len() as u32;
         let signed = vol.kind == ValueKind::Signed;
+        let (log_lo, inv_log_span) = settings.density_scale.log_uniforms();
         let t = &settings.transfer;
         let program = match (&self.direct, &self.morph) {
             (Some(_), _) => Program::Direct,
@@ -579,14 +580,18 @@ impl VolumePass {
             k2: settings.k2,
             inv_max: 1.0 / vol.max_abs,
             ref_step: vol.step,
-            signed_field: u32::from(signed),
+            signed_field: match (signed, settings.density_scale) {
+                (true, _) => 1,
+                (false, DensityScale::Linear) => 0,
+                (false, DensityScale::Log { .. }) => 2,
+            },
             shape_positive: t.positive.shape.index(),
             shape_negative: t.negative.shape.index(),
             tf_bits: bits,
             visible_min: visibility_threshold(settings.k1, settings.k2, signed),
             morph_k: self.morph.as_ref().map_or(0.0, |m| m.k),
-            _pad0: 0.0,
-            _pad1: 0.0,
+            log_lo,
+            inv_log_span,
             tf_positive: lobe(&t.positive),
             tf_negative: lobe(&t.negative),
             gradient_power: t.gradient_power,

@@ -157,6 +157,17 @@ pub fn show_wavefunction(
     evaluate_wavefunction(ctx, fill, doc, view)?.map(|e| e.show(ctx, layer)).transpose()
 }
 
+/// Sets `volume.k1` from `grid` ([`crate::scene::opacity::auto_k1`]) when `volume.auto_k1`
+/// asks for it: the first picture of any grid has contrast.
+pub fn auto_opacity(volume: &mut crate::scene::VolumeSettings, grid: &VolumeGrid) {
+    if volume.auto_k1 {
+        let signed = grid.kind == ValueKind::Signed;
+        let max = grid.stats.max_abs as f32;
+        volume.k1 =
+            crate::scene::opacity::auto_k1(&grid.values, grid.dims, signed, max, volume.density_scale, volume.k2);
+    }
+}
+
 /// The isosurfaces `iso` asks for on `grid`, each with its colour: ψ = +v and ψ = −v for a
 /// signed grid, ρ = v for a density. Empty when `iso` is hidden.
 pub fn isosurfaces(grid: &VolumeGrid, iso: &IsosurfaceSettings) -> Vec<(Mesh, [f32; 3])> {

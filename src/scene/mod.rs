@@ -2,6 +2,7 @@
 
 pub mod camera;
 pub mod objects;
+pub mod opacity;
 pub mod settings;
 pub mod slicing;
 pub mod transfer;
@@ -9,6 +10,7 @@ pub mod view;
 
 pub use camera::Camera;
 pub use objects::{ObjectState, Placement, Session};
+pub use opacity::DensityScale;
 pub use settings::{AtomStyle, Interpolation, IsoLevel, IsosurfaceSettings, RenderSettings, SliceMode, VolumeSettings};
 pub use transfer::{ClipPlane, Shape, Transfer, TransferKind};
 pub use view::{ViewDirection, ViewPreset};

@@ -2,6 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::opacity::DensityScale;
 use super::transfer::{ClipPlane, Transfer};
 
 /// How the volume is cut into slices.
@@ -43,6 +44,17 @@ pub struct VolumeSettings {
     /// `transfer.kind` is `Shaped`; k1 and k2 apply to the power law).
     pub transfer: Transfer,
     pub clip: ClipPlane,
+    /// How a density's values are scaled (orbitals: |ψ| / max |ψ| always).
+    #[serde(default)]
+    pub density_scale: DensityScale,
+    /// Whether k1 is chosen from each grid shown ([`super::opacity::auto_k1`]); editing k1
+    /// turns it off.
+    #[serde(default = "yes")]
+    pub auto_k1: bool,
+}
+
+fn yes() -> bool {
+    true
 }
 
 impl Default for VolumeSettings {
@@ -57,6 +69,8 @@ impl Default for VolumeSettings {
             negative_color: [0.10, 0.30, 0.95],
             transfer: Transfer::default(),
             clip: ClipPlane::default(),
+            density_scale: DensityScale::default(),
+            auto_k1: true,
         }
     }
 }
