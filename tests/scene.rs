@@ -36,7 +36,13 @@ fn camera() -> Camera {
 fn draw(ctx: &GpuContext, renderer: &mut Renderer, clouds: &[VolumeSettings]) -> image::RgbaImage {
     let target = OffscreenTarget::new(&ctx.device, SIZE);
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
-    let frame = FrameInput { camera: &camera(), background: RenderSettings::default().background, clouds, size: SIZE };
+    let frame = FrameInput {
+        camera: &camera(),
+        background: RenderSettings::default().background,
+        clouds,
+        size: SIZE,
+        tile: None,
+    };
     renderer.render(ctx, &mut encoder, &target.color_view, &frame);
     ctx.queue.submit([encoder.finish()]);
     target.read_rgba(&ctx.device, &ctx.queue).unwrap()
@@ -176,4 +182,53 @@ fn gpu_errors_inside_a_guard_become_messages() {
     }
     // The device goes on working after the caught error.
     assert!(guarded(&ctx.device, || Ok(Renderer::new(&ctx).layer_count())).is_ok());
+}
+
+#[test]
+fn a_frame_drawn_in_bands_equals_the_frame_drawn_at_once() {
+    use orbcloud::gpu::Tile;
+    let ctx = lavapipe();
+    let (doc, states) = two_objects();
+    let mut renderer = Renderer::new(&ctx);
+    for (n, state) in states.iter().enumerate() {
+        show_object(&ctx, renderer.layer_mut(&ctx, n), &doc, state).unwrap();
+    }
+    let clouds = [states[0].settings.volume, states[1].settings.volume];
+    let whole = draw(&ctx, &mut renderer, &clouds);
+    let target = OffscreenTarget::new(&ctx.device, SIZE);
+    let camera = camera();
+    let mut partial = None;
+    for (n, y) in (0..SIZE[1]).step_by(37).enumerate() {
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        let tile = Tile { rect: [0, y, SIZE[0], 37], first: n == 0 };
+        let frame = FrameInput {
+            camera: &camera,
+            background: RenderSettings::default().background,
+            clouds: &clouds,
+            size: SIZE,
+            tile: Some(tile),
+        };
+        renderer.render(&ctx, &mut encoder, &target.color_view, &frame);
+        ctx.queue.submit([encoder.finish()]);
+        if n == 1 {
+            partial = Some(target.read_rgba(&ctx.device, &ctx.queue).unwrap());
+        }
+    }
+    let banded = target.read_rgba(&ctx.device, &ctx.queue).unwrap();
+    let worst = whole
+        .pixels()
+        .zip(banded.pixels())
+        .map(|(a, b)| (0..3).map(|c| a[c].abs_diff(b[c])).max().unwrap())
+        .max()
+        .unwrap();
+    assert!(worst <= 1, "bands differ from the whole frame by {worst}/255");
+    // Two bands in, the clouds below them are not drawn yet; the atoms and surfaces are.
+    let partial = partial.unwrap();
+    let below = |img: &image::RgbaImage| {
+        (74..SIZE[1])
+            .flat_map(|y| (0..SIZE[0]).map(move |x| (x, y)))
+            .filter(|&(x, y)| img.get_pixel(x, y) != whole.get_pixel(x, y))
+            .count()
+    };
+    assert!(below(&partial) > 100, "the lower bands fill in later");
 }

@@ -497,3 +497,46 @@ fn files_open_without_a_system_dialog_and_a_failed_file_leaves_the_demo() {
     }
     assert!(h.state().error.as_deref().unwrap().contains("broken.molden"));
 }
+
+#[test]
+fn direct_mode_draws_in_bands_and_the_window_keeps_answering() {
+    let benzene = std::path::PathBuf::from(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/fixtures/wavefunctions/benzene_631gs.molden"
+    ));
+    let mut h = Harness::builder()
+        .with_size([1000.0, 700.0])
+        .wgpu_setup(wgpu_setup(true))
+        .build_eframe(move |cc| OrbApp::cube_demo(cc));
+    let ctx = h.ctx.clone();
+    h.state_mut().open_as(benzene, orbcloud::app::Opening::Replace, &ctx);
+    wait_loaded(&mut h);
+    h.state_mut().view.settings.volume.slices = 48;
+    h.get_by_label("per sample (direct)").click();
+    wait_loaded(&mut h);
+    assert!(h.state().orbitals.direct);
+    // 96 basis functions per sample: the frame is drawn band by band, each UI frame short.
+    let (mut steps, mut slowest, mut seen) = (0, 0.0f64, Vec::new());
+    h.run_steps(1);
+    while let Some(p) = h.state().frame_progress() {
+        seen.push(p);
+        let t = std::time::Instant::now();
+        h.run_steps(1);
+        slowest = slowest.max(t.elapsed().as_secs_f64());
+        steps += 1;
+        assert!(steps < 3000, "the frame never finished");
+        if steps == 3 {
+            // An input in the middle of the frame is applied in the next UI frame (and starts
+            // the frame anew from the new view).
+            let yaw = h.state().view.camera.yaw;
+            h.key_press(egui::Key::ArrowLeft);
+            h.run_steps(1);
+            assert_ne!(h.state().view.camera.yaw, yaw, "the key was applied at once");
+        }
+    }
+    eprintln!("direct mode: {steps} UI frames, slowest {:.0} ms, progress {seen:?}", slowest * 1e3);
+    // After the restart at step 3 the picture fills in band by band.
+    let after = &seen[4.min(seen.len())..];
+    assert!(after.len() >= 2 && after.windows(2).all(|w| w[1] >= w[0]), "the picture fills in: {seen:?}");
+    assert!(slowest < 1.5, "a UI frame took {slowest:.2} s");
+}

@@ -275,6 +275,12 @@ impl OrbApp {
         self.viewport.as_ref()?.hovered
     }
 
+    /// How much of a costly frame (drawn in bands) the single-file view has drawn (0..1);
+    /// `None` when no such frame is under way.
+    pub fn frame_progress(&self) -> Option<f32> {
+        self.viewport.as_ref()?.progress()
+    }
+
     /// Each view shown: (size on screen, size of its last frame), pixels. The frame is smaller
     /// while a drag or the animation runs on a CPU adapter ([`detail`]).
     pub fn view_sizes(&self) -> Vec<([u32; 2], [u32; 2])> {

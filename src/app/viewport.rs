@@ -9,13 +9,14 @@ use super::state::{DRAG_ROTATE, KEY_ROTATE, KEY_ZOOM, ViewState};
 use crate::gpu::context::guarded;
 use crate::gpu::frame::PickId;
 use crate::gpu::gto::GtoFillPass;
-use crate::gpu::{FrameInput, GpuContext, GpuError, OffscreenTarget, Renderer};
+use crate::gpu::{FrameInput, GpuContext, GpuError, OffscreenTarget, Renderer, Tile};
 use crate::headless::scan::ScanScene;
 use crate::headless::{Evaluated, WavefunctionView, evaluate_wavefunction, isosurfaces, show_meshes};
 use crate::model::isosurface::Mesh;
 use crate::model::{Document, VolumeGrid};
 use crate::scene::{IsosurfaceSettings, ObjectState, RenderSettings, VolumeSettings};
 use std::sync::Arc;
+use std::time::{Duration, Instant};
 
 /// A click in the view: what the frame showed under the pointer, and whether Shift was held.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -31,6 +32,18 @@ pub struct TwistInput {
     pub drag_twists: bool,
     /// The rotatable bond (world, bohr): a drag that starts on it twists.
     pub bond: Option<[glam::Vec3; 2]>,
+}
+
+/// How long one UI frame may spend drawing bands of a costly frame, and how long one band
+/// should take: inputs are answered within about 100 ms whatever the view shows.
+const FRAME_BUDGET: Duration = Duration::from_millis(40);
+const BAND_TIME: Duration = Duration::from_millis(25);
+
+/// A costly frame being drawn in bands: the first row not drawn yet, and rows per band.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Progress {
+    next_row: u32,
+    rows: u32,
 }
 
 /// Screen distance (points) within which a press grabs the rotatable bond.
@@ -76,6 +89,9 @@ pub struct Viewport {
     layout: Option<(egui::Rect, [u32; 2])>,
     /// Whether the current drag twists the dihedral.
     twisting: bool,
+    /// A costly frame being drawn band by band, and how many rows the last band drew.
+    progress: Option<Progress>,
+    band_rows: u32,
     /// The scan frame shown: (θ, interpolation), for tests and redraws.
     pub scan_shown: Option<(f64, crate::scene::Interpolation)>,
     /// The θ and settings a scan view's isosurfaces were last asked for (`None`: hidden).
@@ -108,6 +124,8 @@ impl Viewport {
             layout: None,
             twisting: false,
             scan_shown: None,
+            progress: None,
+            band_rows: 8,
             scan_iso: None,
         }
     }
@@ -376,13 +394,50 @@ impl Viewport {
         };
         let key = (drawn, clouds, size, self.generation);
         if let Some((target, id)) = &self.target {
-            if self.drawn.as_ref() != Some(&key) {
-                let mut encoder =
-                    self.ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("viewport") });
-                let frame =
-                    FrameInput { camera: &drawn.camera, background: drawn.settings.background, clouds: &key.1, size };
-                self.renderer.render(&self.ctx, &mut encoder, &target.color_view, &frame);
-                self.ctx.queue.submit([encoder.finish()]);
+            let changed = self.drawn.as_ref() != Some(&key);
+            if changed {
+                // A costly frame (orbitals evaluated per sample) is drawn in bands over several
+                // frames, so the window answers while the picture fills in.
+                self.progress = self.renderer.is_costly().then_some(Progress { next_row: 0, rows: self.band_rows });
+            }
+            if changed || self.progress.is_some() {
+                let frame = FrameInput {
+                    camera: &key.0.camera,
+                    background: key.0.settings.background,
+                    clouds: &key.1,
+                    size,
+                    tile: None,
+                };
+                match &mut self.progress {
+                    None => {
+                        let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
+                        self.renderer.render(&self.ctx, &mut encoder, &target.color_view, &frame);
+                        self.ctx.queue.submit([encoder.finish()]);
+                    }
+                    Some(p) => {
+                        let start = Instant::now();
+                        while p.next_row < size[1] && start.elapsed() < FRAME_BUDGET {
+                            let rows = p.rows.min(size[1] - p.next_row);
+                            let tile = Tile { rect: [0, p.next_row, size[0], rows], first: p.next_row == 0 };
+                            let band = Instant::now();
+                            let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
+                            let frame = FrameInput { tile: Some(tile), ..frame };
+                            self.renderer.render(&self.ctx, &mut encoder, &target.color_view, &frame);
+                            self.ctx.queue.submit([encoder.finish()]);
+                            // Waiting here keeps each frame's GPU work within the budget.
+                            let _ = self.ctx.device.poll(wgpu::PollType::wait_indefinitely());
+                            let per_row = band.elapsed().as_secs_f64() / rows as f64;
+                            p.next_row += rows;
+                            p.rows = ((BAND_TIME.as_secs_f64() / per_row.max(1e-6)) as u32).clamp(1, size[1]);
+                        }
+                        self.band_rows = p.rows;
+                        if p.next_row >= size[1] {
+                            self.progress = None;
+                        } else {
+                            ui.ctx().request_repaint();
+                        }
+                    }
+                }
                 self.drawn = Some(key);
             }
             let uv = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
@@ -445,12 +500,24 @@ impl Viewport {
         let mut encoder =
             self.ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("snapshot") });
         let clouds = if self.clouds.is_empty() { vec![view.settings.volume] } else { self.clouds.clone() };
-        let frame = FrameInput { camera: &view.camera, background: view.settings.background, clouds: &clouds, size };
+        let frame = FrameInput {
+            camera: &view.camera,
+            background: view.settings.background,
+            clouds: &clouds,
+            size,
+            tile: None,
+        };
         self.renderer.render(&self.ctx, &mut encoder, &target.color_view, &frame);
         self.ctx.queue.submit([encoder.finish()]);
         // The viewport's own frame must be redrawn: the renderer's buffers changed size.
         self.drawn = None;
         target.read_rgba(&self.ctx.device, &self.ctx.queue)
+    }
+
+    /// How much of a frame drawn in bands is done (0..1); `None` when none is under way.
+    pub fn progress(&self) -> Option<f32> {
+        let p = self.progress?;
+        Some(p.next_row as f32 / self.rendered_size()?[1].max(1) as f32)
     }
 
     /// The view's size on screen, pixels.

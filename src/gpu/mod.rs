@@ -16,7 +16,7 @@ pub mod target;
 pub mod volume;
 
 pub use context::{AdapterPreference, GpuContext, GpuError};
-pub use renderer::{FrameInput, Renderer};
+pub use renderer::{FrameInput, Renderer, Tile};
 pub use target::OffscreenTarget;
 
 /// The format of the final image (sRGB storage).

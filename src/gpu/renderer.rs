@@ -23,12 +23,30 @@ pub struct FrameInput<'a> {
     pub clouds: &'a [VolumeSettings],
     /// Target size in pixels.
     pub size: [u32; 2],
+    /// Draw only this part of the clouds (a frame too costly for one go, drawn over several).
+    pub tile: Option<Tile>,
+}
+
+/// One band of a frame drawn progressively: the first clears the targets and draws every opaque
+/// thing; each draws the clouds inside its rectangle only, over what the earlier ones left.
+/// Every tile resolves the whole frame, so the picture fills in band by band.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Tile {
+    /// x, y, width, height in pixels.
+    pub rect: [u32; 4],
+    pub first: bool,
 }
 
 impl<'a> FrameInput<'a> {
     /// A frame of one layer drawn with `settings` (the CLI, scan views, tests).
     pub fn single(camera: &'a Camera, settings: &'a RenderSettings, size: [u32; 2]) -> Self {
-        Self { camera, background: settings.background, clouds: std::slice::from_ref(&settings.volume), size }
+        Self {
+            camera,
+            background: settings.background,
+            clouds: std::slice::from_ref(&settings.volume),
+            size,
+            tile: None,
+        }
     }
 }
 
@@ -180,6 +198,12 @@ impl Renderer {
         }
     }
 
+    /// Whether a frame is costly enough to draw in tiles: a visible cloud evaluates its orbital
+    /// per sample (seed 004's direct mode).
+    pub fn is_costly(&self) -> bool {
+        self.layers.iter().any(|l| l.visible && l.volume.is_direct())
+    }
+
     pub fn layer_count(&self) -> usize {
         self.layers.len()
     }
@@ -238,7 +262,18 @@ impl Renderer {
                 self.resolve.draw(encoder, resolve, output);
                 continue;
             }
+            // A later tile keeps what the first drew: only the clouds inside it are added.
+            if node.phase == Phase::Opaque && frame.tile.is_some_and(|t| !t.first) {
+                continue;
+            }
             let mut pass = targets.begin(encoder, node, frame.background);
+            if let Some(Tile { rect: [x, y, w, h], .. }) = frame.tile
+                && node.phase == Phase::Translucent
+            {
+                let [fw, fh] = targets.size;
+                let (x, y) = (x.min(fw - 1), y.min(fh - 1));
+                pass.set_scissor_rect(x, y, w.clamp(1, fw - x), h.clamp(1, fh - y));
+            }
             for layer in self.layers.iter().filter(|l| l.visible) {
                 for drawer in layer.drawers().into_iter().filter(|d| d.phases().contains(&node.phase)) {
                     drawer.draw(node.phase, &mut pass);

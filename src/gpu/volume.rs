@@ -517,6 +517,11 @@ impl VolumePass {
         self.morph = Some(Morph { _partner: b, bind_group, k: k.clamp(0.0, 1.0), mode });
     }
 
+    /// Whether the orbital is evaluated per sample from its basis functions (direct mode).
+    pub fn is_direct(&self) -> bool {
+        self.direct.is_some()
+    }
+
     pub fn volume(&self) -> Option<&VolumeTexture> {
         self.volume.as_ref()
     }
