@@ -119,7 +119,7 @@ enum SpinArg {
 struct WavefunctionArgs {
     #[command(flatten)]
     what: WhatArgs,
-    /// Evaluate the orbital per slice sample from the basis functions (seed 004's direct mode)
+    /// Evaluate the orbital per slice sample from the basis functions (Jang & Varetto's direct mode)
     /// instead of on a GPU-filled grid.
     #[arg(long)]
     direct: bool,
@@ -223,7 +223,7 @@ enum BenchCommand {
         #[command(flatten)]
         wavefunction: WavefunctionArgs,
     },
-    /// Frame time against the number of resident key volumes K of a scan (seed 000's Fig. 6).
+    /// Frame time against the number of resident key volumes K of a scan (Naka et al.'s Fig. 6).
     Keyvolumes(scan_cli::KeyVolumeBench),
     /// ms to extract an isosurface (both signs of an orbital) from a grid.
     Isosurface(surface_cli::IsoBench),
@@ -255,7 +255,7 @@ struct RenderArgs {
 enum ModeArg {
     /// Slices perpendicular to the view direction.
     View,
-    /// Seed 000's three axis-aligned stacks.
+    /// Naka et al.'s three axis-aligned stacks.
     Axis,
 }
 
@@ -306,7 +306,7 @@ struct ViewArgs {
     /// Hide the volume (atoms only).
     #[arg(long)]
     no_volume: bool,
-    /// Transfer function: seed 000's power law, or one of seed 004's shapes (both signs).
+    /// Transfer function: Naka et al.'s power law, or one of Jang & Varetto's shapes (both signs).
     #[arg(long, value_enum, default_value_t = TfArg::Power)]
     tf: TfArg,
     /// Shape centre (iso-value), a fraction of max|value|.

@@ -180,9 +180,18 @@ fn scan_export_writes_the_interpolated_orbital_and_render_writes_both_views() {
     let img = image::open(&png).unwrap();
     assert_eq!((img.width(), img.height()), (192, 64), "two views side by side");
 
-    let out = orbcloud(&["scan", "render", manifest, "--angle", "-90", "--orbital", "homo-7", "-o", "x.png"]);
-    assert!(!out.status.success());
-    assert!(String::from_utf8_lossy(&out.stderr).contains("homo-7"));
+    // Wrong arguments are refused before the key volumes are made (seconds of GPU work).
+    for (args, says) in [
+        (["--angle", "-90", "--orbital", "homo-7"], "--orbital homo-7: the scan shows homo, lumo"),
+        (["--angle", "30", "--orbital", "homo"], "--angle 30 is outside the scan's -180°..0°"),
+    ] {
+        let start = std::time::Instant::now();
+        let out = orbcloud(&[&["scan", "render", manifest][..], &args[..], &["-o", "x.png"][..]].concat());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success() && err.contains(says), "{args:?}: {err}");
+        assert!(!err.contains("key volumes"), "{args:?}: checked only after building: {err}");
+        assert!(start.elapsed().as_secs_f64() < 3.0, "{args:?} took {:?}", start.elapsed());
+    }
 }
 
 const FIXTURES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/wavefunctions");

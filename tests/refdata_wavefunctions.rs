@@ -347,3 +347,18 @@ fn orbitals_and_densities_match_the_expected_values() {
     }
     eprintln!("{report}");
 }
+
+#[test]
+fn fchk_files_name_their_writer() {
+    if common::refdata("refdata_wavefunctions::fchk_files_name_their_writer").is_none() {
+        return;
+    }
+    for (file, writer) in [
+        ("o2_cc_pvtz_cart.fchk", "Gaussian"),
+        ("water_dimer_ghost.fchk", "Gaussian"),
+        ("water_hf_sto3g_qchem5.2.fchk", "Q-Chem"),
+    ] {
+        let doc = load(&dir().join(file));
+        assert_eq!(doc.wavefunction.unwrap().normalization.program, writer, "{file}");
+    }
+}

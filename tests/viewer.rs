@@ -137,7 +137,7 @@ fn a_molden_file_opens_on_its_homo_and_the_browser_switches_orbitals() {
     let homo = wf.homo(orbcloud::model::Spin::Alpha).unwrap();
     assert_eq!(app.orbitals.shown, Quantity::Orbital(homo), "opens on the HOMO");
     let lumo = wf.lumo(orbcloud::model::Spin::Alpha).unwrap();
-    h.get_by_label(&format!("MO {}", lumo + 1)).click();
+    h.get_by_label_contains(&format!("MO {} ", lumo + 1)).click();
     h.run_steps(2);
     assert_eq!(h.state().orbitals.shown, Quantity::Orbital(lumo));
     h.get_by_label("per sample (direct)").click();

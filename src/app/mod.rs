@@ -87,6 +87,24 @@ pub enum Opening {
     Restore(Box<ObjectState>),
 }
 
+/// Text sizes readable at 1280×800 (egui's defaults make small print of 9 points).
+fn readable_text(ctx: &egui::Context) {
+    use egui::{FontFamily, FontId, TextStyle};
+    ctx.all_styles_mut(|style| {
+        for (text_style, size) in [
+            (TextStyle::Small, 11.0),
+            (TextStyle::Body, 13.5),
+            (TextStyle::Button, 13.5),
+            (TextStyle::Monospace, 12.5),
+            (TextStyle::Heading, 18.0),
+        ] {
+            let family =
+                if text_style == TextStyle::Monospace { FontFamily::Monospace } else { FontFamily::Proportional };
+            style.text_styles.insert(text_style, FontId::new(size, family));
+        }
+    });
+}
+
 /// Recent files kept.
 const RECENT_FILES: usize = 10;
 
@@ -192,6 +210,7 @@ impl OrbApp {
     }
 
     fn empty(cc: &eframe::CreationContext<'_>, files: Vec<PathBuf>) -> Self {
+        readable_text(&cc.egui_ctx);
         let viewport = cc
             .wgpu_render_state
             .as_ref()

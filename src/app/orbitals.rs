@@ -17,7 +17,7 @@ const SHELL_LETTERS: [&str; 6] = ["s", "p", "d", "f", "g", "h"];
 /// `scroll_to_frontier` brings the HOMO's row into view once (after a file opens).
 pub fn panel(ui: &mut egui::Ui, doc: &Document, view: &mut OrbitalView, scroll_to_frontier: &mut bool) {
     let Some(wf) = &doc.wavefunction else { return };
-    egui::Panel::right("orbitals").default_size(330.0).show(ui, |ui| {
+    egui::Panel::right("orbitals").exact_size(360.0).show(ui, |ui| {
         ui.heading("Orbitals");
         let n = &wf.normalization;
         ui.label(
@@ -55,7 +55,7 @@ pub fn panel(ui: &mut egui::Ui, doc: &Document, view: &mut OrbitalView, scroll_t
                 "a compute pass fills a 3D texture; the slices sample it (fast to view, switch in one pass)",
             );
             ui.selectable_value(&mut view.direct, true, "per sample (direct)").on_hover_text(
-                "seed 004: every slice fragment evaluates the orbital from the basis functions, no grid",
+                "Jang & Varetto's direct mode: every slice fragment evaluates the orbital from the basis functions, no grid",
             );
         });
         keyboard(ui, wf, view);
@@ -88,34 +88,41 @@ fn orbital_table(ui: &mut egui::Ui, wf: &Wavefunction, view: &mut OrbitalView, s
     // Highest energy at the top, as in an orbital diagram.
     let mut order = wf.by_energy(spin);
     order.reverse();
-    ui.label(RichText::new("click to show; Shift + up/down arrows to step").small().weak());
+    ui.label(RichText::new("click a row to show it; Shift + up/down arrows to step").small().weak());
+    // One monospace line per orbital: the whole row is the button, and the header above the
+    // scrolled list lines up with it and stays in view.
+    ui.label(RichText::new(row_text("", "", "sym", "E / Eh", "E / eV", "occ")).monospace().strong());
     ScrollArea::vertical().max_height(ui.available_height() * 0.6).show(ui, |ui| {
-        egui::Grid::new("orbital table").striped(true).num_columns(6).show(ui, |ui| {
-            for h in ["", "", "sym", "E / Eh", "E / eV", "occ"] {
-                ui.label(RichText::new(h).strong());
+        for i in order {
+            let o = &wf.orbitals[i];
+            let number = wf.of_spin(o.spin).position(|(j, _)| j == i).map_or(0, |p| p + 1);
+            let selected = view.shown == Quantity::Orbital(i);
+            let text = row_text(
+                &format!("MO {number}"),
+                &wf.frontier_label(i, 5).unwrap_or_default(),
+                &o.symmetry,
+                &format!("{:.5}", o.energy),
+                &format!("{:.3}", o.energy * EV_PER_HARTREE),
+                &format!("{:.2}", o.occupation),
+            );
+            let row = ui.add(
+                egui::Button::selectable(selected, RichText::new(text).monospace())
+                    .min_size(egui::vec2(ui.available_width(), 0.0)),
+            );
+            if row.clicked() {
+                view.shown = Quantity::Orbital(i);
             }
-            ui.end_row();
-            for i in order {
-                let o = &wf.orbitals[i];
-                let number = wf.of_spin(o.spin).position(|(j, _)| j == i).map_or(0, |p| p + 1);
-                let selected = view.shown == Quantity::Orbital(i);
-                let row = ui.selectable_label(selected, format!("MO {number}"));
-                if row.clicked() {
-                    view.shown = Quantity::Orbital(i);
-                }
-                if *scroll_to_frontier && Some(i) == wf.homo(spin) {
-                    row.scroll_to_me(Some(egui::Align::Center));
-                    *scroll_to_frontier = false;
-                }
-                ui.label(RichText::new(wf.frontier_label(i, 5).unwrap_or_default()).strong());
-                ui.label(&o.symmetry);
-                ui.label(format!("{:.5}", o.energy));
-                ui.label(format!("{:.3}", o.energy * EV_PER_HARTREE));
-                ui.label(format!("{:.2}", o.occupation));
-                ui.end_row();
+            if *scroll_to_frontier && Some(i) == wf.homo(spin) {
+                row.scroll_to_me(Some(egui::Align::Center));
+                *scroll_to_frontier = false;
             }
-        });
+        }
     });
+}
+
+/// One line of the orbital table, columns padded to fixed widths.
+fn row_text(name: &str, label: &str, sym: &str, eh: &str, ev: &str, occ: &str) -> String {
+    format!("{name:<6}{label:<7}{sym:<4}{eh:>9}{ev:>8}{occ:>5}")
 }
 
 /// Seed 004's atomic-orbital selector: restrict the shown orbital to chosen shells.

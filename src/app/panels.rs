@@ -11,6 +11,9 @@ use crate::scene::{
     ViewPreset,
 };
 
+/// The side panel's width, points.
+const SIDE_PANEL_WIDTH: f32 = 290.0;
+
 pub enum Action {
     None,
     Open,
@@ -146,7 +149,8 @@ fn status_line(ui: &mut egui::Ui, app: &OrbApp, cancel: &mut bool) {
 }
 
 pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
-    egui::Panel::left("controls").default_size(250.0).show(ui, |ui| {
+    // A fixed width: opening a section never makes the panel jump.
+    egui::Panel::left("controls").exact_size(SIDE_PANEL_WIDTH).show(ui, |ui| {
         egui::ScrollArea::vertical().show(ui, |ui| {
             super::scene_panel::section(ui, app);
             if app.scan.is_none() && !app.objects.is_empty() {
@@ -195,6 +199,8 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
             });
             ui.add(Slider::new(&mut vs.slices, 16..=512).text("slice count"));
             ui.horizontal(|ui| {
+                // Room for the value, the name and the auto box within the panel.
+                ui.spacing_mut().slider_width = 70.0;
                 let k1 = ui.add(Slider::new(&mut vs.k1, 0.0..=2.0).logarithmic(true).text("k1 (opacity)"));
                 if k1.changed() {
                     vs.auto_k1 = false;
@@ -264,12 +270,20 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
                 // A scan's atoms where they are at θ.
                 let twisted = app.scan.as_ref().map(|s| s.scene.scan.geometry_at(s.theta));
                 let molecule = twisted.as_ref().unwrap_or(&app.doc().molecule);
-                egui::Grid::new("atoms").striped(true).show(ui, |ui| {
+                // Coordinates in columns of their own, so none is cut off by the panel's edge.
+                egui::Grid::new("atoms").striped(true).num_columns(5).show(ui, |ui| {
+                    for h in ["", "", "x / Å", "y / Å", "z / Å"] {
+                        ui.label(RichText::new(h).strong());
+                    }
+                    ui.end_row();
                     for (i, a) in molecule.atoms.iter().enumerate().take(500) {
                         let p = a.position * ANGSTROM_PER_BOHR;
                         ui.label(format!("{}", i + 1));
-                        ui.label(format!("{}{}", a.element().symbol, if a.ghost { " (ghost)" } else { "" }));
-                        ui.label(format!("{:.3} {:.3} {:.3} Å", p.x, p.y, p.z));
+                        ui.label(format!("{}{}", a.element().symbol, if a.ghost { "*" } else { "" }))
+                            .on_hover_text(if a.ghost { "ghost atom: basis functions, no nucleus" } else { "" });
+                        for c in [p.x, p.y, p.z] {
+                            ui.label(RichText::new(format!("{c:.3}")).monospace());
+                        }
                         ui.end_row();
                     }
                 });

@@ -222,7 +222,8 @@ pub fn controls(ui: &mut egui::Ui, scan: &mut ScanView) -> Option<Follow> {
         let (lo, hi) = scan.scene.scan.range();
         ui.horizontal(|ui| {
             let play = if scan.playing { "Pause" } else { "Play" };
-            if ui.button(play).on_hover_text("Animate θ (Space)").clicked() {
+            // One width for both words: the slider beside it stays where it is.
+            if ui.add_sized([58.0, 22.0], egui::Button::new(play)).on_hover_text("Animate θ (Space)").clicked() {
                 scan.playing = !scan.playing;
             }
             ui.checkbox(&mut scan.looping, "loop");
@@ -244,7 +245,7 @@ pub fn controls(ui: &mut egui::Ui, scan: &mut ScanView) -> Option<Follow> {
             ui.radio_value(&mut scan.mode, Interpolation::Exact, "exact")
                 .on_hover_text("mix the two key volumes per sample");
             ui.radio_value(&mut scan.mode, Interpolation::ThreePass, "three-pass")
-                .on_hover_text("seed 000: attenuate, add (1−k)A, add kB per slice");
+                .on_hover_text("Naka et al.'s three blending passes: attenuate, add (1−k)A, add kB per slice");
             let mut by_overlap = scan.scene.tracks.follow == Follow::Overlap;
             let swaps = scan.scene.tracks.swaps.len();
             if ui

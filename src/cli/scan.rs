@@ -1,6 +1,6 @@
 //! `orbcloud scan …` and `orbcloud bench keyvolumes`: dihedral scans from the command line.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
@@ -71,7 +71,7 @@ pub enum FollowArg {
 pub enum InterpolationArg {
     /// Both key volumes mixed per sample (the interpolated orbital).
     Exact,
-    /// Seed 000's three blending passes per slice.
+    /// Naka et al.'s three blending passes per slice.
     ThreePass,
 }
 
@@ -123,8 +123,7 @@ fn follow_of(arg: Option<FollowArg>, file: &ScanFile) -> Follow {
 }
 
 /// Loads a scan and makes its key volumes, reporting progress on stderr.
-fn build(ctx: &GpuContext, path: &Path, keys: &KeyArgs) -> Result<ScanScene> {
-    let file = load_scan(path)?;
+fn build(ctx: &GpuContext, file: ScanFile, keys: &KeyArgs) -> Result<ScanScene> {
     let options = KeyOptions {
         points: keys.points.clamp(8, 512),
         follow: follow_of(keys.follow, &file),
@@ -157,7 +156,18 @@ fn build(ctx: &GpuContext, path: &Path, keys: &KeyArgs) -> Result<ScanScene> {
 }
 
 fn slot_of(scan: &Scan, name: &str) -> Result<usize> {
-    scan.slot(name).with_context(|| format!("the scan shows {:?}, not {name:?}", scan.orbitals))
+    scan.slot(name).with_context(|| {
+        format!("--orbital {name}: the scan shows {} (as its manifest names them)", scan.orbitals.join(", "))
+    })
+}
+
+/// Refuses an angle outside the scan's range (it would be drawn at the nearest end).
+fn check_angle(scan: &Scan, angle: f64) -> Result<()> {
+    let (lo, hi) = scan.range();
+    if !(lo..=hi).contains(&angle) {
+        bail!("--angle {angle} is outside the scan's {lo}°..{hi}°");
+    }
+    Ok(())
 }
 
 pub fn run(command: ScanCommand) -> Result<()> {
@@ -224,12 +234,15 @@ pub fn run(command: ScanCommand) -> Result<()> {
             Ok(())
         }
         ScanCommand::Render(args) => {
-            let ctx = gpu(args.lavapipe)?;
-            let scene = build(&ctx, &args.scan, &args.keys)?;
+            // Arguments are checked before the key volumes are made.
+            let file = load_scan(&args.scan)?;
             let slots: Vec<usize> = match &args.orbital {
-                Some(name) => vec![slot_of(&scene.scan, name)?],
-                None => (0..scene.slots()).collect(),
+                Some(name) => vec![slot_of(&file.scan, name)?],
+                None => (0..file.scan.orbitals.len()).collect(),
             };
+            check_angle(&file.scan, args.angle)?;
+            let ctx = gpu(args.lavapipe)?;
+            let scene = build(&ctx, file, &args.keys)?;
             let settings = args.view.settings();
             let mut camera = scene.camera();
             camera.orbit(args.view.yaw.to_radians(), args.view.pitch.to_radians());
@@ -255,10 +268,7 @@ pub fn run(command: ScanCommand) -> Result<()> {
             let follow = follow_of(keys.follow, &file);
             let s = &file.scan;
             let slot = slot_of(s, &orbital)?;
-            let (lo, hi) = s.range();
-            if !(lo..=hi).contains(&angle) {
-                bail!("--angle {angle} is outside the scan's {lo}°..{hi}°");
-            }
+            check_angle(s, angle)?;
             let tracks = s.track(follow)?;
             let grid = s.key_grid(&tracks, orbcloud::headless::ORBITAL_MARGIN, keys.points.clamp(8, 512));
             let label = format!("{orbital} at {angle} deg (interpolated)");
@@ -274,7 +284,7 @@ pub fn run(command: ScanCommand) -> Result<()> {
 }
 
 /// `bench keyvolumes`: frame time against the number of resident key volumes K (the analogue
-/// of seed 000's Figure 6), and the largest K that fits the memory budget.
+/// of Naka et al.'s Figure 6), and the largest K that fits the memory budget.
 #[derive(Args)]
 pub struct KeyVolumeBench {
     /// A scan manifest; the bundled PSB3 demo when omitted.

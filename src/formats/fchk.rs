@@ -77,6 +77,19 @@ pub struct FchkFile {
     pub geometries: Vec<GeometrySet>,
     /// Lines in the file (for end-of-file errors).
     pub n_lines: usize,
+    /// Whether the file has records only Q-Chem writes.
+    pub labels_of_qchem: bool,
+}
+
+/// Records Q-Chem's fchk files carry and Gaussian's do not.
+const QCHEM_ONLY: [&str; 4] = ["Pure Switching", "Core Hamiltonian Matrix", "Octapole", "Hexadecapole"];
+
+impl FchkFile {
+    /// The program that wrote the file: one its title names, else Q-Chem when it has Q-Chem's
+    /// own records, else Gaussian (whose format this is).
+    pub fn writer(&self) -> &'static str {
+        program_named_in(&self.title).unwrap_or(if self.labels_of_qchem { "Q-Chem" } else { "Gaussian" })
+    }
 }
 
 /// The records [`FchkFile::parse`] keeps.
@@ -164,6 +177,7 @@ impl FchkFile {
                 _ => None,
             };
             let wanted = NEEDED.contains(&label) || (kind == 'R' && is_geometry_label(label));
+            out.labels_of_qchem |= QCHEM_ONLY.contains(&label);
             let Some(count) = count else {
                 // A scalar.
                 if wanted {
@@ -495,7 +509,7 @@ impl FchkFile {
             }
         }
         let wf = Wavefunction { basis, orbitals, restricted: !unrestricted, normalization: Default::default() };
-        Ok(wavefunction_document(source, &self.title, atoms, wf, program_named_in(&self.title), overlap))
+        Ok(wavefunction_document(source, &self.title, atoms, wf, Some(self.writer()), overlap))
     }
 }
 
