@@ -396,9 +396,12 @@ impl Viewport {
         if let Some((target, id)) = &self.target {
             let changed = self.drawn.as_ref() != Some(&key);
             if changed {
-                // A costly frame (orbitals evaluated per sample) is drawn in bands over several
-                // frames, so the window answers while the picture fills in.
-                self.progress = self.renderer.is_costly().then_some(Progress { next_row: 0, rows: self.band_rows });
+                // A costly frame (orbitals evaluated per sample, or any frame on a CPU rasteriser)
+                // is drawn in bands over several UI frames, so the window answers while the
+                // picture fills in; a cheap one still takes one band.
+                let cpu = self.ctx.info.device_type == wgpu::DeviceType::Cpu;
+                self.progress =
+                    (cpu || self.renderer.is_costly()).then_some(Progress { next_row: 0, rows: self.band_rows });
             }
             if changed || self.progress.is_some() {
                 let frame = FrameInput {
