@@ -232,3 +232,55 @@ fn a_frame_drawn_in_bands_equals_the_frame_drawn_at_once() {
     };
     assert!(below(&partial) > 100, "the lower bands fill in later");
 }
+
+#[test]
+fn grids_over_the_gpus_limits_are_shown_coarser_with_a_note() {
+    use orbcloud::headless::{WavefunctionView, coarser_note, evaluate_within, isosurfaces_within};
+    let ctx = lavapipe();
+    // One side longer than any 3D texture this device makes: shown with every 2nd point.
+    let max = ctx.device.limits().max_texture_dimension_3d as usize;
+    let long = orbcloud::model::VolumeGrid::new(
+        "long",
+        [max + 1, 2, 2],
+        orbcloud::model::VolumeGrid::affine(DVec3::ZERO, [DVec3::X * 0.01, DVec3::Y, DVec3::Z]),
+        (0..(max + 1) * 4).map(|i| (i % 7) as f32).collect(),
+    );
+    let mut renderer = Renderer::new(&ctx);
+    let step = renderer.main().set_volume(&ctx, Some(&long)).expect("shown coarser, not refused");
+    assert_eq!(step, 2);
+    let shown = renderer.layer(0).unwrap().volume.volume().unwrap().dims;
+    assert_eq!(shown, long.subsampled(2).dims);
+    assert!(coarser_note("long.cube", long.dims, 2).contains("one point in 2"));
+
+    // An orbital asked on more points than the limits allow is evaluated on fewer, with a note.
+    let doc = orbcloud::formats::load(std::path::Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/fixtures/wavefunctions/h2o_cart_631gs.molden"
+    )))
+    .unwrap();
+    let mut small = ctx.device.limits();
+    small.max_texture_dimension_3d = 24;
+    let homo = doc.wavefunction.as_ref().unwrap().homo(orbcloud::model::Spin::Alpha).unwrap();
+    let view = WavefunctionView {
+        quantity: orbcloud::model::orbitals::Quantity::Orbital(homo),
+        direct: false,
+        points: 64,
+        shells: None,
+    };
+    let fill = orbcloud::gpu::gto::GtoFillPass::new(&ctx);
+    let (evaluated, note) = evaluate_within(&ctx, &fill, &doc, &view, &small).unwrap();
+    let grid = evaluated.unwrap().grid;
+    assert!(grid.dims.iter().all(|&d| d <= 24), "{:?}", grid.dims);
+    assert!(note.unwrap().contains("64 points per side are more than this GPU holds"));
+
+    // Isosurfaces whose meshes would not fit a buffer are cut from a coarser grid.
+    let p = p_orbital(48, false);
+    let iso =
+        orbcloud::scene::IsosurfaceSettings { visible: true, level: IsoLevel::Absolute(0.2), ..Default::default() };
+    let (whole, none) = isosurfaces_within(&p, &[iso], u64::MAX);
+    assert!(none.is_none());
+    let biggest = whole.iter().map(|(m, _)| m.positions.len() as u64 * 24).max().unwrap();
+    let (coarse, note) = isosurfaces_within(&p, &[iso], biggest / 2);
+    assert!(note.unwrap().contains("one point in 2"));
+    assert!(coarse.iter().all(|(m, _)| m.positions.len() as u64 * 24 <= biggest / 2) && !coarse.is_empty());
+}

@@ -105,6 +105,9 @@ fn readable_text(ctx: &egui::Context) {
     });
 }
 
+/// How a lost GPU device is reported.
+const DEVICE_LOST: &str = "the GPU device was lost";
+
 /// Recent files kept.
 const RECENT_FILES: usize = 10;
 
@@ -228,6 +231,15 @@ impl OrbApp {
                 errors.lock().unwrap_or_else(|p| p.into_inner()).push(e.to_string());
                 repaint.request_repaint();
             }));
+            // A lost device cannot be recreated under eframe's window: keep the scene and say how
+            // to get it back.
+            let (errors, repaint) = (gpu_errors.clone(), cc.egui_ctx.clone());
+            vp.ctx.device.set_device_lost_callback(move |reason, message| {
+                if reason != wgpu::DeviceLostReason::Destroyed {
+                    errors.lock().unwrap_or_else(|p| p.into_inner()).push(format!("{DEVICE_LOST} ({message})"));
+                    repaint.request_repaint();
+                }
+            });
         }
         let mut app = Self {
             objects: Vec::new(),
@@ -395,10 +407,13 @@ impl OrbApp {
             return;
         }
         let Some(vp) = &mut self.viewport else { return };
-        if let Err(e) = vp.set_object(keep, &doc, &state) {
-            self.error = Some(format!("{}: {e}", doc.source));
-            return;
-        }
+        let note = match vp.set_object(keep, &doc, &state) {
+            Ok(note) => note,
+            Err(e) => {
+                self.error = Some(format!("{}: {e}", doc.source));
+                return;
+            }
+        };
         if replace {
             vp.truncate(1);
         }
@@ -408,7 +423,7 @@ impl OrbApp {
             self.measurements = measure::Measurements::default();
         }
         self.scan = None;
-        self.status = format!("opened {}", doc.source);
+        self.status = note.unwrap_or_else(|| format!("opened {}", doc.source));
         let mut orbitals = doc.wavefunction.as_ref().map(OrbitalView::for_wavefunction).unwrap_or_default();
         if let Some(q) = state.quantity {
             orbitals.shown = q;
@@ -684,7 +699,16 @@ impl OrbApp {
     fn poll_job(&mut self, ctx: &egui::Context) {
         self.poll_object_jobs();
         let reported: Vec<String> = std::mem::take(&mut *self.gpu_errors.lock().unwrap_or_else(|p| p.into_inner()));
-        if let Some(last) = reported.last() {
+        if reported.iter().any(|e| e.starts_with(DEVICE_LOST)) {
+            self.save_last_session();
+            let kept = self
+                .last_session
+                .as_ref()
+                .map_or(String::new(), |p| format!(" The scene is saved in {}.", p.display()));
+            self.error = Some(format!(
+                "{DEVICE_LOST}: the view cannot be drawn any more.{kept} Restart orbcloud and choose *Last session* to reopen it."
+            ));
+        } else if let Some(last) = reported.last() {
             self.error = Some(format!("the GPU reported an error (the view may be incomplete): {last}"));
         }
         if let Some((job, _)) = &self.job
@@ -776,8 +800,10 @@ impl OrbApp {
         let (was, now) = (&before.settings.volume, &self.view.settings.volume);
         let law_changed = was.k2 != now.k2 || was.density_scale != now.density_scale || (now.auto_k1 && !was.auto_k1);
         if before.volume != self.view.volume {
-            if let Err(e) = vp.set_volume(n, &o.doc, &o.state) {
-                self.error = Some(e.to_string());
+            match vp.set_volume(n, &o.doc, &o.state) {
+                Ok(Some(note)) => self.status = note,
+                Ok(None) => {}
+                Err(e) => self.error = Some(e.to_string()),
             }
             self.auto_opacity(n);
         } else if law_changed {

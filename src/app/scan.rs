@@ -16,7 +16,7 @@ use super::state::ViewState;
 use super::viewport::{TwistInput, Viewport};
 use crate::formats::scan::{ScanFile, load_scan};
 use crate::gpu::GpuContext;
-use crate::headless::isosurfaces;
+use crate::headless::isosurfaces_within;
 use crate::headless::scan::{KeyOptions, ScanScene, ScanSceneError, mix};
 use crate::model::scan::Follow;
 use crate::model::units::EV_PER_HARTREE;
@@ -376,10 +376,16 @@ pub fn views(
                 vp.scan_iso = wanted;
                 let (a, b, k) = scan.scene.bracket_grids(slot, scan.theta);
                 let iso = view.settings.iso;
-                vp.request_meshes(0, move || isosurfaces(&mix(&a, &b, k), &iso));
+                vp.request_meshes(0, move |max_bytes| isosurfaces_within(&mix(&a, &b, k), &[iso], max_bytes));
             }
             match vp.poll_meshes(0) {
-                Some(Ok(n)) if n > 0 => said = Some(format!("isosurfaces at θ = {:.1}°: {n} triangles", scan.theta)),
+                Some(Ok((n, note))) if n > 0 => {
+                    said = Some(format!(
+                        "{}isosurfaces at θ = {:.1}°: {n} triangles",
+                        note.map_or(String::new(), |n| n + "; "),
+                        scan.theta
+                    ))
+                }
                 Some(Err(e)) => said = Some(e),
                 _ => {}
             }

@@ -11,7 +11,7 @@ use crate::gpu::frame::PickId;
 use crate::gpu::gto::GtoFillPass;
 use crate::gpu::{FrameInput, GpuContext, GpuError, OffscreenTarget, Renderer, Tile};
 use crate::headless::scan::ScanScene;
-use crate::headless::{Evaluated, WavefunctionView, evaluate_wavefunction, isosurfaces, show_meshes};
+use crate::headless::{Evaluated, WavefunctionView, evaluate_within, isosurfaces_within, show_meshes};
 use crate::model::isosurface::Mesh;
 use crate::model::{Document, VolumeGrid};
 use crate::scene::{IsosurfaceSettings, ObjectState, RenderSettings, VolumeSettings};
@@ -46,18 +46,33 @@ struct Progress {
     rows: u32,
 }
 
+/// The note for a document's volume shown at every `step`-th point (`None` when whole).
+fn coarser(doc: &Document, state: &ObjectState, step: usize) -> Option<String> {
+    let grid = doc.volumes.get(state.volume).filter(|_| step > 1)?;
+    Some(crate::headless::coarser_note(&doc.source, grid.dims, step))
+}
+
 /// Screen distance (points) within which a press grabs the rotatable bond.
 const BOND_GRAB: f32 = 10.0;
+
+/// An orbital or density evaluated in the background, with a note when its grid had to be
+/// coarser than asked.
+type Evaluation = Result<(Option<Evaluated>, Option<String>), GpuError>;
+
+/// Isosurfaces made in the background, each with its colour, and a note when they had to be
+/// cut from a coarser grid.
+pub type Meshes = (Vec<(Mesh, [f32; 3])>, Option<String>);
 
 /// What the viewport keeps per object besides its renderer layer.
 struct ObjectJobs {
     /// Values on the grid shown when computed from a basis (cube files' grids stay in the
     /// document): isosurfaces are cut from it.
     computed: Option<Arc<VolumeGrid>>,
-    /// Orbitals filled on the GPU and densities evaluated on the CPU.
-    evaluation: Latest<Result<Option<Evaluated>, GpuError>>,
+    /// Orbitals filled on the GPU and densities evaluated on the CPU, with a note when the grid
+    /// had to be coarser than asked.
+    evaluation: Latest<Evaluation>,
     /// Marching cubes over the grid shown.
-    extraction: Latest<Vec<(Mesh, [f32; 3])>>,
+    extraction: Latest<Meshes>,
 }
 
 pub struct Viewport {
@@ -131,14 +146,20 @@ impl Viewport {
     }
 
     /// Uploads object `n` of the scene: its molecule, the volume its state chooses and its
-    /// placement; its isosurfaces are cut in the background.
-    pub fn set_object(&mut self, n: usize, doc: &Arc<Document>, state: &ObjectState) -> Result<(), GpuError> {
+    /// placement; its isosurfaces are cut in the background. Returns a note when the volume is
+    /// more than the GPU holds and is shown coarser.
+    pub fn set_object(
+        &mut self,
+        n: usize,
+        doc: &Arc<Document>,
+        state: &ObjectState,
+    ) -> Result<Option<String>, GpuError> {
         let (ctx, layer) = (&self.ctx, self.renderer.layer_mut(&self.ctx, n));
-        guarded(&ctx.device, || {
-            layer.set_volume(ctx, doc.volumes.get(state.volume))?;
+        let step = guarded(&ctx.device, || {
+            let step = layer.set_volume(ctx, doc.volumes.get(state.volume))?;
             layer.set_molecule(ctx, &doc.molecule, state.settings.atoms);
             layer.surfaces.clear();
-            Ok(())
+            Ok(step)
         })?;
         layer.world_from_object = state.placement.world_from_object();
         layer.visible = state.visible;
@@ -147,16 +168,21 @@ impl Viewport {
         slot.computed = None;
         self.generation += 1;
         self.update_isosurfaces(n, doc, state);
-        Ok(())
+        Ok(coarser(doc, state, step))
     }
 
-    /// Shows the volume object `n`'s state chooses.
-    pub fn set_volume(&mut self, n: usize, doc: &Arc<Document>, state: &ObjectState) -> Result<(), GpuError> {
+    /// Shows the volume object `n`'s state chooses (a note when it is shown coarser).
+    pub fn set_volume(
+        &mut self,
+        n: usize,
+        doc: &Arc<Document>,
+        state: &ObjectState,
+    ) -> Result<Option<String>, GpuError> {
         let (ctx, layer) = (&self.ctx, self.renderer.layer_mut(&self.ctx, n));
-        guarded(&ctx.device, || layer.set_volume(ctx, doc.volumes.get(state.volume)))?;
+        let step = guarded(&ctx.device, || layer.set_volume(ctx, doc.volumes.get(state.volume)))?;
         self.generation += 1;
         self.update_isosurfaces(n, doc, state);
-        Ok(())
+        Ok(coarser(doc, state, step))
     }
 
     /// Evaluates a wavefunction's orbital or density for object `n` in the background
@@ -168,9 +194,10 @@ impl Viewport {
         let ctx = self.ctx.clone();
         let fill = self.fill.get_or_insert_with(|| Arc::new(GtoFillPass::new(&ctx))).clone();
         let doc = doc.clone();
-        self.slot(n)
-            .evaluation
-            .request(move |_| guarded(&ctx.device, || evaluate_wavefunction(&ctx, &fill, &doc, &view)));
+        self.slot(n).evaluation.request(move |_| {
+            let limits = ctx.device.limits();
+            evaluate_within(&ctx, &fill, &doc, &view, &limits)
+        });
     }
 
     /// Cuts every isosurface object `n`'s state asks for, from the grid it shows, in the
@@ -179,26 +206,29 @@ impl Viewport {
         let computed = self.slot(n).computed.clone();
         let (doc, volume) = (doc.clone(), state.volume);
         let levels: Vec<IsosurfaceSettings> = state.all_isosurfaces().copied().collect();
-        self.request_meshes(n, move || {
+        self.request_meshes(n, move |max_bytes| {
             let grid = computed.as_deref().or(doc.volumes.get(volume));
-            grid.map(|g| levels.iter().flat_map(|iso| isosurfaces(g, iso)).collect()).unwrap_or_default()
+            grid.map(|g| isosurfaces_within(g, &levels, max_bytes)).unwrap_or_default()
         });
     }
 
     /// Makes object `n`'s isosurfaces with `make` in the background (the newest request wins);
-    /// [`Self::poll_meshes`] shows them when they are done.
-    pub fn request_meshes(&mut self, n: usize, make: impl FnOnce() -> Vec<(Mesh, [f32; 3])> + Send + 'static) {
-        self.slot(n).extraction.request(move |_| make());
+    /// `make` gets the largest buffer this device makes (bytes). [`Self::poll_meshes`] shows
+    /// them when they are done.
+    pub fn request_meshes(&mut self, n: usize, make: impl FnOnce(u64) -> Meshes + Send + 'static) {
+        let max_bytes = self.ctx.device.limits().max_buffer_size;
+        self.slot(n).extraction.request(move |_| make(max_bytes));
     }
 
-    /// Shows object `n`'s isosurfaces if their job finished: `Ok` with the triangle count, or
-    /// the failure.
-    pub fn poll_meshes(&mut self, n: usize) -> Option<Result<usize, String>> {
+    /// Shows object `n`'s isosurfaces if their job finished: `Ok` with the triangle count and
+    /// any note, or the failure.
+    pub fn poll_meshes(&mut self, n: usize) -> Option<Result<(usize, Option<String>), String>> {
         let result = self.slot(n).extraction.poll()?;
         self.generation += 1;
-        Some(result.and_then(|meshes| {
+        Some(result.and_then(|(meshes, note)| {
             let (ctx, layer) = (&self.ctx, self.renderer.layer_mut(&self.ctx, n));
-            guarded(&ctx.device, || Ok(show_meshes(ctx, layer, &meshes))).map_err(|e| e.to_string())
+            let triangles = guarded(&ctx.device, || Ok(show_meshes(ctx, layer, &meshes))).map_err(|e| e.to_string())?;
+            Ok((triangles, note))
         }))
     }
 
@@ -208,7 +238,11 @@ impl Viewport {
         let mut said = Vec::new();
         let mut evaluated = false;
         if let Some(result) = self.slot(n).evaluation.poll() {
-            let shown = result.and_then(|r| r.map_err(|e| e.to_string())).and_then(|evaluated| {
+            let result = result.and_then(|r| r.map_err(|e| e.to_string()));
+            if let Ok((_, Some(note))) = &result {
+                said.push(Ok(note.clone()));
+            }
+            let shown = result.and_then(|(evaluated, _)| {
                 let Some(evaluated) = evaluated else { return Ok(None) };
                 let (ctx, layer) = (&self.ctx, self.renderer.layer_mut(&self.ctx, n));
                 guarded(&ctx.device, || evaluated.show(ctx, layer)).map(Some).map_err(|e| e.to_string())
@@ -224,8 +258,11 @@ impl Viewport {
             }
         }
         match self.poll_meshes(n) {
-            Some(Ok(0)) | None => {}
-            Some(Ok(triangles)) => said.push(Ok(format!("isosurfaces: {triangles} triangles"))),
+            Some(Ok((0, _))) | None => {}
+            Some(Ok((triangles, note))) => said
+                .push(Ok(note.map_or(format!("isosurfaces: {triangles} triangles"), |note| {
+                    format!("{note}: {triangles} triangles")
+                }))),
             Some(Err(e)) => said.push(Err(format!("{}: isosurfaces: {e}", doc.source))),
         }
         (said, evaluated)

@@ -72,8 +72,17 @@ impl Layer {
         self.molecule_bounds = molecule.bounds().map(|(lo, hi)| (lo.as_vec3() - 4.5, hi.as_vec3() + 4.5));
     }
 
-    pub fn set_volume(&mut self, ctx: &GpuContext, grid: Option<&VolumeGrid>) -> Result<(), GpuError> {
-        self.volume.set_volume(ctx, grid)
+    /// Shows `grid` as the layer's cloud. A grid over this device's limits is shown at every
+    /// `step`-th point instead ([`super::volume::fitting_step`]); returns the step (1: whole).
+    pub fn set_volume(&mut self, ctx: &GpuContext, grid: Option<&VolumeGrid>) -> Result<usize, GpuError> {
+        let step = grid.map_or(1, |g| {
+            super::volume::fitting_step(g.dims, super::volume::texel_bytes(ctx.volume_format), &ctx.device.limits())
+        });
+        match grid {
+            Some(g) if step > 1 => self.volume.set_volume(ctx, Some(&g.subsampled(step)))?,
+            _ => self.volume.set_volume(ctx, grid)?,
+        }
+        Ok(step)
     }
 
     /// Shows a volume already on the GPU (a filled GTO grid).

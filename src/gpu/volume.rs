@@ -657,6 +657,20 @@ impl super::frame::Draw for VolumePass {
     }
 }
 
+/// The smallest step (1: every point) at which a grid of `dims` fits this device as a volume
+/// texture of `texel` bytes per point: every side within `max_texture_dimension_3d`, the
+/// whole within half of [`residency_budget`] (one volume of many that may be resident).
+pub fn fitting_step(dims: [usize; 3], texel: u64, limits: &wgpu::Limits) -> usize {
+    let max_side = limits.max_texture_dimension_3d.max(1) as usize;
+    let budget = residency_budget(limits) / 2;
+    (1..=max_side.max(dims.into_iter().max().unwrap_or(1)))
+        .find(|&s| {
+            let d = dims.map(|n| n.div_ceil(s));
+            d.iter().all(|&n| n <= max_side) && d.iter().product::<usize>() as u64 * texel <= budget
+        })
+        .unwrap_or(usize::MAX)
+}
+
 /// Bytes one texel of a volume format takes.
 pub fn texel_bytes(format: wgpu::TextureFormat) -> u64 {
     format.block_copy_size(None).unwrap_or(4) as u64

@@ -131,13 +131,48 @@ pub fn evaluate_wavefunction(
     }
 }
 
+/// [`evaluate_wavefunction`] on a grid this device holds: `view.points` per side, or fewer when
+/// that many are over `limits` or the device refuses the memory, with a note saying so. Runs
+/// its GPU work in error scopes on the calling thread.
+pub fn evaluate_within(
+    ctx: &GpuContext,
+    fill: &GtoFillPass,
+    doc: &Document,
+    view: &WavefunctionView,
+    limits: &wgpu::Limits,
+) -> Result<(Option<Evaluated>, Option<String>), GpuError> {
+    let requested = view.points;
+    // p³ R32Float values must fit both the 3D texture's side and the memory budget.
+    let mut points = requested;
+    while points > 8 && crate::gpu::volume::fitting_step([points; 3], 4, limits) > 1 {
+        points = points * 7 / 8;
+    }
+    loop {
+        let attempt = WavefunctionView { points, ..view.clone() };
+        match crate::gpu::context::guarded(&ctx.device, || evaluate_wavefunction(ctx, fill, doc, &attempt)) {
+            Err(GpuError::Rejected(_) | GpuError::VolumeTooLarge { .. }) if points > 16 => points = points * 3 / 4,
+            result => {
+                let note = (points < requested).then(|| {
+                    format!(
+                        "{}: {requested} points per side are more than this GPU holds; evaluated on {points}",
+                        doc.source
+                    )
+                });
+                return result.map(|e| (e, note));
+            }
+        }
+    }
+}
+
 impl Evaluated {
     /// Shows the cloud in `layer`; returns the values on the grid.
     pub fn show(self, ctx: &GpuContext, layer: &mut Layer) -> Result<VolumeGrid, GpuError> {
         match self.cloud {
             Cloud::Texture(volume) => layer.set_volume_texture(ctx, volume),
             Cloud::Direct(expansion, geometry) => layer.set_direct(ctx, &expansion, &geometry, self.grid.stats.max_abs),
-            Cloud::Values => layer.set_volume(ctx, Some(&self.grid))?,
+            Cloud::Values => {
+                layer.set_volume(ctx, Some(&self.grid))?;
+            }
         }
         Ok(self.grid)
     }
@@ -180,6 +215,31 @@ pub fn isosurfaces(grid: &VolumeGrid, iso: &IsosurfaceSettings) -> Vec<(Mesh, [f
     isosurface::extract(grid, &levels).into_iter().zip(colors).collect()
 }
 
+/// Isosurfaces of `grid` at every level of `levels` (each as [`isosurfaces`] cuts it), every
+/// mesh's vertex and index data within `max_bytes` (a GPU buffer's limit): when the whole
+/// grid's meshes would not fit, they are cut from every 2nd, 4th, … point, with a note.
+pub fn isosurfaces_within(
+    grid: &VolumeGrid,
+    levels: &[IsosurfaceSettings],
+    max_bytes: u64,
+) -> (Vec<(Mesh, [f32; 3])>, Option<String>) {
+    let mut step = 1;
+    loop {
+        let coarse = (step > 1).then(|| grid.subsampled(step));
+        let g = coarse.as_ref().unwrap_or(grid);
+        let meshes: Vec<_> = levels.iter().flat_map(|iso| isosurfaces(g, iso)).collect();
+        let fits =
+            meshes.iter().all(|(m, _)| (m.positions.len() as u64 * 24).max(m.indices.len() as u64 * 4) <= max_bytes);
+        if fits || step >= 64 {
+            let note = (step > 1).then(|| {
+                format!("isosurfaces cut from one point in {step} along each axis: the whole grid's are more than a GPU buffer holds")
+            });
+            return (meshes, note);
+        }
+        step *= 2;
+    }
+}
+
 /// Extracts the isosurfaces of `grid` and shows them in `layer` (none when `iso` is hidden).
 /// Returns the number of triangles.
 pub fn show_isosurfaces(ctx: &GpuContext, layer: &mut Layer, grid: &VolumeGrid, iso: &IsosurfaceSettings) -> usize {
@@ -190,6 +250,15 @@ pub fn show_isosurfaces(ctx: &GpuContext, layer: &mut Layer, grid: &VolumeGrid, 
 pub fn show_meshes(ctx: &GpuContext, layer: &mut Layer, meshes: &[(Mesh, [f32; 3])]) -> usize {
     layer.surfaces.set_meshes(ctx, meshes);
     meshes.iter().map(|(m, _)| m.triangle_count()).sum()
+}
+
+/// What to tell the user when a grid of `dims` is shown at every `step`-th point.
+pub fn coarser_note(what: &str, dims: [usize; 3], step: usize) -> String {
+    let coarse = dims.map(|d| d.div_ceil(step));
+    format!(
+        "{what}: the grid of {}×{}×{} points is more than this GPU holds; shown with one point in {step} along each axis ({}×{}×{})",
+        dims[0], dims[1], dims[2], coarse[0], coarse[1], coarse[2]
+    )
 }
 
 /// Puts `doc` into `layer` as `state` shows it: its molecule in the state's atom style, the

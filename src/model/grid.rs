@@ -159,6 +159,32 @@ impl VolumeGrid {
         (i * self.dims[1] + j) * self.dims[2] + k
     }
 
+    /// Every `step`-th point along each axis (the last point kept where it falls on the step):
+    /// the same field on a coarser grid over nearly the same box, for a device that cannot hold
+    /// the whole grid. `kind` is kept.
+    pub fn subsampled(&self, step: usize) -> VolumeGrid {
+        let step = step.max(1);
+        let dims = self.dims.map(|d| d.div_ceil(step).max(1));
+        let mut values = Vec::with_capacity(dims.iter().product());
+        for i in 0..dims[0] {
+            for j in 0..dims[1] {
+                for k in 0..dims[2] {
+                    values.push(self.values[self.index(i * step, j * step, k * step)]);
+                }
+            }
+        }
+        let s = step as f64;
+        let world = DMat4::from_cols(
+            self.world_from_grid.x_axis * s,
+            self.world_from_grid.y_axis * s,
+            self.world_from_grid.z_axis * s,
+            self.world_from_grid.w_axis,
+        );
+        let mut grid = VolumeGrid::new(format!("{} (one point in {step})", self.label), dims, world, values);
+        grid.kind = self.kind;
+        grid
+    }
+
     pub fn value(&self, i: usize, j: usize, k: usize) -> f32 {
         self.values[self.index(i, j, k)]
     }
@@ -348,6 +374,12 @@ mod tests {
     fn stats_and_kind() {
         let g = linear_grid();
         assert_eq!(g.kind, ValueKind::Signed);
+        // Every other point: the same values at the same places.
+        let coarse = g.subsampled(2);
+        assert_eq!(coarse.dims, g.dims.map(|d| d.div_ceil(2)));
+        let (i, j, k) = (1, 0, 0);
+        assert_eq!(coarse.values[coarse.index(i, j, k)], g.values[g.index(2 * i, 2 * j, 2 * k)]);
+        assert!((coarse.point(i, j, k) - g.point(2 * i, 2 * j, 2 * k)).length() < 1e-12);
         assert_eq!(g.stats.min, -15.0);
         assert_eq!(g.stats.max, 43.0);
         assert_eq!(g.stats.max_abs, 43.0);
