@@ -1,0 +1,36 @@
+//! One entry per reader: the bytes of a file named as that reader expects. A reader may refuse
+//! any input with an error; a panic, a hang or an allocation beyond the bound is a finding.
+
+use std::path::Path;
+use std::sync::LazyLock;
+
+use glam::DVec3;
+use orbcloud::model::{Atom, Document, Molecule};
+
+/// Reads `data` as a file named `name` (the extension picks the reader; `.gz` inflates first).
+pub fn read_as(name: &str, data: &[u8]) {
+    let _ = orbcloud::formats::load_bytes(Path::new(name), data);
+}
+
+/// A frame every manifest's files load as: H–O–O–H, so dihedrals of its four atoms are valid.
+static FRAME: LazyLock<Document> = LazyLock::new(|| {
+    let atom = |z, x, y, w| Atom { z, charge: z as f64, position: DVec3::new(x, y, w), ghost: false };
+    Document {
+        source: "frame".into(),
+        title: "frame".into(),
+        molecule: Molecule::new(vec![
+            atom(1, -1.8, 1.5, 0.0),
+            atom(8, -1.4, 0.0, 0.0),
+            atom(8, 1.4, 0.0, 0.0),
+            atom(1, 1.8, 1.5, 0.5),
+        ]),
+        volumes: Vec::new(),
+        wavefunction: None,
+    }
+});
+
+/// Parses `data` as a scan manifest whose frames all load as [`FRAME`].
+pub fn read_manifest(data: &[u8]) {
+    let Ok(text) = std::str::from_utf8(data) else { return };
+    let _ = orbcloud::formats::scan::parse_scan(Path::new("fuzz.scan.toml"), text, &mut |_| Ok(FRAME.clone()));
+}

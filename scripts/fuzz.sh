@@ -1,0 +1,82 @@
+#!/usr/bin/env bash
+# Fuzzes every reader with AFL++ (cargo-afl, stable toolchain), seeded with the test fixtures.
+#   scripts/fuzz.sh [EXECUTIONS_PER_TARGET] [TARGET …]     (default 10000000, every target)
+# Installs cargo-afl when missing. Each target runs until it has made that many executions;
+# two run at a time. Findings land in fuzz/out/TARGET/default/{crashes,hangs}; the summary
+# line per target gives executions, seconds, crashes and hangs. A finding becomes a regression
+# test in tests/hostile_inputs.rs.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+execs="${1:-10000000}"
+shift || true
+targets=("$@")
+[ ${#targets[@]} -gt 0 ] || targets=(cube cube_gz molden fchk scan_manifest)
+
+command -v cargo-afl >/dev/null || cargo install cargo-afl --locked
+# Seeds: the fixtures each reader is tested with, kept small (AFL slows on big inputs).
+seed() {
+    local target=$1; shift
+    mkdir -p "fuzz/seeds/$target"
+    for f in "$@"; do
+        [ -f "$f" ] && [ "$(stat -c %s "$f")" -lt 60000 ] && cp "$f" "fuzz/seeds/$target/" || true
+    done
+}
+# Two small cubes: bohr with one orbital; ångström (negative voxel counts) with two orbitals.
+mkdir -p fuzz/seeds/cube
+cat > fuzz/seeds/cube/water.cube <<'CUBE'
+water
+ SCF density
+    3   -1.000000   -1.000000   -1.000000
+    3    1.000000    0.000000    0.000000
+    3    0.000000    1.000000    0.000000
+    3    0.000000    0.000000    1.000000
+    8    8.000000    0.000000    0.000000    0.221665
+    1    1.000000    0.000000    1.430901   -0.886659
+    1    1.000000    0.000000   -1.430901   -0.886659
+ 1.0E-01 2.0E-01 3.0E-01 4.0E-01 5.0E-01 6.0E-01
+ 7.0E-01 8.0E-01 9.0E-01 1.0E+00 1.1E+00 1.2E+00
+ 1.3E+00 1.4E+00 1.5E+00 1.6E+00 1.7E+00 1.8E+00
+ 1.9E+00 2.0E+00 2.1E+00 2.2E+00 2.3E+00 2.4E+00
+ 2.5E+00 2.6E+00 2.7E+00
+CUBE
+cat > fuzz/seeds/cube/two_orbitals.cube <<'CUBE'
+h2
+ MO 1 and 2, angstrom
+   -2   -0.500000   -0.500000   -0.500000
+   -2    0.500000    0.000000    0.000000
+   -2    0.000000    0.500000    0.000000
+   -2    0.000000    0.000000    0.500000
+    1    1.000000    0.000000    0.000000    0.370000
+    1    1.000000    0.000000    0.000000   -0.370000
+    2    1    2
+ 1.0E-02 -2.0E-02 3.0E-02 -4.0E-02 5.0E-02 -6.0E-02
+ 7.0E-02 -8.0E-02 9.0E-02 -1.0E-01 1.1E-01 -1.2E-01
+ 1.3E-01 -1.4E-01 1.5E-01 -1.6E-01
+CUBE
+seed molden tests/fixtures/wavefunctions/*.molden tests/fixtures/readers/*.molden
+seed fchk tests/fixtures/wavefunctions/*.fchk tests/fixtures/readers/*.fchk
+seed scan_manifest assets/psb3/*.scan.toml tests/fixtures/*/*.scan.toml
+mkdir -p fuzz/seeds/cube_gz
+for f in fuzz/seeds/cube/*; do gzip -c "$f" > "fuzz/seeds/cube_gz/$(basename "$f").gz"; done
+
+(cd fuzz && cargo afl build --release)
+export AFL_SKIP_CPUFREQ=1 AFL_I_DONT_CARE_ABOUT_MISSING_CRASHES=1 AFL_NO_UI=1
+run() {
+    local target=$1 start=$SECONDS
+    rm -rf "fuzz/out/$target"
+    # -E: stop after about this many executions; -t: a hang is an input taking over 1 s;
+    # -m: at most 1 GiB of memory per execution.
+    cargo afl fuzz -i "fuzz/seeds/$target" -o "fuzz/out/$target" -E "$execs" -t 1000 -m 1024 \
+        "fuzz/target/release/$target" > "fuzz/out/$target.log" 2>&1 || true
+    local stats="fuzz/out/$target/default/fuzzer_stats"
+    local done crashes hangs
+    done=$(awk -F': *' '/^execs_done/ {print $2}' "$stats")
+    crashes=$(awk -F': *' '/^saved_crashes/ {print $2}' "$stats")
+    hangs=$(awk -F': *' '/^saved_hangs/ {print $2}' "$stats")
+    echo "$target: $done executions in $((SECONDS - start)) s, $crashes crashes, $hangs hangs"
+}
+for ((i = 0; i < ${#targets[@]}; i += 2)); do
+    run "${targets[i]}" &
+    [ $((i + 1)) -lt ${#targets[@]} ] && run "${targets[i + 1]}" &
+    wait
+done
