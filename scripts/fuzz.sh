@@ -53,8 +53,8 @@ h2
  7.0E-02 -8.0E-02 9.0E-02 -1.0E-01 1.1E-01 -1.2E-01
  1.3E-01 -1.4E-01 1.5E-01 -1.6E-01
 CUBE
-seed molden tests/fixtures/wavefunctions/*.molden tests/fixtures/readers/*.molden
-seed fchk tests/fixtures/wavefunctions/*.fchk tests/fixtures/readers/*.fchk
+seed molden tests/fixtures/wavefunctions/h2o_cart_631gs.molden tests/fixtures/wavefunctions/h2o_cation_uhf_631gs.molden tests/fixtures/wavefunctions/h2_spdfgh.molden
+seed fchk tests/fixtures/wavefunctions/h2o_cart_631gs.fchk tests/fixtures/wavefunctions/h2o_cation_uhf_631gs.fchk
 seed scan_manifest assets/psb3/*.scan.toml tests/fixtures/*/*.scan.toml
 mkdir -p fuzz/seeds/cube_gz
 for f in fuzz/seeds/cube/*; do gzip -c "$f" > "fuzz/seeds/cube_gz/$(basename "$f").gz"; done
