@@ -64,6 +64,7 @@ export AFL_SKIP_CPUFREQ=1 AFL_I_DONT_CARE_ABOUT_MISSING_CRASHES=1 AFL_NO_UI=1
 run() {
     local target=$1 start=$SECONDS
     rm -rf "fuzz/out/$target"
+    mkdir -p fuzz/out
     # -E: stop after about this many executions; -t: a hang is an input taking over 1 s;
     # -m: at most 1 GiB of memory per execution.
     cargo afl fuzz -i "fuzz/seeds/$target" -o "fuzz/out/$target" -E "$execs" -t 1000 -m 1024 \

@@ -316,3 +316,13 @@ fn info_on_a_gzip_bomb_stays_small_and_fast() {
     assert!(rss_kb < 200 * 1024, "max RSS {rss_kb} kB");
     assert!(wall < Duration::from_secs(5), "took {wall:?}");
 }
+
+/// Fuzzing findings (scripts/fuzz.sh), each kept as the input that found it.
+#[test]
+fn fuzzing_findings_stay_fixed() {
+    // AFL++, cube target: an atom 4e20 bohr away put its bond-search cell at the i64 limit, and
+    // the neighbouring cell's index overflowed (a panic in a build with overflow checks).
+    let far_atom = "h2\n MO 1 and 2, angstrom\n   -2   -0.5 -0.5 -0.5\n   -2    0.5 0.0 0.0\n   -2    0.0 0.5 0.0\n   -2    0.0 0.0 0.5\n    1    1.0 0.0 0.0 0444444444444444444444.37\n    1    1.0 0.0 0.0 -0.37\n    2    1    2\n 1.0E-02 -2.0E-02 3.0E-02 -4.0E-02 5.0E-02 -6.0E-02\n 7.0E-02 -8.0E-02 9.0E-02 -1.0E-01 1.1E-01 -1.2E-01\n 1.3E-01 -1.4E-01 1.5E-01 -1.6E-01\n";
+    let doc = formats::load_bytes(Path::new("far.cube"), far_atom.as_bytes());
+    assert!(doc.is_ok_and(|d| d.molecule.bonds.is_empty()), "read, no bond to an atom that far");
+}

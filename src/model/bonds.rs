@@ -42,7 +42,9 @@ pub fn infer_bonds(atoms: &[Atom]) -> Vec<Bond> {
         for dx in -1..=1 {
             for dy in -1..=1 {
                 for dz in -1..=1 {
-                    let Some(list) = cells.get(&(cx + dx, cy + dy, cz + dz)) else {
+                    // Saturating: a far-away atom's cell index sits at the i64 limit.
+                    let neighbour = (cx.saturating_add(dx), cy.saturating_add(dy), cz.saturating_add(dz));
+                    let Some(list) = cells.get(&neighbour) else {
                         continue;
                     };
                     if list.len() > MAX_ATOMS_PER_CELL {
