@@ -155,14 +155,7 @@ impl Viewport {
         state: &ObjectState,
     ) -> Result<Option<String>, GpuError> {
         let (ctx, layer) = (&self.ctx, self.renderer.layer_mut(&self.ctx, n));
-        let step = guarded(&ctx.device, || {
-            let step = layer.set_volume(ctx, doc.volumes.get(state.volume))?;
-            layer.set_molecule(ctx, &doc.molecule, state.settings.atoms);
-            layer.surfaces.clear();
-            Ok(step)
-        })?;
-        layer.world_from_object = state.placement.world_from_object();
-        layer.visible = state.visible;
+        let step = guarded(&ctx.device, || crate::headless::show_document(ctx, layer, doc, state))?;
         let slot = self.slot(n);
         slot.evaluation.cancel();
         slot.computed = None;

@@ -261,6 +261,24 @@ pub fn coarser_note(what: &str, dims: [usize; 3], step: usize) -> String {
     )
 }
 
+/// Puts `doc` into `layer` as `state` shows it, all but its isosurfaces (none until they are
+/// cut): the molecule in the state's atom style, the volume it chooses, placement and
+/// visibility. Returns the step the volume is shown at (1: every point; see
+/// [`Layer::set_volume`]).
+pub fn show_document(
+    ctx: &GpuContext,
+    layer: &mut Layer,
+    doc: &Document,
+    state: &ObjectState,
+) -> Result<usize, GpuError> {
+    let step = layer.set_volume(ctx, doc.volumes.get(state.volume))?;
+    layer.set_molecule(ctx, &doc.molecule, state.settings.atoms);
+    layer.surfaces.clear();
+    layer.world_from_object = state.placement.world_from_object();
+    layer.visible = state.visible;
+    Ok(step)
+}
+
 /// Puts `doc` into `layer` as `state` shows it: its molecule in the state's atom style, the
 /// volume it chooses (none past the document's volumes) with every isosurface of it, its
 /// placement and visibility. Returns the isosurfaces' triangle count.
@@ -270,12 +288,8 @@ pub fn show_object(
     doc: &Document,
     state: &ObjectState,
 ) -> Result<usize, GpuError> {
-    let grid = doc.volumes.get(state.volume);
-    layer.set_volume(ctx, grid)?;
-    layer.set_molecule(ctx, &doc.molecule, state.settings.atoms);
-    layer.world_from_object = state.placement.world_from_object();
-    layer.visible = state.visible;
-    let meshes: Vec<_> = match grid {
+    show_document(ctx, layer, doc, state)?;
+    let meshes: Vec<_> = match doc.volumes.get(state.volume) {
         Some(grid) => state.all_isosurfaces().flat_map(|iso| isosurfaces(grid, iso)).collect(),
         None => Vec::new(),
     };
