@@ -10,7 +10,7 @@ cd "$(dirname "$0")/.."
 execs="${1:-10000000}"
 shift || true
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(cube cube_gz molden fchk scan_manifest)
+[ ${#targets[@]} -gt 0 ] || targets=(cube cube_gz molden fchk scan_manifest pdb mmcif xyz)
 
 command -v cargo-afl >/dev/null || cargo install cargo-afl --locked
 # Seeds: the fixtures each reader is tested with, kept small (AFL slows on big inputs).
@@ -56,6 +56,9 @@ CUBE
 seed molden tests/fixtures/wavefunctions/h2o_cart_631gs.molden tests/fixtures/wavefunctions/h2o_cation_uhf_631gs.molden tests/fixtures/wavefunctions/h2_spdfgh.molden
 seed fchk tests/fixtures/wavefunctions/h2o_cart_631gs.fchk tests/fixtures/wavefunctions/h2o_cation_uhf_631gs.fchk
 seed scan_manifest assets/psb3/*.scan.toml tests/fixtures/*/*.scan.toml
+seed pdb tests/fixtures/structures/*.pdb
+seed mmcif tests/fixtures/structures/*.cif
+seed xyz tests/fixtures/structures/*.xyz
 mkdir -p fuzz/seeds/cube_gz
 for f in fuzz/seeds/cube/*; do gzip -c "$f" > "fuzz/seeds/cube_gz/$(basename "$f").gz"; done
 

@@ -1,19 +1,12 @@
-// Ball-and-stick impostors: camera-facing quads, exact ray–sphere and ray–cylinder
-// intersection per fragment, lit, with the true surface depth written.
+// Atoms drawn from storage buffers: spheres and cylinders too big for the compute rasteriser
+// as camera-facing quads with exact ray intersection and depth (instances from the lists
+// atoms_cull.wgsl made), the small spheres it rasterised resolved to colour, id and depth in
+// one full-screen pass, and bonds as lines in the lines style.
 
-struct Globals {
-    clip_from_world: mat4x4<f32>,
-    // xyz: eye position (bohr)
-    eye: vec4<f32>,
-    // xyz: unit direction towards the light
-    light: vec4<f32>,
-    // xyz: camera up vector
-    up: vec4<f32>,
-    // x: high bits of this object's atom pick ids; the atom index is added
-    pick: vec4<u32>,
-};
+@group(1) @binding(0) var<storage, read> lists: array<u32>;
+@group(1) @binding(1) var<storage, read> splat: array<u32>;
 
-@group(0) @binding(0) var<uniform> g: Globals;
+const LISTS: u32 = 8u;
 
 const CORNERS = array<vec2<f32>, 6>(
     vec2<f32>(-1.0, -1.0), vec2<f32>(1.0, -1.0), vec2<f32>(1.0, 1.0),
@@ -36,30 +29,31 @@ fn shade(base: vec3<f32>, n: vec3<f32>, view: vec3<f32>) -> vec3<f32> {
     return base * (0.22 + 0.78 * diffuse) + vec3<f32>(0.35 * specular + 0.08 * rim);
 }
 
-fn depth_of(world: vec3<f32>) -> f32 {
-    let c = g.clip_from_world * vec4<f32>(world, 1.0);
-    return c.z / c.w;
+// The lit sphere of atom i where the ray eye + t·d hits it first.
+fn sphere_fragment(i: u32, d: vec3<f32>, t: f32) -> FragOut {
+    let center = positions[i].xyz;
+    let hit = g.eye.xyz + d * t;
+    let n = normalize(hit - center);
+    var out: FragOut;
+    out.color = vec4<f32>(shade(color_of(i), n, -normalize(d)), 1.0);
+    out.id = g.pick.x | i;
+    out.depth = depth_of(hit);
+    return out;
 }
 
-// ---- spheres ----
+// ---- spheres as quads ----
 
 struct SphereOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) world: vec3<f32>,
-    @location(1) @interpolate(flat) center: vec3<f32>,
-    @location(2) @interpolate(flat) radius: f32,
-    @location(3) @interpolate(flat) color: vec4<f32>,
-    @location(4) @interpolate(flat) atom: u32,
+    @location(1) @interpolate(flat) atom: u32,
 };
 
 @vertex
-fn vs_sphere(
-    @builtin(vertex_index) vi: u32,
-    @builtin(instance_index) atom: u32,
-    @location(0) center: vec3<f32>,
-    @location(1) radius: f32,
-    @location(2) color: vec4<f32>,
-) -> SphereOut {
+fn vs_sphere(@builtin(vertex_index) vi: u32, @builtin(instance_index) k: u32) -> SphereOut {
+    let atom = lists[LISTS + k];
+    let center = positions[atom].xyz;
+    let radius = radius_of(atom);
     let to_eye = g.eye.xyz - center;
     let dist = max(length(to_eye), radius * 1.01);
     let f = to_eye / dist;
@@ -76,55 +70,61 @@ fn vs_sphere(
     var out: SphereOut;
     out.clip = g.clip_from_world * vec4<f32>(world, 1.0);
     out.world = world;
-    out.center = center;
-    out.radius = radius;
-    out.color = color;
     out.atom = atom;
     return out;
 }
 
 @fragment
 fn fs_sphere(in: SphereOut) -> FragOut {
-    let ro = g.eye.xyz;
-    let rd = normalize(in.world - ro);
-    let oc = ro - in.center;
-    let b = dot(oc, rd);
-    let c = dot(oc, oc) - in.radius * in.radius;
-    let disc = b * b - c;
-    if (disc < 0.0) {
+    let d = in.world - g.eye.xyz;
+    let t = hit_sphere(d, positions[in.atom].xyz, radius_of(in.atom));
+    if (t < 0.0) {
         discard;
     }
-    let t = -b - sqrt(disc);
-    let hit = ro + rd * t;
-    let n = normalize(hit - in.center);
-    var out: FragOut;
-    out.color = vec4<f32>(shade(in.color.rgb, n, -rd), 1.0);
-    out.id = g.pick.x | in.atom;
-    out.depth = depth_of(hit);
+    return sphere_fragment(in.atom, d, t);
+}
+
+// ---- spheres the compute rasteriser drew ----
+
+@vertex
+fn vs_fullscreen(@builtin(vertex_index) vi: u32) -> @builtin(position) vec4<f32> {
+    let p = vec2<f32>(f32((vi << 1u) & 2u), f32(vi & 2u));
+    return vec4<f32>(p * 2.0 - 1.0, 0.0, 1.0);
+}
+
+@fragment
+fn fs_splats(@builtin(position) frag: vec4<f32>) -> FragOut {
+    let w = u32(g.viewport.x);
+    let pixel = u32(frag.y) * w + u32(frag.x);
+    let id = splat[u32(g.viewport.x) * u32(g.viewport.y) + pixel];
+    if (id == 0u) {
+        discard;
+    }
+    let i = id - 1u;
+    let d = ray_through(frag.xy);
+    // The rasteriser kept only pixels whose ray hits; rounding may still miss by a hair.
+    let t = max(hit_sphere(d, positions[i].xyz, splat_radius(i)), 0.0);
+    var out = sphere_fragment(i, d, t);
+    if (t == 0.0) {
+        out.depth = depth_of(positions[i].xyz);
+    }
     return out;
 }
 
-// ---- cylinders ----
+// ---- bonds as cylinders, one instance per bond, each half in its atom's colour ----
 
 struct CylinderOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) world: vec3<f32>,
-    @location(1) @interpolate(flat) p0: vec3<f32>,
-    @location(2) @interpolate(flat) p1: vec3<f32>,
-    @location(3) @interpolate(flat) radius: f32,
-    @location(4) @interpolate(flat) color: vec4<f32>,
-    @location(5) @interpolate(flat) atom: u32,
+    @location(1) @interpolate(flat) atoms: vec2<u32>,
 };
 
 @vertex
-fn vs_cylinder(
-    @builtin(vertex_index) vi: u32,
-    @location(0) p0: vec3<f32>,
-    @location(1) radius: f32,
-    @location(2) p1: vec3<f32>,
-    @location(3) color: vec4<f32>,
-    @location(4) atom: u32,
-) -> CylinderOut {
+fn vs_cylinder(@builtin(vertex_index) vi: u32, @builtin(instance_index) k: u32) -> CylinderOut {
+    let bond = bonds[lists[LISTS + g.counts.x + k]];
+    let p0 = positions[bond.x].xyz;
+    let p1 = positions[bond.y].xyz;
+    let radius = g.sticks.x;
     let axis = p1 - p0;
     let len = max(length(axis), 1e-6);
     let a = axis / len;
@@ -144,11 +144,7 @@ fn vs_cylinder(
     var out: CylinderOut;
     out.clip = g.clip_from_world * vec4<f32>(world, 1.0);
     out.world = world;
-    out.p0 = p0;
-    out.p1 = p1;
-    out.radius = radius;
-    out.color = color;
-    out.atom = atom;
+    out.atoms = bond;
     return out;
 }
 
@@ -156,29 +152,66 @@ fn vs_cylinder(
 fn fs_cylinder(in: CylinderOut) -> FragOut {
     let ro = g.eye.xyz;
     let rd = normalize(in.world - ro);
-    let axis = in.p1 - in.p0;
+    let p0 = positions[in.atoms.x].xyz;
+    let axis = positions[in.atoms.y].xyz - p0;
     let len = length(axis);
     let a = axis / len;
-    let oc = ro - in.p0;
+    let radius = g.sticks.x;
+    let oc = ro - p0;
     let d_perp = rd - a * dot(rd, a);
     let o_perp = oc - a * dot(oc, a);
     let qa = dot(d_perp, d_perp);
     let qb = dot(d_perp, o_perp);
-    let qc = dot(o_perp, o_perp) - in.radius * in.radius;
+    let qc = dot(o_perp, o_perp) - radius * radius;
     let disc = qb * qb - qa * qc;
     if (disc < 0.0 || qa < 1e-12) {
         discard;
     }
     let t = (-qb - sqrt(disc)) / qa;
     let hit = ro + rd * t;
-    let h = dot(hit - in.p0, a);
+    let h = dot(hit - p0, a);
     if (h < 0.0 || h > len) {
         discard;
     }
-    let n = normalize(hit - in.p0 - a * h);
+    // The half nearer an atom is that atom's: its colour, and picking it picks the atom.
+    let atom = select(in.atoms.y, in.atoms.x, h < 0.5 * len);
+    let n = normalize(hit - p0 - a * h);
     var out: FragOut;
-    out.color = vec4<f32>(shade(in.color.rgb, n, -rd), 1.0);
-    out.id = g.pick.x | in.atom;
+    out.color = vec4<f32>(shade(color_of(atom), n, -rd), 1.0);
+    out.id = g.pick.x | atom;
     out.depth = depth_of(hit);
+    return out;
+}
+
+// ---- bonds as lines (big structures) ----
+
+struct LineOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) @interpolate(flat) atom: u32,
+};
+
+struct LineFrag {
+    @location(0) color: vec4<f32>,
+    @location(1) id: u32,
+};
+
+@vertex
+fn vs_line(@builtin(vertex_index) vi: u32, @builtin(instance_index) b: u32) -> LineOut {
+    // Two segments per bond: atom x to the middle, the middle to atom y.
+    let bond = bonds[b];
+    let p0 = positions[bond.x].xyz;
+    let p1 = positions[bond.y].xyz;
+    let ends = array<vec3<f32>, 4>(p0, 0.5 * (p0 + p1), 0.5 * (p0 + p1), p1);
+    var out: LineOut;
+    out.clip = g.clip_from_world * vec4<f32>(ends[vi], 1.0);
+    out.atom = select(bond.y, bond.x, vi < 2u);
+    return out;
+}
+
+@fragment
+fn fs_line(in: LineOut) -> LineFrag {
+    var out: LineFrag;
+    out.color = vec4<f32>(color_of(in.atom), 1.0);
+    out.id = g.pick.x | in.atom;
     return out;
 }

@@ -55,6 +55,48 @@ pub struct WavefunctionInfo {
 }
 
 #[derive(Serialize)]
+pub struct ModelInfo {
+    /// The number the file gives (MODEL n; frames count from 1).
+    pub number: i32,
+    pub atoms: usize,
+    pub title: String,
+}
+
+#[derive(Serialize)]
+pub struct ChainInfo {
+    pub name: String,
+    /// 0-based index into `models`.
+    pub model: u32,
+    pub residues: usize,
+    pub atoms: usize,
+}
+
+#[derive(Serialize)]
+pub struct ResidueInfo {
+    pub name: String,
+    pub number: i32,
+    /// The insertion code, "" when none.
+    pub insertion: String,
+    /// 0-based index into `chains`.
+    pub chain: u32,
+    pub hetero: bool,
+    pub secondary: crate::model::structure::Secondary,
+    pub atoms: usize,
+}
+
+/// What a structure file (PDB, mmCIF, XYZ) says beyond atoms: every model, chain and residue
+/// (all models), and which model `atoms` lists.
+#[derive(Serialize)]
+pub struct StructureInfo {
+    pub shown_model: usize,
+    /// Atoms of every model and alternate location.
+    pub all_atoms: usize,
+    pub models: Vec<ModelInfo>,
+    pub chains: Vec<ChainInfo>,
+    pub residues: Vec<ResidueInfo>,
+}
+
+#[derive(Serialize)]
 pub struct DocumentInfo {
     pub source: String,
     pub title: String,
@@ -63,6 +105,47 @@ pub struct DocumentInfo {
     pub bonds: usize,
     pub grids: Vec<GridInfo>,
     pub wavefunction: Option<WavefunctionInfo>,
+    pub structure: Option<StructureInfo>,
+}
+
+fn structure_info(view: &crate::model::StructureView) -> StructureInfo {
+    let s = &view.structure;
+    let len = |r: &std::ops::Range<u32>| (r.end - r.start) as usize;
+    StructureInfo {
+        shown_model: view.model,
+        all_atoms: s.len(),
+        models: s
+            .models
+            .iter()
+            .map(|m| ModelInfo { number: m.number, atoms: len(&m.atoms), title: m.title.clone() })
+            .collect(),
+        chains: s
+            .chains
+            .iter()
+            .map(|c| ChainInfo {
+                name: c.name.to_string(),
+                model: c.model,
+                residues: len(&c.residues),
+                atoms: s.residues[c.residues.start as usize..c.residues.end as usize]
+                    .iter()
+                    .map(|r| len(&r.atoms))
+                    .sum(),
+            })
+            .collect(),
+        residues: s
+            .residues
+            .iter()
+            .map(|r| ResidueInfo {
+                name: r.name.to_string(),
+                number: r.number,
+                insertion: if r.insertion == 0 { String::new() } else { (r.insertion as char).to_string() },
+                chain: r.chain,
+                hetero: r.hetero,
+                secondary: r.secondary,
+                atoms: len(&r.atoms),
+            })
+            .collect(),
+    }
 }
 
 fn orbital_info(wf: &Wavefunction, i: usize) -> OrbitalInfo {
@@ -126,6 +209,7 @@ pub fn describe(doc: &Document) -> DocumentInfo {
             })
             .collect(),
         wavefunction: doc.wavefunction.as_ref().map(wavefunction_info),
+        structure: doc.structure.as_ref().map(structure_info),
     }
 }
 
@@ -135,6 +219,17 @@ pub fn text(doc: &Document) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "{}: {}", info.source, info.title);
     let _ = writeln!(s, "{} atoms ({}), {} bonds", info.atoms.len(), info.formula, info.bonds);
+    if let Some(st) = &info.structure {
+        let _ = writeln!(
+            s,
+            "structure: {} models (model {} shown), {} chains, {} residues, {} atoms with every model and alternate location",
+            st.models.len(),
+            st.models.get(st.shown_model).map_or(1, |m| m.number),
+            st.chains.len(),
+            st.residues.len(),
+            st.all_atoms
+        );
+    }
     for a in &info.atoms {
         let p = a.position_bohr;
         let ang = p.map(|v| v * ANGSTROM_PER_BOHR);

@@ -15,12 +15,16 @@ use orbcloud::model::VolumeGrid;
 use orbcloud::model::gto::PreparedBasis;
 use orbcloud::model::orbitals::{OrbitalSpec, Quantity, Spin, Wavefunction};
 use orbcloud::scene::transfer::PRESETS;
-use orbcloud::scene::{AtomStyle, Camera, ClipPlane, RenderSettings, Shape, SliceMode, TransferKind, ViewPreset};
+use orbcloud::scene::{
+    AtomColoring, AtomStyle, Camera, ClipPlane, RenderSettings, Shape, SliceMode, TransferKind, ViewPreset,
+};
 use orbcloud::{demo, formats, info};
 use rayon::prelude::*;
 
 #[path = "cli/scan.rs"]
 mod scan_cli;
+#[path = "cli/structure.rs"]
+mod structure_cli;
 #[path = "cli/surface.rs"]
 mod surface_cli;
 
@@ -30,8 +34,9 @@ struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
     /// Files to open in the viewer: Gaussian cube (.cube, .cub), Molden (.molden, .molden.input,
-    /// .mold), Gaussian formatted checkpoint (.fchk, .fch), each also gzipped (.gz), or a scan
-    /// manifest (.scan.toml); the bundled demo when none.
+    /// .mold), Gaussian formatted checkpoint (.fchk, .fch), PDB (.pdb, .ent), mmCIF (.cif,
+    /// .mmcif), XYZ (.xyz), each also gzipped (.gz), or a scan manifest (.scan.toml); the bundled
+    /// demo when none.
     files: Vec<PathBuf>,
 }
 
@@ -40,16 +45,18 @@ enum Command {
     /// Open the interactive viewer (the default).
     Viewer {
         /// Files to open: Gaussian cube (.cube, .cub), Molden (.molden, .molden.input, .mold),
-        /// Gaussian formatted checkpoint (.fchk, .fch), each also gzipped (.gz), or a scan manifest
-        /// (.scan.toml); the bundled demo when none.
+        /// Gaussian formatted checkpoint (.fchk, .fch), PDB (.pdb, .ent), mmCIF (.cif, .mmcif), XYZ
+        /// (.xyz), each also gzipped (.gz), or a scan manifest (.scan.toml); the bundled demo when
+        /// none.
         files: Vec<PathBuf>,
     },
     /// Render a file to a PNG without a window.
     Render(RenderArgs),
     /// Print atoms and grids of a file.
     Info {
-        /// Gaussian cube (.cube, .cub), Molden (.molden, .molden.input, .mold) or Gaussian
-        /// formatted checkpoint (.fchk, .fch), each also gzipped (.gz).
+        /// Gaussian cube (.cube, .cub), Molden (.molden, .molden.input, .mold), Gaussian formatted
+        /// checkpoint (.fchk, .fch), PDB (.pdb, .ent), mmCIF (.cif, .mmcif) or XYZ (.xyz), each
+        /// also gzipped (.gz).
         file: PathBuf,
         /// Machine-readable JSON instead of text.
         #[arg(long)]
@@ -227,12 +234,17 @@ enum BenchCommand {
     Keyvolumes(scan_cli::KeyVolumeBench),
     /// ms to extract an isosurface (both signs of an orbital) from a grid.
     Isosurface(surface_cli::IsoBench),
+    /// ms to read a file (PDB, mmCIF, XYZ, or any other the viewer opens) and atoms per second.
+    Load(structure_cli::LoadBench),
+    /// ms per frame of many atoms (synthetic, or a file's) and GPU bytes per atom.
+    Spheres(structure_cli::SpheresBench),
 }
 
 #[derive(Args)]
 struct RenderArgs {
-    /// Gaussian cube (.cube, .cub), Molden (.molden, .molden.input, .mold) or Gaussian formatted
-    /// checkpoint (.fchk, .fch), each also gzipped (.gz); the bundled demo when omitted.
+    /// Gaussian cube (.cube, .cub), Molden (.molden, .molden.input, .mold), Gaussian formatted
+    /// checkpoint (.fchk, .fch), PDB (.pdb, .ent), mmCIF (.cif, .mmcif) or XYZ (.xyz), each also
+    /// gzipped (.gz); the bundled demo when omitted.
     file: Option<PathBuf>,
     /// Output PNG.
     #[arg(short, long)]
@@ -264,7 +276,31 @@ enum AtomsArg {
     BallAndStick,
     SpaceFilling,
     Sticks,
+    Licorice,
+    Lines,
     Hidden,
+}
+
+impl AtomsArg {
+    fn style(self) -> AtomStyle {
+        match self {
+            AtomsArg::BallAndStick => AtomStyle::BallAndStick,
+            AtomsArg::SpaceFilling => AtomStyle::SpaceFilling,
+            AtomsArg::Sticks => AtomStyle::Sticks,
+            AtomsArg::Licorice => AtomStyle::Licorice,
+            AtomsArg::Lines => AtomStyle::Lines,
+            AtomsArg::Hidden => AtomStyle::Hidden,
+        }
+    }
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum ColorArg {
+    Element,
+    Chain,
+    Residue,
+    BFactor,
+    Secondary,
 }
 
 #[derive(Args)]
@@ -303,6 +339,10 @@ struct ViewArgs {
     k2: Option<f32>,
     #[arg(long, value_enum, default_value_t = AtomsArg::BallAndStick)]
     atoms: AtomsArg,
+    /// What colours the atoms (chains, residues, B-factors and secondary structure come from
+    /// PDB and mmCIF files; other files are coloured by element).
+    #[arg(long, value_enum, default_value_t = ColorArg::Element)]
+    color: ColorArg,
     /// Hide the volume (atoms only).
     #[arg(long)]
     no_volume: bool,
@@ -421,11 +461,13 @@ impl ViewArgs {
             s.volume.positive_color = pos;
             s.volume.negative_color = neg;
         }
-        s.atoms = match self.atoms {
-            AtomsArg::BallAndStick => AtomStyle::BallAndStick,
-            AtomsArg::SpaceFilling => AtomStyle::SpaceFilling,
-            AtomsArg::Sticks => AtomStyle::Sticks,
-            AtomsArg::Hidden => AtomStyle::Hidden,
+        s.atoms = self.atoms.style();
+        s.atom_colors = match self.color {
+            ColorArg::Element => AtomColoring::Element,
+            ColorArg::Chain => AtomColoring::Chain,
+            ColorArg::Residue => AtomColoring::Residue,
+            ColorArg::BFactor => AtomColoring::BFactor,
+            ColorArg::Secondary => AtomColoring::Secondary,
         };
         s
     }
@@ -564,6 +606,8 @@ fn main() -> Result<()> {
         Some(Command::Mesh(args)) => surface_cli::mesh(&args),
         Some(Command::Bench(BenchCommand::Keyvolumes(args))) => scan_cli::bench_keyvolumes(args),
         Some(Command::Bench(BenchCommand::Isosurface(args))) => surface_cli::bench(&args),
+        Some(Command::Bench(BenchCommand::Load(args))) => structure_cli::bench_load(&args),
+        Some(Command::Bench(BenchCommand::Spheres(args))) => structure_cli::bench_spheres(&args),
         Some(Command::Bench(BenchCommand::Render { file, view, frames, lavapipe, wavefunction })) => {
             let doc = load(file.as_deref())?;
             let camera = view.camera(&doc)?;

@@ -258,10 +258,10 @@ fn help_names_every_format_read() {
         assert!(out.status.success(), "{args:?}");
         String::from_utf8_lossy(&out.stdout).into_owned()
     };
-    let one = [".cube", ".cub", ".molden", ".molden.input", ".mold", ".fchk", ".fch", ".gz"];
+    let one: Vec<&str> = orbcloud::formats::extensions().chain([".gz"]).collect();
     for args in [&["--help"][..], &["viewer", "--help"], &["info", "--help"], &["render", "--help"]] {
         let help = text(args);
-        for ext in one {
+        for &ext in &one {
             assert!(help.contains(ext), "`orbcloud {}` does not name {ext}:\n{help}", args.join(" "));
         }
         let viewer = args.len() == 1 || args[0] == "viewer";
@@ -297,4 +297,48 @@ fn render_views_along_presets_and_refuses_bad_ones_before_any_gpu_work() {
         assert!(!out.status.success() && err.contains(says), "--view {view}: {err}");
         assert!(start.elapsed().as_secs_f64() < 5.0, "--view {view} took {:?}", start.elapsed());
     }
+}
+
+#[test]
+fn structures_through_info_render_and_bench() {
+    let pdb = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/structures/4e43_excerpt.pdb");
+    let out = orbcloud(&["info", pdb, "--json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let st = &v["structure"];
+    assert_eq!(st["models"].as_array().unwrap().len(), 1);
+    assert_eq!(st["all_atoms"], 197);
+    assert_eq!(st["chains"][0]["name"], "A");
+    assert_eq!(st["residues"][4]["name"], "GLU");
+    assert_eq!(st["residues"][4]["number"], 34);
+    // The shown atoms: the first alternate location only.
+    assert_eq!(v["atoms"].as_array().unwrap().len(), 197 - 16);
+    assert!(v["atoms"][0]["position_bohr"][0].as_f64().unwrap() > 30.0);
+
+    let png = std::env::temp_dir().join(format!("orbcloud-cli-structure-{}.png", std::process::id()));
+    let out = orbcloud(&[
+        "render",
+        pdb,
+        "-o",
+        png.to_str().unwrap(),
+        "--size",
+        "96x72",
+        "--atoms",
+        "licorice",
+        "--color",
+        "chain",
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(image::open(&png).unwrap().width(), 96);
+    std::fs::remove_file(&png).ok();
+
+    let out = orbcloud(&["bench", "load", pdb, "--repeat", "1"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("atoms=197") && text.contains("bonds_ms="), "{text}");
+    let out = orbcloud(&["bench", "spheres", "--atoms", "2000", "--size", "64x48", "--frames", "1"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success() && text.contains("ms_per_frame_median=") && text.contains("gpu_bytes_per_atom="),
+        "{text}"
+    );
 }

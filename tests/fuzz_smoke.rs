@@ -104,7 +104,11 @@ fn fuzz(name: &str, seeds: &[Vec<u8>], read: impl Fn(&[u8])) -> usize {
 }
 
 fn files(ext: &str) -> Vec<Vec<u8>> {
-    let mut seeds: Vec<Vec<u8>> = std::fs::read_dir(FIXTURES)
+    files_in(FIXTURES, ext)
+}
+
+fn files_in(dir: &str, ext: &str) -> Vec<Vec<u8>> {
+    let mut seeds: Vec<Vec<u8>> = std::fs::read_dir(dir)
         .unwrap()
         .flatten()
         .map(|e| e.path())
@@ -126,6 +130,14 @@ fn read(name: &'static str) -> impl Fn(&[u8]) {
     move |data| {
         let _ = orbcloud::formats::load_bytes(Path::new(name), data);
     }
+}
+
+#[test]
+fn structure_readers_survive_mutated_fixtures() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/structures");
+    fuzz("pdb", &files_in(dir, "pdb"), read("fuzz.pdb"));
+    fuzz("mmcif", &files_in(dir, "cif"), read("fuzz.cif"));
+    fuzz("xyz", &files_in(dir, "xyz"), read("fuzz.xyz"));
 }
 
 #[test]
@@ -156,6 +168,7 @@ fn scan_manifests_survive_mutations() {
         ]),
         volumes: Vec::new(),
         wavefunction: None,
+        structure: None,
     };
     let manifest = br#"title = "HOOH"
 dihedral = [1, 2, 3, 4]

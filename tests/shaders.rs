@@ -93,7 +93,12 @@ fn rust_mirrors_match_the_wgsl_layouts() {
                 light,
             ]
         ),
-        mirror!("atoms.wgsl", "Globals", AtomGlobals, [clip_from_world, eye, light, up, pick]),
+        mirror!(
+            "atoms.wgsl",
+            "Globals",
+            AtomGlobals,
+            [clip_from_world, eye, light, up, pick, viewport, ray_f0, ray_fx, ray_fy, counts, sticks, cells]
+        ),
         mirror!("isosurface.wgsl", "SurfaceUniforms", SurfaceUniforms, [clip_from_world, eye, light, color, pick]),
         mirror!("gto_fill.wgsl", "FillParams", FillParams, [world_from_grid, dims]),
         mirror!("gto_fill.wgsl", "GtoShell", GpuShell, [center, cutoff2, l, prim_offset, prim_count, weight_offset]),

@@ -29,6 +29,7 @@ static FRAME: LazyLock<Document> = LazyLock::new(|| {
         ]),
         volumes: Vec::new(),
         wavefunction: None,
+        structure: None,
     }
 });
 

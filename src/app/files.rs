@@ -31,9 +31,7 @@ impl Purpose {
         let name = name.strip_suffix(".gz").unwrap_or(&name);
         match self {
             Purpose::Open => {
-                [".cube", ".cub", ".molden", ".mold", ".molden.input", ".fchk", ".fch", ".scan.toml"]
-                    .iter()
-                    .any(|e| name.ends_with(e))
+                crate::formats::extensions().chain([".scan.toml"]).any(|e| name.ends_with(e))
                     || name.ends_with(crate::scene::objects::SESSION_SUFFIX)
             }
             Purpose::SaveSession => name.ends_with(crate::scene::objects::SESSION_SUFFIX),
@@ -62,8 +60,11 @@ pub fn native(purpose: Purpose, file_name: &str) -> Native {
     let chosen = match purpose {
         Purpose::Open => dialog
             .add_filter(
-                "Cube, Molden, fchk, scan, session",
-                &["cube", "cub", "molden", "mold", "fchk", "fch", "toml", "gz"],
+                "Cube, Molden, fchk, PDB, mmCIF, XYZ, scan, session",
+                &crate::formats::extensions()
+                    .filter_map(|e| e.rsplit('.').next())
+                    .chain(["toml", "gz"])
+                    .collect::<Vec<_>>(),
             )
             .pick_file(),
         Purpose::SaveSession => dialog.add_filter("orbcloud session", &["toml"]).set_file_name(file_name).save_file(),

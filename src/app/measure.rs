@@ -51,7 +51,8 @@ impl Measurements {
             return label;
         }
         let p = a.position * ANGSTROM_PER_BOHR;
-        format!("atom {} {} at {:.3} {:.3} {:.3} Å", atom + 1, a.element().symbol, p.x, p.y, p.z)
+        let about = world.annotation(object as usize, index as usize).map(|s| format!(" ({s})")).unwrap_or_default();
+        format!("atom {} {}{about} at {:.3} {:.3} {:.3} Å", atom + 1, a.element().symbol, p.x, p.y, p.z)
     }
 }
 
@@ -78,15 +79,16 @@ pub fn overlay(ui: &egui::Ui, vp: &Viewport, camera: &Camera, world: &World, m: 
             }
         }
     }
-    if let Some(PickId::Atom { object, index }) = vp.hovered
-        && let Some(index) = world.atom(object as usize, index as usize)
+    if let Some(PickId::Atom { object, index: own }) = vp.hovered
+        && let Some(index) = world.atom(object as usize, own as usize)
         && let (Some(p), Some(atom)) = (screen(index), molecule.atoms.get(index))
     {
         painter.circle_stroke(p, 11.0, Stroke::new(1.5, Color32::from_white_alpha(160)));
+        let about = world.annotation(object as usize, own as usize).map(|s| format!("  {s}")).unwrap_or_default();
         painter.text(
             p + egui::vec2(12.0, 10.0),
             egui::Align2::LEFT_TOP,
-            format!("{}{}", atom.element().symbol, index + 1),
+            format!("{}{}{about}", atom.element().symbol, index + 1),
             egui::FontId::proportional(14.0),
             Color32::WHITE,
         );
@@ -144,7 +146,7 @@ mod tests {
         let atom = |x: f64, y: f64, z: f64| Atom { z: 6, charge: 6.0, position: DVec3::new(x, y, z), ghost: false };
         let mol =
             Molecule::new(vec![atom(0.0, 2.0, 0.0), atom(0.0, 0.0, 0.0), atom(2.8, 0.0, 0.0), atom(2.8, 0.0, 2.0)]);
-        let mol = World { molecule: mol, offsets: vec![0] };
+        let mol = World { molecule: mol, offsets: vec![0], docs: Vec::new() };
         let mut m = Measurements::default();
         let pick = |i: u32, shift| Click { picked: Some(PickId::Atom { object: 0, index: i }), shift };
         assert!(m.click(pick(0, false), &mol).starts_with("atom 1 C"));
@@ -168,6 +170,7 @@ mod tests {
         let world = World {
             molecule: Molecule { atoms: vec![atom(0.0), atom(2.0), atom(10.0)], bonds: vec![] },
             offsets: vec![0, 2],
+            docs: Vec::new(),
         };
         let mut m = Measurements::default();
         let pick = |object, index, shift| Click { picked: Some(PickId::Atom { object, index }), shift };

@@ -5,6 +5,7 @@ pub mod files;
 pub mod jobs;
 mod loader;
 pub mod measure;
+pub mod models;
 mod orbitals;
 mod panels;
 pub mod scan;
@@ -145,6 +146,8 @@ pub struct OrbApp {
     /// Picked atoms and measurements between them; atoms are numbered through the scene
     /// ([`Self::world`]).
     pub measurements: measure::Measurements,
+    /// Which model of a multi-model structure is shown, and whether they play in turn.
+    pub models: models::Player,
     /// Every object's atoms where they are placed, one numbering through the scene.
     world: World,
     /// Where the session is saved between runs (`None`: not kept, as in tests).
@@ -165,6 +168,8 @@ pub struct World {
     pub molecule: Molecule,
     /// Index of each object's first atom.
     pub offsets: Vec<usize>,
+    /// Each object's document, for what a file says of an atom (residue, chain, B-factor).
+    pub docs: Vec<Arc<Document>>,
 }
 
 impl World {
@@ -172,6 +177,7 @@ impl World {
         let mut world = Self::default();
         for o in objects {
             world.offsets.push(world.molecule.atoms.len());
+            world.docs.push(o.doc.clone());
             let m = o.state.placement.world_from_object().as_dmat4();
             world.molecule.atoms.extend(
                 o.doc.molecule.atoms.iter().map(|a| Atom { position: m.transform_point3(a.position), ..a.clone() }),
@@ -182,7 +188,19 @@ impl World {
 
     /// One molecule as the whole scene (a scan's skeleton at θ).
     pub fn single(molecule: Molecule) -> Self {
-        Self { molecule, offsets: vec![0] }
+        Self { molecule, offsets: vec![0], docs: Vec::new() }
+    }
+
+    /// What object `object`'s file says of its atom `index` beyond element and position:
+    /// "A ALA 42 CA · B 12.3 · occupancy 0.50", `None` for files without residues.
+    pub fn annotation(&self, object: usize, index: usize) -> Option<String> {
+        let view = self.docs.get(object)?.structure.as_ref()?;
+        let i = *view.atoms.get(index)? as usize;
+        let s = &view.structure;
+        if s.residues.get(s.residue[i] as usize)?.name.as_str().is_empty() {
+            return None; // an XYZ frame: nothing beyond the element
+        }
+        Some(format!("{} · B {:.1} · occupancy {:.2}", s.describe(i), s.b_factor[i], s.occupancy[i]))
     }
 
     /// The scene-wide number of atom `index` of object `object`.
@@ -260,6 +278,7 @@ impl OrbApp {
             scan_retry: None,
             scan_budget: None,
             measurements: measure::Measurements::default(),
+            models: models::Player::default(),
             world: World::default(),
             last_session: None,
             gpu_errors,
@@ -573,13 +592,13 @@ impl OrbApp {
         vp.update_isosurfaces(n, &o.doc, &o.state);
     }
 
-    /// Shows object `n`'s atoms in its state's style.
+    /// Shows object `n`'s atoms in its state's style and colouring.
     pub fn restyle_atoms(&mut self, n: usize) {
         if n == self.active {
             self.commit_active();
         }
         let (Some(vp), Some(o)) = (&mut self.viewport, self.objects.get(n)) else { return };
-        vp.set_atom_style(n, &o.doc, o.state.settings.atoms);
+        vp.set_atom_look(n, &o.doc, &o.state.settings);
     }
 
     /// Computes what the active object's orbital browser asks for and hands it to the viewport.
@@ -813,8 +832,10 @@ impl OrbApp {
         if before.settings.iso != self.view.settings.iso {
             vp.update_isosurfaces(n, &o.doc, &o.state);
         }
-        if before.settings.atoms != self.view.settings.atoms {
-            vp.set_atom_style(n, &o.doc, self.view.settings.atoms);
+        if (before.settings.atoms, before.settings.atom_colors)
+            != (self.view.settings.atoms, self.view.settings.atom_colors)
+        {
+            vp.set_atom_look(n, &o.doc, &self.view.settings);
             if let Some(scan) = &mut self.scan {
                 scan::restyle(scan);
             }
@@ -870,6 +891,9 @@ impl eframe::App for OrbApp {
             self.show_wavefunction();
         }
         self.apply(&before);
+        if let Some(model) = models::tick(&ctx, self) {
+            self.show_model(model);
+        }
         match action {
             panels::Action::Open => {
                 if let Some(path) = self.choose(files::Purpose::Open, "") {

@@ -7,8 +7,8 @@ use crate::model::orbitals::Quantity;
 use crate::model::units::ANGSTROM_PER_BOHR;
 use crate::scene::transfer::{Lobe, PRESETS};
 use crate::scene::{
-    AtomStyle, ClipPlane, DensityScale, IsoLevel, IsosurfaceSettings, Shape, SliceMode, Transfer, TransferKind,
-    ViewPreset,
+    AtomColoring, AtomStyle, ClipPlane, DensityScale, IsoLevel, IsosurfaceSettings, Shape, SliceMode, Transfer,
+    TransferKind, ViewPreset,
 };
 
 /// The side panel's width, points.
@@ -247,6 +247,15 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
             ComboBox::from_label("style").selected_text(view.settings.atoms.name()).show_ui(ui, |ui| {
                 for style in AtomStyle::ALL {
                     ui.selectable_value(&mut view.settings.atoms, style, style.name());
+                }
+            });
+            if let Some(model) = super::models::controls(ui, app) {
+                app.show_model(model);
+            }
+            let view = &mut app.view;
+            ComboBox::from_label("colour by").selected_text(view.settings.atom_colors.name()).show_ui(ui, |ui| {
+                for coloring in AtomColoring::ALL {
+                    ui.selectable_value(&mut view.settings.atom_colors, coloring, coloring.name());
                 }
             });
             ui.horizontal(|ui| {

@@ -299,8 +299,16 @@ impl Viewport {
         &mut self.slots[n]
     }
 
-    pub fn set_atom_style(&mut self, n: usize, doc: &Document, style: crate::scene::AtomStyle) {
-        self.renderer.layer_mut(&self.ctx, n).set_molecule(&self.ctx, &doc.molecule, style);
+    /// Restyles and recolours object `n`'s atoms (positions stay on the GPU as they are).
+    pub fn set_atom_look(&mut self, n: usize, doc: &Document, settings: &crate::scene::RenderSettings) {
+        let colors = crate::scene::coloring::atom_colors(&doc.molecule, doc.structure.as_ref(), settings.atom_colors);
+        self.renderer.layer_mut(&self.ctx, n).atoms.set_look(&self.ctx, settings.atoms, &colors);
+        self.generation += 1;
+    }
+
+    /// Puts object `n`'s molecule anew (another model or frame of a structure).
+    pub fn set_atoms(&mut self, n: usize, doc: &Document, settings: &crate::scene::RenderSettings) {
+        crate::headless::show_atoms(&self.ctx, self.renderer.layer_mut(&self.ctx, n), doc, settings);
         self.generation += 1;
     }
 

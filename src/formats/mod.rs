@@ -1,15 +1,20 @@
 //! File readers: text -> model. Each reader stays faithful to its format and reports
 //! malformed input as a typed error naming the file, the line and what was expected.
 
+mod cif;
 pub mod cube;
 pub mod cube_write;
 mod error;
 pub mod fchk;
 pub mod mesh_write;
+pub mod mmcif;
 pub mod molden;
+pub mod pdb;
 pub mod scan;
+mod structure;
 mod text;
 pub mod wavefunction;
+pub mod xyz;
 
 pub use error::{LoadError, ParseError};
 pub use wavefunction::OverlapFn;
@@ -43,7 +48,8 @@ pub const MAX_LINE_BYTES: usize = 1 << 20;
 pub const MAX_TRAILING_BYTES: usize = 64 << 10;
 
 /// Reads a file from disk, picking the reader by extension: `.cube`, `.cub`, `.molden`,
-/// `.molden.input`, `.mold`, `.fchk`, `.fch`, each also gzipped (`.gz`).
+/// `.molden.input`, `.mold`, `.fchk`, `.fch`, `.pdb`, `.ent`, `.cif`, `.mmcif`, `.xyz`, each
+/// also gzipped (`.gz`).
 pub fn load(path: &Path) -> Result<Document, LoadError> {
     load_with(path, DEFAULT_OVERLAP)
 }
@@ -75,6 +81,9 @@ fn parse_text(name: &str, reader: Reader, text: Bounded, overlap: Option<Overlap
         Reader::Cube => cube::parse(name, &text.text),
         Reader::Molden => molden::parse(name, &text.text, overlap),
         Reader::Fchk => fchk::parse(name, &text.text, overlap),
+        Reader::Pdb => pdb::parse(name, &text.text),
+        Reader::Mmcif => mmcif::parse(name, &text.text),
+        Reader::Xyz => xyz::parse(name, &text.text),
     };
     // When reading stopped early the parser names the first fault in what was read, if it
     // sees one; otherwise the reason reading stopped is the error.
@@ -91,20 +100,40 @@ enum Reader {
     Cube,
     Molden,
     Fchk,
+    Pdb,
+    Mmcif,
+    Xyz,
+}
+
+/// Every file name ending a reader takes (each also with `.gz`), and the reader.
+const READERS: [(&str, Reader); 12] = [
+    (".cube", Reader::Cube),
+    (".cub", Reader::Cube),
+    (".molden", Reader::Molden),
+    (".molden.input", Reader::Molden),
+    (".mold", Reader::Molden),
+    (".fchk", Reader::Fchk),
+    (".fch", Reader::Fchk),
+    (".pdb", Reader::Pdb),
+    (".ent", Reader::Pdb),
+    (".cif", Reader::Mmcif),
+    (".mmcif", Reader::Mmcif),
+    (".xyz", Reader::Xyz),
+];
+
+/// The file name endings [`load`] reads (each also gzipped, `.gz`).
+pub fn extensions() -> impl Iterator<Item = &'static str> {
+    READERS.iter().map(|(e, _)| *e)
 }
 
 fn reader_for(path: &Path) -> Result<Reader, LoadError> {
     let name = path.file_name().map(|n| n.to_string_lossy().to_lowercase()).unwrap_or_default();
     let base = name.strip_suffix(".gz").unwrap_or(&name);
-    if base.ends_with(".cube") || base.ends_with(".cub") {
-        Ok(Reader::Cube)
-    } else if base.ends_with(".molden") || base.ends_with(".molden.input") || base.ends_with(".mold") {
-        Ok(Reader::Molden)
-    } else if base.ends_with(".fchk") || base.ends_with(".fch") {
-        Ok(Reader::Fchk)
-    } else {
-        Err(LoadError::UnknownFormat { path: path.display().to_string() })
-    }
+    READERS
+        .iter()
+        .find(|(e, _)| base.ends_with(e))
+        .map(|&(_, r)| r)
+        .ok_or_else(|| LoadError::UnknownFormat { path: path.display().to_string() })
 }
 
 /// Reads a whole file, transparently gunzipping `*.gz`, within the bounds of [`read_bounded`].

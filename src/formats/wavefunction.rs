@@ -249,6 +249,7 @@ pub fn wavefunction_document(
         molecule: crate::model::Molecule::new(atoms),
         volumes: vec![],
         wavefunction: Some(check_and_repair(wf, program, overlap)),
+        structure: None,
     }
 }
 

@@ -1,15 +1,21 @@
-//! Atoms as sphere impostors and bonds as cylinder impostors (seed 001's P4 point sprites,
-//! done as instanced quads with exact per-pixel intersection and depth).
+//! Atoms and bonds from GPU storage buffers (seed 001): positions, packed attributes and bonds
+//! are uploaded once; a colour change rewrites only the attributes, a style change only the
+//! small radius table. Each frame a compute pass culls to the frustum and applies seed 002's
+//! screen-size level of detail: spheres of at most [`AtomsPass::splat_radius_px`] pixels are
+//! rasterised in compute (exact per-pixel ray–sphere depth, nearest wins by an atomic maximum)
+//! and resolved in one full-screen pass; bigger ones, and bonds thicker than a third of a
+//! pixel, are appended to lists that instanced impostor quads draw (exact ray–sphere and
+//! ray–cylinder intersection and depth).
 
 use bytemuck::{Pod, Zeroable};
-use glam::Vec3;
+use glam::{Mat4, Vec3, Vec4};
 
 use super::GpuContext;
 use super::frame::{Draw, ObjectView, Phase, PickId, opaque_depth, opaque_targets};
 use crate::model::{Molecule, units::BOHR_PER_ANGSTROM};
-use crate::scene::AtomStyle;
+use crate::scene::{AtomColors, AtomStyle};
 
-/// Mirror of `Globals` in atoms.wgsl.
+/// Mirror of `Globals` in atoms_common.wgsl.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
 pub struct AtomGlobals {
@@ -19,40 +25,225 @@ pub struct AtomGlobals {
     pub up: [f32; 4],
     /// x: the high bits of this object's atom pick ids ([`PickId::atom_base`]).
     pub pick: [u32; 4],
+    /// Viewport width and height (px), pixels per bohr at unit clip w, the splat threshold (px).
+    pub viewport: [f32; 4],
+    pub ray_f0: [f32; 4],
+    pub ray_fx: [f32; 4],
+    pub ray_fy: [f32; 4],
+    /// Atoms, bonds, style flags, invocations per dispatch row.
+    pub counts: [u32; 4],
+    /// x: stick radius (bohr).
+    pub sticks: [f32; 4],
+    /// Cells to rasterise this frame, where their order starts in the lists, where the atom
+    /// indices start in the cell data.
+    pub cells: [u32; 4],
 }
-const _: () = assert!(std::mem::size_of::<AtomGlobals>() == 128);
-
-#[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
-pub struct SphereInstance {
-    pub center: [f32; 3],
-    pub radius: f32,
-    pub color: [f32; 4],
-}
-const _: () = assert!(std::mem::size_of::<SphereInstance>() == 32);
-
-#[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
-pub struct CylinderInstance {
-    pub p0: [f32; 3],
-    pub radius: f32,
-    pub p1: [f32; 3],
-    /// The atom this half-bond belongs to: picking it picks the atom.
-    pub atom: u32,
-    pub color: [f32; 4],
-}
-const _: () = assert!(std::mem::size_of::<CylinderInstance>() == 48);
+const _: () = assert!(std::mem::size_of::<AtomGlobals>() == 240);
 
 /// Ball radius as a fraction of the van der Waals radius in ball-and-stick.
 const BALL_FRACTION: f32 = 0.24;
-/// Stick radius in ball-and-stick, ångström.
+/// Stick radius in ball-and-stick and sticks, ångström.
 const STICK_RADIUS_ANG: f32 = 0.13;
+/// Stick (and cap) radius of licorice, ångström.
+const LICORICE_RADIUS_ANG: f32 = 0.3;
+/// Radius of an unbonded atom (an ion, a water oxygen) in the lines style, ångström.
+const LINES_BALL_ANG: f32 = 0.25;
 
-fn attribute(shader_location: u32, format: wgpu::VertexFormat, offset: u64) -> wgpu::VertexAttribute {
-    wgpu::VertexAttribute { format, offset, shader_location }
+const FLAG_GHOST: u32 = 1;
+const FLAG_BONDED: u32 = 4;
+const STYLE_CYLINDERS: u32 = 1;
+const STYLE_UNBONDED_ONLY: u32 = 2;
+/// Radii per atomic number come first in the looks buffer, then the palette.
+const PALETTE_AT: usize = 128;
+/// u32s before the lists: the sphere and the bond indirect draw arguments.
+const LIST_HEADER: usize = 8;
+const WORKGROUP: u32 = 64;
+/// Bytes a splat buffer takes per pixel: a depth key and an atom id.
+const SPLAT_BYTES_PER_PIXEL: u64 = 8;
+
+/// Atoms a spatial cell holds on average; a cell is culled, ordered nearest first and
+/// rasterised by one workgroup. Measured on lavapipe (10⁶ atoms, 800×600): 48 atoms per cell
+/// spend more on launching workgroups than they save by finer order, 480 lose occlusion;
+/// 256 was fastest for space filling and ball and stick alike.
+const CELL_ATOMS: f32 = 256.0;
+/// The largest atom radius any style draws (bohr), padding cells' bounds for culling.
+const MAX_ATOM_RADIUS: f32 = 5.0;
+/// Header words per cell in `cell_data`.
+const CELL_WORDS: usize = 6;
+
+/// Atoms binned into cubic cells: the GPU's `cell_data` ([`CELL_WORDS`] per cell: first,
+/// count and the bounding sphere's centre and radius as f32 bits; then the atom indices cell
+/// by cell) and each cell's bounding sphere (centre, radius) for the CPU,
+/// which culls and orders cells every frame.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Cells {
+    pub data: Vec<u32>,
+    pub spheres: Vec<[f32; 4]>,
 }
 
-fn linear_color(srgb: [u8; 3]) -> [f32; 4] {
+impl Cells {
+    pub fn new(positions: &[[f32; 4]]) -> Self {
+        let n = positions.len();
+        if n == 0 {
+            return Self::default();
+        }
+        let p = |i: usize| Vec3::new(positions[i][0], positions[i][1], positions[i][2]);
+        let (lo, hi) = (0..n).fold((p(0), p(0)), |(lo, hi), i| (lo.min(p(i)), hi.max(p(i))));
+        let extent = (hi - lo).max(Vec3::splat(1.0));
+        let mut edge = (extent.x * extent.y * extent.z / n as f32 * CELL_ATOMS).cbrt().max(2.0);
+        let dims = |edge: f32| (extent / edge).floor().as_uvec3() + 1;
+        // At most a few cells per atom however the atoms spread.
+        while dims(edge).as_u64vec3().element_product() > 4 * n as u64 + 8 {
+            edge *= 1.26;
+        }
+        let d = dims(edge);
+        let cell_of = |i: usize| {
+            let c = ((p(i) - lo) / edge).floor().as_uvec3().min(d - 1);
+            (c.x + d.x * (c.y + d.y * c.z)) as usize
+        };
+        let total = (d.x * d.y * d.z) as usize;
+        let mut start = vec![0u32; total + 1];
+        let cell: Vec<usize> = (0..n).map(cell_of).collect();
+        for &c in &cell {
+            start[c + 1] += 1;
+        }
+        for c in 0..total {
+            start[c + 1] += start[c];
+        }
+        let mut fill = start.clone();
+        let mut atoms = vec![0u32; n];
+        for (i, &c) in cell.iter().enumerate() {
+            atoms[fill[c] as usize] = i as u32;
+            fill[c] += 1;
+        }
+        let mut data = Vec::new();
+        let mut spheres = Vec::new();
+        let radius = 0.5 * 3f32.sqrt() * edge;
+        for c in 0..total {
+            let count = start[c + 1] - start[c];
+            if count > 0 {
+                let (x, y, z) = (c as u32 % d.x, c as u32 / d.x % d.y, c as u32 / (d.x * d.y));
+                let centre = lo + (Vec3::new(x as f32, y as f32, z as f32) + 0.5) * edge;
+                let sphere = centre.extend(radius).to_array();
+                data.extend([start[c], count]);
+                data.extend(sphere.map(f32::to_bits));
+                spheres.push(sphere);
+            }
+        }
+        data.extend(atoms);
+        Self { data, spheres }
+    }
+
+    pub fn len(&self) -> usize {
+        self.spheres.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.spheres.is_empty()
+    }
+
+    /// The cells any part of which the frustum of `clip_from_object` holds, nearest to `eye`
+    /// (along `view_dir`) first.
+    pub fn visible_order(&self, clip_from_object: Mat4, eye: Vec3, view_dir: Vec3) -> Vec<u32> {
+        let r = |k: usize| clip_from_object.row(k);
+        // Gribb–Hartmann planes for 0..1 depth: left, right, bottom, top, near, far.
+        let planes = [r(3) + r(0), r(3) - r(0), r(3) + r(1), r(3) - r(1), r(2), r(3) - r(2)]
+            .map(|p| p / p.truncate().length().max(1e-20));
+        let mut visible: Vec<(f32, u32)> = self
+            .spheres
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| {
+                let c = Vec4::new(s[0], s[1], s[2], 1.0);
+                planes.iter().all(|p| p.dot(c) >= -(s[3] + MAX_ATOM_RADIUS))
+            })
+            .map(|(k, s)| ((Vec3::new(s[0], s[1], s[2]) - eye).dot(view_dir), k as u32))
+            .collect();
+        visible.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+        visible.into_iter().map(|(_, k)| k).collect()
+    }
+}
+
+/// What the GPU holds per atom and bond, as plain arrays (testable without a GPU).
+#[derive(Debug, Clone, PartialEq)]
+pub struct AtomData {
+    /// xyz bohr, w unused (16-byte loads).
+    pub positions: Vec<[f32; 4]>,
+    /// Bits 0–7 atomic number, 8–15 flags, 16–31 palette index.
+    pub attrs: Vec<u32>,
+    pub bonds: Vec<[u32; 2]>,
+    pub cells: Cells,
+}
+
+impl AtomData {
+    pub fn new(molecule: &Molecule, colors: &AtomColors) -> Self {
+        let mut bonded = vec![false; molecule.atoms.len()];
+        for b in &molecule.bonds {
+            bonded[b.a as usize] = true;
+            bonded[b.b as usize] = true;
+        }
+        let attrs = molecule
+            .atoms
+            .iter()
+            .enumerate()
+            .map(|(i, a)| {
+                let flags = if a.ghost { FLAG_GHOST } else { 0 } | if bonded[i] { FLAG_BONDED } else { 0 };
+                let color = colors.index.get(i).copied().unwrap_or(0) as u32;
+                a.z.min(127) | flags << 8 | color << 16
+            })
+            .collect();
+        let positions: Vec<[f32; 4]> =
+            molecule.atoms.iter().map(|a| a.position.as_vec3().extend(0.0).to_array()).collect();
+        Self {
+            cells: Cells::new(&positions),
+            positions,
+            attrs,
+            bonds: molecule.bonds.iter().map(|b| [b.a, b.b]).collect(),
+        }
+    }
+
+    /// Bytes on the GPU: positions, attributes, list slots, cells, bonds with their slots.
+    pub fn gpu_bytes(&self) -> usize {
+        self.positions.len() * (16 + 4 + 4)
+            + self.cells.data.len() * 4
+            + self.cells.len() * 4
+            + self.bonds.len() * (8 + 4)
+    }
+}
+
+/// The style's radius per atomic number (bohr), then the palette (linear RGB).
+pub fn looks(style: AtomStyle, colors: &AtomColors) -> Vec<[f32; 4]> {
+    let bohr = BOHR_PER_ANGSTROM as f32;
+    let mut out: Vec<[f32; 4]> = (0..PALETTE_AT)
+        .map(|z| {
+            let e = crate::model::elements::element(z as u32);
+            let r = match style {
+                AtomStyle::BallAndStick => e.vdw_radius * BALL_FRACTION,
+                AtomStyle::SpaceFilling => e.vdw_radius,
+                AtomStyle::Sticks => STICK_RADIUS_ANG,
+                AtomStyle::Licorice => LICORICE_RADIUS_ANG,
+                AtomStyle::Lines => LINES_BALL_ANG,
+                AtomStyle::Hidden => 0.0,
+            };
+            [r * bohr, 0.0, 0.0, 0.0]
+        })
+        .collect();
+    out.extend(colors.palette.iter().map(|&c| linear_color(c)));
+    out
+}
+
+/// Stick radius (bohr) and style flags.
+fn style_flags(style: AtomStyle) -> (f32, u32) {
+    let bohr = BOHR_PER_ANGSTROM as f32;
+    match style {
+        AtomStyle::BallAndStick | AtomStyle::Sticks => (STICK_RADIUS_ANG * bohr, STYLE_CYLINDERS),
+        AtomStyle::Licorice => (LICORICE_RADIUS_ANG * bohr, STYLE_CYLINDERS),
+        AtomStyle::Lines => (0.0, STYLE_UNBONDED_ONLY),
+        AtomStyle::SpaceFilling | AtomStyle::Hidden => (0.0, 0),
+    }
+}
+
+pub(crate) fn linear_color(srgb: [u8; 3]) -> [f32; 4] {
     let lin = |c: u8| {
         let c = c as f32 / 255.0;
         if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
@@ -60,83 +251,123 @@ fn linear_color(srgb: [u8; 3]) -> [f32; 4] {
     [lin(srgb[0]), lin(srgb[1]), lin(srgb[2]), 1.0]
 }
 
-/// The impostor instances for a molecule in a style: plain data, testable without a GPU.
-pub fn instances(molecule: &Molecule, style: AtomStyle) -> (Vec<SphereInstance>, Vec<CylinderInstance>) {
-    let bohr = BOHR_PER_ANGSTROM as f32;
-    let spheres = match style {
-        AtomStyle::Hidden => Vec::new(),
-        _ => molecule
-            .atoms
-            .iter()
-            .map(|a| {
-                let e = a.element();
-                let mut radius = match style {
-                    AtomStyle::SpaceFilling => e.vdw_radius,
-                    AtomStyle::Sticks => STICK_RADIUS_ANG,
-                    _ => e.vdw_radius * BALL_FRACTION,
-                } * bohr;
-                let mut color = linear_color(e.color);
-                if a.ghost {
-                    radius *= 0.5;
-                    color = [0.35, 0.35, 0.35, 1.0];
-                }
-                SphereInstance { center: a.position.as_vec3().to_array(), radius, color }
-            })
-            .collect(),
-    };
-    let cylinders = match style {
-        AtomStyle::BallAndStick | AtomStyle::Sticks => molecule
-            .bonds
-            .iter()
-            .flat_map(|b| {
-                let (a, c) = (&molecule.atoms[b.a as usize], &molecule.atoms[b.b as usize]);
-                let (pa, pc) = (a.position.as_vec3(), c.position.as_vec3());
-                let mid = 0.5 * (pa + pc);
-                let half = |p: Vec3, atom, color| CylinderInstance {
-                    p0: p.to_array(),
-                    radius: STICK_RADIUS_ANG * bohr,
-                    p1: mid.to_array(),
-                    atom,
-                    color,
-                };
-                [half(pa, b.a, linear_color(a.element().color)), half(pc, b.b, linear_color(c.element().color))]
-            })
-            .collect(),
-        _ => Vec::new(),
-    };
-    (spheres, cylinders)
+/// Workgroups for `n` invocations, as (x, y) within the per-dimension limit, and the
+/// invocations per row the shader indexes with.
+fn dispatch(n: u32) -> ([u32; 2], u32) {
+    let groups = n.div_ceil(WORKGROUP).max(1);
+    let x = groups.min(65_535);
+    ([x, groups.div_ceil(x)], x * WORKGROUP)
+}
+
+/// The buffers of one uploaded molecule.
+struct Uploaded {
+    positions: wgpu::Buffer,
+    attrs: wgpu::Buffer,
+    looks: wgpu::Buffer,
+    bonds: wgpu::Buffer,
+    /// Indirect draw arguments, the sphere list, the bond list, then this frame's cell order.
+    lists: wgpu::Buffer,
+    cell_data: wgpu::Buffer,
+    cells: Cells,
+    /// Cells in this frame's view, nearest first (how many the compute passes walk).
+    visible_cells: u32,
+    atoms: u32,
+    bond_count: u32,
+    /// CPU copy of the attributes: a recolouring changes their palette bits only.
+    attr_words: Vec<u32>,
+    group: wgpu::BindGroup,
 }
 
 pub struct AtomsPass {
-    spheres_pipeline: wgpu::RenderPipeline,
-    cylinders_pipeline: wgpu::RenderPipeline,
-    layout: wgpu::BindGroupLayout,
+    shared: std::sync::Arc<Pipelines>,
     globals: wgpu::Buffer,
-    bind_group: wgpu::BindGroup,
-    spheres: Option<(wgpu::Buffer, u32)>,
-    cylinders: Option<(wgpu::Buffer, u32)>,
+    data: Option<Uploaded>,
+    style: AtomStyle,
+    /// Depth keys then atom ids, one of each per pixel; sized to the last frame.
+    splat: Option<(wgpu::Buffer, [u32; 2])>,
+    /// Bind groups of the lists and the splat buffer (compute: writable; render: read-only).
+    frame_groups: Option<(wgpu::BindGroup, wgpu::BindGroup)>,
+    /// Spheres up to this projected radius (pixels) are drawn by the compute rasteriser.
+    pub splat_radius_px: f32,
 }
 
-impl AtomsPass {
-    pub fn new(ctx: &GpuContext) -> Self {
+struct Pipelines {
+    data_layout: wgpu::BindGroupLayout,
+    compute_layout: wgpu::BindGroupLayout,
+    render_layout: wgpu::BindGroupLayout,
+    cull_atoms: wgpu::ComputePipeline,
+    splat_ids: wgpu::ComputePipeline,
+    cull_bonds: wgpu::ComputePipeline,
+    spheres: wgpu::RenderPipeline,
+    splats: wgpu::RenderPipeline,
+    cylinders: wgpu::RenderPipeline,
+    lines: wgpu::RenderPipeline,
+}
+
+/// Default splat threshold: measured on lavapipe, see README (`orbcloud bench spheres`).
+pub const SPLAT_RADIUS_PX: f32 = 8.0;
+
+impl Pipelines {
+    fn new(ctx: &GpuContext) -> Self {
+        use wgpu::BufferBindingType::{Storage, Uniform};
+        use wgpu::ShaderStages as S;
         let device = &ctx.device;
+        let entry = super::buffer_entry;
+        let all = S::VERTEX_FRAGMENT | S::COMPUTE;
+        let read = Storage { read_only: true };
+        let data_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("atoms data layout"),
+            entries: &[
+                entry(0, all, Uniform),
+                entry(1, all, read),
+                entry(2, all, read),
+                entry(3, all, read),
+                entry(4, all, read),
+                entry(5, all, read),
+            ],
+        });
+        let compute_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("atoms compute layout"),
+            entries: &[
+                entry(0, S::COMPUTE, Storage { read_only: false }),
+                entry(1, S::COMPUTE, Storage { read_only: false }),
+            ],
+        });
+        let render_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("atoms render layout"),
+            entries: &[entry(0, S::VERTEX, read), entry(1, S::FRAGMENT, read)],
+        });
+        let layout = |second: &wgpu::BindGroupLayout| {
+            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("atoms pipeline layout"),
+                bind_group_layouts: &[Some(&data_layout), Some(second)],
+                immediate_size: 0,
+            })
+        };
+        let (compute_pl, render_pl) = (layout(&compute_layout), layout(&render_layout));
+        let cull = super::shader_module(device, "atoms_cull.wgsl");
+        let compute = |entry: &str| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: Some(&compute_pl),
+                module: &cull,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
         let module = super::shader_module(device, "atoms.wgsl");
-        let (layout, pipeline_layout) = super::uniform_layouts(device, "atoms");
-        let pipeline = |label: &str, vs: &str, fs: &str, stride: u64, attributes: &[wgpu::VertexAttribute]| {
+        let render = |label: &str, vs: &str, fs: &str, topology| {
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some(label),
-                layout: Some(&pipeline_layout),
+                layout: Some(&render_pl),
                 vertex: wgpu::VertexState {
                     module: &module,
                     entry_point: Some(vs),
                     compilation_options: Default::default(),
-                    buffers: &[Some(wgpu::VertexBufferLayout {
-                        array_stride: stride,
-                        step_mode: wgpu::VertexStepMode::Instance,
-                        attributes,
-                    })],
+                    buffers: &[],
                 },
-                primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+                primitive: wgpu::PrimitiveState { topology, cull_mode: None, ..Default::default() },
                 depth_stencil: Some(opaque_depth()),
                 multisample: Default::default(),
                 fragment: Some(wgpu::FragmentState {
@@ -149,84 +380,224 @@ impl AtomsPass {
                 cache: None,
             })
         };
-        let spheres_pipeline = pipeline(
-            "sphere impostors",
-            "vs_sphere",
-            "fs_sphere",
-            32,
-            &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32, 2 => Float32x4],
-        );
-        let cylinders_pipeline = pipeline(
-            "cylinder impostors",
-            "vs_cylinder",
-            "fs_cylinder",
-            48,
-            // Not vertex_attr_array!: the atom index sits between p1 and the colour.
-            &[
-                attribute(0, wgpu::VertexFormat::Float32x3, 0),
-                attribute(1, wgpu::VertexFormat::Float32, 12),
-                attribute(2, wgpu::VertexFormat::Float32x3, 16),
-                attribute(3, wgpu::VertexFormat::Float32x4, 32),
-                attribute(4, wgpu::VertexFormat::Uint32, 28),
-            ],
-        );
-        let globals = super::uniform_buffer(device, "atoms globals", std::mem::size_of::<AtomGlobals>());
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("atoms bind group"),
-            layout: &layout,
-            entries: &[wgpu::BindGroupEntry { binding: 0, resource: globals.as_entire_binding() }],
-        });
-        Self { spheres_pipeline, cylinders_pipeline, layout, globals, bind_group, spheres: None, cylinders: None }
+        use wgpu::PrimitiveTopology::{LineList, TriangleList};
+        Self {
+            cull_atoms: compute("cs_atoms"),
+            splat_ids: compute("cs_splat_ids"),
+            cull_bonds: compute("cs_bonds"),
+            spheres: render("sphere impostors", "vs_sphere", "fs_sphere", TriangleList),
+            splats: render("sphere splats", "vs_fullscreen", "fs_splats", TriangleList),
+            cylinders: render("cylinder impostors", "vs_cylinder", "fs_cylinder", TriangleList),
+            lines: render("bond lines", "vs_line", "fs_line", LineList),
+            data_layout,
+            compute_layout,
+            render_layout,
+        }
+    }
+}
+
+fn storage(ctx: &GpuContext, label: &str, bytes: &[u8], extra: wgpu::BufferUsages) -> wgpu::Buffer {
+    use wgpu::util::DeviceExt;
+    // A binding may not be empty.
+    let zeros = [0u8; 16];
+    let contents = if bytes.is_empty() { &zeros[..] } else { bytes };
+    ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | extra,
+    })
+}
+
+impl AtomsPass {
+    pub fn new(ctx: &GpuContext) -> Self {
+        Self::with(ctx, std::sync::Arc::new(Pipelines::new(ctx)))
     }
 
-    /// Uploads the impostor instances of a molecule in a style.
-    pub fn set_molecule(&mut self, ctx: &GpuContext, molecule: &Molecule, style: AtomStyle) {
-        use wgpu::util::DeviceExt;
-        let (spheres, cylinders) = instances(molecule, style);
-        let upload = |label: &str, bytes: &[u8], n: usize| {
-            (n > 0).then(|| {
-                let buffer = ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some(label),
-                    contents: bytes,
-                    usage: wgpu::BufferUsages::VERTEX,
-                });
-                (buffer, n as u32)
-            })
-        };
-        self.spheres = upload("sphere instances", bytemuck::cast_slice(&spheres), spheres.len());
-        self.cylinders = upload("cylinder instances", bytemuck::cast_slice(&cylinders), cylinders.len());
+    fn with(ctx: &GpuContext, shared: std::sync::Arc<Pipelines>) -> Self {
+        Self {
+            shared,
+            globals: super::uniform_buffer(&ctx.device, "atoms globals", std::mem::size_of::<AtomGlobals>()),
+            data: None,
+            style: AtomStyle::Hidden,
+            splat: None,
+            frame_groups: None,
+            splat_radius_px: SPLAT_RADIUS_PX,
+        }
     }
 
     /// Another set of atoms drawn with this one's pipelines.
     pub fn instance(&self, ctx: &GpuContext) -> Self {
-        let globals = super::uniform_buffer(&ctx.device, "atoms globals", std::mem::size_of::<AtomGlobals>());
-        let bind_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("atoms bind group"),
-            layout: &self.layout,
-            entries: &[wgpu::BindGroupEntry { binding: 0, resource: globals.as_entire_binding() }],
+        Self::with(ctx, self.shared.clone())
+    }
+
+    /// Uploads a molecule in a style and colours (element colours when `colors` is `None`).
+    pub fn set_molecule(
+        &mut self,
+        ctx: &GpuContext,
+        molecule: &Molecule,
+        style: AtomStyle,
+        colors: Option<&AtomColors>,
+    ) {
+        let element = crate::scene::coloring::atom_colors(molecule, None, crate::scene::AtomColoring::Element);
+        let colors = colors.filter(|c| c.index.len() == molecule.atoms.len()).unwrap_or(&element);
+        let data = AtomData::new(molecule, colors);
+        let usage = wgpu::BufferUsages::empty();
+        let positions = storage(ctx, "atom positions", bytemuck::cast_slice(&data.positions), usage);
+        let attrs = storage(ctx, "atom attributes", bytemuck::cast_slice(&data.attrs), usage);
+        let looks = storage(ctx, "atom looks", bytemuck::cast_slice(&looks(style, colors)), usage);
+        let bonds = storage(ctx, "bonds", bytemuck::cast_slice(&data.bonds), usage);
+        let list_words = LIST_HEADER + data.positions.len() + data.bonds.len() + data.cells.len();
+        let lists = storage(ctx, "atom lists", &vec![0u8; list_words * 4], wgpu::BufferUsages::INDIRECT);
+        let cell_data = storage(ctx, "atom cells", bytemuck::cast_slice(&data.cells.data), usage);
+        let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("atoms data"),
+            layout: &self.shared.data_layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: self.globals.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: positions.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: attrs.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 3, resource: looks.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 4, resource: bonds.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 5, resource: cell_data.as_entire_binding() },
+            ],
         });
-        Self {
-            spheres_pipeline: self.spheres_pipeline.clone(),
-            cylinders_pipeline: self.cylinders_pipeline.clone(),
-            layout: self.layout.clone(),
-            globals,
-            bind_group,
-            spheres: None,
-            cylinders: None,
+        self.style = style;
+        self.frame_groups = None;
+        self.data = Some(Uploaded {
+            positions,
+            attrs,
+            looks,
+            bonds,
+            lists,
+            cell_data,
+            cells: data.cells,
+            visible_cells: 0,
+            atoms: data.positions.len() as u32,
+            bond_count: data.bonds.len() as u32,
+            attr_words: data.attrs,
+            group,
+        });
+    }
+
+    /// Restyles and recolours: rewrites the attributes' palette bits and the small radius and
+    /// palette table; positions and bonds stay as uploaded.
+    pub fn set_look(&mut self, ctx: &GpuContext, style: AtomStyle, colors: &AtomColors) {
+        self.style = style;
+        let Some(d) = &mut self.data else { return };
+        if colors.index.len() != d.attr_words.len() {
+            return;
+        }
+        for (w, &c) in d.attr_words.iter_mut().zip(&colors.index) {
+            *w = (*w & 0xffff) | (c as u32) << 16;
+        }
+        ctx.queue.write_buffer(&d.attrs, 0, bytemuck::cast_slice(&d.attr_words));
+        self.write_looks(ctx, style, colors);
+    }
+
+    fn write_looks(&mut self, ctx: &GpuContext, style: AtomStyle, colors: &AtomColors) {
+        let Some(d) = &mut self.data else { return };
+        let bytes: Vec<u8> = bytemuck::cast_slice(&looks(style, colors)).to_vec();
+        if bytes.len() as u64 > d.looks.size() {
+            // A bigger palette: a new buffer, and the bind group that names it.
+            d.looks = storage(ctx, "atom looks", &bytes, wgpu::BufferUsages::empty());
+            d.group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("atoms data"),
+                layout: &self.shared.data_layout,
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: self.globals.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 1, resource: d.positions.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 2, resource: d.attrs.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 3, resource: d.looks.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 4, resource: d.bonds.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 5, resource: d.cell_data.as_entire_binding() },
+                ],
+            });
+        } else {
+            ctx.queue.write_buffer(&d.looks, 0, &bytes);
         }
     }
 
+    /// Bytes of GPU memory the uploaded atoms take (not counting the per-pixel splat buffer).
+    pub fn gpu_bytes(&self) -> u64 {
+        self.data.as_ref().map_or(0, |d| {
+            d.positions.size() + d.attrs.size() + d.looks.size() + d.bonds.size() + d.lists.size() + d.cell_data.size()
+        })
+    }
+
+    fn drawn(&self) -> Option<&Uploaded> {
+        self.data.as_ref().filter(|d| d.atoms > 0 && self.style != AtomStyle::Hidden)
+    }
+
     /// This frame's camera, in the frame of the object the atoms belong to; their pick ids name
-    /// `object`.
-    pub fn prepare(&self, queue: &wgpu::Queue, view: &ObjectView, object: u32) {
+    /// `object`. `size` is the frame's in pixels.
+    pub fn prepare(&mut self, ctx: &GpuContext, view: &ObjectView, object: u32, size: [u32; 2]) {
+        let clip = view.clip_from_object;
+        let world_from_clip = clip.inverse();
+        let far = |x: f32, y: f32| {
+            let p = world_from_clip * Vec4::new(x, y, 1.0, 1.0);
+            p.truncate() / p.w
+        };
+        let f0 = far(0.0, 0.0);
+        let (atoms, bonds) = self.data.as_ref().map_or((0, 0), |d| (d.atoms, d.bond_count));
+        // Cells in view, nearest first: the compute passes walk them in this order.
+        let order = match &self.data {
+            Some(d) if self.style != AtomStyle::Hidden => d.cells.visible_order(clip, view.eye, view.view_dir),
+            _ => Vec::new(),
+        };
+        let order_at = LIST_HEADER as u32 + atoms + bonds;
+        let cells_at = self.data.as_ref().map_or(0, |d| (CELL_WORDS * d.cells.len()) as u32);
+        let (stick, style) = style_flags(self.style);
+        let size = size.map(|v| v.max(1));
+        let pixels_per_bohr = clip.row(1).truncate().length() * 0.5 * size[1] as f32;
         let g = AtomGlobals {
-            clip_from_world: view.clip_from_object.to_cols_array_2d(),
+            clip_from_world: clip.to_cols_array_2d(),
             eye: view.eye.extend(1.0).to_array(),
             light: view.light.extend(0.0).to_array(),
             up: view.up.extend(0.0).to_array(),
             pick: [PickId::atom_base(object), 0, 0, 0],
+            viewport: [size[0] as f32, size[1] as f32, pixels_per_bohr, self.splat_radius_px],
+            ray_f0: f0.extend(0.0).to_array(),
+            ray_fx: (far(1.0, 0.0) - f0).extend(0.0).to_array(),
+            ray_fy: (far(0.0, 1.0) - f0).extend(0.0).to_array(),
+            counts: [atoms, bonds, style, dispatch(bonds).1],
+            sticks: [stick, 0.0, 0.0, 0.0],
+            cells: [order.len() as u32, order_at, cells_at, 0],
         };
-        queue.write_buffer(&self.globals, 0, bytemuck::bytes_of(&g));
+        ctx.queue.write_buffer(&self.globals, 0, bytemuck::bytes_of(&g));
+        let Some(d) = &mut self.data else { return };
+        // Quads: six vertices per sphere and per bond; instance counts filled by the culling.
+        ctx.queue.write_buffer(&d.lists, 0, bytemuck::cast_slice(&[6u32, 0, 0, 0, 6, 0, 0, 0]));
+        if !order.is_empty() {
+            ctx.queue.write_buffer(&d.lists, order_at as u64 * 4, bytemuck::cast_slice(&order));
+        }
+        d.visible_cells = order.len() as u32;
+        let d = &*d;
+        if self.splat.as_ref().is_none_or(|(_, s)| *s != size) {
+            let bytes = size[0] as u64 * size[1] as u64 * SPLAT_BYTES_PER_PIXEL;
+            let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("sphere splats"),
+                size: bytes,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            self.splat = Some((buffer, size));
+            self.frame_groups = None;
+        }
+        if self.frame_groups.is_none()
+            && let Some((splat, _)) = &self.splat
+        {
+            let group = |layout: &wgpu::BindGroupLayout| {
+                ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("atoms frame"),
+                    layout,
+                    entries: &[
+                        wgpu::BindGroupEntry { binding: 0, resource: d.lists.as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: 1, resource: splat.as_entire_binding() },
+                    ],
+                })
+            };
+            self.frame_groups = Some((group(&self.shared.compute_layout), group(&self.shared.render_layout)));
+        }
     }
 }
 
@@ -238,23 +609,56 @@ pub fn headlight(eye: Vec3, target: Vec3, camera_up: Vec3) -> (Vec3, Vec3) {
     ((back + 0.6 * up - 0.4 * right).normalize(), up)
 }
 
+/// Projected radius in pixels of a sphere of `radius` at `center` (the shader's rule, for tests
+/// and benchmarks).
+pub fn projected_radius_px(clip_from_world: Mat4, center: Vec3, radius: f32, height_px: u32) -> f32 {
+    let w = (clip_from_world * center.extend(1.0)).w;
+    radius * clip_from_world.row(1).truncate().length() * 0.5 * height_px as f32 / w
+}
+
 impl Draw for AtomsPass {
     fn phases(&self) -> &'static [Phase] {
-        &[Phase::Opaque]
+        &[Phase::Cull, Phase::Opaque]
+    }
+
+    fn compute(&self, encoder: &mut wgpu::CommandEncoder) {
+        let (Some(d), Some((splat, _)), Some((compute, _))) = (self.drawn(), &self.splat, &self.frame_groups) else {
+            return;
+        };
+        encoder.clear_buffer(splat, 0, None);
+        let mut pass = encoder
+            .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("cull and splat"), timestamp_writes: None });
+        pass.set_bind_group(0, &d.group, &[]);
+        pass.set_bind_group(1, compute, &[]);
+        // One row width for both dispatches: the shader indexes with it.
+        if d.visible_cells > 0 {
+            let (x, y) = (d.visible_cells.min(65_535), d.visible_cells.div_ceil(65_535));
+            pass.set_pipeline(&self.shared.cull_atoms);
+            pass.dispatch_workgroups(x, y, 1);
+            pass.set_pipeline(&self.shared.splat_ids);
+            pass.dispatch_workgroups(x, y, 1);
+        }
+        if d.bond_count > 0 && style_flags(self.style).1 & STYLE_CYLINDERS != 0 {
+            let ([x, y], _) = dispatch(d.bond_count);
+            pass.set_pipeline(&self.shared.cull_bonds);
+            pass.dispatch_workgroups(x, y, 1);
+        }
     }
 
     fn draw(&self, _phase: Phase, pass: &mut wgpu::RenderPass<'_>) {
-        pass.set_bind_group(0, &self.bind_group, &[]);
-        if let Some((buffer, n)) = &self.cylinders {
-            pass.set_pipeline(&self.cylinders_pipeline);
-            pass.set_vertex_buffer(0, buffer.slice(..));
-            pass.draw(0..6, 0..*n);
+        let (Some(d), Some((_, render))) = (self.drawn(), &self.frame_groups) else { return };
+        pass.set_bind_group(0, &d.group, &[]);
+        pass.set_bind_group(1, render, &[]);
+        if self.style == AtomStyle::Lines && d.bond_count > 0 {
+            pass.set_pipeline(&self.shared.lines);
+            pass.draw(0..4, 0..d.bond_count);
         }
-        if let Some((buffer, n)) = &self.spheres {
-            pass.set_pipeline(&self.spheres_pipeline);
-            pass.set_vertex_buffer(0, buffer.slice(..));
-            pass.draw(0..6, 0..*n);
-        }
+        pass.set_pipeline(&self.shared.cylinders);
+        pass.draw_indirect(&d.lists, 16);
+        pass.set_pipeline(&self.shared.spheres);
+        pass.draw_indirect(&d.lists, 0);
+        pass.set_pipeline(&self.shared.splats);
+        pass.draw(0..3, 0..1);
     }
 }
 
@@ -262,22 +666,69 @@ impl Draw for AtomsPass {
 mod tests {
     use super::*;
     use crate::model::Atom;
+    use crate::scene::AtomColoring;
+    use crate::scene::coloring::atom_colors;
     use glam::DVec3;
 
     #[test]
-    fn ball_and_stick_has_two_half_bonds_per_bond() {
+    fn packed_attributes_and_radii() {
         let atom = |z, x| Atom { z, charge: z as f64, position: DVec3::new(x, 0.0, 0.0), ghost: false };
-        let m = Molecule::new(vec![atom(6, 0.0), atom(8, 2.28)]);
+        let mut m = Molecule::new(vec![atom(6, 0.0), atom(8, 2.28), atom(11, 9.0)]);
+        m.atoms[2].ghost = true;
         assert_eq!(m.bonds.len(), 1);
-        let (s, c) = instances(&m, AtomStyle::BallAndStick);
-        assert_eq!((s.len(), c.len()), (2, 2));
-        assert_eq!(c[0].p1, c[1].p1);
-        assert!((c[0].p1[0] - 1.14).abs() < 1e-6);
-        let (s2, c2) = instances(&m, AtomStyle::SpaceFilling);
-        assert!(c2.is_empty() && s2[0].radius > 3.0 * s[0].radius);
-        assert!(instances(&m, AtomStyle::Hidden).0.is_empty());
-        let (s3, c3) = instances(&m, AtomStyle::Sticks);
-        assert_eq!(c3.len(), 2);
-        assert!(s3.iter().all(|s| (s.radius - c3[0].radius).abs() < 1e-6), "caps as wide as the sticks");
+        let colors = atom_colors(&m, None, AtomColoring::Element);
+        let d = AtomData::new(&m, &colors);
+        assert_eq!(d.attrs[0] & 0xff, 6);
+        assert_eq!(d.attrs[0] >> 8 & 0xff, FLAG_BONDED);
+        assert_eq!(d.attrs[2] >> 8 & 0xff, FLAG_GHOST);
+        assert_eq!(colors.palette[(d.attrs[1] >> 16) as usize], crate::model::elements::element(8).color);
+        assert_eq!(d.bonds, vec![[0, 1]]);
+        assert!(d.gpu_bytes() / 3 <= 64, "{} bytes per atom", d.gpu_bytes() / 3);
+        let ball = looks(AtomStyle::BallAndStick, &colors);
+        let fill = looks(AtomStyle::SpaceFilling, &colors);
+        assert!(fill[6][0] > 3.0 * ball[6][0]);
+        assert_eq!(looks(AtomStyle::Hidden, &colors)[6][0], 0.0);
+        assert_eq!(ball.len(), PALETTE_AT + colors.palette.len());
+        assert_eq!(style_flags(AtomStyle::Lines).1, STYLE_UNBONDED_ONLY);
+    }
+
+    #[test]
+    fn cells_hold_every_atom_once_and_order_nearest_first() {
+        let m = crate::model::synthetic::atom_box(5_000);
+        let positions: Vec<[f32; 4]> = m.atoms.iter().map(|a| a.position.as_vec3().extend(0.0).to_array()).collect();
+        let cells = Cells::new(&positions);
+        let k = cells.len();
+        let mut seen: Vec<u32> = cells.data[CELL_WORDS * k..].to_vec();
+        seen.sort_unstable();
+        assert_eq!(seen, (0..5_000).collect::<Vec<u32>>());
+        for c in 0..k {
+            let (first, count) = (cells.data[CELL_WORDS * c] as usize, cells.data[CELL_WORDS * c + 1] as usize);
+            let s = cells.spheres[c];
+            assert_eq!(f32::from_bits(cells.data[CELL_WORDS * c + 5]), s[3]);
+            let atoms = CELL_WORDS * k + first;
+            for &i in &cells.data[atoms..atoms + count] {
+                let p = Vec3::from_slice(&positions[i as usize][..3]);
+                assert!(p.distance(Vec3::new(s[0], s[1], s[2])) <= s[3] * 1.0001, "atom {i} outside its cell");
+            }
+        }
+        let eye = Vec3::new(0.0, 0.0, 200.0);
+        let clip = glam::camera::rh::proj::directx::perspective(0.8, 1.0, 1.0, 500.0)
+            * glam::camera::rh::view::look_at_mat4(eye, Vec3::ZERO, Vec3::Y);
+        let order = cells.visible_order(clip, eye, Vec3::NEG_Z);
+        assert_eq!(order.len(), k, "the whole box is in view");
+        let depth = |c: u32| -cells.spheres[c as usize][2];
+        assert!(order.windows(2).all(|w| depth(w[0]) <= depth(w[1])), "nearest first");
+        let behind = glam::camera::rh::proj::directx::perspective(0.8, 1.0, 1.0, 500.0)
+            * glam::camera::rh::view::look_at_mat4(eye, eye + Vec3::Z, Vec3::Y);
+        assert!(cells.visible_order(behind, eye, Vec3::Z).is_empty(), "nothing behind the eye");
+    }
+
+    #[test]
+    fn dispatch_covers_every_atom_within_limits() {
+        for n in [1u32, 63, 64, 65, 4_194_240, 4_194_305, 16_000_000] {
+            let ([x, y], row) = dispatch(n);
+            assert!(x <= 65_535 && y <= 65_535);
+            assert!(row as u64 * y as u64 >= n as u64);
+        }
     }
 }

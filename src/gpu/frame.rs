@@ -20,6 +20,8 @@ pub enum Target {
     Depth,
     /// The id of the opaque surface in each pixel ([`PickId`]), read back for picking.
     Ids,
+    /// Each atom layer's culled draw lists and compute-rasterised small spheres.
+    Splats,
     /// The caller's 8-bit sRGB view.
     Output,
 }
@@ -27,6 +29,8 @@ pub enum Target {
 /// One phase: one render pass over the shared targets.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Phase {
+    /// Compute work before drawing: frustum culling, level of detail, small spheres rasterised.
+    Cull,
     /// Opaque geometry (atoms, isosurfaces): clears colour, depth and ids, writes all three.
     Opaque,
     /// Translucent clouds back to front: blends over colour, tests depth without writing it.
@@ -44,12 +48,14 @@ pub struct PhaseNode {
     pub writes: &'static [Target],
 }
 
-/// The frame every host draws: opaque geometry, then translucent clouds over it, then resolve.
+/// The frame every host draws: culling and small spheres (compute), opaque geometry, then
+/// translucent clouds over it, then resolve.
 pub const STANDARD_FRAME: &[PhaseNode] = &[
+    PhaseNode { phase: Phase::Cull, label: "cull and splat", reads: &[], writes: &[Target::Splats] },
     PhaseNode {
         phase: Phase::Opaque,
         label: "opaque",
-        reads: &[],
+        reads: &[Target::Splats],
         writes: &[Target::Color, Target::Depth, Target::Ids],
     },
     PhaseNode {
@@ -75,6 +81,8 @@ pub trait Draw {
     fn phases(&self) -> &'static [Phase];
     /// Records its draws into the open render pass of `phase`.
     fn draw(&self, phase: Phase, pass: &mut wgpu::RenderPass<'_>);
+    /// Records its compute work of [`Phase::Cull`].
+    fn compute(&self, _encoder: &mut wgpu::CommandEncoder) {}
 }
 
 /// The frame's camera as one object sees it: every vector in the object's own frame, so a

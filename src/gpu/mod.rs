@@ -34,7 +34,9 @@ pub const SHADERS: &[(&str, &str)] = &[
     ("volume_slices.wgsl", include_str!("../../shaders/volume_slices.wgsl")),
     ("volume_direct.wgsl", include_str!("../../shaders/volume_direct.wgsl")),
     ("volume_morph.wgsl", include_str!("../../shaders/volume_morph.wgsl")),
+    ("atoms_common.wgsl", include_str!("../../shaders/atoms_common.wgsl")),
     ("atoms.wgsl", include_str!("../../shaders/atoms.wgsl")),
+    ("atoms_cull.wgsl", include_str!("../../shaders/atoms_cull.wgsl")),
     ("resolve.wgsl", include_str!("../../shaders/resolve.wgsl")),
     ("isosurface.wgsl", include_str!("../../shaders/isosurface.wgsl")),
     ("gto_common.wgsl", include_str!("../../shaders/gto_common.wgsl")),
@@ -48,6 +50,8 @@ pub const SHADER_MODULES: &[(&str, &[&str])] = &[
     ("volume_direct.wgsl", &["volume_common.wgsl", "gto_common.wgsl", "volume_direct.wgsl"]),
     ("volume_morph.wgsl", &["volume_common.wgsl", "volume_gradient.wgsl", "volume_morph.wgsl"]),
     ("gto_fill.wgsl", &["gto_common.wgsl", "gto_fill.wgsl"]),
+    ("atoms.wgsl", &["atoms_common.wgsl", "atoms.wgsl"]),
+    ("atoms_cull.wgsl", &["atoms_common.wgsl", "atoms_cull.wgsl"]),
 ];
 
 /// The full source of a shader module: its prerequisites, then itself.

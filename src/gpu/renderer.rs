@@ -11,7 +11,7 @@ use super::{GpuContext, GpuError};
 use crate::model::GridSpec;
 use crate::model::cartesian::CartesianExpansion;
 use crate::model::{Molecule, VolumeGrid};
-use crate::scene::{AtomStyle, Camera, RenderSettings, VolumeSettings};
+use crate::scene::{AtomColors, AtomStyle, Camera, RenderSettings, VolumeSettings};
 
 /// What one frame needs besides the long-lived GPU state.
 #[derive(Debug, Clone, Copy)]
@@ -66,8 +66,14 @@ pub struct Layer {
 }
 
 impl Layer {
+    /// Shows a molecule's atoms in a style, coloured by element.
     pub fn set_molecule(&mut self, ctx: &GpuContext, molecule: &Molecule, style: AtomStyle) {
-        self.atoms.set_molecule(ctx, molecule, style);
+        self.set_atoms(ctx, molecule, style, None);
+    }
+
+    /// Shows a molecule's atoms in a style and colours (by element when `None`).
+    pub fn set_atoms(&mut self, ctx: &GpuContext, molecule: &Molecule, style: AtomStyle, colors: Option<&AtomColors>) {
+        self.atoms.set_molecule(ctx, molecule, style, colors);
         // Pad by the largest space-filling radius so near/far planes never clip an atom.
         self.molecule_bounds = molecule.bounds().map(|(lo, hi)| (lo.as_vec3() - 4.5, hi.as_vec3() + 4.5));
     }
@@ -260,7 +266,7 @@ impl Renderer {
         let hidden = VolumeSettings { visible: false, ..VolumeSettings::default() };
         for (n, layer) in self.layers.iter_mut().enumerate() {
             let view = ObjectView::new(&world, layer.world_from_object);
-            layer.atoms.prepare(&ctx.queue, &view, n as u32);
+            layer.atoms.prepare(ctx, &view, n as u32, frame.size);
             layer.surfaces.prepare(&ctx.queue, &view, n as u32);
             let cloud = frame.clouds.get(n).unwrap_or(&hidden);
             layer.volume.prepare(&ctx.device, &ctx.queue, &view, cloud);
@@ -272,7 +278,15 @@ impl Renderer {
                 continue;
             }
             // A later tile keeps what the first drew: only the clouds inside it are added.
-            if node.phase == Phase::Opaque && frame.tile.is_some_and(|t| !t.first) {
+            if matches!(node.phase, Phase::Cull | Phase::Opaque) && frame.tile.is_some_and(|t| !t.first) {
+                continue;
+            }
+            if node.phase == Phase::Cull {
+                for layer in self.layers.iter().filter(|l| l.visible) {
+                    for drawer in layer.drawers().into_iter().filter(|d| d.phases().contains(&Phase::Cull)) {
+                        drawer.compute(encoder);
+                    }
+                }
                 continue;
             }
             let mut pass = targets.begin(encoder, node, frame.background);

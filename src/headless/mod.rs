@@ -16,6 +16,7 @@ use crate::model::gto::{GridSpec, PreparedBasis};
 use crate::model::isosurface::{self, Level, Mesh};
 use crate::model::orbitals::Quantity;
 use crate::model::{Document, VolumeGrid};
+use crate::scene::coloring::atom_colors;
 use crate::scene::{Camera, IsosurfaceSettings, ObjectState, RenderSettings, ViewPreset};
 
 /// Space (bohr) around the atoms in which orbitals are evaluated.
@@ -261,6 +262,12 @@ pub fn coarser_note(what: &str, dims: [usize; 3], step: usize) -> String {
     )
 }
 
+/// Puts `doc`'s atoms into `layer` in the settings' style and colouring.
+pub fn show_atoms(ctx: &GpuContext, layer: &mut Layer, doc: &Document, settings: &RenderSettings) {
+    let colors = atom_colors(&doc.molecule, doc.structure.as_ref(), settings.atom_colors);
+    layer.set_atoms(ctx, &doc.molecule, settings.atoms, Some(&colors));
+}
+
 /// Puts `doc` into `layer` as `state` shows it, all but its isosurfaces (none until they are
 /// cut): the molecule in the state's atom style, the volume it chooses, placement and
 /// visibility. Returns the step the volume is shown at (1: every point; see
@@ -272,7 +279,7 @@ pub fn show_document(
     state: &ObjectState,
 ) -> Result<usize, GpuError> {
     let step = layer.set_volume(ctx, doc.volumes.get(state.volume))?;
-    layer.set_molecule(ctx, &doc.molecule, state.settings.atoms);
+    show_atoms(ctx, layer, doc, &state.settings);
     layer.surfaces.clear();
     layer.world_from_object = state.placement.world_from_object();
     layer.visible = state.visible;
@@ -313,7 +320,7 @@ impl Headless {
     ) -> Result<Self, GpuError> {
         let mut renderer = Renderer::new(ctx);
         let layer = renderer.main();
-        layer.set_molecule(ctx, &doc.molecule, settings.atoms);
+        show_atoms(ctx, layer, doc, settings);
         let grid = volume_index.and_then(|i| doc.volumes.get(i));
         layer.set_volume(ctx, grid)?;
         if let Some(grid) = grid {

@@ -1,10 +1,9 @@
-//! Bond perception from covalent radii, O(n) with a uniform spatial hash.
-
-use std::collections::HashMap;
+//! Bond perception from covalent radii, O(n) with a cell search.
 
 use glam::DVec3;
 
 use super::molecule::{Atom, Bond};
+use super::neighbours::for_each_near_pair;
 use super::units::BOHR_PER_ANGSTROM;
 
 /// Two atoms bond when their distance is below the sum of covalent radii plus this (Å),
@@ -12,56 +11,32 @@ use super::units::BOHR_PER_ANGSTROM;
 const BOND_TOLERANCE_ANG: f64 = 0.45;
 /// Closer than this (Å) is an overlap, not a bond.
 const MIN_BOND_ANG: f64 = 0.1;
-/// A cell as wide as the longest bond holds a few dozen real atoms; more means a degenerate
-/// structure (atoms piled on one spot), whose pairs are not searched so that a hostile file
-/// cannot make bond perception quadratic.
-const MAX_ATOMS_PER_CELL: usize = 256;
-
 /// Bonds between non-ghost atoms, each pair once with `a < b`, sorted.
 pub fn infer_bonds(atoms: &[Atom]) -> Vec<Bond> {
+    bonds_where(atoms, |_, _| true)
+}
+
+/// Bonds from covalent radii between the non-ghost atoms `accept` allows (a structure allows
+/// pairs within a residue and polymer links between residues), each pair once, sorted.
+pub fn bonds_where(atoms: &[Atom], accept: impl Fn(usize, usize) -> bool) -> Vec<Bond> {
     let max_radius = atoms.iter().filter(|a| !a.ghost).map(|a| a.element().covalent_radius as f64).fold(0.0, f64::max);
-    // A cell as wide as the longest possible bond: neighbours lie in the 27 cells around.
+    // A cell as wide as the longest possible bond: partners lie in the neighbouring cells.
     let cell = ((2.0 * max_radius + BOND_TOLERANCE_ANG) * BOHR_PER_ANGSTROM).max(1e-3);
-    let key = |p: DVec3| {
-        let c = (p / cell).floor();
-        (c.x as i64, c.y as i64, c.z as i64)
-    };
-    let mut cells: HashMap<(i64, i64, i64), Vec<u32>> = HashMap::new();
-    for (i, a) in atoms.iter().enumerate() {
-        if !a.ghost && a.position.is_finite() {
-            cells.entry(key(a.position)).or_default().push(i as u32);
-        }
-    }
+    let positions: Vec<DVec3> = atoms.iter().map(|a| a.position).collect();
     let mut bonds = Vec::new();
-    for (i, a) in atoms.iter().enumerate() {
-        if a.ghost || !a.position.is_finite() {
-            continue;
-        }
-        let (cx, cy, cz) = key(a.position);
-        let ra = a.element().covalent_radius as f64;
-        for dx in -1..=1 {
-            for dy in -1..=1 {
-                for dz in -1..=1 {
-                    // Saturating: a far-away atom's cell index sits at the i64 limit.
-                    let neighbour = (cx.saturating_add(dx), cy.saturating_add(dy), cz.saturating_add(dz));
-                    let Some(list) = cells.get(&neighbour) else {
-                        continue;
-                    };
-                    if list.len() > MAX_ATOMS_PER_CELL {
-                        continue;
-                    }
-                    for &j in list.iter().filter(|&&j| j as usize > i) {
-                        let b = &atoms[j as usize];
-                        let rb = b.element().covalent_radius as f64;
-                        let d = a.position.distance(b.position) / BOHR_PER_ANGSTROM;
-                        if d > MIN_BOND_ANG && d < ra + rb + BOND_TOLERANCE_ANG {
-                            bonds.push(Bond { a: i as u32, b: j });
-                        }
-                    }
-                }
+    for_each_near_pair(
+        &positions,
+        |i| !atoms[i].ghost,
+        cell,
+        |i, j| {
+            let (a, b) = (&atoms[i], &atoms[j]);
+            let reach = (a.element().covalent_radius + b.element().covalent_radius) as f64 + BOND_TOLERANCE_ANG;
+            let d = a.position.distance(b.position) / BOHR_PER_ANGSTROM;
+            if d > MIN_BOND_ANG && d < reach && accept(i, j) {
+                bonds.push(Bond { a: i as u32, b: j as u32 });
             }
-        }
-    }
+        },
+    );
     bonds.sort_unstable_by_key(|b| (b.a, b.b));
     bonds
 }

@@ -1,6 +1,6 @@
 //! What one opened file gives the viewer: a molecule and zero or more volumes.
 
-use super::{Molecule, VolumeGrid, Wavefunction};
+use super::{Molecule, StructureView, VolumeGrid, Wavefunction};
 
 #[derive(Debug, Clone, Default)]
 pub struct Document {
@@ -12,6 +12,9 @@ pub struct Document {
     pub volumes: Vec<VolumeGrid>,
     /// Basis set and orbitals (Molden, fchk); `None` for grid-only files.
     pub wavefunction: Option<Wavefunction>,
+    /// Residues, chains, models and per-atom annotations (PDB, mmCIF, multi-frame XYZ);
+    /// `molecule` is the model it shows.
+    pub structure: Option<StructureView>,
 }
 
 impl Document {

@@ -15,10 +15,13 @@ pub mod gto;
 pub mod isosurface;
 pub mod measure;
 pub mod molecule;
+pub mod neighbours;
 pub mod orbitals;
 pub mod overlap;
 pub mod scan;
 pub mod solid_harmonics;
+pub mod structure;
+pub mod synthetic;
 pub mod units;
 
 pub use document::Document;
@@ -26,3 +29,4 @@ pub use grid::{GridSpec, GridStats, VolumeGrid};
 pub use gto::PreparedBasis;
 pub use molecule::{Atom, Bond, Molecule};
 pub use orbitals::{MolecularOrbital, Spin, Wavefunction};
+pub use structure::{Structure, StructureView};

@@ -1,6 +1,7 @@
 //! What to draw and how: camera and render settings. Plain, serialisable data; no wgpu.
 
 pub mod camera;
+pub mod coloring;
 pub mod objects;
 pub mod opacity;
 pub mod settings;
@@ -9,8 +10,11 @@ pub mod transfer;
 pub mod view;
 
 pub use camera::Camera;
+pub use coloring::AtomColors;
 pub use objects::{ObjectState, Placement, Session};
 pub use opacity::DensityScale;
-pub use settings::{AtomStyle, Interpolation, IsoLevel, IsosurfaceSettings, RenderSettings, SliceMode, VolumeSettings};
+pub use settings::{
+    AtomColoring, AtomStyle, Interpolation, IsoLevel, IsosurfaceSettings, RenderSettings, SliceMode, VolumeSettings,
+};
 pub use transfer::{ClipPlane, Shape, Transfer, TransferKind};
 pub use view::{ViewDirection, ViewPreset};

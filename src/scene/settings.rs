@@ -82,19 +82,66 @@ pub enum AtomStyle {
     SpaceFilling,
     /// Bonds as sticks, atoms as caps of the same radius.
     Sticks,
+    /// Thick sticks with caps (proteins read well this way).
+    Licorice,
+    /// Bonds as one-pixel lines, unbonded atoms as small balls: the lightest for big structures.
+    Lines,
     Hidden,
 }
 
 impl AtomStyle {
-    pub const ALL: [AtomStyle; 4] =
-        [AtomStyle::BallAndStick, AtomStyle::SpaceFilling, AtomStyle::Sticks, AtomStyle::Hidden];
+    pub const ALL: [AtomStyle; 6] = [
+        AtomStyle::BallAndStick,
+        AtomStyle::SpaceFilling,
+        AtomStyle::Sticks,
+        AtomStyle::Licorice,
+        AtomStyle::Lines,
+        AtomStyle::Hidden,
+    ];
 
     pub fn name(self) -> &'static str {
         match self {
             AtomStyle::BallAndStick => "ball and stick",
             AtomStyle::SpaceFilling => "space filling",
             AtomStyle::Sticks => "sticks",
+            AtomStyle::Licorice => "licorice",
+            AtomStyle::Lines => "lines",
             AtomStyle::Hidden => "hidden",
+        }
+    }
+}
+
+/// What colours the atoms.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub enum AtomColoring {
+    /// Jmol's CPK colours.
+    #[default]
+    Element,
+    Chain,
+    /// Each amino acid and nucleotide its own colour (Jmol's "amino" and "nucleic" schemes).
+    Residue,
+    /// Blue (lowest) through white to red (highest B-factor).
+    BFactor,
+    /// Helices magenta, strands yellow, the rest white, as the file declares them.
+    Secondary,
+}
+
+impl AtomColoring {
+    pub const ALL: [AtomColoring; 5] = [
+        AtomColoring::Element,
+        AtomColoring::Chain,
+        AtomColoring::Residue,
+        AtomColoring::BFactor,
+        AtomColoring::Secondary,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            AtomColoring::Element => "element",
+            AtomColoring::Chain => "chain",
+            AtomColoring::Residue => "residue",
+            AtomColoring::BFactor => "B-factor",
+            AtomColoring::Secondary => "secondary structure",
         }
     }
 }
@@ -149,6 +196,7 @@ impl Default for IsosurfaceSettings {
 pub struct RenderSettings {
     pub volume: VolumeSettings,
     pub atoms: AtomStyle,
+    pub atom_colors: AtomColoring,
     pub iso: IsosurfaceSettings,
     /// Linear RGB background.
     pub background: [f32; 3],
@@ -159,6 +207,7 @@ impl Default for RenderSettings {
         Self {
             volume: VolumeSettings::default(),
             atoms: AtomStyle::default(),
+            atom_colors: AtomColoring::default(),
             iso: IsosurfaceSettings::default(),
             background: [0.02, 0.02, 0.03],
         }

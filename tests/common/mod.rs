@@ -64,6 +64,7 @@ pub fn scene(with_volume: Option<VolumeGrid>) -> Document {
         molecule: formaldehyde(),
         volumes: with_volume.into_iter().collect(),
         wavefunction: None,
+        structure: None,
     }
 }
 

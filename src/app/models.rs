@@ -1,0 +1,80 @@
+//! Models of a structure (an NMR ensemble's, an XYZ trajectory's frames): which one the active
+//! object shows, and playing them in turn like a scan's θ.
+
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use egui::{RichText, Slider};
+
+use super::{OrbApp, World};
+
+/// Time each model stays on screen while playing.
+const STEP: Duration = Duration::from_millis(120);
+
+#[derive(Debug, Default)]
+pub struct Player {
+    pub playing: bool,
+    last: Option<Instant>,
+}
+
+/// The slider and play button, when the active object has more than one model; the model
+/// chosen, if the user moved to another.
+pub fn controls(ui: &mut egui::Ui, app: &mut OrbApp) -> Option<usize> {
+    let view = app.objects.get(app.active)?.doc.structure.as_ref()?;
+    let count = view.structure.models.len();
+    if count < 2 {
+        return None;
+    }
+    let mut shown = view.model + 1;
+    let model = &view.structure.models[view.model];
+    let mut chosen = None;
+    ui.horizontal(|ui| {
+        if ui.add(Slider::new(&mut shown, 1..=count).text("model")).changed() {
+            chosen = Some(shown - 1);
+        }
+        let label = if app.models.playing { "pause" } else { "play" };
+        if ui.button(label).clicked() {
+            app.models.playing = !app.models.playing;
+            app.models.last = None;
+        }
+    });
+    let title = if model.title.is_empty() { format!("MODEL {}", model.number) } else { model.title.clone() };
+    ui.label(RichText::new(title).small().weak());
+    chosen
+}
+
+/// The next model while playing, when its time has come; asks for the repaint that comes back.
+pub fn tick(ctx: &egui::Context, app: &mut OrbApp) -> Option<usize> {
+    if !app.models.playing {
+        return None;
+    }
+    let view = app.objects.get(app.active)?.doc.structure.as_ref()?;
+    let count = view.structure.models.len();
+    ctx.request_repaint_after(STEP);
+    let now = Instant::now();
+    if app.models.last.is_some_and(|t| now - t < STEP) || count < 2 {
+        return None;
+    }
+    app.models.last = Some(now);
+    Some((view.model + 1) % count)
+}
+
+impl OrbApp {
+    /// Shows model `model` of the active object's structure: its atoms, bonds and picks.
+    pub fn show_model(&mut self, model: usize) {
+        let n = self.active;
+        // The scene's atoms hold the documents too: let go first so the document is not copied.
+        self.world = World::default();
+        let Some(o) = self.objects.get_mut(n) else { return };
+        let doc = Arc::make_mut(&mut o.doc);
+        if let Some(view) = &mut doc.structure {
+            doc.molecule = view.show(model);
+        }
+        self.measurements.selection.clear();
+        self.measurements.list.clear();
+        if let Some(vp) = &mut self.viewport {
+            vp.set_atoms(n, &self.objects[n].doc, &self.objects[n].state.settings);
+        }
+        self.world = World::of(&self.objects);
+    }
+}

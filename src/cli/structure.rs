@@ -1,0 +1,135 @@
+//! `bench load`: how fast a structure file (PDB, mmCIF, XYZ; any file the viewer opens) is read.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::Result;
+use clap::Args;
+use orbcloud::formats;
+
+#[derive(Args)]
+pub struct LoadBench {
+    /// The file to read.
+    pub file: PathBuf,
+    /// Times to read it; the fastest counts.
+    #[arg(long, default_value_t = 3)]
+    pub repeat: u32,
+}
+
+/// Prints the time to read the file into the model (bounded read, gunzip, parse, bonds), the
+/// atoms per second, and the time bond perception alone takes.
+pub fn bench_load(args: &LoadBench) -> Result<()> {
+    let mut best = f64::INFINITY;
+    let mut doc = None;
+    for _ in 0..args.repeat.max(1) {
+        drop(doc.take());
+        let t = Instant::now();
+        doc = Some(formats::load(&args.file)?);
+        best = best.min(t.elapsed().as_secs_f64());
+    }
+    let doc = doc.expect("read at least once");
+    let atoms = doc.structure.as_ref().map_or(doc.molecule.atoms.len(), |v| v.structure.len());
+    println!("file: {} ({} bytes)", args.file.display(), std::fs::metadata(&args.file)?.len());
+    println!(
+        "load_ms={:.0} atoms={atoms} atoms_per_s={:.3e} shown_atoms={} bonds={}",
+        best * 1e3,
+        atoms as f64 / best,
+        doc.molecule.atoms.len(),
+        doc.molecule.bonds.len()
+    );
+    if let Some(view) = &doc.structure {
+        let t = Instant::now();
+        let molecule = view.structure.molecule(&view.atoms);
+        println!(
+            "bonds_ms={:.0} ({} bonds of {} atoms; residues={} chains={} models={})",
+            t.elapsed().as_secs_f64() * 1e3,
+            molecule.bonds.len(),
+            molecule.atoms.len(),
+            view.structure.residues.len(),
+            view.structure.chains.len(),
+            view.structure.models.len()
+        );
+    }
+    Ok(())
+}
+
+#[derive(Args)]
+pub struct SpheresBench {
+    /// A structure (or any file with atoms) to draw instead of synthetic atoms.
+    pub file: Option<PathBuf>,
+    /// Synthetic atoms packed as densely as in a protein (ignored with a file).
+    #[arg(long, default_value_t = 1_000_000)]
+    pub atoms: usize,
+    /// Image size, WIDTHxHEIGHT.
+    #[arg(long, default_value = "800x600", value_parser = super::parse_size)]
+    pub size: [u32; 2],
+    #[arg(long, value_enum, default_value_t = super::AtomsArg::SpaceFilling)]
+    pub style: super::AtomsArg,
+    /// Spheres up to this projected radius (pixels) are rasterised in compute; 0 draws every
+    /// sphere as an impostor quad.
+    #[arg(long, default_value_t = orbcloud::gpu::atoms::SPLAT_RADIUS_PX)]
+    pub splat_px: f32,
+    /// Frames to time (after two warm-up frames).
+    #[arg(long, default_value_t = 10)]
+    pub frames: u32,
+    /// Use the CPU Vulkan adapter (lavapipe) even when a GPU is present.
+    #[arg(long)]
+    pub lavapipe: bool,
+}
+
+/// Prints ms per frame of atoms alone, the whole structure in view and turning a little each
+/// frame as in the viewer, and the GPU memory per atom.
+pub fn bench_spheres(args: &SpheresBench) -> Result<()> {
+    use orbcloud::gpu::{FrameInput, OffscreenTarget, Renderer};
+    use orbcloud::scene::{Camera, RenderSettings};
+    let (molecule, what) = match &args.file {
+        Some(path) => {
+            let doc = formats::load(path)?;
+            (doc.molecule, path.display().to_string())
+        }
+        None => (orbcloud::model::synthetic::atom_box(args.atoms), "synthetic protein-dense box".to_string()),
+    };
+    let Some((lo, hi)) = molecule.bounds() else { anyhow::bail!("{what}: no atoms to draw") };
+    let ctx = super::gpu(args.lavapipe)?;
+    let style = args.style.style();
+    let mut renderer = Renderer::new(&ctx);
+    renderer.main().set_molecule(&ctx, &molecule, style);
+    renderer.main().atoms.splat_radius_px = args.splat_px;
+    let gpu_bytes = renderer.main().atoms.gpu_bytes();
+    let target = OffscreenTarget::new(&ctx.device, args.size);
+    let settings = RenderSettings::default();
+    let camera = Camera::framing(lo.as_vec3(), hi.as_vec3());
+    let mut times = Vec::new();
+    for f in 0..args.frames.max(1) + 2 {
+        let mut cam = camera;
+        cam.orbit(0.02 * f as f32, 0.01 * f as f32);
+        let t = Instant::now();
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        renderer.render(&ctx, &mut encoder, &target.color_view, &FrameInput::single(&cam, &settings, args.size));
+        ctx.queue.submit([encoder.finish()]);
+        ctx.device.poll(wgpu::PollType::wait_indefinitely())?;
+        if f >= 2 {
+            times.push(t.elapsed().as_secs_f64() * 1e3);
+        }
+    }
+    times.sort_by(f64::total_cmp);
+    let n = molecule.atoms.len();
+    println!("adapter: {}", ctx.describe());
+    println!(
+        "scene: {what}, {n} atoms, {} bonds, {:?}, {}x{}, splat radius {} px",
+        molecule.bonds.len(),
+        style,
+        args.size[0],
+        args.size[1],
+        args.splat_px
+    );
+    println!("gpu_bytes_per_atom={:.1}", gpu_bytes as f64 / n as f64);
+    println!(
+        "ms_per_frame_median={:.1} min={:.1} max={:.1} frames={}",
+        times[times.len() / 2],
+        times[0],
+        times[times.len() - 1],
+        times.len()
+    );
+    Ok(())
+}

@@ -1,0 +1,27 @@
+//! What the structure readers (PDB, mmCIF, XYZ) share: element symbols, and the document a
+//! structure becomes.
+
+use crate::model::elements::atomic_number;
+use crate::model::{Document, Structure, StructureView};
+
+/// Atomic number of an element symbol as structure files write it ("C", "FE", "Fe2+", "O1-").
+pub(crate) fn element_of(symbol: &str) -> Option<u8> {
+    let s = symbol.trim().trim_end_matches(['+', '-']).trim_end_matches(|c: char| c.is_ascii_digit());
+    if s.eq_ignore_ascii_case("D") || s.eq_ignore_ascii_case("T") {
+        return Some(1); // deuterium, tritium
+    }
+    atomic_number(s).map(|z| z as u8)
+}
+
+/// The document of a structure: its first model shown.
+pub(crate) fn document(source: &str, title: &str, structure: Structure) -> Document {
+    let (view, molecule) = StructureView::new(structure);
+    Document {
+        source: source.to_string(),
+        title: if title.trim().is_empty() { source.to_string() } else { title.trim().to_string() },
+        molecule,
+        volumes: Vec::new(),
+        wavefunction: None,
+        structure: Some(view),
+    }
+}

@@ -1,0 +1,70 @@
+//! A protein (PDB 4E43, residues 30–50 with waters and acetates) in every representation and
+//! colouring on lavapipe: golden images, and checks that each colouring shows what it says.
+
+mod common;
+
+use common::{assert_golden, lavapipe};
+use orbcloud::headless::{default_camera, render_document};
+use orbcloud::model::Document;
+use orbcloud::scene::{AtomColoring, AtomStyle, RenderSettings};
+
+const SIZE: [u32; 2] = [200, 160];
+
+fn protein() -> Document {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/structures/4e43_excerpt.pdb");
+    orbcloud::formats::load(std::path::Path::new(path)).unwrap()
+}
+
+fn render(doc: &Document, atoms: AtomStyle, colors: AtomColoring) -> image::RgbaImage {
+    let s = RenderSettings { atoms, atom_colors: colors, ..RenderSettings::default() };
+    render_document(&lavapipe(), doc, None, &default_camera(doc), &s, SIZE).expect("render")
+}
+
+/// Distinct colours among the lit pixels (quantised), a rough count of what a colouring shows.
+fn hues(img: &image::RgbaImage) -> usize {
+    let bg = img.get_pixel(0, 0).0;
+    let mut seen = std::collections::HashSet::new();
+    for p in img.pixels().filter(|p| (0..3).any(|c| p.0[c].abs_diff(bg[c]) > 30)) {
+        let max = p.0[..3].iter().copied().max().unwrap_or(1).max(1) as u32;
+        // Hue-like: each channel relative to the brightest, in fifths (shading cancels out).
+        seen.insert(p.0[..3].iter().map(|&c| c as u32 * 5 / max).collect::<Vec<u32>>());
+    }
+    seen.len()
+}
+
+#[test]
+fn every_representation() {
+    let doc = protein();
+    let mut covered = Vec::new();
+    for (style, name) in [
+        (AtomStyle::BallAndStick, "protein_ball_and_stick"),
+        (AtomStyle::SpaceFilling, "protein_space_filling"),
+        (AtomStyle::Licorice, "protein_licorice"),
+        (AtomStyle::Lines, "protein_lines"),
+    ] {
+        let img = render(&doc, style, AtomColoring::Element);
+        let bg = img.get_pixel(0, 0).0;
+        covered.push(common::coverage(&img, [bg[0], bg[1], bg[2]]));
+        assert_golden(name, &img);
+    }
+    // Space filling covers most, lines least.
+    assert!(covered[1] > covered[0] && covered[0] > covered[3] && covered[2] > covered[3], "{covered:?}");
+}
+
+#[test]
+fn every_colouring() {
+    let doc = protein();
+    let element = hues(&render(&doc, AtomStyle::Licorice, AtomColoring::Element));
+    for (coloring, name) in [
+        (AtomColoring::Residue, "protein_by_residue"),
+        (AtomColoring::BFactor, "protein_by_b_factor"),
+        (AtomColoring::Secondary, "protein_by_secondary_structure"),
+    ] {
+        let img = render(&doc, AtomStyle::Licorice, coloring);
+        assert_golden(name, &img);
+        assert_ne!(hues(&img), 0, "{coloring:?}");
+        if coloring == AtomColoring::Residue {
+            assert!(hues(&img) > element, "residues show more colours than elements");
+        }
+    }
+}
