@@ -161,19 +161,6 @@ fn rasterise(i: u32) {
     }
 }
 
-@compute @workgroup_size(64)
-fn cs_atoms(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
-    let cell = cell_of(wid);
-    if (cell == 0xffffffffu || cell_hidden(cell)) {
-        return;
-    }
-    let first = cell_data[CELL_WORDS * cell];
-    let count = cell_data[CELL_WORDS * cell + 1u];
-    for (var k = lane; k < count; k += 64u) {
-        rasterise(cell_data[g.cells.z + first + k]);
-    }
-}
-
 fn write_id(i: u32) {
     let s = screen_of(i);
     if (s.p.w != 1.0) {
@@ -196,9 +183,12 @@ fn write_id(i: u32) {
     }
 }
 
-// After cs_atoms: each splatted atom writes its id where its depth won.
+// Which pass a pipeline runs: 0 rasterises depth keys, 1 (after 0) has each splatted atom
+// write its id where its depth won.
+override PASS: u32 = 0u;
+
 @compute @workgroup_size(64)
-fn cs_splat_ids(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
+fn cs_cells(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
     let cell = cell_of(wid);
     if (cell == 0xffffffffu || cell_hidden(cell)) {
         return;
@@ -206,7 +196,12 @@ fn cs_splat_ids(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation
     let first = cell_data[CELL_WORDS * cell];
     let count = cell_data[CELL_WORDS * cell + 1u];
     for (var k = lane; k < count; k += 64u) {
-        write_id(cell_data[g.cells.z + first + k]);
+        let i = cell_data[g.cells.z + first + k];
+        if (PASS == 0u) {
+            rasterise(i);
+        } else {
+            write_id(i);
+        }
     }
 }
 

@@ -540,3 +540,35 @@ fn direct_mode_draws_in_bands_and_the_window_keeps_answering() {
     assert!(after.len() >= 2 && after.windows(2).all(|w| w[1] >= w[0]), "the picture fills in: {seen:?}");
     assert!(slowest < 1.5, "a UI frame took {slowest:.2} s");
 }
+
+#[test]
+fn a_structure_shows_its_models_and_picks_tell_residues() {
+    use orbcloud::app::Opening;
+    let mut h = harness();
+    h.run_steps(1);
+    let ctx = h.ctx.clone();
+    let nmr =
+        std::path::PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/structures/nmr_excerpt.pdb"));
+    h.state_mut().open_as(nmr, Opening::Replace, &ctx);
+    wait_loaded(&mut h);
+    let first = h.state().objects[0].doc.molecule.atoms[0].position;
+    // Playing steps through the three models, a step at most every 120 ms, and wraps around.
+    h.state_mut().models.playing = true;
+    let mut seen = Vec::new();
+    for _ in 0..3 {
+        std::thread::sleep(std::time::Duration::from_millis(150));
+        h.run_steps(1);
+        seen.push(h.state().objects[0].doc.structure.as_ref().unwrap().model);
+    }
+    assert_eq!(seen, vec![1, 2, 0]);
+    h.state_mut().models.playing = false;
+    h.state_mut().show_model(2);
+    h.run_steps(2);
+    let app = h.state();
+    let view = app.objects[0].doc.structure.as_ref().unwrap();
+    assert_eq!((view.model, view.structure.models.len()), (2, 3));
+    assert!(app.objects[0].doc.molecule.atoms[0].position.distance(first) > 1e-3, "model 3's own coordinates");
+    // What the file says of an atom: chain, residue, atom name, B-factor, occupancy.
+    let about = app.world().annotation(0, 0).expect("residue information");
+    assert!(about.starts_with("A ") && about.contains(" 1 N") && about.contains("occupancy 1.00"), "{about}");
+}

@@ -410,7 +410,10 @@ impl OrbApp {
             Opening::Restore(state) => *state,
             _ => ObjectState {
                 path: (!doc.source.is_empty()).then(|| PathBuf::from(&doc.source)).filter(|p| p.exists()),
-                settings: RenderSettings { background: self.view.settings.background, ..self.defaults },
+                settings: RenderSettings { background: self.view.settings.background, ..self.defaults }.for_structure(
+                    doc.molecule.atoms.len(),
+                    doc.structure.as_ref().map_or(0, |s| s.structure.chains.len()),
+                ),
                 ..ObjectState::default()
             },
         };

@@ -155,13 +155,10 @@ pub fn parse(file: &str, text: &str) -> Result<Document, ParseError> {
     let mut block: Option<String> = None;
     let mut pending: Option<Token> = None;
     let mut row: Vec<Token> = Vec::new();
-    loop {
-        let Some(tok) = (match pending.take() {
-            Some(p) => Some(p),
-            None => t.next_token()?,
-        }) else {
-            break;
-        };
+    while let Some(tok) = match pending.take() {
+        Some(p) => Some(p),
+        None => t.next_token()?,
+    } {
         match tok.kind {
             Kind::Data if block.is_some() => break,
             Kind::Data => block = Some(tok.text[5..].to_string()),
@@ -215,7 +212,7 @@ pub fn parse(file: &str, text: &str) -> Result<Document, ParseError> {
                     }
                     next = t.next_token()?;
                 }
-                if count % items.len() != 0 {
+                if !count.is_multiple_of(items.len()) {
                     return Err(t.error(
                         last_line,
                         format!("a multiple of {} values in the {category} loop", items.len()),

@@ -346,13 +346,16 @@ impl Pipelines {
         };
         let (compute_pl, render_pl) = (layout(&compute_layout), layout(&render_layout));
         let cull = super::shader_module(device, "atoms_cull.wgsl");
-        let compute = |entry: &str| {
+        let compute = |entry: &str, pass: f64| {
             device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(entry),
                 layout: Some(&compute_pl),
                 module: &cull,
                 entry_point: Some(entry),
-                compilation_options: Default::default(),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants: &[("PASS", pass)],
+                    ..Default::default()
+                },
                 cache: None,
             })
         };
@@ -382,9 +385,9 @@ impl Pipelines {
         };
         use wgpu::PrimitiveTopology::{LineList, TriangleList};
         Self {
-            cull_atoms: compute("cs_atoms"),
-            splat_ids: compute("cs_splat_ids"),
-            cull_bonds: compute("cs_bonds"),
+            cull_atoms: compute("cs_cells", 0.0),
+            splat_ids: compute("cs_cells", 1.0),
+            cull_bonds: compute("cs_bonds", 0.0),
             spheres: render("sphere impostors", "vs_sphere", "fs_sphere", TriangleList),
             splats: render("sphere splats", "vs_fullscreen", "fs_splats", TriangleList),
             cylinders: render("cylinder impostors", "vs_cylinder", "fs_cylinder", TriangleList),

@@ -202,6 +202,23 @@ pub struct RenderSettings {
     pub background: [f32; 3],
 }
 
+/// Above this many atoms a file opens space filling (ball and stick is sub-pixel noise at that
+/// scale) and, when it has several chains, coloured by chain.
+pub const BIG_STRUCTURE_ATOMS: usize = 20_000;
+
+impl RenderSettings {
+    /// These settings as a file of `atoms` atoms in `chains` chains first opens with them.
+    pub fn for_structure(mut self, atoms: usize, chains: usize) -> Self {
+        if atoms > BIG_STRUCTURE_ATOMS && self.atoms == AtomStyle::BallAndStick {
+            self.atoms = AtomStyle::SpaceFilling;
+            if chains > 1 && self.atom_colors == AtomColoring::Element {
+                self.atom_colors = AtomColoring::Chain;
+            }
+        }
+        self
+    }
+}
+
 impl Default for RenderSettings {
     fn default() -> Self {
         Self {
