@@ -13,13 +13,20 @@
 const LISTS: u32 = 8u;
 // The rasteriser's largest footprint side (pixels): bounds the loop whatever the inputs.
 const MAX_SIDE: i32 = 40;
+// Largest half side (pixels) of the square a big sphere writes as an occluder.
+const MAX_OCCLUDER: i32 = 48;
+// Whether this frame may have spheres too big for the rasteriser (the CPU knows from the
+// nearest cell): then they are culled and occlude. Without them the code is left out, which
+// llvmpipe runs measurably faster.
+override BIG_SPHERES: bool = true;
 
 fn index_of(gid: vec3<u32>) -> u32 {
     return gid.x + gid.y * g.counts.w;
 }
 
 struct Screen {
-    // x, y: pixel position of the centre; z: projected radius (px); w: 0 culled, 1 splat, 2 quad
+    // x, y: pixel position of the centre; z: projected radius (px); w: 0 culled, 1 splat,
+    // 2 quad, 3 quad through the eye's plane
     p: vec4<f32>,
 };
 
@@ -33,8 +40,9 @@ fn screen_of(i: u32) -> Screen {
     }
     let c = g.clip_from_world * vec4<f32>(positions[i].xyz, 1.0);
     if (c.w <= r) {
-        // At or behind the eye's plane: a quad (clipped by the rasteriser) if in front at all.
-        s.p.w = select(0.0, 2.0, c.w > -r);
+        // At or behind the eye's plane: a quad (clipped by the rasteriser) if in front at all,
+        // with no screen position to test or occlude with.
+        s.p.w = select(0.0, 3.0, c.w > -r);
         return s;
     }
     let r_px = r * g.viewport.z / c.w;
@@ -135,11 +143,44 @@ fn hidden(f: vec4<i32>, key: u32) -> bool {
     return true;
 }
 
+// A sphere too big to rasterise here: culled if what is drawn hides it, else appended to the
+// quads' list and its inscribed square written at its centre's depth, a conservative occluder
+// (the sphere's surface is nearer there) that lets farther atoms be culled.
+fn big_sphere(i: u32, s: Screen) {
+    let e = max(s.p.z, 0.5) * 1.05 + 0.02;
+    let whole = 2.0 * e + 1.0 <= f32(MAX_SIDE);
+    if (whole && s.p.w == 2.0 && hidden(footprint(s), front_key(i))) {
+        return;
+    }
+    let k = atomicAdd(&lists[1], 1u);
+    atomicStore(&lists[LISTS + k], i);
+    let h = s.p.z * 0.7;
+    if (h < 1.0 || h > f32(MAX_OCCLUDER) || s.p.w != 2.0) {
+        return;
+    }
+    let key = 0xffffffffu - bitcast<u32>(clamp(depth_of(positions[i].xyz), 0.0, 1.0));
+    let lo = max(vec2<i32>(ceil(s.p.xy - 0.5 - h)), vec2<i32>(0));
+    let hi = min(vec2<i32>(floor(s.p.xy - 0.5 + h)), vec2<i32>(g.viewport.xy) - 1);
+    let w = i32(g.viewport.x);
+    for (var y = lo.y; y <= hi.y; y++) {
+        for (var x = lo.x; x <= hi.x; x++) {
+            let pixel = u32(y * w + x);
+            if (key > atomicLoad(&splat[pixel])) {
+                atomicMax(&splat[pixel], key);
+            }
+        }
+    }
+}
+
 fn rasterise(i: u32) {
     let s = screen_of(i);
-    if (s.p.w == 2.0) {
-        let k = atomicAdd(&lists[1], 1u);
-        atomicStore(&lists[LISTS + k], i);
+    if (s.p.w >= 2.0) {
+        if (BIG_SPHERES) {
+            big_sphere(i, s);
+        } else {
+            let k = atomicAdd(&lists[1], 1u);
+            atomicStore(&lists[LISTS + k], i);
+        }
         return;
     }
     if (s.p.w == 0.0) {
@@ -183,12 +224,9 @@ fn write_id(i: u32) {
     }
 }
 
-// Which pass a pipeline runs: 0 rasterises depth keys, 1 (after 0) has each splatted atom
-// write its id where its depth won.
-override PASS: u32 = 0u;
-
-@compute @workgroup_size(64)
-fn cs_cells(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
+// One lane's share of one cell's atoms: `which` 0 rasterises depth keys, 1 (after 0) has
+// each splatted atom write its id where its depth won.
+fn cell_pass(wid: vec3<u32>, lane: u32, which: u32) {
     let cell = cell_of(wid);
     if (cell == 0xffffffffu || cell_hidden(cell)) {
         return;
@@ -197,12 +235,22 @@ fn cs_cells(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_ind
     let count = cell_data[CELL_WORDS * cell + 1u];
     for (var k = lane; k < count; k += 64u) {
         let i = cell_data[g.cells.z + first + k];
-        if (PASS == 0u) {
+        if (which == 0u) {
             rasterise(i);
         } else {
             write_id(i);
         }
     }
+}
+
+@compute @workgroup_size(64)
+fn cs_atoms(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
+    cell_pass(wid, lane, 0u);
+}
+
+@compute @workgroup_size(64)
+fn cs_splat_ids(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
+    cell_pass(wid, lane, 1u);
 }
 
 @compute @workgroup_size(64)

@@ -271,6 +271,8 @@ struct Uploaded {
     cells: Cells,
     /// Cells in this frame's view, nearest first (how many the compute passes walk).
     visible_cells: u32,
+    /// Whether a sphere in view may project bigger than the rasteriser draws.
+    big_spheres: bool,
     atoms: u32,
     bond_count: u32,
     /// CPU copy of the attributes: a recolouring changes their palette bits only.
@@ -295,7 +297,8 @@ struct Pipelines {
     data_layout: wgpu::BindGroupLayout,
     compute_layout: wgpu::BindGroupLayout,
     render_layout: wgpu::BindGroupLayout,
-    cull_atoms: wgpu::ComputePipeline,
+    /// Without and with the code for spheres too big to rasterise.
+    cull_atoms: [wgpu::ComputePipeline; 2],
     splat_ids: wgpu::ComputePipeline,
     cull_bonds: wgpu::ComputePipeline,
     spheres: wgpu::RenderPipeline,
@@ -346,14 +349,14 @@ impl Pipelines {
         };
         let (compute_pl, render_pl) = (layout(&compute_layout), layout(&render_layout));
         let cull = super::shader_module(device, "atoms_cull.wgsl");
-        let compute = |entry: &str, pass: f64| {
+        let compute = |entry: &str, big: bool| {
             device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(entry),
                 layout: Some(&compute_pl),
                 module: &cull,
                 entry_point: Some(entry),
                 compilation_options: wgpu::PipelineCompilationOptions {
-                    constants: &[("PASS", pass)],
+                    constants: &[("BIG_SPHERES", if big { 1.0 } else { 0.0 })],
                     ..Default::default()
                 },
                 cache: None,
@@ -385,9 +388,9 @@ impl Pipelines {
         };
         use wgpu::PrimitiveTopology::{LineList, TriangleList};
         Self {
-            cull_atoms: compute("cs_cells", 0.0),
-            splat_ids: compute("cs_cells", 1.0),
-            cull_bonds: compute("cs_bonds", 0.0),
+            cull_atoms: [compute("cs_atoms", false), compute("cs_atoms", true)],
+            splat_ids: compute("cs_splat_ids", false),
+            cull_bonds: compute("cs_bonds", false),
             spheres: render("sphere impostors", "vs_sphere", "fs_sphere", TriangleList),
             splats: render("sphere splats", "vs_fullscreen", "fs_splats", TriangleList),
             cylinders: render("cylinder impostors", "vs_cylinder", "fs_cylinder", TriangleList),
@@ -475,6 +478,7 @@ impl AtomsPass {
             cell_data,
             cells: data.cells,
             visible_cells: 0,
+            big_spheres: true,
             atoms: data.positions.len() as u32,
             bond_count: data.bonds.len() as u32,
             attr_words: data.attrs,
@@ -574,6 +578,16 @@ impl AtomsPass {
             ctx.queue.write_buffer(&d.lists, order_at as u64 * 4, bytemuck::cast_slice(&order));
         }
         d.visible_cells = order.len() as u32;
+        // The nearest cell bounds how big any sphere projects.
+        let largest = looks(self.style, &AtomColors { palette: Vec::new(), index: Vec::new() })
+            .iter()
+            .map(|l| l[0])
+            .fold(0.0, f32::max);
+        d.big_spheres = order.first().is_none_or(|&c| {
+            let s = d.cells.spheres[c as usize];
+            let w = (clip * Vec4::new(s[0], s[1], s[2], 1.0)).w - s[3] - largest;
+            w <= 0.0 || largest * pixels_per_bohr / w > self.splat_radius_px
+        });
         let d = &*d;
         if self.splat.as_ref().is_none_or(|(_, s)| *s != size) {
             let bytes = size[0] as u64 * size[1] as u64 * SPLAT_BYTES_PER_PIXEL;
@@ -636,7 +650,7 @@ impl Draw for AtomsPass {
         // One row width for both dispatches: the shader indexes with it.
         if d.visible_cells > 0 {
             let (x, y) = (d.visible_cells.min(65_535), d.visible_cells.div_ceil(65_535));
-            pass.set_pipeline(&self.shared.cull_atoms);
+            pass.set_pipeline(&self.shared.cull_atoms[d.big_spheres as usize]);
             pass.dispatch_workgroups(x, y, 1);
             pass.set_pipeline(&self.shared.splat_ids);
             pass.dispatch_workgroups(x, y, 1);
