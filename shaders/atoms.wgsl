@@ -205,6 +205,10 @@ fn vs_line(@builtin(vertex_index) vi: u32, @builtin(instance_index) b: u32) -> L
     var out: LineOut;
     out.clip = g.clip_from_world * vec4<f32>(ends[vi], 1.0);
     out.atom = select(bond.y, bond.x, vi < 2u);
+    if (((flags_of(bond.x) | flags_of(bond.y)) & FLAG_HIDDEN) != 0u) {
+        // A bond to an atom the selection leaves out: a point outside the clip volume.
+        out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
+    }
     return out;
 }
 

@@ -68,3 +68,44 @@ fn every_colouring() {
         }
     }
 }
+
+/// A selection hides the atoms it leaves out, and their bonds: only the waters remain, and
+/// every atom a pixel shows is a water's.
+#[test]
+fn a_selection_shows_only_what_it_names() {
+    use orbcloud::gpu::frame::PickId;
+    use orbcloud::gpu::{FrameInput, OffscreenTarget, Renderer};
+    use orbcloud::scene::ObjectState;
+    let ctx = lavapipe();
+    let doc = protein();
+    let draw = |selection: &str| {
+        let state = ObjectState { selection: selection.into(), ..ObjectState::default() };
+        let mut r = Renderer::new(&ctx);
+        orbcloud::headless::show_object(&ctx, r.main(), &doc, &state).unwrap();
+        let target = OffscreenTarget::new(&ctx.device, SIZE);
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        let cam = default_camera(&doc);
+        r.render(&ctx, &mut encoder, &target.color_view, &FrameInput::single(&cam, &state.settings, SIZE));
+        ctx.queue.submit([encoder.finish()]);
+        (target.read_rgba(&ctx.device, &ctx.queue).unwrap(), r)
+    };
+    let (all, _) = draw("");
+    let (waters, r) = draw("resn HOH");
+    let bg = all.get_pixel(0, 0).0;
+    let (c_all, c_waters) =
+        (common::coverage(&all, [bg[0], bg[1], bg[2]]), common::coverage(&waters, [bg[0], bg[1], bg[2]]));
+    assert!(c_waters > 0.0 && c_waters * 10.0 < c_all, "waters {c_waters}, all {c_all}");
+    let view = doc.structure.as_ref().unwrap();
+    let s = &view.structure;
+    let mut picked = 0;
+    for y in (0..SIZE[1]).step_by(4) {
+        for x in (0..SIZE[0]).step_by(4) {
+            if let Some(PickId::Atom { index, .. }) = r.pick(&ctx, [x, y]).unwrap() {
+                let residue = &s.residues[s.residue[view.atoms[index as usize] as usize] as usize];
+                assert_eq!(residue.name.as_str(), "HOH", "pixel {x},{y} shows atom {index}");
+                picked += 1;
+            }
+        }
+    }
+    assert!(picked > 0, "the waters are picked");
+}

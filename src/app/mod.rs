@@ -601,7 +601,7 @@ impl OrbApp {
             self.commit_active();
         }
         let (Some(vp), Some(o)) = (&mut self.viewport, self.objects.get(n)) else { return };
-        vp.set_atom_look(n, &o.doc, &o.state.settings);
+        vp.set_atom_look(n, &o.doc, &o.state);
     }
 
     /// Computes what the active object's orbital browser asks for and hands it to the viewport.
@@ -838,7 +838,7 @@ impl OrbApp {
         if (before.settings.atoms, before.settings.atom_colors)
             != (self.view.settings.atoms, self.view.settings.atom_colors)
         {
-            vp.set_atom_look(n, &o.doc, &self.view.settings);
+            vp.set_atom_look(n, &o.doc, &o.state);
             if let Some(scan) = &mut self.scan {
                 scan::restyle(scan);
             }

@@ -1,5 +1,6 @@
 //! Models of a structure (an NMR ensemble's, an XYZ trajectory's frames): which one the active
-//! object shows, and playing them in turn like a scan's θ.
+//! object shows, and playing them in turn like a scan's θ; and which of its atoms are shown
+//! (a selection by chain, residue number and residue name).
 
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -7,6 +8,7 @@ use std::time::{Duration, Instant};
 use egui::{RichText, Slider};
 
 use super::{OrbApp, World};
+use crate::scene::selection::Selection;
 
 /// Time each model stays on screen while playing.
 const STEP: Duration = Duration::from_millis(120);
@@ -43,6 +45,29 @@ pub fn controls(ui: &mut egui::Ui, app: &mut OrbApp) -> Option<usize> {
     chosen
 }
 
+/// The *show* field of a structure: which of its atoms are drawn (`chain A resi 30-50`,
+/// `not resn HOH`; empty: all). A query that does not parse shows what it expected.
+pub fn selection(ui: &mut egui::Ui, app: &mut OrbApp) {
+    let n = app.active;
+    let Some(o) = app.objects.get_mut(n).filter(|o| o.doc.structure.is_some()) else { return };
+    let mut query = o.state.selection.clone();
+    let changed = ui
+        .horizontal(|ui| {
+            let edit = egui::TextEdit::singleline(&mut query).hint_text("chain A resi 30-50").desired_width(170.0);
+            let changed = ui.add(edit).changed();
+            ui.label("show");
+            changed
+        })
+        .inner;
+    if let Err(expected) = Selection::parse(&query) {
+        ui.label(RichText::new(format!("expected {expected}")).small().color(ui.visuals().error_fg_color));
+    }
+    if changed {
+        o.state.selection = query;
+        app.restyle_atoms(n);
+    }
+}
+
 /// The next model while playing, when its time has come; asks for the repaint that comes back.
 pub fn tick(ctx: &egui::Context, app: &mut OrbApp) -> Option<usize> {
     if !app.models.playing {
@@ -73,7 +98,7 @@ impl OrbApp {
         self.measurements.selection.clear();
         self.measurements.list.clear();
         if let Some(vp) = &mut self.viewport {
-            vp.set_atoms(n, &self.objects[n].doc, &self.objects[n].state.settings);
+            vp.set_atoms(n, &self.objects[n].doc, &self.objects[n].state);
         }
         self.world = World::of(&self.objects);
     }

@@ -258,6 +258,8 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
                     ui.selectable_value(&mut view.settings.atom_colors, coloring, coloring.name());
                 }
             });
+            super::models::selection(ui, app);
+            let view = &mut app.view;
             ui.horizontal(|ui| {
                 ui.color_edit_button_rgb(&mut view.settings.background);
                 ui.label("background");

@@ -299,16 +299,22 @@ impl Viewport {
         &mut self.slots[n]
     }
 
-    /// Restyles and recolours object `n`'s atoms (positions stay on the GPU as they are).
-    pub fn set_atom_look(&mut self, n: usize, doc: &Document, settings: &crate::scene::RenderSettings) {
-        let colors = crate::scene::coloring::atom_colors(&doc.molecule, doc.structure.as_ref(), settings.atom_colors);
-        self.renderer.layer_mut(&self.ctx, n).atoms.set_look(&self.ctx, settings.atoms, &colors);
+    /// Restyles, recolours and reselects object `n`'s atoms (positions stay on the GPU).
+    pub fn set_atom_look(&mut self, n: usize, doc: &Document, state: &crate::scene::ObjectState) {
+        let look = crate::headless::atom_look(doc, &state.settings, &state.selection);
+        self.renderer.layer_mut(&self.ctx, n).atoms.set_look(&self.ctx, state.settings.atoms, &look);
         self.generation += 1;
     }
 
     /// Puts object `n`'s molecule anew (another model or frame of a structure).
-    pub fn set_atoms(&mut self, n: usize, doc: &Document, settings: &crate::scene::RenderSettings) {
-        crate::headless::show_atoms(&self.ctx, self.renderer.layer_mut(&self.ctx, n), doc, settings);
+    pub fn set_atoms(&mut self, n: usize, doc: &Document, state: &crate::scene::ObjectState) {
+        crate::headless::show_atoms(
+            &self.ctx,
+            self.renderer.layer_mut(&self.ctx, n),
+            doc,
+            &state.settings,
+            &state.selection,
+        );
         self.generation += 1;
     }
 

@@ -50,6 +50,7 @@ const LICORICE_RADIUS_ANG: f32 = 0.3;
 const LINES_BALL_ANG: f32 = 0.25;
 
 const FLAG_GHOST: u32 = 1;
+const FLAG_HIDDEN: u32 = 2;
 const FLAG_BONDED: u32 = 4;
 const STYLE_CYLINDERS: u32 = 1;
 const STYLE_UNBONDED_ONLY: u32 = 2;
@@ -187,7 +188,10 @@ impl AtomData {
             .iter()
             .enumerate()
             .map(|(i, a)| {
-                let flags = if a.ghost { FLAG_GHOST } else { 0 } | if bonded[i] { FLAG_BONDED } else { 0 };
+                let hidden = colors.shown.get(i).is_some_and(|&shown| !shown);
+                let flags = if a.ghost { FLAG_GHOST } else { 0 }
+                    | if bonded[i] { FLAG_BONDED } else { 0 }
+                    | if hidden { FLAG_HIDDEN } else { 0 };
                 let color = colors.index.get(i).copied().unwrap_or(0) as u32;
                 a.z.min(127) | flags << 8 | color << 16
             })
@@ -486,16 +490,17 @@ impl AtomsPass {
         });
     }
 
-    /// Restyles and recolours: rewrites the attributes' palette bits and the small radius and
-    /// palette table; positions and bonds stay as uploaded.
+    /// Restyles, recolours and reselects: rewrites the attributes' palette and hidden bits and
+    /// the small radius and palette table; positions and bonds stay as uploaded.
     pub fn set_look(&mut self, ctx: &GpuContext, style: AtomStyle, colors: &AtomColors) {
         self.style = style;
         let Some(d) = &mut self.data else { return };
         if colors.index.len() != d.attr_words.len() {
             return;
         }
-        for (w, &c) in d.attr_words.iter_mut().zip(&colors.index) {
-            *w = (*w & 0xffff) | (c as u32) << 16;
+        for (i, (w, &c)) in d.attr_words.iter_mut().zip(&colors.index).enumerate() {
+            let hidden = colors.shown.get(i).is_some_and(|&shown| !shown);
+            *w = (*w & 0xffff & !(FLAG_HIDDEN << 8)) | if hidden { FLAG_HIDDEN << 8 } else { 0 } | (c as u32) << 16;
         }
         ctx.queue.write_buffer(&d.attrs, 0, bytemuck::cast_slice(&d.attr_words));
         self.write_looks(ctx, style, colors);
@@ -579,10 +584,7 @@ impl AtomsPass {
         }
         d.visible_cells = order.len() as u32;
         // The nearest cell bounds how big any sphere projects.
-        let largest = looks(self.style, &AtomColors { palette: Vec::new(), index: Vec::new() })
-            .iter()
-            .map(|l| l[0])
-            .fold(0.0, f32::max);
+        let largest = looks(self.style, &AtomColors::default()).iter().map(|l| l[0]).fold(0.0, f32::max);
         d.big_spheres = order.first().is_none_or(|&c| {
             let s = d.cells.spheres[c as usize];
             let w = (clip * Vec4::new(s[0], s[1], s[2], 1.0)).w - s[3] - largest;

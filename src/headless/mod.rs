@@ -16,7 +16,8 @@ use crate::model::gto::{GridSpec, PreparedBasis};
 use crate::model::isosurface::{self, Level, Mesh};
 use crate::model::orbitals::Quantity;
 use crate::model::{Document, VolumeGrid};
-use crate::scene::coloring::atom_colors;
+use crate::scene::coloring::{AtomColors, atom_colors};
+use crate::scene::selection::Selection;
 use crate::scene::{Camera, IsosurfaceSettings, ObjectState, RenderSettings, ViewPreset};
 
 /// Space (bohr) around the atoms in which orbitals are evaluated.
@@ -262,10 +263,22 @@ pub fn coarser_note(what: &str, dims: [usize; 3], step: usize) -> String {
     )
 }
 
-/// Puts `doc`'s atoms into `layer` in the settings' style and colouring.
-pub fn show_atoms(ctx: &GpuContext, layer: &mut Layer, doc: &Document, settings: &RenderSettings) {
-    let colors = atom_colors(&doc.molecule, doc.structure.as_ref(), settings.atom_colors);
-    layer.set_atoms(ctx, &doc.molecule, settings.atoms, Some(&colors));
+/// Puts `doc`'s atoms into `layer` in the settings' style and colouring, those `selection`
+/// leaves out hidden.
+pub fn show_atoms(ctx: &GpuContext, layer: &mut Layer, doc: &Document, settings: &RenderSettings, selection: &str) {
+    layer.set_atoms(ctx, &doc.molecule, settings.atoms, Some(&atom_look(doc, settings, selection)));
+}
+
+/// The colours of `doc`'s atoms, and which are shown: all when `selection` does not parse (the
+/// panel says why).
+pub fn atom_look(doc: &Document, settings: &RenderSettings, selection: &str) -> AtomColors {
+    let mut colors = atom_colors(&doc.molecule, doc.structure.as_ref(), settings.atom_colors);
+    if let Ok(s) = Selection::parse(selection)
+        && !s.is_everything()
+    {
+        colors.shown = s.mask(&doc.molecule, doc.structure.as_ref());
+    }
+    colors
 }
 
 /// Puts `doc` into `layer` as `state` shows it, all but its isosurfaces (none until they are
@@ -279,7 +292,7 @@ pub fn show_document(
     state: &ObjectState,
 ) -> Result<usize, GpuError> {
     let step = layer.set_volume(ctx, doc.volumes.get(state.volume))?;
-    show_atoms(ctx, layer, doc, &state.settings);
+    show_atoms(ctx, layer, doc, &state.settings, &state.selection);
     layer.surfaces.clear();
     layer.world_from_object = state.placement.world_from_object();
     layer.visible = state.visible;
@@ -320,7 +333,7 @@ impl Headless {
     ) -> Result<Self, GpuError> {
         let mut renderer = Renderer::new(ctx);
         let layer = renderer.main();
-        show_atoms(ctx, layer, doc, settings);
+        show_atoms(ctx, layer, doc, settings, "");
         let grid = volume_index.and_then(|i| doc.volumes.get(i));
         layer.set_volume(ctx, grid)?;
         if let Some(grid) = grid {

@@ -7,11 +7,13 @@ use crate::model::{Molecule, StructureView};
 
 use super::settings::AtomColoring;
 
-/// sRGB palette and, per atom of the molecule, an index into it.
-#[derive(Debug, Clone, PartialEq)]
+/// sRGB palette and, per atom of the molecule, an index into it and whether the atom is shown
+/// (a selection's mask; empty: every atom).
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct AtomColors {
     pub palette: Vec<[u8; 3]>,
     pub index: Vec<u16>,
+    pub shown: Vec<bool>,
 }
 
 /// Ghost centres are grey whatever the colouring.
@@ -105,7 +107,7 @@ pub fn atom_colors(molecule: &Molecule, structure: Option<&StructureView>, color
         palette.push(GHOST);
         let ghost = (palette.len() - 1) as u16;
         let index = molecule.atoms.iter().map(|a| if a.ghost { ghost } else { a.z.min(118) as u16 }).collect();
-        AtomColors { palette, index }
+        AtomColors { palette, index, shown: Vec::new() }
     };
     let Some(view) = structure.filter(|v| v.atoms.len() == molecule.atoms.len()) else { return by_element() };
     let s = &view.structure;
@@ -113,6 +115,7 @@ pub fn atom_colors(molecule: &Molecule, structure: Option<&StructureView>, color
     let per_atom = |palette: Vec<[u8; 3]>, f: &dyn Fn(usize) -> u16| AtomColors {
         index: (0..molecule.atoms.len()).map(f).collect(),
         palette,
+        shown: Vec::new(),
     };
     match coloring {
         AtomColoring::Element => by_element(),

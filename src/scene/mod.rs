@@ -4,6 +4,7 @@ pub mod camera;
 pub mod coloring;
 pub mod objects;
 pub mod opacity;
+pub mod selection;
 pub mod settings;
 pub mod slicing;
 pub mod transfer;

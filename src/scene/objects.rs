@@ -56,6 +56,8 @@ pub struct ObjectState {
     /// The orbital, density or spin density shown, for files with a wavefunction (`None`: the
     /// HOMO, as a new file opens).
     pub quantity: Option<Quantity>,
+    /// Which atoms of a structure are shown ([`super::selection::Selection`]; empty: all).
+    pub selection: String,
 }
 
 impl Default for ObjectState {
@@ -68,6 +70,7 @@ impl Default for ObjectState {
             isosurfaces: Vec::new(),
             volume: 0,
             quantity: None,
+            selection: String::new(),
         }
     }
 }
