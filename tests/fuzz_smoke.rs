@@ -166,9 +166,7 @@ fn scan_manifests_survive_mutations() {
             atom(8, 1.4, 0.0, 0.0),
             atom(1, 1.8, 1.5, 0.5),
         ]),
-        volumes: Vec::new(),
-        wavefunction: None,
-        structure: None,
+        ..Document::default()
     };
     let manifest = br#"title = "HOOH"
 dihedral = [1, 2, 3, 4]

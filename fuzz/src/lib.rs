@@ -27,9 +27,7 @@ static FRAME: LazyLock<Document> = LazyLock::new(|| {
             atom(8, 1.4, 0.0, 0.0),
             atom(1, 1.8, 1.5, 0.5),
         ]),
-        volumes: Vec::new(),
-        wavefunction: None,
-        structure: None,
+        ..Document::default()
     }
 });
 

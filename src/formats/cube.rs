@@ -307,7 +307,7 @@ impl CubeFile {
                 .collect()
         };
 
-        Document { source: source.to_string(), title, molecule, volumes, wavefunction: None, structure: None }
+        Document { source: source.to_string(), title, molecule, volumes, ..Document::default() }
     }
 }
 

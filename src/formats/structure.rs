@@ -7,7 +7,8 @@ use crate::model::{Document, Structure, StructureView};
 /// Atomic number of an element symbol as structure files write it ("C", "FE", "Fe2+", "O1-").
 pub(crate) fn element_of(symbol: &str) -> Option<u8> {
     // The elements of biomolecules first: a million atoms would otherwise each scan the table.
-    match symbol.trim().as_bytes() {
+    let symbol = symbol.trim();
+    match symbol.as_bytes() {
         [b'C' | b'c'] => return Some(6),
         [b'N' | b'n'] => return Some(7),
         [b'O' | b'o'] => return Some(8),
@@ -16,7 +17,7 @@ pub(crate) fn element_of(symbol: &str) -> Option<u8> {
         [b'P' | b'p'] => return Some(15),
         _ => {}
     }
-    let s = symbol.trim().trim_end_matches(['+', '-']).trim_end_matches(|c: char| c.is_ascii_digit());
+    let s = symbol.trim_end_matches(['+', '-']).trim_end_matches(|c: char| c.is_ascii_digit());
     if s.eq_ignore_ascii_case("D") || s.eq_ignore_ascii_case("T") {
         return Some(1); // deuterium, tritium
     }
@@ -30,8 +31,7 @@ pub(crate) fn document(source: &str, title: &str, structure: Structure) -> Docum
         source: source.to_string(),
         title: if title.trim().is_empty() { source.to_string() } else { title.trim().to_string() },
         molecule,
-        volumes: Vec::new(),
-        wavefunction: None,
         structure: Some(view),
+        ..Document::default()
     }
 }

@@ -247,9 +247,8 @@ pub fn wavefunction_document(
         source: source.to_string(),
         title: if title.is_empty() { source.to_string() } else { title.to_string() },
         molecule: crate::model::Molecule::new(atoms),
-        volumes: vec![],
         wavefunction: Some(check_and_repair(wf, program, overlap)),
-        structure: None,
+        ..Default::default()
     }
 }
 

@@ -217,23 +217,22 @@ impl AtomData {
 
 /// The style's radius per atomic number (bohr), then the palette (linear RGB).
 pub fn looks(style: AtomStyle, colors: &AtomColors) -> Vec<[f32; 4]> {
-    let bohr = BOHR_PER_ANGSTROM as f32;
-    let mut out: Vec<[f32; 4]> = (0..PALETTE_AT)
-        .map(|z| {
-            let e = crate::model::elements::element(z as u32);
-            let r = match style {
-                AtomStyle::BallAndStick => e.vdw_radius * BALL_FRACTION,
-                AtomStyle::SpaceFilling => e.vdw_radius,
-                AtomStyle::Sticks => STICK_RADIUS_ANG,
-                AtomStyle::Licorice => LICORICE_RADIUS_ANG,
-                AtomStyle::Lines => LINES_BALL_ANG,
-                AtomStyle::Hidden => 0.0,
-            };
-            [r * bohr, 0.0, 0.0, 0.0]
-        })
-        .collect();
-    out.extend(colors.palette.iter().map(|&c| linear_color(c)));
-    out
+    let radii = (0..PALETTE_AT).map(|z| [radius(style, z as u32), 0.0, 0.0, 0.0]);
+    radii.chain(colors.palette.iter().map(|&c| linear_color(c))).collect()
+}
+
+/// The radius (bohr) an atom of atomic number `z` is drawn with in `style`.
+fn radius(style: AtomStyle, z: u32) -> f32 {
+    let e = crate::model::elements::element(z);
+    let r = match style {
+        AtomStyle::BallAndStick => e.vdw_radius * BALL_FRACTION,
+        AtomStyle::SpaceFilling => e.vdw_radius,
+        AtomStyle::Sticks => STICK_RADIUS_ANG,
+        AtomStyle::Licorice => LICORICE_RADIUS_ANG,
+        AtomStyle::Lines => LINES_BALL_ANG,
+        AtomStyle::Hidden => 0.0,
+    };
+    r * BOHR_PER_ANGSTROM as f32
 }
 
 /// Stick radius (bohr) and style flags.
@@ -448,8 +447,14 @@ impl AtomsPass {
         style: AtomStyle,
         colors: Option<&AtomColors>,
     ) {
-        let element = crate::scene::coloring::atom_colors(molecule, None, crate::scene::AtomColoring::Element);
-        let colors = colors.filter(|c| c.index.len() == molecule.atoms.len()).unwrap_or(&element);
+        let element;
+        let colors = match colors.filter(|c| c.index.len() == molecule.atoms.len()) {
+            Some(c) => c,
+            None => {
+                element = crate::scene::coloring::atom_colors(molecule, None, crate::scene::AtomColoring::Element);
+                &element
+            }
+        };
         let data = AtomData::new(molecule, colors);
         let usage = wgpu::BufferUsages::empty();
         let positions = storage(ctx, "atom positions", bytemuck::cast_slice(&data.positions), usage);
@@ -459,18 +464,8 @@ impl AtomsPass {
         let list_words = LIST_HEADER + data.positions.len() + data.bonds.len() + data.cells.len();
         let lists = storage(ctx, "atom lists", &vec![0u8; list_words * 4], wgpu::BufferUsages::INDIRECT);
         let cell_data = storage(ctx, "atom cells", bytemuck::cast_slice(&data.cells.data), usage);
-        let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("atoms data"),
-            layout: &self.shared.data_layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: self.globals.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: positions.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 2, resource: attrs.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 3, resource: looks.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 4, resource: bonds.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 5, resource: cell_data.as_entire_binding() },
-            ],
-        });
+        let group =
+            Self::data_group(ctx, &self.shared, &self.globals, [&positions, &attrs, &looks, &bonds, &cell_data]);
         self.style = style;
         self.frame_groups = None;
         self.data = Some(Uploaded {
@@ -506,24 +501,35 @@ impl AtomsPass {
         self.write_looks(ctx, style, colors);
     }
 
+    /// The bind group of the globals and the per-atom buffers (positions, attributes, looks,
+    /// bonds, cells), in binding order.
+    fn data_group(
+        ctx: &GpuContext,
+        shared: &Pipelines,
+        globals: &wgpu::Buffer,
+        buffers: [&wgpu::Buffer; 5],
+    ) -> wgpu::BindGroup {
+        let entries: Vec<wgpu::BindGroupEntry> = std::iter::once(globals)
+            .chain(buffers)
+            .enumerate()
+            .map(|(binding, b)| wgpu::BindGroupEntry { binding: binding as u32, resource: b.as_entire_binding() })
+            .collect();
+        ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("atoms data"),
+            layout: &shared.data_layout,
+            entries: &entries,
+        })
+    }
+
     fn write_looks(&mut self, ctx: &GpuContext, style: AtomStyle, colors: &AtomColors) {
         let Some(d) = &mut self.data else { return };
         let bytes: Vec<u8> = bytemuck::cast_slice(&looks(style, colors)).to_vec();
         if bytes.len() as u64 > d.looks.size() {
             // A bigger palette: a new buffer, and the bind group that names it.
-            d.looks = storage(ctx, "atom looks", &bytes, wgpu::BufferUsages::empty());
-            d.group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("atoms data"),
-                layout: &self.shared.data_layout,
-                entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: self.globals.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 1, resource: d.positions.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 2, resource: d.attrs.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 3, resource: d.looks.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 4, resource: d.bonds.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 5, resource: d.cell_data.as_entire_binding() },
-                ],
-            });
+            let looks = storage(ctx, "atom looks", &bytes, wgpu::BufferUsages::empty());
+            let buffers = [&d.positions, &d.attrs, &looks, &d.bonds, &d.cell_data];
+            d.group = Self::data_group(ctx, &self.shared, &self.globals, buffers);
+            d.looks = looks;
         } else {
             ctx.queue.write_buffer(&d.looks, 0, &bytes);
         }
@@ -584,7 +590,7 @@ impl AtomsPass {
         }
         d.visible_cells = order.len() as u32;
         // The nearest cell bounds how big any sphere projects.
-        let largest = looks(self.style, &AtomColors::default()).iter().map(|l| l[0]).fold(0.0, f32::max);
+        let largest = (0..PALETTE_AT as u32).map(|z| radius(self.style, z)).fold(0.0, f32::max);
         d.big_spheres = order.first().is_none_or(|&c| {
             let s = d.cells.spheres[c as usize];
             let w = (clip * Vec4::new(s[0], s[1], s[2], 1.0)).w - s[3] - largest;

@@ -63,8 +63,7 @@ pub fn scene(with_volume: Option<VolumeGrid>) -> Document {
         title: "formaldehyde-like test scene".into(),
         molecule: formaldehyde(),
         volumes: with_volume.into_iter().collect(),
-        wavefunction: None,
-        structure: None,
+        ..Document::default()
     }
 }
 
