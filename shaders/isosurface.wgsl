@@ -57,3 +57,39 @@ fn fs_main(in: VertexOut) -> FragOut {
     out.id = u.pick.x;
     return out;
 }
+
+// Translucent surfaces: every fragment in front of the opaque scene is appended to its
+// pixel's list (resolve.wgsl sorts and composites them). Prepended: oit_common.wgsl.
+
+@group(1) @binding(0) var<uniform> lists: ListInfo;
+@group(1) @binding(1) var<storage, read_write> heads: array<atomic<u32>>;
+@group(1) @binding(2) var<storage, read_write> nodes: array<FragmentNode>;
+@group(1) @binding(3) var<storage, read_write> counter: atomic<u32>;
+@group(1) @binding(4) var opaque_depth: texture_depth_2d;
+
+@fragment
+fn fs_collect(in: VertexOut) {
+    let px = vec2<u32>(in.clip.xy);
+    // The shader writes storage, so the hardware depth test cannot run before it: test here.
+    if (in.clip.z >= textureLoad(opaque_depth, px, 0)) {
+        return;
+    }
+    let v = normalize(u.eye.xyz - in.world);
+    let n = normalize(in.normal);
+    let l = u.light.xyz;
+    let n_dot_l = dot(n, l);
+    let n_dot_v = dot(n, v);
+    let r_dot_v = 2.0 * n_dot_l * n_dot_v - dot(l, v);
+    let index = atomicAdd(&counter, 1u);
+    if (index >= lists.capacity) {
+        // Counted: the frame is drawn again in bands that fit.
+        return;
+    }
+    let previous = atomicExchange(&heads[px.y * lists.width + px.x], index + 1u);
+    nodes[index] = FragmentNode(
+        in.clip.z,
+        pack2x16float(vec2<f32>(n_dot_v, n_dot_l)),
+        (pack2x16float(vec2<f32>(r_dot_v, 0.0)) & 0xffffu) | (u.pick.y << 16u),
+        previous,
+    );
+}

@@ -14,6 +14,7 @@ use crate::headless::scan::ScanScene;
 use crate::headless::{Evaluated, WavefunctionView, evaluate_within, isosurfaces_within, show_meshes};
 use crate::model::isosurface::Mesh;
 use crate::model::{Document, VolumeGrid};
+use crate::scene::translucency::SurfaceLook;
 use crate::scene::{IsosurfaceSettings, ObjectState, RenderSettings, VolumeSettings};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -61,7 +62,7 @@ type Evaluation = Result<(Option<Evaluated>, Option<String>), GpuError>;
 
 /// Isosurfaces made in the background, each with its colour, and a note when they had to be
 /// cut from a coarser grid.
-pub type Meshes = (Vec<(Mesh, [f32; 3])>, Option<String>);
+pub type Meshes = (Vec<(Mesh, SurfaceLook)>, Option<String>);
 
 /// What the viewport keeps per object besides its renderer layer.
 struct ObjectJobs {

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
-use clap::Args;
+use clap::{Args, ValueEnum};
 use orbcloud::formats::mesh_write::{self, MeshFormat, NamedMesh};
 use orbcloud::gpu::frame::PickId;
 use orbcloud::gpu::{GpuContext, Renderer};
@@ -14,7 +14,8 @@ use orbcloud::model::gto::PreparedBasis;
 use orbcloud::model::isosurface::{self, Level, Mesh};
 use orbcloud::model::units::BOHR_PER_ANGSTROM;
 use orbcloud::model::{Document, VolumeGrid};
-use orbcloud::scene::{IsoLevel, IsosurfaceSettings};
+use orbcloud::scene::translucency::SurfaceLook;
+use orbcloud::scene::{IsoLevel, IsosurfaceSettings, OpticsPreset};
 
 use super::{WhatArgs, load, wavefunction_of};
 
@@ -28,6 +29,33 @@ pub struct IsoArgs {
     /// Isosurface at S standard deviations of the grid's values; repeatable.
     #[arg(long = "iso-sigma")]
     pub sigmas: Vec<f32>,
+    /// Draw the isosurfaces translucent (seed 003's optics, composited in exact depth order).
+    #[arg(long)]
+    pub translucent: bool,
+    /// The look of translucent surfaces.
+    #[arg(long, value_enum, default_value_t = OpticsArg::Koide)]
+    pub optics: OpticsArg,
+}
+
+#[derive(Clone, Copy, Default, ValueEnum)]
+pub enum OpticsArg {
+    /// Seed 003's pictures: tinted glass with an emitting rim; overlaps glow.
+    #[default]
+    Koide,
+    /// Clear glass with strong highlights.
+    Glassy,
+    /// Emitting, absorbing smoke.
+    Smoke,
+}
+
+impl OpticsArg {
+    pub fn preset(self) -> OpticsPreset {
+        match self {
+            OpticsArg::Koide => OpticsPreset::Koide,
+            OpticsArg::Glassy => OpticsPreset::Glassy,
+            OpticsArg::Smoke => OpticsPreset::Smoke,
+        }
+    }
 }
 
 impl IsoArgs {
@@ -36,10 +64,20 @@ impl IsoArgs {
         abs.chain(self.sigmas.iter().map(|&s| IsoLevel::Sigma(s))).collect()
     }
 
-    /// Each level's surfaces with their colours, later levels paler so nested ones tell apart.
-    pub fn meshes(&self, grid: &VolumeGrid, base: &IsosurfaceSettings) -> Vec<(Mesh, [f32; 3])> {
+    /// The settings every level starts from: translucent or not.
+    pub fn base(&self) -> IsosurfaceSettings {
+        IsosurfaceSettings { translucent: self.translucent, optics: self.optics.preset(), ..Default::default() }
+    }
+
+    /// Each level's surfaces with their colours, larger values paler so nested ones tell
+    /// apart; the order the levels were given in changes nothing.
+    pub fn meshes(&self, grid: &VolumeGrid, base: &IsosurfaceSettings) -> Vec<(Mesh, SurfaceLook)> {
+        let sigma = grid.stats.sigma;
+        let mut levels = self.levels();
+        levels.sort_by(|a, b| a.value(sigma).total_cmp(&b.value(sigma)));
+        levels.dedup_by(|a, b| a.value(sigma) == b.value(sigma));
         let mut out = Vec::new();
-        for (n, level) in self.levels().into_iter().enumerate() {
+        for (n, level) in levels.into_iter().enumerate() {
             let pale = |c: [f32; 3]| c.map(|v| v + (1.0 - v) * (1.0 - 0.6f32.powi(n as i32)));
             let iso = IsosurfaceSettings {
                 visible: true,
@@ -47,6 +85,7 @@ impl IsoArgs {
                 positive_color: pale(base.positive_color),
                 negative_color: pale(base.negative_color),
                 density_color: pale(base.density_color),
+                ..*base
             };
             out.extend(isosurfaces(grid, &iso));
         }
@@ -59,9 +98,10 @@ pub fn show(ctx: &GpuContext, renderer: &mut Renderer, grid: &VolumeGrid, iso: &
     if iso.levels().is_empty() {
         return;
     }
-    let meshes = iso.meshes(grid, &IsosurfaceSettings::default());
+    let meshes = iso.meshes(grid, &iso.base());
     let triangles = show_meshes(ctx, renderer.main(), &meshes);
-    eprintln!("isosurfaces: {} surface(s), {triangles} triangles", meshes.len());
+    let how = if iso.translucent { ", translucent" } else { "" };
+    eprintln!("isosurfaces: {} surface(s), {triangles} triangles{how}", meshes.len());
 }
 
 /// Prints what the rendered frame shows at `pixel`, and how long the pick took.
@@ -153,11 +193,11 @@ pub fn mesh(args: &MeshArgs) -> Result<()> {
     }
     let doc = load(Some(&args.file))?;
     let grid = args.grid.grid(&doc)?;
-    let meshes: Vec<(Mesh, [f32; 3])> =
+    let meshes: Vec<(Mesh, SurfaceLook)> =
         args.iso.meshes(&grid, &IsosurfaceSettings::default()).into_iter().map(|(m, c)| (m.welded(), c)).collect();
     let names = surface_names(&grid, &args.iso);
     let named: Vec<NamedMesh> =
-        meshes.iter().zip(&names).map(|((mesh, color), name)| NamedMesh { name, mesh, color: *color }).collect();
+        meshes.iter().zip(&names).map(|((mesh, color), name)| NamedMesh { name, mesh, color: color.color }).collect();
     let file = std::fs::File::create(&args.output).with_context(|| format!("creating {}", args.output.display()))?;
     let mut w = std::io::BufWriter::new(file);
     mesh_write::write(&mut w, format, &named).with_context(|| format!("writing {}", args.output.display()))?;

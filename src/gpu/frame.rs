@@ -22,6 +22,8 @@ pub enum Target {
     Ids,
     /// Each atom layer's culled draw lists and compute-rasterised small spheres.
     Splats,
+    /// Per-pixel lists of translucent surface fragments ([`super::oit`]).
+    Fragments,
     /// The caller's 8-bit sRGB view.
     Output,
 }
@@ -35,7 +37,12 @@ pub enum Phase {
     Opaque,
     /// Translucent clouds back to front: blends over colour, tests depth without writing it.
     Translucent,
-    /// Copies the float colour into the caller's output.
+    /// Translucent surfaces append their fragments in front of the opaque depth to per-pixel
+    /// lists (seed 003); a frame whose lists overflow their budget repeats this and the
+    /// resolve band by band.
+    Fragments,
+    /// Sorts each pixel's fragments and composites them over the float colour, exactly in
+    /// depth order, into the caller's output.
     Resolve,
 }
 
@@ -49,7 +56,7 @@ pub struct PhaseNode {
 }
 
 /// The frame every host draws: culling and small spheres (compute), opaque geometry, then
-/// translucent clouds over it, then resolve.
+/// translucent clouds over it, translucent surfaces into fragment lists, then resolve.
 pub const STANDARD_FRAME: &[PhaseNode] = &[
     PhaseNode { phase: Phase::Cull, label: "cull and splat", reads: &[], writes: &[Target::Splats] },
     PhaseNode {
@@ -64,7 +71,18 @@ pub const STANDARD_FRAME: &[PhaseNode] = &[
         reads: &[Target::Color, Target::Depth],
         writes: &[Target::Color],
     },
-    PhaseNode { phase: Phase::Resolve, label: "resolve", reads: &[Target::Color], writes: &[Target::Output] },
+    PhaseNode {
+        phase: Phase::Fragments,
+        label: "translucent surfaces",
+        reads: &[Target::Depth],
+        writes: &[Target::Fragments],
+    },
+    PhaseNode {
+        phase: Phase::Resolve,
+        label: "sort, composite and resolve",
+        reads: &[Target::Color, Target::Fragments],
+        writes: &[Target::Output],
+    },
 ];
 
 /// True when every target a phase reads was written by an earlier phase.
@@ -162,6 +180,7 @@ impl PickId {
 /// The targets of one frame size; rebuilt when the size changes.
 pub struct FrameTargets {
     pub size: [u32; 2],
+    pub color: wgpu::Texture,
     pub color_view: wgpu::TextureView,
     pub depth: wgpu::Texture,
     pub depth_view: wgpu::TextureView,
@@ -185,7 +204,7 @@ impl FrameTargets {
             })
         };
         let read = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
-        let color = texture("frame colour", SCENE_FORMAT, wgpu::TextureUsages::TEXTURE_BINDING);
+        let color = texture("frame colour", SCENE_FORMAT, read);
         let depth = texture("frame depth", DEPTH_FORMAT, read);
         let ids = texture("frame ids", ID_FORMAT, wgpu::TextureUsages::COPY_SRC);
         Self {
@@ -193,6 +212,7 @@ impl FrameTargets {
             color_view: color.create_view(&Default::default()),
             depth_view: depth.create_view(&Default::default()),
             ids_view: ids.create_view(&Default::default()),
+            color,
             depth,
             ids,
         }
@@ -224,15 +244,17 @@ impl FrameTargets {
             .writes
             .contains(&Target::Depth)
             .then_some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store });
+        // A phase that only reads depth opens it read-only; the fragment lists read it as a
+        // texture instead.
+        let depth = (node.phase != Phase::Fragments).then_some(wgpu::RenderPassDepthStencilAttachment {
+            view: &self.depth_view,
+            depth_ops,
+            stencil_ops: None,
+        });
         encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(node.label),
             color_attachments: &colors,
-            // A phase that only reads depth opens it read-only.
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &self.depth_view,
-                depth_ops,
-                stencil_ops: None,
-            }),
+            depth_stencil_attachment: depth,
             timestamp_writes: None,
             occlusion_query_set: None,
             multiview_mask: None,

@@ -1,5 +1,6 @@
-//! Opaque, lit isosurfaces: one triangle mesh per surface (an orbital's +v and −v, a density's
-//! one), drawn in the opaque phase with depth and pick ids.
+//! Lit isosurfaces: one triangle mesh per surface (an orbital's +v and −v, a density's one).
+//! Opaque ones draw in the opaque phase with depth and pick ids; translucent ones (seed 003)
+//! append their fragments to the frame's per-pixel lists ([`super::oit`]).
 
 use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
@@ -7,6 +8,7 @@ use wgpu::util::DeviceExt;
 use super::GpuContext;
 use super::frame::{Draw, ObjectView, Phase, PickId, opaque_depth, opaque_targets};
 use crate::model::isosurface::Mesh;
+use crate::scene::translucency::{MAX_TRANSLUCENT_SURFACES, Optics, SurfaceLook};
 
 /// Mirror of `SurfaceUniforms` in isosurface.wgsl.
 #[repr(C)]
@@ -37,32 +39,41 @@ struct GpuSurface {
     color: [f32; 3],
     /// The surface's index in its layer.
     pick: u32,
+    optics: Option<Optics>,
+    /// This frame: its index among the frame's translucent surfaces (`None`: drawn opaque).
+    translucent: Option<u32>,
 }
 
 pub struct IsosurfacePass {
     pipeline: wgpu::RenderPipeline,
+    collect: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
     surfaces: Vec<GpuSurface>,
+    /// The frame's fragment lists (set in `prepare` when a surface is translucent).
+    lists: Option<wgpu::BindGroup>,
 }
 
 impl IsosurfacePass {
-    pub fn new(ctx: &GpuContext) -> Self {
+    /// `lists`: the layout of the fragment lists' collect group.
+    pub fn new(ctx: &GpuContext, lists: &wgpu::BindGroupLayout) -> Self {
         let device = &ctx.device;
         let module = super::shader_module(device, "isosurface.wgsl");
         let (layout, pipeline_layout) = super::uniform_layouts(device, "isosurface");
+        let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3];
+        let vertex = wgpu::VertexState {
+            module: &module,
+            entry_point: Some("vs_main"),
+            compilation_options: Default::default(),
+            buffers: &[Some(wgpu::VertexBufferLayout {
+                array_stride: std::mem::size_of::<SurfaceVertex>() as u64,
+                step_mode: wgpu::VertexStepMode::Vertex,
+                attributes: &attributes,
+            })],
+        };
         let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("isosurfaces"),
             layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[Some(wgpu::VertexBufferLayout {
-                    array_stride: std::mem::size_of::<SurfaceVertex>() as u64,
-                    step_mode: wgpu::VertexStepMode::Vertex,
-                    attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3],
-                })],
-            },
+            vertex: vertex.clone(),
             // Both sides: a surface cut by the grid's box shows its inside.
             primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
             depth_stencil: Some(opaque_depth()),
@@ -76,18 +87,46 @@ impl IsosurfacePass {
             multiview_mask: None,
             cache: None,
         });
-        Self { pipeline, layout, surfaces: Vec::new() }
+        let collect_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("translucent isosurfaces"),
+            bind_group_layouts: &[Some(&layout), Some(lists)],
+            immediate_size: 0,
+        });
+        let collect = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("translucent isosurfaces"),
+            layout: Some(&collect_layout),
+            vertex,
+            // Every face: front faces enter a surface, back faces leave it.
+            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+            depth_stencil: None,
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_collect"),
+                compilation_options: Default::default(),
+                // The pass needs an attachment; nothing is written to it.
+                targets: &[Some(wgpu::ColorTargetState {
+                    format: super::SCENE_FORMAT,
+                    blend: None,
+                    write_mask: wgpu::ColorWrites::empty(),
+                })],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        Self { pipeline, collect, layout, surfaces: Vec::new(), lists: None }
     }
 
-    /// Replaces the surfaces shown: each mesh with its linear RGB colour. Surface `n` picks as
-    /// `PickId::Surface { object, index: n }`, the object given each frame.
-    pub fn set_meshes(&mut self, ctx: &GpuContext, meshes: &[(Mesh, [f32; 3])]) {
+    /// Replaces the surfaces shown: each mesh with its look. Surface `n` picks as
+    /// `PickId::Surface { object, index: n }`, the object given each frame (translucent ones
+    /// are not picked: what lies behind them is).
+    pub fn set_meshes(&mut self, ctx: &GpuContext, meshes: &[(Mesh, SurfaceLook)]) {
         let device = &ctx.device;
         self.surfaces = meshes
             .iter()
             .enumerate()
             .filter(|(_, (mesh, _))| !mesh.is_empty())
-            .map(|(n, (mesh, color))| {
+            .map(|(n, (mesh, look))| {
                 let vertices: Vec<SurfaceVertex> = mesh
                     .positions
                     .iter()
@@ -117,8 +156,10 @@ impl IsosurfacePass {
                     index_count: mesh.indices.len() as u32,
                     uniforms,
                     bind_group,
-                    color: *color,
+                    color: look.color,
                     pick,
+                    optics: look.optics,
+                    translucent: None,
                 }
             })
             .collect();
@@ -134,19 +175,46 @@ impl IsosurfacePass {
 
     /// Another set of surfaces drawn with this one's pipeline.
     pub fn instance(&self) -> Self {
-        Self { pipeline: self.pipeline.clone(), layout: self.layout.clone(), surfaces: Vec::new() }
+        Self {
+            pipeline: self.pipeline.clone(),
+            collect: self.collect.clone(),
+            layout: self.layout.clone(),
+            surfaces: Vec::new(),
+            lists: None,
+        }
+    }
+
+    /// The optics of the translucent surfaces, in the order [`Self::prepare`] numbers them.
+    pub fn translucent(&self) -> impl Iterator<Item = Optics> + '_ {
+        self.surfaces.iter().filter_map(|s| s.optics)
     }
 
     /// This frame's camera, in the frame of the object the surfaces belong to; their pick ids
-    /// name `object`.
-    pub fn prepare(&self, queue: &wgpu::Queue, view: &ObjectView, object: u32) {
-        for s in &self.surfaces {
+    /// name `object`. Translucent surfaces are numbered from `first_translucent` among the
+    /// frame's; past [`MAX_TRANSLUCENT_SURFACES`] they are drawn opaque. `lists`: the frame's
+    /// fragment lists.
+    pub fn prepare(
+        &mut self,
+        queue: &wgpu::Queue,
+        view: &ObjectView,
+        object: u32,
+        first_translucent: usize,
+        lists: Option<&wgpu::BindGroup>,
+    ) {
+        self.lists = lists.cloned();
+        let mut next = first_translucent;
+        for s in &mut self.surfaces {
+            s.translucent = None;
+            if s.optics.is_some() && next < MAX_TRANSLUCENT_SURFACES && lists.is_some() {
+                s.translucent = Some(next as u32);
+                next += 1;
+            }
             let u = SurfaceUniforms {
                 clip_from_world: view.clip_from_object.to_cols_array_2d(),
                 eye: view.eye.extend(1.0).to_array(),
                 light: view.light.extend(0.0).to_array(),
                 color: [s.color[0], s.color[1], s.color[2], 1.0],
-                pick: [PickId::Surface { object, index: s.pick }.encode(), 0, 0, 0],
+                pick: [PickId::Surface { object, index: s.pick }.encode(), s.translucent.unwrap_or(0), 0, 0],
             };
             queue.write_buffer(&s.uniforms, 0, bytemuck::bytes_of(&u));
         }
@@ -155,12 +223,19 @@ impl IsosurfacePass {
 
 impl Draw for IsosurfacePass {
     fn phases(&self) -> &'static [Phase] {
-        &[Phase::Opaque]
+        &[Phase::Opaque, Phase::Fragments]
     }
 
-    fn draw(&self, _phase: Phase, pass: &mut wgpu::RenderPass<'_>) {
-        pass.set_pipeline(&self.pipeline);
-        for s in &self.surfaces {
+    fn draw(&self, phase: Phase, pass: &mut wgpu::RenderPass<'_>) {
+        let translucent = phase == Phase::Fragments;
+        if translucent {
+            let Some(lists) = &self.lists else { return };
+            pass.set_pipeline(&self.collect);
+            pass.set_bind_group(1, lists, &[]);
+        } else {
+            pass.set_pipeline(&self.pipeline);
+        }
+        for s in self.surfaces.iter().filter(|s| s.translucent.is_some() == translucent) {
             pass.set_bind_group(0, &s.bind_group, &[]);
             pass.set_vertex_buffer(0, s.vertices.slice(..));
             pass.set_index_buffer(s.indices.slice(..), wgpu::IndexFormat::Uint32);

@@ -9,6 +9,7 @@ pub mod context;
 pub mod frame;
 pub mod gto;
 pub mod isosurface;
+pub mod oit;
 pub mod readback;
 pub mod renderer;
 pub mod resolve;
@@ -37,6 +38,7 @@ pub const SHADERS: &[(&str, &str)] = &[
     ("atoms_common.wgsl", include_str!("../../shaders/atoms_common.wgsl")),
     ("atoms.wgsl", include_str!("../../shaders/atoms.wgsl")),
     ("atoms_cull.wgsl", include_str!("../../shaders/atoms_cull.wgsl")),
+    ("oit_common.wgsl", include_str!("../../shaders/oit_common.wgsl")),
     ("resolve.wgsl", include_str!("../../shaders/resolve.wgsl")),
     ("isosurface.wgsl", include_str!("../../shaders/isosurface.wgsl")),
     ("gto_common.wgsl", include_str!("../../shaders/gto_common.wgsl")),
@@ -52,6 +54,8 @@ pub const SHADER_MODULES: &[(&str, &[&str])] = &[
     ("gto_fill.wgsl", &["gto_common.wgsl", "gto_fill.wgsl"]),
     ("atoms.wgsl", &["atoms_common.wgsl", "atoms.wgsl"]),
     ("atoms_cull.wgsl", &["atoms_common.wgsl", "atoms_cull.wgsl"]),
+    ("isosurface.wgsl", &["oit_common.wgsl", "isosurface.wgsl"]),
+    ("resolve.wgsl", &["oit_common.wgsl", "resolve.wgsl"]),
 ];
 
 /// The full source of a shader module: its prerequisites, then itself.

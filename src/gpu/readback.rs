@@ -39,6 +39,26 @@ pub fn read_texture(
     })
 }
 
+/// The first `size` bytes of `buffer` (which must allow `COPY_SRC`).
+pub fn read_buffer(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    buffer: &wgpu::Buffer,
+    size: u64,
+) -> Result<Vec<u8>, GpuError> {
+    let size = size.min(buffer.size()).div_ceil(4) * 4;
+    let staging = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("buffer readback"),
+        size: size.max(4),
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("buffer readback") });
+    encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
+    queue.submit([encoder.finish()]);
+    map_and_read(device, &staging, |data| data[..size as usize].to_vec())
+}
+
 /// Maps a readback buffer (waiting for the GPU) and copies out what `read` takes of it.
 fn map_and_read<T>(device: &wgpu::Device, buffer: &wgpu::Buffer, read: impl FnOnce(&[u8]) -> T) -> Result<T, GpuError> {
     let fail = |e: String| GpuError::Readback(e);

@@ -5,12 +5,14 @@ use glam::{Mat4, Vec3};
 use super::atoms::AtomsPass;
 use super::frame::{Draw, FrameTargets, ObjectView, Phase, PhaseNode, PickId, STANDARD_FRAME};
 use super::isosurface::IsosurfacePass;
-use super::resolve::ResolvePass;
+use super::oit::{FragmentDump, FragmentLists, FragmentStats, MAX_BANDS};
+use super::resolve::{ResolvePass, Rows};
 use super::volume::{VolumePass, VolumeTexture};
 use super::{GpuContext, GpuError};
 use crate::model::GridSpec;
 use crate::model::cartesian::CartesianExpansion;
 use crate::model::{Molecule, VolumeGrid};
+use crate::scene::translucency::TranslucentSurface;
 use crate::scene::{AtomColors, AtomStyle, Camera, RenderSettings, VolumeSettings};
 
 /// What one frame needs besides the long-lived GPU state.
@@ -149,6 +151,8 @@ pub struct Renderer {
     /// At least one; layer `n` is object `n` of the scene.
     layers: Vec<Layer>,
     resolve: ResolvePass,
+    /// The translucent surfaces' fragment lists, shared by every layer.
+    lists: FragmentLists,
     frame: &'static [PhaseNode],
     /// The targets at the last frame's size, and the resolve pass's view of their colour.
     targets: Option<(FrameTargets, wgpu::BindGroup)>,
@@ -156,15 +160,26 @@ pub struct Renderer {
 
 impl Renderer {
     pub fn new(ctx: &GpuContext) -> Self {
+        Self::with_lists(ctx, FragmentLists::new(ctx))
+    }
+
+    /// A renderer whose fragment lists hold `capacity` fragments per band (tests use a small
+    /// one to see frames drawn in bands).
+    pub fn with_fragment_capacity(ctx: &GpuContext, capacity: u32) -> Self {
+        Self::with_lists(ctx, FragmentLists::with_capacity(ctx, capacity))
+    }
+
+    fn with_lists(ctx: &GpuContext, lists: FragmentLists) -> Self {
         let layer = Layer {
             atoms: AtomsPass::new(ctx),
-            surfaces: IsosurfacePass::new(ctx),
+            surfaces: IsosurfacePass::new(ctx, &lists.collect_layout),
             volume: VolumePass::new(ctx),
             world_from_object: Mat4::IDENTITY,
             visible: true,
             molecule_bounds: None,
         };
-        Self { layers: vec![layer], resolve: ResolvePass::new(ctx), frame: STANDARD_FRAME, targets: None }
+        let resolve = ResolvePass::new(ctx, &lists.composite_layout);
+        Self { layers: vec![layer], resolve, lists, frame: STANDARD_FRAME, targets: None }
     }
 
     /// Layer `n` (object `n`); layer 0 always exists.
@@ -248,7 +263,8 @@ impl Renderer {
         output: &wgpu::TextureView,
         frame: &FrameInput,
     ) {
-        if self.targets.as_ref().is_none_or(|(t, _)| t.size != frame.size.map(|v| v.max(1))) {
+        let resized = self.targets.as_ref().is_none_or(|(t, _)| t.size != frame.size.map(|v| v.max(1)));
+        if resized {
             let targets = FrameTargets::new(&ctx.device, frame.size);
             let bind = self.resolve.bind(&ctx.device, &targets.color_view);
             self.targets = Some((targets, bind));
@@ -263,46 +279,148 @@ impl Renderer {
             light,
             up,
         };
+        let Some((targets, resolve)) = &self.targets else { return };
+        // The frame's translucent surfaces, numbered across layers in drawing order.
+        let translucent: Vec<TranslucentSurface> = (self.layers.iter().enumerate().filter(|(_, l)| l.visible))
+            .flat_map(|(n, l)| {
+                l.surfaces.translucent().map(move |optics| TranslucentSurface { optics, object: n as u32 })
+            })
+            .collect();
+        self.lists.prepare(ctx, targets.size, &translucent, &targets.depth_view, resized);
+        let lists = (self.lists.surfaces > 0).then(|| self.lists.collect_bind()).flatten();
         let hidden = VolumeSettings { visible: false, ..VolumeSettings::default() };
+        let mut first_translucent = 0;
         for (n, layer) in self.layers.iter_mut().enumerate() {
             let view = ObjectView::new(&world, layer.world_from_object);
             layer.atoms.prepare(ctx, &view, n as u32, frame.size);
-            layer.surfaces.prepare(&ctx.queue, &view, n as u32);
+            let layer_lists = lists.filter(|_| layer.visible);
+            layer.surfaces.prepare(&ctx.queue, &view, n as u32, first_translucent, layer_lists);
+            if layer.visible {
+                first_translucent += layer.surfaces.translucent().count();
+            }
             let cloud = frame.clouds.get(n).unwrap_or(&hidden);
             layer.volume.prepare(&ctx.device, &ctx.queue, &view, cloud);
         }
-        let Some((targets, resolve)) = &self.targets else { return };
+        let oit = self.lists.surfaces > 0;
+        let [width, height] = targets.size;
+        let bands = if oit { self.lists.bands.clamp(1, MAX_BANDS).min(height) } else { 1 };
+        self.lists.bands = bands;
+        // A later tile keeps what the first drew: only the clouds inside it are added, and the
+        // fragment lists of a frame drawn in one band.
+        let later_tile = frame.tile.is_some_and(|t| !t.first);
+        let collects = oit && (bands > 1 || !later_tile);
+        if collects {
+            self.lists.begin_frame(encoder);
+        }
+        let composite = self.lists.composite_bind().filter(|_| oit);
         for node in self.frame {
-            if node.phase == Phase::Resolve {
-                self.resolve.draw(encoder, resolve, output);
-                continue;
-            }
-            // A later tile keeps what the first drew: only the clouds inside it are added.
-            if matches!(node.phase, Phase::Cull | Phase::Opaque) && frame.tile.is_some_and(|t| !t.first) {
-                continue;
-            }
-            if node.phase == Phase::Cull {
-                for layer in self.layers.iter().filter(|l| l.visible) {
-                    for drawer in layer.drawers().into_iter().filter(|d| d.phases().contains(&Phase::Cull)) {
-                        drawer.compute(encoder);
+            match node.phase {
+                Phase::Resolve if bands > 1 => {
+                    for band in 0..bands {
+                        let (start, count) = FragmentLists::band_rows(height, band, bands);
+                        self.collect(encoder, targets, frame.background, Some((start, count)));
+                        self.lists.end_band(encoder, band);
+                        let rows = Rows { start, count, first: band == 0 };
+                        self.resolve.draw(encoder, resolve, output, composite, Some(rows), width);
                     }
                 }
-                continue;
-            }
-            let mut pass = targets.begin(encoder, node, frame.background);
-            if let Some(Tile { rect: [x, y, w, h], .. }) = frame.tile
-                && node.phase == Phase::Translucent
-            {
-                let [fw, fh] = targets.size;
-                let (x, y) = (x.min(fw - 1), y.min(fh - 1));
-                pass.set_scissor_rect(x, y, w.clamp(1, fw - x), h.clamp(1, fh - y));
-            }
-            for layer in self.layers.iter().filter(|l| l.visible) {
-                for drawer in layer.drawers().into_iter().filter(|d| d.phases().contains(&node.phase)) {
-                    drawer.draw(node.phase, &mut pass);
+                Phase::Resolve => self.resolve.draw(encoder, resolve, output, composite, None, width),
+                Phase::Fragments => {
+                    if collects && bands == 1 {
+                        self.collect(encoder, targets, frame.background, None);
+                        self.lists.end_band(encoder, 0);
+                    }
+                }
+                Phase::Cull | Phase::Opaque if later_tile => {}
+                Phase::Cull => {
+                    for layer in self.layers.iter().filter(|l| l.visible) {
+                        for drawer in layer.drawers().into_iter().filter(|d| d.phases().contains(&Phase::Cull)) {
+                            drawer.compute(encoder);
+                        }
+                    }
+                }
+                _ => {
+                    let mut pass = targets.begin(encoder, node, frame.background);
+                    if let Some(Tile { rect: [x, y, w, h], .. }) = frame.tile
+                        && node.phase == Phase::Translucent
+                    {
+                        let [fw, fh] = targets.size;
+                        let (x, y) = (x.min(fw - 1), y.min(fh - 1));
+                        pass.set_scissor_rect(x, y, w.clamp(1, fw - x), h.clamp(1, fh - y));
+                    }
+                    self.draw_phase(node.phase, &mut pass);
                 }
             }
         }
+        if collects {
+            self.lists.end_frame(encoder);
+        }
+    }
+
+    /// Every visible layer's drawers of `phase`, layer by layer, into the open pass.
+    fn draw_phase(&self, phase: Phase, pass: &mut wgpu::RenderPass<'_>) {
+        for layer in self.layers.iter().filter(|l| l.visible) {
+            for drawer in layer.drawers().into_iter().filter(|d| d.phases().contains(&phase)) {
+                drawer.draw(phase, pass);
+            }
+        }
+    }
+
+    /// Empties the fragment lists and collects the translucent surfaces' fragments, in the
+    /// rows `band` (start, count) or the whole frame.
+    fn collect(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        targets: &FrameTargets,
+        background: [f32; 3],
+        band: Option<(u32, u32)>,
+    ) {
+        self.lists.clear(encoder);
+        let Some(node) = self.frame.iter().find(|n| n.phase == Phase::Fragments) else { return };
+        let mut pass = targets.begin(encoder, node, background);
+        if let Some((start, count)) = band {
+            pass.set_scissor_rect(0, start, targets.size[0], count.max(1));
+        }
+        self.draw_phase(Phase::Fragments, &mut pass);
+    }
+
+    /// The last frame's fragment lists (its last band's) and its float colour before the
+    /// translucent surfaces went over it (linear RGB, row by row): what the CPU reference
+    /// composites ([`crate::scene::translucency::composite`]).
+    pub fn read_translucency(&self, ctx: &GpuContext) -> Result<(FragmentDump, Vec<[f32; 3]>), GpuError> {
+        let Some((targets, _)) = &self.targets else { return Err(GpuError::Readback("no frame was drawn".into())) };
+        let bytes = super::readback::read_texture(&ctx.device, &ctx.queue, &targets.color, 8)?;
+        let halves: &[half::f16] = bytemuck::cast_slice(&bytes);
+        let behind = halves.chunks_exact(4).map(|c| [c[0].to_f32(), c[1].to_f32(), c[2].to_f32()]).collect();
+        Ok((self.lists.read(ctx)?, behind))
+    }
+
+    /// Whether the last frame drew translucent surfaces (through fragment lists).
+    pub fn has_translucent(&self) -> bool {
+        self.lists.surfaces > 0
+    }
+
+    /// Waits for the last frame's fragment counts. When the lists overflowed, later frames
+    /// are drawn in more bands; the caller draws the frame again (`fits()` is false).
+    pub fn settle_fragments(&mut self, ctx: &GpuContext) -> Option<FragmentStats> {
+        if !self.has_translucent() {
+            return None;
+        }
+        let stats = self.lists.read_stats(ctx)?;
+        self.lists.bands = stats.bands_needed();
+        Some(stats)
+    }
+
+    /// Like [`Self::settle_fragments`] without waiting: the counts of a frame that has
+    /// finished, if one has (the viewer asks every frame and redraws when they overflowed).
+    pub fn poll_fragments(&mut self) -> Option<FragmentStats> {
+        if !self.has_translucent() {
+            return None;
+        }
+        self.lists.request_stats();
+        let stats = self.lists.take_stats()?;
+        self.lists.bands = stats.bands_needed();
+        Some(stats)
     }
 
     /// What the last frame drew at `pixel` (x right, y down, in that frame's pixels): an atom,

@@ -1,14 +1,26 @@
-//! The last phase of a frame: the float colour copied into the caller's 8-bit sRGB target.
+//! The last phase of a frame: the float colour copied into the caller's 8-bit sRGB target,
+//! with the translucent surfaces' fragment lists sorted and composited over it when there are
+//! any ([`super::oit`]).
 
 use super::{COLOR_FORMAT, GpuContext};
 
 pub struct ResolvePass {
     pipeline: wgpu::RenderPipeline,
+    composite: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
 }
 
+/// Which rows a resolve writes, and whether it is the frame's first.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Rows {
+    pub start: u32,
+    pub count: u32,
+    pub first: bool,
+}
+
 impl ResolvePass {
-    pub fn new(ctx: &GpuContext) -> Self {
+    /// `lists`: the layout of the fragment lists' composite group.
+    pub fn new(ctx: &GpuContext, lists: &wgpu::BindGroupLayout) -> Self {
         let device = &ctx.device;
         let module = super::shader_module(device, "resolve.wgsl");
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -24,37 +36,41 @@ impl ResolvePass {
                 count: None,
             }],
         });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("resolve pipeline layout"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("resolve"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: Default::default(),
-            depth_stencil: None,
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: COLOR_FORMAT,
-                    blend: None,
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
-        Self { pipeline, layout }
+        let pipeline = |label, layouts: &[Option<&wgpu::BindGroupLayout>], entry| {
+            let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some(label),
+                bind_group_layouts: layouts,
+                immediate_size: 0,
+            });
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(label),
+                layout: Some(&pipeline_layout),
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some("vs_main"),
+                    compilation_options: Default::default(),
+                    buffers: &[],
+                },
+                primitive: Default::default(),
+                depth_stencil: None,
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some(entry),
+                    compilation_options: Default::default(),
+                    targets: &[Some(wgpu::ColorTargetState {
+                        format: COLOR_FORMAT,
+                        blend: None,
+                        write_mask: wgpu::ColorWrites::ALL,
+                    })],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        let composite = pipeline("resolve with translucent surfaces", &[Some(&layout), Some(lists)], "fs_composite");
+        let pipeline = pipeline("resolve", &[Some(&layout)], "fs_main");
+        Self { pipeline, composite, layout }
     }
 
     /// The bind group through which the pass reads `color` (the frame's float colour).
@@ -66,21 +82,45 @@ impl ResolvePass {
         })
     }
 
-    pub fn draw(&self, encoder: &mut wgpu::CommandEncoder, color: &wgpu::BindGroup, output: &wgpu::TextureView) {
+    /// Resolves into `output`: the whole frame, or with `lists` (the fragment lists' composite
+    /// group) the translucent surfaces composited over it in `rows` (the whole frame when
+    /// `None`); a later band keeps the rows the earlier ones wrote.
+    pub fn draw(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        color: &wgpu::BindGroup,
+        output: &wgpu::TextureView,
+        lists: Option<&wgpu::BindGroup>,
+        rows: Option<Rows>,
+        width: u32,
+    ) {
+        let load = match rows {
+            Some(Rows { first: false, .. }) => wgpu::LoadOp::Load,
+            _ => wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+        };
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("resolve"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
                 view: output,
                 depth_slice: None,
                 resolve_target: None,
-                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::BLACK), store: wgpu::StoreOp::Store },
+                ops: wgpu::Operations { load, store: wgpu::StoreOp::Store },
             })],
             depth_stencil_attachment: None,
             timestamp_writes: None,
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_pipeline(&self.pipeline);
+        if let Some(Rows { start, count, .. }) = rows {
+            pass.set_scissor_rect(0, start, width, count.max(1));
+        }
+        match lists {
+            Some(lists) => {
+                pass.set_pipeline(&self.composite);
+                pass.set_bind_group(1, lists, &[]);
+            }
+            None => pass.set_pipeline(&self.pipeline),
+        }
         pass.set_bind_group(0, color, &[]);
         pass.draw(0..3, 0..1);
     }

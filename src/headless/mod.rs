@@ -6,6 +6,7 @@ pub mod scan;
 use glam::DVec3;
 
 use crate::gpu::gto::{GtoFillPass, read_volume, volume_from_texture};
+use crate::gpu::oit::FragmentStats;
 use crate::gpu::renderer::Layer;
 use crate::gpu::volume::VolumeTexture;
 use crate::gpu::{FrameInput, GpuContext, GpuError, OffscreenTarget, Renderer};
@@ -18,6 +19,7 @@ use crate::model::orbitals::Quantity;
 use crate::model::{Document, VolumeGrid};
 use crate::scene::coloring::{AtomColors, atom_colors};
 use crate::scene::selection::Selection;
+use crate::scene::translucency::SurfaceLook;
 use crate::scene::{Camera, IsosurfaceSettings, ObjectState, RenderSettings, ViewPreset};
 
 /// Space (bohr) around the atoms in which orbitals are evaluated.
@@ -207,14 +209,14 @@ pub fn auto_opacity(volume: &mut crate::scene::VolumeSettings, grid: &VolumeGrid
 
 /// The isosurfaces `iso` asks for on `grid`, each with its colour: ψ = +v and ψ = −v for a
 /// signed grid, ρ = v for a density. Empty when `iso` is hidden.
-pub fn isosurfaces(grid: &VolumeGrid, iso: &IsosurfaceSettings) -> Vec<(Mesh, [f32; 3])> {
+pub fn isosurfaces(grid: &VolumeGrid, iso: &IsosurfaceSettings) -> Vec<(Mesh, SurfaceLook)> {
     if !iso.visible {
         return Vec::new();
     }
     let signed = grid.kind == ValueKind::Signed;
     let levels = Level::pair(iso.level.value(grid.stats.sigma), signed);
     let colors = if signed { vec![iso.positive_color, iso.negative_color] } else { vec![iso.density_color] };
-    isosurface::extract(grid, &levels).into_iter().zip(colors).collect()
+    isosurface::extract(grid, &levels).into_iter().zip(colors.into_iter().map(|c| iso.look(c))).collect()
 }
 
 /// Isosurfaces of `grid` at every level of `levels` (each as [`isosurfaces`] cuts it), every
@@ -224,7 +226,7 @@ pub fn isosurfaces_within(
     grid: &VolumeGrid,
     levels: &[IsosurfaceSettings],
     max_bytes: u64,
-) -> (Vec<(Mesh, [f32; 3])>, Option<String>) {
+) -> (Vec<(Mesh, SurfaceLook)>, Option<String>) {
     let mut step = 1;
     loop {
         let coarse = (step > 1).then(|| grid.subsampled(step));
@@ -249,7 +251,7 @@ pub fn show_isosurfaces(ctx: &GpuContext, layer: &mut Layer, grid: &VolumeGrid, 
 }
 
 /// Shows `meshes`, each in its colour, as the layer's isosurfaces; returns the triangle count.
-pub fn show_meshes(ctx: &GpuContext, layer: &mut Layer, meshes: &[(Mesh, [f32; 3])]) -> usize {
+pub fn show_meshes(ctx: &GpuContext, layer: &mut Layer, meshes: &[(Mesh, SurfaceLook)]) -> usize {
     layer.surfaces.set_meshes(ctx, meshes);
     meshes.iter().map(|(m, _)| m.triangle_count()).sum()
 }
@@ -342,12 +344,10 @@ impl Headless {
         Ok(Self { renderer, target: OffscreenTarget::new(&ctx.device, size) })
     }
 
-    /// Records and submits one frame (does not wait for it).
+    /// Records and submits one frame (waits for it only when it has translucent surfaces).
     pub fn draw(&mut self, ctx: &GpuContext, camera: &Camera, settings: &RenderSettings) {
-        let mut encoder = ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         let frame = FrameInput::single(camera, settings, self.target.size);
-        self.renderer.render(ctx, &mut encoder, &self.target.color_view, &frame);
-        ctx.queue.submit([encoder.finish()]);
+        draw_exact(ctx, &mut self.renderer, &self.target.color_view, &frame);
     }
 
     /// Draws one frame and reads it back.
@@ -359,6 +359,29 @@ impl Headless {
     ) -> Result<image::RgbaImage, GpuError> {
         self.draw(ctx, camera, settings);
         self.target.read_rgba(&ctx.device, &ctx.queue)
+    }
+}
+
+/// Draws `frame` into `output` and submits it. With translucent surfaces it waits for the
+/// fragment counts, and a frame whose lists overflowed is drawn again in more bands until every
+/// fragment was kept. Returns the last counts.
+pub fn draw_exact(
+    ctx: &GpuContext,
+    renderer: &mut Renderer,
+    output: &wgpu::TextureView,
+    frame: &FrameInput,
+) -> Option<FragmentStats> {
+    let mut last_bands = 0;
+    loop {
+        let mut encoder = ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
+        renderer.render(ctx, &mut encoder, output, frame);
+        ctx.queue.submit([encoder.finish()]);
+        let stats = renderer.settle_fragments(ctx)?;
+        // No more bands to be had (one per row, or the most there are): the counts say so.
+        if stats.fits() || stats.bands == last_bands {
+            return Some(stats);
+        }
+        last_bands = stats.bands;
     }
 }
 

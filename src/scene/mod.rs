@@ -8,6 +8,7 @@ pub mod selection;
 pub mod settings;
 pub mod slicing;
 pub mod transfer;
+pub mod translucency;
 pub mod view;
 
 pub use camera::Camera;
@@ -18,4 +19,5 @@ pub use settings::{
     AtomColoring, AtomStyle, Interpolation, IsoLevel, IsosurfaceSettings, RenderSettings, SliceMode, VolumeSettings,
 };
 pub use transfer::{ClipPlane, Shape, Transfer, TransferKind};
+pub use translucency::{Optics, OpticsPreset};
 pub use view::{ViewDirection, ViewPreset};

@@ -176,6 +176,12 @@ pub struct IsosurfaceSettings {
     pub negative_color: [f32; 3],
     /// Linear RGB of a density's surface.
     pub density_color: [f32; 3],
+    /// Drawn translucent with seed 003's optics, in exact depth order with every other
+    /// translucent surface.
+    #[serde(default)]
+    pub translucent: bool,
+    #[serde(default)]
+    pub optics: super::OpticsPreset,
 }
 
 impl Default for IsosurfaceSettings {
@@ -187,7 +193,16 @@ impl Default for IsosurfaceSettings {
             positive_color: [0.85, 0.10, 0.08],
             negative_color: [0.08, 0.25, 0.85],
             density_color: [0.55, 0.62, 0.75],
+            translucent: false,
+            optics: super::OpticsPreset::default(),
         }
+    }
+}
+
+impl IsosurfaceSettings {
+    /// How a surface of this setting in `color` is drawn.
+    pub fn look(&self, color: [f32; 3]) -> super::translucency::SurfaceLook {
+        super::translucency::SurfaceLook { color, optics: self.translucent.then(|| self.optics.optics(color)) }
     }
 }
 
