@@ -93,3 +93,31 @@ fn fs_collect(in: VertexOut) {
         previous,
     );
 }
+
+// Weighted blended transparency (McGuire & Bavoil 2013), kept to measure what exact order
+// buys: one pass, no lists, colours averaged with depth weights; no order, hence no glow.
+@group(1) @binding(5) var<uniform> optics: array<SurfaceOptics, 64>;
+
+struct Weighted {
+    @location(0) accum: vec4<f32>,
+    @location(1) revealage: vec4<f32>,
+};
+
+@fragment
+fn fs_weighted(in: VertexOut) -> Weighted {
+    let px = vec2<u32>(in.clip.xy);
+    if (in.clip.z >= textureLoad(opaque_depth, px, 0)) {
+        discard;
+    }
+    let v = normalize(u.eye.xyz - in.world);
+    let n = normalize(in.normal);
+    let l = u.light.xyz;
+    let n_dot_l = dot(n, l);
+    let n_dot_v = dot(n, v);
+    let shaded = koide(optics[u.pick.y], n_dot_l, n_dot_v, 2.0 * n_dot_l * n_dot_v - dot(l, v), false);
+    let alpha = clamp(1.0 - dot(shaded.transmission, vec3<f32>(1.0 / 3.0)), 0.0, 1.0);
+    // Their weight of equation 10, on window depth.
+    let near = 1.0 - in.clip.z;
+    let w = clamp(alpha * 3e3 * near * near * near, 1e-2, 3e3);
+    return Weighted(vec4<f32>(shaded.luminance * w, alpha * w), vec4<f32>(alpha));
+}

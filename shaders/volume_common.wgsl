@@ -45,6 +45,12 @@ struct VolumeUniforms {
     clip: vec4<f32>,
     // xyz: unit direction towards the light
     light: vec4<f32>,
+    // Where translucent surfaces go through the cloud (volume_interleave.wgsl): the inverse of
+    // clip_from_world, the slices' box mapped to the unit cube, and x: the nearest plane's
+    // distance along `plane`, y: the number of planes, zw: the frame's size in pixels.
+    world_from_clip: mat4x4<f32>,
+    box_from_world: mat4x4<f32>,
+    slab: vec4<f32>,
 };
 
 @group(0) @binding(0) var<uniform> u: VolumeUniforms;

@@ -1,8 +1,5 @@
-// Slices sampling the grid's 3D texture. Prepended: volume_common.wgsl, volume_gradient.wgsl.
-
-fn field(uvw: vec3<f32>) -> f32 {
-    return textureSampleLevel(volume, volume_sampler, uvw, 0.0).r;
-}
+// Slices sampling the grid's 3D texture. Prepended: volume_common.wgsl, volume_gradient.wgsl,
+// volume_field.wgsl.
 
 @fragment
 fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {

@@ -238,6 +238,9 @@ enum BenchCommand {
     Load(structure_cli::LoadBench),
     /// ms per frame of many atoms (synthetic, or a file's) and GPU bytes per atom.
     Spheres(structure_cli::SpheresBench),
+    /// ms per frame of 2, 4 and 16 translucent surfaces, exact order against weighted blending,
+    /// with the fragment memory and weighted blending's image error.
+    Surfaces(surface_cli::TranslucentBench),
 }
 
 #[derive(Args)]
@@ -608,6 +611,7 @@ fn main() -> Result<()> {
         Some(Command::Bench(BenchCommand::Isosurface(args))) => surface_cli::bench(&args),
         Some(Command::Bench(BenchCommand::Load(args))) => structure_cli::bench_load(&args),
         Some(Command::Bench(BenchCommand::Spheres(args))) => structure_cli::bench_spheres(&args),
+        Some(Command::Bench(BenchCommand::Surfaces(args))) => surface_cli::bench_translucent(&args),
         Some(Command::Bench(BenchCommand::Render { file, view, frames, lavapipe, wavefunction })) => {
             let doc = load(file.as_deref())?;
             let camera = view.camera(&doc)?;

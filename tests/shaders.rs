@@ -29,7 +29,10 @@ fn every_shader_module_validates() {
         let source = module_source(name);
         let module =
             naga::front::wgsl::parse_str(&source).unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&source)));
-        naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::default())
+        // pack2x16float/unpack2x16float (the fragment lists' half floats) need this one; wgpu
+        // grants it on Vulkan, Metal and DX12 (DownlevelFlags::SHADER_F16_IN_F32).
+        let capabilities = naga::valid::Capabilities::default() | naga::valid::Capabilities::SHADER_FLOAT16_IN_FLOAT32;
+        naga::valid::Validator::new(naga::valid::ValidationFlags::all(), capabilities)
             .validate(&module)
             .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&source)));
         assert!(!module.entry_points.is_empty(), "{name} has no entry points");
@@ -57,7 +60,8 @@ macro_rules! mirror {
 #[test]
 fn rust_mirrors_match_the_wgsl_layouts() {
     use orbcloud::gpu::{
-        atoms::AtomGlobals, gto::FillParams, gto::GpuShell, isosurface::SurfaceUniforms, volume::VolumeUniforms,
+        atoms::AtomGlobals, gto::FillParams, gto::GpuShell, isosurface::SurfaceUniforms, oit::GpuOptics, oit::ListInfo,
+        volume::VolumeUniforms,
     };
     let mirrors = [
         mirror!(
@@ -91,6 +95,9 @@ fn rust_mirrors_match_the_wgsl_layouts() {
                 _pad2,
                 clip,
                 light,
+                world_from_clip,
+                box_from_world,
+                slab,
             ]
         ),
         mirror!(
@@ -100,6 +107,8 @@ fn rust_mirrors_match_the_wgsl_layouts() {
             [clip_from_world, eye, light, up, pick, viewport, ray_f0, ray_fx, ray_fy, counts, sticks, cells]
         ),
         mirror!("isosurface.wgsl", "SurfaceUniforms", SurfaceUniforms, [clip_from_world, eye, light, color, pick]),
+        mirror!("isosurface.wgsl", "ListInfo", ListInfo, [width, capacity, surfaces, _pad]),
+        mirror!("resolve.wgsl", "SurfaceOptics", GpuOptics, [a, b, c, d, f, g, glow_d, glow_f, glow_g, same_object]),
         mirror!("gto_fill.wgsl", "FillParams", FillParams, [world_from_grid, dims]),
         mirror!("gto_fill.wgsl", "GtoShell", GpuShell, [center, cutoff2, l, prim_offset, prim_count, weight_offset]),
     ];

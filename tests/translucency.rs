@@ -1,16 +1,17 @@
 //! Translucent isosurfaces (seed 003) on lavapipe: the GPU's sorted fragment lists against a
 //! CPU reference that sorts every fragment, independence of the order surfaces are given in,
-//! frames over the fragment budget drawn in bands, and the glow where surfaces of two objects
-//! overlap.
+//! frames over the fragment budget drawn in bands, the glow where surfaces of two objects
+//! overlap, and surfaces inside a cloud against a CPU reference that walks both.
 
 mod common;
 
+use common::cloud::{CloudReference, srgb_encode};
 use common::{formaldehyde, lavapipe, p_orbital};
 use glam::{DVec3, Vec3};
 use orbcloud::gpu::{FrameInput, GpuContext, OffscreenTarget, Renderer};
 use orbcloud::headless::{draw_exact, isosurfaces, show_meshes, show_object};
 use orbcloud::model::{Document, VolumeGrid};
-use orbcloud::scene::translucency::{composite, sort_fragments};
+use orbcloud::scene::translucency::{Walk, composite, sort_fragments};
 use orbcloud::scene::{AtomStyle, Camera, IsoLevel, IsosurfaceSettings, ObjectState, OpticsPreset, VolumeSettings};
 
 const SIZE: [u32; 2] = [160, 120];
@@ -202,4 +203,78 @@ fn surfaces_of_two_objects_glow_where_they_overlap_and_only_there() {
     let overlap = in_red.iter().zip(&in_blue).filter(|(r, b)| **r && **b).count();
     eprintln!("{glowing} of {overlap} pixels covered by both glow");
     assert!(glowing > 200 && glowing <= overlap, "{glowing} glowing of {overlap}");
+}
+
+#[test]
+fn surfaces_inside_a_cloud_match_a_cpu_reference_that_walks_both() {
+    let ctx = lavapipe();
+    let grid = p_orbital(32, false);
+    let doc = Document { volumes: vec![grid.clone()], ..Default::default() };
+    let max = grid.stats.max_abs as f32;
+    let mut iso = translucent(0.3 * max, [0.85, 0.1, 0.08]);
+    iso.negative_color = [0.08, 0.25, 0.85];
+    let mut state = object(iso, AtomStyle::Hidden);
+    state.settings.volume.visible = true;
+    state.settings.volume.slices = 48;
+    state.settings.volume.k1 = 0.5;
+    let mut renderer = Renderer::new(&ctx);
+    show_object(&ctx, renderer.main(), &doc, &state).expect("orbital");
+    let cam = camera();
+    let target = OffscreenTarget::new(&ctx.device, SIZE);
+    let frame = FrameInput {
+        camera: &cam,
+        background: BACKGROUND,
+        clouds: std::slice::from_ref(&state.settings.volume),
+        size: SIZE,
+        tile: None,
+    };
+    draw_exact(&ctx, &mut renderer, &target.color_view, &frame).expect("translucent surfaces drawn");
+    let gpu = target.read_rgba(&ctx.device, &ctx.queue).expect("read back");
+    let (dump, _) = renderer.read_translucency(&ctx).expect("fragments read back");
+    let clip = renderer.clip_from_world(&cam, SIZE).as_dmat4();
+    let settings = orbcloud::scene::RenderSettings { background: BACKGROUND, ..state.settings };
+    let cloud = CloudReference::new(&grid, &cam, &settings);
+    // `interleaved`: each sample after the fragments nearer than it; else every fragment in
+    // front of the cloud (what compositing the surfaces over the finished cloud would give).
+    let reference = |interleaved: bool| {
+        image::RgbaImage::from_fn(SIZE[0], SIZE[1], |px, py| {
+            let mut fragments = dump.lists[(py * SIZE[0] + px) as usize].clone();
+            sort_fragments(&mut fragments);
+            let d = cloud.ray(&cam, SIZE, px, py);
+            let mut walk = Walk::new(&fragments);
+            let mut next = fragments.iter().peekable();
+            for sample in cloud.samples(d).into_iter().rev() {
+                let z = clip.project_point3(cloud.eye + d * sample.t).z as f32;
+                while let Some(frag) = next.next_if(|f| f.depth < z || !interleaved) {
+                    walk.fragment(frag, &dump.surfaces);
+                }
+                walk.sample(sample.color.map(|c| c as f32), sample.alpha as f32);
+            }
+            for frag in next {
+                walk.fragment(frag, &dump.surfaces);
+            }
+            let c = walk.finish(BACKGROUND);
+            image::Rgba([srgb_encode(c[0] as f64), srgb_encode(c[1] as f64), srgb_encode(c[2] as f64), 255])
+        })
+    };
+    let cpu = reference(true);
+    let inside = dump.lists.iter().filter(|l| !l.is_empty()).count();
+    let mean = mean_difference(&gpu, &cpu);
+    let over = gpu.pixels().zip(cpu.pixels()).filter(|(p, q)| (0..3).any(|k| p[k].abs_diff(q[k]) > 3)).count();
+    let n = gpu.pixels().len();
+    eprintln!(
+        "cloud and surfaces against the CPU walk: mean {mean:.3}/255, {over} of {n} pixels > 3/255; {inside} pixels hold fragments"
+    );
+    assert!(inside > 1_000, "{inside} pixels show surfaces");
+    // The tolerance of the cloud's own reference (tests/volume_reference.rs): the f16 scene
+    // buffer rounds every blend, and a ray grazing a slice's edge may see one slice more.
+    assert!(mean < 1.0 && over * 100 < n, "mean {mean:.3}/255, {over} pixels > 3/255");
+    // Surfaces merely laid over the cloud would be far off.
+    let over_the_cloud = mean_difference(&gpu, &reference(false));
+    assert!(over_the_cloud > 5.0 * mean.max(0.2), "surfaces over the cloud: {over_the_cloud:.3}/255");
+    // The cloud veils the surfaces: without it they would look different.
+    let mut bare = Renderer::new(&ctx);
+    show_object(&ctx, bare.main(), &doc, &object(iso, AtomStyle::Hidden)).expect("orbital");
+    let (alone, _) = draw(&ctx, &mut bare);
+    assert!(mean_difference(&alone, &gpu) > 3.0, "the cloud changes the picture");
 }

@@ -331,6 +331,11 @@ impl OrbApp {
         self.viewport.as_ref()?.progress()
     }
 
+    /// What the single-file view's translucent surfaces took (fragments, bands).
+    pub fn fragment_note(&self) -> Option<String> {
+        self.viewport.as_ref()?.fragment_note()
+    }
+
     /// Each view shown: (size on screen, size of its last frame), pixels. The frame is smaller
     /// while a drag or the animation runs on a CPU adapter ([`detail`]).
     pub fn view_sizes(&self) -> Vec<([u32; 2], [u32; 2])> {

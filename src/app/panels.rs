@@ -7,8 +7,8 @@ use crate::model::orbitals::Quantity;
 use crate::model::units::ANGSTROM_PER_BOHR;
 use crate::scene::transfer::{Lobe, PRESETS};
 use crate::scene::{
-    AtomColoring, AtomStyle, ClipPlane, DensityScale, IsoLevel, IsosurfaceSettings, Shape, SliceMode, Transfer,
-    TransferKind, ViewPreset,
+    AtomColoring, AtomStyle, ClipPlane, DensityScale, IsoLevel, IsosurfaceSettings, OpticsPreset, Shape, SliceMode,
+    Transfer, TransferKind, ViewPreset,
 };
 
 /// The side panel's width, points.
@@ -114,6 +114,10 @@ fn status_line(ui: &mut egui::Ui, app: &OrbApp, cancel: &mut bool) {
             }
             let m = &app.doc().molecule;
             ui.label(format!("{} atoms ({}), {} bonds", m.atoms.len(), m.formula(), m.bonds.len()));
+            if let Some(note) = app.fragment_note() {
+                ui.separator();
+                ui.label(RichText::new(note).weak());
+            }
             if let (Some(wf), Quantity::Orbital(i)) = (&app.doc().wavefunction, app.orbitals.shown) {
                 let o = &wf.orbitals[i];
                 ui.separator();
@@ -495,4 +499,24 @@ fn isosurface_editor(ui: &mut egui::Ui, iso: &mut IsosurfaceSettings, signed: bo
             ui.label("surface");
         }
     });
+    translucency_editor(ui, iso);
+}
+
+/// Translucent or opaque, and the look of a translucent surface (seed 003's optics).
+pub fn translucency_editor(ui: &mut egui::Ui, iso: &mut IsosurfaceSettings) -> bool {
+    ui.horizontal(|ui| {
+        let mut changed = ui
+            .checkbox(&mut iso.translucent, "translucent")
+            .on_hover_text("see every surface through the others, in exact depth order; overlaps with other objects' surfaces glow")
+            .changed();
+        if iso.translucent {
+            egui::ComboBox::from_id_salt(ui.next_auto_id()).selected_text(iso.optics.label()).show_ui(ui, |ui| {
+                for preset in OpticsPreset::ALL {
+                    changed |= ui.selectable_value(&mut iso.optics, preset, preset.label()).changed();
+                }
+            });
+        }
+        changed
+    })
+    .inner
 }

@@ -61,6 +61,7 @@ pub fn section(ui: &mut egui::Ui, app: &mut OrbApp) {
                     changed |= level_slider(ui, &mut iso.level);
                     changed |= ui.color_edit_button_rgb(&mut iso.positive_color).changed();
                     changed |= ui.color_edit_button_rgb(&mut iso.negative_color).changed();
+                    changed |= super::panels::translucency_editor(ui, iso);
                     if ui.small_button("×").on_hover_text("remove this isosurface").clicked() {
                         remove = Some(k);
                     }

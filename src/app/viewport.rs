@@ -9,6 +9,7 @@ use super::state::{DRAG_ROTATE, KEY_ROTATE, KEY_ZOOM, ViewState};
 use crate::gpu::context::guarded;
 use crate::gpu::frame::PickId;
 use crate::gpu::gto::GtoFillPass;
+use crate::gpu::oit::FragmentStats;
 use crate::gpu::{FrameInput, GpuContext, GpuError, OffscreenTarget, Renderer, Tile};
 use crate::headless::scan::ScanScene;
 use crate::headless::{Evaluated, WavefunctionView, evaluate_within, isosurfaces_within, show_meshes};
@@ -112,6 +113,10 @@ pub struct Viewport {
     pub scan_shown: Option<(f64, crate::scene::Interpolation)>,
     /// The θ and settings a scan view's isosurfaces were last asked for (`None`: hidden).
     pub scan_iso: Option<(f64, IsosurfaceSettings)>,
+    /// A frame with translucent surfaces was drawn and its fragment counts are not back yet.
+    awaiting_fragments: bool,
+    /// The last frame's fragment counts, when it had translucent surfaces.
+    fragments: Option<FragmentStats>,
 }
 
 impl Viewport {
@@ -143,6 +148,8 @@ impl Viewport {
             progress: None,
             band_rows: 8,
             scan_iso: None,
+            awaiting_fragments: false,
+            fragments: None,
         }
     }
 
@@ -487,10 +494,15 @@ impl Viewport {
                     }
                 }
                 self.drawn = Some(key);
+                self.awaiting_fragments = self.renderer.has_translucent();
+                if !self.awaiting_fragments {
+                    self.fragments = None;
+                }
             }
             let uv = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
             ui.painter().image(*id, rect, uv, egui::Color32::WHITE);
         }
+        self.check_fragments(ui.ctx());
         self.layout = Some((rect, size));
         // Hover: read the id under the pointer when it moved and no button is held.
         let pointer = response.hover_pos().filter(|_| !ui.input(|i| i.pointer.any_down()));
@@ -523,6 +535,51 @@ impl Viewport {
             }
         }
         twisted
+    }
+
+    /// Reads the last frame's fragment counts once they are back: a frame whose lists
+    /// overflowed is drawn again, in as many bands as it needs.
+    fn check_fragments(&mut self, ctx: &egui::Context) {
+        if !self.awaiting_fragments {
+            return;
+        }
+        let _ = self.ctx.device.poll(wgpu::PollType::Poll);
+        match self.renderer.poll_fragments() {
+            Some(stats) => {
+                self.awaiting_fragments = false;
+                if !stats.fits() {
+                    self.drawn = None;
+                    ctx.request_repaint();
+                }
+                self.fragments = Some(stats);
+            }
+            None => ctx.request_repaint(),
+        }
+    }
+
+    /// What the translucent surfaces of the last frame took: fragments, and bands when the
+    /// frame needed more than the lists hold.
+    pub fn fragment_note(&self) -> Option<String> {
+        let s = self.fragments?;
+        let millions = |n: u32| n as f64 / 1e6;
+        Some(
+            match (s.fits(), s.bands) {
+                (true, 1) => format!("translucent: {:.2} M fragments, exact order", millions(s.needed)),
+                (true, b) => format!(
+                    "translucent: drawn in {b} bands of at most {:.2} M fragments, exact order",
+                    millions(s.capacity)
+                ),
+                (false, _) => format!(
+                    "translucent: {:.2} M fragments in a band, over the {:.2} M the lists hold: drawing again in more bands",
+                    millions(s.needed),
+                    millions(s.capacity)
+                ),
+            } + &if s.deep_pixels > 0 {
+                format!("; {} pixels with over 48 layers show their nearest 48", s.deep_pixels)
+            } else {
+                String::new()
+            },
+        )
     }
 
     /// What the frame on screen (the one just drawn) shows at window position `pos`.

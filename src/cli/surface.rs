@@ -276,3 +276,124 @@ pub fn bench(args: &IsoBench) -> Result<()> {
     );
     Ok(())
 }
+
+#[derive(Args)]
+pub struct TranslucentBench {
+    /// A cube file with an orbital; the bundled demo (formaldehyde's HOMO) when omitted.
+    file: Option<PathBuf>,
+    /// Image size, WIDTHxHEIGHT.
+    #[arg(long, default_value = "800x600", value_parser = super::parse_size)]
+    size: [u32; 2],
+    /// Frames to time per case (after two warm-up frames).
+    #[arg(long, default_value_t = 10)]
+    frames: u32,
+    /// Use the CPU Vulkan adapter (lavapipe) even when a GPU is present.
+    #[arg(long)]
+    lavapipe: bool,
+    /// Write each case's last frames here (exact_N.png, weighted_N.png).
+    #[arg(long)]
+    images: Option<PathBuf>,
+}
+
+/// One timed case of [`bench_translucent`]: the median ms per frame, the last image and, for
+/// exact order, the fragment counts.
+struct Timed {
+    ms: f64,
+    image: image::RgbaImage,
+    stats: Option<orbcloud::gpu::oit::FragmentStats>,
+}
+
+/// `orbcloud bench surfaces`: ms per frame of 2, 4 and 16 translucent surfaces (nested ± shells
+/// of an orbital) in exact order and with weighted blending, the fragment memory, and how far
+/// weighted blending's image is from the exact one.
+pub fn bench_translucent(args: &TranslucentBench) -> Result<()> {
+    use orbcloud::gpu::oit::Transparency;
+    use orbcloud::gpu::{FrameInput, OffscreenTarget};
+    use orbcloud::headless::{default_camera, draw_exact};
+    use orbcloud::scene::RenderSettings;
+    let doc = load(args.file.as_deref())?;
+    let grid = doc.volumes.first().context("the file has no volume")?;
+    let ctx = super::gpu(args.lavapipe)?;
+    let camera = default_camera(&doc);
+    let mut settings = RenderSettings::default();
+    settings.volume.visible = false;
+    println!("adapter: {}", ctx.describe());
+    println!("scene: {}, grid {:?}, atoms ball and stick, {}x{}", doc.source, grid.dims, args.size[0], args.size[1]);
+    let max = grid.stats.max_abs as f32;
+    for count in [2usize, 4, 16] {
+        // Nested shells of both signs, from a tenth of the largest |ψ| down to a hundredth.
+        let levels = count / 2;
+        let iso = IsoArgs {
+            values: (0..levels).map(|k| max * 0.1 * 0.1f32.powf(k as f32 / (levels.max(2) - 1) as f32)).collect(),
+            translucent: true,
+            ..Default::default()
+        };
+        let meshes = iso.meshes(grid, &iso.base());
+        let triangles: usize = meshes.iter().map(|(m, _)| m.triangle_count()).sum();
+        let mut h = orbcloud::headless::Headless::new(&ctx, &doc, None, &settings, args.size)?;
+        show_meshes(&ctx, h.renderer.main(), &meshes);
+        let target = OffscreenTarget::new(&ctx.device, args.size);
+        let mut time = |transparency| -> Result<Timed> {
+            h.renderer.set_transparency(transparency);
+            let mut times = Vec::new();
+            let mut stats = None;
+            for f in 0..args.frames.max(1) + 2 {
+                let mut cam = camera;
+                cam.orbit(0.02 * f as f32, 0.01 * f as f32);
+                let t = Instant::now();
+                let frame = FrameInput::single(&cam, &settings, args.size);
+                stats = draw_exact(&ctx, &mut h.renderer, &target.color_view, &frame);
+                ctx.device.poll(wgpu::PollType::wait_indefinitely())?;
+                if f >= 2 {
+                    times.push(t.elapsed().as_secs_f64() * 1e3);
+                }
+            }
+            times.sort_by(f64::total_cmp);
+            let image = target.read_rgba(&ctx.device, &ctx.queue)?;
+            Ok(Timed { ms: times[times.len() / 2], image, stats })
+        };
+        let exact = time(Transparency::Exact)?;
+        let weighted = time(Transparency::WeightedBlended)?;
+        let stats = exact.stats.context("no fragment counts came back")?;
+        let [w, hgt] = args.size;
+        let heads = w as u64 * hgt as u64 * 4;
+        let (mean, covered) = image_error(&exact.image, &weighted.image, &settings.background);
+        if let Some(dir) = &args.images {
+            std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+            for (name, img) in [("exact", &exact.image), ("weighted", &weighted.image)] {
+                let path = dir.join(format!("{name}_{count}.png"));
+                img.save(&path).with_context(|| format!("writing {}", path.display()))?;
+            }
+        }
+        println!(
+            "surfaces={count} triangles={triangles} exact_ms={:.1} weighted_ms={:.1} fragments={} bands={} deep_pixels={} \
+             fragment_mib_used={:.1} fragment_mib_reserved={:.1} weighted_error_mean={mean:.2}/255 weighted_error_covered={covered:.2}/255",
+            exact.ms,
+            weighted.ms,
+            stats.needed,
+            stats.bands,
+            stats.deep_pixels,
+            (heads + stats.needed as u64 * orbcloud::gpu::oit::NODE_BYTES) as f64 / (1u64 << 20) as f64,
+            (heads + stats.node_bytes()) as f64 / (1u64 << 20) as f64,
+        );
+    }
+    Ok(())
+}
+
+/// Mean |a − b| per channel (of 255) over the whole image, and over the pixels either image
+/// draws something in (not the background).
+fn image_error(a: &image::RgbaImage, b: &image::RgbaImage, background: &[f32; 3]) -> (f64, f64) {
+    let srgb = |v: f32| if v <= 0.003_130_8 { 12.92 * v } else { 1.055 * v.powf(1.0 / 2.4) - 0.055 };
+    let bg = background.map(|v| (srgb(v) * 255.0).round() as i32);
+    let is_bg = |p: &image::Rgba<u8>| (0..3).all(|k| (p[k] as i32 - bg[k]).abs() <= 1);
+    let (mut all, mut covered, mut n_covered) = (0u64, 0u64, 0u64);
+    for (p, q) in a.pixels().zip(b.pixels()) {
+        let d: u64 = (0..3).map(|k| p[k].abs_diff(q[k]) as u64).sum();
+        all += d;
+        if !(is_bg(p) && is_bg(q)) {
+            covered += d;
+            n_covered += 1;
+        }
+    }
+    (all as f64 / (3 * a.width() * a.height()) as f64, covered as f64 / (3 * n_covered.max(1)) as f64)
+}

@@ -7,6 +7,7 @@ use wgpu::util::DeviceExt;
 
 use super::GpuContext;
 use super::frame::{Draw, ObjectView, Phase, PickId, opaque_depth, opaque_targets};
+use super::oit::Transparency;
 use crate::model::isosurface::Mesh;
 use crate::scene::translucency::{MAX_TRANSLUCENT_SURFACES, Optics, SurfaceLook};
 
@@ -47,6 +48,8 @@ struct GpuSurface {
 pub struct IsosurfacePass {
     pipeline: wgpu::RenderPipeline,
     collect: wgpu::RenderPipeline,
+    weighted: wgpu::RenderPipeline,
+    transparency: Transparency,
     layout: wgpu::BindGroupLayout,
     surfaces: Vec<GpuSurface>,
     /// The frame's fragment lists (set in `prepare` when a surface is translucent).
@@ -92,29 +95,70 @@ impl IsosurfacePass {
             bind_group_layouts: &[Some(&layout), Some(lists)],
             immediate_size: 0,
         });
-        let collect = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("translucent isosurfaces"),
-            layout: Some(&collect_layout),
-            vertex,
-            // Every face: front faces enter a surface, back faces leave it.
-            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
-            depth_stencil: None,
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_collect"),
-                compilation_options: Default::default(),
-                // The pass needs an attachment; nothing is written to it.
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: super::SCENE_FORMAT,
-                    blend: None,
-                    write_mask: wgpu::ColorWrites::empty(),
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
-        Self { pipeline, collect, layout, surfaces: Vec::new(), lists: None }
+        let translucent = |label, entry, targets: &[Option<wgpu::ColorTargetState>]| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(label),
+                layout: Some(&collect_layout),
+                vertex: vertex.clone(),
+                // Every face: front faces enter a surface, back faces leave it.
+                primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+                depth_stencil: None,
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some(entry),
+                    compilation_options: Default::default(),
+                    targets,
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        // The pass needs an attachment; nothing is written to it.
+        let collect = translucent(
+            "translucent isosurfaces",
+            "fs_collect",
+            &[Some(wgpu::ColorTargetState {
+                format: super::SCENE_FORMAT,
+                blend: None,
+                write_mask: wgpu::ColorWrites::empty(),
+            })],
+        );
+        let add = wgpu::BlendComponent {
+            src_factor: wgpu::BlendFactor::One,
+            dst_factor: wgpu::BlendFactor::One,
+            operation: wgpu::BlendOperation::Add,
+        };
+        let reveal = wgpu::BlendComponent {
+            src_factor: wgpu::BlendFactor::Zero,
+            dst_factor: wgpu::BlendFactor::OneMinusSrc,
+            operation: wgpu::BlendOperation::Add,
+        };
+        let weighted = translucent(
+            "weighted blended isosurfaces",
+            "fs_weighted",
+            &[
+                Some(wgpu::ColorTargetState {
+                    format: super::oit::ACCUM_FORMAT,
+                    blend: Some(wgpu::BlendState { color: add, alpha: add }),
+                    write_mask: wgpu::ColorWrites::ALL,
+                }),
+                Some(wgpu::ColorTargetState {
+                    format: super::oit::REVEALAGE_FORMAT,
+                    blend: Some(wgpu::BlendState { color: reveal, alpha: reveal }),
+                    write_mask: wgpu::ColorWrites::ALL,
+                }),
+            ],
+        );
+        Self {
+            pipeline,
+            collect,
+            weighted,
+            layout,
+            surfaces: Vec::new(),
+            lists: None,
+            transparency: Transparency::Exact,
+        }
     }
 
     /// Replaces the surfaces shown: each mesh with its look. Surface `n` picks as
@@ -178,9 +222,11 @@ impl IsosurfacePass {
         Self {
             pipeline: self.pipeline.clone(),
             collect: self.collect.clone(),
+            weighted: self.weighted.clone(),
             layout: self.layout.clone(),
             surfaces: Vec::new(),
             lists: None,
+            transparency: Transparency::Exact,
         }
     }
 
@@ -192,16 +238,17 @@ impl IsosurfacePass {
     /// This frame's camera, in the frame of the object the surfaces belong to; their pick ids
     /// name `object`. Translucent surfaces are numbered from `first_translucent` among the
     /// frame's; past [`MAX_TRANSLUCENT_SURFACES`] they are drawn opaque. `lists`: the frame's
-    /// fragment lists.
+    /// fragment lists, and how they are composited.
     pub fn prepare(
         &mut self,
         queue: &wgpu::Queue,
         view: &ObjectView,
         object: u32,
         first_translucent: usize,
-        lists: Option<&wgpu::BindGroup>,
+        lists: Option<(&wgpu::BindGroup, Transparency)>,
     ) {
-        self.lists = lists.cloned();
+        self.lists = lists.map(|(l, _)| l.clone());
+        self.transparency = lists.map_or(Transparency::Exact, |(_, t)| t);
         let mut next = first_translucent;
         for s in &mut self.surfaces {
             s.translucent = None;
@@ -230,7 +277,10 @@ impl Draw for IsosurfacePass {
         let translucent = phase == Phase::Fragments;
         if translucent {
             let Some(lists) = &self.lists else { return };
-            pass.set_pipeline(&self.collect);
+            pass.set_pipeline(match self.transparency {
+                Transparency::Exact => &self.collect,
+                Transparency::WeightedBlended => &self.weighted,
+            });
             pass.set_bind_group(1, lists, &[]);
         } else {
             pass.set_pipeline(&self.pipeline);

@@ -32,6 +32,8 @@ pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 pub const SHADERS: &[(&str, &str)] = &[
     ("volume_common.wgsl", include_str!("../../shaders/volume_common.wgsl")),
     ("volume_gradient.wgsl", include_str!("../../shaders/volume_gradient.wgsl")),
+    ("volume_field.wgsl", include_str!("../../shaders/volume_field.wgsl")),
+    ("volume_interleave.wgsl", include_str!("../../shaders/volume_interleave.wgsl")),
     ("volume_slices.wgsl", include_str!("../../shaders/volume_slices.wgsl")),
     ("volume_direct.wgsl", include_str!("../../shaders/volume_direct.wgsl")),
     ("volume_morph.wgsl", include_str!("../../shaders/volume_morph.wgsl")),
@@ -39,6 +41,7 @@ pub const SHADERS: &[(&str, &str)] = &[
     ("atoms.wgsl", include_str!("../../shaders/atoms.wgsl")),
     ("atoms_cull.wgsl", include_str!("../../shaders/atoms_cull.wgsl")),
     ("oit_common.wgsl", include_str!("../../shaders/oit_common.wgsl")),
+    ("oit_sort.wgsl", include_str!("../../shaders/oit_sort.wgsl")),
     ("resolve.wgsl", include_str!("../../shaders/resolve.wgsl")),
     ("isosurface.wgsl", include_str!("../../shaders/isosurface.wgsl")),
     ("gto_common.wgsl", include_str!("../../shaders/gto_common.wgsl")),
@@ -48,14 +51,25 @@ pub const SHADERS: &[(&str, &str)] = &[
 /// Shaders that are only complete with others prepended (WGSL has no includes): the module
 /// for `name` is the concatenation of these files, in order.
 pub const SHADER_MODULES: &[(&str, &[&str])] = &[
-    ("volume_slices.wgsl", &["volume_common.wgsl", "volume_gradient.wgsl", "volume_slices.wgsl"]),
+    ("volume_slices.wgsl", &["volume_common.wgsl", "volume_gradient.wgsl", "volume_field.wgsl", "volume_slices.wgsl"]),
+    (
+        "volume_interleave.wgsl",
+        &[
+            "volume_common.wgsl",
+            "volume_gradient.wgsl",
+            "volume_field.wgsl",
+            "oit_common.wgsl",
+            "oit_sort.wgsl",
+            "volume_interleave.wgsl",
+        ],
+    ),
     ("volume_direct.wgsl", &["volume_common.wgsl", "gto_common.wgsl", "volume_direct.wgsl"]),
     ("volume_morph.wgsl", &["volume_common.wgsl", "volume_gradient.wgsl", "volume_morph.wgsl"]),
     ("gto_fill.wgsl", &["gto_common.wgsl", "gto_fill.wgsl"]),
     ("atoms.wgsl", &["atoms_common.wgsl", "atoms.wgsl"]),
     ("atoms_cull.wgsl", &["atoms_common.wgsl", "atoms_cull.wgsl"]),
     ("isosurface.wgsl", &["oit_common.wgsl", "isosurface.wgsl"]),
-    ("resolve.wgsl", &["oit_common.wgsl", "resolve.wgsl"]),
+    ("resolve.wgsl", &["oit_common.wgsl", "oit_sort.wgsl", "resolve.wgsl"]),
 ];
 
 /// The full source of a shader module: its prerequisites, then itself.

@@ -19,34 +19,34 @@ use crate::scene::translucency::{Fragment, MAX_TRANSLUCENT_SURFACES, Optics, Tra
 /// Bytes of one fragment node (oit_common.wgsl's `FragmentNode`).
 pub const NODE_BYTES: u64 = 16;
 /// Most bytes of fragment nodes, whatever the device allows.
-pub const NODE_BUDGET_BYTES: u64 = 96 << 20;
+pub const NODE_BUDGET_BYTES: u64 = 64 << 20;
 /// Most bands a frame is split into.
 pub const MAX_BANDS: u32 = 64;
 
 /// Mirror of `ListInfo` in oit_common.wgsl.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
-struct ListInfo {
-    width: u32,
-    capacity: u32,
-    surfaces: u32,
-    _pad: u32,
+pub struct ListInfo {
+    pub width: u32,
+    pub capacity: u32,
+    pub surfaces: u32,
+    pub _pad: u32,
 }
 
-/// Mirror of `SurfaceOptics` in resolve.wgsl.
+/// Mirror of `SurfaceOptics` in oit_common.wgsl.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
-struct GpuOptics {
-    a: [f32; 4],
-    b: [f32; 4],
-    c: [f32; 4],
-    d: [f32; 4],
-    f: [f32; 4],
-    g: [f32; 4],
-    glow_d: [f32; 4],
-    glow_f: [f32; 4],
-    glow_g: [f32; 4],
-    same_object: [u32; 4],
+pub struct GpuOptics {
+    pub a: [f32; 4],
+    pub b: [f32; 4],
+    pub c: [f32; 4],
+    pub d: [f32; 4],
+    pub f: [f32; 4],
+    pub g: [f32; 4],
+    pub glow_d: [f32; 4],
+    pub glow_f: [f32; 4],
+    pub glow_g: [f32; 4],
+    pub same_object: [u32; 4],
 }
 
 impl GpuOptics {
@@ -106,6 +106,29 @@ impl FragmentStats {
     }
 }
 
+/// How translucent surfaces are composited.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Transparency {
+    /// Per-pixel fragment lists sorted in exact depth order, with seed 003's glow.
+    #[default]
+    Exact,
+    /// Weighted blended order-independent transparency (McGuire & Bavoil 2013): one pass,
+    /// bounded memory, approximate; kept to measure what exact order buys.
+    WeightedBlended,
+}
+
+/// Weighted blending's two targets: the weighted sum of colour and alpha, and the product of
+/// 1 − α (the revealage).
+pub struct WeightedTargets {
+    pub accum: wgpu::TextureView,
+    pub revealage: wgpu::TextureView,
+    pub resolve_bind: wgpu::BindGroup,
+}
+
+/// Formats of [`WeightedTargets`].
+pub const ACCUM_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+pub const REVEALAGE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R16Float;
+
 /// A frame's fragment lists read back ([`FragmentLists::read`]).
 #[derive(Debug, Clone)]
 pub struct FragmentDump {
@@ -129,6 +152,9 @@ pub struct FragmentLists {
     table: wgpu::Buffer,
     pub collect_layout: wgpu::BindGroupLayout,
     pub composite_layout: wgpu::BindGroupLayout,
+    pub weighted_layout: wgpu::BindGroupLayout,
+    /// Weighted blending's targets at this size, made when first used.
+    weighted: Option<WeightedTargets>,
     collect_bind: Option<wgpu::BindGroup>,
     composite_bind: Option<wgpu::BindGroup>,
     size: [u32; 2],
@@ -171,6 +197,16 @@ impl FragmentLists {
         let ro = wgpu::BufferBindingType::Storage { read_only: true };
         let uniform = wgpu::BufferBindingType::Uniform;
         let entry = super::buffer_entry;
+        let depth_entry = |binding| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: fragment,
+            ty: wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Depth,
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled: false,
+            },
+            count: None,
+        };
         let collect_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("fragment lists: collect"),
             entries: &[
@@ -178,17 +214,23 @@ impl FragmentLists {
                 entry(1, fragment, rw),
                 entry(2, fragment, rw),
                 entry(3, fragment, rw),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 4,
-                    visibility: fragment,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Depth,
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
+                depth_entry(4),
+                entry(5, fragment, uniform),
             ],
+        });
+        let texture = |binding| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: fragment,
+            ty: wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled: false,
+            },
+            count: None,
+        };
+        let weighted_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("weighted blending: resolve"),
+            entries: &[texture(0), texture(1)],
         });
         let composite_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("fragment lists: composite"),
@@ -198,13 +240,15 @@ impl FragmentLists {
                 entry(2, fragment, ro),
                 entry(3, fragment, uniform),
                 entry(4, fragment, rw),
+                depth_entry(5),
             ],
         });
         let copy = wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
         Self {
             info: super::uniform_buffer(device, "fragment list info", size_of::<ListInfo>()),
             heads: storage(device, "fragment list heads", 4, copy),
-            nodes: storage(device, "fragment nodes", capacity as u64 * NODE_BYTES, wgpu::BufferUsages::COPY_SRC),
+            // Made when a frame first has translucent surfaces.
+            nodes: storage(device, "fragment nodes", 4, wgpu::BufferUsages::COPY_SRC),
             counter: storage(device, "fragment counter", 4, copy),
             needed: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("fragments needed"),
@@ -222,6 +266,8 @@ impl FragmentLists {
             table: super::uniform_buffer(device, "translucent optics", TABLE_BYTES),
             collect_layout,
             composite_layout,
+            weighted_layout,
+            weighted: None,
             collect_bind: None,
             composite_bind: None,
             size: [0, 0],
@@ -255,6 +301,10 @@ impl FragmentLists {
         }
         if size != self.size || resized || self.collect_bind.is_none() {
             self.size = size;
+            let nodes = self.capacity as u64 * NODE_BYTES;
+            if self.nodes.size() < nodes {
+                self.nodes = storage(device, "fragment nodes", nodes, wgpu::BufferUsages::COPY_SRC);
+            }
             let copy = wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
             self.heads = storage(device, "fragment list heads", size[0] as u64 * size[1] as u64 * 4, copy);
             self.collect_bind = Some(device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -266,8 +316,10 @@ impl FragmentLists {
                     wgpu::BindGroupEntry { binding: 2, resource: wgpu::Buffer::as_entire_binding(&self.nodes) },
                     wgpu::BindGroupEntry { binding: 3, resource: wgpu::Buffer::as_entire_binding(&self.counter) },
                     wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(depth) },
+                    wgpu::BindGroupEntry { binding: 5, resource: wgpu::Buffer::as_entire_binding(&self.table) },
                 ],
             }));
+            self.weighted = None;
             self.composite_bind = Some(device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("fragment lists: composite"),
                 layout: &self.composite_layout,
@@ -277,6 +329,7 @@ impl FragmentLists {
                     wgpu::BindGroupEntry { binding: 2, resource: wgpu::Buffer::as_entire_binding(&self.nodes) },
                     wgpu::BindGroupEntry { binding: 3, resource: wgpu::Buffer::as_entire_binding(&self.table) },
                     wgpu::BindGroupEntry { binding: 4, resource: wgpu::Buffer::as_entire_binding(&self.deep) },
+                    wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(depth) },
                 ],
             }));
         }
@@ -296,6 +349,44 @@ impl FragmentLists {
             })
             .collect();
         ctx.queue.write_buffer(&self.table, 0, bytemuck::cast_slice(&table));
+    }
+
+    /// Weighted blending's targets at the frame's size (after [`Self::prepare`]).
+    pub fn weighted_targets(&mut self, ctx: &GpuContext) -> &WeightedTargets {
+        let size = self.size;
+        let layout = &self.weighted_layout;
+        self.weighted.get_or_insert_with(|| {
+            let texture = |label, format| {
+                ctx.device
+                    .create_texture(&wgpu::TextureDescriptor {
+                        label: Some(label),
+                        size: wgpu::Extent3d { width: size[0], height: size[1], depth_or_array_layers: 1 },
+                        mip_level_count: 1,
+                        sample_count: 1,
+                        dimension: wgpu::TextureDimension::D2,
+                        format,
+                        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+                        view_formats: &[],
+                    })
+                    .create_view(&Default::default())
+            };
+            let accum = texture("weighted colour", ACCUM_FORMAT);
+            let revealage = texture("revealage", REVEALAGE_FORMAT);
+            let resolve_bind = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("weighted blending: resolve"),
+                layout,
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&accum) },
+                    wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&revealage) },
+                ],
+            });
+            WeightedTargets { accum, revealage, resolve_bind }
+        })
+    }
+
+    /// Weighted blending's targets, when made.
+    pub fn weighted(&self) -> Option<&WeightedTargets> {
+        self.weighted.as_ref()
     }
 
     /// The bind group of the surfaces' collect pass (after [`Self::prepare`] with surfaces).

@@ -5,8 +5,8 @@ use glam::{Mat4, Vec3};
 use super::atoms::AtomsPass;
 use super::frame::{Draw, FrameTargets, ObjectView, Phase, PhaseNode, PickId, STANDARD_FRAME};
 use super::isosurface::IsosurfacePass;
-use super::oit::{FragmentDump, FragmentLists, FragmentStats, MAX_BANDS};
-use super::resolve::{ResolvePass, Rows};
+use super::oit::{FragmentDump, FragmentLists, FragmentStats, MAX_BANDS, Transparency};
+use super::resolve::{Lists, ResolvePass, Rows};
 use super::volume::{VolumePass, VolumeTexture};
 use super::{GpuContext, GpuError};
 use crate::model::GridSpec;
@@ -153,6 +153,7 @@ pub struct Renderer {
     resolve: ResolvePass,
     /// The translucent surfaces' fragment lists, shared by every layer.
     lists: FragmentLists,
+    transparency: Transparency,
     frame: &'static [PhaseNode],
     /// The targets at the last frame's size, and the resolve pass's view of their colour.
     targets: Option<(FrameTargets, wgpu::BindGroup)>,
@@ -170,16 +171,28 @@ impl Renderer {
     }
 
     fn with_lists(ctx: &GpuContext, lists: FragmentLists) -> Self {
+        let resolve = ResolvePass::new(ctx, &lists.composite_layout, &lists.weighted_layout);
         let layer = Layer {
             atoms: AtomsPass::new(ctx),
             surfaces: IsosurfacePass::new(ctx, &lists.collect_layout),
-            volume: VolumePass::new(ctx),
+            volume: VolumePass::new(ctx, &resolve.layout, &lists.composite_layout),
             world_from_object: Mat4::IDENTITY,
             visible: true,
             molecule_bounds: None,
         };
-        let resolve = ResolvePass::new(ctx, &lists.composite_layout);
-        Self { layers: vec![layer], resolve, lists, frame: STANDARD_FRAME, targets: None }
+        Self {
+            layers: vec![layer],
+            resolve,
+            lists,
+            transparency: Transparency::Exact,
+            frame: STANDARD_FRAME,
+            targets: None,
+        }
+    }
+
+    /// How translucent surfaces are composited from the next frame on.
+    pub fn set_transparency(&mut self, transparency: Transparency) {
+        self.transparency = transparency;
     }
 
     /// Layer `n` (object `n`); layer 0 always exists.
@@ -287,32 +300,52 @@ impl Renderer {
             })
             .collect();
         self.lists.prepare(ctx, targets.size, &translucent, &targets.depth_view, resized);
+        let weighted = self.transparency == Transparency::WeightedBlended;
+        if weighted && self.lists.surfaces > 0 {
+            self.lists.weighted_targets(ctx);
+        }
         let lists = (self.lists.surfaces > 0).then(|| self.lists.collect_bind()).flatten();
         let hidden = VolumeSettings { visible: false, ..VolumeSettings::default() };
         let mut first_translucent = 0;
         for (n, layer) in self.layers.iter_mut().enumerate() {
             let view = ObjectView::new(&world, layer.world_from_object);
             layer.atoms.prepare(ctx, &view, n as u32, frame.size);
-            let layer_lists = lists.filter(|_| layer.visible);
+            let layer_lists = lists.filter(|_| layer.visible).map(|l| (l, self.transparency));
             layer.surfaces.prepare(&ctx.queue, &view, n as u32, first_translucent, layer_lists);
             if layer.visible {
                 first_translucent += layer.surfaces.translucent().count();
             }
             let cloud = frame.clouds.get(n).unwrap_or(&hidden);
-            layer.volume.prepare(&ctx.device, &ctx.queue, &view, cloud);
+            layer.volume.prepare(&ctx.device, &ctx.queue, &view, cloud, frame.size);
         }
         let oit = self.lists.surfaces > 0;
         let [width, height] = targets.size;
-        let bands = if oit { self.lists.bands.clamp(1, MAX_BANDS).min(height) } else { 1 };
-        self.lists.bands = bands;
+        // Weighted blending keeps no lists: one band always.
+        let bands = if oit && !weighted { self.lists.bands.clamp(1, MAX_BANDS).min(height) } else { 1 };
+        if !weighted {
+            self.lists.bands = bands;
+        }
         // A later tile keeps what the first drew: only the clouds inside it are added, and the
         // fragment lists of a frame drawn in one band.
         let later_tile = frame.tile.is_some_and(|t| !t.first);
         let collects = oit && (bands > 1 || !later_tile);
-        if collects {
+        if collects && !weighted {
             self.lists.begin_frame(encoder);
         }
-        let composite = self.lists.composite_bind().filter(|_| oit);
+        // The first cloud drawn from a texture takes the surfaces through it; any others stay
+        // behind them.
+        let through = match oit && !weighted {
+            true => self.layers.iter().filter(|l| l.visible).find_map(|l| l.volume.interleave(&ctx.device)),
+            false => None,
+        };
+        let composite = match (oit, self.lists.weighted().filter(|_| weighted), &through) {
+            (false, _, _) => None,
+            (true, Some(w), _) => Some(Lists::Weighted(&w.resolve_bind)),
+            (true, None, Some((pipeline, cloud))) => {
+                self.lists.composite_bind().map(|lists| Lists::ThroughCloud(lists, pipeline, cloud))
+            }
+            (true, None, None) => self.lists.composite_bind().map(Lists::Sorted),
+        };
         for node in self.frame {
             match node.phase {
                 Phase::Resolve if bands > 1 => {
@@ -325,6 +358,7 @@ impl Renderer {
                     }
                 }
                 Phase::Resolve => self.resolve.draw(encoder, resolve, output, composite, None, width),
+                Phase::Fragments if collects && weighted => self.collect_weighted(encoder),
                 Phase::Fragments => {
                     if collects && bands == 1 {
                         self.collect(encoder, targets, frame.background, None);
@@ -352,9 +386,34 @@ impl Renderer {
                 }
             }
         }
-        if collects {
+        if collects && !weighted {
             self.lists.end_frame(encoder);
         }
+    }
+
+    /// Weighted blending's one pass: every translucent fragment adds to the sums.
+    fn collect_weighted(&self, encoder: &mut wgpu::CommandEncoder) {
+        let Some(w) = self.lists.weighted() else { return };
+        let attachment = |view, clear| {
+            Some(wgpu::RenderPassColorAttachment {
+                view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(clear), store: wgpu::StoreOp::Store },
+            })
+        };
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("weighted blended surfaces"),
+            color_attachments: &[
+                attachment(&w.accum, wgpu::Color::TRANSPARENT),
+                attachment(&w.revealage, wgpu::Color::WHITE),
+            ],
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        self.draw_phase(Phase::Fragments, &mut pass);
     }
 
     /// Every visible layer's drawers of `phase`, layer by layer, into the open pass.
@@ -403,7 +462,7 @@ impl Renderer {
     /// Waits for the last frame's fragment counts. When the lists overflowed, later frames
     /// are drawn in more bands; the caller draws the frame again (`fits()` is false).
     pub fn settle_fragments(&mut self, ctx: &GpuContext) -> Option<FragmentStats> {
-        if !self.has_translucent() {
+        if !self.has_translucent() || self.transparency != Transparency::Exact {
             return None;
         }
         let stats = self.lists.read_stats(ctx)?;
@@ -414,7 +473,7 @@ impl Renderer {
     /// Like [`Self::settle_fragments`] without waiting: the counts of a frame that has
     /// finished, if one has (the viewer asks every frame and redraws when they overflowed).
     pub fn poll_fragments(&mut self) -> Option<FragmentStats> {
-        if !self.has_translucent() {
+        if !self.has_translucent() || self.transparency != Transparency::Exact {
             return None;
         }
         self.lists.request_stats();

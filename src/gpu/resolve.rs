@@ -7,7 +7,20 @@ use super::{COLOR_FORMAT, GpuContext};
 pub struct ResolvePass {
     pipeline: wgpu::RenderPipeline,
     composite: wgpu::RenderPipeline,
-    layout: wgpu::BindGroupLayout,
+    weighted: wgpu::RenderPipeline,
+    /// The scene colour's layout (group 1 of every resolve program).
+    pub layout: wgpu::BindGroupLayout,
+}
+
+/// What the resolve composites over the scene: the fragment lists' composite group, or
+/// weighted blending's targets.
+#[derive(Debug, Clone, Copy)]
+pub enum Lists<'a> {
+    Sorted(&'a wgpu::BindGroup),
+    Weighted(&'a wgpu::BindGroup),
+    /// Sorted, through a cloud: the lists, the cloud's pipeline and its bind group
+    /// ([`super::volume::VolumePass::interleave`]).
+    ThroughCloud(&'a wgpu::BindGroup, &'a wgpu::RenderPipeline, &'a wgpu::BindGroup),
 }
 
 /// Which rows a resolve writes, and whether it is the frame's first.
@@ -19,8 +32,9 @@ pub struct Rows {
 }
 
 impl ResolvePass {
-    /// `lists`: the layout of the fragment lists' composite group.
-    pub fn new(ctx: &GpuContext, lists: &wgpu::BindGroupLayout) -> Self {
+    /// `lists`: the layout of the fragment lists' composite group; `weighted`: of weighted
+    /// blending's targets.
+    pub fn new(ctx: &GpuContext, lists: &wgpu::BindGroupLayout, weighted: &wgpu::BindGroupLayout) -> Self {
         let device = &ctx.device;
         let module = super::shader_module(device, "resolve.wgsl");
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -68,9 +82,14 @@ impl ResolvePass {
                 cache: None,
             })
         };
-        let composite = pipeline("resolve with translucent surfaces", &[Some(&layout), Some(lists)], "fs_composite");
-        let pipeline = pipeline("resolve", &[Some(&layout)], "fs_main");
-        Self { pipeline, composite, layout }
+        // Group 0 is a cloud's (volume_interleave.wgsl); 1 the scene, 2 the lists, 3 weighted
+        // blending's targets.
+        let composite =
+            pipeline("resolve with translucent surfaces", &[None, Some(&layout), Some(lists)], "fs_composite");
+        let weighted =
+            pipeline("resolve weighted blending", &[None, Some(&layout), None, Some(weighted)], "fs_weighted");
+        let pipeline = pipeline("resolve", &[None, Some(&layout)], "fs_main");
+        Self { pipeline, composite, weighted, layout }
     }
 
     /// The bind group through which the pass reads `color` (the frame's float colour).
@@ -90,7 +109,7 @@ impl ResolvePass {
         encoder: &mut wgpu::CommandEncoder,
         color: &wgpu::BindGroup,
         output: &wgpu::TextureView,
-        lists: Option<&wgpu::BindGroup>,
+        lists: Option<Lists>,
         rows: Option<Rows>,
         width: u32,
     ) {
@@ -115,13 +134,22 @@ impl ResolvePass {
             pass.set_scissor_rect(0, start, width, count.max(1));
         }
         match lists {
-            Some(lists) => {
+            Some(Lists::Sorted(lists)) => {
                 pass.set_pipeline(&self.composite);
-                pass.set_bind_group(1, lists, &[]);
+                pass.set_bind_group(2, lists, &[]);
+            }
+            Some(Lists::Weighted(targets)) => {
+                pass.set_pipeline(&self.weighted);
+                pass.set_bind_group(3, targets, &[]);
+            }
+            Some(Lists::ThroughCloud(lists, pipeline, cloud)) => {
+                pass.set_pipeline(pipeline);
+                pass.set_bind_group(0, cloud, &[]);
+                pass.set_bind_group(2, lists, &[]);
             }
             None => pass.set_pipeline(&self.pipeline),
         }
-        pass.set_bind_group(0, color, &[]);
+        pass.set_bind_group(1, color, &[]);
         pass.draw(0..3, 0..1);
     }
 }

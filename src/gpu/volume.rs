@@ -45,8 +45,11 @@ pub struct VolumeUniforms {
     pub _pad2: f32,
     pub clip: [f32; 4],
     pub light: [f32; 4],
+    pub world_from_clip: [[f32; 4]; 4],
+    pub box_from_world: [[f32; 4]; 4],
+    pub slab: [f32; 4],
 }
-const _: () = assert!(std::mem::size_of::<VolumeUniforms>() == 320);
+const _: () = assert!(std::mem::size_of::<VolumeUniforms>() == 464);
 
 /// Extinction per reference step below which a sample cannot be seen.
 const INVISIBLE: f32 = 1e-4;
@@ -191,6 +194,9 @@ enum Program {
     Attenuate,
     AddA,
     AddB,
+    /// A full-screen pass of the resolve: translucent surfaces' fragments and the cloud's
+    /// samples composited in one walk per pixel (volume_interleave.wgsl).
+    Interleave,
 }
 
 impl Program {
@@ -202,6 +208,7 @@ impl Program {
             Program::Attenuate => "fs_attenuate",
             Program::AddA => "fs_add_a",
             Program::AddB => "fs_add_b",
+            Program::Interleave => "fs_interleave",
         }
     }
 
@@ -270,6 +277,7 @@ struct VolumeShaders {
     slices: SliceShader,
     direct: SliceShader,
     morph: SliceShader,
+    interleave: SliceShader,
     layout: wgpu::BindGroupLayout,
     morph_layout: wgpu::BindGroupLayout,
     gto_layout: wgpu::BindGroupLayout,
@@ -283,7 +291,10 @@ impl VolumeShaders {
         let mut pipelines = self.pipelines.lock().unwrap_or_else(|e| e.into_inner());
         pipelines
             .entry(variant)
-            .or_insert_with(|| make_pipeline(device, (&self.slices, &self.direct, &self.morph), variant))
+            .or_insert_with(|| match variant.program {
+                Program::Interleave => make_interleave_pipeline(device, &self.interleave, variant),
+                _ => make_pipeline(device, (&self.slices, &self.direct, &self.morph), variant),
+            })
             .clone()
     }
 }
@@ -309,20 +320,56 @@ pub struct VolumePass {
     direct: Option<GtoBuffers>,
 }
 
+/// The override constants of `variant`.
+fn constants(variant: Variant) -> [(&'static str, f64); 3] {
+    let flag = |b: bool| f64::from(u8::from(b));
+    [("GRADIENT", flag(variant.gradient)), ("SHAPED", flag(variant.shaped)), ("CLIP", flag(variant.clip))]
+}
+
+/// The full-screen pipeline that walks fragments and cloud samples together for `variant`'s
+/// transfer function.
+fn make_interleave_pipeline(device: &wgpu::Device, shader: &SliceShader, variant: Variant) -> wgpu::RenderPipeline {
+    let constants = constants(variant);
+    let options = wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() };
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(&format!("cloud with translucent surfaces {variant:?}")),
+        layout: Some(&shader.layout),
+        vertex: wgpu::VertexState {
+            module: &shader.module,
+            entry_point: Some("vs_fullscreen"),
+            compilation_options: options.clone(),
+            buffers: &[],
+        },
+        primitive: Default::default(),
+        depth_stencil: None,
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module: &shader.module,
+            entry_point: Some(variant.program.entry()),
+            compilation_options: options,
+            targets: &[Some(wgpu::ColorTargetState {
+                format: super::COLOR_FORMAT,
+                blend: None,
+                write_mask: wgpu::ColorWrites::ALL,
+            })],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
 /// The slice pipeline for one shader variant.
 fn make_pipeline(
     device: &wgpu::Device,
     shaders: (&SliceShader, &SliceShader, &SliceShader),
     variant: Variant,
 ) -> wgpu::RenderPipeline {
-    let flag = |b: bool| f64::from(u8::from(b));
     let shader = match variant.program {
         Program::Slices => &shaders.0,
         Program::Direct => &shaders.1,
         _ => &shaders.2,
     };
-    let constants =
-        [("GRADIENT", flag(variant.gradient)), ("SHAPED", flag(variant.shaped)), ("CLIP", flag(variant.clip))];
+    let constants = constants(variant);
     let options = wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() };
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(&format!("volume slices {variant:?}")),
@@ -377,7 +424,9 @@ fn volume_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
 }
 
 impl VolumePass {
-    pub fn new(ctx: &GpuContext) -> Self {
+    /// `scene` and `lists`: the layouts of the resolve's scene colour and of the fragment
+    /// lists, which the pass that takes translucent surfaces through the cloud reads.
+    pub fn new(ctx: &GpuContext, scene: &wgpu::BindGroupLayout, lists: &wgpu::BindGroupLayout) -> Self {
         let device = &ctx.device;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("volume bind group layout"),
@@ -400,6 +449,7 @@ impl VolumePass {
         let slices = SliceShader::new(device, "volume_slices.wgsl", &[Some(&layout)]);
         let direct = SliceShader::new(device, "volume_direct.wgsl", &[Some(&layout), Some(&gto_layout)]);
         let morph = SliceShader::new(device, "volume_morph.wgsl", &[Some(&layout), Some(&morph_layout)]);
+        let interleave = SliceShader::new(device, "volume_interleave.wgsl", &[Some(&layout), Some(scene), Some(lists)]);
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("volume sampler"),
             address_mode_u: wgpu::AddressMode::ClampToEdge,
@@ -413,6 +463,7 @@ impl VolumePass {
             slices,
             direct,
             morph,
+            interleave,
             layout,
             morph_layout,
             gto_layout,
@@ -533,6 +584,7 @@ impl VolumePass {
         queue: &wgpu::Queue,
         view: &super::frame::ObjectView,
         settings: &VolumeSettings,
+        size: [u32; 2],
     ) {
         let (eye, view_dir) = (view.eye, view.view_dir);
         self.vertex_count = 0;
@@ -542,7 +594,8 @@ impl VolumePass {
         }
         let slices = vol.grid_box.slices(settings.mode, settings.slices, eye, view_dir);
         self.ranges = slices.ranges().collect();
-        let Slices { vertices, normal, spacing, .. } = slices;
+        let planes = slices.starts.len() as f32;
+        let Slices { vertices, normal, spacing, nearest, .. } = slices;
         if vertices.is_empty() {
             return;
         }
@@ -605,8 +658,28 @@ impl VolumePass {
             _pad2: 0.0,
             clip: clip_normal.extend(clip_normal.dot(box_centre) + settings.clip.offset).to_array(),
             light: view.light.extend(0.0).to_array(),
+            world_from_clip: view.clip_from_object.inverse().to_cols_array_2d(),
+            box_from_world: glam::Mat4::from_cols(
+                vol.grid_box.edges[0].extend(0.0),
+                vol.grid_box.edges[1].extend(0.0),
+                vol.grid_box.edges[2].extend(0.0),
+                vol.grid_box.origin.extend(1.0),
+            )
+            .inverse()
+            .to_cols_array_2d(),
+            slab: [nearest, planes, size[0] as f32, size[1] as f32],
         };
         queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
+    }
+
+    /// The full-screen pipeline that takes translucent surfaces through this frame's cloud, and
+    /// the cloud's bind group; `None` unless the cloud is drawn from a 3D texture in one pass
+    /// (direct-mode and interpolated clouds stay behind the surfaces).
+    pub fn interleave(&self, device: &wgpu::Device) -> Option<(wgpu::RenderPipeline, &wgpu::BindGroup)> {
+        let bind_group = self.bind_group.as_ref()?;
+        (self.variant.program == Program::Slices && self.vertex_count > 0).then(|| {
+            (self.shared.pipeline(device, Variant { program: Program::Interleave, ..self.variant }), bind_group)
+        })
     }
 
     /// The programs each slice is drawn with this frame, in order.

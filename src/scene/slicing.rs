@@ -25,6 +25,9 @@ pub struct Slices {
     pub spacing: f32,
     /// Index of each slice's first vertex, back to front (a slice ends where the next starts).
     pub starts: Vec<u32>,
+    /// Signed distance along `normal` of the nearest plane: plane j (front to back) lies at
+    /// `nearest + j·spacing`, j < `starts.len()`.
+    pub nearest: f32,
 }
 
 impl Slices {
@@ -100,7 +103,7 @@ impl GridBox {
             }
             triangulate_convex(&mut poly, n, &mut vertices);
         }
-        Slices { vertices, normal: n, spacing, starts }
+        Slices { vertices, normal: n, spacing, starts, nearest: lo + 0.5 * spacing }
     }
 
     /// Seed 000's three stacks: planes of constant grid coordinate along the axis that faces the
@@ -131,7 +134,12 @@ impl GridBox {
             let quad = [p, p + e[u], p + e[u] + e[w], p + e[w]];
             vertices.extend_from_slice(&[quad[0], quad[1], quad[2], quad[0], quad[2], quad[3]]);
         }
-        Slices { vertices, normal, spacing, starts }
+        // The planes lie at t = (i + ½)/count along the axis; the nearest is the end the
+        // normal points away from.
+        let along = e[axis].dot(normal);
+        let nearest =
+            normal.dot(self.origin) + (0.5 / count as f32 * along).min((count as f32 - 0.5) / count as f32 * along);
+        Slices { vertices, normal, spacing, starts, nearest }
     }
 }
 
@@ -203,5 +211,26 @@ mod tests {
         let s = b.axis_aligned(4, Vec3::new(-20.0, 1.0, 1.5), Vec3::X);
         assert!(s.normal.z.abs() < 1e-6 && s.normal.x > 0.5);
         assert!(s.vertices[0].x > s.vertices[6].x);
+    }
+
+    #[test]
+    fn plane_j_from_the_front_lies_at_nearest_plus_j_spacings() {
+        let b = GridBox {
+            origin: Vec3::new(-1.0, 0.5, 0.0),
+            edges: [Vec3::X * 4.0, Vec3::new(1.0, 2.0, 0.0), Vec3::Z * 3.0],
+        };
+        let eye = Vec3::new(2.0, 1.0, 20.0);
+        for s in [
+            b.view_aligned(7, Vec3::new(0.2, -0.3, -1.0)),
+            b.axis_aligned(6, eye, Vec3::new(0.1, 0.0, -1.0)),
+            b.axis_aligned(5, Vec3::new(2.0, 1.0, -20.0), Vec3::new(0.1, 0.0, 1.0)),
+        ] {
+            let count = s.starts.len();
+            for (back_to_front, &start) in s.starts.iter().enumerate() {
+                let j = count - 1 - back_to_front;
+                let d = s.normal.dot(s.vertices[start as usize]);
+                assert!((d - (s.nearest + j as f32 * s.spacing)).abs() < 1e-4, "plane {j}: {d} vs {}", s.nearest);
+            }
+        }
     }
 }

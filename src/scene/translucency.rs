@@ -173,41 +173,71 @@ pub fn sort_fragments(fragments: &mut [Fragment]) {
 
 /// The colour of a pixel whose opaque scene (atoms, clouds, background) is `behind`, seen
 /// through `fragments` (sorted front to back, [`sort_fragments`]).
-///
-/// Walking front to back, a front face (N·V > 0) enters its surface and a back face leaves it;
-/// a surface whose first fragment is a back face encloses the eye. A fragment glows where the
-/// ray is inside a surface of another object.
 pub fn composite(fragments: &[Fragment], surfaces: &[TranslucentSurface], behind: [f32; 3]) -> [f32; 3] {
-    let mut seen = 0u64;
-    let mut inside = 0u64;
+    let mut walk = Walk::new(fragments);
     for frag in fragments {
-        let bit = 1u64 << (frag.surface % 64);
-        if seen & bit == 0 {
-            seen |= bit;
-            if frag.n_dot_v < 0.0 {
-                inside |= bit;
+        walk.fragment(frag, surfaces);
+    }
+    walk.finish(behind)
+}
+
+/// A ray walked front to back through sorted fragments (and, between them, a cloud's samples).
+///
+/// A front face (N·V > 0) enters its surface and a back face leaves it; a surface whose first
+/// fragment is a back face encloses the eye. A fragment glows where the ray is inside a
+/// surface of another object.
+#[derive(Debug, Clone, Copy)]
+pub struct Walk {
+    color: [f32; 3],
+    through: [f32; 3],
+    inside: u64,
+}
+
+impl Walk {
+    /// A walk over `fragments` (sorted front to back): which surfaces enclose the eye.
+    pub fn new(fragments: &[Fragment]) -> Self {
+        let mut seen = 0u64;
+        let mut inside = 0u64;
+        for frag in fragments {
+            let bit = 1u64 << (frag.surface % 64);
+            if seen & bit == 0 {
+                seen |= bit;
+                if frag.n_dot_v < 0.0 {
+                    inside |= bit;
+                }
             }
         }
+        Self { color: [0.0; 3], through: [1.0; 3], inside }
     }
-    let mut color = [0.0f32; 3];
-    let mut through = [1.0f32; 3];
-    for frag in fragments {
-        let Some(s) = surfaces.get(frag.surface as usize) else { continue };
+
+    /// Composites the next fragment behind what the walk holds.
+    pub fn fragment(&mut self, frag: &Fragment, surfaces: &[TranslucentSurface]) {
+        let Some(s) = surfaces.get(frag.surface as usize) else { return };
+        let glow =
+            surfaces.iter().enumerate().take(64).any(|(k, o)| self.inside & (1 << k) != 0 && o.object != s.object);
+        let (i, t) = s.optics.shade(frag.n_dot_l, frag.n_dot_v, frag.r_dot_v, glow);
+        self.add(i, t);
         let bit = 1u64 << (frag.surface % 64);
-        let others = surfaces
-            .iter()
-            .enumerate()
-            .take(64)
-            .filter(|(k, o)| inside & (1 << k) != 0 && o.object != s.object)
-            .count();
-        let (i, t) = s.optics.shade(frag.n_dot_l, frag.n_dot_v, frag.r_dot_v, others > 0);
-        for k in 0..3 {
-            color[k] += through[k] * i[k];
-            through[k] *= t[k];
-        }
-        if frag.n_dot_v > 0.0 { inside |= bit } else { inside &= !bit }
+        if frag.n_dot_v > 0.0 { self.inside |= bit } else { self.inside &= !bit }
     }
-    std::array::from_fn(|k| color[k] + through[k] * behind[k])
+
+    /// Composites a cloud sample of colour `color` and opacity `alpha` behind what the walk
+    /// holds (seed 000's emission–absorption, premultiplied).
+    pub fn sample(&mut self, color: [f32; 3], alpha: f32) {
+        self.add(color.map(|c| c * alpha), [1.0 - alpha; 3]);
+    }
+
+    /// B = I + t·B, seen from the front: light `i` dimmed by all in front, then `t` dims
+    /// everything behind.
+    fn add(&mut self, i: [f32; 3], t: [f32; 3]) {
+        self.color = std::array::from_fn(|k| self.color[k] + self.through[k] * i[k]);
+        self.through = std::array::from_fn(|k| self.through[k] * t[k]);
+    }
+
+    /// The pixel: what was composited, over `behind`.
+    pub fn finish(self, behind: [f32; 3]) -> [f32; 3] {
+        std::array::from_fn(|k| self.color[k] + self.through[k] * behind[k])
+    }
 }
 
 #[cfg(test)]

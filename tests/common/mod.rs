@@ -1,6 +1,8 @@
 //! Shared by the GPU tests: the lavapipe context, synthetic scenes and golden-image checks.
 #![allow(dead_code)]
 
+pub mod cloud;
+
 use std::path::PathBuf;
 
 use glam::DVec3;

@@ -1,0 +1,135 @@
+//! An independent CPU compositor of the slice pass: the same slice polygons, ray–triangle
+//! intersection per pixel, trilinear sampling in f64 and the same opacity law.
+
+use glam::{DVec3, Vec3};
+use orbcloud::model::VolumeGrid;
+use orbcloud::model::grid::ValueKind;
+use orbcloud::scene::slicing::GridBox;
+use orbcloud::scene::{Camera, RenderSettings, TransferKind, VolumeSettings};
+
+pub fn srgb_encode(c: f64) -> u8 {
+    let c = c.clamp(0.0, 1.0);
+    let v = if c <= 0.0031308 { 12.92 * c } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 };
+    (v * 255.0).round() as u8
+}
+
+fn ray_triangle(o: DVec3, d: DVec3, t: [DVec3; 3]) -> Option<f64> {
+    let (e1, e2) = (t[1] - t[0], t[2] - t[0]);
+    let p = d.cross(e2);
+    let det = e1.dot(p);
+    if det.abs() < 1e-14 {
+        return None;
+    }
+    let s = o - t[0];
+    let u = s.dot(p) / det;
+    let q = s.cross(e1);
+    let v = d.dot(q) / det;
+    (u >= 0.0 && v >= 0.0 && u + v <= 1.0).then(|| e2.dot(q) / det)
+}
+
+/// One sample of a ray: its distance from the eye, colour and opacity.
+pub struct Sample {
+    pub t: f64,
+    pub color: [f64; 3],
+    pub alpha: f64,
+}
+
+/// The slices of one frame of a cloud, sampled along rays as the GPU's slice pass does.
+pub struct CloudReference<'a> {
+    grid: &'a VolumeGrid,
+    vs: VolumeSettings,
+    tris: Vec<[DVec3; 3]>,
+    spacing: f64,
+    normal: DVec3,
+    grid_from_world: glam::DMat4,
+    clip: (DVec3, f64),
+    pub eye: DVec3,
+}
+
+impl<'a> CloudReference<'a> {
+    pub fn new(grid: &'a VolumeGrid, cam: &Camera, s: &RenderSettings) -> Self {
+        let e = grid.box_edges();
+        let gbox = GridBox {
+            origin: grid.origin().as_vec3(),
+            edges: [e.x_axis.as_vec3(), e.y_axis.as_vec3(), e.z_axis.as_vec3()],
+        };
+        let eye = cam.eye();
+        let view_dir = (cam.target - eye).normalize();
+        let slices = gbox.slices(s.volume.mode, s.volume.slices, eye, view_dir);
+        let tris = slices.vertices.chunks(3).map(|t| [t[0].as_dvec3(), t[1].as_dvec3(), t[2].as_dvec3()]).collect();
+        let vs = s.volume;
+        let clip_n = Vec3::from(vs.clip.normal).normalize().as_dvec3();
+        let centre = (gbox.origin + 0.5 * (gbox.edges[0] + gbox.edges[1] + gbox.edges[2])).as_dvec3();
+        Self {
+            grid,
+            vs,
+            tris,
+            spacing: slices.spacing as f64,
+            normal: slices.normal.as_dvec3(),
+            grid_from_world: grid.world_from_grid.inverse(),
+            clip: (clip_n, clip_n.dot(centre) + vs.clip.offset as f64),
+            eye: eye.as_dvec3(),
+        }
+    }
+
+    /// The unit direction of the ray through the centre of pixel (px, py) of a `size` frame.
+    pub fn ray(&self, cam: &Camera, size: [u32; 2], px: u32, py: u32) -> DVec3 {
+        let aspect = size[0] as f32 / size[1] as f32;
+        let world_from_clip = cam.clip_from_world(aspect, 20.0).inverse().as_dmat4();
+        let ndc_x = (px as f64 + 0.5) / size[0] as f64 * 2.0 - 1.0;
+        let ndc_y = 1.0 - (py as f64 + 0.5) / size[1] as f64 * 2.0;
+        let far = world_from_clip.project_point3(DVec3::new(ndc_x, ndc_y, 0.9));
+        (far - self.eye).normalize()
+    }
+
+    /// Extinction of one reference step for a value: seed 000's k1·ρ^k2 or seed 004's shapes.
+    fn extinction(&self, v: f64) -> f64 {
+        let vs = &self.vs;
+        let signed = self.grid.kind == ValueKind::Signed;
+        let t = if signed { (v / self.grid.stats.max_abs).abs() } else { self.density_t(v) };
+        let (k1, k2) = (vs.k1 as f64, vs.k2 as f64);
+        match vs.transfer.kind {
+            TransferKind::PowerLaw if signed => k1 * (t * t).powf(k2),
+            TransferKind::PowerLaw => k1 * t.powf(k2),
+            TransferKind::Shaped => {
+                let lobe = if v >= 0.0 { vs.transfer.positive } else { vs.transfer.negative };
+                lobe.opacity as f64 * lobe.shape.factor(t as f32, lobe.center, lobe.width) as f64
+            }
+        }
+    }
+
+    /// A density's t: on its scale (log by default), the shader's `transfer_value`.
+    fn density_t(&self, v: f64) -> f64 {
+        self.vs.density_scale.t(v as f32, self.grid.stats.max_abs as f32) as f64
+    }
+
+    /// The samples along the ray from the eye in direction `d`, back to front.
+    pub fn samples(&self, d: DVec3) -> Vec<Sample> {
+        let mut hits: Vec<f64> = self.tris.iter().filter_map(|&t| ray_triangle(self.eye, d, t)).collect();
+        hits.sort_by(|a, b| b.total_cmp(a));
+        let step = self.grid.voxel_volume().cbrt();
+        let (pos, neg) = (self.vs.positive_color.map(|c| c as f64), self.vs.negative_color.map(|c| c as f64));
+        let signed = self.grid.kind == ValueKind::Signed;
+        hits.into_iter()
+            .filter_map(|t| {
+                let p = self.eye + d * t;
+                if self.vs.clip.enabled && self.clip.0.dot(p) > self.clip.1 {
+                    return None;
+                }
+                let v = self.grid.sample(self.grid_from_world.transform_point3(p));
+                let path = self.spacing / d.dot(self.normal).abs().max(0.05);
+                let alpha = 1.0 - (-self.extinction(v) * path / step).exp();
+                let color = match (signed, v >= 0.0) {
+                    (true, true) => pos,
+                    (true, false) => neg,
+                    // A density's colour runs from the thin to the dense end.
+                    (false, _) => {
+                        let w = self.density_t(v).min(1.0).sqrt();
+                        [0, 1, 2].map(|i| neg[i] + (pos[i] - neg[i]) * w)
+                    }
+                };
+                Some(Sample { t, color, alpha })
+            })
+            .collect()
+    }
+}
