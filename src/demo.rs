@@ -1,10 +1,13 @@
-//! The bundled demo shown when the viewer starts with no file.
+//! The bundled demos: the formaldehyde cube, the PSB3 scan the viewer starts with, and the
+//! diene + SO₂ scene of translucent orbitals.
 
 use std::path::Path;
 
 use crate::formats::scan::ScanFile;
 use crate::formats::{self, LoadError};
 use crate::model::Document;
+use crate::model::orbitals::{Quantity, Spin};
+use crate::scene::{IsoLevel, IsosurfaceSettings, ObjectState, OpticsPreset};
 
 /// Formaldehyde's HOMO on a 48³ grid, written by scripts/make_assets.py (PySCF).
 const DEMO_CUBE_GZ: &[u8] = include_bytes!("../assets/demo.cube.gz");
@@ -55,4 +58,43 @@ pub fn scan() -> Result<ScanFile, LoadError> {
         }
     };
     formats::scan::parse_scan(Path::new(SCAN_NAME), SCAN_MANIFEST, &mut load)
+}
+
+/// The diene + SO₂ demo (seed 003's picture): s-cis butadiene and SO₂ placed as in a
+/// cheletropic approach, RHF/6-31G*, written by scripts/make_cycloaddition_demo.py (PySCF).
+const BUTADIENE_MOLDEN_GZ: &[u8] = include_bytes!("../assets/cycloaddition/butadiene.molden.gz");
+const SO2_MOLDEN_GZ: &[u8] = include_bytes!("../assets/cycloaddition/so2.molden.gz");
+pub const CYCLOADDITION_NAME: &str = "diene + SO₂ (bundled)";
+/// How the demo is first seen, as yaw and pitch (radians) from the camera that frames it: from
+/// the side and a little above, the diene's π lobes rising to SO₂'s.
+pub const CYCLOADDITION_VIEW: (f32, f32) = (0.5, -1.35);
+
+/// The diene + SO₂ scene: butadiene's HOMO and SO₂'s LUMO as translucent isosurfaces, each
+/// molecule its own object in one frame, so where the lobes meet they glow.
+pub fn cycloaddition() -> Result<Vec<(Document, ObjectState)>, LoadError> {
+    let parts = [
+        ("butadiene.molden.gz", BUTADIENE_MOLDEN_GZ, false, [0.9, 0.2, 0.12], [0.15, 0.35, 0.95]),
+        ("so2.molden.gz", SO2_MOLDEN_GZ, true, [0.95, 0.7, 0.15], [0.2, 0.8, 0.4]),
+    ];
+    parts
+        .into_iter()
+        .map(|(name, bytes, lumo, positive, negative)| {
+            let doc = formats::load_bytes(Path::new(name), bytes)?;
+            let wf = doc.wavefunction.as_ref();
+            let orbital = wf.and_then(|wf| if lumo { wf.lumo(Spin::Alpha) } else { wf.homo(Spin::Alpha) });
+            let mut state = ObjectState { quantity: orbital.map(Quantity::Orbital), ..ObjectState::default() };
+            let s = &mut state.settings;
+            s.volume.visible = false;
+            s.iso = IsosurfaceSettings {
+                visible: true,
+                level: IsoLevel::Absolute(0.03),
+                positive_color: positive,
+                negative_color: negative,
+                translucent: true,
+                optics: OpticsPreset::Koide,
+                ..IsosurfaceSettings::default()
+            };
+            Ok((doc, state))
+        })
+        .collect()
 }

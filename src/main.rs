@@ -38,6 +38,29 @@ struct Cli {
     /// .mmcif), XYZ (.xyz), each also gzipped (.gz), or a scan manifest (.scan.toml); the bundled
     /// demo when none.
     files: Vec<PathBuf>,
+    /// Open a bundled demo instead of files.
+    #[arg(long, value_enum)]
+    demo: Option<DemoArg>,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum DemoArg {
+    /// The PSB3 twist scan (what opens with no file).
+    Scan,
+    /// Formaldehyde's HOMO as a cube.
+    Cube,
+    /// Butadiene's HOMO meeting SO₂'s LUMO, translucent and glowing where they overlap.
+    Cycloaddition,
+}
+
+impl DemoArg {
+    fn demo(self) -> orbcloud::app::Demo {
+        match self {
+            DemoArg::Scan => orbcloud::app::Demo::Scan,
+            DemoArg::Cube => orbcloud::app::Demo::Cube,
+            DemoArg::Cycloaddition => orbcloud::app::Demo::Cycloaddition,
+        }
+    }
 }
 
 #[derive(Subcommand)]
@@ -49,6 +72,9 @@ enum Command {
         /// (.xyz), each also gzipped (.gz), or a scan manifest (.scan.toml); the bundled demo when
         /// none.
         files: Vec<PathBuf>,
+        /// Open a bundled demo instead of files.
+        #[arg(long, value_enum)]
+        demo: Option<DemoArg>,
     },
     /// Render a file to a PNG without a window.
     Render(RenderArgs),
@@ -264,6 +290,9 @@ struct RenderArgs {
     /// Print what is drawn at pixel X,Y of the image (an atom, a surface, or nothing).
     #[arg(long, value_parser = surface_cli::parse_pixel)]
     pick: Option<[u32; 2]>,
+    /// Render a bundled demo scene instead of a file (cycloaddition: several objects).
+    #[arg(long, value_enum)]
+    demo: Option<DemoArg>,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -509,9 +538,20 @@ fn main() -> Result<()> {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let cli = Cli::parse();
     match cli.command {
-        None => Ok(orbcloud::app::run(cli.files)?),
-        Some(Command::Viewer { files }) => Ok(orbcloud::app::run(files)?),
+        None => Ok(orbcloud::app::run(cli.files, cli.demo.map(DemoArg::demo))?),
+        Some(Command::Viewer { files, demo }) => Ok(orbcloud::app::run(files, demo.map(DemoArg::demo))?),
+        Some(Command::Render(args)) if matches!(args.demo, Some(DemoArg::Cycloaddition)) => {
+            let ctx = gpu(args.lavapipe)?;
+            let scene = demo::cycloaddition().context("the bundled demo did not load")?;
+            let img = surface_cli::render_scene(&ctx, scene, &args.iso, args.view.size)?;
+            img.save(&args.output).with_context(|| format!("writing {}", args.output.display()))?;
+            eprintln!("wrote {} ({}x{}, {})", args.output.display(), img.width(), img.height(), ctx.describe());
+            Ok(())
+        }
         Some(Command::Render(args)) => {
+            if matches!(args.demo, Some(DemoArg::Scan)) {
+                bail!("the scan demo renders with `orbcloud scan render`");
+            }
             let doc = load(args.file.as_deref())?;
             // Arguments that depend on the file are checked before any GPU work.
             let camera = args.view.camera(&doc)?;

@@ -12,7 +12,7 @@ const MODULE_RULES: &[(&str, &[&str])] = &[
     ("gpu", &["formats", "headless", "app", "demo", "info"]),
     ("headless", &["formats", "app", "demo", "info"]),
     ("info.rs", &["gpu", "headless", "app", "demo"]),
-    ("demo.rs", &["scene", "gpu", "headless", "app", "info"]),
+    ("demo.rs", &["gpu", "headless", "app", "info"]),
     ("app", &[]),
 ];
 
@@ -28,7 +28,7 @@ const CRATE_RULES: &[(&str, &[&str])] = &[
     ("demo.rs", &["flate2"]),
     ("app", &["glam", "serde", "toml", "wgpu", "image", "log", "egui", "eframe", "egui_wgpu", "egui_plot", "rfd"]),
     // The binary: main.rs and its subcommands.
-    ("cli", &["wgpu", "glam", "rayon", "clap", "anyhow"]),
+    ("cli", &["wgpu", "glam", "rayon", "clap", "anyhow", "image"]),
     ("main.rs", &["wgpu", "glam", "rayon", "clap", "anyhow", "serde_json", "env_logger"]),
 ];
 

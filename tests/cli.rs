@@ -252,6 +252,27 @@ fn render_with_isosurfaces_and_a_pick() {
 }
 
 #[test]
+fn the_translucent_demo_renders_the_same_whatever_order_the_values_come_in() {
+    let dir = tempfile::tempdir().unwrap();
+    let render = |name: &str, values: [&str; 2]| {
+        let png = dir.path().join(name);
+        let args =
+            ["render", "--demo", "cycloaddition", "--lavapipe", "--size", "160x120", "-o", png.to_str().unwrap()];
+        let run = orbcloud(&[&args[..], &["--iso", values[0], "--iso", values[1]]].concat());
+        let said = String::from_utf8_lossy(&run.stderr).into_owned();
+        assert!(run.status.success(), "{said}");
+        assert!(said.contains("exact order"), "{said}");
+        image::open(&png).unwrap().to_rgba8()
+    };
+    let a = render("a.png", ["0.02", "0.05"]);
+    let b = render("b.png", ["0.05", "0.02"]);
+    assert_eq!(a, b, "the order of --iso values changes nothing");
+    // Translucent surfaces of two molecules in colour, not a blank frame.
+    let coloured = a.pixels().filter(|p| p[0].abs_diff(p[2]) > 40 || p[1].abs_diff(p[2]) > 40).count();
+    assert!(coloured > 2_000, "{coloured} coloured pixels");
+}
+
+#[test]
 fn help_names_every_format_read() {
     let text = |args: &[&str]| {
         let out = orbcloud(args);

@@ -9,7 +9,7 @@ use common::cloud::{CloudReference, srgb_encode};
 use common::{formaldehyde, lavapipe, p_orbital};
 use glam::{DVec3, Vec3};
 use orbcloud::gpu::{FrameInput, GpuContext, OffscreenTarget, Renderer};
-use orbcloud::headless::{draw_exact, isosurfaces, show_meshes, show_object};
+use orbcloud::headless::{draw_exact, isosurfaces, show_meshes, show_object, show_scene};
 use orbcloud::model::{Document, VolumeGrid};
 use orbcloud::scene::translucency::{Walk, composite, sort_fragments};
 use orbcloud::scene::{AtomStyle, Camera, IsoLevel, IsosurfaceSettings, ObjectState, OpticsPreset, VolumeSettings};
@@ -277,4 +277,38 @@ fn surfaces_inside_a_cloud_match_a_cpu_reference_that_walks_both() {
     show_object(&ctx, bare.main(), &doc, &object(iso, AtomStyle::Hidden)).expect("orbital");
     let (alone, _) = draw(&ctx, &mut bare);
     assert!(mean_difference(&alone, &gpu) > 3.0, "the cloud changes the picture");
+}
+
+#[test]
+fn the_diene_so2_demo_and_nested_shells_match_their_golden_images() {
+    let ctx = lavapipe();
+    let size = [240, 180];
+    let scene = orbcloud::demo::cycloaddition().expect("the bundled demo loads");
+    let quantities: Vec<_> = scene.iter().map(|(_, s)| s.quantity).collect();
+    // Butadiene's HOMO is MO 15, SO₂'s LUMO MO 17 (scripts/make_cycloaddition_demo.py).
+    use orbcloud::model::orbitals::Quantity::Orbital;
+    assert_eq!(quantities, [Some(Orbital(14)), Some(Orbital(16))]);
+    let mut renderer = Renderer::new(&ctx);
+    let (clouds, bounds) = show_scene(&ctx, &mut renderer, &scene, 48).expect("scene shown");
+    let (lo, hi) = bounds.expect("bounds");
+    let mut cam = Camera::framing(lo.as_vec3(), hi.as_vec3());
+    let (yaw, pitch) = orbcloud::demo::CYCLOADDITION_VIEW;
+    cam.orbit(yaw, pitch);
+    let target = OffscreenTarget::new(&ctx.device, size);
+    let frame = FrameInput { camera: &cam, background: BACKGROUND, clouds: &clouds, size, tile: None };
+    let stats = draw_exact(&ctx, &mut renderer, &target.color_view, &frame).expect("translucent surfaces");
+    let (dump, _) = renderer.read_translucency(&ctx).expect("fragments");
+    assert_eq!(dump.surfaces.len(), 4, "± lobes of two orbitals");
+    assert!(stats.fits() && stats.deep_pixels == 0, "{stats:?}");
+    common::assert_golden("translucent_diene_so2", &target.read_rgba(&ctx.device, &ctx.queue).expect("read back"));
+
+    let grid = blob(DVec3::ZERO);
+    let shells: Vec<_> = [0.05, 0.2, 0.45, 0.8]
+        .iter()
+        .zip([[0.2, 0.4, 0.9], [0.2, 0.8, 0.4], [0.9, 0.8, 0.2], [0.9, 0.2, 0.1]])
+        .flat_map(|(&v, c)| isosurfaces(&grid, &translucent(v, c)))
+        .collect();
+    let mut renderer = Renderer::new(&ctx);
+    show_meshes(&ctx, renderer.main(), &shells);
+    common::assert_golden("translucent_density_shells", &draw(&ctx, &mut renderer).0);
 }

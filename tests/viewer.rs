@@ -572,3 +572,29 @@ fn a_structure_shows_its_models_and_picks_tell_residues() {
     let about = app.world().annotation(0, 0).expect("residue information");
     assert!(about.starts_with("A ") && about.contains(" 1 N") && about.contains("occupancy 1.00"), "{about}");
 }
+
+#[test]
+fn the_translucent_demo_opens_two_molecules_in_exact_order_from_the_demos_menu() {
+    let mut h = harness();
+    h.get_by_label("Demos").click();
+    h.run_steps(2);
+    h.get_by_label("diene HOMO + SO₂ LUMO (translucent)").click();
+    let start = std::time::Instant::now();
+    // The orbitals are evaluated in the background; then the frame's fragment counts come back.
+    while h.state().fragment_note().is_none() {
+        assert!(start.elapsed().as_secs() < 120, "no translucent frame; error: {:?}", h.state().error);
+        std::thread::sleep(std::time::Duration::from_millis(20));
+        h.run_steps(1);
+    }
+    let app = h.state();
+    assert!(app.error.is_none(), "{:?}", app.error);
+    assert_eq!(app.objects.len(), 2, "butadiene and SO₂");
+    let note = app.fragment_note().unwrap();
+    assert!(note.contains("exact order"), "{note}");
+    for object in &app.objects {
+        let iso = object.state.settings.iso;
+        assert!(iso.visible && iso.translucent, "{:?}", object.doc.source);
+    }
+    // The translucent controls of the active object's isosurface.
+    h.get_by_label("translucent");
+}

@@ -27,8 +27,32 @@ use scan::{ScanFailure, ScanJob, ScanSource, ScanView};
 pub use state::{OrbitalView, ViewState};
 use viewport::Viewport;
 
-/// Opens the window on `files` (the bundled demo when empty) and runs until it closes.
-pub fn run(files: Vec<PathBuf>) -> eframe::Result<()> {
+/// A bundled demo the viewer can open.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Demo {
+    /// The PSB3 twist scan (seed 000): what the viewer opens with no file.
+    Scan,
+    /// Formaldehyde's HOMO as a cube.
+    Cube,
+    /// Butadiene's HOMO meeting SO₂'s LUMO, translucent (seed 003).
+    Cycloaddition,
+}
+
+impl Demo {
+    pub const ALL: [Demo; 3] = [Demo::Scan, Demo::Cube, Demo::Cycloaddition];
+
+    pub fn label(self) -> &'static str {
+        match self {
+            Demo::Scan => "PSB3 twist (dihedral scan)",
+            Demo::Cube => "formaldehyde HOMO (cube)",
+            Demo::Cycloaddition => "diene HOMO + SO₂ LUMO (translucent)",
+        }
+    }
+}
+
+/// Opens the window on `files` (with none, `demo`, or the bundled scan) and runs until it
+/// closes.
+pub fn run(files: Vec<PathBuf>, demo: Option<Demo>) -> eframe::Result<()> {
     let options = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default()
             .with_title("orbcloud")
@@ -41,7 +65,14 @@ pub fn run(files: Vec<PathBuf>) -> eframe::Result<()> {
         "orbcloud",
         options,
         Box::new(|cc| {
-            let mut app = OrbApp::new(cc, files);
+            let mut app = match demo {
+                Some(demo) if files.is_empty() => {
+                    let mut app = OrbApp::empty(cc, Vec::new());
+                    app.open_demo(demo, &cc.egui_ctx);
+                    app
+                }
+                _ => OrbApp::new(cc, files),
+            };
             if let Some(path) = session::last_session_path() {
                 app.keep_session_in(path);
             }
@@ -223,11 +254,32 @@ impl OrbApp {
     /// Opens the bundled formaldehyde cube (a single volume, no scan).
     pub fn cube_demo(cc: &eframe::CreationContext<'_>) -> Self {
         let mut app = Self::empty(cc, Vec::new());
-        match crate::demo::document() {
-            Ok(doc) => app.add_object(doc, Opening::Replace),
-            Err(e) => app.error = Some(e.to_string()),
-        }
+        app.open_demo(Demo::Cube, &cc.egui_ctx);
         app
+    }
+
+    /// Opens a bundled demo in place of the scene.
+    pub fn open_demo(&mut self, demo: Demo, ctx: &egui::Context) {
+        match demo {
+            Demo::Scan => self.open_scan(ScanSource::Demo, ctx),
+            Demo::Cube => match crate::demo::document() {
+                Ok(doc) => self.add_object(doc, Opening::Replace),
+                Err(e) => self.error = Some(e.to_string()),
+            },
+            Demo::Cycloaddition => match crate::demo::cycloaddition() {
+                Ok(scene) => {
+                    self.clear_scene();
+                    for (doc, state) in scene {
+                        self.add_object(doc, Opening::Restore(Box::new(state)));
+                    }
+                    self.view.camera = self.framing_camera();
+                    let (yaw, pitch) = crate::demo::CYCLOADDITION_VIEW;
+                    self.view.camera.orbit(yaw, pitch);
+                    self.status = format!("opened {}", crate::demo::CYCLOADDITION_NAME);
+                }
+                Err(e) => self.error = Some(e.to_string()),
+            },
+        }
     }
 
     fn empty(cc: &eframe::CreationContext<'_>, files: Vec<PathBuf>) -> Self {
@@ -913,6 +965,7 @@ impl eframe::App for OrbApp {
                     self.save_session(&session::with_suffix(path));
                 }
             }
+            panels::Action::Demo(demo) => self.open_demo(demo, &ctx),
             panels::Action::ReopenLast => {
                 if let Some(path) = self.last_session.clone() {
                     self.open_session(&path, &ctx);

@@ -2,6 +2,7 @@
 
 use egui::{ComboBox, RichText, Slider};
 
+use super::Demo;
 use super::OrbApp;
 use crate::model::orbitals::Quantity;
 use crate::model::units::ANGSTROM_PER_BOHR;
@@ -21,6 +22,7 @@ pub enum Action {
     ReopenLast,
     Screenshot,
     ResetView,
+    Demo(Demo),
 }
 
 pub fn top_bar(ui: &mut egui::Ui, app: &mut OrbApp) -> Action {
@@ -48,6 +50,13 @@ pub fn top_bar(ui: &mut egui::Ui, app: &mut OrbApp) -> Action {
             if ui.button("Reset view").clicked() {
                 action = Action::ResetView;
             }
+            ui.menu_button("Demos", |ui| {
+                for demo in Demo::ALL {
+                    if ui.button(demo.label()).clicked() {
+                        action = Action::Demo(demo);
+                    }
+                }
+            });
             ui.separator();
             let source = match &app.scan {
                 Some(s) => s.scene.scan.title.clone(),

@@ -64,6 +64,37 @@ impl IsoArgs {
         abs.chain(self.sigmas.iter().map(|&s| IsoLevel::Sigma(s))).collect()
     }
 
+    /// Puts these levels (when any were given) in place of an object's isosurfaces: the first as
+    /// its first isosurface, the others as further ones, larger values paler.
+    pub fn apply_to(&self, state: &mut orbcloud::scene::ObjectState) {
+        let mut levels = self.levels();
+        if levels.is_empty() {
+            return;
+        }
+        levels.sort_by(|a, b| a.value(1.0).total_cmp(&b.value(1.0)));
+        let first = IsosurfaceSettings {
+            translucent: state.settings.iso.translucent || self.translucent,
+            ..state.settings.iso
+        };
+        let all: Vec<IsosurfaceSettings> = levels
+            .into_iter()
+            .enumerate()
+            .map(|(n, level)| {
+                let pale = |c: [f32; 3]| c.map(|v| v + (1.0 - v) * (1.0 - 0.6f32.powi(n as i32)));
+                IsosurfaceSettings {
+                    visible: true,
+                    level,
+                    positive_color: pale(first.positive_color),
+                    negative_color: pale(first.negative_color),
+                    density_color: pale(first.density_color),
+                    ..first
+                }
+            })
+            .collect();
+        state.settings.iso = all[0];
+        state.isosurfaces = all[1..].to_vec();
+    }
+
     /// The settings every level starts from: translucent or not.
     pub fn base(&self) -> IsosurfaceSettings {
         IsosurfaceSettings { translucent: self.translucent, optics: self.optics.preset(), ..Default::default() }
@@ -396,4 +427,34 @@ fn image_error(a: &image::RgbaImage, b: &image::RgbaImage, background: &[f32; 3]
         }
     }
     (all as f64 / (3 * a.width() * a.height()) as f64, covered as f64 / (3 * n_covered.max(1)) as f64)
+}
+
+/// Draws a scene of several objects (a bundled demo), framed as the demo's view
+/// ([`orbcloud::demo::CYCLOADDITION_VIEW`]). `--iso` values, when given, replace each object's
+/// isosurface levels (drawn as its first isosurface is, larger values paler).
+pub fn render_scene(
+    ctx: &GpuContext,
+    mut scene: Vec<(Document, orbcloud::scene::ObjectState)>,
+    iso: &IsoArgs,
+    size: [u32; 2],
+) -> Result<image::RgbaImage> {
+    use orbcloud::gpu::{FrameInput, OffscreenTarget};
+    use orbcloud::headless::{draw_exact, show_scene};
+    use orbcloud::scene::{Camera, RenderSettings};
+    for (_, state) in &mut scene {
+        iso.apply_to(state);
+    }
+    let mut renderer = Renderer::new(ctx);
+    let (clouds, bounds) = show_scene(ctx, &mut renderer, &scene, 64)?;
+    let (lo, hi) = bounds.context("the scene is empty")?;
+    let mut camera = Camera::framing(lo.as_vec3(), hi.as_vec3());
+    let (yaw, pitch) = orbcloud::demo::CYCLOADDITION_VIEW;
+    camera.orbit(yaw, pitch);
+    let target = OffscreenTarget::new(&ctx.device, size);
+    let background = RenderSettings::default().background;
+    let frame = FrameInput { camera: &camera, background, clouds: &clouds, size, tile: None };
+    if let Some(s) = draw_exact(ctx, &mut renderer, &target.color_view, &frame) {
+        eprintln!("translucent surfaces: {} fragments in {} band(s), exact order", s.needed, s.bands);
+    }
+    Ok(target.read_rgba(&ctx.device, &ctx.queue)?)
 }

@@ -318,6 +318,42 @@ pub fn show_object(
     Ok(show_meshes(ctx, layer, &meshes))
 }
 
+/// Each object's cloud settings, and the scene's bounds (bohr).
+pub type ShownScene = (Vec<crate::scene::VolumeSettings>, Option<(glam::DVec3, glam::DVec3)>);
+
+/// Puts each object of `scene` into its layer of `renderer`: its atoms and placement, its
+/// wavefunction's orbital or density (the state's quantity; the density when none) evaluated on
+/// a grid of `points` per side, or its document's volume, and every isosurface of its state.
+/// Returns each object's cloud settings (opacity scaled to its grid) and the scene's bounds.
+pub fn show_scene(
+    ctx: &GpuContext,
+    renderer: &mut Renderer,
+    scene: &[(Document, ObjectState)],
+    points: usize,
+) -> Result<ShownScene, GpuError> {
+    let mut fill = None;
+    let mut clouds = Vec::new();
+    let mut bounds: Option<(glam::DVec3, glam::DVec3)> = None;
+    for (n, (doc, state)) in scene.iter().enumerate() {
+        let layer = renderer.layer_mut(ctx, n);
+        show_document(ctx, layer, doc, state)?;
+        let quantity = state.quantity.unwrap_or(Quantity::Density);
+        let view = WavefunctionView { quantity, direct: false, points, shells: None };
+        let evaluated = show_wavefunction(ctx, layer, &mut fill, doc, &view)?;
+        let mut cloud = state.settings.volume;
+        if let Some(grid) = evaluated.as_ref().or(doc.volumes.get(state.volume)) {
+            auto_opacity(&mut cloud, grid);
+            let meshes: Vec<_> = state.all_isosurfaces().flat_map(|iso| isosurfaces(grid, iso)).collect();
+            show_meshes(ctx, layer, &meshes);
+        }
+        clouds.push(cloud);
+        if let Some((lo, hi)) = doc.bounds() {
+            bounds = Some(bounds.map_or((lo, hi), |(l, h)| (l.min(lo), h.max(hi))));
+        }
+    }
+    Ok((clouds, bounds))
+}
+
 /// A renderer with an offscreen target of a fixed size.
 pub struct Headless {
     pub renderer: Renderer,
