@@ -265,6 +265,30 @@ fn the_translucent_demo_renders_the_same_whatever_order_the_values_come_in() {
         image::open(&png).unwrap().to_rgba8()
     };
     let a = render("a.png", ["0.02", "0.05"]);
+    // Coefficients edited per channel change the picture; a name that is none is refused.
+    let png = dir.path().join("tuned.png");
+    let tuned = orbcloud(&[
+        "render",
+        "--demo",
+        "cycloaddition",
+        "--lavapipe",
+        "--size",
+        "160x120",
+        "--iso",
+        "0.02",
+        "--iso",
+        "0.05",
+        "--optics-scale",
+        "g=3",
+        "--optics-scale",
+        "d=1,0.2,0.2",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert!(tuned.status.success(), "{}", String::from_utf8_lossy(&tuned.stderr));
+    assert_ne!(image::open(&png).unwrap().to_rgba8(), a, "--optics-scale changes the image");
+    let bad = orbcloud(&["render", "--demo", "cycloaddition", "--optics-scale", "q=1", "-o", "x.png"]);
+    assert!(!bad.status.success() && String::from_utf8_lossy(&bad.stderr).contains("not a coefficient"));
     let b = render("b.png", ["0.05", "0.02"]);
     assert_eq!(a, b, "the order of --iso values changes nothing");
     // Translucent surfaces of two molecules in colour, not a blank frame.

@@ -7,6 +7,7 @@ use super::OrbApp;
 use crate::model::orbitals::Quantity;
 use crate::model::units::ANGSTROM_PER_BOHR;
 use crate::scene::transfer::{Lobe, PRESETS};
+use crate::scene::translucency::OpticsTuning;
 use crate::scene::{
     AtomColoring, AtomStyle, ClipPlane, DensityScale, IsoLevel, IsosurfaceSettings, OpticsPreset, Shape, SliceMode,
     Transfer, TransferKind, ViewPreset,
@@ -528,4 +529,33 @@ pub fn translucency_editor(ui: &mut egui::Ui, iso: &mut IsosurfaceSettings) -> b
         changed
     })
     .inner
+        | (iso.translucent && coefficients_editor(ui, &mut iso.tuning))
+}
+
+/// Seed 003's coefficients of a translucent surface, per R, G, B, as factors on its preset.
+fn coefficients_editor(ui: &mut egui::Ui, tuning: &mut OpticsTuning) -> bool {
+    let mut changed = false;
+    egui::CollapsingHeader::new("coefficients").id_salt(ui.next_auto_id()).show(ui, |ui| {
+        ui.label(
+            RichText::new("× the preset's, per R G B: a diffuse, b c n highlight, d f emission, g thickness; glow_: inside another object's surface")
+                .small()
+                .weak(),
+        );
+        egui::Grid::new(ui.next_auto_id()).num_columns(4).show(ui, |ui| {
+            for name in OpticsTuning::NAMES {
+                ui.label(name);
+                if let Some(factors) = tuning.factors_mut(name) {
+                    for k in factors.iter_mut() {
+                        changed |= ui.add(egui::DragValue::new(k).speed(0.01).range(0.0..=10.0)).changed();
+                    }
+                }
+                ui.end_row();
+            }
+        });
+        if ui.button("preset as it is").clicked() {
+            *tuning = OpticsTuning::default();
+            changed = true;
+        }
+    });
+    changed
 }

@@ -14,7 +14,7 @@ use orbcloud::model::gto::PreparedBasis;
 use orbcloud::model::isosurface::{self, Level, Mesh};
 use orbcloud::model::units::BOHR_PER_ANGSTROM;
 use orbcloud::model::{Document, VolumeGrid};
-use orbcloud::scene::translucency::SurfaceLook;
+use orbcloud::scene::translucency::{OpticsTuning, SurfaceLook};
 use orbcloud::scene::{IsoLevel, IsosurfaceSettings, OpticsPreset};
 
 use super::{WhatArgs, load, wavefunction_of};
@@ -35,6 +35,29 @@ pub struct IsoArgs {
     /// The look of translucent surfaces.
     #[arg(long, value_enum, default_value_t = OpticsArg::Koide)]
     pub optics: OpticsArg,
+    /// Multiply a coefficient of the preset (a, b, c, n, d, f, g, glow_d, glow_f, glow_g) by
+    /// R,G,B factors or one factor, e.g. `g=0.5` or `d=1,0.5,0.5`; repeatable.
+    #[arg(long = "optics-scale", value_parser = parse_tuning)]
+    pub tuning: Vec<(String, Vec<f32>)>,
+}
+
+/// `NAME=X` or `NAME=R,G,B`, NAME a coefficient of [`OpticsTuning::NAMES`].
+fn parse_tuning(s: &str) -> Result<(String, Vec<f32>), String> {
+    let (name, values) = s.split_once('=').ok_or_else(|| format!("expected NAME=R,G,B or NAME=X, got {s:?}"))?;
+    if !OpticsTuning::NAMES.contains(&name) {
+        return Err(format!("{name:?} is not a coefficient: one of {}", OpticsTuning::NAMES.join(", ")));
+    }
+    let factors: Vec<f32> = values
+        .split(',')
+        .map(|v| v.trim().parse::<f32>().ok().filter(|f| f.is_finite() && *f >= 0.0))
+        .collect::<Option<_>>()
+        .ok_or_else(|| format!("{name}: expected factors ≥ 0, got {values:?}"))?;
+    match (name, factors.len()) {
+        (_, 1) | ("a" | "b" | "c" | "d" | "f" | "g" | "glow_d" | "glow_f" | "glow_g", 3) => {
+            Ok((name.to_string(), factors))
+        }
+        _ => Err(format!("{name}: expected {} factor(s), got {}", if name == "n" { 1 } else { 3 }, factors.len())),
+    }
 }
 
 #[derive(Clone, Copy, Default, ValueEnum)]
@@ -72,10 +95,9 @@ impl IsoArgs {
             return;
         }
         levels.sort_by(|a, b| a.value(1.0).total_cmp(&b.value(1.0)));
-        let first = IsosurfaceSettings {
-            translucent: state.settings.iso.translucent || self.translucent,
-            ..state.settings.iso
-        };
+        let own = state.settings.iso;
+        let tuning = if self.tuning.is_empty() { own.tuning } else { self.tuning() };
+        let first = IsosurfaceSettings { translucent: own.translucent || self.translucent, tuning, ..own };
         let all: Vec<IsosurfaceSettings> = levels
             .into_iter()
             .enumerate()
@@ -97,7 +119,25 @@ impl IsoArgs {
 
     /// The settings every level starts from: translucent or not.
     pub fn base(&self) -> IsosurfaceSettings {
-        IsosurfaceSettings { translucent: self.translucent, optics: self.optics.preset(), ..Default::default() }
+        IsosurfaceSettings {
+            translucent: self.translucent,
+            optics: self.optics.preset(),
+            tuning: self.tuning(),
+            ..Default::default()
+        }
+    }
+
+    /// The `--optics-scale` factors.
+    pub fn tuning(&self) -> OpticsTuning {
+        let mut tuning = OpticsTuning::default();
+        for (name, factors) in &self.tuning {
+            if let Some(slot) = tuning.factors_mut(name) {
+                for (k, v) in slot.iter_mut().enumerate() {
+                    *v = factors[k.min(factors.len() - 1)];
+                }
+            }
+        }
+        tuning
     }
 
     /// Each level's surfaces with their colours, larger values paler so nested ones tell

@@ -182,6 +182,9 @@ pub struct IsosurfaceSettings {
     pub translucent: bool,
     #[serde(default)]
     pub optics: super::OpticsPreset,
+    /// Per-channel factors on the preset's coefficients.
+    #[serde(default)]
+    pub tuning: super::translucency::OpticsTuning,
 }
 
 impl Default for IsosurfaceSettings {
@@ -195,6 +198,7 @@ impl Default for IsosurfaceSettings {
             density_color: [0.55, 0.62, 0.75],
             translucent: false,
             optics: super::OpticsPreset::default(),
+            tuning: Default::default(),
         }
     }
 }
@@ -202,7 +206,8 @@ impl Default for IsosurfaceSettings {
 impl IsosurfaceSettings {
     /// How a surface of this setting in `color` is drawn.
     pub fn look(&self, color: [f32; 3]) -> super::translucency::SurfaceLook {
-        super::translucency::SurfaceLook { color, optics: self.translucent.then(|| self.optics.optics(color)) }
+        let optics = self.translucent.then(|| self.tuning.apply(self.optics.optics(color)));
+        super::translucency::SurfaceLook { color, optics }
     }
 }
 

@@ -105,6 +105,79 @@ impl OpticsPreset {
     }
 }
 
+/// Per-channel factors on a preset's coefficients (all 1: the preset as it is): how a surface's
+/// a, b, c, n, d, f, g and glow are edited per R, G, B while staying tied to its colour.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct OpticsTuning {
+    pub a: [f32; 3],
+    pub b: [f32; 3],
+    pub c: [f32; 3],
+    pub n: f32,
+    pub d: [f32; 3],
+    pub f: [f32; 3],
+    pub g: [f32; 3],
+    pub glow_d: [f32; 3],
+    pub glow_f: [f32; 3],
+    pub glow_g: [f32; 3],
+}
+
+impl Default for OpticsTuning {
+    fn default() -> Self {
+        Self {
+            a: [1.0; 3],
+            b: [1.0; 3],
+            c: [1.0; 3],
+            n: 1.0,
+            d: [1.0; 3],
+            f: [1.0; 3],
+            g: [1.0; 3],
+            glow_d: [1.0; 3],
+            glow_f: [1.0; 3],
+            glow_g: [1.0; 3],
+        }
+    }
+}
+
+impl OpticsTuning {
+    /// The coefficients' names, as the command line and the editor give them.
+    pub const NAMES: [&'static str; 10] = ["a", "b", "c", "n", "d", "f", "g", "glow_d", "glow_f", "glow_g"];
+
+    /// The factors of coefficient `name` (`n` has one, repeated), or `None` for no such name.
+    pub fn factors_mut(&mut self, name: &str) -> Option<&mut [f32]> {
+        Some(match name {
+            "a" => &mut self.a,
+            "b" => &mut self.b,
+            "c" => &mut self.c,
+            "n" => std::slice::from_mut(&mut self.n),
+            "d" => &mut self.d,
+            "f" => &mut self.f,
+            "g" => &mut self.g,
+            "glow_d" => &mut self.glow_d,
+            "glow_f" => &mut self.glow_f,
+            "glow_g" => &mut self.glow_g,
+            _ => return None,
+        })
+    }
+
+    /// `optics` with every coefficient multiplied by its factors.
+    pub fn apply(&self, o: Optics) -> Optics {
+        let mul = |v: [f32; 3], k: [f32; 3]| std::array::from_fn(|i| v[i] * k[i].max(0.0));
+        Optics {
+            a: mul(o.a, self.a),
+            b: mul(o.b, self.b),
+            c: mul(o.c, self.c),
+            n: o.n * self.n.max(0.0),
+            d: mul(o.d, self.d),
+            f: mul(o.f, self.f),
+            g: mul(o.g, self.g),
+            glow_d: mul(o.glow_d, self.glow_d),
+            glow_f: mul(o.glow_f, self.glow_f),
+            glow_g: mul(o.glow_g, self.glow_g),
+        }
+    }
+}
+
 /// How one isosurface mesh is drawn: opaque in a colour, or translucent with seed 003's optics.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SurfaceLook {
@@ -303,6 +376,21 @@ mod tests {
         let enclosed = composite(&[frag(0.2, 0, 0.7), frag(0.3, 0, -0.7), b_at(-0.7)], &[a, b], [0.0; 3]);
         let apart = composite(&[frag(0.2, 0, 0.7), frag(0.3, 0, -0.7), b_at(0.7)], &[a, b], [0.0; 3]);
         assert!(enclosed[1] > apart[1] + 0.1, "{enclosed:?} vs {apart:?}");
+    }
+
+    #[test]
+    fn tuning_scales_each_channel_of_a_preset() {
+        let preset = OpticsPreset::Glassy.optics([0.2, 0.5, 0.9]);
+        let mut tuning = OpticsTuning::default();
+        assert_eq!(tuning.apply(preset), preset);
+        tuning.factors_mut("g").unwrap().copy_from_slice(&[2.0, 1.0, 0.5]);
+        tuning.factors_mut("n").unwrap()[0] = 0.5;
+        let tuned = tuning.apply(preset);
+        assert_eq!(tuned.g, [2.0 * preset.g[0], preset.g[1], 0.5 * preset.g[2]]);
+        assert_eq!(tuned.n, 0.5 * preset.n);
+        assert_eq!((tuned.a, tuned.glow_d), (preset.a, preset.glow_d));
+        assert!(tuning.factors_mut("x").is_none());
+        assert!(OpticsTuning::NAMES.iter().all(|n| tuning.factors_mut(n).is_some()));
     }
 
     #[test]
