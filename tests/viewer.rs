@@ -598,3 +598,34 @@ fn the_translucent_demo_opens_two_molecules_in_exact_order_from_the_demos_menu()
     // The translucent controls of the active object's isosurface.
     h.get_by_label("translucent");
 }
+
+#[test]
+fn a_lost_device_brings_the_scene_back_on_a_new_device_without_reading_files_again() {
+    use std::sync::{Arc, Mutex};
+    let mut h = harness();
+    let slot: orbcloud::app::restart::CarrySlot = Arc::new(Mutex::new(None));
+    h.state_mut().restart_into(slot.clone());
+    h.state_mut().view.camera.orbit(0.7, 0.2);
+    let camera = h.state().view.camera;
+    let docs: Vec<_> = h.state().documents().cloned().collect();
+    assert_eq!(docs.len(), 1);
+    h.state().lose_device("rehearsed in a test");
+    h.run_steps(2);
+    let carried = slot.lock().unwrap().take().expect("the scene was handed on");
+    drop(h);
+    let mut next = Harness::builder()
+        .with_size([1000.0, 700.0])
+        .wgpu_setup(wgpu_setup(true))
+        .build_eframe(move |cc| OrbApp::resume(cc, carried));
+    next.run_steps(3);
+    let app = next.state();
+    assert!(app.error.is_none(), "{:?}", app.error);
+    let notice = app.notice.clone().unwrap_or_default();
+    assert!(notice.contains("back on a new device"), "{notice}");
+    let resumed: Vec<_> = app.documents().cloned().collect();
+    assert_eq!(resumed.len(), 1);
+    assert!(Arc::ptr_eq(&resumed[0], &docs[0]), "the document itself, not read again");
+    assert_eq!(app.view.camera, camera);
+    // And it draws: the view holds the cube's cloud on the new device.
+    next.get_by_label("cloud");
+}

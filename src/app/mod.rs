@@ -8,6 +8,7 @@ pub mod measure;
 pub mod models;
 mod orbitals;
 mod panels;
+pub mod restart;
 pub mod scan;
 mod scene_panel;
 pub mod session;
@@ -51,34 +52,56 @@ impl Demo {
 }
 
 /// Opens the window on `files` (with none, `demo`, or the bundled scan) and runs until it
-/// closes.
+/// closes. When the GPU device is lost, the window closes and a new one opens on a new device
+/// with the scene as it was ([`restart`]). `ORBCLOUD_SIMULATE_DEVICE_LOSS=SECONDS` rehearses
+/// that: the first window reports its device lost after that long.
 pub fn run(files: Vec<PathBuf>, demo: Option<Demo>) -> eframe::Result<()> {
-    let options = eframe::NativeOptions {
-        viewport: egui::ViewportBuilder::default()
-            .with_title("orbcloud")
-            .with_inner_size([1280.0, 800.0])
-            .with_drag_and_drop(true),
-        wgpu_options: egui_wgpu::WgpuConfiguration { wgpu_setup: wgpu_setup(false), ..Default::default() },
-        ..Default::default()
-    };
-    eframe::run_native(
-        "orbcloud",
-        options,
-        Box::new(|cc| {
-            let mut app = match demo {
-                Some(demo) if files.is_empty() => {
-                    let mut app = OrbApp::empty(cc, Vec::new());
-                    app.open_demo(demo, &cc.egui_ctx);
-                    app
+    let slot: restart::CarrySlot = Arc::default();
+    let rehearse = std::env::var("ORBCLOUD_SIMULATE_DEVICE_LOSS").ok().and_then(|s| s.parse::<f64>().ok());
+    let mut first = Some((files, demo));
+    loop {
+        let options = eframe::NativeOptions {
+            viewport: egui::ViewportBuilder::default()
+                .with_title("orbcloud")
+                .with_inner_size([1280.0, 800.0])
+                .with_drag_and_drop(true),
+            wgpu_options: egui_wgpu::WgpuConfiguration { wgpu_setup: wgpu_setup(false), ..Default::default() },
+            // Returns when the window closes, so that another can open after a lost device.
+            run_and_return: true,
+            ..Default::default()
+        };
+        let carried = slot.lock().unwrap_or_else(|p| p.into_inner()).take();
+        let opening = first.take();
+        let next = slot.clone();
+        eframe::run_native(
+            "orbcloud",
+            options,
+            Box::new(move |cc| {
+                let mut app = match (carried, opening) {
+                    (Some(carried), _) => OrbApp::resume(cc, carried),
+                    (None, Some((files, Some(demo)))) if files.is_empty() => {
+                        let mut app = OrbApp::empty(cc, Vec::new());
+                        app.open_demo(demo, &cc.egui_ctx);
+                        app.rehearse_device_loss(rehearse);
+                        app
+                    }
+                    (None, opening) => {
+                        let mut app = OrbApp::new(cc, opening.map(|(files, _)| files).unwrap_or_default());
+                        app.rehearse_device_loss(rehearse);
+                        app
+                    }
+                };
+                if let Some(path) = session::last_session_path() {
+                    app.keep_session_in(path);
                 }
-                _ => OrbApp::new(cc, files),
-            };
-            if let Some(path) = session::last_session_path() {
-                app.keep_session_in(path);
-            }
-            Ok(Box::new(app))
-        }),
-    )
+                app.restart_into(next);
+                Ok(Box::new(app))
+            }),
+        )?;
+        if slot.lock().unwrap_or_else(|p| p.into_inner()).is_none() {
+            return Ok(());
+        }
+    }
 }
 
 /// The window's device: the renderer's features and the adapter's limits. `lavapipe` picks
@@ -191,6 +214,13 @@ pub struct OrbApp {
     pub browser: Option<files::FileBrowser>,
     /// Files opened recently, newest first (kept with the last session).
     pub recent: Vec<PathBuf>,
+    /// Where the scene goes when the device is lost, for the next window ([`restart`]).
+    restart: Option<restart::CarrySlot>,
+    /// When a rehearsed device loss is reported.
+    rehearsal: Option<std::time::Instant>,
+    /// A message that stays in the status line until dismissed (the scene came back on a new
+    /// device).
+    pub notice: Option<String>,
 }
 
 /// The scene's atoms in world space, numbered object after object: what measurements index.
@@ -301,8 +331,7 @@ impl OrbApp {
                 errors.lock().unwrap_or_else(|p| p.into_inner()).push(e.to_string());
                 repaint.request_repaint();
             }));
-            // A lost device cannot be recreated under eframe's window: keep the scene and say how
-            // to get it back.
+            // A lost device: the scene moves to a new window on a new device (`restart`).
             let (errors, repaint) = (gpu_errors.clone(), cc.egui_ctx.clone());
             vp.ctx.device.set_device_lost_callback(move |reason, message| {
                 if reason != wgpu::DeviceLostReason::Destroyed {
@@ -337,6 +366,9 @@ impl OrbApp {
             native_dialogs: true,
             browser: None,
             recent: Vec::new(),
+            restart: None,
+            rehearsal: None,
+            notice: None,
         };
         if app.viewport.is_none() {
             app.error = Some("no wgpu render state: the viewer needs eframe's wgpu backend".into());
@@ -460,7 +492,11 @@ impl OrbApp {
     /// Adds a loaded document to the scene as `how` says: beside the others, instead of them,
     /// or as a session saved it. It becomes the active object.
     fn add_object(&mut self, doc: Document, how: Opening) {
-        let doc = Arc::new(doc);
+        self.add_shared_object(Arc::new(doc), how);
+    }
+
+    /// [`Self::add_object`] of a document already shared (carried from a lost device's window).
+    fn add_shared_object(&mut self, doc: Arc<Document>, how: Opening) {
         let restoring = matches!(how, Opening::Restore(_));
         let replace = how == Opening::Replace;
         let mut state = match how {
@@ -778,8 +814,12 @@ impl OrbApp {
     fn poll_job(&mut self, ctx: &egui::Context) {
         self.poll_object_jobs();
         let reported: Vec<String> = std::mem::take(&mut *self.gpu_errors.lock().unwrap_or_else(|p| p.into_inner()));
-        if reported.iter().any(|e| e.starts_with(DEVICE_LOST)) {
+        if let Some(lost) = reported.iter().find(|e| e.starts_with(DEVICE_LOST)) {
             self.save_last_session();
+            let reason = lost.trim_start_matches(DEVICE_LOST).trim_matches([' ', '(', ')']).to_string();
+            if self.carry_away(&reason, ctx) {
+                return;
+            }
             let kept = self
                 .last_session
                 .as_ref()
@@ -938,6 +978,7 @@ impl eframe::App for OrbApp {
 
     fn ui(&mut self, ui: &mut egui::Ui, frame: &mut eframe::Frame) {
         let ctx = ui.ctx().clone();
+        self.tick_rehearsal(&ctx);
         self.poll_job(&ctx);
         let before = self.view;
         let action = panels::top_bar(ui, self);

@@ -71,16 +71,24 @@ pub fn top_bar(ui: &mut egui::Ui, app: &mut OrbApp) -> Action {
 }
 
 pub fn status_bar(ui: &mut egui::Ui, app: &mut OrbApp) {
-    let mut cancel = false;
-    status_line(ui, app, &mut cancel);
+    let (mut cancel, mut dismiss) = (false, false);
+    status_line(ui, app, &mut cancel, &mut dismiss);
     if cancel {
         app.cancel_jobs();
     }
+    if dismiss {
+        app.notice = None;
+    }
 }
 
-fn status_line(ui: &mut egui::Ui, app: &OrbApp, cancel: &mut bool) {
+fn status_line(ui: &mut egui::Ui, app: &OrbApp, cancel: &mut bool, dismiss: &mut bool) {
     egui::Panel::bottom("status").show(ui, |ui| {
         ui.horizontal(|ui| {
+            if let Some(notice) = &app.notice {
+                ui.label(RichText::new(notice).strong());
+                *dismiss = ui.small_button("×").on_hover_text("dismiss").clicked();
+                ui.separator();
+            }
             if let Some(job) = &app.job {
                 let (f, parsing) = job.0.progress();
                 let text = if parsing { "parsing…".to_string() } else { format!("reading {:.0}%", 100.0 * f) };
