@@ -67,19 +67,29 @@ fn fs_main(in: VertexOut) -> FragOut {
 @group(1) @binding(3) var<storage, read_write> counter: atomic<u32>;
 @group(1) @binding(4) var opaque_depth: texture_depth_2d;
 
-@fragment
-fn fs_collect(in: VertexOut) {
-    let px = vec2<u32>(in.clip.xy);
-    // The shader writes storage, so the hardware depth test cannot run before it: test here.
-    if (in.clip.z >= textureLoad(opaque_depth, px, 0)) {
-        return;
-    }
+// Whether the opaque scene hides this fragment. The translucent programs write storage, so
+// the hardware depth test cannot run before them: they test here.
+fn behind_opaque(in: VertexOut) -> bool {
+    return in.clip.z >= textureLoad(opaque_depth, vec2<u32>(in.clip.xy), 0);
+}
+
+// N·L, N·V and R·V (R = 2(N·L)N − L, the reflected light) of a fragment.
+fn cosines(in: VertexOut) -> vec3<f32> {
     let v = normalize(u.eye.xyz - in.world);
     let n = normalize(in.normal);
     let l = u.light.xyz;
     let n_dot_l = dot(n, l);
     let n_dot_v = dot(n, v);
-    let r_dot_v = 2.0 * n_dot_l * n_dot_v - dot(l, v);
+    return vec3<f32>(n_dot_l, n_dot_v, 2.0 * n_dot_l * n_dot_v - dot(l, v));
+}
+
+@fragment
+fn fs_collect(in: VertexOut) {
+    if (behind_opaque(in)) {
+        return;
+    }
+    let px = vec2<u32>(in.clip.xy);
+    let c = cosines(in);
     let index = atomicAdd(&counter, 1u);
     if (index >= lists.capacity) {
         // Counted: the frame is drawn again in bands that fit.
@@ -88,8 +98,8 @@ fn fs_collect(in: VertexOut) {
     let previous = atomicExchange(&heads[px.y * lists.width + px.x], index + 1u);
     nodes[index] = FragmentNode(
         in.clip.z,
-        pack2x16float(vec2<f32>(n_dot_v, n_dot_l)),
-        (pack2x16float(vec2<f32>(r_dot_v, 0.0)) & 0xffffu) | (u.pick.y << 16u),
+        pack2x16float(vec2<f32>(c.y, c.x)),
+        (pack2x16float(vec2<f32>(c.z, 0.0)) & 0xffffu) | (u.pick.y << 16u),
         previous,
     );
 }
@@ -105,16 +115,11 @@ struct Weighted {
 
 @fragment
 fn fs_weighted(in: VertexOut) -> Weighted {
-    let px = vec2<u32>(in.clip.xy);
-    if (in.clip.z >= textureLoad(opaque_depth, px, 0)) {
+    if (behind_opaque(in)) {
         discard;
     }
-    let v = normalize(u.eye.xyz - in.world);
-    let n = normalize(in.normal);
-    let l = u.light.xyz;
-    let n_dot_l = dot(n, l);
-    let n_dot_v = dot(n, v);
-    let shaded = koide(optics[u.pick.y], n_dot_l, n_dot_v, 2.0 * n_dot_l * n_dot_v - dot(l, v), false);
+    let c = cosines(in);
+    let shaded = koide(optics[u.pick.y], c.x, c.y, c.z, false);
     let alpha = clamp(1.0 - dot(shaded.transmission, vec3<f32>(1.0 / 3.0)), 0.0, 1.0);
     // Their weight of equation 10, on window depth.
     let near = 1.0 - in.clip.z;

@@ -4,17 +4,8 @@
 // The slices already drew the cloud alone into the scene, over what lies behind it, so the
 // scene behind the cloud is what that drawing let through: every fragment's transmission
 // multiplies it too.
-// Prepended: volume_common.wgsl, volume_gradient.wgsl, volume_field.wgsl, oit_common.wgsl,
-// oit_sort.wgsl.
-
-@group(1) @binding(0) var scene: texture_2d<f32>;
-
-@vertex
-fn vs_fullscreen(@builtin(vertex_index) vi: u32) -> @builtin(position) vec4<f32> {
-    let x = f32((vi << 1u) & 2u) * 2.0 - 1.0;
-    let y = f32(vi & 2u) * 2.0 - 1.0;
-    return vec4<f32>(x, y, 0.0, 1.0);
-}
+// Prepended: volume_common.wgsl, volume_gradient.wgsl, volume_field.wgsl, fullscreen.wgsl,
+// oit_common.wgsl, oit_sort.wgsl.
 
 @fragment
 fn fs_interleave(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {

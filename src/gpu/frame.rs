@@ -191,18 +191,7 @@ pub struct FrameTargets {
 impl FrameTargets {
     pub fn new(device: &wgpu::Device, size: [u32; 2]) -> Self {
         let size = [size[0].max(1), size[1].max(1)];
-        let texture = |label, format, usage| {
-            device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d { width: size[0], height: size[1], depth_or_array_layers: 1 },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | usage,
-                view_formats: &[],
-            })
-        };
+        let texture = |label, format, usage| target_texture(device, label, size, format, usage);
         let read = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
         let color = texture("frame colour", SCENE_FORMAT, read);
         let depth = texture("frame depth", DEPTH_FORMAT, read);
@@ -260,6 +249,26 @@ impl FrameTargets {
             multiview_mask: None,
         })
     }
+}
+
+/// A 2D target of the frame's `size` in `format`, renderable and usable as `usage` says.
+pub fn target_texture(
+    device: &wgpu::Device,
+    label: &str,
+    size: [u32; 2],
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d { width: size[0], height: size[1], depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | usage,
+        view_formats: &[],
+    })
 }
 
 /// The colour targets of a pipeline drawing in [`Phase::Opaque`]: scene colour, then ids.

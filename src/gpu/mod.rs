@@ -40,6 +40,7 @@ pub const SHADERS: &[(&str, &str)] = &[
     ("atoms_common.wgsl", include_str!("../../shaders/atoms_common.wgsl")),
     ("atoms.wgsl", include_str!("../../shaders/atoms.wgsl")),
     ("atoms_cull.wgsl", include_str!("../../shaders/atoms_cull.wgsl")),
+    ("fullscreen.wgsl", include_str!("../../shaders/fullscreen.wgsl")),
     ("oit_common.wgsl", include_str!("../../shaders/oit_common.wgsl")),
     ("oit_sort.wgsl", include_str!("../../shaders/oit_sort.wgsl")),
     ("resolve.wgsl", include_str!("../../shaders/resolve.wgsl")),
@@ -58,6 +59,7 @@ pub const SHADER_MODULES: &[(&str, &[&str])] = &[
             "volume_common.wgsl",
             "volume_gradient.wgsl",
             "volume_field.wgsl",
+            "fullscreen.wgsl",
             "oit_common.wgsl",
             "oit_sort.wgsl",
             "volume_interleave.wgsl",
@@ -69,7 +71,7 @@ pub const SHADER_MODULES: &[(&str, &[&str])] = &[
     ("atoms.wgsl", &["atoms_common.wgsl", "atoms.wgsl"]),
     ("atoms_cull.wgsl", &["atoms_common.wgsl", "atoms_cull.wgsl"]),
     ("isosurface.wgsl", &["oit_common.wgsl", "isosurface.wgsl"]),
-    ("resolve.wgsl", &["oit_common.wgsl", "oit_sort.wgsl", "resolve.wgsl"]),
+    ("resolve.wgsl", &["fullscreen.wgsl", "oit_common.wgsl", "oit_sort.wgsl", "resolve.wgsl"]),
 ];
 
 /// The full source of a shader module: its prerequisites, then itself.

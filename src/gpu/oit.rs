@@ -357,17 +357,7 @@ impl FragmentLists {
         let layout = &self.weighted_layout;
         self.weighted.get_or_insert_with(|| {
             let texture = |label, format| {
-                ctx.device
-                    .create_texture(&wgpu::TextureDescriptor {
-                        label: Some(label),
-                        size: wgpu::Extent3d { width: size[0], height: size[1], depth_or_array_layers: 1 },
-                        mip_level_count: 1,
-                        sample_count: 1,
-                        dimension: wgpu::TextureDimension::D2,
-                        format,
-                        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-                        view_formats: &[],
-                    })
+                super::frame::target_texture(&ctx.device, label, size, format, wgpu::TextureUsages::TEXTURE_BINDING)
                     .create_view(&Default::default())
             };
             let accum = texture("weighted colour", ACCUM_FORMAT);

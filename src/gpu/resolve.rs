@@ -61,7 +61,7 @@ impl ResolvePass {
                 layout: Some(&pipeline_layout),
                 vertex: wgpu::VertexState {
                     module: &module,
-                    entry_point: Some("vs_main"),
+                    entry_point: Some("vs_fullscreen"),
                     compilation_options: Default::default(),
                     buffers: &[],
                 },

@@ -108,34 +108,13 @@ impl OpticsPreset {
 /// Per-channel factors on a preset's coefficients (all 1: the preset as it is): how a surface's
 /// a, b, c, n, d, f, g and glow are edited per R, G, B while staying tied to its colour.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
-pub struct OpticsTuning {
-    pub a: [f32; 3],
-    pub b: [f32; 3],
-    pub c: [f32; 3],
-    pub n: f32,
-    pub d: [f32; 3],
-    pub f: [f32; 3],
-    pub g: [f32; 3],
-    pub glow_d: [f32; 3],
-    pub glow_f: [f32; 3],
-    pub glow_g: [f32; 3],
-}
+#[serde(transparent)]
+pub struct OpticsTuning(pub Optics);
 
 impl Default for OpticsTuning {
     fn default() -> Self {
-        Self {
-            a: [1.0; 3],
-            b: [1.0; 3],
-            c: [1.0; 3],
-            n: 1.0,
-            d: [1.0; 3],
-            f: [1.0; 3],
-            g: [1.0; 3],
-            glow_d: [1.0; 3],
-            glow_f: [1.0; 3],
-            glow_g: [1.0; 3],
-        }
+        let one = [1.0; 3];
+        Self(Optics { a: one, b: one, c: one, n: 1.0, d: one, f: one, g: one, glow_d: one, glow_f: one, glow_g: one })
     }
 }
 
@@ -143,37 +122,39 @@ impl OpticsTuning {
     /// The coefficients' names, as the command line and the editor give them.
     pub const NAMES: [&'static str; 10] = ["a", "b", "c", "n", "d", "f", "g", "glow_d", "glow_f", "glow_g"];
 
-    /// The factors of coefficient `name` (`n` has one, repeated), or `None` for no such name.
+    /// The factors of coefficient `name` (`n` has one), or `None` for no such name.
     pub fn factors_mut(&mut self, name: &str) -> Option<&mut [f32]> {
+        let o = &mut self.0;
         Some(match name {
-            "a" => &mut self.a,
-            "b" => &mut self.b,
-            "c" => &mut self.c,
-            "n" => std::slice::from_mut(&mut self.n),
-            "d" => &mut self.d,
-            "f" => &mut self.f,
-            "g" => &mut self.g,
-            "glow_d" => &mut self.glow_d,
-            "glow_f" => &mut self.glow_f,
-            "glow_g" => &mut self.glow_g,
+            "a" => &mut o.a,
+            "b" => &mut o.b,
+            "c" => &mut o.c,
+            "n" => std::slice::from_mut(&mut o.n),
+            "d" => &mut o.d,
+            "f" => &mut o.f,
+            "g" => &mut o.g,
+            "glow_d" => &mut o.glow_d,
+            "glow_f" => &mut o.glow_f,
+            "glow_g" => &mut o.glow_g,
             _ => return None,
         })
     }
 
     /// `optics` with every coefficient multiplied by its factors.
     pub fn apply(&self, o: Optics) -> Optics {
+        let k = &self.0;
         let mul = |v: [f32; 3], k: [f32; 3]| std::array::from_fn(|i| v[i] * k[i].max(0.0));
         Optics {
-            a: mul(o.a, self.a),
-            b: mul(o.b, self.b),
-            c: mul(o.c, self.c),
-            n: o.n * self.n.max(0.0),
-            d: mul(o.d, self.d),
-            f: mul(o.f, self.f),
-            g: mul(o.g, self.g),
-            glow_d: mul(o.glow_d, self.glow_d),
-            glow_f: mul(o.glow_f, self.glow_f),
-            glow_g: mul(o.glow_g, self.glow_g),
+            a: mul(o.a, k.a),
+            b: mul(o.b, k.b),
+            c: mul(o.c, k.c),
+            n: o.n * k.n.max(0.0),
+            d: mul(o.d, k.d),
+            f: mul(o.f, k.f),
+            g: mul(o.g, k.g),
+            glow_d: mul(o.glow_d, k.glow_d),
+            glow_f: mul(o.glow_f, k.glow_f),
+            glow_g: mul(o.glow_g, k.glow_g),
         }
     }
 }
