@@ -88,7 +88,8 @@ impl IsoArgs {
     }
 
     /// Puts these levels (when any were given) in place of an object's isosurfaces: the first as
-    /// its first isosurface, the others as further ones, larger values paler.
+    /// its first isosurface, the others as further ones, told apart by colour
+    /// ([`IsosurfaceSettings::nested`]).
     pub fn apply_to(&self, state: &mut orbcloud::scene::ObjectState) {
         let mut levels = self.levels();
         if levels.is_empty() {
@@ -98,21 +99,9 @@ impl IsoArgs {
         let own = state.settings.iso;
         let tuning = if self.tuning.is_empty() { own.tuning } else { self.tuning() };
         let first = IsosurfaceSettings { translucent: own.translucent || self.translucent, tuning, ..own };
-        let all: Vec<IsosurfaceSettings> = levels
-            .into_iter()
-            .enumerate()
-            .map(|(n, level)| {
-                let pale = |c: [f32; 3]| c.map(|v| v + (1.0 - v) * (1.0 - 0.6f32.powi(n as i32)));
-                IsosurfaceSettings {
-                    visible: true,
-                    level,
-                    positive_color: pale(first.positive_color),
-                    negative_color: pale(first.negative_color),
-                    density_color: pale(first.density_color),
-                    ..first
-                }
-            })
-            .collect();
+        let count = levels.len();
+        let all: Vec<IsosurfaceSettings> =
+            levels.into_iter().enumerate().map(|(n, level)| first.nested(level, n, count)).collect();
         state.settings.iso = all[0];
         state.isosurfaces = all[1..].to_vec();
     }
@@ -140,27 +129,15 @@ impl IsoArgs {
         tuning
     }
 
-    /// Each level's surfaces with their colours, larger values paler so nested ones tell
+    /// Each level's surfaces with their colours ([`IsosurfaceSettings::nested`]), so nested ones tell
     /// apart; the order the levels were given in changes nothing.
     pub fn meshes(&self, grid: &VolumeGrid, base: &IsosurfaceSettings) -> Vec<(Mesh, SurfaceLook)> {
         let sigma = grid.stats.sigma;
         let mut levels = self.levels();
         levels.sort_by(|a, b| a.value(sigma).total_cmp(&b.value(sigma)));
         levels.dedup_by(|a, b| a.value(sigma) == b.value(sigma));
-        let mut out = Vec::new();
-        for (n, level) in levels.into_iter().enumerate() {
-            let pale = |c: [f32; 3]| c.map(|v| v + (1.0 - v) * (1.0 - 0.6f32.powi(n as i32)));
-            let iso = IsosurfaceSettings {
-                visible: true,
-                level,
-                positive_color: pale(base.positive_color),
-                negative_color: pale(base.negative_color),
-                density_color: pale(base.density_color),
-                ..*base
-            };
-            out.extend(isosurfaces(grid, &iso));
-        }
-        out
+        let count = levels.len();
+        levels.into_iter().enumerate().flat_map(|(n, level)| isosurfaces(grid, &base.nested(level, n, count))).collect()
     }
 }
 
@@ -471,7 +448,7 @@ fn image_error(a: &image::RgbaImage, b: &image::RgbaImage, background: &[f32; 3]
 
 /// Draws a scene of several objects (a bundled demo), framed as the demo's view
 /// ([`orbcloud::demo::CYCLOADDITION_VIEW`]). `--iso` values, when given, replace each object's
-/// isosurface levels (drawn as its first isosurface is, larger values paler).
+/// isosurface levels (drawn as its first isosurface is, told apart by colour).
 pub fn render_scene(
     ctx: &GpuContext,
     mut scene: Vec<(Document, orbcloud::scene::ObjectState)>,

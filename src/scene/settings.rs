@@ -204,6 +204,32 @@ impl Default for IsosurfaceSettings {
 }
 
 impl IsosurfaceSettings {
+    /// The `n`-th (from the smallest value) of `count` nested levels at `level`, told apart by
+    /// colour: an orbital's two colours paler inward, a density's shells along a ramp from
+    /// cool outside to warm inside.
+    pub fn nested(&self, level: IsoLevel, n: usize, count: usize) -> Self {
+        const RAMP: [[f32; 3]; 5] =
+            [[0.15, 0.35, 0.95], [0.1, 0.75, 0.85], [0.2, 0.8, 0.3], [0.95, 0.8, 0.15], [0.9, 0.2, 0.1]];
+        let pale = |c: [f32; 3]| c.map(|v| v + (1.0 - v) * (1.0 - 0.6f32.powi(n as i32)));
+        let density_color = match count {
+            0 | 1 => self.density_color,
+            _ => {
+                let t = n as f32 / (count - 1) as f32 * (RAMP.len() - 1) as f32;
+                let (i, f) = ((t as usize).min(RAMP.len() - 2), t.fract());
+                let f = if t as usize >= RAMP.len() - 1 { 1.0 } else { f };
+                std::array::from_fn(|k| RAMP[i][k] + (RAMP[i + 1][k] - RAMP[i][k]) * f)
+            }
+        };
+        Self {
+            visible: true,
+            level,
+            positive_color: pale(self.positive_color),
+            negative_color: pale(self.negative_color),
+            density_color,
+            ..*self
+        }
+    }
+
     /// How a surface of this setting in `color` is drawn.
     pub fn look(&self, color: [f32; 3]) -> super::translucency::SurfaceLook {
         let optics = self.translucent.then(|| self.tuning.apply(self.optics.optics(color)));
@@ -248,5 +274,23 @@ impl Default for RenderSettings {
             iso: IsosurfaceSettings::default(),
             background: [0.02, 0.02, 0.03],
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn nested_levels_run_from_cool_to_warm_for_a_density_and_pale_for_an_orbital() {
+        let base = IsosurfaceSettings { translucent: true, ..Default::default() };
+        let outer = base.nested(IsoLevel::Absolute(0.01), 0, 4);
+        let inner = base.nested(IsoLevel::Absolute(0.3), 3, 4);
+        assert!(outer.visible && outer.translucent && outer.level == IsoLevel::Absolute(0.01));
+        assert!(outer.density_color[2] > outer.density_color[0], "outside blue: {:?}", outer.density_color);
+        assert!(inner.density_color[0] > inner.density_color[2], "inside red: {:?}", inner.density_color);
+        assert_eq!(outer.positive_color, base.positive_color);
+        assert!(inner.positive_color.iter().zip(base.positive_color).all(|(p, b)| *p >= b));
+        assert_eq!(base.nested(IsoLevel::Sigma(2.0), 0, 1).density_color, base.density_color);
     }
 }
