@@ -21,6 +21,8 @@ use orbcloud::scene::{
 use orbcloud::{demo, formats, info};
 use rayon::prelude::*;
 
+#[path = "cli/molsurface.rs"]
+mod molsurface_cli;
 #[path = "cli/scan.rs"]
 mod scan_cli;
 #[path = "cli/structure.rs"]
@@ -115,7 +117,8 @@ enum Command {
         #[arg(short, long)]
         output: PathBuf,
     },
-    /// Write isosurfaces (both signs of an orbital, or a density's) as OBJ, PLY or glTF.
+    /// Write isosurfaces (both signs of an orbital, or a density's) or a molecular surface
+    /// (--surface) as OBJ, PLY or glTF.
     Mesh(surface_cli::MeshArgs),
     /// Dihedral scans: make a manifest, inspect, render or export an angle.
     #[command(subcommand)]
@@ -267,6 +270,9 @@ enum BenchCommand {
     /// ms per frame of 2, 4 and 16 translucent surfaces, exact order against weighted blending,
     /// with the fragment memory and weighted blending's image error.
     Surfaces(surface_cli::TranslucentBench),
+    /// ms to build a molecular surface (Gaussian, solvent-excluded) of a file's atoms, and ms
+    /// per frame drawing it.
+    Surface(molsurface_cli::SurfaceBench),
 }
 
 #[derive(Args)]
@@ -287,6 +293,8 @@ struct RenderArgs {
     wavefunction: WavefunctionArgs,
     #[command(flatten)]
     iso: surface_cli::IsoArgs,
+    #[command(flatten)]
+    molsurface: molsurface_cli::MolSurfaceArgs,
     /// Print what is drawn at pixel X,Y of the image (an atom, a surface, or nothing).
     #[arg(long, value_parser = surface_cli::parse_pixel)]
     pick: Option<[u32; 2]>,
@@ -560,10 +568,12 @@ fn main() -> Result<()> {
             let mut settings = args.view.settings();
             let mut h = Headless::new(&ctx, &doc, volume, &settings, args.view.size)?;
             let computed = args.wavefunction.apply(&ctx, &mut h, &doc)?.map(|(_, g)| g);
-            if let Some(grid) = computed.as_ref().or(volume.and_then(|i| doc.volumes.get(i))) {
+            let grid = computed.as_ref().or(volume.and_then(|i| doc.volumes.get(i)));
+            if let Some(grid) = grid {
                 orbcloud::headless::auto_opacity(&mut settings.volume, grid);
-                surface_cli::show(&ctx, &mut h.renderer, grid, &args.iso);
             }
+            let molsurface = args.molsurface.mesh(&doc, &args.iso.base())?;
+            surface_cli::show(&ctx, &mut h.renderer, grid, &args.iso, molsurface);
             let img = h.render(&ctx, &camera, &settings)?;
             img.save(&args.output).with_context(|| format!("writing {}", args.output.display()))?;
             eprintln!("wrote {} ({}x{}, {})", args.output.display(), img.width(), img.height(), ctx.describe());
@@ -652,6 +662,7 @@ fn main() -> Result<()> {
         Some(Command::Bench(BenchCommand::Load(args))) => structure_cli::bench_load(&args),
         Some(Command::Bench(BenchCommand::Spheres(args))) => structure_cli::bench_spheres(&args),
         Some(Command::Bench(BenchCommand::Surfaces(args))) => surface_cli::bench_translucent(&args),
+        Some(Command::Bench(BenchCommand::Surface(args))) => molsurface_cli::bench(&args),
         Some(Command::Bench(BenchCommand::Render { file, view, frames, lavapipe, wavefunction })) => {
             let doc = load(file.as_deref())?;
             let camera = view.camera(&doc)?;

@@ -141,15 +141,26 @@ impl IsoArgs {
     }
 }
 
-/// Puts `--iso` surfaces of `grid` into the renderer (nothing when none were asked for).
-pub fn show(ctx: &GpuContext, renderer: &mut Renderer, grid: &VolumeGrid, iso: &IsoArgs) {
-    if iso.levels().is_empty() {
+/// Puts `--iso` surfaces of `grid` and a molecular surface into the renderer (nothing when
+/// neither was asked for).
+pub fn show(
+    ctx: &GpuContext,
+    renderer: &mut Renderer,
+    grid: Option<&VolumeGrid>,
+    iso: &IsoArgs,
+    molsurface: Option<(Mesh, SurfaceLook)>,
+) {
+    let mut meshes = match grid {
+        Some(grid) if !iso.levels().is_empty() => iso.meshes(grid, &iso.base()),
+        _ => Vec::new(),
+    };
+    meshes.extend(molsurface);
+    if meshes.is_empty() {
         return;
     }
-    let meshes = iso.meshes(grid, &iso.base());
     let triangles = show_meshes(ctx, renderer.main(), &meshes);
     let how = if iso.translucent { ", translucent" } else { "" };
-    eprintln!("isosurfaces: {} surface(s), {triangles} triangles{how}", meshes.len());
+    eprintln!("surfaces: {} surface(s), {triangles} triangles{how}", meshes.len());
 }
 
 /// Prints what the rendered frame shows at `pixel`, and how long the pick took.
@@ -228,6 +239,8 @@ pub struct MeshArgs {
     iso: IsoArgs,
     #[command(flatten)]
     grid: GridArgs,
+    #[command(flatten)]
+    molsurface: super::molsurface_cli::MolSurfaceArgs,
     /// Output: .obj (Wavefront), .ply (binary) or .glb (glTF binary); positions in ångström.
     #[arg(short, long)]
     output: PathBuf,
@@ -236,14 +249,18 @@ pub struct MeshArgs {
 pub fn mesh(args: &MeshArgs) -> Result<()> {
     let format = MeshFormat::from_path(&args.output)
         .with_context(|| format!("{}: the extension must be .obj, .ply or .glb", args.output.display()))?;
-    if args.iso.levels().is_empty() {
-        bail!("give at least one --iso VALUE or --iso-sigma S");
+    if args.iso.levels().is_empty() && args.molsurface.surface.is_none() {
+        bail!("give at least one --iso VALUE or --iso-sigma S, or --surface gaussian|ses");
     }
     let doc = load(Some(&args.file))?;
-    let grid = args.grid.grid(&doc)?;
-    let meshes: Vec<(Mesh, SurfaceLook)> =
-        args.iso.meshes(&grid, &IsosurfaceSettings::default()).into_iter().map(|(m, c)| (m.welded(), c)).collect();
-    let names = surface_names(&grid, &args.iso);
+    let (meshes, names) = if args.molsurface.surface.is_some() {
+        let built = args.molsurface.mesh(&doc, &IsosurfaceSettings::default())?;
+        (built.into_iter().collect(), vec![args.molsurface.name().to_string()])
+    } else {
+        let grid = args.grid.grid(&doc)?;
+        (args.iso.meshes(&grid, &IsosurfaceSettings::default()), surface_names(&grid, &args.iso))
+    };
+    let meshes: Vec<(Mesh, SurfaceLook)> = meshes.into_iter().map(|(m, c)| (m.welded(), c)).collect();
     let named: Vec<NamedMesh> =
         meshes.iter().zip(&names).map(|((mesh, color), name)| NamedMesh { name, mesh, color: color.color }).collect();
     let file = std::fs::File::create(&args.output).with_context(|| format!("creating {}", args.output.display()))?;

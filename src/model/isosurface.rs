@@ -38,6 +38,12 @@ impl Mesh {
         self.triangles().map(|[a, b, c]| 0.5 * (b - a).cross(c - a).length()).sum()
     }
 
+    /// Enclosed volume (bohr³) of a closed mesh wound counter-clockwise seen from outside: the
+    /// divergence theorem, one signed tetrahedron per triangle.
+    pub fn volume(&self) -> f64 {
+        self.triangles().map(|[a, b, c]| a.dot(b.cross(c)) / 6.0).sum()
+    }
+
     /// The corner positions of each triangle, in double precision.
     pub fn triangles(&self) -> impl Iterator<Item = [DVec3; 3]> + '_ {
         self.indices.chunks_exact(3).map(|t| std::array::from_fn(|c| self.positions[t[c] as usize].as_dvec3()))

@@ -21,6 +21,7 @@ pub mod overlap;
 pub mod scan;
 pub mod solid_harmonics;
 pub mod structure;
+pub mod surface;
 pub mod synthetic;
 pub mod units;
 

@@ -1,0 +1,185 @@
+//! `render`/`mesh --surface gaussian|ses` and `bench surface`: molecular surfaces from the
+//! command line.
+
+use std::sync::atomic::AtomicBool;
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use clap::{Args, ValueEnum};
+use orbcloud::model::Document;
+use orbcloud::model::isosurface::Mesh;
+use orbcloud::model::surface::{self, Sphere, Surface, SurfaceKind, SurfaceParams};
+use orbcloud::model::units::BOHR_PER_ANGSTROM;
+use orbcloud::scene::IsosurfaceSettings;
+use orbcloud::scene::translucency::SurfaceLook;
+
+#[derive(Clone, Copy, ValueEnum)]
+pub enum SurfaceArg {
+    /// Gaussian density of the atoms (VMD's QuickSurf, Mol*'s default).
+    Gaussian,
+    /// Solvent-excluded surface (Connolly's), for a probe of radius --probe.
+    Ses,
+}
+
+/// The molecular surface options of `render` and `mesh`.
+#[derive(Args, Clone)]
+pub struct MolSurfaceArgs {
+    /// A molecular surface around the atoms.
+    #[arg(long, value_enum)]
+    pub surface: Option<SurfaceArg>,
+    /// Grid spacing of the molecular surface, Å (default 0.25 Å, coarser for big molecules).
+    #[arg(long)]
+    pub surface_resolution: Option<f64>,
+    /// Probe radius of the solvent-excluded surface, Å.
+    #[arg(long, default_value_t = 1.4)]
+    pub probe: f64,
+    /// Smoothness α of the Gaussian surface (larger hugs the atoms tighter).
+    #[arg(long, default_value_t = SurfaceParams::SMOOTHNESS)]
+    pub smoothness: f64,
+}
+
+/// The colour molecular surfaces are drawn in (linear RGB): a pale blue-grey that shows shape
+/// by its shading.
+pub const SURFACE_COLOR: [f32; 3] = [0.62, 0.68, 0.80];
+
+impl MolSurfaceArgs {
+    fn kind(arg: SurfaceArg) -> SurfaceKind {
+        match arg {
+            SurfaceArg::Gaussian => SurfaceKind::Gaussian,
+            SurfaceArg::Ses => SurfaceKind::SolventExcluded,
+        }
+    }
+
+    /// The parameters for these spheres.
+    pub fn params(&self, arg: SurfaceArg, spheres: &[Sphere]) -> SurfaceParams {
+        let mut p = SurfaceParams::auto(Self::kind(arg), spheres);
+        if let Some(r) = self.surface_resolution {
+            p.resolution = r * BOHR_PER_ANGSTROM;
+        }
+        p.probe = self.probe * BOHR_PER_ANGSTROM;
+        p.smoothness = self.smoothness;
+        p
+    }
+
+    /// Builds the surface asked for, if any, telling how long it took.
+    pub fn build(&self, doc: &Document) -> Result<Option<Surface>> {
+        let Some(arg) = self.surface else { return Ok(None) };
+        let spheres = Sphere::of_molecule(&doc.molecule);
+        let params = self.params(arg, &spheres);
+        let t = Instant::now();
+        let built = surface::build(&spheres, &params, &AtomicBool::new(false))
+            .with_context(|| format!("{}: the molecular surface", doc.source))?;
+        eprintln!(
+            "{:?} surface: {} atoms, grid {:?} at {:.2} Å, {} triangles, area {:.1} Å², volume {:.1} Å³, {:.0} ms",
+            params.kind,
+            spheres.len(),
+            built.grid.dims,
+            params.resolution / BOHR_PER_ANGSTROM,
+            built.mesh.triangle_count(),
+            built.mesh.area() / BOHR_PER_ANGSTROM.powi(2),
+            built.mesh.volume() / BOHR_PER_ANGSTROM.powi(3),
+            t.elapsed().as_secs_f64() * 1e3
+        );
+        Ok(Some(built))
+    }
+
+    /// The surface asked for with its look (translucent with seed 003's optics when `iso` says so).
+    pub fn mesh(&self, doc: &Document, iso: &IsosurfaceSettings) -> Result<Option<(Mesh, SurfaceLook)>> {
+        Ok(self.build(doc)?.map(|s| (s.mesh, iso.look(SURFACE_COLOR))))
+    }
+
+    /// What mesh files call it.
+    pub fn name(&self) -> &'static str {
+        match self.surface {
+            Some(SurfaceArg::Gaussian) => "gaussian_surface",
+            Some(SurfaceArg::Ses) => "solvent_excluded_surface",
+            None => "surface",
+        }
+    }
+}
+
+#[derive(Args)]
+pub struct SurfaceBench {
+    /// A structure or molecule file (PDB, mmCIF, XYZ, cube, Molden, fchk).
+    file: std::path::PathBuf,
+    #[command(flatten)]
+    surface: MolSurfaceArgs,
+    /// Timed builds per kind (the median is reported).
+    #[arg(long, default_value_t = 3)]
+    runs: usize,
+    /// Image size, WIDTHxHEIGHT.
+    #[arg(long, default_value = "800x600", value_parser = super::parse_size)]
+    size: [u32; 2],
+    /// Frames to time (after two warm-up frames).
+    #[arg(long, default_value_t = 10)]
+    frames: u32,
+    /// Use the CPU Vulkan adapter (lavapipe) even when a GPU is present.
+    #[arg(long)]
+    lavapipe: bool,
+}
+
+/// `orbcloud bench surface`: the build time of each surface (or the one `--surface` names),
+/// its size, and ms per frame drawing it at the given size, turning a little each frame.
+pub fn bench(args: &SurfaceBench) -> Result<()> {
+    use orbcloud::gpu::{FrameInput, OffscreenTarget, Renderer};
+    use orbcloud::scene::{AtomStyle, Camera, RenderSettings};
+    let doc = orbcloud::formats::load(&args.file)?;
+    let spheres = Sphere::of_molecule(&doc.molecule);
+    let kinds = match args.surface.surface {
+        Some(k) => vec![k],
+        None => vec![SurfaceArg::Gaussian, SurfaceArg::Ses],
+    };
+    let ctx = super::gpu(args.lavapipe)?;
+    println!("adapter: {}", ctx.describe());
+    println!("file: {}, {} atoms, {} threads", doc.source, spheres.len(), rayon::current_num_threads());
+    for arg in kinds {
+        let params = args.surface.params(arg, &spheres);
+        let mut times = Vec::new();
+        let mut built = None;
+        for _ in 0..args.runs.max(1) {
+            let t = Instant::now();
+            built = Some(surface::build(&spheres, &params, &AtomicBool::new(false))?);
+            times.push(t.elapsed().as_secs_f64() * 1e3);
+        }
+        times.sort_by(f64::total_cmp);
+        let s = built.context("no surface was built")?;
+        // Drawn alone, opaque, as the viewer draws a surface.
+        let mut renderer = Renderer::new(&ctx);
+        renderer.main().set_molecule(&ctx, &doc.molecule, AtomStyle::Hidden);
+        let triangles =
+            orbcloud::headless::show_meshes(&ctx, renderer.main(), &[(s.mesh.clone(), SURFACE_COLOR.into())]);
+        let (lo, hi) = s.grid.bounds();
+        let camera = Camera::framing(lo.as_vec3(), hi.as_vec3());
+        let target = OffscreenTarget::new(&ctx.device, args.size);
+        let settings = RenderSettings::default();
+        let mut frames = Vec::new();
+        for f in 0..args.frames.max(1) + 2 {
+            let mut cam = camera;
+            cam.orbit(0.02 * f as f32, 0.01 * f as f32);
+            let t = Instant::now();
+            let mut encoder = ctx.device.create_command_encoder(&Default::default());
+            renderer.render(&ctx, &mut encoder, &target.color_view, &FrameInput::single(&cam, &settings, args.size));
+            ctx.queue.submit([encoder.finish()]);
+            ctx.device.poll(wgpu::PollType::wait_indefinitely())?;
+            if f >= 2 {
+                frames.push(t.elapsed().as_secs_f64() * 1e3);
+            }
+        }
+        frames.sort_by(f64::total_cmp);
+        println!(
+            "surface={:?} resolution_angstrom={:.2} grid={:?} triangles={triangles} area_angstrom2={:.1} volume_angstrom3={:.1} \
+             build_ms_median={:.1} build_ms_min={:.1} frame_ms_median={:.1} ({}x{})",
+            params.kind,
+            params.resolution / BOHR_PER_ANGSTROM,
+            s.grid.dims,
+            s.mesh.area() / BOHR_PER_ANGSTROM.powi(2),
+            s.mesh.volume() / BOHR_PER_ANGSTROM.powi(3),
+            times[times.len() / 2],
+            times[0],
+            frames[frames.len() / 2],
+            args.size[0],
+            args.size[1]
+        );
+    }
+    Ok(())
+}
