@@ -387,3 +387,51 @@ fn structures_through_info_render_and_bench() {
         "{text}"
     );
 }
+
+#[test]
+fn molecular_surfaces_are_written_and_rendered() {
+    let pdb = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/structures/4e43_excerpt.pdb");
+    let dir = tempfile::tempdir().unwrap();
+    let mut areas = Vec::new();
+    for (kind, name) in [("ses", "solvent_excluded_surface"), ("gaussian", "gaussian_surface")] {
+        let out = dir.path().join(format!("{kind}.obj"));
+        let run =
+            orbcloud(&["mesh", pdb, "--surface", kind, "--surface-resolution", "0.5", "-o", out.to_str().unwrap()]);
+        let said = String::from_utf8_lossy(&run.stderr).to_string();
+        assert!(run.status.success(), "{said}");
+        let obj = std::fs::read_to_string(&out).unwrap();
+        assert_eq!(obj.lines().filter(|l| l.starts_with("o ")).collect::<Vec<_>>(), [format!("o {name}")]);
+        assert!(obj.lines().filter(|l| l.starts_with("f ")).count() > 10_000, "{kind}: a protein's surface");
+        let area: f64 = said.split("area ").nth(1).and_then(|t| t.split(' ').next()).unwrap().parse().unwrap();
+        areas.push(area);
+    }
+    // 181 atoms shown: each kind's area is of the order of the atoms' own (≈ 10–20 Å² each).
+    assert!(areas.iter().all(|a| (1000.0..4000.0).contains(a)), "{areas:?}");
+    let png = dir.path().join("ses.png");
+    let run = orbcloud(&[
+        "render",
+        pdb,
+        "--surface",
+        "ses",
+        "--surface-resolution",
+        "0.6",
+        "--atoms",
+        "hidden",
+        "--lavapipe",
+        "--size",
+        "120x90",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let img = image::open(&png).unwrap().to_rgba8();
+    let bg = *img.get_pixel(0, 0);
+    let drawn = img.pixels().filter(|p| p.0.iter().zip(bg.0).any(|(a, b)| a.abs_diff(b) > 8)).count();
+    assert!(drawn > 120 * 90 / 10, "the surface covers the middle of the picture: {drawn} pixels");
+    let bad = orbcloud(&["mesh", pdb, "--surface", "ses", "--surface-resolution", "0.0001", "-o", "x.obj"]);
+    let said = String::from_utf8_lossy(&bad.stderr);
+    assert!(
+        !bad.status.success() && said.contains("coarser resolution") && said.contains("4e43_excerpt.pdb"),
+        "{said}"
+    );
+}

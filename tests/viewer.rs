@@ -629,3 +629,44 @@ fn a_lost_device_brings_the_scene_back_on_a_new_device_without_reading_files_aga
     // And it draws: the view holds the cube's cloud on the new device.
     next.get_by_label("cloud");
 }
+
+#[test]
+fn a_structure_gets_a_molecular_surface_from_the_scene_panel_that_follows_its_selection() {
+    use orbcloud::app::Opening;
+    use orbcloud::gpu::frame::PickId;
+    let mut h = harness();
+    h.run_steps(1);
+    let ctx = h.ctx.clone();
+    let pdb =
+        std::path::PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/structures/4e43_excerpt.pdb"));
+    h.state_mut().open_as(pdb, Opening::Replace, &ctx);
+    wait_loaded(&mut h);
+    h.get_by_role_and_label(egui::accesskit::Role::ComboBox, "surface").click();
+    h.run_steps(2);
+    h.get_by_label("solvent-excluded").click();
+    wait_loaded(&mut h);
+    let state = h.state().objects[0].state.surface;
+    assert_eq!(state.choice, orbcloud::scene::SurfaceChoice::SolventExcluded);
+    let all = h.state().status.clone();
+    assert!(all.starts_with("isosurfaces: ") && !all.starts_with("isosurfaces: 0 "), "{all}");
+    // The surface covers the atoms: what lies under an atom's centre is the surface.
+    let atom = h.state().atom_on_screen(0).expect("an atom on screen");
+    h.hover_at(atom);
+    h.run_steps(2);
+    assert!(matches!(h.state().hovered(), Some(PickId::Surface { object: 0, .. })), "{:?}", h.state().hovered());
+    // Leaving the waters out wraps fewer atoms: fewer triangles.
+    h.state_mut().objects[0].state.selection = "not resn HOH".into();
+    h.state_mut().refresh_isosurfaces(0);
+    wait_loaded(&mut h);
+    let count = |s: &str| s.split_whitespace().nth(1).and_then(|n| n.parse::<usize>().ok()).expect(s);
+    let protein = h.state().status.clone();
+    assert!(count(&protein) < count(&all), "{protein} vs {all}");
+    // Turning it off leaves no surface.
+    h.get_by_role_and_label(egui::accesskit::Role::ComboBox, "surface").click();
+    h.run_steps(2);
+    h.get_by_label("off").click();
+    wait_loaded(&mut h);
+    h.hover_at(atom);
+    h.run_steps(2);
+    assert!(!matches!(h.state().hovered(), Some(PickId::Surface { .. })), "{:?}", h.state().hovered());
+}

@@ -64,7 +64,12 @@ pub fn selection(ui: &mut egui::Ui, app: &mut OrbApp) {
     }
     if changed {
         o.state.selection = query;
+        let surface = o.state.surface.choice != crate::scene::SurfaceChoice::Off;
         app.restyle_atoms(n);
+        if surface {
+            // The molecular surface wraps the atoms shown.
+            app.refresh_isosurfaces(n);
+        }
     }
 }
 
@@ -99,6 +104,9 @@ impl OrbApp {
         self.measurements.list.clear();
         if let Some(vp) = &mut self.viewport {
             vp.set_atoms(n, &self.objects[n].doc, &self.objects[n].state);
+        }
+        if self.objects[n].state.surface.choice != crate::scene::SurfaceChoice::Off {
+            self.refresh_isosurfaces(n);
         }
         self.world = World::of(&self.objects);
     }

@@ -7,7 +7,7 @@ use egui::{ComboBox, DragValue, RichText, Slider};
 
 use super::OrbApp;
 use crate::model::units::{ANGSTROM_PER_BOHR, BOHR_PER_ANGSTROM};
-use crate::scene::{AtomStyle, IsoLevel, IsosurfaceSettings, Placement};
+use crate::scene::{AtomStyle, IsoLevel, IsosurfaceSettings, Placement, SurfaceChoice, SurfaceSettings};
 
 /// What the user asked for in the panel this frame, applied after it is drawn.
 enum Edit {
@@ -75,6 +75,7 @@ pub fn section(ui: &mut egui::Ui, app: &mut OrbApp) {
                 object.state.isosurfaces.push(another_isosurface(s.iso, &object.state.isosurfaces));
                 changed = true;
             }
+            changed |= surface_editor(ui, &mut object.state.surface);
             if changed {
                 edits.push(Edit::Isosurfaces);
             }
@@ -93,6 +94,49 @@ pub fn section(ui: &mut egui::Ui, app: &mut OrbApp) {
             Edit::Isosurfaces => app.refresh_isosurfaces(n),
         }
     }
+}
+
+/// The molecular surface: which kind, its grid spacing and probe or smoothness, its colour
+/// and translucency. Whether anything changed.
+fn surface_editor(ui: &mut egui::Ui, s: &mut SurfaceSettings) -> bool {
+    let before = *s;
+    ui.horizontal(|ui| {
+        let label = ui.label("surface");
+        ComboBox::from_id_salt("scene molecular surface")
+            .selected_text(s.choice.name())
+            .show_ui(ui, |ui| {
+                for c in SurfaceChoice::ALL {
+                    ui.selectable_value(&mut s.choice, c, c.name());
+                }
+            })
+            .response
+            .labelled_by(label.id)
+            .on_hover_text("Gaussian: the atoms' blended density (VMD's QuickSurf); solvent-excluded: where a probe cannot reach (Connolly's)");
+        if s.choice != SurfaceChoice::Off {
+            ui.color_edit_button_rgb(&mut s.color);
+            ui.checkbox(&mut s.translucent, "translucent");
+        }
+    });
+    if s.choice != SurfaceChoice::Off {
+        ui.horizontal(|ui| {
+            let mut auto = s.resolution.is_none();
+            if ui.checkbox(&mut auto, "auto grid").on_hover_text("0.25 Å, coarser for big molecules").changed() {
+                s.resolution = if auto { None } else { Some(0.5) };
+            }
+            if let Some(r) = &mut s.resolution {
+                ui.add(DragValue::new(r).speed(0.01).range(0.1..=3.0).suffix(" Å").max_decimals(2));
+            }
+            match s.choice {
+                SurfaceChoice::SolventExcluded => {
+                    ui.add(DragValue::new(&mut s.probe).speed(0.02).range(0.0..=3.0).prefix("probe ").suffix(" Å"));
+                }
+                _ => {
+                    ui.add(DragValue::new(&mut s.smoothness).speed(0.05).range(0.3..=5.0).prefix("α "));
+                }
+            }
+        });
+    }
+    *s != before
 }
 
 fn atom_style(ui: &mut egui::Ui, style: &mut AtomStyle, label: egui::Id) {

@@ -12,12 +12,15 @@ use crate::gpu::gto::GtoFillPass;
 use crate::gpu::oit::FragmentStats;
 use crate::gpu::{FrameInput, GpuContext, GpuError, OffscreenTarget, Renderer, Tile};
 use crate::headless::scan::ScanScene;
-use crate::headless::{Evaluated, WavefunctionView, evaluate_within, isosurfaces_within, show_meshes};
+use crate::headless::{
+    Evaluated, WavefunctionView, evaluate_within, isosurfaces_within, molecular_surface, show_meshes,
+};
 use crate::model::isosurface::Mesh;
 use crate::model::{Document, VolumeGrid};
 use crate::scene::translucency::SurfaceLook;
-use crate::scene::{IsosurfaceSettings, ObjectState, RenderSettings, VolumeSettings};
-use std::sync::Arc;
+use crate::scene::{IsosurfaceSettings, ObjectState, RenderSettings, SurfaceChoice, SurfaceSettings, VolumeSettings};
+use std::sync::atomic::AtomicBool;
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 /// A click in the view: what the frame showed under the pointer, and whether Shift was held.
@@ -73,8 +76,31 @@ struct ObjectJobs {
     /// Orbitals filled on the GPU and densities evaluated on the CPU, with a note when the grid
     /// had to be coarser than asked.
     evaluation: Latest<Evaluation>,
-    /// Marching cubes over the grid shown.
+    /// Marching cubes over the grid shown, and the molecular surface.
     extraction: Latest<Meshes>,
+    /// The last molecular surface built, kept while only its look changes (an isosurface
+    /// slider moving does not build it again).
+    surface: Arc<Mutex<Option<BuiltSurface>>>,
+}
+
+/// A molecular surface with what it was built from: its settings and the atoms' fingerprint.
+struct BuiltSurface {
+    settings: SurfaceSettings,
+    atoms: (usize, [u64; 3]),
+    mesh: Mesh,
+    note: Option<String>,
+}
+
+/// Enough of the atoms shown to tell when a surface must be built again (another model,
+/// another selection): their count and the sum of their positions' bits.
+fn fingerprint(doc: &Document, selection: &str) -> (usize, [u64; 3]) {
+    let sum = doc.molecule.atoms.iter().fold([0u64; 3], |acc, a| {
+        let p = a.position.to_array().map(f64::to_bits);
+        [acc[0].wrapping_add(p[0]), acc[1].wrapping_add(p[1]), acc[2].wrapping_add(p[2])]
+    });
+    let mut hash = std::hash::DefaultHasher::new();
+    std::hash::Hash::hash(selection, &mut hash);
+    (doc.molecule.atoms.len(), [sum[0], sum[1], sum[2] ^ std::hash::Hasher::finish(&hash)])
 }
 
 pub struct Viewport {
@@ -205,11 +231,17 @@ impl Viewport {
     /// background; [`Self::poll`] shows them when they are done.
     pub fn update_isosurfaces(&mut self, n: usize, doc: &Arc<Document>, state: &ObjectState) {
         let computed = self.slot(n).computed.clone();
+        let cache = self.slot(n).surface.clone();
         let (doc, volume) = (doc.clone(), state.volume);
         let levels: Vec<IsosurfaceSettings> = state.all_isosurfaces().copied().collect();
-        self.request_meshes(n, move |max_bytes| {
+        let (surface, selection) = (state.surface, state.selection.clone());
+        let max_bytes = self.ctx.device.limits().max_buffer_size;
+        self.slot(n).extraction.request(move |cancel| {
             let grid = computed.as_deref().or(doc.volumes.get(volume));
-            grid.map(|g| isosurfaces_within(g, &levels, max_bytes)).unwrap_or_default()
+            let (mut meshes, note) = grid.map(|g| isosurfaces_within(g, &levels, max_bytes)).unwrap_or_default();
+            let (built, surface_note) = molecular_surface_cached(&cache, &doc, &surface, &selection, max_bytes, cancel);
+            meshes.extend(built);
+            (meshes, note.into_iter().chain(surface_note).reduce(|a, b| format!("{a}; {b}")))
         });
     }
 
@@ -274,7 +306,7 @@ impl Viewport {
         if self.slots.iter().any(|s| s.evaluation.is_busy()) {
             Some("evaluating on the grid…")
         } else if self.slots.iter().any(|s| s.extraction.is_busy()) {
-            Some("cutting isosurfaces…")
+            Some("cutting surfaces…")
         } else {
             None
         }
@@ -302,6 +334,7 @@ impl Viewport {
                 computed: None,
                 evaluation: Latest::new("evaluating the orbital", move || repaint()),
                 extraction: Latest::new("cutting isosurfaces", move || again()),
+                surface: Arc::default(),
             });
         }
         &mut self.slots[n]
@@ -688,4 +721,31 @@ fn handle_input(ui: &egui::Ui, response: &egui::Response, view: &mut ViewState) 
             cam.zoom(KEY_ZOOM);
         }
     });
+}
+
+/// Object's molecular surface with its look (nothing when it is off), from `cache` when the
+/// geometry and atoms are those it was built for; a note when it was built coarser or failed.
+fn molecular_surface_cached(
+    cache: &Mutex<Option<BuiltSurface>>,
+    doc: &Document,
+    settings: &SurfaceSettings,
+    selection: &str,
+    max_bytes: u64,
+    cancel: &AtomicBool,
+) -> (Option<(Mesh, SurfaceLook)>, Option<String>) {
+    if settings.choice == SurfaceChoice::Off {
+        return (None, None);
+    }
+    let atoms = fingerprint(doc, selection);
+    let mut cache = cache.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+    let fresh = cache.as_ref().is_some_and(|b| b.atoms == atoms && b.settings.same_geometry(settings));
+    if !fresh {
+        match molecular_surface(doc, settings, selection, max_bytes, cancel) {
+            Ok(Some((mesh, note))) => *cache = Some(BuiltSurface { settings: *settings, atoms, mesh, note }),
+            Ok(None) => return (None, None),
+            Err(e) => return (None, Some(format!("molecular surface: {e}"))),
+        }
+    }
+    let built = cache.as_ref().expect("just built");
+    (Some((built.mesh.clone(), settings.look())), built.note.clone())
 }

@@ -6,12 +6,13 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
+use orbcloud::headless::molecular_surface;
 use orbcloud::model::Document;
 use orbcloud::model::isosurface::Mesh;
-use orbcloud::model::surface::{self, Sphere, Surface, SurfaceKind, SurfaceParams};
+use orbcloud::model::surface::{self, Sphere, SurfaceParams};
 use orbcloud::model::units::BOHR_PER_ANGSTROM;
-use orbcloud::scene::IsosurfaceSettings;
 use orbcloud::scene::translucency::SurfaceLook;
+use orbcloud::scene::{SurfaceChoice, SurfaceSettings};
 
 #[derive(Clone, Copy, ValueEnum)]
 pub enum SurfaceArg {
@@ -38,54 +39,39 @@ pub struct MolSurfaceArgs {
     pub smoothness: f64,
 }
 
-/// The colour molecular surfaces are drawn in (linear RGB): a pale blue-grey that shows shape
-/// by its shading.
-pub const SURFACE_COLOR: [f32; 3] = [0.62, 0.68, 0.80];
-
 impl MolSurfaceArgs {
-    fn kind(arg: SurfaceArg) -> SurfaceKind {
-        match arg {
-            SurfaceArg::Gaussian => SurfaceKind::Gaussian,
-            SurfaceArg::Ses => SurfaceKind::SolventExcluded,
+    /// The surface these options ask for (off without `--surface`).
+    pub fn settings(&self, translucent: bool) -> SurfaceSettings {
+        SurfaceSettings {
+            choice: match self.surface {
+                None => SurfaceChoice::Off,
+                Some(SurfaceArg::Gaussian) => SurfaceChoice::Gaussian,
+                Some(SurfaceArg::Ses) => SurfaceChoice::SolventExcluded,
+            },
+            resolution: self.surface_resolution.map(|r| r as f32),
+            probe: self.probe as f32,
+            smoothness: self.smoothness as f32,
+            translucent,
+            ..Default::default()
         }
     }
 
-    /// The parameters for these spheres.
-    pub fn params(&self, arg: SurfaceArg, spheres: &[Sphere]) -> SurfaceParams {
-        let mut p = SurfaceParams::auto(Self::kind(arg), spheres);
-        if let Some(r) = self.surface_resolution {
-            p.resolution = r * BOHR_PER_ANGSTROM;
-        }
-        p.probe = self.probe * BOHR_PER_ANGSTROM;
-        p.smoothness = self.smoothness;
-        p
-    }
-
-    /// Builds the surface asked for, if any, telling how long it took.
-    pub fn build(&self, doc: &Document) -> Result<Option<Surface>> {
-        let Some(arg) = self.surface else { return Ok(None) };
-        let spheres = Sphere::of_molecule(&doc.molecule);
-        let params = self.params(arg, &spheres);
+    /// The surface asked for, if any, with its look, telling what was built and how long it took.
+    pub fn mesh(&self, doc: &Document, translucent: bool) -> Result<Option<(Mesh, SurfaceLook)>> {
+        let settings = self.settings(translucent);
         let t = Instant::now();
-        let built = surface::build(&spheres, &params, &AtomicBool::new(false))
+        let built = molecular_surface(doc, &settings, "", u64::MAX, &AtomicBool::new(false))
             .with_context(|| format!("{}: the molecular surface", doc.source))?;
+        let Some((mesh, _)) = built else { return Ok(None) };
         eprintln!(
-            "{:?} surface: {} atoms, grid {:?} at {:.2} Å, {} triangles, area {:.1} Å², volume {:.1} Å³, {:.0} ms",
-            params.kind,
-            spheres.len(),
-            built.grid.dims,
-            params.resolution / BOHR_PER_ANGSTROM,
-            built.mesh.triangle_count(),
-            built.mesh.area() / BOHR_PER_ANGSTROM.powi(2),
-            built.mesh.volume() / BOHR_PER_ANGSTROM.powi(3),
+            "{} surface: {} triangles, area {:.1} Å², volume {:.1} Å³, {:.0} ms",
+            settings.choice.name(),
+            mesh.triangle_count(),
+            mesh.area() / BOHR_PER_ANGSTROM.powi(2),
+            mesh.volume() / BOHR_PER_ANGSTROM.powi(3),
             t.elapsed().as_secs_f64() * 1e3
         );
-        Ok(Some(built))
-    }
-
-    /// The surface asked for with its look (translucent with seed 003's optics when `iso` says so).
-    pub fn mesh(&self, doc: &Document, iso: &IsosurfaceSettings) -> Result<Option<(Mesh, SurfaceLook)>> {
-        Ok(self.build(doc)?.map(|s| (s.mesh, iso.look(SURFACE_COLOR))))
+        Ok(Some((mesh, settings.look())))
     }
 
     /// What mesh files call it.
@@ -124,16 +110,18 @@ pub fn bench(args: &SurfaceBench) -> Result<()> {
     use orbcloud::gpu::{FrameInput, OffscreenTarget, Renderer};
     use orbcloud::scene::{AtomStyle, Camera, RenderSettings};
     let doc = orbcloud::formats::load(&args.file)?;
-    let spheres = Sphere::of_molecule(&doc.molecule);
+    let spheres = Sphere::of_molecule(&doc.molecule, None);
     let kinds = match args.surface.surface {
         Some(k) => vec![k],
         None => vec![SurfaceArg::Gaussian, SurfaceArg::Ses],
     };
+    let color = SurfaceSettings::default().color;
     let ctx = super::gpu(args.lavapipe)?;
     println!("adapter: {}", ctx.describe());
     println!("file: {}, {} atoms, {} threads", doc.source, spheres.len(), rayon::current_num_threads());
     for arg in kinds {
-        let params = args.surface.params(arg, &spheres);
+        let asked = MolSurfaceArgs { surface: Some(arg), ..args.surface.clone() };
+        let params = asked.settings(false).params(&spheres).context("a surface kind")?;
         let mut times = Vec::new();
         let mut built = None;
         for _ in 0..args.runs.max(1) {
@@ -146,8 +134,7 @@ pub fn bench(args: &SurfaceBench) -> Result<()> {
         // Drawn alone, opaque, as the viewer draws a surface.
         let mut renderer = Renderer::new(&ctx);
         renderer.main().set_molecule(&ctx, &doc.molecule, AtomStyle::Hidden);
-        let triangles =
-            orbcloud::headless::show_meshes(&ctx, renderer.main(), &[(s.mesh.clone(), SURFACE_COLOR.into())]);
+        let triangles = orbcloud::headless::show_meshes(&ctx, renderer.main(), &[(s.mesh.clone(), color.into())]);
         let (lo, hi) = s.grid.bounds();
         let camera = Camera::framing(lo.as_vec3(), hi.as_vec3());
         let target = OffscreenTarget::new(&ctx.device, args.size);

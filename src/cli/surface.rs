@@ -154,13 +154,14 @@ pub fn show(
         Some(grid) if !iso.levels().is_empty() => iso.meshes(grid, &iso.base()),
         _ => Vec::new(),
     };
+    let what = if molsurface.is_some() { "surfaces" } else { "isosurfaces" };
     meshes.extend(molsurface);
     if meshes.is_empty() {
         return;
     }
     let triangles = show_meshes(ctx, renderer.main(), &meshes);
     let how = if iso.translucent { ", translucent" } else { "" };
-    eprintln!("surfaces: {} surface(s), {triangles} triangles{how}", meshes.len());
+    eprintln!("{what}: {} surface(s), {triangles} triangles{how}", meshes.len());
 }
 
 /// Prints what the rendered frame shows at `pixel`, and how long the pick took.
@@ -254,7 +255,7 @@ pub fn mesh(args: &MeshArgs) -> Result<()> {
     }
     let doc = load(Some(&args.file))?;
     let (meshes, names) = if args.molsurface.surface.is_some() {
-        let built = args.molsurface.mesh(&doc, &IsosurfaceSettings::default())?;
+        let built = args.molsurface.mesh(&doc, false)?;
         (built.into_iter().collect(), vec![args.molsurface.name().to_string()])
     } else {
         let grid = args.grid.grid(&doc)?;

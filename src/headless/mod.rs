@@ -3,6 +3,8 @@
 
 pub mod scan;
 
+use std::sync::atomic::AtomicBool;
+
 use glam::DVec3;
 
 use crate::gpu::gto::{GtoFillPass, read_volume, volume_from_texture};
@@ -16,11 +18,13 @@ use crate::model::grid::ValueKind;
 use crate::model::gto::{GridSpec, PreparedBasis};
 use crate::model::isosurface::{self, Level, Mesh};
 use crate::model::orbitals::Quantity;
+use crate::model::surface::{self, Sphere, SurfaceError};
+use crate::model::units::ANGSTROM_PER_BOHR;
 use crate::model::{Document, VolumeGrid};
 use crate::scene::coloring::{AtomColors, atom_colors};
 use crate::scene::selection::Selection;
 use crate::scene::translucency::SurfaceLook;
-use crate::scene::{Camera, IsosurfaceSettings, ObjectState, RenderSettings, ViewPreset};
+use crate::scene::{Camera, IsosurfaceSettings, ObjectState, RenderSettings, SurfaceSettings, ViewPreset};
 
 /// Space (bohr) around the atoms in which orbitals are evaluated.
 pub const ORBITAL_MARGIN: f64 = 4.5;
@@ -232,8 +236,7 @@ pub fn isosurfaces_within(
         let coarse = (step > 1).then(|| grid.subsampled(step));
         let g = coarse.as_ref().unwrap_or(grid);
         let meshes: Vec<_> = levels.iter().flat_map(|iso| isosurfaces(g, iso)).collect();
-        let fits =
-            meshes.iter().all(|(m, _)| (m.positions.len() as u64 * 24).max(m.indices.len() as u64 * 4) <= max_bytes);
+        let fits = meshes.iter().all(|(m, _)| mesh_fits(m, max_bytes));
         if fits || step >= 64 {
             let note = (step > 1).then(|| {
                 format!("isosurfaces cut from one point in {step} along each axis: the whole grid's are more than a GPU buffer holds")
@@ -241,6 +244,45 @@ pub fn isosurfaces_within(
             return (meshes, note);
         }
         step *= 2;
+    }
+}
+
+/// Whether a mesh fits the GPU buffers of `max_bytes` (24-byte vertices, 4-byte indices).
+fn mesh_fits(m: &Mesh, max_bytes: u64) -> bool {
+    (m.positions.len() as u64 * 24).max(m.indices.len() as u64 * 4) <= max_bytes
+}
+
+/// `doc`'s molecular surface as `s` asks (`None` when it is off), built around the atoms
+/// `selection` shows (all when it is empty or does not parse); built again at twice the
+/// spacing, with a note saying so, while its mesh would not fit a GPU buffer of `max_bytes`.
+/// `cancel` stops it between grid planes.
+pub fn molecular_surface(
+    doc: &Document,
+    s: &SurfaceSettings,
+    selection: &str,
+    max_bytes: u64,
+    cancel: &AtomicBool,
+) -> Result<Option<(Mesh, Option<String>)>, SurfaceError> {
+    let mask = Selection::parse(selection)
+        .ok()
+        .filter(|q| !q.is_everything())
+        .map(|q| q.mask(&doc.molecule, doc.structure.as_ref()));
+    let spheres = Sphere::of_molecule(&doc.molecule, mask.as_deref());
+    let Some(mut params) = s.params(&spheres) else { return Ok(None) };
+    let asked = params.resolution;
+    loop {
+        let built = surface::build(&spheres, &params, cancel)?;
+        if mesh_fits(&built.mesh, max_bytes) || params.resolution >= 16.0 * asked {
+            let note = (params.resolution > asked).then(|| {
+                format!(
+                    "molecular surface built at {:.2} Å: at {:.2} Å its mesh is more than a GPU buffer holds",
+                    params.resolution * ANGSTROM_PER_BOHR,
+                    asked * ANGSTROM_PER_BOHR
+                )
+            });
+            return Ok(Some((built.mesh, note)));
+        }
+        params.resolution *= 2.0;
     }
 }
 

@@ -39,12 +39,15 @@ pub struct Sphere {
 }
 
 impl Sphere {
-    /// A molecule's atoms as van der Waals spheres (ghosts and dummy centres left out).
-    pub fn of_molecule(molecule: &super::Molecule) -> Vec<Sphere> {
+    /// A molecule's atoms as van der Waals spheres: those `shown` marks (all without a mask),
+    /// ghosts and dummy centres left out.
+    pub fn of_molecule(molecule: &super::Molecule, shown: Option<&[bool]>) -> Vec<Sphere> {
         molecule
             .atoms
             .iter()
-            .filter(|a| !a.ghost && a.z > 0)
+            .enumerate()
+            .filter(|&(i, a)| !a.ghost && a.z > 0 && shown.is_none_or(|m| m.get(i).copied().unwrap_or(true)))
+            .map(|(_, a)| a)
             .map(|a| Sphere { centre: a.position, radius: a.element().vdw_radius as f64 * BOHR_PER_ANGSTROM })
             .collect()
     }
@@ -308,36 +311,108 @@ fn ses_field(spec: &GridSpec, spheres: &[Sphere], probe: f64, cancel: &AtomicBoo
         let (i, j, k) = (p / np, p / nz % ny, p % nz);
         o + DVec3::new(i as f64, j as f64, k as f64) * h
     };
-    let near_surface = probe + 2.0 * h;
+    // Only points near the SES need the exact distance (the estimate is at most ~2 voxels long).
+    let band = 2.5 * h;
+    let reach = 4.0 * h;
+    let grown_spheres: Vec<Sphere> = spheres.iter().map(|s| grown(s, probe)).collect();
+    let cells = CellIndex::new(&grown_spheres, reach);
     let mut values = vec![0f32; spec.len()];
-    values.par_chunks_mut(np).enumerate().for_each(|(i, plane)| {
-        let mut around = Vec::new();
-        for (q, v) in plane.iter_mut().enumerate() {
-            let p = i * np + q;
-            if outside[p] >= 0.0 {
-                *v = -probe as f32 - outside[p].min(margin as f32);
-                continue;
+    values.par_chunks_mut(np).enumerate().for_each_init(
+        || (Vec::new(), Vec::new()),
+        |(local, set), (i, plane)| {
+            for (q, v) in plane.iter_mut().enumerate() {
+                let p = i * np + q;
+                if outside[p] >= 0.0 {
+                    *v = -probe as f32 - outside[p].min(margin as f32);
+                    continue;
+                }
+                let x = point(p);
+                let f = point(feature[p] as usize);
+                let f_sphere = spheres.get(nearest[feature[p] as usize] as usize);
+                let mut dist = (x - on_sphere(f, f_sphere, probe)).length();
+                if (dist - probe).abs() < band {
+                    // Every accessible sphere that could cover a point within `reach` of the
+                    // outside point, and among them those whose surface passes that near.
+                    local.clear();
+                    cells.for_each_near(f, |s| {
+                        if (f - s.centre).length() < s.radius + reach {
+                            local.push(*s);
+                        }
+                    });
+                    set.clear();
+                    set.extend(local.iter().filter(|s| ((f - s.centre).length() - s.radius).abs() <= reach));
+                    dist = dist.min(nearest_on_union_surface(x, set, local, (f, reach)));
+                }
+                *v = (dist - probe) as f32;
             }
-            let x = point(p);
-            let f = feature[p] as usize;
-            let mut dist = (x - on_sphere(point(f), spheres.get(nearest[f] as usize), probe)).length();
-            if dist < near_surface {
-                // The spheres around the outside point: the nearest accessible point lies on
-                // one of them, on a circle where two meet, or where three meet.
-                around.clear();
-                for_each_neighbour(f, [nx, ny, nz], |n| {
-                    let s = nearest[n];
-                    if s != NO_SPHERE && !around.contains(&s) {
-                        around.push(s);
-                    }
-                });
-                let set: Vec<Sphere> = around.iter().map(|&a| grown(&spheres[a as usize], probe)).collect();
-                dist = dist.min(nearest_on_union_surface(x, &set));
-            }
-            *v = (dist - probe) as f32;
-        }
-    });
+        },
+    );
     Ok(values)
+}
+
+/// Spheres binned in cubic cells at least as wide as the largest sphere plus `reach`, so
+/// every sphere that covers a point within `reach` of a query point lies in the 27 cells
+/// around it.
+struct CellIndex<'a> {
+    spheres: &'a [Sphere],
+    origin: DVec3,
+    size: f64,
+    dims: [usize; 3],
+    /// Sphere indices of cell c: `items[start[c]..start[c + 1]]`.
+    start: Vec<u32>,
+    items: Vec<u32>,
+}
+
+impl<'a> CellIndex<'a> {
+    fn new(spheres: &'a [Sphere], reach: f64) -> Self {
+        let size = spheres.iter().map(|s| s.radius).fold(0.0, f64::max) + reach;
+        let (lo, hi) = bounds(spheres, |_| 0.0);
+        let dims = ((hi - lo) / size).to_array().map(|e| e.floor() as usize + 1);
+        let mut index = Self { spheres, origin: lo, size, dims, start: Vec::new(), items: Vec::new() };
+        let cell_of: Vec<usize> = spheres.iter().map(|s| index.cell(index.coords(s.centre))).collect();
+        let mut count = vec![0u32; dims.iter().product::<usize>() + 1];
+        for &c in &cell_of {
+            count[c + 1] += 1;
+        }
+        for c in 1..count.len() {
+            count[c] += count[c - 1];
+        }
+        let mut fill = count.clone();
+        index.items = vec![0; spheres.len()];
+        for (i, &c) in cell_of.iter().enumerate() {
+            index.items[fill[c] as usize] = i as u32;
+            fill[c] += 1;
+        }
+        index.start = count;
+        index
+    }
+
+    fn coords(&self, p: DVec3) -> [i64; 3] {
+        ((p - self.origin) / self.size).floor().to_array().map(|c| c as i64)
+    }
+
+    fn cell(&self, [i, j, k]: [i64; 3]) -> usize {
+        let [_, ny, nz] = self.dims;
+        (i as usize * ny + j as usize) * nz + k as usize
+    }
+
+    /// Calls `f` with each sphere in the 27 cells around `p`.
+    fn for_each_near(&self, p: DVec3, mut f: impl FnMut(&Sphere)) {
+        let c = self.coords(p);
+        for i in c[0] - 1..=c[0] + 1 {
+            for j in c[1] - 1..=c[1] + 1 {
+                for k in c[2] - 1..=c[2] + 1 {
+                    let inside = [i, j, k].iter().zip(self.dims).all(|(&v, n)| v >= 0 && (v as usize) < n);
+                    if inside {
+                        let cell = self.cell([i, j, k]);
+                        for &s in &self.items[self.start[cell] as usize..self.start[cell + 1] as usize] {
+                            f(&self.spheres[s as usize]);
+                        }
+                    }
+                }
+            }
+        }
+    }
 }
 
 /// A sphere grown by the probe radius: where the probe's centre may touch it.
@@ -357,24 +432,15 @@ fn on_sphere(q: DVec3, s: Option<&Sphere>, probe: f64) -> DVec3 {
     }
 }
 
-/// Calls `f` with grid point `p` and each of its 26 neighbours inside the grid.
-fn for_each_neighbour(p: usize, [nx, ny, nz]: [usize; 3], mut f: impl FnMut(usize)) {
-    let (i, j, k) = (p / (ny * nz), p / nz % ny, p % nz);
-    for a in i.saturating_sub(1)..=(i + 1).min(nx - 1) {
-        for b in j.saturating_sub(1)..=(j + 1).min(ny - 1) {
-            for c in k.saturating_sub(1)..=(k + 1).min(nz - 1) {
-                f((a * ny + b) * nz + c);
-            }
-        }
-    }
-}
-
-/// The distance from `x` (inside the union of `set`) to the nearest point of the union's
-/// surface, among the candidates that can be nearest: `x` projected onto each sphere, onto
-/// each circle where two meet, and the points where three meet; a candidate buried in another
-/// sphere of the set is no surface point. Infinite when none qualifies.
-fn nearest_on_union_surface(x: DVec3, set: &[Sphere]) -> f64 {
-    let exposed = |c: DVec3| set.iter().all(|s| (c - s.centre).length() >= s.radius * (1.0 - 1e-9));
+/// The distance from `x` (inside the union of the spheres) to the nearest point of the
+/// union's surface, among the candidates that can be nearest: `x` projected onto each sphere
+/// of `set`, onto each circle where two meet, and the points where three meet. Only candidates
+/// within `near.1` of `near.0` count, and only those no sphere of `blockers` (every sphere
+/// that can reach that far) buries. Infinite when none qualifies.
+fn nearest_on_union_surface(x: DVec3, set: &[Sphere], blockers: &[Sphere], near: (DVec3, f64)) -> f64 {
+    let exposed = |c: DVec3| {
+        (c - near.0).length() <= near.1 && blockers.iter().all(|s| (c - s.centre).length() >= s.radius * (1.0 - 1e-9))
+    };
     let mut best = f64::INFINITY;
     let mut consider = |c: DVec3| {
         let d = (x - c).length();

@@ -2,6 +2,7 @@
 
 pub mod camera;
 pub mod coloring;
+pub mod molsurface;
 pub mod objects;
 pub mod opacity;
 pub mod selection;
@@ -13,6 +14,7 @@ pub mod view;
 
 pub use camera::Camera;
 pub use coloring::AtomColors;
+pub use molsurface::{SurfaceChoice, SurfaceSettings};
 pub use objects::{ObjectState, Placement, Session};
 pub use opacity::DensityScale;
 pub use settings::{

@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::model::orbitals::Quantity;
 
-use super::{Camera, IsosurfaceSettings, RenderSettings};
+use super::{Camera, IsosurfaceSettings, RenderSettings, SurfaceSettings};
 
 /// Where an object sits in the scene: a rigid placement (rotation about the object's own
 /// origin, then a translation), so distances and the clouds' opacity per path are unchanged.
@@ -58,6 +58,8 @@ pub struct ObjectState {
     pub quantity: Option<Quantity>,
     /// Which atoms of a structure are shown ([`super::selection::Selection`]; empty: all).
     pub selection: String,
+    /// A molecular surface around the atoms shown.
+    pub surface: SurfaceSettings,
 }
 
 impl Default for ObjectState {
@@ -71,6 +73,7 @@ impl Default for ObjectState {
             volume: 0,
             quantity: None,
             selection: String::new(),
+            surface: SurfaceSettings::default(),
         }
     }
 }
