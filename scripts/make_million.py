@@ -3,7 +3,11 @@
 domain) replicated on an 8x9x8 lattice, 1,081,152 atoms in 1,728 chains; writes it as mmCIF and
 PDB (hybrid-36 serials) and times gemmi reading each, the peer figure for `orbcloud bench load`.
 
-    python3 scripts/make_million.py [OUT_DIR]      (default target/million; needs gemmi)
+    python3 scripts/make_million.py [OUT_DIR] [--lattice NxMxK] [--name NAME]
+        (default target/million, 8x9x8, "million"; needs gemmi)
+
+Smaller lattices make the 10^4- and 10^5-atom systems of the surface benchmarks
+(`--lattice 5x1x1 --name p10k`, `--lattice 6x3x3 --name p100k`).
 """
 import os
 import sys
@@ -14,7 +18,6 @@ import gemmi
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from make_structure_fixtures import source  # noqa: E402
 
-LATTICE = (8, 9, 8)
 NAMES = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789"
 
 
@@ -24,19 +27,27 @@ def chain_name(k):
 
 
 def main():
-    out = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "..", "target", "million")
+    import argparse
+
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("out", nargs="?", default=os.path.join(os.path.dirname(__file__), "..", "target", "million"))
+    ap.add_argument("--lattice", default="8x9x8", help="copies along x, y and z")
+    ap.add_argument("--name", default="million", help="file name stem")
+    args = ap.parse_args()
+    out = args.out
+    lattice = tuple(int(n) for n in args.lattice.split("x"))
     os.makedirs(out, exist_ok=True)
     unit = gemmi.read_structure(source("4E43.pdb"))
     unit.remove_empty_chains()
     box = unit.calculate_box()
     size = [box.maximum.x - box.minimum.x + 4, box.maximum.y - box.minimum.y + 4, box.maximum.z - box.minimum.z + 4]
     big = gemmi.Structure()
-    big.name = "4E43 x %d lattice" % (LATTICE[0] * LATTICE[1] * LATTICE[2])
+    big.name = "4E43 x %d lattice" % (lattice[0] * lattice[1] * lattice[2])
     model = gemmi.Model(1)
     k = 0
-    for i in range(LATTICE[0]):
-        for j in range(LATTICE[1]):
-            for l in range(LATTICE[2]):
+    for i in range(lattice[0]):
+        for j in range(lattice[1]):
+            for l in range(lattice[2]):
                 shift = gemmi.Position(i * size[0], j * size[1], l * size[2])
                 for ch in unit[0]:
                     c = gemmi.Chain(chain_name(k))
@@ -50,8 +61,8 @@ def main():
     big.add_model(model)
     big.setup_entities()
     atoms = big[0].count_atom_sites()
-    cif = os.path.join(out, "million.cif")
-    pdb = os.path.join(out, "million.pdb")
+    cif = os.path.join(out, args.name + ".cif")
+    pdb = os.path.join(out, args.name + ".pdb")
     big.make_mmcif_document().write_file(cif)
     big.write_pdb(pdb)
     print(f"{atoms} atoms in {k} chains: {cif} ({os.path.getsize(cif)} bytes), {pdb} ({os.path.getsize(pdb)} bytes)")

@@ -153,6 +153,8 @@ pub fn bench(args: &SurfaceBench) -> Result<()> {
             }
         }
         frames.sort_by(f64::total_cmp);
+        let phases: Vec<String> = s.phases.iter().map(|(name, t)| format!("{name} {:.0}", t * 1e3)).collect();
+        println!("phases (ms, last run): {}", phases.join(", "));
         println!(
             "surface={:?} resolution_angstrom={:.2} grid={:?} triangles={triangles} area_angstrom2={:.1} volume_angstrom3={:.1} \
              build_ms_median={:.1} build_ms_min={:.1} frame_ms_median={:.1} ({}x{})",

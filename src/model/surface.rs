@@ -72,7 +72,7 @@ impl SurfaceParams {
     pub const SMOOTHNESS: f64 = 1.5;
 
     /// Points the automatic resolution aims for at most.
-    pub const AUTO_POINTS: f64 = 3.0e7;
+    pub const AUTO_POINTS: f64 = 1.0e7;
 
     /// Defaults for these atoms: 0.25 Å voxels, coarser where the atoms' box would need more
     /// than [`Self::AUTO_POINTS`] grid points (up to 2 Å).
@@ -111,6 +111,27 @@ pub const MAX_GRID_POINTS: u64 = 150_000_000;
 pub struct Surface {
     pub mesh: Mesh,
     pub grid: GridSpec,
+    /// Seconds spent in each phase, in order (for benchmarks).
+    pub phases: Vec<(&'static str, f64)>,
+}
+
+/// Seconds per phase, as the build goes.
+struct Phases {
+    list: Vec<(&'static str, f64)>,
+    last: std::time::Instant,
+}
+
+impl Phases {
+    fn new() -> Self {
+        Self { list: Vec::new(), last: std::time::Instant::now() }
+    }
+
+    /// Ends the phase called `name`.
+    fn done(&mut self, name: &'static str) {
+        let now = std::time::Instant::now();
+        self.list.push((name, (now - self.last).as_secs_f64()));
+        self.last = now;
+    }
 }
 
 /// Builds the surface of `spheres`. `cancel` is polled between planes.
@@ -151,15 +172,19 @@ pub fn build(spheres: &[Sphere], params: &SurfaceParams, cancel: &AtomicBool) ->
         });
     }
     let spec = GridSpec::spaced(lo, hi, h);
+    let mut phases = Phases::new();
     let (values, level) = match params.kind {
         SurfaceKind::Gaussian => {
-            (gaussian_field(&spec, spheres, params.smoothness, cancel)?, (-params.smoothness).exp() as f32)
+            let values = gaussian_field(&spec, spheres, params.smoothness, cancel)?;
+            phases.done("gaussians");
+            (values, (-params.smoothness).exp() as f32)
         }
-        SurfaceKind::SolventExcluded => (ses_field(&spec, spheres, params.probe, cancel)?, 0.0),
+        SurfaceKind::SolventExcluded => (ses_field(&spec, spheres, params.probe, cancel, &mut phases)?, 0.0),
     };
     let grid = VolumeGrid::new("surface", spec.dims, spec.world_from_grid, values);
     let mesh = isosurface::extract(&grid, &[Level { value: level, sign: 1.0 }]).pop().unwrap_or_default();
-    Ok(Surface { mesh, grid: spec })
+    phases.done("marching cubes");
+    Ok(Surface { mesh, grid: spec, phases: phases.list })
 }
 
 /// The box holding every sphere grown by `pad`.
@@ -275,7 +300,13 @@ const NO_SPHERE: u32 = u32::MAX;
 /// F = (distance to the nearest place the probe's centre may be) − probe: positive inside the
 /// SES, zero on it. Outside the accessible spheres F = −probe − (distance outside them), so a
 /// point probe gives the union of the atoms' spheres with a smooth field across it.
-fn ses_field(spec: &GridSpec, spheres: &[Sphere], probe: f64, cancel: &AtomicBool) -> Result<Vec<f32>, SurfaceError> {
+fn ses_field(
+    spec: &GridSpec,
+    spheres: &[Sphere],
+    probe: f64,
+    cancel: &AtomicBool,
+    phases: &mut Phases,
+) -> Result<Vec<f32>, SurfaceError> {
     let (o, h) = (spec.origin(), spec.step(0).x);
     let [nx, ny, nz] = spec.dims;
     let np = plane_len(spec);
@@ -301,52 +332,73 @@ fn ses_field(spec: &GridSpec, spheres: &[Sphere], probe: f64, cancel: &AtomicBoo
         }
         Ok(())
     })?;
+    phases.done("accessible spheres");
     // 2. For every point inside, the nearest grid point outside the accessible spheres.
     let inside: Vec<bool> = outside.iter().map(|&d| d < 0.0).collect();
     let feature = nearest_outside(&inside, [nx, ny, nz], cancel)?;
     drop(inside);
     cancelled(cancel)?;
+    phases.done("distance transform");
     // 3. The distance to the accessible surface near that point, exact where it matters.
     let point = |p: usize| {
         let (i, j, k) = (p / np, p / nz % ny, p % nz);
         o + DVec3::new(i as f64, j as f64, k as f64) * h
     };
-    // Only points near the SES need the exact distance (the estimate is at most ~2 voxels long).
+    // Only points near the SES need the exact distance (the estimate is at most ~2 voxels
+    // long); they are refined grouped by their outside point, whose neighbourhood they share.
     let band = 2.5 * h;
-    let reach = 4.0 * h;
-    let grown_spheres: Vec<Sphere> = spheres.iter().map(|s| grown(s, probe)).collect();
-    let cells = CellIndex::new(&grown_spheres, reach);
+    let reach = (4.0 * h).min(1.2 * BOHR_PER_ANGSTROM);
     let mut values = vec![0f32; spec.len()];
-    values.par_chunks_mut(np).enumerate().for_each_init(
-        || (Vec::new(), Vec::new()),
-        |(local, set), (i, plane)| {
+    let mut refine: Vec<(u32, u32)> = values
+        .par_chunks_mut(np)
+        .enumerate()
+        .flat_map_iter(|(i, plane)| {
+            let mut near = Vec::new();
             for (q, v) in plane.iter_mut().enumerate() {
                 let p = i * np + q;
                 if outside[p] >= 0.0 {
                     *v = -probe as f32 - outside[p].min(margin as f32);
                     continue;
                 }
-                let x = point(p);
-                let f = point(feature[p] as usize);
-                let f_sphere = spheres.get(nearest[feature[p] as usize] as usize);
-                let mut dist = (x - on_sphere(f, f_sphere, probe)).length();
-                if (dist - probe).abs() < band {
-                    // Every accessible sphere that could cover a point within `reach` of the
-                    // outside point, and among them those whose surface passes that near.
-                    local.clear();
-                    cells.for_each_near(f, |s| {
-                        if (f - s.centre).length() < s.radius + reach {
-                            local.push(*s);
-                        }
-                    });
-                    set.clear();
-                    set.extend(local.iter().filter(|s| ((f - s.centre).length() - s.radius).abs() <= reach));
-                    dist = dist.min(nearest_on_union_surface(x, set, local, (f, reach)));
-                }
+                let f = feature[p] as usize;
+                let dist = (point(p) - on_sphere(point(f), spheres.get(nearest[f] as usize), probe)).length();
                 *v = (dist - probe) as f32;
+                if (dist - probe).abs() < band {
+                    near.push((f as u32, p as u32));
+                }
             }
-        },
-    );
+            near
+        })
+        .collect();
+    drop((feature, nearest, outside));
+    cancelled(cancel)?;
+    phases.done("estimate");
+    refine.par_sort_unstable();
+    let grown_spheres: Vec<Sphere> = spheres.iter().map(|s| grown(s, probe)).collect();
+    let cells = CellIndex::new(&grown_spheres, reach);
+    let groups: Vec<&[(u32, u32)]> = refine.chunk_by(|a, b| a.0 == b.0).collect();
+    let refined: Vec<(u32, f32)> = groups
+        .par_iter()
+        .flat_map_iter(|group| {
+            // Every accessible sphere that could cover a point within `reach` of the outside
+            // point, and among them those whose surface passes that near.
+            let f = point(group[0].0 as usize);
+            let mut local = Vec::new();
+            cells.for_each_near(f, |s| {
+                if (f - s.centre).length() < s.radius + reach {
+                    local.push(*s);
+                }
+            });
+            let set: Vec<Sphere> =
+                local.iter().filter(|s| ((f - s.centre).length() - s.radius).abs() <= reach).copied().collect();
+            let near = NearSurface::new(&set, &local, (f, reach));
+            group.iter().map(move |&(_, p)| (p, (near.distance(point(p as usize)) - probe) as f32)).collect::<Vec<_>>()
+        })
+        .collect();
+    for (p, v) in refined {
+        values[p as usize] = values[p as usize].min(v);
+    }
+    phases.done("exact distances");
     Ok(values)
 }
 
@@ -432,40 +484,64 @@ fn on_sphere(q: DVec3, s: Option<&Sphere>, probe: f64) -> DVec3 {
     }
 }
 
-/// The distance from `x` (inside the union of the spheres) to the nearest point of the
-/// union's surface, among the candidates that can be nearest: `x` projected onto each sphere
-/// of `set`, onto each circle where two meet, and the points where three meet. Only candidates
-/// within `near.1` of `near.0` count, and only those no sphere of `blockers` (every sphere
-/// that can reach that far) buries. Infinite when none qualifies.
-fn nearest_on_union_surface(x: DVec3, set: &[Sphere], blockers: &[Sphere], near: (DVec3, f64)) -> f64 {
-    let exposed = |c: DVec3| {
-        (c - near.0).length() <= near.1 && blockers.iter().all(|s| (c - s.centre).length() >= s.radius * (1.0 - 1e-9))
-    };
-    let mut best = f64::INFINITY;
-    let mut consider = |c: DVec3| {
-        let d = (x - c).length();
-        if d < best && exposed(c) {
-            best = d;
-        }
-    };
-    for (a, sa) in set.iter().enumerate() {
-        let out = x - sa.centre;
-        if out.length() > 0.0 {
-            consider(sa.centre + out.normalize() * sa.radius);
-        }
-        for (b, sb) in set.iter().enumerate().skip(a + 1) {
-            let Some((m, n, r)) = circle_of(sa, sb) else { continue };
-            let v = (x - m) - n * (x - m).dot(n);
-            let radial = if v.length() > 1e-12 { v.normalize() } else { n.any_orthonormal_vector() };
-            consider(m + radial * r);
-            for sc in &set[b + 1..] {
-                for c in meeting_points(sc, (m, n, r)) {
-                    consider(c);
+/// The nearest point of the union's surface to points near one outside grid point, among the
+/// candidates that can be nearest: a point projected onto each sphere of `set`, onto each
+/// circle where two meet, and the points where three meet. Only candidates within `near.1` of
+/// `near.0` count, and only those no sphere of `blockers` (every sphere that can reach that
+/// far) buries.
+struct NearSurface<'a> {
+    set: &'a [Sphere],
+    blockers: &'a [Sphere],
+    near: (DVec3, f64),
+    circles: Vec<(DVec3, DVec3, f64)>,
+    /// Exposed points where three spheres meet.
+    corners: Vec<DVec3>,
+}
+
+impl<'a> NearSurface<'a> {
+    fn new(set: &'a [Sphere], blockers: &'a [Sphere], near: (DVec3, f64)) -> Self {
+        let mut this = Self { set, blockers, near, circles: Vec::new(), corners: Vec::new() };
+        for (a, sa) in set.iter().enumerate() {
+            for (b, sb) in set.iter().enumerate().skip(a + 1) {
+                let Some(circle) = circle_of(sa, sb) else { continue };
+                this.circles.push(circle);
+                for sc in &set[b + 1..] {
+                    let exposed: Vec<DVec3> =
+                        meeting_points(sc, circle).into_iter().filter(|&c| this.exposed(c)).collect();
+                    this.corners.extend(exposed);
                 }
             }
         }
+        this
     }
-    best
+
+    fn exposed(&self, c: DVec3) -> bool {
+        (c - self.near.0).length() <= self.near.1
+            && self.blockers.iter().all(|s| (c - s.centre).length() >= s.radius * (1.0 - 1e-9))
+    }
+
+    /// The distance from `x` to the nearest candidate; infinite when none qualifies.
+    fn distance(&self, x: DVec3) -> f64 {
+        let mut best = self.corners.iter().map(|&c| (x - c).length()).fold(f64::INFINITY, f64::min);
+        let mut consider = |c: DVec3| {
+            let d = (x - c).length();
+            if d < best && self.exposed(c) {
+                best = d;
+            }
+        };
+        for s in self.set {
+            let out = x - s.centre;
+            if out.length() > 0.0 {
+                consider(s.centre + out.normalize() * s.radius);
+            }
+        }
+        for &(m, n, r) in &self.circles {
+            let v = (x - m) - n * (x - m).dot(n);
+            let radial = if v.length() > 1e-12 { v.normalize() } else { n.any_orthonormal_vector() };
+            consider(m + radial * r);
+        }
+        best
+    }
 }
 
 /// The circle where two spheres' surfaces meet: centre, unit axis (from a to b), radius.
@@ -531,19 +607,41 @@ fn nearest_outside(inside: &[bool], dims: [usize; 3], cancel: &AtomicBool) -> Re
         },
     );
     cancelled(cancel)?;
-    // Along x: columns of stride ny·nz, gathered a row of (j, k) at a time for locality.
-    let columns: Vec<(Vec<f32>, Vec<u32>)> = (0..np)
+    // Along x: columns of stride ny·nz, taken BLOCK neighbours at a time so each plane is read
+    // in runs rather than one scattered value per column.
+    const BLOCK: usize = 64;
+    let blocks: Vec<(usize, Vec<u32>)> = (0..np.div_ceil(BLOCK))
         .into_par_iter()
-        .map_init(Envelope::default, |env, c| {
-            let mut d: Vec<f32> = (0..nx).map(|i| dist[i * np + c]).collect();
-            let mut f: Vec<u32> = (0..nx).map(|i| feature[i * np + c]).collect();
-            env.line(&mut d, &mut f);
-            (d, f)
-        })
+        .map_init(
+            || (Envelope::default(), vec![0f32; BLOCK * nx], vec![0u32; BLOCK * nx]),
+            |(env, d, f), b| {
+                let (c0, c1) = (b * BLOCK, ((b + 1) * BLOCK).min(np));
+                let width = c1 - c0;
+                // Transposed into the block: column c is d[c·nx..(c + 1)·nx].
+                for i in 0..nx {
+                    let row = i * np + c0;
+                    for c in 0..width {
+                        d[c * nx + i] = dist[row + c];
+                        f[c * nx + i] = feature[row + c];
+                    }
+                }
+                for c in 0..width {
+                    env.line(&mut d[c * nx..(c + 1) * nx], &mut f[c * nx..(c + 1) * nx]);
+                }
+                let mut out = vec![0u32; width * nx];
+                for i in 0..nx {
+                    for c in 0..width {
+                        out[i * width + c] = f[c * nx + i];
+                    }
+                }
+                (c0, out)
+            },
+        )
         .collect();
-    for (c, (_, f)) in columns.into_iter().enumerate() {
-        for (i, v) in f.into_iter().enumerate() {
-            feature[i * np + c] = v;
+    for (c0, out) in blocks {
+        let width = out.len() / nx;
+        for i in 0..nx {
+            feature[i * np + c0..i * np + c0 + width].copy_from_slice(&out[i * width..(i + 1) * width]);
         }
     }
     Ok(feature)
