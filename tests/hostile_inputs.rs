@@ -325,4 +325,13 @@ fn fuzzing_findings_stay_fixed() {
     let far_atom = "h2\n MO 1 and 2, angstrom\n   -2   -0.5 -0.5 -0.5\n   -2    0.5 0.0 0.0\n   -2    0.0 0.5 0.0\n   -2    0.0 0.0 0.5\n    1    1.0 0.0 0.0 0444444444444444444444.37\n    1    1.0 0.0 0.0 -0.37\n    2    1    2\n 1.0E-02 -2.0E-02 3.0E-02 -4.0E-02 5.0E-02 -6.0E-02\n 7.0E-02 -8.0E-02 9.0E-02 -1.0E-01 1.1E-01 -1.2E-01\n 1.3E-01 -1.4E-01 1.5E-01 -1.6E-01\n";
     let doc = formats::load_bytes(Path::new("far.cube"), far_atom.as_bytes());
     assert!(doc.is_ok_and(|d| d.molecule.bonds.is_empty()), "read, no bond to an atom that far");
+    // AFL++, mmCIF target: a token of multi-byte characters was cut at byte 5 to look for
+    // `data_` (a panic inside a character); and the same inside an atom_site loop.
+    for (name, text) in [
+        ("nbsp.cif", "\u{a0}\u{a0}\u{a0}".to_string()),
+        ("loop.cif", "data_x\nloop_\n_atom_site.id\n_atom_site.Cartn_x\n02\u{7f0}\u{7f7}V0 1.0\n".to_string()),
+    ] {
+        let err = formats::load_bytes(Path::new(name), text.as_bytes()).expect_err("no atoms to show");
+        assert!(err.to_string().contains(name), "{err}");
+    }
 }

@@ -133,7 +133,7 @@ impl<'a> Tokens<'a> {
             Kind::Tag
         } else if text.eq_ignore_ascii_case("loop_") {
             Kind::Loop
-        } else if text.len() >= 5 && text[..5].eq_ignore_ascii_case("data_") {
+        } else if text.len() >= 5 && text.as_bytes()[..5].eq_ignore_ascii_case(b"data_") {
             Kind::Data
         } else {
             Kind::Value
