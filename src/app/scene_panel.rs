@@ -114,7 +114,6 @@ fn surface_editor(ui: &mut egui::Ui, s: &mut SurfaceSettings) -> bool {
             .on_hover_text("Gaussian: the atoms' blended density (VMD's QuickSurf); solvent-excluded: where a probe cannot reach (Connolly's)");
         if s.choice != SurfaceChoice::Off {
             ui.color_edit_button_rgb(&mut s.color);
-            ui.checkbox(&mut s.translucent, "translucent");
         }
     });
     if s.choice != SurfaceChoice::Off {
@@ -126,6 +125,9 @@ fn surface_editor(ui: &mut egui::Ui, s: &mut SurfaceSettings) -> bool {
             if let Some(r) = &mut s.resolution {
                 ui.add(DragValue::new(r).speed(0.01).range(0.1..=3.0).suffix(" Å").max_decimals(2));
             }
+        });
+        ui.horizontal(|ui| {
+            ui.checkbox(&mut s.translucent, "translucent");
             match s.choice {
                 SurfaceChoice::SolventExcluded => {
                     ui.add(DragValue::new(&mut s.probe).speed(0.02).range(0.0..=3.0).prefix("probe ").suffix(" Å"));
