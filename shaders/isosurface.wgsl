@@ -11,6 +11,8 @@ struct SurfaceUniforms {
     color: vec4<f32>,
     // x: pick id
     pick: vec4<u32>,
+    // xy: clip-space x and y per object unit at w = 1 (the projection's scales), for splats
+    splat: vec4<f32>,
 };
 
 @group(0) @binding(0) var<uniform> u: SurfaceUniforms;
@@ -37,8 +39,16 @@ struct FragOut {
 
 @fragment
 fn fs_main(in: VertexOut) -> FragOut {
-    let view = normalize(u.eye.xyz - in.world);
-    var n = normalize(in.normal);
+    var out: FragOut;
+    out.color = vec4<f32>(lit(in.world, in.normal), 1.0);
+    out.id = u.pick.x;
+    return out;
+}
+
+// The surface's colour at `world` with normal `normal`: headlight diffuse, specular and rim.
+fn lit(world: vec3<f32>, normal: vec3<f32>) -> vec3<f32> {
+    let view = normalize(u.eye.xyz - world);
+    var n = normalize(normal);
     // A surface cut open by the grid's box shows its inside: light that side too, a little
     // darker so the cut reads as one.
     var inner = 1.0;
@@ -52,8 +62,45 @@ fn fs_main(in: VertexOut) -> FragOut {
     let specular = pow(max(dot(n, h), 0.0), 40.0);
     let rim = pow(1.0 - max(dot(n, view), 0.0), 3.0);
     let base = u.color.rgb * inner;
+    return base * (0.25 + 0.75 * diffuse) + vec3<f32>(0.3 * specular + 0.06 * rim) * inner;
+}
+
+// Seed 002's points: a cell of the surface too small on screen to be worth its triangles,
+// drawn as a disc facing the eye at the cell's centre, big enough to cover the cell (so no
+// holes open between cells), lit with the cell's mean normal.
+struct SplatOut {
+    @builtin(position) clip: vec4<f32>,
+    // −1..1 across the disc
+    @location(0) corner: vec2<f32>,
+    @location(1) world: vec3<f32>,
+    @location(2) normal: vec3<f32>,
+};
+
+@vertex
+fn vs_splat(
+    @builtin(vertex_index) vertex: u32,
+    @location(0) centre: vec3<f32>,
+    @location(1) radius: f32,
+    @location(2) normal: vec3<f32>,
+) -> SplatOut {
+    // A triangle strip: (−1, −1), (1, −1), (−1, 1), (1, 1).
+    let corner = vec2<f32>(f32(vertex & 1u) * 2.0 - 1.0, f32(vertex >> 1u) * 2.0 - 1.0);
+    var out: SplatOut;
+    out.clip = u.clip_from_world * vec4<f32>(centre, 1.0);
+    out.clip = vec4<f32>(out.clip.xy + corner * radius * u.splat.xy, out.clip.zw);
+    out.corner = corner;
+    out.world = centre;
+    out.normal = normal;
+    return out;
+}
+
+@fragment
+fn fs_splat(in: SplatOut) -> FragOut {
+    if (dot(in.corner, in.corner) > 1.0) {
+        discard;
+    }
     var out: FragOut;
-    out.color = vec4<f32>(base * (0.25 + 0.75 * diffuse) + vec3<f32>(0.3 * specular + 0.06 * rim) * inner, 1.0);
+    out.color = vec4<f32>(lit(in.world, in.normal), 1.0);
     out.id = u.pick.x;
     return out;
 }

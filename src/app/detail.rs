@@ -1,6 +1,7 @@
 //! How much a view draws while the user drags or the animation plays (seed 001's dynamic level
-//! of detail): fewer slices on every adapter, and on a CPU rasteriser fewer pixels too, which
-//! the texture filter scales up. The full picture returns with the first frame after.
+//! of detail): fewer slices on every adapter, more of a big surface as points (seed 002), and on
+//! a CPU rasteriser fewer pixels too, which the texture filter scales up. The full picture
+//! returns with the first frame after.
 
 use crate::scene::RenderSettings;
 
@@ -12,16 +13,22 @@ pub const INTERACTIVE_SLICES: u32 = 64;
 /// drag ~12 times a second; the time is linear in pixels × slices.
 pub const CPU_INTERACTIVE_PIXELS: u32 = 2 * 256 * 256;
 
+/// How much coarser a big surface's level of detail is while interacting: parts up to this
+/// many times the threshold's size on screen are drawn as points.
+pub const INTERACTIVE_LOD_SCALE: f32 = 4.0;
+
 /// What one view draws this frame.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Detail {
     pub max_slices: u32,
     /// At most this many pixels; the view's size is scaled down to fit, keeping its aspect.
     pub max_pixels: u32,
+    /// The factor on surfaces' level-of-detail thresholds (seed 002).
+    pub lod_scale: f32,
 }
 
 impl Detail {
-    pub const FULL: Self = Self { max_slices: u32::MAX, max_pixels: u32::MAX };
+    pub const FULL: Self = Self { max_slices: u32::MAX, max_pixels: u32::MAX, lod_scale: 1.0 };
 
     /// The detail for each of `views` views: full when `interacting` is false.
     pub fn for_frame(interacting: bool, adapter: wgpu::DeviceType, views: usize) -> Self {
@@ -32,7 +39,7 @@ impl Detail {
             wgpu::DeviceType::Cpu => CPU_INTERACTIVE_PIXELS / views.max(1) as u32,
             _ => u32::MAX,
         };
-        Self { max_slices: INTERACTIVE_SLICES, max_pixels }
+        Self { max_slices: INTERACTIVE_SLICES, max_pixels, lod_scale: INTERACTIVE_LOD_SCALE }
     }
 
     /// The size to render a view shown at `size` pixels.

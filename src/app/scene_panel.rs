@@ -126,6 +126,12 @@ fn surface_editor(ui: &mut egui::Ui, s: &mut SurfaceSettings) -> bool {
                 ui.add(DragValue::new(r).speed(0.01).range(0.1..=3.0).suffix(" Å").max_decimals(2));
             }
         });
+        if !s.translucent {
+            ui.horizontal(|ui| {
+                ui.add(DragValue::new(&mut s.lod_px).speed(0.1).range(0.0..=30.0).prefix("points under ").suffix(" px"))
+                    .on_hover_text("seed 002's level of detail: parts smaller than this on screen are drawn as points (0: every triangle); four times more while you drag");
+            });
+        }
         ui.horizontal(|ui| {
             ui.checkbox(&mut s.translucent, "translucent");
             match s.choice {

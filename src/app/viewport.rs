@@ -23,6 +23,10 @@ use std::sync::atomic::AtomicBool;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
+/// What a frame drew: the view, the clouds, the size, the scene's generation and the bits of
+/// the level-of-detail scale; a frame is drawn again when any of them changes.
+type Drawn = (ViewState, Vec<VolumeSettings>, [u32; 2], u64, u32);
+
 /// A click in the view: what the frame showed under the pointer, and whether Shift was held.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Click {
@@ -113,7 +117,7 @@ pub struct Viewport {
     /// What the next frames draw: set each frame by the caller.
     pub detail: Detail,
     /// The state the texture currently shows; a frame is drawn only when this changes.
-    drawn: Option<(ViewState, Vec<VolumeSettings>, [u32; 2], u64)>,
+    drawn: Option<Drawn>,
     /// Bumped whenever the renderer's data changes.
     generation: u64,
     /// Per object: its computed grid and its background jobs.
@@ -477,7 +481,8 @@ impl Viewport {
                 .map(|&volume| self.detail.apply(RenderSettings { volume, ..drawn.settings }).volume)
                 .collect()
         };
-        let key = (drawn, clouds, size, self.generation);
+        self.renderer.set_lod_scale(self.detail.lod_scale);
+        let key = (drawn, clouds, size, self.generation, self.detail.lod_scale.to_bits());
         if let Some((target, id)) = &self.target {
             let changed = self.drawn.as_ref() != Some(&key);
             if changed {

@@ -6,6 +6,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
+use orbcloud::gpu::isosurface::LodStats;
 use orbcloud::headless::molecular_surface;
 use orbcloud::model::Document;
 use orbcloud::model::isosurface::Mesh;
@@ -37,6 +38,10 @@ pub struct MolSurfaceArgs {
     /// Smoothness α of the Gaussian surface (larger hugs the atoms tighter).
     #[arg(long, default_value_t = SurfaceParams::SMOOTHNESS)]
     pub smoothness: f64,
+    /// Seed 002's level of detail: parts smaller than this many pixels are drawn as points
+    /// (0: every triangle).
+    #[arg(long, default_value_t = SurfaceSettings::LOD_PX)]
+    pub lod_px: f32,
 }
 
 impl MolSurfaceArgs {
@@ -52,6 +57,7 @@ impl MolSurfaceArgs {
             probe: self.probe as f32,
             smoothness: self.smoothness as f32,
             translucent,
+            lod_px: self.lod_px,
             ..Default::default()
         }
     }
@@ -102,10 +108,14 @@ pub struct SurfaceBench {
     /// Use the CPU Vulkan adapter (lavapipe) even when a GPU is present.
     #[arg(long)]
     lavapipe: bool,
+    /// Write each surface's last frame with and without the level of detail here.
+    #[arg(long)]
+    images: Option<std::path::PathBuf>,
 }
 
 /// `orbcloud bench surface`: the build time of each surface (or the one `--surface` names),
-/// its size, and ms per frame drawing it at the given size, turning a little each frame.
+/// its size, and ms per frame drawing it at the given size, turning a little each frame, with
+/// every triangle and with seed 002's level of detail, and how far apart the two images are.
 pub fn bench(args: &SurfaceBench) -> Result<()> {
     use orbcloud::gpu::{FrameInput, OffscreenTarget, Renderer};
     use orbcloud::scene::{AtomStyle, Camera, RenderSettings};
@@ -131,33 +141,58 @@ pub fn bench(args: &SurfaceBench) -> Result<()> {
         }
         times.sort_by(f64::total_cmp);
         let s = built.context("no surface was built")?;
-        // Drawn alone, opaque, as the viewer draws a surface.
+        // Drawn alone, opaque, as the viewer draws a surface: every triangle, then with seed
+        // 002's level of detail, the same frames.
         let mut renderer = Renderer::new(&ctx);
         renderer.main().set_molecule(&ctx, &doc.molecule, AtomStyle::Hidden);
-        let triangles = orbcloud::headless::show_meshes(&ctx, renderer.main(), &[(s.mesh.clone(), color.into())]);
         let (lo, hi) = s.grid.bounds();
         let camera = Camera::framing(lo.as_vec3(), hi.as_vec3());
         let target = OffscreenTarget::new(&ctx.device, args.size);
         let settings = RenderSettings::default();
-        let mut frames = Vec::new();
-        for f in 0..args.frames.max(1) + 2 {
-            let mut cam = camera;
-            cam.orbit(0.02 * f as f32, 0.01 * f as f32);
-            let t = Instant::now();
-            let mut encoder = ctx.device.create_command_encoder(&Default::default());
-            renderer.render(&ctx, &mut encoder, &target.color_view, &FrameInput::single(&cam, &settings, args.size));
-            ctx.queue.submit([encoder.finish()]);
-            ctx.device.poll(wgpu::PollType::wait_indefinitely())?;
-            if f >= 2 {
-                frames.push(t.elapsed().as_secs_f64() * 1e3);
+        let mut draw = |lod_px: Option<f32>| -> Result<(f64, image::RgbaImage, LodStats)> {
+            let look = SurfaceLook { lod_px, ..color.into() };
+            orbcloud::headless::show_meshes(&ctx, renderer.main(), &[(s.mesh.clone(), look)]);
+            let mut frames = Vec::new();
+            for f in 0..args.frames.max(1) + 2 {
+                let mut cam = camera;
+                cam.orbit(0.02 * f as f32, 0.01 * f as f32);
+                let t = Instant::now();
+                let mut encoder = ctx.device.create_command_encoder(&Default::default());
+                renderer.render(
+                    &ctx,
+                    &mut encoder,
+                    &target.color_view,
+                    &FrameInput::single(&cam, &settings, args.size),
+                );
+                ctx.queue.submit([encoder.finish()]);
+                ctx.device.poll(wgpu::PollType::wait_indefinitely())?;
+                if f >= 2 {
+                    frames.push(t.elapsed().as_secs_f64() * 1e3);
+                }
+            }
+            frames.sort_by(f64::total_cmp);
+            let image = target.read_rgba(&ctx.device, &ctx.queue)?;
+            Ok((frames[frames.len() / 2], image, renderer.main().surfaces.lod_stats()))
+        };
+        let (full_ms, full, _) = draw(None)?;
+        let lod_px = args.surface.lod_px;
+        let (lod_ms, lod, stats) = draw(Some(lod_px))?;
+        let (mean, covered) = super::surface_cli::image_error(&full, &lod, &settings.background);
+        if let Some(dir) = &args.images {
+            std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+            for (name, img) in [("full", &full), ("lod", &lod)] {
+                let path = dir.join(format!("{}_{name}.png", asked.name()));
+                img.save(&path).with_context(|| format!("writing {}", path.display()))?;
             }
         }
-        frames.sort_by(f64::total_cmp);
+        let triangles = s.mesh.triangle_count();
         let phases: Vec<String> = s.phases.iter().map(|(name, t)| format!("{name} {:.0}", t * 1e3)).collect();
         println!("phases (ms, last run): {}", phases.join(", "));
         println!(
             "surface={:?} resolution_angstrom={:.2} grid={:?} triangles={triangles} area_angstrom2={:.1} volume_angstrom3={:.1} \
-             build_ms_median={:.1} build_ms_min={:.1} frame_ms_median={:.1} ({}x{})",
+             build_ms_median={:.1} build_ms_min={:.1} ({}x{}) frame_ms_all_triangles={full_ms:.1} \
+             frame_ms_lod={lod_ms:.1} lod_px={lod_px} lod_triangles={} lod_points={} speedup={:.2} \
+             lod_error_mean={mean:.2}/255 lod_error_covered={covered:.2}/255",
             params.kind,
             params.resolution / BOHR_PER_ANGSTROM,
             s.grid.dims,
@@ -165,9 +200,11 @@ pub fn bench(args: &SurfaceBench) -> Result<()> {
             s.mesh.volume() / BOHR_PER_ANGSTROM.powi(3),
             times[times.len() / 2],
             times[0],
-            frames[frames.len() / 2],
             args.size[0],
-            args.size[1]
+            args.size[1],
+            stats.triangles,
+            stats.splats,
+            full_ms / lod_ms
         );
     }
     Ok(())

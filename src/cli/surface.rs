@@ -448,7 +448,7 @@ pub fn bench_translucent(args: &TranslucentBench) -> Result<()> {
 
 /// Mean |a − b| per channel (of 255) over the whole image, and over the pixels either image
 /// draws something in (not the background).
-fn image_error(a: &image::RgbaImage, b: &image::RgbaImage, background: &[f32; 3]) -> (f64, f64) {
+pub fn image_error(a: &image::RgbaImage, b: &image::RgbaImage, background: &[f32; 3]) -> (f64, f64) {
     let srgb = |v: f32| if v <= 0.003_130_8 { 12.92 * v } else { 1.055 * v.powf(1.0 / 2.4) - 0.055 };
     let bg = background.map(|v| (srgb(v) * 255.0).round() as i32);
     let is_bg = |p: &image::Rgba<u8>| (0..3).all(|k| (p[k] as i32 - bg[k]).abs() <= 1);

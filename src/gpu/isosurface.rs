@@ -9,6 +9,7 @@ use super::GpuContext;
 use super::frame::{Draw, ObjectView, Phase, PickId, opaque_depth, opaque_targets};
 use super::oit::Transparency;
 use crate::model::isosurface::Mesh;
+use crate::model::octree::{LodView, Selection, SurfaceOctree};
 use crate::scene::translucency::{MAX_TRANSLUCENT_SURFACES, Optics, SurfaceLook};
 
 /// Mirror of `SurfaceUniforms` in isosurface.wgsl.
@@ -20,8 +21,19 @@ pub struct SurfaceUniforms {
     pub light: [f32; 4],
     pub color: [f32; 4],
     pub pick: [u32; 4],
+    /// Clip-space x and y per object unit at w = 1 (for splats).
+    pub splat: [f32; 4],
 }
-const _: () = assert!(std::mem::size_of::<SurfaceUniforms>() == 128);
+const _: () = assert!(std::mem::size_of::<SurfaceUniforms>() == 144);
+
+/// One splat as the instance buffer holds it (mirror of `vs_splat`'s inputs).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+struct SplatInstance {
+    centre: [f32; 3],
+    radius: f32,
+    normal: [f32; 3],
+}
 
 /// Interleaved position and normal, as the vertex buffer holds them.
 #[repr(C)]
@@ -43,10 +55,37 @@ struct GpuSurface {
     optics: Option<Optics>,
     /// This frame: its index among the frame's translucent surfaces (`None`: drawn opaque).
     translucent: Option<u32>,
+    /// Seed 002's level of detail (big opaque surfaces): the mesh's octree (its reordered
+    /// indices are the index buffer) and what this frame draws of it.
+    lod: Option<Lod>,
 }
+
+struct Lod {
+    tree: SurfaceOctree,
+    threshold_px: f32,
+    /// Room for a splat per cell.
+    splats: wgpu::Buffer,
+    selection: Selection,
+    /// The selection's splats, as uploaded.
+    staged: Vec<SplatInstance>,
+}
+
+/// What the last frame drew of the surfaces with a level of detail: triangles, points and
+/// triangles in all.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct LodStats {
+    pub triangles: u64,
+    pub splats: u64,
+    pub total_triangles: u64,
+}
+
+/// The octree's leaves: about an atom's size (3 Å), in bohr.
+const LEAF_SIZE: f32 = 5.7;
 
 pub struct IsosurfacePass {
     pipeline: wgpu::RenderPipeline,
+    closed: wgpu::RenderPipeline,
+    splat: wgpu::RenderPipeline,
     collect: wgpu::RenderPipeline,
     weighted: wgpu::RenderPipeline,
     transparency: Transparency,
@@ -73,17 +112,49 @@ impl IsosurfacePass {
                 attributes: &attributes,
             })],
         };
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("isosurfaces"),
+        let opaque = |label, cull_mode| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(label),
+                layout: Some(&pipeline_layout),
+                vertex: vertex.clone(),
+                primitive: wgpu::PrimitiveState { cull_mode, ..Default::default() },
+                depth_stencil: Some(opaque_depth()),
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some("fs_main"),
+                    compilation_options: Default::default(),
+                    targets: &opaque_targets(),
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        // Both sides: a surface cut by the grid's box shows its inside.
+        let pipeline = opaque("isosurfaces", None);
+        // A closed surface (molecular surfaces, wound counter-clockwise seen from outside) shows
+        // only its outside: the rasteriser skips the half facing away.
+        let closed = opaque("closed surfaces", Some(wgpu::Face::Back));
+        let splat_attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32, 2 => Float32x3];
+        let splat = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("surface splats"),
             layout: Some(&pipeline_layout),
-            vertex: vertex.clone(),
-            // Both sides: a surface cut by the grid's box shows its inside.
-            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_splat"),
+                compilation_options: Default::default(),
+                buffers: &[Some(wgpu::VertexBufferLayout {
+                    array_stride: std::mem::size_of::<SplatInstance>() as u64,
+                    step_mode: wgpu::VertexStepMode::Instance,
+                    attributes: &splat_attributes,
+                })],
+            },
+            primitive: wgpu::PrimitiveState { topology: wgpu::PrimitiveTopology::TriangleStrip, ..Default::default() },
             depth_stencil: Some(opaque_depth()),
             multisample: Default::default(),
             fragment: Some(wgpu::FragmentState {
                 module: &module,
-                entry_point: Some("fs_main"),
+                entry_point: Some("fs_splat"),
                 compilation_options: Default::default(),
                 targets: &opaque_targets(),
             }),
@@ -152,6 +223,8 @@ impl IsosurfacePass {
         );
         Self {
             pipeline,
+            closed,
+            splat,
             collect,
             weighted,
             layout,
@@ -182,10 +255,25 @@ impl IsosurfacePass {
                     contents: bytemuck::cast_slice(&vertices),
                     usage: wgpu::BufferUsages::VERTEX,
                 });
+                // Drawn with a level of detail: the octree's order of the triangles.
+                let tree =
+                    look.lod_px.filter(|_| look.optics.is_none()).map(|px| (SurfaceOctree::build(mesh, LEAF_SIZE), px));
                 let indices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                     label: Some("isosurface indices"),
-                    contents: bytemuck::cast_slice(&mesh.indices),
+                    contents: bytemuck::cast_slice(tree.as_ref().map_or(&mesh.indices, |(t, _)| &t.indices)),
                     usage: wgpu::BufferUsages::INDEX,
+                });
+                let lod = tree.map(|(tree, threshold_px)| Lod {
+                    splats: device.create_buffer(&wgpu::BufferDescriptor {
+                        label: Some("surface splats"),
+                        size: (tree.cells.len().max(1) * std::mem::size_of::<SplatInstance>()) as u64,
+                        usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+                        mapped_at_creation: false,
+                    }),
+                    tree,
+                    threshold_px,
+                    selection: Selection::default(),
+                    staged: Vec::new(),
                 });
                 let uniforms = super::uniform_buffer(device, "isosurface uniforms", size_of::<SurfaceUniforms>());
                 let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -204,6 +292,7 @@ impl IsosurfacePass {
                     pick,
                     optics: look.optics,
                     translucent: None,
+                    lod,
                 }
             })
             .collect();
@@ -221,6 +310,8 @@ impl IsosurfacePass {
     pub fn instance(&self) -> Self {
         Self {
             pipeline: self.pipeline.clone(),
+            closed: self.closed.clone(),
+            splat: self.splat.clone(),
             collect: self.collect.clone(),
             weighted: self.weighted.clone(),
             layout: self.layout.clone(),
@@ -230,13 +321,25 @@ impl IsosurfacePass {
         }
     }
 
+    /// What the last frame drew of the surfaces drawn with a level of detail.
+    pub fn lod_stats(&self) -> LodStats {
+        let mut stats = LodStats::default();
+        for lod in self.surfaces.iter().filter_map(|s| s.lod.as_ref()) {
+            stats.triangles += lod.selection.triangles as u64;
+            stats.splats += lod.staged.len() as u64;
+            stats.total_triangles += lod.tree.indices.len() as u64 / 3;
+        }
+        stats
+    }
+
     /// The optics of the translucent surfaces, in the order [`Self::prepare`] numbers them.
     pub fn translucent(&self) -> impl Iterator<Item = Optics> + '_ {
         self.surfaces.iter().filter_map(|s| s.optics)
     }
 
     /// This frame's camera, in the frame of the object the surfaces belong to; their pick ids
-    /// name `object`. Translucent surfaces are numbered from `first_translucent` among the
+    /// name `object`. `size` and `lod_scale`: the frame's pixels and the factor on each level of
+    /// detail's threshold. Translucent surfaces are numbered from `first_translucent` among the
     /// frame's; past [`MAX_TRANSLUCENT_SURFACES`] they are drawn opaque. `lists`: the frame's
     /// fragment lists, and how they are composited.
     pub fn prepare(
@@ -244,9 +347,13 @@ impl IsosurfacePass {
         queue: &wgpu::Queue,
         view: &ObjectView,
         object: u32,
+        (size, lod_scale): ([u32; 2], f32),
         first_translucent: usize,
         lists: Option<(&wgpu::BindGroup, Transparency)>,
     ) {
+        let m = view.clip_from_object;
+        let scale = |row: usize| glam::Vec3::new(m.x_axis[row], m.y_axis[row], m.z_axis[row]).length();
+        let splat = [scale(0), scale(1), 0.0, 0.0];
         self.lists = lists.map(|(l, _)| l.clone());
         self.transparency = lists.map_or(Transparency::Exact, |(_, t)| t);
         let mut next = first_translucent;
@@ -262,8 +369,28 @@ impl IsosurfacePass {
                 light: view.light.extend(0.0).to_array(),
                 color: [s.color[0], s.color[1], s.color[2], 1.0],
                 pick: [PickId::Surface { object, index: s.pick }.encode(), s.translucent.unwrap_or(0), 0, 0],
+                splat,
             };
             queue.write_buffer(&s.uniforms, 0, bytemuck::bytes_of(&u));
+            if let Some(lod) = &mut s.lod {
+                let lod_view = LodView {
+                    clip_from_object: view.clip_from_object,
+                    eye: view.eye,
+                    height_px: size[1] as f32,
+                    threshold_px: lod.threshold_px * lod_scale,
+                    back_faces: true,
+                };
+                lod.tree.select(&lod_view, &mut lod.selection);
+                lod.staged.clear();
+                lod.staged.extend(lod.selection.splats.iter().map(|p| SplatInstance {
+                    centre: p.centre.to_array(),
+                    radius: p.radius,
+                    normal: p.normal.to_array(),
+                }));
+                if !lod.staged.is_empty() {
+                    queue.write_buffer(&lod.splats, 0, bytemuck::cast_slice(&lod.staged));
+                }
+            }
         }
     }
 }
@@ -289,7 +416,27 @@ impl Draw for IsosurfacePass {
             pass.set_bind_group(0, &s.bind_group, &[]);
             pass.set_vertex_buffer(0, s.vertices.slice(..));
             pass.set_index_buffer(s.indices.slice(..), wgpu::IndexFormat::Uint32);
-            pass.draw_indexed(0..s.index_count, 0, 0..1);
+            match &s.lod {
+                None => pass.draw_indexed(0..s.index_count, 0, 0..1),
+                Some(lod) => {
+                    pass.set_pipeline(&self.closed);
+                    for r in &lod.selection.ranges {
+                        pass.draw_indexed(3 * r.start..3 * r.end, 0, 0..1);
+                    }
+                    pass.set_pipeline(&self.pipeline);
+                }
+            }
+        }
+        if !translucent {
+            for (s, lod) in self.surfaces.iter().filter_map(|s| Some((s, s.lod.as_ref()?))) {
+                if lod.staged.is_empty() {
+                    continue;
+                }
+                pass.set_pipeline(&self.splat);
+                pass.set_bind_group(0, &s.bind_group, &[]);
+                pass.set_vertex_buffer(0, lod.splats.slice(..));
+                pass.draw(0..4, 0..lod.staged.len() as u32);
+            }
         }
     }
 }

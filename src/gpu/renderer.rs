@@ -154,6 +154,7 @@ pub struct Renderer {
     /// The translucent surfaces' fragment lists, shared by every layer.
     lists: FragmentLists,
     transparency: Transparency,
+    lod_scale: f32,
     frame: &'static [PhaseNode],
     /// The targets at the last frame's size, and the resolve pass's view of their colour.
     targets: Option<(FrameTargets, wgpu::BindGroup)>,
@@ -185,6 +186,7 @@ impl Renderer {
             resolve,
             lists,
             transparency: Transparency::Exact,
+            lod_scale: 1.0,
             frame: STANDARD_FRAME,
             targets: None,
         }
@@ -193,6 +195,12 @@ impl Renderer {
     /// How translucent surfaces are composited from the next frame on.
     pub fn set_transparency(&mut self, transparency: Transparency) {
         self.transparency = transparency;
+    }
+
+    /// Multiplies every surface's level-of-detail threshold (seed 002): above 1 while the user
+    /// drags, so more of a big surface is drawn as points and the view keeps up.
+    pub fn set_lod_scale(&mut self, scale: f32) {
+        self.lod_scale = scale;
     }
 
     /// Layer `n` (object `n`); layer 0 always exists.
@@ -311,7 +319,8 @@ impl Renderer {
             let view = ObjectView::new(&world, layer.world_from_object);
             layer.atoms.prepare(ctx, &view, n as u32, frame.size);
             let layer_lists = lists.filter(|_| layer.visible).map(|l| (l, self.transparency));
-            layer.surfaces.prepare(&ctx.queue, &view, n as u32, first_translucent, layer_lists);
+            let lod = (frame.size, self.lod_scale);
+            layer.surfaces.prepare(&ctx.queue, &view, n as u32, lod, first_translucent, layer_lists);
             if layer.visible {
                 first_translucent += layer.surfaces.translucent().count();
             }

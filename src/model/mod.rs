@@ -16,6 +16,7 @@ pub mod isosurface;
 pub mod measure;
 pub mod molecule;
 pub mod neighbours;
+pub mod octree;
 pub mod orbitals;
 pub mod overlap;
 pub mod scan;

@@ -55,6 +55,9 @@ pub struct SurfaceSettings {
     pub color: [f32; 3],
     /// Translucent with seed 003's optics, in exact order with every other translucent surface.
     pub translucent: bool,
+    /// Seed 002's level of detail: parts of the surface smaller than this many pixels on screen
+    /// are drawn as points (0: every triangle). Opaque surfaces only.
+    pub lod_px: f32,
 }
 
 impl Default for SurfaceSettings {
@@ -67,6 +70,7 @@ impl Default for SurfaceSettings {
             // A pale blue-grey that shows shape by its shading.
             color: [0.62, 0.68, 0.80],
             translucent: false,
+            lod_px: Self::LOD_PX,
         }
     }
 }
@@ -84,9 +88,14 @@ impl SurfaceSettings {
         Some(p)
     }
 
-    /// How the mesh is drawn: opaque in its colour, or with the default translucent optics.
+    /// The level of detail's default threshold, pixels.
+    pub const LOD_PX: f32 = 3.0;
+
+    /// How the mesh is drawn: opaque in its colour (with the level of detail), or with the
+    /// default translucent optics.
     pub fn look(&self) -> SurfaceLook {
-        IsosurfaceSettings { translucent: self.translucent, ..Default::default() }.look(self.color)
+        let look = IsosurfaceSettings { translucent: self.translucent, ..Default::default() }.look(self.color);
+        SurfaceLook { lod_px: (!self.translucent && self.lod_px > 0.0).then_some(self.lod_px), ..look }
     }
 
     /// Whether a mesh built with `other` serves these settings too (only the look differs).

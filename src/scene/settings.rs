@@ -233,7 +233,7 @@ impl IsosurfaceSettings {
     /// How a surface of this setting in `color` is drawn.
     pub fn look(&self, color: [f32; 3]) -> super::translucency::SurfaceLook {
         let optics = self.translucent.then(|| self.tuning.apply(self.optics.optics(color)));
-        super::translucency::SurfaceLook { color, optics }
+        super::translucency::SurfaceLook { color, optics, lod_px: None }
     }
 }
 

@@ -165,11 +165,14 @@ pub struct SurfaceLook {
     /// Linear RGB (of the opaque surface; a translucent one's optics were made from it).
     pub color: [f32; 3],
     pub optics: Option<Optics>,
+    /// Seed 002's level of detail for an opaque closed surface: parts that look smaller than
+    /// this many pixels are drawn as points ([`crate::model::octree`]); `None`: every triangle.
+    pub lod_px: Option<f32>,
 }
 
 impl From<[f32; 3]> for SurfaceLook {
     fn from(color: [f32; 3]) -> Self {
-        Self { color, optics: None }
+        Self { color, optics: None, lod_px: None }
     }
 }
 

@@ -1,0 +1,409 @@
+//! Seed 002's hybrid point/polygon level of detail for big surfaces: a mesh's triangles binned
+//! into an octree whose cells shrink to about an atom's size, empty cells dropped; per frame,
+//! cells outside the view or facing away are skipped, a cell whose projected size falls under
+//! a threshold is drawn as one point splat (its area-weighted centre and normal, sized to cover
+//! the cell), and nearer cells as their triangles.
+//!
+//! The triangles are reordered along a Morton curve of their centroids, so every cell holds a
+//! contiguous run of them: drawing a cell's triangles is drawing one index range, and runs of
+//! neighbouring cells merge into one range.
+
+use std::ops::Range;
+
+use glam::{Mat4, Vec3};
+use rayon::prelude::*;
+
+use super::isosurface::Mesh;
+
+/// One cell: the box of its triangles, the run of triangles it holds, its children, and what a
+/// splat standing for it needs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Cell {
+    /// Box of the cell's triangles (not of the octree cell): tight, for culling.
+    pub lo: Vec3,
+    pub hi: Vec3,
+    /// Its triangles: `indices[3·start..3·end]` of the reordered mesh.
+    pub triangles: (u32, u32),
+    /// Children: `cells[first..first + count]` (count 0: a leaf).
+    pub first_child: u32,
+    pub child_count: u32,
+    /// Area-weighted centre and unit normal of its triangles.
+    pub centre: Vec3,
+    pub normal: Vec3,
+    /// Cosine of the widest angle between `normal` and a triangle's normal (−1: any way).
+    pub cone: f32,
+}
+
+impl Cell {
+    /// Half the box's diagonal: a sphere around the centre of the box that holds the cell.
+    pub fn radius(&self) -> f32 {
+        0.5 * (self.hi - self.lo).length()
+    }
+}
+
+/// The octree of one mesh, with the mesh's triangles in cell order.
+#[derive(Debug, Clone, Default)]
+pub struct SurfaceOctree {
+    /// Cell 0 is the root; every cell's children are contiguous.
+    pub cells: Vec<Cell>,
+    /// The mesh's indices reordered so each cell's triangles are contiguous.
+    pub indices: Vec<u32>,
+}
+
+/// A cell drawn as one point: where, which way it faces, and its radius (object units).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Splat {
+    pub centre: Vec3,
+    pub radius: f32,
+    pub normal: Vec3,
+}
+
+/// The camera as the selection needs it.
+#[derive(Debug, Clone, Copy)]
+pub struct LodView {
+    pub clip_from_object: Mat4,
+    /// The eye in the mesh's frame.
+    pub eye: Vec3,
+    /// Viewport height in pixels.
+    pub height_px: f32,
+    /// A cell whose projected size is under this many pixels is drawn as a point.
+    pub threshold_px: f32,
+    /// Skip cells whose triangles all face away from the eye (closed surfaces only).
+    pub back_faces: bool,
+}
+
+/// What one frame draws of a mesh.
+#[derive(Debug, Clone, Default)]
+pub struct Selection {
+    /// Triangle ranges (merged where they touch).
+    pub ranges: Vec<Range<u32>>,
+    pub splats: Vec<Splat>,
+    /// Triangles drawn, cells visited.
+    pub triangles: u32,
+    pub visited: u32,
+}
+
+/// Most levels an octree gets (a Morton code of 3 × 10 bits).
+const MAX_DEPTH: u32 = 10;
+
+impl SurfaceOctree {
+    /// Bins `mesh`'s triangles into cells split at their midpoints until a cell's side is at most
+    /// `leaf_size` (an atom's size) or the tree is [`MAX_DEPTH`] deep; empty cells are never made.
+    pub fn build(mesh: &Mesh, leaf_size: f32) -> Self {
+        let n = mesh.triangle_count();
+        if n == 0 {
+            return Self::default();
+        }
+        let tri = |t: usize| std::array::from_fn::<Vec3, 3, _>(|c| mesh.positions[mesh.indices[3 * t + c] as usize]);
+        let (lo, hi) =
+            mesh.positions.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+        let side = (hi - lo).max_element().max(1e-6);
+        let depth = ((side / leaf_size.max(1e-6)).log2().ceil().max(0.0) as u32).min(MAX_DEPTH);
+        let scale = (1u32 << depth) as f32 / side;
+        // Each triangle's Morton code at the leaves' level, then the triangles in that order.
+        let mut keyed: Vec<(u32, u32)> = (0..n)
+            .into_par_iter()
+            .map(|t| {
+                let [a, b, c] = tri(t);
+                let cell = (((a + b + c) / 3.0 - lo) * scale).floor();
+                let max = (1u32 << depth) - 1;
+                let q = |v: f32| (v.max(0.0) as u32).min(max);
+                (morton(q(cell.x), q(cell.y), q(cell.z)), t as u32)
+            })
+            .collect();
+        keyed.par_sort_unstable();
+        let indices: Vec<u32> =
+            keyed.iter().flat_map(|&(_, t)| (0..3).map(move |c| mesh.indices[3 * t as usize + c])).collect();
+        let codes: Vec<u32> = keyed.iter().map(|&(k, _)| k).collect();
+        let mut tree = Self { cells: Vec::new(), indices };
+        let positions = &mesh.positions;
+        let normal_of = |t: usize, indices: &[u32]| {
+            let [a, b, c] = std::array::from_fn::<Vec3, 3, _>(|k| positions[indices[3 * t + k] as usize]);
+            (b - a).cross(c - a)
+        };
+        // Breadth first: a cell's children are made together, so they sit side by side.
+        tree.cells.push(tree.summary(0..n as u32, positions, &normal_of));
+        let mut level = vec![(0usize, 0u32)]; // (cell, its depth)
+        while !level.is_empty() {
+            let mut next = Vec::new();
+            for (cell, d) in level {
+                if d >= depth {
+                    continue;
+                }
+                let (start, end) = tree.cells[cell].triangles;
+                // Children: runs of equal code prefix at depth d + 1.
+                let shift = 3 * (depth - d - 1);
+                let first = tree.cells.len() as u32;
+                let mut s = start;
+                while s < end {
+                    let key = codes[s as usize] >> shift;
+                    let e = s + codes[s as usize..end as usize].partition_point(|&c| c >> shift == key) as u32;
+                    next.push((tree.cells.len(), d + 1));
+                    let child = tree.summary(s..e, positions, &normal_of);
+                    tree.cells.push(child);
+                    s = e;
+                }
+                let count = tree.cells.len() as u32 - first;
+                tree.cells[cell].first_child = first;
+                tree.cells[cell].child_count = count;
+            }
+            level = next;
+        }
+        tree
+    }
+
+    /// A cell over triangles `run` (in the reordered order).
+    fn summary(&self, run: Range<u32>, positions: &[Vec3], normal_of: &impl Fn(usize, &[u32]) -> Vec3) -> Cell {
+        let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+        let (mut centre, mut normal, mut area) = (Vec3::ZERO, Vec3::ZERO, 0.0);
+        for t in run.clone() {
+            let t = t as usize;
+            for k in 0..3 {
+                let p = positions[self.indices[3 * t + k] as usize];
+                lo = lo.min(p);
+                hi = hi.max(p);
+            }
+            let cross = normal_of(t, &self.indices);
+            let a = 0.5 * cross.length();
+            let c = (0..3).map(|k| positions[self.indices[3 * t + k] as usize]).sum::<Vec3>() / 3.0;
+            centre += c * a;
+            normal += cross * 0.5;
+            area += a;
+        }
+        let normal = normal.normalize_or_zero();
+        let mut cone: f32 = 1.0;
+        for t in run.clone() {
+            let n = normal_of(t as usize, &self.indices).normalize_or_zero();
+            cone = cone.min(if normal == Vec3::ZERO { -1.0 } else { n.dot(normal) });
+        }
+        Cell {
+            lo,
+            hi,
+            triangles: (run.start, run.end),
+            first_child: 0,
+            child_count: 0,
+            centre: if area > 0.0 { centre / area } else { 0.5 * (lo + hi) },
+            normal,
+            cone,
+        }
+    }
+
+    /// What to draw this frame: cells in view, facing the eye (when asked), as points where they
+    /// look smaller than the threshold and as triangles otherwise.
+    pub fn select(&self, view: &LodView, out: &mut Selection) {
+        out.ranges.clear();
+        out.splats.clear();
+        out.triangles = 0;
+        out.visited = 0;
+        if self.cells.is_empty() {
+            return;
+        }
+        let m = view.clip_from_object;
+        // Pixels per object unit at clip w = 1: the projection's y scale times half the height
+        // (Size = r·(n/z_eye)·(h/(t − b)), seed 002).
+        let sy = Vec3::new(m.x_axis.y, m.y_axis.y, m.z_axis.y).length();
+        let px_per_unit = sy * 0.5 * view.height_px;
+        let mut stack = vec![0u32];
+        while let Some(c) = stack.pop() {
+            out.visited += 1;
+            let cell = &self.cells[c as usize];
+            if outside_frustum(&m, cell.lo, cell.hi) || (view.back_faces && faces_away(cell, view.eye)) {
+                continue;
+            }
+            let centre = 0.5 * (cell.lo + cell.hi);
+            let w = (m * centre.extend(1.0)).w;
+            let r = cell.radius();
+            let leaf = cell.child_count == 0;
+            // Size on screen of the cell's diameter; a cell the eye is inside is never small.
+            let size = if w > r { 2.0 * r * px_per_unit / w } else { f32::INFINITY };
+            if size < view.threshold_px {
+                out.splats.push(Splat { centre: cell.centre, radius: r, normal: cell.normal });
+            } else if leaf {
+                let (s, e) = cell.triangles;
+                out.triangles += e - s;
+                match out.ranges.last_mut() {
+                    Some(last) if last.end == s => last.end = e,
+                    _ => out.ranges.push(s..e),
+                }
+            } else {
+                // Children pushed last first, so they pop in Morton order and their ranges merge.
+                for k in (0..cell.child_count).rev() {
+                    stack.push(cell.first_child + k);
+                }
+            }
+        }
+    }
+}
+
+/// Whether the box lies wholly outside one of the view's six clip planes.
+fn outside_frustum(m: &Mat4, lo: Vec3, hi: Vec3) -> bool {
+    let corners: [glam::Vec4; 8] = std::array::from_fn(|k| {
+        let p = Vec3::new(
+            if k & 1 == 0 { lo.x } else { hi.x },
+            if k & 2 == 0 { lo.y } else { hi.y },
+            if k & 4 == 0 { lo.z } else { hi.z },
+        );
+        *m * p.extend(1.0)
+    });
+    let all = |f: &dyn Fn(&glam::Vec4) -> bool| corners.iter().all(f);
+    all(&|c| c.x < -c.w)
+        || all(&|c| c.x > c.w)
+        || all(&|c| c.y < -c.w)
+        || all(&|c| c.y > c.w)
+        || all(&|c| c.z < 0.0)
+        || all(&|c| c.z > c.w)
+}
+
+/// Whether every triangle of the cell faces away from `eye` seen from anywhere in its box:
+/// the normals lie within the cone around `normal`, so the cell is hidden when the eye is
+/// farther than the cone's half-angle beyond the back of each corner's tangent plane.
+fn faces_away(cell: &Cell, eye: Vec3) -> bool {
+    if cell.cone <= 0.0 {
+        return false;
+    }
+    let sin = (1.0 - cell.cone * cell.cone).max(0.0).sqrt();
+    (0..8).all(|k| {
+        let corner = Vec3::new(
+            if k & 1 == 0 { cell.lo.x } else { cell.hi.x },
+            if k & 2 == 0 { cell.lo.y } else { cell.hi.y },
+            if k & 4 == 0 { cell.lo.z } else { cell.hi.z },
+        );
+        let to_eye = (eye - corner).normalize_or_zero();
+        cell.normal.dot(to_eye) < -sin
+    })
+}
+
+/// Interleaves the bits of x, y, z (10 each): z highest, so sorting by it walks the octree.
+fn morton(x: u32, y: u32, z: u32) -> u32 {
+    fn spread(v: u32) -> u32 {
+        let mut v = v & 0x3ff;
+        v = (v | (v << 16)) & 0x030000ff;
+        v = (v | (v << 8)) & 0x0300f00f;
+        v = (v | (v << 4)) & 0x030c30c3;
+        (v | (v << 2)) & 0x09249249
+    }
+    spread(x) | (spread(y) << 1) | (spread(z) << 2)
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::atomic::AtomicBool;
+
+    use glam::DVec3;
+
+    use super::*;
+    use crate::model::surface::{self, Sphere, SurfaceKind, SurfaceParams};
+
+    /// Two atoms' solvent-excluded surface, about 3000 triangles, 10 bohr across.
+    fn mesh() -> Mesh {
+        let spheres =
+            [Sphere { centre: DVec3::ZERO, radius: 3.2 }, Sphere { centre: DVec3::new(5.0, 1.0, 0.0), radius: 3.0 }];
+        let mut p = SurfaceParams::auto(SurfaceKind::SolventExcluded, &spheres);
+        p.resolution = 0.6;
+        surface::build(&spheres, &p, &AtomicBool::new(false)).unwrap().mesh
+    }
+
+    fn looking_at_origin(from: Vec3, height_px: f32, threshold_px: f32) -> LodView {
+        let view = glam::camera::rh::view::look_at_mat4(from, Vec3::ZERO, Vec3::Y);
+        let proj = glam::camera::rh::proj::directx::perspective(0.8, 1.0, 0.1, 1.0e5);
+        LodView { clip_from_object: proj * view, eye: from, height_px, threshold_px, back_faces: false }
+    }
+
+    #[test]
+    fn cells_hold_contiguous_runs_of_every_triangle_once() {
+        let mesh = mesh();
+        let tree = SurfaceOctree::build(&mesh, 2.0);
+        let n = mesh.triangle_count() as u32;
+        let mut tris: Vec<[u32; 3]> = tree.indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect();
+        let mut original: Vec<[u32; 3]> = mesh.indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect();
+        tris.sort_unstable();
+        original.sort_unstable();
+        assert_eq!(tris, original, "a permutation of the triangles");
+        assert_eq!(tree.cells[0].triangles, (0, n));
+        let mut leaves = 0;
+        for cell in &tree.cells {
+            let (s, e) = cell.triangles;
+            assert!(e > s, "no empty cell");
+            if cell.child_count == 0 {
+                leaves += 1;
+                continue;
+            }
+            let kids = &tree.cells[cell.first_child as usize..(cell.first_child + cell.child_count) as usize];
+            assert!(kids.len() <= 8);
+            assert_eq!(kids[0].triangles.0, s);
+            assert_eq!(kids.last().unwrap().triangles.1, e);
+            for pair in kids.windows(2) {
+                assert_eq!(pair[0].triangles.1, pair[1].triangles.0, "children tile their parent's run");
+            }
+            for k in kids {
+                assert!(k.lo.cmpge(cell.lo).all() && k.hi.cmple(cell.hi).all(), "a child's box lies in its parent's");
+            }
+        }
+        // Leaves are about the asked size: their triangles' centroids fit in a 2-bohr cell.
+        assert!(leaves > 20, "{leaves} leaves");
+        for cell in tree.cells.iter().filter(|c| c.child_count == 0) {
+            let (s, e) = cell.triangles;
+            let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+            for t in s..e {
+                let c = (0..3).map(|k| mesh.positions[tree.indices[3 * t as usize + k] as usize]).sum::<Vec3>() / 3.0;
+                lo = lo.min(c);
+                hi = hi.max(c);
+            }
+            assert!((hi - lo).max_element() <= 2.0 + 1e-4, "leaf spans {}", (hi - lo).max_element());
+        }
+    }
+
+    #[test]
+    fn near_cells_draw_triangles_far_ones_points_and_nothing_outside_the_view() {
+        let mesh = mesh();
+        let tree = SurfaceOctree::build(&mesh, 2.0);
+        let n = mesh.triangle_count() as u32;
+        let mut sel = Selection::default();
+        // No threshold: every triangle, in one merged range.
+        tree.select(&looking_at_origin(Vec3::new(0.0, 0.0, 40.0), 600.0, 0.0), &mut sel);
+        assert_eq!((sel.triangles, sel.ranges.len(), sel.splats.len()), (n, 1, 0));
+        assert_eq!(sel.ranges[0], 0..n);
+        // Far away: the whole surface is a few pixels, one point.
+        tree.select(&looking_at_origin(Vec3::new(0.0, 0.0, 4000.0), 600.0, 3.0), &mut sel);
+        assert_eq!((sel.triangles, sel.splats.len()), (0, 1));
+        assert!(sel.splats[0].radius > 5.0 && sel.splats[0].radius < 12.0, "{:?}", sel.splats[0]);
+        // In between: some of each, and the points stand for what the triangles leave out.
+        tree.select(&looking_at_origin(Vec3::new(0.0, 0.0, 150.0), 600.0, 8.0), &mut sel);
+        assert!(
+            sel.triangles < n && !sel.splats.is_empty(),
+            "{} triangles, {} points",
+            sel.triangles,
+            sel.splats.len()
+        );
+        // Looking away: nothing.
+        let mut away = looking_at_origin(Vec3::new(0.0, 0.0, 40.0), 600.0, 0.0);
+        away.clip_from_object = glam::camera::rh::proj::directx::perspective(0.8, 1.0, 0.1, 1.0e5)
+            * glam::camera::rh::view::look_at_mat4(Vec3::new(0.0, 0.0, 40.0), Vec3::new(0.0, 0.0, 80.0), Vec3::Y);
+        tree.select(&away, &mut sel);
+        assert_eq!((sel.triangles, sel.splats.len()), (0, 0));
+    }
+
+    #[test]
+    fn back_facing_cells_of_a_closed_surface_are_skipped() {
+        let mesh = mesh();
+        let tree = SurfaceOctree::build(&mesh, 1.0);
+        let mut view = looking_at_origin(Vec3::new(0.0, 0.0, 40.0), 600.0, 0.0);
+        view.back_faces = true;
+        let mut sel = Selection::default();
+        tree.select(&view, &mut sel);
+        let n = mesh.triangle_count() as u32;
+        assert!(sel.triangles < n * 3 / 4 && sel.triangles > n / 3, "{} of {n}", sel.triangles);
+        // Every triangle left out faces away from the eye.
+        let mut drawn = vec![false; n as usize];
+        for r in &sel.ranges {
+            for t in r.clone() {
+                drawn[t as usize] = true;
+            }
+        }
+        for (t, _) in drawn.iter().enumerate().filter(|(_, d)| !**d) {
+            let [a, b, c] = std::array::from_fn::<Vec3, 3, _>(|k| mesh.positions[tree.indices[3 * t + k] as usize]);
+            let normal = (b - a).cross(c - a);
+            assert!(normal.dot(view.eye - a) < 0.0, "triangle {t} faces the eye but was skipped");
+        }
+    }
+}

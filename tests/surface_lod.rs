@@ -1,0 +1,94 @@
+//! Molecular surfaces on the GPU (lavapipe): the solvent-excluded surface of a protein fragment
+//! against its golden image, and seed 002's level of detail against every triangle: parts far
+//! away become points, the picture stays within 2/255, picking still finds the surface.
+
+mod common;
+
+use std::sync::atomic::AtomicBool;
+
+use orbcloud::gpu::frame::PickId;
+use orbcloud::gpu::{FrameInput, OffscreenTarget, Renderer};
+use orbcloud::headless::molecular_surface;
+use orbcloud::model::isosurface::Mesh;
+use orbcloud::scene::translucency::SurfaceLook;
+use orbcloud::scene::{AtomStyle, Camera, RenderSettings, SurfaceChoice, SurfaceSettings};
+
+const SIZE: [u32; 2] = [256, 192];
+
+fn fragment() -> (orbcloud::model::Document, Mesh) {
+    let pdb = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/structures/4e43_excerpt.pdb");
+    let doc = orbcloud::formats::load(std::path::Path::new(pdb)).unwrap();
+    let settings =
+        SurfaceSettings { choice: SurfaceChoice::SolventExcluded, resolution: Some(0.35), ..Default::default() };
+    let (mesh, note) =
+        molecular_surface(&doc, &settings, "not resn HOH", u64::MAX, &AtomicBool::new(false)).unwrap().unwrap();
+    assert!(note.is_none(), "{note:?}");
+    (doc, mesh)
+}
+
+fn draw(
+    ctx: &orbcloud::gpu::GpuContext,
+    renderer: &mut Renderer,
+    camera: &Camera,
+) -> (image::RgbaImage, orbcloud::gpu::isosurface::LodStats) {
+    let target = OffscreenTarget::new(&ctx.device, SIZE);
+    let settings = RenderSettings::default();
+    let mut encoder = ctx.device.create_command_encoder(&Default::default());
+    renderer.render(ctx, &mut encoder, &target.color_view, &FrameInput::single(camera, &settings, SIZE));
+    ctx.queue.submit([encoder.finish()]);
+    (target.read_rgba(&ctx.device, &ctx.queue).unwrap(), renderer.main().surfaces.lod_stats())
+}
+
+fn mean_difference(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
+    let sum: u64 =
+        a.pixels().zip(b.pixels()).map(|(p, q)| (0..3).map(|k| p[k].abs_diff(q[k]) as u64).sum::<u64>()).sum();
+    sum as f64 / (3 * a.width() * a.height()) as f64
+}
+
+#[test]
+fn far_parts_become_points_within_two_levels_of_every_triangle() {
+    let ctx = common::lavapipe();
+    let (doc, mesh) = fragment();
+    let mut renderer = Renderer::new(&ctx);
+    renderer.main().set_molecule(&ctx, &doc.molecule, AtomStyle::Hidden);
+    let (lo, hi) = doc.molecule.bounds().unwrap();
+    let mut camera = Camera::framing(lo.as_vec3(), hi.as_vec3());
+    camera.orbit(0.6, 0.3);
+    let color = SurfaceSettings::default().color;
+
+    // Every triangle: the golden picture.
+    orbcloud::headless::show_meshes(&ctx, renderer.main(), &[(mesh.clone(), color.into())]);
+    let (full, stats) = draw(&ctx, &mut renderer, &camera);
+    assert_eq!(stats.total_triangles, 0, "no level of detail asked for");
+    common::assert_golden("surface_ses_fragment", &full);
+
+    // Seed 002's level of detail at the viewer's threshold: some cells are points, the rest
+    // triangles, the picture within 2/255.
+    let look = SurfaceLook { lod_px: Some(SurfaceSettings::LOD_PX), ..color.into() };
+    orbcloud::headless::show_meshes(&ctx, renderer.main(), &[(mesh.clone(), look)]);
+    let (lod, stats) = draw(&ctx, &mut renderer, &camera);
+    let n = mesh.triangle_count() as u64;
+    assert_eq!(stats.total_triangles, n);
+    assert!(stats.splats > 0 && stats.triangles < n, "{stats:?}");
+    let mean = mean_difference(&full, &lod);
+    eprintln!("level of detail at {} px: {stats:?}, mean difference {mean:.3}/255", SurfaceSettings::LOD_PX);
+    assert!(mean < 2.0, "mean difference {mean}/255");
+    // Where the frame shows the surface, picking says so, points included.
+    let covered = full.enumerate_pixels().filter(|(_, _, p)| p[0] > 100).count();
+    assert!(covered > (SIZE[0] * SIZE[1] / 10) as usize, "the surface fills the view: {covered} pixels");
+    let picked = renderer.pick(&ctx, [SIZE[0] / 2, SIZE[1] / 2]).unwrap();
+    assert!(matches!(picked, Some(PickId::Surface { object: 0, index: 0 })), "{picked:?}");
+
+    // While the view is dragged the threshold is four times larger: more points, fewer
+    // triangles, and still the same surface at a glance.
+    renderer.set_lod_scale(4.0);
+    let (dragged, coarse) = draw(&ctx, &mut renderer, &camera);
+    assert!(coarse.splats > stats.splats && coarse.triangles < stats.triangles, "{coarse:?} vs {stats:?}");
+    let mean = mean_difference(&full, &dragged);
+    assert!(mean < 8.0, "while dragging: mean difference {mean}/255");
+    // Far away, the whole fragment is a handful of points.
+    camera.distance *= 40.0;
+    renderer.set_lod_scale(1.0);
+    let (_, far) = draw(&ctx, &mut renderer, &camera);
+    assert!(far.triangles == 0 && (1..64).contains(&far.splats), "{far:?}");
+}
