@@ -108,6 +108,10 @@ pub struct SurfaceBench {
     /// Use the CPU Vulkan adapter (lavapipe) even when a GPU is present.
     #[arg(long)]
     lavapipe: bool,
+    /// Zoom factor (> 1 comes closer; < 1 moves away, where the level of detail draws more
+    /// points).
+    #[arg(long, default_value_t = 1.0)]
+    zoom: f32,
     /// Write each surface's last frame with and without the level of detail here.
     #[arg(long)]
     images: Option<std::path::PathBuf>,
@@ -146,7 +150,8 @@ pub fn bench(args: &SurfaceBench) -> Result<()> {
         let mut renderer = Renderer::new(&ctx);
         renderer.main().set_molecule(&ctx, &doc.molecule, AtomStyle::Hidden);
         let (lo, hi) = s.grid.bounds();
-        let camera = Camera::framing(lo.as_vec3(), hi.as_vec3());
+        let mut camera = Camera::framing(lo.as_vec3(), hi.as_vec3());
+        camera.zoom(1.0 / args.zoom.max(1e-3));
         let target = OffscreenTarget::new(&ctx.device, args.size);
         let settings = RenderSettings::default();
         let mut draw = |lod_px: Option<f32>| -> Result<(f64, image::RgbaImage, LodStats)> {
