@@ -21,14 +21,17 @@ struct VertexOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) world: vec3<f32>,
     @location(1) normal: vec3<f32>,
+    // linear RGB times the surface's colour (white where the surface has one colour)
+    @location(2) tint: vec3<f32>,
 };
 
 @vertex
-fn vs_main(@location(0) position: vec3<f32>, @location(1) normal: vec3<f32>) -> VertexOut {
+fn vs_main(@location(0) position: vec3<f32>, @location(1) normal: vec3<f32>, @location(2) tint: vec3<f32>) -> VertexOut {
     var out: VertexOut;
     out.clip = u.clip_from_world * vec4<f32>(position, 1.0);
     out.world = position;
     out.normal = normal;
+    out.tint = tint;
     return out;
 }
 
@@ -40,13 +43,14 @@ struct FragOut {
 @fragment
 fn fs_main(in: VertexOut) -> FragOut {
     var out: FragOut;
-    out.color = vec4<f32>(lit(in.world, in.normal), 1.0);
+    out.color = vec4<f32>(lit(in.world, in.normal, in.tint), 1.0);
     out.id = u.pick.x;
     return out;
 }
 
-// The surface's colour at `world` with normal `normal`: headlight diffuse, specular and rim.
-fn lit(world: vec3<f32>, normal: vec3<f32>) -> vec3<f32> {
+// The surface's colour (times `tint`) at `world` with normal `normal`: headlight diffuse,
+// specular and rim.
+fn lit(world: vec3<f32>, normal: vec3<f32>, tint: vec3<f32>) -> vec3<f32> {
     let view = normalize(u.eye.xyz - world);
     var n = normalize(normal);
     // A surface cut open by the grid's box shows its inside: light that side too, a little
@@ -61,7 +65,7 @@ fn lit(world: vec3<f32>, normal: vec3<f32>) -> vec3<f32> {
     let h = normalize(l + view);
     let specular = pow(max(dot(n, h), 0.0), 40.0);
     let rim = pow(1.0 - max(dot(n, view), 0.0), 3.0);
-    let base = u.color.rgb * inner;
+    let base = u.color.rgb * tint * inner;
     return base * (0.25 + 0.75 * diffuse) + vec3<f32>(0.3 * specular + 0.06 * rim) * inner;
 }
 
@@ -74,6 +78,7 @@ struct SplatOut {
     @location(0) corner: vec2<f32>,
     @location(1) world: vec3<f32>,
     @location(2) normal: vec3<f32>,
+    @location(3) tint: vec3<f32>,
 };
 
 @vertex
@@ -82,6 +87,7 @@ fn vs_splat(
     @location(0) centre: vec3<f32>,
     @location(1) radius: f32,
     @location(2) normal: vec3<f32>,
+    @location(3) tint: vec3<f32>,
 ) -> SplatOut {
     // A triangle strip: (−1, −1), (1, −1), (−1, 1), (1, 1).
     let corner = vec2<f32>(f32(vertex & 1u) * 2.0 - 1.0, f32(vertex >> 1u) * 2.0 - 1.0);
@@ -91,6 +97,7 @@ fn vs_splat(
     out.corner = corner;
     out.world = centre;
     out.normal = normal;
+    out.tint = tint;
     return out;
 }
 
@@ -100,7 +107,7 @@ fn fs_splat(in: SplatOut) -> FragOut {
         discard;
     }
     var out: FragOut;
-    out.color = vec4<f32>(lit(in.world, in.normal), 1.0);
+    out.color = vec4<f32>(lit(in.world, in.normal, in.tint), 1.0);
     out.id = u.pick.x;
     return out;
 }

@@ -92,3 +92,39 @@ fn far_parts_become_points_within_two_levels_of_every_triangle() {
     let (_, far) = draw(&ctx, &mut renderer, &camera);
     assert!(far.triangles == 0 && (1..64).contains(&far.splats), "{far:?}");
 }
+
+/// Coloured by atoms, each vertex takes the colour of the atom whose van der Waals surface is
+/// nearest it (checked by brute force on every 50th vertex).
+#[test]
+fn a_surface_coloured_by_element_takes_each_vertex_from_its_nearest_atom() {
+    use orbcloud::model::surface::Sphere;
+    use orbcloud::scene::AtomColoring;
+    let (doc, mut mesh) = fragment();
+    let settings = SurfaceSettings {
+        choice: SurfaceChoice::SolventExcluded,
+        color_by: Some(AtomColoring::Element),
+        ..Default::default()
+    };
+    orbcloud::headless::color_surface(&mut mesh, &doc, &settings, "not resn HOH");
+    assert_eq!(mesh.colors.len(), mesh.positions.len());
+    let selection = orbcloud::scene::selection::Selection::parse("not resn HOH").unwrap();
+    let mask = selection.mask(&doc.molecule, doc.structure.as_ref());
+    let (spheres, atoms) = Sphere::of_atoms(&doc.molecule, Some(&mask));
+    let mut elements = std::collections::BTreeSet::new();
+    for (v, (p, c)) in mesh.positions.iter().zip(&mesh.colors).enumerate().step_by(50) {
+        let p = p.as_dvec3();
+        let nearest = (0..spheres.len())
+            .min_by(|&a, &b| {
+                let d = |k: usize| (p - spheres[k].centre).length() - spheres[k].radius;
+                d(a).total_cmp(&d(b))
+            })
+            .unwrap();
+        let atom = &doc.molecule.atoms[atoms[nearest] as usize];
+        let expected = orbcloud::scene::coloring::linear(atom.element().color);
+        assert_eq!(*c, expected, "vertex {v} at {p}: nearest atom {} ({})", atoms[nearest], atom.element().symbol);
+        elements.insert(atom.element().symbol);
+    }
+    assert!(elements.contains("C") && elements.contains("N") && elements.contains("O"), "{elements:?}");
+    // The look carries no colour of its own: the vertices do.
+    assert_eq!(settings.look().color, [1.0; 3]);
+}

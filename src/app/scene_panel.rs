@@ -7,7 +7,7 @@ use egui::{ComboBox, DragValue, RichText, Slider};
 
 use super::OrbApp;
 use crate::model::units::{ANGSTROM_PER_BOHR, BOHR_PER_ANGSTROM};
-use crate::scene::{AtomStyle, IsoLevel, IsosurfaceSettings, Placement, SurfaceChoice, SurfaceSettings};
+use crate::scene::{AtomColoring, AtomStyle, IsoLevel, IsosurfaceSettings, Placement, SurfaceChoice, SurfaceSettings};
 
 /// What the user asked for in the panel this frame, applied after it is drawn.
 enum Edit {
@@ -112,10 +112,26 @@ fn surface_editor(ui: &mut egui::Ui, s: &mut SurfaceSettings) -> bool {
             .response
             .labelled_by(label.id)
             .on_hover_text("Gaussian: the atoms' blended density (VMD's QuickSurf); solvent-excluded: where a probe cannot reach (Connolly's)");
-        if s.choice != SurfaceChoice::Off {
+        if s.choice != SurfaceChoice::Off && s.color_by.is_none() {
             ui.color_edit_button_rgb(&mut s.color);
         }
     });
+    if s.choice != SurfaceChoice::Off {
+        ui.horizontal(|ui| {
+            let label = ui.label("colour by");
+            ComboBox::from_id_salt("scene surface colouring")
+                .selected_text(s.color_by.map_or("one colour", AtomColoring::name))
+                .show_ui(ui, |ui| {
+                    ui.selectable_value(&mut s.color_by, None, "one colour");
+                    for c in AtomColoring::ALL {
+                        ui.selectable_value(&mut s.color_by, Some(c), c.name());
+                    }
+                })
+                .response
+                .labelled_by(label.id)
+                .on_hover_text("the nearest atom's colour");
+        });
+    }
     if s.choice != SurfaceChoice::Off {
         ui.horizontal(|ui| {
             let mut auto = s.resolution.is_none();

@@ -752,5 +752,7 @@ fn molecular_surface_cached(
         }
     }
     let built = cache.as_ref().expect("just built");
-    (Some((built.mesh.clone(), settings.look())), built.note.clone())
+    let mut mesh = built.mesh.clone();
+    crate::headless::color_surface(&mut mesh, doc, settings, selection);
+    (Some((mesh, settings.look())), built.note.clone())
 }

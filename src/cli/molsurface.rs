@@ -13,7 +13,7 @@ use orbcloud::model::isosurface::Mesh;
 use orbcloud::model::surface::{self, Sphere, SurfaceParams};
 use orbcloud::model::units::BOHR_PER_ANGSTROM;
 use orbcloud::scene::translucency::SurfaceLook;
-use orbcloud::scene::{SurfaceChoice, SurfaceSettings};
+use orbcloud::scene::{AtomColoring, SurfaceChoice, SurfaceSettings};
 
 #[derive(Clone, Copy, ValueEnum)]
 pub enum SurfaceArg {
@@ -21,6 +21,29 @@ pub enum SurfaceArg {
     Gaussian,
     /// Solvent-excluded surface (Connolly's), for a probe of radius --probe.
     Ses,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub enum SurfaceColorArg {
+    Uniform,
+    Element,
+    Chain,
+    Residue,
+    BFactor,
+    Secondary,
+}
+
+impl SurfaceColorArg {
+    fn coloring(self) -> Option<AtomColoring> {
+        match self {
+            SurfaceColorArg::Uniform => None,
+            SurfaceColorArg::Element => Some(AtomColoring::Element),
+            SurfaceColorArg::Chain => Some(AtomColoring::Chain),
+            SurfaceColorArg::Residue => Some(AtomColoring::Residue),
+            SurfaceColorArg::BFactor => Some(AtomColoring::BFactor),
+            SurfaceColorArg::Secondary => Some(AtomColoring::Secondary),
+        }
+    }
 }
 
 /// The molecular surface options of `render` and `mesh`.
@@ -38,6 +61,10 @@ pub struct MolSurfaceArgs {
     /// Smoothness α of the Gaussian surface (larger hugs the atoms tighter).
     #[arg(long, default_value_t = SurfaceParams::SMOOTHNESS)]
     pub smoothness: f64,
+    /// What colours the molecular surface: one colour, or the nearest atom's element, chain,
+    /// residue, B-factor or secondary structure.
+    #[arg(long, value_enum, default_value_t = SurfaceColorArg::Uniform)]
+    pub surface_color: SurfaceColorArg,
     /// Seed 002's level of detail: parts smaller than this many pixels are drawn as points
     /// (0: every triangle).
     #[arg(long, default_value_t = SurfaceSettings::LOD_PX)]
@@ -58,6 +85,7 @@ impl MolSurfaceArgs {
             smoothness: self.smoothness as f32,
             translucent,
             lod_px: self.lod_px,
+            color_by: self.surface_color.coloring(),
             ..Default::default()
         }
     }
@@ -68,7 +96,8 @@ impl MolSurfaceArgs {
         let t = Instant::now();
         let built = molecular_surface(doc, &settings, "", u64::MAX, &AtomicBool::new(false))
             .with_context(|| format!("{}: the molecular surface", doc.source))?;
-        let Some((mesh, _)) = built else { return Ok(None) };
+        let Some((mut mesh, _)) = built else { return Ok(None) };
+        orbcloud::headless::color_surface(&mut mesh, doc, &settings, "");
         eprintln!(
             "{} surface: {} triangles, area {:.1} Å², volume {:.1} Å³, {:.0} ms",
             settings.choice.name(),

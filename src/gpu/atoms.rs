@@ -247,11 +247,8 @@ fn style_flags(style: AtomStyle) -> (f32, u32) {
 }
 
 pub(crate) fn linear_color(srgb: [u8; 3]) -> [f32; 4] {
-    let lin = |c: u8| {
-        let c = c as f32 / 255.0;
-        if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
-    };
-    [lin(srgb[0]), lin(srgb[1]), lin(srgb[2]), 1.0]
+    let [r, g, b] = crate::scene::coloring::linear(srgb);
+    [r, g, b, 1.0]
 }
 
 /// Workgroups for `n` invocations, as (x, y) within the per-dimension limit, and the

@@ -33,14 +33,17 @@ struct SplatInstance {
     centre: [f32; 3],
     radius: f32,
     normal: [f32; 3],
+    tint: [f32; 3],
 }
 
-/// Interleaved position and normal, as the vertex buffer holds them.
+/// Interleaved position, normal and tint (the vertex's colour, white for a one-colour
+/// surface), as the vertex buffer holds them.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
 struct SurfaceVertex {
     position: [f32; 3],
     normal: [f32; 3],
+    tint: [f32; 3],
 }
 
 struct GpuSurface {
@@ -101,7 +104,7 @@ impl IsosurfacePass {
         let device = &ctx.device;
         let module = super::shader_module(device, "isosurface.wgsl");
         let (layout, pipeline_layout) = super::uniform_layouts(device, "isosurface");
-        let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3];
+        let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x3];
         let vertex = wgpu::VertexState {
             module: &module,
             entry_point: Some("vs_main"),
@@ -135,7 +138,7 @@ impl IsosurfacePass {
         // A closed surface (molecular surfaces, wound counter-clockwise seen from outside) shows
         // only its outside: the rasteriser skips the half facing away.
         let closed = opaque("closed surfaces", Some(wgpu::Face::Back));
-        let splat_attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32, 2 => Float32x3];
+        let splat_attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32, 2 => Float32x3, 3 => Float32x3];
         let splat = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("surface splats"),
             layout: Some(&pipeline_layout),
@@ -244,11 +247,12 @@ impl IsosurfacePass {
             .enumerate()
             .filter(|(_, (mesh, _))| !mesh.is_empty())
             .map(|(n, (mesh, look))| {
-                let vertices: Vec<SurfaceVertex> = mesh
-                    .positions
-                    .iter()
-                    .zip(&mesh.normals)
-                    .map(|(p, n)| SurfaceVertex { position: p.to_array(), normal: n.to_array() })
+                let vertices: Vec<SurfaceVertex> = (mesh.positions.iter().zip(&mesh.normals).enumerate())
+                    .map(|(i, (p, n))| SurfaceVertex {
+                        position: p.to_array(),
+                        normal: n.to_array(),
+                        tint: mesh.colors.get(i).copied().unwrap_or([1.0; 3]),
+                    })
                     .collect();
                 let vertices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                     label: Some("isosurface vertices"),
@@ -386,6 +390,7 @@ impl IsosurfacePass {
                     centre: p.centre.to_array(),
                     radius: p.radius,
                     normal: p.normal.to_array(),
+                    tint: p.color.to_array(),
                 }));
                 if !lod.staged.is_empty() {
                     queue.write_buffer(&lod.splats, 0, bytemuck::cast_slice(&lod.staged));

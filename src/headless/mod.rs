@@ -286,6 +286,28 @@ pub fn molecular_surface(
     }
 }
 
+/// Colours `mesh`, `doc`'s molecular surface built around the atoms `selection` shows, by the
+/// atom nearest each vertex as `s.color_by` says (no colours when it says none).
+pub fn color_surface(mesh: &mut Mesh, doc: &Document, s: &SurfaceSettings, selection: &str) {
+    mesh.colors.clear();
+    let Some(coloring) = s.color_by else { return };
+    let mask = Selection::parse(selection)
+        .ok()
+        .filter(|q| !q.is_everything())
+        .map(|q| q.mask(&doc.molecule, doc.structure.as_ref()));
+    let (spheres, atoms) = Sphere::of_atoms(&doc.molecule, mask.as_deref());
+    let colors = atom_colors(&doc.molecule, doc.structure.as_ref(), coloring);
+    let reach = s.probe as f64 * crate::model::units::BOHR_PER_ANGSTROM + 2.0;
+    let nearest = surface::nearest_spheres(&spheres, &mesh.positions, reach);
+    mesh.colors = nearest
+        .iter()
+        .map(|&n| match atoms.get(n as usize).and_then(|&a| colors.index.get(a as usize)) {
+            Some(&i) => crate::scene::coloring::linear(colors.palette[i as usize]),
+            None => s.color,
+        })
+        .collect();
+}
+
 /// Extracts the isosurfaces of `grid` and shows them in `layer` (none when `iso` is hidden).
 /// Returns the number of triangles.
 pub fn show_isosurfaces(ctx: &GpuContext, layer: &mut Layer, grid: &VolumeGrid, iso: &IsosurfaceSettings) -> usize {

@@ -22,6 +22,9 @@ pub struct Mesh {
     pub positions: Vec<Vec3>,
     pub normals: Vec<Vec3>,
     pub indices: Vec<u32>,
+    /// Linear RGB per vertex (a molecular surface coloured by its atoms); empty: the surface's
+    /// one colour.
+    pub colors: Vec<[f32; 3]>,
 }
 
 impl Mesh {
@@ -59,10 +62,14 @@ impl Mesh {
             .positions
             .iter()
             .zip(&self.normals)
-            .map(|(p, n)| {
+            .enumerate()
+            .map(|(i, (p, n))| {
                 *map.entry(p.to_array().map(f32::to_bits)).or_insert_with(|| {
                     out.positions.push(*p);
                     out.normals.push(*n);
+                    if let Some(c) = self.colors.get(i) {
+                        out.colors.push(*c);
+                    }
                     (out.positions.len() - 1) as u32
                 })
             })
@@ -75,6 +82,7 @@ impl Mesh {
         let base = self.positions.len() as u32;
         self.positions.extend(other.positions);
         self.normals.extend(other.normals);
+        self.colors.extend(other.colors);
         self.indices.extend(other.indices.into_iter().map(|i| i + base));
     }
 }

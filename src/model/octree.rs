@@ -30,6 +30,8 @@ pub struct Cell {
     /// Area-weighted centre and unit normal of its triangles.
     pub centre: Vec3,
     pub normal: Vec3,
+    /// Area-weighted mean of its vertices' colours (white for a one-colour mesh).
+    pub color: Vec3,
     /// Cosine of the widest angle between `normal` and a triangle's normal (−1: any way).
     pub cone: f32,
 }
@@ -56,6 +58,7 @@ pub struct Splat {
     pub centre: Vec3,
     pub radius: f32,
     pub normal: Vec3,
+    pub color: Vec3,
 }
 
 /// The camera as the selection needs it.
@@ -122,7 +125,8 @@ impl SurfaceOctree {
             (b - a).cross(c - a)
         };
         // Breadth first: a cell's children are made together, so they sit side by side.
-        tree.cells.push(tree.summary(0..n as u32, positions, &normal_of));
+        let colors = &mesh.colors;
+        tree.cells.push(tree.summary(0..n as u32, positions, colors, &normal_of));
         let mut level = vec![(0usize, 0u32)]; // (cell, its depth)
         while !level.is_empty() {
             let mut next = Vec::new();
@@ -139,7 +143,7 @@ impl SurfaceOctree {
                     let key = codes[s as usize] >> shift;
                     let e = s + codes[s as usize..end as usize].partition_point(|&c| c >> shift == key) as u32;
                     next.push((tree.cells.len(), d + 1));
-                    let child = tree.summary(s..e, positions, &normal_of);
+                    let child = tree.summary(s..e, positions, colors, &normal_of);
                     tree.cells.push(child);
                     s = e;
                 }
@@ -153,9 +157,15 @@ impl SurfaceOctree {
     }
 
     /// A cell over triangles `run` (in the reordered order).
-    fn summary(&self, run: Range<u32>, positions: &[Vec3], normal_of: &impl Fn(usize, &[u32]) -> Vec3) -> Cell {
+    fn summary(
+        &self,
+        run: Range<u32>,
+        positions: &[Vec3],
+        colors: &[[f32; 3]],
+        normal_of: &impl Fn(usize, &[u32]) -> Vec3,
+    ) -> Cell {
         let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
-        let (mut centre, mut normal, mut area) = (Vec3::ZERO, Vec3::ZERO, 0.0);
+        let (mut centre, mut normal, mut area, mut color) = (Vec3::ZERO, Vec3::ZERO, 0.0, Vec3::ZERO);
         for t in run.clone() {
             let t = t as usize;
             for k in 0..3 {
@@ -169,6 +179,8 @@ impl SurfaceOctree {
             centre += c * a;
             normal += cross * 0.5;
             area += a;
+            let tint = |k: usize| colors.get(self.indices[3 * t + k] as usize).map_or(Vec3::ONE, |&c| Vec3::from(c));
+            color += (tint(0) + tint(1) + tint(2)) / 3.0 * a;
         }
         let normal = normal.normalize_or_zero();
         let mut cone: f32 = 1.0;
@@ -184,6 +196,7 @@ impl SurfaceOctree {
             child_count: 0,
             centre: if area > 0.0 { centre / area } else { 0.5 * (lo + hi) },
             normal,
+            color: if area > 0.0 { color / area } else { Vec3::ONE },
             cone,
         }
     }
@@ -217,7 +230,7 @@ impl SurfaceOctree {
             // Size on screen of the cell's diameter; a cell the eye is inside is never small.
             let size = if w > r { 2.0 * r * px_per_unit / w } else { f32::INFINITY };
             if size < view.threshold_px {
-                out.splats.push(Splat { centre: cell.centre, radius: r, normal: cell.normal });
+                out.splats.push(Splat { centre: cell.centre, radius: r, normal: cell.normal, color: cell.color });
             } else if leaf {
                 let (s, e) = cell.triangles;
                 out.triangles += e - s;

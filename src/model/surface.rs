@@ -42,15 +42,47 @@ impl Sphere {
     /// A molecule's atoms as van der Waals spheres: those `shown` marks (all without a mask),
     /// ghosts and dummy centres left out.
     pub fn of_molecule(molecule: &super::Molecule, shown: Option<&[bool]>) -> Vec<Sphere> {
+        Self::of_atoms(molecule, shown).0
+    }
+
+    /// [`Self::of_molecule`] with each sphere's atom index.
+    pub fn of_atoms(molecule: &super::Molecule, shown: Option<&[bool]>) -> (Vec<Sphere>, Vec<u32>) {
         molecule
             .atoms
             .iter()
             .enumerate()
             .filter(|&(i, a)| !a.ghost && a.z > 0 && shown.is_none_or(|m| m.get(i).copied().unwrap_or(true)))
-            .map(|(_, a)| a)
-            .map(|a| Sphere { centre: a.position, radius: a.element().vdw_radius as f64 * BOHR_PER_ANGSTROM })
-            .collect()
+            .map(|(i, a)| (Self::of(a), i as u32))
+            .unzip()
     }
+
+    fn of(a: &super::Atom) -> Sphere {
+        Sphere { centre: a.position, radius: a.element().vdw_radius as f64 * BOHR_PER_ANGSTROM }
+    }
+}
+
+/// For each point (near the surface of `spheres`), the sphere whose surface is nearest to it:
+/// what colours a molecular surface by its atoms. `u32::MAX` where no sphere lies within
+/// `reach` of its surface.
+pub fn nearest_spheres(spheres: &[Sphere], points: &[glam::Vec3], reach: f64) -> Vec<u32> {
+    if spheres.is_empty() {
+        return vec![u32::MAX; points.len()];
+    }
+    let cells = CellIndex::new(spheres, reach);
+    points
+        .par_iter()
+        .map(|p| {
+            let p = p.as_dvec3();
+            let mut best = (f64::INFINITY, u32::MAX);
+            cells.for_each_near_indexed(p, |i, s| {
+                let d = (p - s.centre).length() - s.radius;
+                if d < best.0 && d <= reach {
+                    best = (d, i);
+                }
+            });
+            best.1
+        })
+        .collect()
 }
 
 /// How a surface is built.
@@ -450,6 +482,11 @@ impl<'a> CellIndex<'a> {
 
     /// Calls `f` with each sphere in the 27 cells around `p`.
     fn for_each_near(&self, p: DVec3, mut f: impl FnMut(&Sphere)) {
+        self.for_each_near_indexed(p, |_, s| f(s));
+    }
+
+    /// [`Self::for_each_near`] with each sphere's index.
+    fn for_each_near_indexed(&self, p: DVec3, mut f: impl FnMut(u32, &Sphere)) {
         let c = self.coords(p);
         for i in c[0] - 1..=c[0] + 1 {
             for j in c[1] - 1..=c[1] + 1 {
@@ -458,7 +495,7 @@ impl<'a> CellIndex<'a> {
                     if inside {
                         let cell = self.cell([i, j, k]);
                         for &s in &self.items[self.start[cell] as usize..self.start[cell + 1] as usize] {
-                            f(&self.spheres[s as usize]);
+                            f(s, &self.spheres[s as usize]);
                         }
                     }
                 }

@@ -16,6 +16,14 @@ pub struct AtomColors {
     pub shown: Vec<bool>,
 }
 
+/// An sRGB colour as linear RGB.
+pub fn linear(srgb: [u8; 3]) -> [f32; 3] {
+    srgb.map(|c| {
+        let c = c as f32 / 255.0;
+        if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+    })
+}
+
 /// Ghost centres are grey whatever the colouring.
 const GHOST: [u8; 3] = [90, 90, 90];
 

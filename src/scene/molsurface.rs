@@ -6,8 +6,8 @@ use serde::{Deserialize, Serialize};
 use crate::model::surface::{Sphere, SurfaceKind, SurfaceParams};
 use crate::model::units::BOHR_PER_ANGSTROM;
 
-use super::IsosurfaceSettings;
 use super::translucency::SurfaceLook;
+use super::{AtomColoring, IsosurfaceSettings};
 
 /// Which molecular surface, if any.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -58,6 +58,9 @@ pub struct SurfaceSettings {
     /// Seed 002's level of detail: parts of the surface smaller than this many pixels on screen
     /// are drawn as points (0: every triangle). Opaque surfaces only.
     pub lod_px: f32,
+    /// Coloured by the nearest atom (its element, chain, residue, B-factor or secondary
+    /// structure); `None`: `color` everywhere.
+    pub color_by: Option<AtomColoring>,
 }
 
 impl Default for SurfaceSettings {
@@ -71,6 +74,7 @@ impl Default for SurfaceSettings {
             color: [0.62, 0.68, 0.80],
             translucent: false,
             lod_px: Self::LOD_PX,
+            color_by: None,
         }
     }
 }
@@ -94,7 +98,9 @@ impl SurfaceSettings {
     /// How the mesh is drawn: opaque in its colour (with the level of detail), or with the
     /// default translucent optics.
     pub fn look(&self) -> SurfaceLook {
-        let look = IsosurfaceSettings { translucent: self.translucent, ..Default::default() }.look(self.color);
+        // Coloured by atoms: the vertices carry the colour.
+        let color = if self.color_by.is_some() { [1.0; 3] } else { self.color };
+        let look = IsosurfaceSettings { translucent: self.translucent, ..Default::default() }.look(color);
         SurfaceLook { lod_px: (!self.translucent && self.lod_px > 0.0).then_some(self.lod_px), ..look }
     }
 
