@@ -537,6 +537,39 @@ fn load(file: Option<&Path>) -> Result<Document> {
     }
 }
 
+/// Draws `frames` frames (after two warm-up frames) at `size`, the camera turning a little each
+/// frame as in the viewer, waiting for each; returns the milliseconds of each, sorted.
+fn time_frames(
+    ctx: &GpuContext,
+    renderer: &mut orbcloud::gpu::Renderer,
+    camera: &Camera,
+    size: [u32; 2],
+    frames: u32,
+) -> Result<Vec<f64>> {
+    let target = orbcloud::gpu::OffscreenTarget::new(&ctx.device, size);
+    let settings = RenderSettings::default();
+    let mut times = Vec::new();
+    for f in 0..frames.max(1) + 2 {
+        let mut cam = *camera;
+        cam.orbit(0.02 * f as f32, 0.01 * f as f32);
+        let t = Instant::now();
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        renderer.render(
+            ctx,
+            &mut encoder,
+            &target.color_view,
+            &orbcloud::gpu::FrameInput::single(&cam, &settings, size),
+        );
+        ctx.queue.submit([encoder.finish()]);
+        ctx.device.poll(wgpu::PollType::wait_indefinitely())?;
+        if f >= 2 {
+            times.push(t.elapsed().as_secs_f64() * 1e3);
+        }
+    }
+    times.sort_by(f64::total_cmp);
+    Ok(times)
+}
+
 fn gpu(lavapipe: bool) -> Result<GpuContext> {
     let pref = if lavapipe { AdapterPreference::LavapipeOnly } else { AdapterPreference::HighPerformance };
     Ok(GpuContext::headless(pref)?)

@@ -428,6 +428,27 @@ fn molecular_surfaces_are_written_and_rendered() {
     let bg = *img.get_pixel(0, 0);
     let drawn = img.pixels().filter(|p| p.0.iter().zip(bg.0).any(|(a, b)| a.abs_diff(b) > 8)).count();
     assert!(drawn > 120 * 90 / 10, "the surface covers the middle of the picture: {drawn} pixels");
+    let bench = orbcloud(&[
+        "bench",
+        "surface",
+        pdb,
+        "--surface",
+        "ses",
+        "--surface-resolution",
+        "0.6",
+        "--runs",
+        "1",
+        "--frames",
+        "1",
+        "--lavapipe",
+        "--size",
+        "120x90",
+    ]);
+    let said = String::from_utf8_lossy(&bench.stdout);
+    assert!(bench.status.success(), "{}", String::from_utf8_lossy(&bench.stderr));
+    for key in ["build_ms_median=", "frame_ms_all_triangles=", "frame_ms_lod=", "lod_error_mean=", "phases (ms"] {
+        assert!(said.contains(key), "{key} missing from {said}");
+    }
     let bad = orbcloud(&["mesh", pdb, "--surface", "ses", "--surface-resolution", "0.0001", "-o", "x.obj"]);
     let said = String::from_utf8_lossy(&bad.stderr);
     assert!(

@@ -186,25 +186,14 @@ pub fn bench(args: &SurfaceBench) -> Result<()> {
         let mut draw = |lod_px: Option<f32>| -> Result<(f64, image::RgbaImage, LodStats)> {
             let look = SurfaceLook { lod_px, ..color.into() };
             orbcloud::headless::show_meshes(&ctx, renderer.main(), &[(s.mesh.clone(), look)]);
-            let mut frames = Vec::new();
-            for f in 0..args.frames.max(1) + 2 {
-                let mut cam = camera;
-                cam.orbit(0.02 * f as f32, 0.01 * f as f32);
-                let t = Instant::now();
-                let mut encoder = ctx.device.create_command_encoder(&Default::default());
-                renderer.render(
-                    &ctx,
-                    &mut encoder,
-                    &target.color_view,
-                    &FrameInput::single(&cam, &settings, args.size),
-                );
-                ctx.queue.submit([encoder.finish()]);
-                ctx.device.poll(wgpu::PollType::wait_indefinitely())?;
-                if f >= 2 {
-                    frames.push(t.elapsed().as_secs_f64() * 1e3);
-                }
-            }
-            frames.sort_by(f64::total_cmp);
+            let frames = super::time_frames(&ctx, &mut renderer, &camera, args.size, args.frames)?;
+            // The last frame again, into a target to read.
+            let mut last = camera;
+            last.orbit(0.02 * (args.frames.max(1) + 1) as f32, 0.01 * (args.frames.max(1) + 1) as f32);
+            let mut encoder = ctx.device.create_command_encoder(&Default::default());
+            let frame = FrameInput::single(&last, &settings, args.size);
+            renderer.render(&ctx, &mut encoder, &target.color_view, &frame);
+            ctx.queue.submit([encoder.finish()]);
             let image = target.read_rgba(&ctx.device, &ctx.queue)?;
             Ok((frames[frames.len() / 2], image, renderer.main().surfaces.lod_stats()))
         };

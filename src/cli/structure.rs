@@ -80,8 +80,8 @@ pub struct SpheresBench {
 /// Prints ms per frame of atoms alone, the whole structure in view and turning a little each
 /// frame as in the viewer, and the GPU memory per atom.
 pub fn bench_spheres(args: &SpheresBench) -> Result<()> {
-    use orbcloud::gpu::{FrameInput, OffscreenTarget, Renderer};
-    use orbcloud::scene::{Camera, RenderSettings};
+    use orbcloud::gpu::Renderer;
+    use orbcloud::scene::Camera;
     let (molecule, what) = match &args.file {
         Some(path) => {
             let doc = formats::load(path)?;
@@ -96,23 +96,8 @@ pub fn bench_spheres(args: &SpheresBench) -> Result<()> {
     renderer.main().set_molecule(&ctx, &molecule, style);
     renderer.main().atoms.splat_radius_px = args.splat_px;
     let gpu_bytes = renderer.main().atoms.gpu_bytes();
-    let target = OffscreenTarget::new(&ctx.device, args.size);
-    let settings = RenderSettings::default();
     let camera = Camera::framing(lo.as_vec3(), hi.as_vec3());
-    let mut times = Vec::new();
-    for f in 0..args.frames.max(1) + 2 {
-        let mut cam = camera;
-        cam.orbit(0.02 * f as f32, 0.01 * f as f32);
-        let t = Instant::now();
-        let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        renderer.render(&ctx, &mut encoder, &target.color_view, &FrameInput::single(&cam, &settings, args.size));
-        ctx.queue.submit([encoder.finish()]);
-        ctx.device.poll(wgpu::PollType::wait_indefinitely())?;
-        if f >= 2 {
-            times.push(t.elapsed().as_secs_f64() * 1e3);
-        }
-    }
-    times.sort_by(f64::total_cmp);
+    let times = super::time_frames(&ctx, &mut renderer, &camera, args.size, args.frames)?;
     let n = molecule.atoms.len();
     println!("adapter: {}", ctx.describe());
     println!(
