@@ -605,7 +605,7 @@ fn main() -> Result<()> {
             if let Some(grid) = grid {
                 orbcloud::headless::auto_opacity(&mut settings.volume, grid);
             }
-            let molsurface = args.molsurface.mesh(&doc, args.iso.translucent)?;
+            let molsurface = args.molsurface.mesh(&doc, args.iso.translucent, grid)?;
             surface_cli::show(&ctx, &mut h.renderer, grid, &args.iso, molsurface);
             let img = h.render(&ctx, &camera, &settings)?;
             img.save(&args.output).with_context(|| format!("writing {}", args.output.display()))?;

@@ -105,7 +105,7 @@ fn a_surface_coloured_by_element_takes_each_vertex_from_its_nearest_atom() {
         color_by: Some(AtomColoring::Element),
         ..Default::default()
     };
-    orbcloud::headless::color_surface(&mut mesh, &doc, &settings, "not resn HOH");
+    orbcloud::headless::color_surface(&mut mesh, &doc, &settings, "not resn HOH", None);
     assert_eq!(mesh.colors.len(), mesh.positions.len());
     let selection = orbcloud::scene::selection::Selection::parse("not resn HOH").unwrap();
     let mask = selection.mask(&doc.molecule, doc.structure.as_ref());
@@ -127,4 +127,28 @@ fn a_surface_coloured_by_element_takes_each_vertex_from_its_nearest_atom() {
     assert!(elements.contains("C") && elements.contains("N") && elements.contains("O"), "{elements:?}");
     // The look carries no colour of its own: the vertices do.
     assert_eq!(settings.look().color, [1.0; 3]);
+}
+
+/// Coloured by a volume (a potential on a grid): negative red, positive blue, white near zero,
+/// grey outside the grid.
+#[test]
+fn a_surface_coloured_by_a_volume_shows_the_sign_of_its_values() {
+    use glam::{DVec3, Vec3};
+    use orbcloud::model::VolumeGrid;
+    // f = x on a grid spanning x ∈ [−5, 5] bohr.
+    let n = 11;
+    let grid = VolumeGrid::new(
+        "potential",
+        [n, n, n],
+        VolumeGrid::affine(DVec3::splat(-5.0), [DVec3::X, DVec3::Y, DVec3::Z]),
+        (0..n * n * n).map(|p| (p / (n * n)) as f32 - 5.0).collect(),
+    );
+    let points =
+        [Vec3::new(-4.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0), Vec3::new(4.0, 0.0, 0.0), Vec3::new(9.0, 0.0, 0.0)];
+    let colors = orbcloud::headless::color_by_values(&points, &grid);
+    let [neg, zero, pos, outside] = [colors[0], colors[1], colors[2], colors[3]];
+    assert!(neg[0] > 0.8 && neg[2] < 0.3, "negative is red: {neg:?}");
+    assert!(pos[2] > 0.8 && pos[0] < 0.3, "positive is blue: {pos:?}");
+    assert!(zero.iter().all(|&c| c > 0.99), "zero is white: {zero:?}");
+    assert_eq!(outside, [0.5; 3], "outside the grid: grey");
 }

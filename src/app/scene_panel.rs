@@ -112,20 +112,26 @@ fn surface_editor(ui: &mut egui::Ui, s: &mut SurfaceSettings) -> bool {
             .response
             .labelled_by(label.id)
             .on_hover_text("Gaussian: the atoms' blended density (VMD's QuickSurf); solvent-excluded: where a probe cannot reach (Connolly's)");
-        if s.choice != SurfaceChoice::Off && s.color_by.is_none() {
+        if s.choice != SurfaceChoice::Off && s.color_by.is_none() && !s.color_by_volume {
             ui.color_edit_button_rgb(&mut s.color);
         }
     });
     if s.choice != SurfaceChoice::Off {
         ui.horizontal(|ui| {
             let label = ui.label("colour by");
+            let shown =
+                if s.color_by_volume { "the volume" } else { s.color_by.map_or("one colour", AtomColoring::name) };
             ComboBox::from_id_salt("scene surface colouring")
-                .selected_text(s.color_by.map_or("one colour", AtomColoring::name))
+                .selected_text(shown)
                 .show_ui(ui, |ui| {
-                    ui.selectable_value(&mut s.color_by, None, "one colour");
+                    let mut choice = (s.color_by_volume, s.color_by);
+                    ui.selectable_value(&mut choice, (false, None), "one colour");
                     for c in AtomColoring::ALL {
-                        ui.selectable_value(&mut s.color_by, Some(c), c.name());
+                        ui.selectable_value(&mut choice, (false, Some(c)), c.name());
                     }
+                    ui.selectable_value(&mut choice, (true, None), "the volume")
+                        .on_hover_text("the values of the cube, orbital or density shown: negative red, positive blue");
+                    (s.color_by_volume, s.color_by) = choice;
                 })
                 .response
                 .labelled_by(label.id)

@@ -243,7 +243,8 @@ impl Viewport {
         self.slot(n).extraction.request(move |cancel| {
             let grid = computed.as_deref().or(doc.volumes.get(volume));
             let (mut meshes, note) = grid.map(|g| isosurfaces_within(g, &levels, max_bytes)).unwrap_or_default();
-            let (built, surface_note) = molecular_surface_cached(&cache, &doc, &surface, &selection, max_bytes, cancel);
+            let shown = (&*doc, &surface, selection.as_str(), grid);
+            let (built, surface_note) = molecular_surface_cached(&cache, shown, max_bytes, cancel);
             meshes.extend(built);
             (meshes, note.into_iter().chain(surface_note).reduce(|a, b| format!("{a}; {b}")))
         });
@@ -728,13 +729,12 @@ fn handle_input(ui: &egui::Ui, response: &egui::Response, view: &mut ViewState) 
     });
 }
 
-/// Object's molecular surface with its look (nothing when it is off), from `cache` when the
-/// geometry and atoms are those it was built for; a note when it was built coarser or failed.
+/// The object's molecular surface with its look (nothing when it is off), from `cache` when the
+/// geometry and atoms are those it was built for, coloured (by atoms, or by `grid`, the volume
+/// the object shows); a note when it was built coarser or failed.
 fn molecular_surface_cached(
     cache: &Mutex<Option<BuiltSurface>>,
-    doc: &Document,
-    settings: &SurfaceSettings,
-    selection: &str,
+    (doc, settings, selection, grid): (&Document, &SurfaceSettings, &str, Option<&VolumeGrid>),
     max_bytes: u64,
     cancel: &AtomicBool,
 ) -> (Option<(Mesh, SurfaceLook)>, Option<String>) {
@@ -753,6 +753,6 @@ fn molecular_surface_cached(
     }
     let built = cache.as_ref().expect("just built");
     let mut mesh = built.mesh.clone();
-    crate::headless::color_surface(&mut mesh, doc, settings, selection);
+    crate::headless::color_surface(&mut mesh, doc, settings, selection, grid);
     (Some((mesh, settings.look())), built.note.clone())
 }

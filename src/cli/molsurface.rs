@@ -31,6 +31,9 @@ pub enum SurfaceColorArg {
     Residue,
     BFactor,
     Secondary,
+    /// The volume's values sampled on the surface (a cube's, or the orbital or density asked
+    /// for): negative red, positive blue.
+    Volume,
 }
 
 impl SurfaceColorArg {
@@ -42,6 +45,7 @@ impl SurfaceColorArg {
             SurfaceColorArg::Residue => Some(AtomColoring::Residue),
             SurfaceColorArg::BFactor => Some(AtomColoring::BFactor),
             SurfaceColorArg::Secondary => Some(AtomColoring::Secondary),
+            SurfaceColorArg::Volume => None,
         }
     }
 }
@@ -86,18 +90,31 @@ impl MolSurfaceArgs {
             translucent,
             lod_px: self.lod_px,
             color_by: self.surface_color.coloring(),
+            color_by_volume: matches!(self.surface_color, SurfaceColorArg::Volume),
             ..Default::default()
         }
     }
 
-    /// The surface asked for, if any, with its look, telling what was built and how long it took.
-    pub fn mesh(&self, doc: &Document, translucent: bool) -> Result<Option<(Mesh, SurfaceLook)>> {
+    /// The surface asked for, if any, with its look (coloured by `grid` when asked), telling
+    /// what was built and how long it took.
+    pub fn mesh(
+        &self,
+        doc: &Document,
+        translucent: bool,
+        grid: Option<&orbcloud::model::VolumeGrid>,
+    ) -> Result<Option<(Mesh, SurfaceLook)>> {
         let settings = self.settings(translucent);
         let t = Instant::now();
         let built = molecular_surface(doc, &settings, "", u64::MAX, &AtomicBool::new(false))
             .with_context(|| format!("{}: the molecular surface", doc.source))?;
         let Some((mut mesh, _)) = built else { return Ok(None) };
-        orbcloud::headless::color_surface(&mut mesh, doc, &settings, "");
+        if settings.color_by_volume && grid.is_none() {
+            anyhow::bail!(
+                "{}: --surface-color volume needs a volume (a cube file, or a Molden/fchk orbital)",
+                doc.source
+            );
+        }
+        orbcloud::headless::color_surface(&mut mesh, doc, &settings, "", grid);
         eprintln!(
             "{} surface: {} triangles, area {:.1} Å², volume {:.1} Å³, {:.0} ms",
             settings.choice.name(),

@@ -255,7 +255,9 @@ pub fn mesh(args: &MeshArgs) -> Result<()> {
     }
     let doc = load(Some(&args.file))?;
     let (meshes, names) = if args.molsurface.surface.is_some() {
-        let built = args.molsurface.mesh(&doc, false)?;
+        let by_volume = matches!(args.molsurface.surface_color, super::molsurface_cli::SurfaceColorArg::Volume);
+        let grid = by_volume.then(|| args.grid.grid(&doc)).transpose()?;
+        let built = args.molsurface.mesh(&doc, false, grid.as_ref())?;
         (built.into_iter().collect(), vec![args.molsurface.name().to_string()])
     } else {
         let grid = args.grid.grid(&doc)?;

@@ -288,8 +288,15 @@ pub fn molecular_surface(
 
 /// Colours `mesh`, `doc`'s molecular surface built around the atoms `selection` shows, by the
 /// atom nearest each vertex as `s.color_by` says (no colours when it says none).
-pub fn color_surface(mesh: &mut Mesh, doc: &Document, s: &SurfaceSettings, selection: &str) {
+/// With `s.color_by_volume`, the colours are `grid`'s values instead ([`color_by_values`]).
+pub fn color_surface(mesh: &mut Mesh, doc: &Document, s: &SurfaceSettings, selection: &str, grid: Option<&VolumeGrid>) {
     mesh.colors.clear();
+    if s.color_by_volume {
+        if let Some(grid) = grid {
+            mesh.colors = color_by_values(&mesh.positions, grid);
+        }
+        return;
+    }
     let Some(coloring) = s.color_by else { return };
     let mask = Selection::parse(selection)
         .ok()
@@ -306,6 +313,36 @@ pub fn color_surface(mesh: &mut Mesh, doc: &Document, s: &SurfaceSettings, selec
             None => s.color,
         })
         .collect();
+}
+
+/// Linear RGB for `grid`'s value at each point: negative red, zero white, positive blue (the
+/// convention of electrostatic potentials on surfaces), scaled to the 98th percentile of |value|
+/// over the points; grey where a point lies outside the grid.
+pub fn color_by_values(points: &[glam::Vec3], grid: &VolumeGrid) -> Vec<[f32; 3]> {
+    let grid_from_world = grid.world_from_grid.inverse();
+    let values: Vec<Option<f64>> = points
+        .iter()
+        .map(|p| {
+            let g = grid_from_world.transform_point3(p.as_dvec3());
+            let inside = (0..3).all(|a| g[a] >= -1e-9 && g[a] <= (grid.dims[a].max(1) - 1) as f64 + 1e-9);
+            inside.then(|| grid.sample(g))
+        })
+        .collect();
+    let mut magnitudes: Vec<f64> = values.iter().flatten().map(|v| v.abs()).collect();
+    magnitudes.sort_by(f64::total_cmp);
+    let scale = magnitudes.get(magnitudes.len() * 98 / 100).copied().unwrap_or(0.0).max(1e-30);
+    let (red, blue) = ([0.85, 0.08, 0.06], [0.06, 0.2, 0.85]);
+    values
+        .iter()
+        .map(|v| match v {
+            None => [0.5; 3],
+            Some(v) => {
+                let t = (v / scale).clamp(-1.0, 1.0) as f32;
+                let end = if t < 0.0 { red } else { blue };
+                std::array::from_fn(|k| 1.0 + (end[k] - 1.0) * t.abs())
+            }
+        })
+        .collect()
 }
 
 /// Extracts the isosurfaces of `grid` and shows them in `layer` (none when `iso` is hidden).

@@ -61,6 +61,10 @@ pub struct SurfaceSettings {
     /// Coloured by the nearest atom (its element, chain, residue, B-factor or secondary
     /// structure); `None`: `color` everywhere.
     pub color_by: Option<AtomColoring>,
+    /// Coloured by the object's volume sampled on the surface (an electrostatic potential
+    /// cube, an orbital): negative red through white to positive blue, as potentials are
+    /// shown; takes precedence over `color_by`.
+    pub color_by_volume: bool,
 }
 
 impl Default for SurfaceSettings {
@@ -75,6 +79,7 @@ impl Default for SurfaceSettings {
             translucent: false,
             lod_px: Self::LOD_PX,
             color_by: None,
+            color_by_volume: false,
         }
     }
 }
@@ -99,7 +104,7 @@ impl SurfaceSettings {
     /// default translucent optics.
     pub fn look(&self) -> SurfaceLook {
         // Coloured by atoms: the vertices carry the colour.
-        let color = if self.color_by.is_some() { [1.0; 3] } else { self.color };
+        let color = if self.color_by.is_some() || self.color_by_volume { [1.0; 3] } else { self.color };
         let look = IsosurfaceSettings { translucent: self.translucent, ..Default::default() }.look(color);
         SurfaceLook { lod_px: (!self.translucent && self.lod_px > 0.0).then_some(self.lod_px), ..look }
     }
