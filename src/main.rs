@@ -537,6 +537,20 @@ fn load(file: Option<&Path>) -> Result<Document> {
     }
 }
 
+/// Image size, frame count and adapter of a frame-time benchmark.
+#[derive(Args)]
+struct BenchFrames {
+    /// Image size, WIDTHxHEIGHT.
+    #[arg(long, default_value = "800x600", value_parser = parse_size)]
+    size: [u32; 2],
+    /// Frames to time (after two warm-up frames).
+    #[arg(long, default_value_t = 10)]
+    frames: u32,
+    /// Use the CPU Vulkan adapter (lavapipe) even when a GPU is present.
+    #[arg(long)]
+    lavapipe: bool,
+}
+
 /// Draws `frames` frames (after two warm-up frames) at `size`, the camera turning a little each
 /// frame as in the viewer, waiting for each; returns the milliseconds of each, sorted.
 fn time_frames(

@@ -145,15 +145,8 @@ pub struct SurfaceBench {
     /// Timed builds per kind (the median is reported).
     #[arg(long, default_value_t = 3)]
     runs: usize,
-    /// Image size, WIDTHxHEIGHT.
-    #[arg(long, default_value = "800x600", value_parser = super::parse_size)]
-    size: [u32; 2],
-    /// Frames to time (after two warm-up frames).
-    #[arg(long, default_value_t = 10)]
-    frames: u32,
-    /// Use the CPU Vulkan adapter (lavapipe) even when a GPU is present.
-    #[arg(long)]
-    lavapipe: bool,
+    #[command(flatten)]
+    bench: super::BenchFrames,
     /// Zoom factor (> 1 comes closer; < 1 moves away, where the level of detail draws more
     /// points).
     #[arg(long, default_value_t = 1.0)]
@@ -176,7 +169,7 @@ pub fn bench(args: &SurfaceBench) -> Result<()> {
         None => vec![SurfaceArg::Gaussian, SurfaceArg::Ses],
     };
     let color = SurfaceSettings::default().color;
-    let ctx = super::gpu(args.lavapipe)?;
+    let ctx = super::gpu(args.bench.lavapipe)?;
     println!("adapter: {}", ctx.describe());
     println!("file: {}, {} atoms, {} threads", doc.source, spheres.len(), rayon::current_num_threads());
     for arg in kinds {
@@ -198,17 +191,17 @@ pub fn bench(args: &SurfaceBench) -> Result<()> {
         let (lo, hi) = s.grid.bounds();
         let mut camera = Camera::framing(lo.as_vec3(), hi.as_vec3());
         camera.zoom(1.0 / args.zoom.max(1e-3));
-        let target = OffscreenTarget::new(&ctx.device, args.size);
+        let target = OffscreenTarget::new(&ctx.device, args.bench.size);
         let settings = RenderSettings::default();
         let mut draw = |lod_px: Option<f32>| -> Result<(f64, image::RgbaImage, LodStats)> {
             let look = SurfaceLook { lod_px, ..color.into() };
             orbcloud::headless::show_meshes(&ctx, renderer.main(), &[(s.mesh.clone(), look)]);
-            let frames = super::time_frames(&ctx, &mut renderer, &camera, args.size, args.frames)?;
+            let frames = super::time_frames(&ctx, &mut renderer, &camera, args.bench.size, args.bench.frames)?;
             // The last frame again, into a target to read.
             let mut last = camera;
-            last.orbit(0.02 * (args.frames.max(1) + 1) as f32, 0.01 * (args.frames.max(1) + 1) as f32);
+            last.orbit(0.02 * (args.bench.frames.max(1) + 1) as f32, 0.01 * (args.bench.frames.max(1) + 1) as f32);
             let mut encoder = ctx.device.create_command_encoder(&Default::default());
-            let frame = FrameInput::single(&last, &settings, args.size);
+            let frame = FrameInput::single(&last, &settings, args.bench.size);
             renderer.render(&ctx, &mut encoder, &target.color_view, &frame);
             ctx.queue.submit([encoder.finish()]);
             let image = target.read_rgba(&ctx.device, &ctx.queue)?;
@@ -240,8 +233,8 @@ pub fn bench(args: &SurfaceBench) -> Result<()> {
             s.mesh.volume() / BOHR_PER_ANGSTROM.powi(3),
             times[times.len() / 2],
             times[0],
-            args.size[0],
-            args.size[1],
+            args.bench.size[0],
+            args.bench.size[1],
             stats.triangles,
             stats.splats,
             full_ms / lod_ms

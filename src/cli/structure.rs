@@ -60,21 +60,14 @@ pub struct SpheresBench {
     /// Synthetic atoms packed as densely as in a protein (ignored with a file).
     #[arg(long, default_value_t = 1_000_000)]
     pub atoms: usize,
-    /// Image size, WIDTHxHEIGHT.
-    #[arg(long, default_value = "800x600", value_parser = super::parse_size)]
-    pub size: [u32; 2],
     #[arg(long, value_enum, default_value_t = super::AtomsArg::SpaceFilling)]
     pub style: super::AtomsArg,
     /// Spheres up to this projected radius (pixels) are rasterised in compute; 0 draws every
     /// sphere as an impostor quad.
     #[arg(long, default_value_t = orbcloud::gpu::atoms::SPLAT_RADIUS_PX)]
     pub splat_px: f32,
-    /// Frames to time (after two warm-up frames).
-    #[arg(long, default_value_t = 10)]
-    pub frames: u32,
-    /// Use the CPU Vulkan adapter (lavapipe) even when a GPU is present.
-    #[arg(long)]
-    pub lavapipe: bool,
+    #[command(flatten)]
+    bench: super::BenchFrames,
 }
 
 /// Prints ms per frame of atoms alone, the whole structure in view and turning a little each
@@ -90,22 +83,22 @@ pub fn bench_spheres(args: &SpheresBench) -> Result<()> {
         None => (orbcloud::model::synthetic::atom_box(args.atoms), "synthetic protein-dense box".to_string()),
     };
     let Some((lo, hi)) = molecule.bounds() else { anyhow::bail!("{what}: no atoms to draw") };
-    let ctx = super::gpu(args.lavapipe)?;
+    let ctx = super::gpu(args.bench.lavapipe)?;
     let style = args.style.style();
     let mut renderer = Renderer::new(&ctx);
     renderer.main().set_molecule(&ctx, &molecule, style);
     renderer.main().atoms.splat_radius_px = args.splat_px;
     let gpu_bytes = renderer.main().atoms.gpu_bytes();
     let camera = Camera::framing(lo.as_vec3(), hi.as_vec3());
-    let times = super::time_frames(&ctx, &mut renderer, &camera, args.size, args.frames)?;
+    let times = super::time_frames(&ctx, &mut renderer, &camera, args.bench.size, args.bench.frames)?;
     let n = molecule.atoms.len();
     println!("adapter: {}", ctx.describe());
     println!(
         "scene: {what}, {n} atoms, {} bonds, {:?}, {}x{}, splat radius {} px",
         molecule.bonds.len(),
         style,
-        args.size[0],
-        args.size[1],
+        args.bench.size[0],
+        args.bench.size[1],
         args.splat_px
     );
     println!("gpu_bytes_per_atom={:.1}", gpu_bytes as f64 / n as f64);

@@ -349,15 +349,8 @@ pub fn bench(args: &IsoBench) -> Result<()> {
 pub struct TranslucentBench {
     /// A cube file with an orbital; the bundled demo (formaldehyde's HOMO) when omitted.
     file: Option<PathBuf>,
-    /// Image size, WIDTHxHEIGHT.
-    #[arg(long, default_value = "800x600", value_parser = super::parse_size)]
-    size: [u32; 2],
-    /// Frames to time per case (after two warm-up frames).
-    #[arg(long, default_value_t = 10)]
-    frames: u32,
-    /// Use the CPU Vulkan adapter (lavapipe) even when a GPU is present.
-    #[arg(long)]
-    lavapipe: bool,
+    #[command(flatten)]
+    bench: super::BenchFrames,
     /// Write each case's last frames here (exact_N.png, weighted_N.png).
     #[arg(long)]
     images: Option<PathBuf>,
@@ -381,12 +374,15 @@ pub fn bench_translucent(args: &TranslucentBench) -> Result<()> {
     use orbcloud::scene::RenderSettings;
     let doc = load(args.file.as_deref())?;
     let grid = doc.volumes.first().context("the file has no volume")?;
-    let ctx = super::gpu(args.lavapipe)?;
+    let ctx = super::gpu(args.bench.lavapipe)?;
     let camera = default_camera(&doc);
     let mut settings = RenderSettings::default();
     settings.volume.visible = false;
     println!("adapter: {}", ctx.describe());
-    println!("scene: {}, grid {:?}, atoms ball and stick, {}x{}", doc.source, grid.dims, args.size[0], args.size[1]);
+    println!(
+        "scene: {}, grid {:?}, atoms ball and stick, {}x{}",
+        doc.source, grid.dims, args.bench.size[0], args.bench.size[1]
+    );
     let max = grid.stats.max_abs as f32;
     for count in [2usize, 4, 16] {
         // Nested shells of both signs, from a tenth of the largest |ψ| down to a hundredth.
@@ -398,18 +394,18 @@ pub fn bench_translucent(args: &TranslucentBench) -> Result<()> {
         };
         let meshes = iso.meshes(grid, &iso.base());
         let triangles: usize = meshes.iter().map(|(m, _)| m.triangle_count()).sum();
-        let mut h = orbcloud::headless::Headless::new(&ctx, &doc, None, &settings, args.size)?;
+        let mut h = orbcloud::headless::Headless::new(&ctx, &doc, None, &settings, args.bench.size)?;
         show_meshes(&ctx, h.renderer.main(), &meshes);
-        let target = OffscreenTarget::new(&ctx.device, args.size);
+        let target = OffscreenTarget::new(&ctx.device, args.bench.size);
         let mut time = |transparency| -> Result<Timed> {
             h.renderer.set_transparency(transparency);
             let mut times = Vec::new();
             let mut stats = None;
-            for f in 0..args.frames.max(1) + 2 {
+            for f in 0..args.bench.frames.max(1) + 2 {
                 let mut cam = camera;
                 cam.orbit(0.02 * f as f32, 0.01 * f as f32);
                 let t = Instant::now();
-                let frame = FrameInput::single(&cam, &settings, args.size);
+                let frame = FrameInput::single(&cam, &settings, args.bench.size);
                 stats = draw_exact(&ctx, &mut h.renderer, &target.color_view, &frame);
                 ctx.device.poll(wgpu::PollType::wait_indefinitely())?;
                 if f >= 2 {
@@ -423,7 +419,7 @@ pub fn bench_translucent(args: &TranslucentBench) -> Result<()> {
         let exact = time(Transparency::Exact)?;
         let weighted = time(Transparency::WeightedBlended)?;
         let stats = exact.stats.context("no fragment counts came back")?;
-        let [w, hgt] = args.size;
+        let [w, hgt] = args.bench.size;
         let heads = w as u64 * hgt as u64 * 4;
         let (mean, covered) = image_error(&exact.image, &weighted.image, &settings.background);
         if let Some(dir) = &args.images {
