@@ -13,9 +13,57 @@ pub const INTERACTIVE_SLICES: u32 = 64;
 /// drag ~12 times a second; the time is linear in pixels × slices.
 pub const CPU_INTERACTIVE_PIXELS: u32 = 2 * 256 * 256;
 
-/// How much coarser a big surface's level of detail is while interacting: parts up to this
-/// many times the threshold's size on screen are drawn as points.
+/// How much coarser a big surface's level of detail starts while interacting: parts up to this
+/// many times the threshold's size on screen are drawn as points. [`LodBudget`] then moves it
+/// to keep frames within [`LOD_FRAME_BUDGET_MS`].
 pub const INTERACTIVE_LOD_SCALE: f32 = 4.0;
+
+/// The frame time a dragged view aims for, ms.
+pub const LOD_FRAME_BUDGET_MS: f64 = 50.0;
+
+/// The level of detail tied to the frame time while interacting (seed 002's threshold "tied
+/// to the frame-time budget"): each picture slower than the budget makes points of bigger
+/// parts, each one well within it (under half) makes them smaller again; still frames are
+/// drawn at the threshold itself. The scale carries over from one drag to the next.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LodBudget {
+    pub scale: f32,
+}
+
+impl Default for LodBudget {
+    fn default() -> Self {
+        Self { scale: INTERACTIVE_LOD_SCALE }
+    }
+}
+
+impl LodBudget {
+    /// The largest factor on the threshold.
+    pub const MAX: f32 = 16.0;
+
+    /// The scale for this frame; `picture_ms`: how long the last picture drawn while
+    /// interacting took, once, when it is complete.
+    pub fn next(&mut self, interacting: bool, picture_ms: Option<f64>) -> f32 {
+        if !interacting {
+            return 1.0;
+        }
+        if let Some(ms) = picture_ms {
+            self.scale = adjust(self.scale, ms);
+        }
+        self.scale
+    }
+}
+
+/// One step of [`LodBudget`]: ×1.5 over budget, ÷1.5 under half of it, within 1..=MAX.
+pub fn adjust(scale: f32, frame_ms: f64) -> f32 {
+    let next = if frame_ms > LOD_FRAME_BUDGET_MS {
+        scale * 1.5
+    } else if frame_ms < 0.5 * LOD_FRAME_BUDGET_MS {
+        scale / 1.5
+    } else {
+        scale
+    };
+    next.clamp(1.0, LodBudget::MAX)
+}
 
 /// What one view draws this frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -87,6 +135,21 @@ mod tests {
         let [w, h] = d.render_size([800, 200]);
         assert!((w as f32 / h as f32 - 4.0).abs() < 0.05, "aspect kept: {w}x{h}");
         assert_eq!(d.render_size([100, 100]), [100, 100], "small views stay sharp");
+    }
+
+    #[test]
+    fn the_level_of_detail_follows_the_frame_time_while_interacting() {
+        assert_eq!(adjust(4.0, 120.0), 6.0, "slow: bigger points");
+        assert_eq!(adjust(4.0, 10.0), 4.0 / 1.5, "fast: smaller points");
+        assert_eq!(adjust(4.0, 40.0), 4.0, "within budget: kept");
+        assert_eq!(adjust(1.0, 1.0), 1.0, "never finer than the threshold");
+        assert_eq!(adjust(LodBudget::MAX, 500.0), LodBudget::MAX);
+        let mut budget = LodBudget::default();
+        assert_eq!(budget.next(true, None), INTERACTIVE_LOD_SCALE, "first frame of a drag");
+        let slow = budget.next(true, Some(200.0));
+        assert!(slow > INTERACTIVE_LOD_SCALE);
+        assert_eq!(budget.next(false, Some(300.0)), 1.0, "still: full detail");
+        assert_eq!(budget.next(true, None), slow, "a new drag starts where the last one ended");
     }
 
     #[test]

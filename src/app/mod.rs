@@ -1045,8 +1045,10 @@ impl eframe::App for OrbApp {
                     }
                 }
                 (None, Some(vp)) => {
-                    vp.detail =
-                        detail::Detail::for_frame(detail::interacting(ui.ctx(), false), vp.ctx.info.device_type, 1);
+                    let interacting = detail::interacting(ui.ctx(), false);
+                    vp.detail = detail::Detail::for_frame(interacting, vp.ctx.info.device_type, 1);
+                    let picture_ms = vp.take_picture_ms();
+                    vp.detail.lod_scale = vp.lod_budget.next(interacting, picture_ms);
                     vp.clouds = self.objects.iter().map(|o| o.state.settings.volume).collect();
                     vp.show(ui, rs, &mut self.view);
                     if let Some(click) = vp.click.take() {

@@ -151,7 +151,7 @@ fn surface_editor(ui: &mut egui::Ui, s: &mut SurfaceSettings) -> bool {
         if !s.translucent {
             ui.horizontal(|ui| {
                 ui.add(DragValue::new(&mut s.lod_px).speed(0.1).range(0.0..=30.0).prefix("points under ").suffix(" px"))
-                    .on_hover_text("seed 002's level of detail: parts smaller than this on screen are drawn as points (0: every triangle); four times more while you drag");
+                    .on_hover_text("seed 002's level of detail: parts smaller than this on screen are drawn as points (0: every triangle); larger while you drag, to keep the view moving");
             });
         }
         ui.horizontal(|ui| {

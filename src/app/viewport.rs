@@ -116,6 +116,12 @@ pub struct Viewport {
     shown_size: Option<[u32; 2]>,
     /// What the next frames draw: set each frame by the caller.
     pub detail: Detail,
+    /// The surfaces' level-of-detail scale while interacting, kept to the frame-time budget.
+    pub lod_budget: super::detail::LodBudget,
+    /// When the picture being drawn was started, and how long the last complete one took (ms,
+    /// taken once).
+    picture_started: Option<Instant>,
+    picture_ms: Option<f64>,
     /// The state the texture currently shows; a frame is drawn only when this changes.
     drawn: Option<Drawn>,
     /// Bumped whenever the renderer's data changes.
@@ -164,6 +170,9 @@ impl Viewport {
             target: None,
             shown_size: None,
             detail: Detail::FULL,
+            lod_budget: Default::default(),
+            picture_started: None,
+            picture_ms: None,
             drawn: None,
             generation: 0,
             slots: Vec::new(),
@@ -323,6 +332,11 @@ impl Viewport {
             s.evaluation.cancel();
             s.extraction.cancel();
         }
+    }
+
+    /// How long the last complete picture took to draw (ms), once.
+    pub fn take_picture_ms(&mut self) -> Option<f64> {
+        self.picture_ms.take()
     }
 
     /// Object `n`'s values on the grid it shows, when they are not one of its document's (an
@@ -487,6 +501,7 @@ impl Viewport {
         if let Some((target, id)) = &self.target {
             let changed = self.drawn.as_ref() != Some(&key);
             if changed {
+                self.picture_started = Some(Instant::now());
                 // A costly frame (orbitals evaluated per sample, or any frame on a CPU rasteriser)
                 // is drawn in bands over several UI frames, so the window answers while the
                 // picture fills in; a cheap one still takes one band.
@@ -507,6 +522,7 @@ impl Viewport {
                         let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
                         self.renderer.render(&self.ctx, &mut encoder, &target.color_view, &frame);
                         self.ctx.queue.submit([encoder.finish()]);
+                        self.picture_ms = self.picture_started.take().map(|t| t.elapsed().as_secs_f64() * 1e3);
                     }
                     Some(p) => {
                         let start = Instant::now();
@@ -527,6 +543,7 @@ impl Viewport {
                         self.band_rows = p.rows;
                         if p.next_row >= size[1] {
                             self.progress = None;
+                            self.picture_ms = self.picture_started.take().map(|t| t.elapsed().as_secs_f64() * 1e3);
                         } else {
                             ui.ctx().request_repaint();
                         }

@@ -56,7 +56,8 @@ pub struct SurfaceSettings {
     /// Translucent with seed 003's optics, in exact order with every other translucent surface.
     pub translucent: bool,
     /// Seed 002's level of detail: parts of the surface smaller than this many pixels on screen
-    /// are drawn as points (0: every triangle). Opaque surfaces only.
+    /// are drawn as points (0: every triangle); the viewer scales it up while the view is
+    /// dragged. Opaque surfaces only.
     pub lod_px: f32,
     /// Coloured by the nearest atom (its element, chain, residue, B-factor or secondary
     /// structure); `None`: `color` everywhere.
