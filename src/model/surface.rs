@@ -378,7 +378,7 @@ fn ses_field(
     };
     // Only points near the SES need the exact distance (the estimate is at most ~2 voxels
     // long); they are refined grouped by their outside point, whose neighbourhood they share.
-    let band = 2.5 * h;
+    let band = 1.5 * h;
     let reach = (4.0 * h).min(1.2 * BOHR_PER_ANGSTROM);
     let mut values = vec![0f32; spec.len()];
     let mut refine: Vec<(u32, u32)> = values
