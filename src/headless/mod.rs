@@ -247,6 +247,13 @@ pub fn isosurfaces_within(
     }
 }
 
+/// Which of `doc`'s atoms `selection` shows; `None` for all of them (an empty query, or one that
+/// does not parse: the panel says why).
+fn shown_atoms(doc: &Document, selection: &str) -> Option<Vec<bool>> {
+    let query = Selection::parse(selection).ok().filter(|q| !q.is_everything())?;
+    Some(query.mask(&doc.molecule, doc.structure.as_ref()))
+}
+
 /// Whether a mesh fits the GPU buffers of `max_bytes` (24-byte vertices, 4-byte indices).
 fn mesh_fits(m: &Mesh, max_bytes: u64) -> bool {
     (m.positions.len() as u64 * 24).max(m.indices.len() as u64 * 4) <= max_bytes
@@ -263,10 +270,7 @@ pub fn molecular_surface(
     max_bytes: u64,
     cancel: &AtomicBool,
 ) -> Result<Option<(Mesh, Option<String>)>, SurfaceError> {
-    let mask = Selection::parse(selection)
-        .ok()
-        .filter(|q| !q.is_everything())
-        .map(|q| q.mask(&doc.molecule, doc.structure.as_ref()));
+    let mask = shown_atoms(doc, selection);
     let spheres = Sphere::of_molecule(&doc.molecule, mask.as_deref());
     let Some(mut params) = s.params(&spheres) else { return Ok(None) };
     let asked = params.resolution;
@@ -298,10 +302,7 @@ pub fn color_surface(mesh: &mut Mesh, doc: &Document, s: &SurfaceSettings, selec
         return;
     }
     let Some(coloring) = s.color_by else { return };
-    let mask = Selection::parse(selection)
-        .ok()
-        .filter(|q| !q.is_everything())
-        .map(|q| q.mask(&doc.molecule, doc.structure.as_ref()));
+    let mask = shown_atoms(doc, selection);
     let (spheres, atoms) = Sphere::of_atoms(&doc.molecule, mask.as_deref());
     let colors = atom_colors(&doc.molecule, doc.structure.as_ref(), coloring);
     let reach = s.probe as f64 * crate::model::units::BOHR_PER_ANGSTROM + 2.0;
@@ -376,10 +377,8 @@ pub fn show_atoms(ctx: &GpuContext, layer: &mut Layer, doc: &Document, settings:
 /// panel says why).
 pub fn atom_look(doc: &Document, settings: &RenderSettings, selection: &str) -> AtomColors {
     let mut colors = atom_colors(&doc.molecule, doc.structure.as_ref(), settings.atom_colors);
-    if let Ok(s) = Selection::parse(selection)
-        && !s.is_everything()
-    {
-        colors.shown = s.mask(&doc.molecule, doc.structure.as_ref());
+    if let Some(mask) = shown_atoms(doc, selection) {
+        colors.shown = mask;
     }
     colors
 }

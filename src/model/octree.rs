@@ -86,6 +86,62 @@ pub struct Selection {
     pub visited: u32,
 }
 
+/// A cell's contents summed: its triangles' box, area-weighted centre, normal and colour, their
+/// area and the cosine of the normal cone.
+#[derive(Debug, Clone, Copy)]
+struct Sums {
+    lo: Vec3,
+    hi: Vec3,
+    centre: Vec3,
+    normal: Vec3,
+    color: Vec3,
+    area: f32,
+    cone: f32,
+}
+
+impl Default for Sums {
+    fn default() -> Self {
+        let zero = Vec3::ZERO;
+        Self {
+            lo: Vec3::INFINITY,
+            hi: Vec3::NEG_INFINITY,
+            centre: zero,
+            normal: zero,
+            color: zero,
+            area: 0.0,
+            cone: -1.0,
+        }
+    }
+}
+
+impl Sums {
+    /// A parent's sums from its children's; its cone holds every child's cone (a cone of
+    /// half-angle a around n_c lies within ∠(n, n_c) + a of the parent's normal n).
+    fn merge(children: &[Sums]) -> Sums {
+        let mut out = Sums::default();
+        for c in children {
+            out.lo = out.lo.min(c.lo);
+            out.hi = out.hi.max(c.hi);
+            out.centre += c.centre;
+            out.normal += c.normal;
+            out.color += c.color;
+            out.area += c.area;
+        }
+        let n = out.normal.normalize_or_zero();
+        out.cone = if n == Vec3::ZERO {
+            -1.0
+        } else {
+            let spread =
+                |c: &Sums| c.normal.normalize_or_zero().dot(n).clamp(-1.0, 1.0).acos() + c.cone.clamp(-1.0, 1.0).acos();
+            children
+                .iter()
+                .map(|c| if spread(c) >= std::f32::consts::PI { -1.0 } else { spread(c).cos() })
+                .fold(1.0, f32::min)
+        };
+        out
+    }
+}
+
 /// Most levels an octree gets (a Morton code of 3 × 10 bits).
 const MAX_DEPTH: u32 = 10;
 
@@ -119,14 +175,20 @@ impl SurfaceOctree {
             keyed.iter().flat_map(|&(_, t)| (0..3).map(move |c| mesh.indices[3 * t as usize + c])).collect();
         let codes: Vec<u32> = keyed.iter().map(|&(k, _)| k).collect();
         let mut tree = Self { cells: Vec::new(), indices };
-        let positions = &mesh.positions;
-        let normal_of = |t: usize, indices: &[u32]| {
-            let [a, b, c] = std::array::from_fn::<Vec3, 3, _>(|k| positions[indices[3 * t + k] as usize]);
-            (b - a).cross(c - a)
+        // Breadth first: a cell's children are made together, so they sit side by side, after
+        // their parent. The cells' contents are summed afterwards, leaves first.
+        let bare = |run: Range<u32>| Cell {
+            lo: Vec3::INFINITY,
+            hi: Vec3::NEG_INFINITY,
+            triangles: (run.start, run.end),
+            first_child: 0,
+            child_count: 0,
+            centre: Vec3::ZERO,
+            normal: Vec3::ZERO,
+            color: Vec3::ONE,
+            cone: -1.0,
         };
-        // Breadth first: a cell's children are made together, so they sit side by side.
-        let colors = &mesh.colors;
-        tree.cells.push(tree.summary(0..n as u32, positions, colors, &normal_of));
+        tree.cells.push(bare(0..n as u32));
         let mut level = vec![(0usize, 0u32)]; // (cell, its depth)
         while !level.is_empty() {
             let mut next = Vec::new();
@@ -143,8 +205,7 @@ impl SurfaceOctree {
                     let key = codes[s as usize] >> shift;
                     let e = s + codes[s as usize..end as usize].partition_point(|&c| c >> shift == key) as u32;
                     next.push((tree.cells.len(), d + 1));
-                    let child = tree.summary(s..e, positions, colors, &normal_of);
-                    tree.cells.push(child);
+                    tree.cells.push(bare(s..e));
                     s = e;
                 }
                 let count = tree.cells.len() as u32 - first;
@@ -153,51 +214,59 @@ impl SurfaceOctree {
             }
             level = next;
         }
+        tree.summarise(&mesh.positions, &mesh.colors);
         tree
     }
 
-    /// A cell over triangles `run` (in the reordered order).
-    fn summary(
-        &self,
-        run: Range<u32>,
-        positions: &[Vec3],
-        colors: &[[f32; 3]],
-        normal_of: &impl Fn(usize, &[u32]) -> Vec3,
-    ) -> Cell {
-        let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
-        let (mut centre, mut normal, mut area, mut color) = (Vec3::ZERO, Vec3::ZERO, 0.0, Vec3::ZERO);
-        for t in run.clone() {
-            let t = t as usize;
-            for k in 0..3 {
-                let p = positions[self.indices[3 * t + k] as usize];
-                lo = lo.min(p);
-                hi = hi.max(p);
+    /// Fills every cell's box, centre, normal, colour and cone: each leaf from its triangles (in
+    /// parallel), each parent from its children (children come after their parent).
+    fn summarise(&mut self, positions: &[Vec3], colors: &[[f32; 3]]) {
+        let indices = &self.indices;
+        let corner = |t: usize, k: usize| positions[indices[3 * t + k] as usize];
+        let leaves: Vec<(usize, Sums)> = (self.cells.par_iter().enumerate())
+            .filter(|(_, c)| c.child_count == 0)
+            .map(|(i, cell)| {
+                let run = cell.triangles.0 as usize..cell.triangles.1 as usize;
+                let mut sums = Sums::default();
+                for t in run.clone() {
+                    let [a, b, c] = [corner(t, 0), corner(t, 1), corner(t, 2)];
+                    let cross = (b - a).cross(c - a);
+                    let area = 0.5 * cross.length();
+                    let tint = |k: usize| colors.get(indices[3 * t + k] as usize).map_or(Vec3::ONE, |&c| Vec3::from(c));
+                    sums.lo = sums.lo.min(a).min(b).min(c);
+                    sums.hi = sums.hi.max(a).max(b).max(c);
+                    sums.centre += (a + b + c) / 3.0 * area;
+                    sums.normal += cross * 0.5;
+                    sums.color += (tint(0) + tint(1) + tint(2)) / 3.0 * area;
+                    sums.area += area;
+                }
+                let normal = sums.normal.normalize_or_zero();
+                sums.cone = if normal == Vec3::ZERO {
+                    -1.0
+                } else {
+                    run.map(|t| {
+                        (corner(t, 1) - corner(t, 0)).cross(corner(t, 2) - corner(t, 0)).normalize_or_zero().dot(normal)
+                    })
+                    .fold(1.0, f32::min)
+                };
+                (i, sums)
+            })
+            .collect();
+        let mut sums = vec![Sums::default(); self.cells.len()];
+        for (i, s) in leaves {
+            sums[i] = s;
+        }
+        for i in (0..self.cells.len()).rev() {
+            let cell = self.cells[i];
+            if cell.child_count > 0 {
+                let kids = cell.first_child as usize..(cell.first_child + cell.child_count) as usize;
+                sums[i] = Sums::merge(&sums[kids]);
             }
-            let cross = normal_of(t, &self.indices);
-            let a = 0.5 * cross.length();
-            let c = (0..3).map(|k| positions[self.indices[3 * t + k] as usize]).sum::<Vec3>() / 3.0;
-            centre += c * a;
-            normal += cross * 0.5;
-            area += a;
-            let tint = |k: usize| colors.get(self.indices[3 * t + k] as usize).map_or(Vec3::ONE, |&c| Vec3::from(c));
-            color += (tint(0) + tint(1) + tint(2)) / 3.0 * a;
-        }
-        let normal = normal.normalize_or_zero();
-        let mut cone: f32 = 1.0;
-        for t in run.clone() {
-            let n = normal_of(t as usize, &self.indices).normalize_or_zero();
-            cone = cone.min(if normal == Vec3::ZERO { -1.0 } else { n.dot(normal) });
-        }
-        Cell {
-            lo,
-            hi,
-            triangles: (run.start, run.end),
-            first_child: 0,
-            child_count: 0,
-            centre: if area > 0.0 { centre / area } else { 0.5 * (lo + hi) },
-            normal,
-            color: if area > 0.0 { color / area } else { Vec3::ONE },
-            cone,
+            let s = &sums[i];
+            let c = &mut self.cells[i];
+            (c.lo, c.hi, c.normal, c.cone) = (s.lo, s.hi, s.normal.normalize_or_zero(), s.cone);
+            c.centre = if s.area > 0.0 { s.centre / s.area } else { 0.5 * (s.lo + s.hi) };
+            c.color = if s.area > 0.0 { s.color / s.area } else { Vec3::ONE };
         }
     }
 
