@@ -6,8 +6,6 @@
 @group(1) @binding(0) var<storage, read> lists: array<u32>;
 @group(1) @binding(1) var<storage, read> splat: array<u32>;
 
-const LISTS: u32 = 8u;
-
 const CORNERS = array<vec2<f32>, 6>(
     vec2<f32>(-1.0, -1.0), vec2<f32>(1.0, -1.0), vec2<f32>(1.0, 1.0),
     vec2<f32>(-1.0, -1.0), vec2<f32>(1.0, 1.0), vec2<f32>(-1.0, 1.0),
@@ -18,6 +16,16 @@ struct FragOut {
     @location(1) id: u32,
     @builtin(frag_depth) depth: f32,
 };
+
+// QuteMol's depth cue: darker with depth across the molecule, so front reads from back.
+fn cued(color: vec3<f32>, world: vec3<f32>) -> vec3<f32> {
+    if (g.cue.z <= 0.0) {
+        return color;
+    }
+    let w = (g.clip_from_world * vec4<f32>(world, 1.0)).w;
+    let f = clamp((w - g.cue.x) / max(g.cue.y - g.cue.x, 1e-6), 0.0, 1.0);
+    return color * (1.0 - g.cue.z * f);
+}
 
 fn shade(base: vec3<f32>, n: vec3<f32>, view: vec3<f32>) -> vec3<f32> {
     let l = g.light.xyz;
@@ -35,7 +43,7 @@ fn sphere_fragment(i: u32, d: vec3<f32>, t: f32) -> FragOut {
     let hit = g.eye.xyz + d * t;
     let n = normalize(hit - center);
     var out: FragOut;
-    out.color = vec4<f32>(shade(color_of(i), n, -normalize(d)), 1.0);
+    out.color = vec4<f32>(cued(shade(color_of(i), n, -normalize(d)), hit), 1.0);
     out.id = g.pick.x | i;
     out.depth = depth_of(hit);
     return out;
@@ -96,7 +104,8 @@ fn vs_fullscreen(@builtin(vertex_index) vi: u32) -> @builtin(position) vec4<f32>
 fn fs_splats(@builtin(position) frag: vec4<f32>) -> FragOut {
     let w = u32(g.viewport.x);
     let pixel = u32(frag.y) * w + u32(frag.x);
-    let id = splat[u32(g.viewport.x) * u32(g.viewport.y) + pixel];
+    // Packed pixels are 64-bit words, id low; else the ids follow the depth keys.
+    let id = select(splat[u32(g.viewport.x) * u32(g.viewport.y) + pixel], splat[2u * pixel], g.pick.y != 0u);
     if (id == 0u) {
         discard;
     }
@@ -177,7 +186,7 @@ fn fs_cylinder(in: CylinderOut) -> FragOut {
     let atom = select(in.atoms.y, in.atoms.x, h < 0.5 * len);
     let n = normalize(hit - p0 - a * h);
     var out: FragOut;
-    out.color = vec4<f32>(shade(color_of(atom), n, -rd), 1.0);
+    out.color = vec4<f32>(cued(shade(color_of(atom), n, -rd), hit), 1.0);
     out.id = g.pick.x | atom;
     out.depth = depth_of(hit);
     return out;
@@ -188,6 +197,7 @@ fn fs_cylinder(in: CylinderOut) -> FragOut {
 struct LineOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) @interpolate(flat) atom: u32,
+    @location(1) world: vec3<f32>,
 };
 
 struct LineFrag {
@@ -205,6 +215,7 @@ fn vs_line(@builtin(vertex_index) vi: u32, @builtin(instance_index) b: u32) -> L
     var out: LineOut;
     out.clip = g.clip_from_world * vec4<f32>(ends[vi], 1.0);
     out.atom = select(bond.y, bond.x, vi < 2u);
+    out.world = ends[vi];
     if (((flags_of(bond.x) | flags_of(bond.y)) & FLAG_HIDDEN) != 0u) {
         // A bond to an atom the selection leaves out: a point outside the clip volume.
         out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
@@ -215,7 +226,7 @@ fn vs_line(@builtin(vertex_index) vi: u32, @builtin(instance_index) b: u32) -> L
 @fragment
 fn fs_line(in: LineOut) -> LineFrag {
     var out: LineFrag;
-    out.color = vec4<f32>(color_of(in.atom), 1.0);
+    out.color = vec4<f32>(cued(color_of(in.atom), in.world), 1.0);
     out.id = g.pick.x | in.atom;
     return out;
 }

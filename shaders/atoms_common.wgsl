@@ -9,7 +9,8 @@ struct Globals {
     light: vec4<f32>,
     // xyz: camera up vector
     up: vec4<f32>,
-    // x: high bits of this object's atom pick ids; the atom index is added
+    // x: high bits of this object's atom pick ids; the atom index is added; y: 1 when the
+    // compute rasteriser's pixels are packed 64-bit words (atoms_splat_packed.wgsl)
     pick: vec4<u32>,
     // x, y: viewport size (px); z: pixels per bohr at unit clip w; w: largest radius (px)
     // the compute rasteriser draws (larger spheres are impostor quads)
@@ -23,9 +24,20 @@ struct Globals {
     // x: stick radius (bohr)
     sticks: vec4<f32>,
     // x: cells to rasterise this frame (nearest first); y: where their order starts in the
-    // lists; z: where the atom indices start in cell_data
+    // lists; z: where the atom indices start in cell_data; w: this frame's number
     cells: vec4<u32>,
+    // Where the cell lists start in `lists`: x: seen last frame (drawn first); y: left for the
+    // occlusion test (later: the cells that write ids); z: left and not hidden; w: the frame
+    // each cell was last seen in
+    cell_lists: vec4<u32>,
+    // Depth cue: x, y: the clip w where darkening starts and where it is full; z: how much the
+    // farthest darkens (0: off)
+    cue: vec4<f32>,
 };
+
+// Words before the lists in `lists`: the spheres' and the bonds' indirect draws, then the cell
+// lists' counts.
+const LISTS: u32 = 12u;
 
 const STYLE_CYLINDERS: u32 = 1u;
 const STYLE_UNBONDED_ONLY: u32 = 2u;

@@ -1,5 +1,8 @@
 // Per frame: one workgroup per spatial cell of atoms, the cells in the frustum nearest first
-// (ordered on the CPU), and one invocation per bond. Seed 002's screen-size level of detail: a
+// (ordered on the CPU), and one invocation per bond. Occlusion culling in two phases: the cells
+// seen last frame are rasterised first; a coarse depth pyramid (the farthest depth of 8×8-pixel
+// tiles and of 8×8-tile blocks) is built from them; every other cell whose bounds it hides is
+// skipped, the rest rasterised; after a second pyramid only the cells that may show write ids. Seed 002's screen-size level of detail: a
 // sphere whose projected radius is at most `viewport.w` pixels is rasterised here exactly (per
 // pixel ray–sphere test, nearest wins through an atomic maximum of the inverted depth, then its
 // id written where it won), after a test that skips it when every pixel it could cover already
@@ -7,10 +10,26 @@
 // appended to the list the impostor quads draw. Bonds thinner than a third of a pixel are left
 // to the atoms.
 
-@group(1) @binding(0) var<storage, read_write> lists: array<atomic<u32>>;
-@group(1) @binding(1) var<storage, read_write> splat: array<atomic<u32>>;
+// The splat buffer (binding 1 of group 1) and how a pixel's depth key and atom id are kept in
+// it come from atoms_splat_pair.wgsl or atoms_splat_packed.wgsl: depth_key, draw_depth, draw_id,
+// coarse_load, coarse_store and PACKED.
 
-const LISTS: u32 = 8u;
+@group(1) @binding(0) var<storage, read_write> lists: array<atomic<u32>>;
+// The cell lists' indirect dispatch arguments (x, y, z, unused): FIRST, REST then IDS. Bound only
+// where the lists are filled (a buffer may not be indirect and writable in one dispatch).
+@group(2) @binding(0) var<storage, read_write> args: array<atomic<u32>>;
+
+// Words of `lists` counting the cell lists' entries (after the two indirect draws).
+const FIRST: u32 = 8u;
+const LEFT: u32 = 9u;
+const REST: u32 = 10u;
+const IDS: u32 = 11u;
+// Coarse depth: a tile is TILE×TILE pixels, a block BLOCK×BLOCK tiles; each holds the smallest
+// (farthest) depth key of its pixels.
+const TILE: i32 = 8;
+const BLOCK: i32 = 8;
+// The most tiles or blocks along a side one coarse test reads.
+const COARSE_SPAN: i32 = 8;
 // The rasteriser's largest footprint side (pixels): bounds the loop whatever the inputs.
 const MAX_SIDE: i32 = 40;
 // Largest half side (pixels) of the square a big sphere writes as an occluder.
@@ -84,58 +103,195 @@ fn key_at(i: u32, x: i32, y: i32) -> u32 {
 const CELL_WORDS: u32 = 6u;
 // Largest atom radius any style draws (bohr): pads a cell's bounds.
 const MAX_ATOM_RADIUS: f32 = 5.0;
-// A cell covering more pixels than this is not tested as a whole (the test would cost more
-// than it saves).
-const MAX_CELL_TEST_PIXELS: i32 = 256;
 
-// Whether the whole cell is hidden behind what is already drawn: its bounding sphere's screen
-// rectangle holds only nearer depths. Every lane tests on its own: llvmpipe runs a workgroup's
-// lanes in SIMD, where a barrier costs more than the repeated loads.
-fn cell_hidden(cell: u32) -> bool {
+fn tiles() -> vec2<i32> {
+    return (vec2<i32>(g.viewport.xy) + TILE - 1) / TILE;
+}
+
+fn blocks() -> vec2<i32> {
+    return (tiles() + BLOCK - 1) / BLOCK;
+}
+
+// Coarse depth words: the tiles, then the blocks.
+fn blocks_at() -> u32 {
+    let t = tiles();
+    return u32(t.x * t.y);
+}
+
+// Whether the coarse depths say every pixel of the rectangle `f` (inclusive pixel bounds)
+// holds something nearer than `key`: read from tiles where few enough cover it, else from
+// blocks; unknown (false) for a rectangle wider still.
+fn coarse_hidden(f: vec4<i32>, key: u32) -> bool {
+    let t0 = f.xy / TILE;
+    let t1 = f.zw / TILE;
+    if (all(t1 - t0 < vec2<i32>(COARSE_SPAN))) {
+        let w = tiles().x;
+        for (var y = t0.y; y <= t1.y; y++) {
+            for (var x = t0.x; x <= t1.x; x++) {
+                if (coarse_load(u32(y * w + x)) <= key) {
+                    return false;
+                }
+            }
+        }
+        return true;
+    }
+    let b0 = t0 / BLOCK;
+    let b1 = t1 / BLOCK;
+    if (any(b1 - b0 >= vec2<i32>(COARSE_SPAN))) {
+        return false;
+    }
+    let w = blocks().x;
+    for (var y = b0.y; y <= b1.y; y++) {
+        for (var x = b0.x; x <= b1.x; x++) {
+            if (coarse_load(blocks_at() + u32(y * w + x)) <= key) {
+                return false;
+            }
+        }
+    }
+    return true;
+}
+
+// Whether any of a cell's atoms may show: its bounding sphere's screen rectangle is not hidden
+// by the coarse depths at the sphere's nearest depth.
+fn cell_may_show(cell: u32) -> bool {
     let base = CELL_WORDS * cell;
     let centre = vec3<f32>(bitcast<f32>(cell_data[base + 2u]), bitcast<f32>(cell_data[base + 3u]),
         bitcast<f32>(cell_data[base + 4u]));
     let radius = bitcast<f32>(cell_data[base + 5u]) + MAX_ATOM_RADIUS;
     let c = g.clip_from_world * vec4<f32>(centre, 1.0);
     if (c.w <= radius) {
-        return false;
+        return true;
     }
     let r_px = radius * g.viewport.z / c.w;
     let p = vec2<f32>((c.x / c.w + 1.0) * 0.5 * g.viewport.x, (1.0 - c.y / c.w) * 0.5 * g.viewport.y);
     let lo = max(vec2<i32>(floor(p - r_px - 1.0)), vec2<i32>(0));
     let hi = min(vec2<i32>(ceil(p + r_px + 1.0)), vec2<i32>(g.viewport.xy) - 1);
-    let size = max(hi - lo + 1, vec2<i32>(0));
-    if (size.x * size.y > MAX_CELL_TEST_PIXELS) {
+    if (any(hi < lo)) {
         return false;
     }
-    let front = centre + normalize(g.eye.xyz - centre) * radius;
-    let key = 0xffffffffu - bitcast<u32>(clamp(depth_of(front), 0.0, 1.0));
-    return hidden(vec4<i32>(lo, hi), key);
+    return !coarse_hidden(vec4<i32>(lo, hi), nearest_key(centre, radius));
 }
 
-// Invocation `lane` of the workgroup for the `slot`-th nearest cell: each of its atoms once.
-fn cell_of(wid: vec3<u32>) -> u32 {
-    let slot = wid.x + wid.y * 65535u;
+// The invocation's index in a one-dimensional dispatch laid out in rows.
+fn flat_index(gid: vec3<u32>, groups: vec3<u32>) -> u32 {
+    return gid.x + gid.y * groups.x * 64u;
+}
+
+// Appends `cell` to the list counted at lists[count] and stored from lists[at], and widens its
+// indirect dispatch (args[head]: one workgroup per cell, at most 65,535; each walks the list
+// in strides of that).
+fn push(count: u32, at: u32, head: u32, cell: u32) {
+    let k = atomicAdd(&lists[count], 1u);
+    atomicStore(&lists[at + k], cell);
+    atomicMax(&args[head], min(k + 1u, 65535u));
+}
+
+// The frame's cells in view split: those seen last frame go first, the others are left for
+// the occlusion test.
+@compute @workgroup_size(64)
+fn cs_split(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let slot = flat_index(gid, groups);
     if (slot >= g.cells.x) {
-        return 0xffffffffu;
+        return;
     }
-    return atomicLoad(&lists[g.cells.y + slot]);
+    let cell = atomicLoad(&lists[g.cells.y + slot]);
+    if (atomicLoad(&lists[g.cell_lists.w + cell]) + 1u == g.cells.w) {
+        push(FIRST, g.cell_lists.x, 0u, cell);
+    } else {
+        let k = atomicAdd(&lists[LEFT], 1u);
+        atomicStore(&lists[g.cell_lists.y + k], cell);
+    }
 }
 
-// The depth key of the sphere's point nearest the eye: no pixel of it can be nearer.
-fn front_key(i: u32) -> u32 {
-    let c = positions[i].xyz;
-    let front = c + normalize(g.eye.xyz - c) * splat_radius(i);
+// The left cells the coarse depths do not hide are rasterised next.
+@compute @workgroup_size(64)
+fn cs_cull_left(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let slot = flat_index(gid, groups);
+    if (slot >= atomicLoad(&lists[LEFT])) {
+        return;
+    }
+    let cell = atomicLoad(&lists[g.cell_lists.y + slot]);
+    if (cell_may_show(cell)) {
+        push(REST, g.cell_lists.z, 4u, cell);
+    }
+}
+
+// With every depth drawn: the cells that may show write ids, and are seen this frame.
+@compute @workgroup_size(64)
+fn cs_cull_shown(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let slot = flat_index(gid, groups);
+    if (slot >= g.cells.x) {
+        return;
+    }
+    let cell = atomicLoad(&lists[g.cells.y + slot]);
+    if (cell_may_show(cell)) {
+        // The left list is spent: its words hold this list.
+        push(IDS, g.cell_lists.y, 8u, cell);
+        atomicStore(&lists[g.cell_lists.w + cell], g.cells.w);
+    }
+}
+
+// Coarse depths: each tile's farthest pixel, then each block's farthest tile.
+@compute @workgroup_size(64)
+fn cs_depth_tiles(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let t = tiles();
+    let k = i32(flat_index(gid, groups));
+    if (k >= t.x * t.y) {
+        return;
+    }
+    let lo = vec2<i32>(k % t.x, k / t.x) * TILE;
+    let hi = min(lo + TILE, vec2<i32>(g.viewport.xy));
+    let w = i32(g.viewport.x);
+    var far = 0xffffffffu;
+    for (var y = lo.y; y < hi.y; y++) {
+        for (var x = lo.x; x < hi.x; x++) {
+            far = min(far, depth_key(u32(y * w + x)));
+        }
+    }
+    coarse_store(u32(k), far);
+}
+
+@compute @workgroup_size(64)
+fn cs_depth_blocks(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let b = blocks();
+    let t = tiles();
+    let k = i32(flat_index(gid, groups));
+    if (k >= b.x * b.y) {
+        return;
+    }
+    let lo = vec2<i32>(k % b.x, k / b.x) * BLOCK;
+    let hi = min(lo + BLOCK, t);
+    var far = 0xffffffffu;
+    for (var y = lo.y; y < hi.y; y++) {
+        for (var x = lo.x; x < hi.x; x++) {
+            far = min(far, coarse_load(u32(y * t.x + x)));
+        }
+    }
+    coarse_store(blocks_at() + u32(k), far);
+}
+
+// The depth key of a sphere's nearest depth (its centre moved by its radius along the view
+// direction; depth grows with the distance along it): no pixel of it can be nearer.
+fn nearest_key(centre: vec3<f32>, radius: f32) -> u32 {
+    let front = centre - normalize(g.ray_f0.xyz - g.eye.xyz) * radius;
     return 0xffffffffu - bitcast<u32>(clamp(depth_of(front), 0.0, 1.0));
 }
 
+fn front_key(i: u32) -> u32 {
+    return nearest_key(positions[i].xyz, splat_radius(i));
+}
+
 // Whether every pixel of the footprint already holds something nearer than `key` (occluded:
-// nothing to draw). Cells are visited nearest first, so most hidden atoms stop here.
-fn hidden(f: vec4<i32>, key: u32) -> bool {
+// nothing to draw): from the coarse depths when they are built (`coarse`), else pixel by
+// pixel. Cells are visited nearest first, so most hidden atoms stop here.
+fn hidden(f: vec4<i32>, key: u32, coarse: bool) -> bool {
+    if (coarse && coarse_hidden(f, key)) {
+        return true;
+    }
     let w = i32(g.viewport.x);
     for (var y = f.y; y <= f.w; y++) {
         for (var x = f.x; x <= f.z; x++) {
-            if (atomicLoad(&splat[u32(y * w + x)]) <= key) {
+            if (depth_key(u32(y * w + x)) <= key) {
                 return false;
             }
         }
@@ -146,10 +302,10 @@ fn hidden(f: vec4<i32>, key: u32) -> bool {
 // A sphere too big to rasterise here: culled if what is drawn hides it, else appended to the
 // quads' list and its inscribed square written at its centre's depth, a conservative occluder
 // (the sphere's surface is nearer there) that lets farther atoms be culled.
-fn big_sphere(i: u32, s: Screen) {
+fn big_sphere(i: u32, s: Screen, coarse: bool) {
     let e = max(s.p.z, 0.5) * 1.05 + 0.02;
     let whole = 2.0 * e + 1.0 <= f32(MAX_SIDE);
-    if (whole && s.p.w == 2.0 && hidden(footprint(s), front_key(i))) {
+    if (whole && s.p.w == 2.0 && hidden(footprint(s), front_key(i), coarse)) {
         return;
     }
     let k = atomicAdd(&lists[1], 1u);
@@ -164,19 +320,16 @@ fn big_sphere(i: u32, s: Screen) {
     let w = i32(g.viewport.x);
     for (var y = lo.y; y <= hi.y; y++) {
         for (var x = lo.x; x <= hi.x; x++) {
-            let pixel = u32(y * w + x);
-            if (key > atomicLoad(&splat[pixel])) {
-                atomicMax(&splat[pixel], key);
-            }
+            draw_depth(u32(y * w + x), key, 0u);
         }
     }
 }
 
-fn rasterise(i: u32) {
+fn rasterise(i: u32, coarse: bool) {
     let s = screen_of(i);
     if (s.p.w >= 2.0) {
         if (BIG_SPHERES) {
-            big_sphere(i, s);
+            big_sphere(i, s, coarse);
         } else {
             let k = atomicAdd(&lists[1], 1u);
             atomicStore(&lists[LISTS + k], i);
@@ -187,17 +340,13 @@ fn rasterise(i: u32) {
         return;
     }
     let f = footprint(s);
-    if (hidden(f, front_key(i))) {
+    if (hidden(f, front_key(i), coarse)) {
         return;
     }
     let w = i32(g.viewport.x);
     for (var y = f.y; y <= f.w; y++) {
         for (var x = f.x; x <= f.z; x++) {
-            let key = key_at(i, x, y);
-            let pixel = u32(y * w + x);
-            if (key > atomicLoad(&splat[pixel])) {
-                atomicMax(&splat[pixel], key);
-            }
+            draw_depth(u32(y * w + x), key_at(i, x, y), i + 1u);
         }
     }
 }
@@ -208,49 +357,50 @@ fn write_id(i: u32) {
         return;
     }
     let f = footprint(s);
-    if (hidden(f, front_key(i))) {
+    if (hidden(f, front_key(i), true)) {
         return;
     }
     let w = i32(g.viewport.x);
-    let ids = u32(g.viewport.x) * u32(g.viewport.y);
     for (var y = f.y; y <= f.w; y++) {
         for (var x = f.x; x <= f.z; x++) {
-            let key = key_at(i, x, y);
-            let pixel = u32(y * w + x);
-            if (key != 0u && key == atomicLoad(&splat[pixel])) {
-                atomicStore(&splat[ids + pixel], i + 1u);
+            draw_id(u32(y * w + x), key_at(i, x, y), i + 1u);
+        }
+    }
+}
+
+// One lane's share of the atoms of the cells in a list (counted at lists[count], stored from
+// lists[at]), a cell per workgroup: `which` 0 rasterises depth keys, 1 (after 0) has each
+// splatted atom write its id where its depth won.
+fn cell_pass(wid: vec3<u32>, lane: u32, count: u32, at: u32, which: u32, coarse: bool) {
+    let n = atomicLoad(&lists[count]);
+    for (var slot = wid.x; slot < n; slot += 65535u) {
+        let cell = atomicLoad(&lists[at + slot]);
+        let first = cell_data[CELL_WORDS * cell];
+        let atoms = cell_data[CELL_WORDS * cell + 1u];
+        for (var k = lane; k < atoms; k += 64u) {
+            let i = cell_data[g.cells.z + first + k];
+            if (which == 0u) {
+                rasterise(i, coarse);
+            } else {
+                write_id(i);
             }
         }
     }
 }
 
-// One lane's share of one cell's atoms: `which` 0 rasterises depth keys, 1 (after 0) has
-// each splatted atom write its id where its depth won.
-fn cell_pass(wid: vec3<u32>, lane: u32, which: u32) {
-    let cell = cell_of(wid);
-    if (cell == 0xffffffffu || cell_hidden(cell)) {
-        return;
-    }
-    let first = cell_data[CELL_WORDS * cell];
-    let count = cell_data[CELL_WORDS * cell + 1u];
-    for (var k = lane; k < count; k += 64u) {
-        let i = cell_data[g.cells.z + first + k];
-        if (which == 0u) {
-            rasterise(i);
-        } else {
-            write_id(i);
-        }
-    }
+@compute @workgroup_size(64)
+fn cs_atoms_first(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
+    cell_pass(wid, lane, FIRST, g.cell_lists.x, 0u, false);
 }
 
 @compute @workgroup_size(64)
-fn cs_atoms(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
-    cell_pass(wid, lane, 0u);
+fn cs_atoms_rest(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
+    cell_pass(wid, lane, REST, g.cell_lists.z, 0u, true);
 }
 
 @compute @workgroup_size(64)
 fn cs_splat_ids(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
-    cell_pass(wid, lane, 1u);
+    cell_pass(wid, lane, IDS, g.cell_lists.y, 1u, true);
 }
 
 @compute @workgroup_size(64)

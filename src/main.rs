@@ -383,6 +383,10 @@ struct ViewArgs {
     /// PDB and mmCIF files; other files are coloured by element).
     #[arg(long, value_enum, default_value_t = ColorArg::Element)]
     color: ColorArg,
+    /// Darken atoms with depth by up to this fraction (0 to 1; the viewer opens big structures
+    /// at 0.6): the front of a big structure reads from its back.
+    #[arg(long, default_value_t = 0.0)]
+    depth_cue: f32,
     /// Hide the volume (atoms only).
     #[arg(long)]
     no_volume: bool,
@@ -509,6 +513,7 @@ impl ViewArgs {
             ColorArg::BFactor => AtomColoring::BFactor,
             ColorArg::Secondary => AtomColoring::Secondary,
         };
+        s.depth_cue = self.depth_cue.clamp(0.0, 1.0);
         s
     }
 

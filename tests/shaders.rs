@@ -31,7 +31,10 @@ fn every_shader_module_validates() {
             naga::front::wgsl::parse_str(&source).unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&source)));
         // pack2x16float/unpack2x16float (the fragment lists' half floats) need this one; wgpu
         // grants it on Vulkan, Metal and DX12 (DownlevelFlags::SHADER_F16_IN_F32).
-        let capabilities = naga::valid::Capabilities::default() | naga::valid::Capabilities::SHADER_FLOAT16_IN_FLOAT32;
+        // The packed splat words need 64-bit atomics (used only where the device has them).
+        use naga::valid::Capabilities as C;
+        let capabilities =
+            C::default() | C::SHADER_FLOAT16_IN_FLOAT32 | C::SHADER_INT64 | C::SHADER_INT64_ATOMIC_ALL_OPS;
         naga::valid::Validator::new(naga::valid::ValidationFlags::all(), capabilities)
             .validate(&module)
             .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&source)));
@@ -104,7 +107,22 @@ fn rust_mirrors_match_the_wgsl_layouts() {
             "atoms.wgsl",
             "Globals",
             AtomGlobals,
-            [clip_from_world, eye, light, up, pick, viewport, ray_f0, ray_fx, ray_fy, counts, sticks, cells]
+            [
+                clip_from_world,
+                eye,
+                light,
+                up,
+                pick,
+                viewport,
+                ray_f0,
+                ray_fx,
+                ray_fy,
+                counts,
+                sticks,
+                cells,
+                cell_lists,
+                cue
+            ]
         ),
         mirror!(
             "isosurface.wgsl",

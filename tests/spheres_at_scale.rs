@@ -110,3 +110,59 @@ fn a_million_atoms_draw_and_pick() {
     // Rounding decides a pixel exactly on the rim between two spheres either way.
     assert!(agree >= pixels.len() - 1, "{agree} of {} picks agree with the CPU ray cast", pixels.len());
 }
+
+/// Occlusion culling (the cells seen last frame drawn first, the others tested against their
+/// coarse depth) changes how much is drawn, never the picture: a frame drawn after another
+/// view matches the same frame drawn with no history, and most cells of a dense box are culled.
+#[test]
+fn occlusion_culling_keeps_the_picture() {
+    let ctx = lavapipe();
+    let m = atom_box(200_000);
+    let size = [320, 240];
+    let before = framing(&m);
+    let mut after = before;
+    after.orbit(0.3, -0.2);
+    let mut warm = Renderer::new(&ctx);
+    warm.main().set_molecule(&ctx, &m, AtomStyle::SpaceFilling);
+    draw(&ctx, &mut warm, &before, size);
+    let culled = draw(&ctx, &mut warm, &after, size);
+    let counts = warm.main().atoms.cell_counts(&ctx).unwrap();
+    let mut cold = Renderer::new(&ctx);
+    cold.main().set_molecule(&ctx, &m, AtomStyle::SpaceFilling);
+    let fresh = draw(&ctx, &mut cold, &after, size);
+    let first = cold.main().atoms.cell_counts(&ctx).unwrap();
+    assert_eq!(mean_difference(&culled, &fresh), 0.0, "the picture changed with the history");
+    for px in [[160, 120], [100, 80], [220, 170], [60, 200]] {
+        assert_eq!(warm.pick(&ctx, px).unwrap(), cold.pick(&ctx, px).unwrap(), "pick at {px:?}");
+    }
+    // The first frame has no history: everything in view is drawn, nearest first.
+    assert_eq!(first.first, first.in_view, "{first:?}");
+    // After one frame: a few cells drawn first, most of the others culled.
+    assert!(counts.first > 0 && counts.first < counts.in_view / 2, "{counts:?}");
+    assert!(counts.rest < counts.tested / 4, "{counts:?}");
+    assert!(counts.shown < counts.in_view / 2, "{counts:?}");
+}
+
+/// Depth and id in one 64-bit word (one pass) and in two words (a second pass for the ids)
+/// draw and pick the same atoms. Lavapipe has 64-bit atomics, so both run here.
+#[test]
+fn packed_and_paired_splat_words_agree() {
+    use orbcloud::gpu::atoms::{AtomsPass, SplatWords};
+    let ctx = lavapipe();
+    assert_eq!(SplatWords::best(&ctx.device), SplatWords::Packed, "lavapipe has 64-bit storage atomics");
+    let m = atom_box(50_000);
+    let cam = framing(&m);
+    let size = [240, 180];
+    let mut drawn = Vec::new();
+    for words in [SplatWords::Pair, SplatWords::Packed] {
+        let mut r = Renderer::new(&ctx);
+        r.main().atoms = AtomsPass::with_words(&ctx, words);
+        r.main().set_molecule(&ctx, &m, AtomStyle::SpaceFilling);
+        let img = draw(&ctx, &mut r, &cam, size);
+        let picks: Vec<_> = (0..12).map(|k| r.pick(&ctx, [30 + k * 15, 20 + k * 12]).unwrap()).collect();
+        drawn.push((img, picks));
+    }
+    assert!(drawn[0].1.iter().filter(|p| p.is_some()).count() >= 8, "{:?}", drawn[0].1);
+    assert_eq!(drawn[0].1, drawn[1].1, "picks differ");
+    assert_eq!(mean_difference(&drawn[0].0, &drawn[1].0), 0.0, "pictures differ");
+}

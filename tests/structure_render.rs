@@ -109,3 +109,28 @@ fn a_selection_shows_only_what_it_names() {
     }
     assert!(picked > 0, "the waters are picked");
 }
+
+/// Depth cueing darkens with depth only: no pixel brightens, the front stays as it was and the
+/// back darkens to about (1 − strength) in linear light.
+#[test]
+fn depth_cue_darkens_the_back() {
+    let doc = protein();
+    let plain = render(&doc, AtomStyle::SpaceFilling, AtomColoring::Element);
+    let s = RenderSettings { atoms: AtomStyle::SpaceFilling, depth_cue: 0.8, ..RenderSettings::default() };
+    let cued = render_document(&lavapipe(), &doc, None, &default_camera(&doc), &s, SIZE).expect("render");
+    assert_golden("protein_depth_cue", &cued);
+    let linear = |v: u8| (v as f32 / 255.0).powf(2.2);
+    let mut ratios = Vec::new();
+    for (p, c) in plain.pixels().zip(cued.pixels()) {
+        assert!((0..3).all(|k| c.0[k] <= p.0[k].saturating_add(2)), "a pixel brightened: {p:?} → {c:?}");
+        let (lp, lc) =
+            (linear(p.0[0]) + linear(p.0[1]) + linear(p.0[2]), linear(c.0[0]) + linear(c.0[1]) + linear(c.0[2]));
+        if lp > 0.1 {
+            ratios.push(lc / lp);
+        }
+    }
+    ratios.sort_by(f32::total_cmp);
+    let (darkest, brightest) = (ratios[ratios.len() / 100], ratios[ratios.len() * 99 / 100]);
+    assert!(brightest > 0.85, "the front darkened: {brightest}");
+    assert!(darkest < 0.45 && darkest > 0.15, "the back: {darkest}");
+}

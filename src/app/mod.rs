@@ -932,9 +932,8 @@ impl OrbApp {
         if before.settings.iso != self.view.settings.iso {
             vp.update_isosurfaces(n, &o.doc, &o.state);
         }
-        if (before.settings.atoms, before.settings.atom_colors)
-            != (self.view.settings.atoms, self.view.settings.atom_colors)
-        {
+        let look = |s: &crate::scene::RenderSettings| (s.atoms, s.atom_colors, s.depth_cue);
+        if look(&before.settings) != look(&self.view.settings) {
             vp.set_atom_look(n, &o.doc, &o.state);
             if let Some(scan) = &mut self.scan {
                 scan::restyle(scan);

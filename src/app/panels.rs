@@ -282,6 +282,8 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
             });
             super::models::selection(ui, app);
             let view = &mut app.view;
+            ui.add(Slider::new(&mut view.settings.depth_cue, 0.0..=1.0).text("depth cue"))
+                .on_hover_text("Darkens atoms with depth, so the front of a big structure reads from its back");
             ui.horizontal(|ui| {
                 ui.color_edit_button_rgb(&mut view.settings.background);
                 ui.label("background");

@@ -12,10 +12,9 @@ use crate::gpu::gto::GtoFillPass;
 use crate::gpu::oit::FragmentStats;
 use crate::gpu::{FrameInput, GpuContext, GpuError, OffscreenTarget, Renderer, Tile};
 use crate::headless::scan::ScanScene;
-use crate::headless::{
-    Evaluated, WavefunctionView, evaluate_within, isosurfaces_within, molecular_surface, show_meshes,
-};
+use crate::headless::{Evaluated, WavefunctionView, evaluate_within, isosurfaces_within, molecular_surface};
 use crate::model::isosurface::Mesh;
+use crate::model::octree::SurfaceOctree;
 use crate::model::{Document, VolumeGrid};
 use crate::scene::translucency::SurfaceLook;
 use crate::scene::{IsosurfaceSettings, ObjectState, RenderSettings, SurfaceChoice, SurfaceSettings, VolumeSettings};
@@ -71,6 +70,13 @@ type Evaluation = Result<(Option<Evaluated>, Option<String>), GpuError>;
 /// Isosurfaces made in the background, each with its colour, and a note when they had to be
 /// cut from a coarser grid.
 pub type Meshes = (Vec<(Mesh, SurfaceLook)>, Option<String>);
+/// Meshes with the octrees they are drawn with, built in the same job.
+type Prepared = (Vec<(Mesh, SurfaceLook)>, Vec<Option<SurfaceOctree>>, Option<String>);
+
+fn prepared((meshes, note): Meshes) -> Prepared {
+    let trees = crate::gpu::isosurface::lod_trees(&meshes);
+    (meshes, trees, note)
+}
 
 /// What the viewport keeps per object besides its renderer layer.
 struct ObjectJobs {
@@ -81,7 +87,7 @@ struct ObjectJobs {
     /// had to be coarser than asked.
     evaluation: Latest<Evaluation>,
     /// Marching cubes over the grid shown, and the molecular surface.
-    extraction: Latest<Meshes>,
+    extraction: Latest<Prepared>,
     /// The last molecular surface built, kept while only its look changes (an isosurface
     /// slider moving does not build it again).
     surface: Arc<Mutex<Option<BuiltSurface>>>,
@@ -255,7 +261,7 @@ impl Viewport {
             let shown = (&*doc, &surface, selection.as_str(), grid);
             let (built, surface_note) = molecular_surface_cached(&cache, shown, max_bytes, cancel);
             meshes.extend(built);
-            (meshes, note.into_iter().chain(surface_note).reduce(|a, b| format!("{a}; {b}")))
+            prepared((meshes, note.into_iter().chain(surface_note).reduce(|a, b| format!("{a}; {b}"))))
         });
     }
 
@@ -264,7 +270,7 @@ impl Viewport {
     /// them when they are done.
     pub fn request_meshes(&mut self, n: usize, make: impl FnOnce(u64) -> Meshes + Send + 'static) {
         let max_bytes = self.ctx.device.limits().max_buffer_size;
-        self.slot(n).extraction.request(move |_| make(max_bytes));
+        self.slot(n).extraction.request(move |_| prepared(make(max_bytes)));
     }
 
     /// Shows object `n`'s isosurfaces if their job finished: `Ok` with the triangle count and
@@ -272,10 +278,14 @@ impl Viewport {
     pub fn poll_meshes(&mut self, n: usize) -> Option<Result<(usize, Option<String>), String>> {
         let result = self.slot(n).extraction.poll()?;
         self.generation += 1;
-        Some(result.and_then(|(meshes, note)| {
+        Some(result.and_then(|(meshes, trees, note)| {
             let (ctx, layer) = (&self.ctx, self.renderer.layer_mut(&self.ctx, n));
-            let triangles = guarded(&ctx.device, || Ok(show_meshes(ctx, layer, &meshes))).map_err(|e| e.to_string())?;
-            Ok((triangles, note))
+            guarded(&ctx.device, || {
+                layer.surfaces.set_meshes_with_trees(ctx, &meshes, trees);
+                Ok(())
+            })
+            .map_err(|e| e.to_string())?;
+            Ok((meshes.iter().map(|(m, _)| m.triangle_count()).sum(), note))
         }))
     }
 
@@ -362,7 +372,9 @@ impl Viewport {
     /// Restyles, recolours and reselects object `n`'s atoms (positions stay on the GPU).
     pub fn set_atom_look(&mut self, n: usize, doc: &Document, state: &crate::scene::ObjectState) {
         let look = crate::headless::atom_look(doc, &state.settings, &state.selection);
-        self.renderer.layer_mut(&self.ctx, n).atoms.set_look(&self.ctx, state.settings.atoms, &look);
+        let atoms = &mut self.renderer.layer_mut(&self.ctx, n).atoms;
+        atoms.set_look(&self.ctx, state.settings.atoms, &look);
+        atoms.depth_cue = state.settings.depth_cue;
         self.generation += 1;
     }
 

@@ -102,6 +102,11 @@ pub fn bench_spheres(args: &SpheresBench) -> Result<()> {
         args.splat_px
     );
     println!("gpu_bytes_per_atom={:.1}", gpu_bytes as f64 / n as f64);
+    let c = renderer.main().atoms.cell_counts(&ctx)?;
+    println!(
+        "cells (last frame): {} of {} in view, {} drawn first (seen the frame before), {} of the {} others drawn after the occlusion test, {} may show",
+        c.in_view, c.total, c.first, c.rest, c.tested, c.shown
+    );
     println!(
         "ms_per_frame_median={:.1} min={:.1} max={:.1} frames={}",
         times[times.len() / 2],

@@ -23,7 +23,8 @@ pub struct AtomGlobals {
     pub eye: [f32; 4],
     pub light: [f32; 4],
     pub up: [f32; 4],
-    /// x: the high bits of this object's atom pick ids ([`PickId::atom_base`]).
+    /// x: the high bits of this object's atom pick ids ([`PickId::atom_base`]); y: 1 when the
+    /// splat pixels are packed 64-bit words ([`SplatWords`]).
     pub pick: [u32; 4],
     /// Viewport width and height (px), pixels per bohr at unit clip w, the splat threshold (px).
     pub viewport: [f32; 4],
@@ -35,10 +36,15 @@ pub struct AtomGlobals {
     /// x: stick radius (bohr).
     pub sticks: [f32; 4],
     /// Cells to rasterise this frame, where their order starts in the lists, where the atom
-    /// indices start in the cell data.
+    /// indices start in the cell data, this frame's number.
     pub cells: [u32; 4],
+    /// Where the cell lists start: seen last frame, left for the occlusion test (later those
+    /// that write ids), left and not hidden, and the frame each cell was last seen in.
+    pub cell_lists: [u32; 4],
+    /// Depth cueing: the nearest and farthest clip w of the molecule's box, and the strength.
+    pub cue: [f32; 4],
 }
-const _: () = assert!(std::mem::size_of::<AtomGlobals>() == 240);
+const _: () = assert!(std::mem::size_of::<AtomGlobals>() == 272);
 
 /// Ball radius as a fraction of the van der Waals radius in ball-and-stick.
 const BALL_FRACTION: f32 = 0.24;
@@ -56,8 +62,17 @@ const STYLE_CYLINDERS: u32 = 1;
 const STYLE_UNBONDED_ONLY: u32 = 2;
 /// Radii per atomic number come first in the looks buffer, then the palette.
 const PALETTE_AT: usize = 128;
-/// u32s before the lists: the sphere and the bond indirect draw arguments.
-const LIST_HEADER: usize = 8;
+/// u32s before the lists: the sphere and the bond indirect draw arguments, then the counts of
+/// the cell lists.
+const LIST_HEADER: usize = 12;
+/// Words per cell in the lists: this frame's order, three cell lists and the frame it was seen.
+const LIST_WORDS_PER_CELL: usize = 5;
+/// The cell lists' indirect dispatches (x, y, z, unused), reset every frame: seen last frame,
+/// left and not hidden, shown.
+const DISPATCH_ARGS: [u32; 12] = [0, 1, 1, 0, 0, 1, 1, 0, 0, 1, 1, 0];
+/// Coarse depth: pixels per tile side and tiles per block side (atoms_cull.wgsl).
+const DEPTH_TILE: u32 = 8;
+const DEPTH_BLOCK: u32 = 8;
 const WORKGROUP: u32 = 64;
 /// Bytes a splat buffer takes per pixel: a depth key and an atom id.
 const SPLAT_BYTES_PER_PIXEL: u64 = 8;
@@ -66,7 +81,7 @@ const SPLAT_BYTES_PER_PIXEL: u64 = 8;
 /// rasterised by one workgroup. Measured on lavapipe (10⁶ atoms, 800×600): 48 atoms per cell
 /// spend more on launching workgroups than they save by finer order, 480 lose occlusion;
 /// 256 was fastest for space filling and ball and stick alike.
-const CELL_ATOMS: f32 = 256.0;
+const CELL_ATOMS: f32 = 64.0;
 /// The largest atom radius any style draws (bohr), padding cells' bounds for culling.
 const MAX_ATOM_RADIUS: f32 = 5.0;
 /// Header words per cell in `cell_data`.
@@ -163,6 +178,19 @@ impl Cells {
         visible.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
         visible.into_iter().map(|(_, k)| k).collect()
     }
+}
+
+/// Cells of atoms in one frame: all, in the frustum, drawn first (seen the frame before),
+/// tested against the coarse depth of those, drawn after that test, and the cells that may
+/// show in the finished frame (they write ids and are drawn first next frame).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct CellCounts {
+    pub total: u32,
+    pub in_view: u32,
+    pub first: u32,
+    pub tested: u32,
+    pub rest: u32,
+    pub shown: u32,
 }
 
 /// What the GPU holds per atom and bond, as plain arrays (testable without a GPU).
@@ -265,8 +293,12 @@ struct Uploaded {
     attrs: wgpu::Buffer,
     looks: wgpu::Buffer,
     bonds: wgpu::Buffer,
-    /// Indirect draw arguments, the sphere list, the bond list, then this frame's cell order.
+    /// Indirect draw arguments, cell list counts, the sphere list, the bond list, this frame's
+    /// cell order, the cell lists and the frame each cell was last seen in.
     lists: wgpu::Buffer,
+    /// Indirect dispatches of the cell lists ([`DISPATCH_ARGS`]) and their bind group.
+    args: wgpu::Buffer,
+    args_group: wgpu::BindGroup,
     cell_data: wgpu::Buffer,
     cells: Cells,
     /// Cells in this frame's view, nearest first (how many the compute passes walk).
@@ -277,6 +309,8 @@ struct Uploaded {
     bond_count: u32,
     /// CPU copy of the attributes: a recolouring changes their palette bits only.
     attr_words: Vec<u32>,
+    /// The atoms' box (bohr).
+    bounds: [Vec3; 2],
     group: wgpu::BindGroup,
 }
 
@@ -291,15 +325,31 @@ pub struct AtomsPass {
     frame_groups: Option<(wgpu::BindGroup, wgpu::BindGroup)>,
     /// Spheres up to this projected radius (pixels) are drawn by the compute rasteriser.
     pub splat_radius_px: f32,
+    /// Frames prepared since the molecule was uploaded: cells seen in the last one are drawn
+    /// first.
+    frame: u32,
+    /// How much the farthest atoms darken (0: none), QuteMol's depth cue: it tells front from
+    /// back in a big structure.
+    pub depth_cue: f32,
 }
 
 struct Pipelines {
     data_layout: wgpu::BindGroupLayout,
     compute_layout: wgpu::BindGroupLayout,
+    args_layout: wgpu::BindGroupLayout,
     render_layout: wgpu::BindGroupLayout,
-    /// Without and with the code for spheres too big to rasterise.
-    cull_atoms: [wgpu::ComputePipeline; 2],
-    splat_ids: wgpu::ComputePipeline,
+    split: wgpu::ComputePipeline,
+    /// Rasterising the cells seen last frame, then the rest the coarse depth does not hide;
+    /// each without and with the code for spheres too big to rasterise.
+    atoms_first: [wgpu::ComputePipeline; 2],
+    atoms_rest: [wgpu::ComputePipeline; 2],
+    depth_tiles: wgpu::ComputePipeline,
+    depth_blocks: wgpu::ComputePipeline,
+    cull_left: wgpu::ComputePipeline,
+    cull_shown: wgpu::ComputePipeline,
+    /// The second pass that writes ids ([`SplatWords::Pair`] only).
+    splat_ids: Option<wgpu::ComputePipeline>,
+    words: SplatWords,
     cull_bonds: wgpu::ComputePipeline,
     spheres: wgpu::RenderPipeline,
     splats: wgpu::RenderPipeline,
@@ -310,8 +360,24 @@ struct Pipelines {
 /// Default splat threshold: measured on lavapipe, see README (`orbcloud bench spheres`).
 pub const SPLAT_RADIUS_PX: f32 = 8.0;
 
+/// How the compute rasteriser keeps a pixel's nearest depth and atom id.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SplatWords {
+    /// Two 32-bit words and a second pass for the ids: any device.
+    Pair,
+    /// One 64-bit word, depth above id, one atomic maximum: devices with 64-bit atomics.
+    Packed,
+}
+
+impl SplatWords {
+    /// The faster one the device can run.
+    pub fn best(device: &wgpu::Device) -> Self {
+        if device.features().contains(super::context::INT64_ATOMICS) { Self::Packed } else { Self::Pair }
+    }
+}
+
 impl Pipelines {
-    fn new(ctx: &GpuContext) -> Self {
+    fn new(ctx: &GpuContext, words: SplatWords) -> Self {
         use wgpu::BufferBindingType::{Storage, Uniform};
         use wgpu::ShaderStages as S;
         let device = &ctx.device;
@@ -336,23 +402,33 @@ impl Pipelines {
                 entry(1, S::COMPUTE, Storage { read_only: false }),
             ],
         });
+        let args_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("atoms dispatch layout"),
+            entries: &[entry(0, S::COMPUTE, Storage { read_only: false })],
+        });
         let render_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("atoms render layout"),
             entries: &[entry(0, S::VERTEX, read), entry(1, S::FRAGMENT, read)],
         });
-        let layout = |second: &wgpu::BindGroupLayout| {
+        let layout = |more: &[Option<&wgpu::BindGroupLayout>]| {
+            let groups: Vec<_> = std::iter::once(Some(&data_layout)).chain(more.iter().copied()).collect();
             device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some("atoms pipeline layout"),
-                bind_group_layouts: &[Some(&data_layout), Some(second)],
+                bind_group_layouts: &groups,
                 immediate_size: 0,
             })
         };
-        let (compute_pl, render_pl) = (layout(&compute_layout), layout(&render_layout));
-        let cull = super::shader_module(device, "atoms_cull.wgsl");
-        let compute = |entry: &str, big: bool| {
+        let compute_pl = layout(&[Some(&compute_layout)]);
+        let listing_pl = layout(&[Some(&compute_layout), Some(&args_layout)]);
+        let render_pl = layout(&[Some(&render_layout)]);
+        let cull = super::shader_module(
+            device,
+            if words == SplatWords::Packed { "atoms_splat_packed.wgsl" } else { "atoms_splat_pair.wgsl" },
+        );
+        let pipeline = |entry: &str, big: bool, layout: &wgpu::PipelineLayout| {
             device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(entry),
-                layout: Some(&compute_pl),
+                layout: Some(layout),
                 module: &cull,
                 entry_point: Some(entry),
                 compilation_options: wgpu::PipelineCompilationOptions {
@@ -362,6 +438,8 @@ impl Pipelines {
                 cache: None,
             })
         };
+        let compute = |entry: &str, big: bool| pipeline(entry, big, &compute_pl);
+        let listing = |entry: &str| pipeline(entry, false, &listing_pl);
         let module = super::shader_module(device, "atoms.wgsl");
         let render = |label: &str, vs: &str, fs: &str, topology| {
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
@@ -388,8 +466,15 @@ impl Pipelines {
         };
         use wgpu::PrimitiveTopology::{LineList, TriangleList};
         Self {
-            cull_atoms: [compute("cs_atoms", false), compute("cs_atoms", true)],
-            splat_ids: compute("cs_splat_ids", false),
+            split: listing("cs_split"),
+            atoms_first: [compute("cs_atoms_first", false), compute("cs_atoms_first", true)],
+            atoms_rest: [compute("cs_atoms_rest", false), compute("cs_atoms_rest", true)],
+            depth_tiles: compute("cs_depth_tiles", false),
+            depth_blocks: compute("cs_depth_blocks", false),
+            cull_left: listing("cs_cull_left"),
+            cull_shown: listing("cs_cull_shown"),
+            splat_ids: (words == SplatWords::Pair).then(|| compute("cs_splat_ids", false)),
+            words,
             cull_bonds: compute("cs_bonds", false),
             spheres: render("sphere impostors", "vs_sphere", "fs_sphere", TriangleList),
             splats: render("sphere splats", "vs_fullscreen", "fs_splats", TriangleList),
@@ -397,6 +482,7 @@ impl Pipelines {
             lines: render("bond lines", "vs_line", "fs_line", LineList),
             data_layout,
             compute_layout,
+            args_layout,
             render_layout,
         }
     }
@@ -416,7 +502,12 @@ fn storage(ctx: &GpuContext, label: &str, bytes: &[u8], extra: wgpu::BufferUsage
 
 impl AtomsPass {
     pub fn new(ctx: &GpuContext) -> Self {
-        Self::with(ctx, std::sync::Arc::new(Pipelines::new(ctx)))
+        Self::with_words(ctx, SplatWords::best(&ctx.device))
+    }
+
+    /// Atoms rasterised with `words` (the device must have 64-bit atomics for `Packed`).
+    pub fn with_words(ctx: &GpuContext, words: SplatWords) -> Self {
+        Self::with(ctx, std::sync::Arc::new(Pipelines::new(ctx, words)))
     }
 
     fn with(ctx: &GpuContext, shared: std::sync::Arc<Pipelines>) -> Self {
@@ -428,6 +519,8 @@ impl AtomsPass {
             splat: None,
             frame_groups: None,
             splat_radius_px: SPLAT_RADIUS_PX,
+            frame: 0,
+            depth_cue: 0.0,
         }
     }
 
@@ -458,25 +551,41 @@ impl AtomsPass {
         let attrs = storage(ctx, "atom attributes", bytemuck::cast_slice(&data.attrs), usage);
         let looks = storage(ctx, "atom looks", bytemuck::cast_slice(&looks(style, colors)), usage);
         let bonds = storage(ctx, "bonds", bytemuck::cast_slice(&data.bonds), usage);
-        let list_words = LIST_HEADER + data.positions.len() + data.bonds.len() + data.cells.len();
-        let lists = storage(ctx, "atom lists", &vec![0u8; list_words * 4], wgpu::BufferUsages::INDIRECT);
+        let list_words = LIST_HEADER + data.positions.len() + data.bonds.len() + LIST_WORDS_PER_CELL * data.cells.len();
+        let lists = storage(
+            ctx,
+            "atom lists",
+            &vec![0u8; list_words * 4],
+            wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_SRC,
+        );
+        let args =
+            storage(ctx, "atom cell dispatches", bytemuck::cast_slice(&DISPATCH_ARGS), wgpu::BufferUsages::INDIRECT);
+        let args_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("atom cell dispatches"),
+            layout: &self.shared.args_layout,
+            entries: &[wgpu::BindGroupEntry { binding: 0, resource: args.as_entire_binding() }],
+        });
         let cell_data = storage(ctx, "atom cells", bytemuck::cast_slice(&data.cells.data), usage);
         let group =
             Self::data_group(ctx, &self.shared, &self.globals, [&positions, &attrs, &looks, &bonds, &cell_data]);
         self.style = style;
         self.frame_groups = None;
+        self.frame = 0;
         self.data = Some(Uploaded {
             positions,
             attrs,
             looks,
             bonds,
             lists,
+            args,
+            args_group,
             cell_data,
             cells: data.cells,
             visible_cells: 0,
             big_spheres: true,
             atoms: data.positions.len() as u32,
             bond_count: data.bonds.len() as u32,
+            bounds: molecule.bounds().map_or([Vec3::ZERO; 2], |(lo, hi)| [lo.as_vec3(), hi.as_vec3()]),
             attr_words: data.attrs,
             group,
         });
@@ -532,6 +641,37 @@ impl AtomsPass {
         }
     }
 
+    /// How the last frame's occlusion culling went (read back from the GPU: for benchmarks and
+    /// tests).
+    pub fn cell_counts(&self, ctx: &GpuContext) -> Result<CellCounts, super::GpuError> {
+        let Some(d) = self.drawn() else { return Ok(CellCounts::default()) };
+        let words = super::readback::read_buffer(&ctx.device, &ctx.queue, &d.lists, LIST_HEADER as u64 * 4)?;
+        let w: &[u32] = bytemuck::cast_slice(&words);
+        Ok(CellCounts {
+            total: d.cells.len() as u32,
+            in_view: d.visible_cells,
+            first: w[8],
+            tested: w[9],
+            rest: w[10],
+            shown: w[11],
+        })
+    }
+
+    /// The depth cue's globals: the clip w where darkening starts (the molecule box's nearest
+    /// corner) and where it is full (halfway from the box's centre to its farthest corner: what
+    /// shows of a dense structure lies in front of its centre), and the strength.
+    fn cue(&self, clip: Mat4) -> [f32; 4] {
+        let Some(d) = self.data.as_ref().filter(|_| self.depth_cue > 0.0) else { return [0.0; 4] };
+        let [lo, hi] = d.bounds;
+        let w = |p: Vec3| (clip * p.extend(1.0)).w;
+        let (near, far) = (0..8).fold((f32::INFINITY, f32::NEG_INFINITY), |(near, far), k| {
+            let corner = Vec3::select(glam::BVec3::new(k & 1 != 0, k & 2 != 0, k & 4 != 0), hi, lo);
+            (near.min(w(corner)), far.max(w(corner)))
+        });
+        let full = 0.5 * (w(0.5 * (lo + hi)) + far);
+        [near.max(0.0), full, self.depth_cue.clamp(0.0, 1.0), 0.0]
+    }
+
     /// Bytes of GPU memory the uploaded atoms take (not counting the per-pixel splat buffer).
     pub fn gpu_bytes(&self) -> u64 {
         self.data.as_ref().map_or(0, |d| {
@@ -560,7 +700,10 @@ impl AtomsPass {
             _ => Vec::new(),
         };
         let order_at = LIST_HEADER as u32 + atoms + bonds;
-        let cells_at = self.data.as_ref().map_or(0, |d| (CELL_WORDS * d.cells.len()) as u32);
+        let total_cells = self.data.as_ref().map_or(0, |d| d.cells.len() as u32);
+        let cells_at = CELL_WORDS as u32 * total_cells;
+        let cell_lists = [1, 2, 3, 4].map(|k| order_at + k * total_cells);
+        self.frame += 1;
         let (stick, style) = style_flags(self.style);
         let size = size.map(|v| v.max(1));
         let pixels_per_bohr = clip.row(1).truncate().length() * 0.5 * size[1] as f32;
@@ -569,19 +712,24 @@ impl AtomsPass {
             eye: view.eye.extend(1.0).to_array(),
             light: view.light.extend(0.0).to_array(),
             up: view.up.extend(0.0).to_array(),
-            pick: [PickId::atom_base(object), 0, 0, 0],
+            pick: [PickId::atom_base(object), (self.shared.words == SplatWords::Packed) as u32, 0, 0],
             viewport: [size[0] as f32, size[1] as f32, pixels_per_bohr, self.splat_radius_px],
             ray_f0: f0.extend(0.0).to_array(),
             ray_fx: (far(1.0, 0.0) - f0).extend(0.0).to_array(),
             ray_fy: (far(0.0, 1.0) - f0).extend(0.0).to_array(),
             counts: [atoms, bonds, style, dispatch(bonds).1],
             sticks: [stick, 0.0, 0.0, 0.0],
-            cells: [order.len() as u32, order_at, cells_at, 0],
+            cells: [order.len() as u32, order_at, cells_at, self.frame],
+            cell_lists,
+            cue: self.cue(clip),
         };
         ctx.queue.write_buffer(&self.globals, 0, bytemuck::bytes_of(&g));
         let Some(d) = &mut self.data else { return };
-        // Quads: six vertices per sphere and per bond; instance counts filled by the culling.
-        ctx.queue.write_buffer(&d.lists, 0, bytemuck::cast_slice(&[6u32, 0, 0, 0, 6, 0, 0, 0]));
+        // Quads: six vertices per sphere and per bond; instance counts filled by the culling,
+        // as are the cell lists' counts and dispatches.
+        let header: [u32; LIST_HEADER] = [6, 0, 0, 0, 6, 0, 0, 0, 0, 0, 0, 0];
+        ctx.queue.write_buffer(&d.lists, 0, bytemuck::cast_slice(&header));
+        ctx.queue.write_buffer(&d.args, 0, bytemuck::cast_slice(&DISPATCH_ARGS));
         if !order.is_empty() {
             ctx.queue.write_buffer(&d.lists, order_at as u64 * 4, bytemuck::cast_slice(&order));
         }
@@ -595,7 +743,11 @@ impl AtomsPass {
         });
         let d = &*d;
         if self.splat.as_ref().is_none_or(|(_, s)| *s != size) {
-            let bytes = size[0] as u64 * size[1] as u64 * SPLAT_BYTES_PER_PIXEL;
+            let tiles = size.map(|v| v.div_ceil(DEPTH_TILE));
+            let blocks = tiles.map(|v| v.div_ceil(DEPTH_BLOCK));
+            // A word per coarse depth, 64-bit when the pixels are.
+            let coarse = (tiles[0] * tiles[1] + blocks[0] * blocks[1]) as u64 * 8;
+            let bytes = size[0] as u64 * size[1] as u64 * SPLAT_BYTES_PER_PIXEL + coarse;
             let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("sphere splats"),
                 size: bytes,
@@ -652,13 +804,35 @@ impl Draw for AtomsPass {
             .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("cull and splat"), timestamp_writes: None });
         pass.set_bind_group(0, &d.group, &[]);
         pass.set_bind_group(1, compute, &[]);
-        // One row width for both dispatches: the shader indexes with it.
         if d.visible_cells > 0 {
-            let (x, y) = (d.visible_cells.min(65_535), d.visible_cells.div_ceil(65_535));
-            pass.set_pipeline(&self.shared.cull_atoms[d.big_spheres as usize]);
-            pass.dispatch_workgroups(x, y, 1);
-            pass.set_pipeline(&self.shared.splat_ids);
-            pass.dispatch_workgroups(x, y, 1);
+            let p = &self.shared;
+            let big = d.big_spheres as usize;
+            let per_cell = dispatch(d.visible_cells).0;
+            let run = |pass: &mut wgpu::ComputePass<'_>, pipeline, [x, y]: [u32; 2]| {
+                pass.set_pipeline(pipeline);
+                pass.dispatch_workgroups(x, y, 1);
+            };
+            let [w, h] = self.splat.as_ref().map_or([1, 1], |(_, s)| *s);
+            let tiles = [w.div_ceil(DEPTH_TILE), h.div_ceil(DEPTH_TILE)];
+            let blocks = tiles.map(|v| v.div_ceil(DEPTH_BLOCK));
+            let coarse = |pass: &mut wgpu::ComputePass<'_>| {
+                run(pass, &p.depth_tiles, dispatch(tiles[0] * tiles[1]).0);
+                run(pass, &p.depth_blocks, dispatch(blocks[0] * blocks[1]).0);
+            };
+            pass.set_bind_group(2, &d.args_group, &[]);
+            run(&mut pass, &p.split, per_cell);
+            pass.set_pipeline(&p.atoms_first[big]);
+            pass.dispatch_workgroups_indirect(&d.args, 0);
+            coarse(&mut pass);
+            run(&mut pass, &p.cull_left, per_cell);
+            pass.set_pipeline(&p.atoms_rest[big]);
+            pass.dispatch_workgroups_indirect(&d.args, 16);
+            coarse(&mut pass);
+            run(&mut pass, &p.cull_shown, per_cell);
+            if let Some(ids) = &p.splat_ids {
+                pass.set_pipeline(ids);
+                pass.dispatch_workgroups_indirect(&d.args, 32);
+            }
         }
         if d.bond_count > 0 && style_flags(self.style).1 & STYLE_CYLINDERS != 0 {
             let ([x, y], _) = dispatch(d.bond_count);

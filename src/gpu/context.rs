@@ -61,9 +61,16 @@ pub struct GpuContext {
     pub volume_format: wgpu::TextureFormat,
 }
 
+/// 64-bit integers with every storage atomic: the compute rasteriser keeps depth and id in one
+/// word where a device has them.
+pub const INT64_ATOMICS: wgpu::Features =
+    wgpu::Features::SHADER_INT64.union(wgpu::Features::SHADER_INT64_ATOMIC_ALL_OPS);
+
 /// Features the renderer uses when the adapter has them.
 pub fn wanted_features(adapter: &wgpu::Adapter) -> wgpu::Features {
-    adapter.features() & wgpu::Features::FLOAT32_FILTERABLE
+    let features = adapter.features();
+    let int64 = if features.contains(INT64_ATOMICS) { INT64_ATOMICS } else { wgpu::Features::empty() };
+    (features & wgpu::Features::FLOAT32_FILTERABLE) | int64
 }
 
 /// Device descriptor with the features the renderer uses and the adapter's own limits

@@ -85,6 +85,22 @@ pub struct LodStats {
 /// The octree's leaves: about an atom's size (3 Å), in bohr.
 const LEAF_SIZE: f32 = 5.7;
 
+/// The LOD threshold (pixels) of a surface drawn with a level of detail: opaque ones that ask.
+fn lod_threshold(look: &SurfaceLook) -> Option<f32> {
+    look.lod_px.filter(|_| look.optics.is_none())
+}
+
+/// The octree each mesh is drawn with (`None` where it has no level of detail): plain CPU
+/// work, for a background job.
+pub fn lod_trees(meshes: &[(Mesh, SurfaceLook)]) -> Vec<Option<SurfaceOctree>> {
+    meshes
+        .iter()
+        .map(|(mesh, look)| {
+            lod_threshold(look).filter(|_| !mesh.is_empty()).map(|_| SurfaceOctree::build(mesh, LEAF_SIZE))
+        })
+        .collect()
+}
+
 pub struct IsosurfacePass {
     pipeline: wgpu::RenderPipeline,
     closed: wgpu::RenderPipeline,
@@ -241,12 +257,25 @@ impl IsosurfacePass {
     /// `PickId::Surface { object, index: n }`, the object given each frame (translucent ones
     /// are not picked: what lies behind them is).
     pub fn set_meshes(&mut self, ctx: &GpuContext, meshes: &[(Mesh, SurfaceLook)]) {
+        self.set_meshes_with_trees(ctx, meshes, lod_trees(meshes));
+    }
+
+    /// [`Self::set_meshes`] with the octrees [`lod_trees`] built (off the UI thread: a
+    /// million triangles take a sixth of a second).
+    pub fn set_meshes_with_trees(
+        &mut self,
+        ctx: &GpuContext,
+        meshes: &[(Mesh, SurfaceLook)],
+        trees: Vec<Option<SurfaceOctree>>,
+    ) {
         let device = &ctx.device;
+        let mut trees = trees.into_iter();
         self.surfaces = meshes
             .iter()
+            .map(|m| (m, trees.next().flatten()))
             .enumerate()
-            .filter(|(_, (mesh, _))| !mesh.is_empty())
-            .map(|(n, (mesh, look))| {
+            .filter(|(_, ((mesh, _), _))| !mesh.is_empty())
+            .map(|(n, ((mesh, look), tree))| {
                 let vertices: Vec<SurfaceVertex> = (mesh.positions.iter().zip(&mesh.normals).enumerate())
                     .map(|(i, (p, n))| SurfaceVertex {
                         position: p.to_array(),
@@ -260,8 +289,7 @@ impl IsosurfacePass {
                     usage: wgpu::BufferUsages::VERTEX,
                 });
                 // Drawn with a level of detail: the octree's order of the triangles.
-                let tree =
-                    look.lod_px.filter(|_| look.optics.is_none()).map(|px| (SurfaceOctree::build(mesh, LEAF_SIZE), px));
+                let tree = tree.zip(lod_threshold(look));
                 let indices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                     label: Some("isosurface indices"),
                     contents: bytemuck::cast_slice(tree.as_ref().map_or(&mesh.indices, |(t, _)| &t.indices)),

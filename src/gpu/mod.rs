@@ -40,6 +40,8 @@ pub const SHADERS: &[(&str, &str)] = &[
     ("atoms_common.wgsl", include_str!("../../shaders/atoms_common.wgsl")),
     ("atoms.wgsl", include_str!("../../shaders/atoms.wgsl")),
     ("atoms_cull.wgsl", include_str!("../../shaders/atoms_cull.wgsl")),
+    ("atoms_splat_pair.wgsl", include_str!("../../shaders/atoms_splat_pair.wgsl")),
+    ("atoms_splat_packed.wgsl", include_str!("../../shaders/atoms_splat_packed.wgsl")),
     ("fullscreen.wgsl", include_str!("../../shaders/fullscreen.wgsl")),
     ("oit_common.wgsl", include_str!("../../shaders/oit_common.wgsl")),
     ("oit_sort.wgsl", include_str!("../../shaders/oit_sort.wgsl")),
@@ -69,7 +71,8 @@ pub const SHADER_MODULES: &[(&str, &[&str])] = &[
     ("volume_morph.wgsl", &["volume_common.wgsl", "volume_gradient.wgsl", "volume_morph.wgsl"]),
     ("gto_fill.wgsl", &["gto_common.wgsl", "gto_fill.wgsl"]),
     ("atoms.wgsl", &["atoms_common.wgsl", "atoms.wgsl"]),
-    ("atoms_cull.wgsl", &["atoms_common.wgsl", "atoms_cull.wgsl"]),
+    ("atoms_splat_pair.wgsl", &["atoms_common.wgsl", "atoms_cull.wgsl", "atoms_splat_pair.wgsl"]),
+    ("atoms_splat_packed.wgsl", &["atoms_common.wgsl", "atoms_cull.wgsl", "atoms_splat_packed.wgsl"]),
     ("isosurface.wgsl", &["oit_common.wgsl", "isosurface.wgsl"]),
     ("resolve.wgsl", &["fullscreen.wgsl", "oit_common.wgsl", "oit_sort.wgsl", "resolve.wgsl"]),
 ];

@@ -371,6 +371,7 @@ pub fn coarser_note(what: &str, dims: [usize; 3], step: usize) -> String {
 /// leaves out hidden.
 pub fn show_atoms(ctx: &GpuContext, layer: &mut Layer, doc: &Document, settings: &RenderSettings, selection: &str) {
     layer.set_atoms(ctx, &doc.molecule, settings.atoms, Some(&atom_look(doc, settings, selection)));
+    layer.atoms.depth_cue = settings.depth_cue;
 }
 
 /// The colours of `doc`'s atoms, and which are shown: all when `selection` does not parse (the

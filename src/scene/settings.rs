@@ -246,17 +246,23 @@ pub struct RenderSettings {
     pub iso: IsosurfaceSettings,
     /// Linear RGB background.
     pub background: [f32; 3],
+    /// How much the farthest atoms darken (0: off; big structures open at
+    /// [`BIG_STRUCTURE_DEPTH_CUE`]).
+    pub depth_cue: f32,
 }
 
 /// Above this many atoms a file opens space filling (ball and stick is sub-pixel noise at that
-/// scale) and, when it has several chains, coloured by chain.
+/// scale), depth cued and, when it has several chains, coloured by chain.
 pub const BIG_STRUCTURE_ATOMS: usize = 20_000;
+/// The depth cue a big structure opens with: front reads from back without hiding the back.
+pub const BIG_STRUCTURE_DEPTH_CUE: f32 = 0.6;
 
 impl RenderSettings {
     /// These settings as a file of `atoms` atoms in `chains` chains first opens with them.
     pub fn for_structure(mut self, atoms: usize, chains: usize) -> Self {
         if atoms > BIG_STRUCTURE_ATOMS && self.atoms == AtomStyle::BallAndStick {
             self.atoms = AtomStyle::SpaceFilling;
+            self.depth_cue = self.depth_cue.max(BIG_STRUCTURE_DEPTH_CUE);
             if chains > 1 && self.atom_colors == AtomColoring::Element {
                 self.atom_colors = AtomColoring::Chain;
             }
@@ -273,6 +279,7 @@ impl Default for RenderSettings {
             atom_colors: AtomColoring::default(),
             iso: IsosurfaceSettings::default(),
             background: [0.02, 0.02, 0.03],
+            depth_cue: 0.0,
         }
     }
 }
