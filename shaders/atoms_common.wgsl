@@ -21,7 +21,7 @@ struct Globals {
     ray_fy: vec4<f32>,
     // x: atoms; y: bonds; z: style flags (STYLE_*); w: invocations per dispatch row
     counts: vec4<u32>,
-    // x: stick radius (bohr)
+    // x: stick radius; y: the largest atom radius drawn (bohr)
     sticks: vec4<f32>,
     // x: cells to rasterise this frame (nearest first); y: where their order starts in the
     // lists; z: where the atom indices start in cell_data; w: this frame's number

@@ -99,10 +99,11 @@ fn key_at(i: u32, x: i32, y: i32) -> u32 {
     return 0xffffffffu - bitcast<u32>(depth);
 }
 
+// The largest screen rectangle (pixels) of a cell tested pixel by pixel.
+const MAX_EXACT_CELL_PIXELS: i32 = 1024;
+
 // Cell header words in cell_data: first atom, atom count, centre x, y, z, radius (f32 bits).
 const CELL_WORDS: u32 = 6u;
-// Largest atom radius any style draws (bohr): pads a cell's bounds.
-const MAX_ATOM_RADIUS: f32 = 5.0;
 
 fn tiles() -> vec2<i32> {
     return (vec2<i32>(g.viewport.xy) + TILE - 1) / TILE;
@@ -152,13 +153,15 @@ fn coarse_hidden(f: vec4<i32>, key: u32) -> bool {
 }
 
 // Whether any of a cell's atoms may show: its bounding sphere's screen rectangle is not hidden
-// by the coarse depths at the sphere's nearest depth.
+// by the coarse depths at the sphere's nearest depth. The sphere holds the atom centres; it is
+// padded by the largest atom drawn, or the half pixel a far atom still covers.
 fn cell_may_show(cell: u32) -> bool {
     let base = CELL_WORDS * cell;
     let centre = vec3<f32>(bitcast<f32>(cell_data[base + 2u]), bitcast<f32>(cell_data[base + 3u]),
         bitcast<f32>(cell_data[base + 4u]));
-    let radius = bitcast<f32>(cell_data[base + 5u]) + MAX_ATOM_RADIUS;
     let c = g.clip_from_world * vec4<f32>(centre, 1.0);
+    let inner = bitcast<f32>(cell_data[base + 5u]);
+    let radius = inner + max(g.sticks.y, 0.5 * (c.w + inner) / g.viewport.z);
     if (c.w <= radius) {
         return true;
     }
@@ -169,7 +172,16 @@ fn cell_may_show(cell: u32) -> bool {
     if (any(hi < lo)) {
         return false;
     }
-    return !coarse_hidden(vec4<i32>(lo, hi), nearest_key(centre, radius));
+    let rect = vec4<i32>(lo, hi);
+    let key = nearest_key(centre, radius);
+    if (coarse_hidden(rect, key)) {
+        return false;
+    }
+    // A tile with a gap in it (the background between molecules) hides nothing behind it; a
+    // rectangle small enough is then tested pixel by pixel (the test stops at the first pixel
+    // not nearer).
+    let size = hi - lo + 1;
+    return size.x * size.y > MAX_EXACT_CELL_PIXELS || !hidden(rect, key, false);
 }
 
 // The invocation's index in a one-dimensional dispatch laid out in rows.

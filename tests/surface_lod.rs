@@ -21,7 +21,9 @@ fn fragment() -> (orbcloud::model::Document, Mesh) {
     let settings =
         SurfaceSettings { choice: SurfaceChoice::SolventExcluded, resolution: Some(0.35), ..Default::default() };
     let (mesh, note) =
-        molecular_surface(&doc, &settings, "not resn HOH", u64::MAX, &AtomicBool::new(false)).unwrap().unwrap();
+        molecular_surface(&doc, &settings, "not resn HOH", u64::MAX, (&AtomicBool::new(false), &Default::default()))
+            .unwrap()
+            .unwrap();
     assert!(note.is_none(), "{note:?}");
     (doc, mesh)
 }

@@ -798,8 +798,9 @@ impl OrbApp {
         }
     }
 
-    /// What the scene's background jobs are doing, in words (`None`: nothing).
-    pub fn busy(&self) -> Option<&'static str> {
+    /// What the scene's background jobs are doing, in words, and how far when that is known
+    /// (`None`: nothing).
+    pub fn busy(&self) -> Option<(&'static str, Option<f32>)> {
         self.viewport.as_ref()?.busy()
     }
 

@@ -96,8 +96,15 @@ fn status_line(ui: &mut egui::Ui, app: &OrbApp, cancel: &mut bool, dismiss: &mut
                 ui.label(job.0.path.display().to_string());
                 ui.separator();
             }
-            if let Some(what) = app.busy() {
-                ui.spinner();
+            if let Some((what, done)) = app.busy() {
+                match done {
+                    Some(f) => {
+                        ui.add(egui::ProgressBar::new(f).desired_width(160.0).text(format!("{:.0}%", 100.0 * f)));
+                    }
+                    None => {
+                        ui.spinner();
+                    }
+                }
                 ui.label(what);
                 if ui.button("Cancel").on_hover_text("stop it; what is shown stays").clicked() {
                     *cancel = true;

@@ -18,7 +18,7 @@ use crate::model::octree::SurfaceOctree;
 use crate::model::{Document, VolumeGrid};
 use crate::scene::translucency::SurfaceLook;
 use crate::scene::{IsosurfaceSettings, ObjectState, RenderSettings, SurfaceChoice, SurfaceSettings, VolumeSettings};
-use std::sync::atomic::AtomicBool;
+use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
@@ -91,6 +91,8 @@ struct ObjectJobs {
     /// The last molecular surface built, kept while only its look changes (an isosurface
     /// slider moving does not build it again).
     surface: Arc<Mutex<Option<BuiltSurface>>>,
+    /// Thousandths of the molecular surface being built (the status line's bar); 0 when none is.
+    surface_progress: Arc<AtomicU32>,
 }
 
 /// A molecular surface with what it was built from: its settings and the atoms' fingerprint.
@@ -251,6 +253,7 @@ impl Viewport {
     pub fn update_isosurfaces(&mut self, n: usize, doc: &Arc<Document>, state: &ObjectState) {
         let computed = self.slot(n).computed.clone();
         let cache = self.slot(n).surface.clone();
+        let progress = self.slot(n).surface_progress.clone();
         let (doc, volume) = (doc.clone(), state.volume);
         let levels: Vec<IsosurfaceSettings> = state.all_isosurfaces().copied().collect();
         let (surface, selection) = (state.surface, state.selection.clone());
@@ -259,7 +262,8 @@ impl Viewport {
             let grid = computed.as_deref().or(doc.volumes.get(volume));
             let (mut meshes, note) = grid.map(|g| isosurfaces_within(g, &levels, max_bytes)).unwrap_or_default();
             let shown = (&*doc, &surface, selection.as_str(), grid);
-            let (built, surface_note) = molecular_surface_cached(&cache, shown, max_bytes, cancel);
+            let (built, surface_note) = molecular_surface_cached(&cache, shown, max_bytes, (cancel, &progress));
+            progress.store(0, Ordering::Relaxed);
             meshes.extend(built);
             prepared((meshes, note.into_iter().chain(surface_note).reduce(|a, b| format!("{a}; {b}"))))
         });
@@ -325,12 +329,16 @@ impl Viewport {
         (said, evaluated)
     }
 
-    /// What runs in the background for the scene, in words (`None`: nothing).
-    pub fn busy(&self) -> Option<&'static str> {
+    /// What runs in the background for the scene, in words, and how far it is when that is
+    /// known (`None`: nothing runs).
+    pub fn busy(&self) -> Option<(&'static str, Option<f32>)> {
+        let surface = self.slots.iter().map(|s| s.surface_progress.load(Ordering::Relaxed)).max().unwrap_or(0);
         if self.slots.iter().any(|s| s.evaluation.is_busy()) {
-            Some("evaluating on the grid…")
+            Some(("evaluating on the grid…", None))
+        } else if surface > 0 {
+            Some(("building the molecular surface…", Some(surface as f32 / 1000.0)))
         } else if self.slots.iter().any(|s| s.extraction.is_busy()) {
-            Some("cutting surfaces…")
+            Some(("cutting surfaces…", None))
         } else {
             None
         }
@@ -364,6 +372,7 @@ impl Viewport {
                 evaluation: Latest::new("evaluating the orbital", move || repaint()),
                 extraction: Latest::new("cutting isosurfaces", move || again()),
                 surface: Arc::default(),
+                surface_progress: Arc::default(),
             });
         }
         &mut self.slots[n]
@@ -765,7 +774,7 @@ fn molecular_surface_cached(
     cache: &Mutex<Option<BuiltSurface>>,
     (doc, settings, selection, grid): (&Document, &SurfaceSettings, &str, Option<&VolumeGrid>),
     max_bytes: u64,
-    cancel: &AtomicBool,
+    (cancel, progress): (&AtomicBool, &AtomicU32),
 ) -> (Option<(Mesh, SurfaceLook)>, Option<String>) {
     if settings.choice == SurfaceChoice::Off {
         return (None, None);
@@ -774,7 +783,7 @@ fn molecular_surface_cached(
     let mut cache = cache.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
     let fresh = cache.as_ref().is_some_and(|b| b.atoms == atoms && b.settings.same_geometry(settings));
     if !fresh {
-        match molecular_surface(doc, settings, selection, max_bytes, cancel) {
+        match molecular_surface(doc, settings, selection, max_bytes, (cancel, progress)) {
             Ok(Some((mesh, note))) => *cache = Some(BuiltSurface { settings: *settings, atoms, mesh, note }),
             Ok(None) => return (None, None),
             Err(e) => return (None, Some(format!("molecular surface: {e}"))),

@@ -105,7 +105,7 @@ impl MolSurfaceArgs {
     ) -> Result<Option<(Mesh, SurfaceLook)>> {
         let settings = self.settings(translucent);
         let t = Instant::now();
-        let built = molecular_surface(doc, &settings, "", u64::MAX, &AtomicBool::new(false))
+        let built = molecular_surface(doc, &settings, "", u64::MAX, (&AtomicBool::new(false), &Default::default()))
             .with_context(|| format!("{}: the molecular surface", doc.source))?;
         let Some((mut mesh, _)) = built else { return Ok(None) };
         if settings.color_by_volume && grid.is_none() {

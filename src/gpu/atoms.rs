@@ -33,7 +33,7 @@ pub struct AtomGlobals {
     pub ray_fy: [f32; 4],
     /// Atoms, bonds, style flags, invocations per dispatch row.
     pub counts: [u32; 4],
-    /// x: stick radius (bohr).
+    /// x: stick radius; y: the largest atom radius drawn (bohr).
     pub sticks: [f32; 4],
     /// Cells to rasterise this frame, where their order starts in the lists, where the atom
     /// indices start in the cell data, this frame's number.
@@ -88,9 +88,9 @@ const MAX_ATOM_RADIUS: f32 = 5.0;
 const CELL_WORDS: usize = 6;
 
 /// Atoms binned into cubic cells: the GPU's `cell_data` ([`CELL_WORDS`] per cell: first,
-/// count and the bounding sphere's centre and radius as f32 bits; then the atom indices cell
-/// by cell) and each cell's bounding sphere (centre, radius) for the CPU,
-/// which culls and orders cells every frame.
+/// count and the sphere around its atom centres, centre and radius as f32 bits; then the atom
+/// indices cell by cell) and each cell's sphere (centre, radius) for the CPU, which culls and
+/// orders cells every frame. The atoms' own radius pads these spheres as the style asks.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Cells {
     pub data: Vec<u32>,
@@ -134,13 +134,16 @@ impl Cells {
         }
         let mut data = Vec::new();
         let mut spheres = Vec::new();
-        let radius = 0.5 * 3f32.sqrt() * edge;
         for c in 0..total {
             let count = start[c + 1] - start[c];
             if count > 0 {
-                let (x, y, z) = (c as u32 % d.x, c as u32 / d.x % d.y, c as u32 / (d.x * d.y));
-                let centre = lo + (Vec3::new(x as f32, y as f32, z as f32) + 0.5) * edge;
-                let sphere = centre.extend(radius).to_array();
+                // The sphere around the box of the cell's atom centres: tighter than the cell's
+                // for a cell the molecule's edge cuts.
+                let members = &atoms[start[c] as usize..start[c + 1] as usize];
+                let first = p(members[0] as usize);
+                let (a, b) =
+                    members.iter().fold((first, first), |(a, b), &i| (a.min(p(i as usize)), b.max(p(i as usize))));
+                let sphere = (0.5 * (a + b)).extend(0.5 * (b - a).length()).to_array();
                 data.extend([start[c], count]);
                 data.extend(sphere.map(f32::to_bits));
                 spheres.push(sphere);
@@ -311,6 +314,8 @@ struct Uploaded {
     attr_words: Vec<u32>,
     /// The atoms' box (bohr).
     bounds: [Vec3; 2],
+    /// The atomic numbers present: the largest radius drawn pads the cells' spheres.
+    elements: Vec<u32>,
     group: wgpu::BindGroup,
 }
 
@@ -585,6 +590,12 @@ impl AtomsPass {
             big_spheres: true,
             atoms: data.positions.len() as u32,
             bond_count: data.bonds.len() as u32,
+            elements: {
+                let mut z: Vec<u32> = molecule.atoms.iter().map(|a| a.z).collect();
+                z.sort_unstable();
+                z.dedup();
+                z
+            },
             bounds: molecule.bounds().map_or([Vec3::ZERO; 2], |(lo, hi)| [lo.as_vec3(), hi.as_vec3()]),
             attr_words: data.attrs,
             group,
@@ -705,6 +716,8 @@ impl AtomsPass {
         let cell_lists = [1, 2, 3, 4].map(|k| order_at + k * total_cells);
         self.frame += 1;
         let (stick, style) = style_flags(self.style);
+        let largest =
+            self.data.as_ref().map_or(0.0, |d| d.elements.iter().map(|&z| radius(self.style, z)).fold(0.0, f32::max));
         let size = size.map(|v| v.max(1));
         let pixels_per_bohr = clip.row(1).truncate().length() * 0.5 * size[1] as f32;
         let g = AtomGlobals {
@@ -718,7 +731,7 @@ impl AtomsPass {
             ray_fx: (far(1.0, 0.0) - f0).extend(0.0).to_array(),
             ray_fy: (far(0.0, 1.0) - f0).extend(0.0).to_array(),
             counts: [atoms, bonds, style, dispatch(bonds).1],
-            sticks: [stick, 0.0, 0.0, 0.0],
+            sticks: [stick, largest, 0.0, 0.0],
             cells: [order.len() as u32, order_at, cells_at, self.frame],
             cell_lists,
             cue: self.cue(clip),
@@ -735,7 +748,6 @@ impl AtomsPass {
         }
         d.visible_cells = order.len() as u32;
         // The nearest cell bounds how big any sphere projects.
-        let largest = (0..PALETTE_AT as u32).map(|z| radius(self.style, z)).fold(0.0, f32::max);
         d.big_spheres = order.first().is_none_or(|&c| {
             let s = d.cells.spheres[c as usize];
             let w = (clip * Vec4::new(s[0], s[1], s[2], 1.0)).w - s[3] - largest;

@@ -3,7 +3,7 @@
 
 pub mod scan;
 
-use std::sync::atomic::AtomicBool;
+use std::sync::atomic::{AtomicBool, AtomicU32};
 
 use glam::DVec3;
 
@@ -262,20 +262,20 @@ fn mesh_fits(m: &Mesh, max_bytes: u64) -> bool {
 /// `doc`'s molecular surface as `s` asks (`None` when it is off), built around the atoms
 /// `selection` shows (all when it is empty or does not parse); built again at twice the
 /// spacing, with a note saying so, while its mesh would not fit a GPU buffer of `max_bytes`.
-/// `cancel` stops it between grid planes.
+/// `cancel` stops it between grid planes; `progress` gets the thousandths built.
 pub fn molecular_surface(
     doc: &Document,
     s: &SurfaceSettings,
     selection: &str,
     max_bytes: u64,
-    cancel: &AtomicBool,
+    (cancel, progress): (&AtomicBool, &AtomicU32),
 ) -> Result<Option<(Mesh, Option<String>)>, SurfaceError> {
     let mask = shown_atoms(doc, selection);
     let spheres = Sphere::of_molecule(&doc.molecule, mask.as_deref());
     let Some(mut params) = s.params(&spheres) else { return Ok(None) };
     let asked = params.resolution;
     loop {
-        let built = surface::build(&spheres, &params, cancel)?;
+        let built = surface::build_reporting(&spheres, &params, cancel, progress)?;
         if mesh_fits(&built.mesh, max_bytes) || params.resolution >= 16.0 * asked {
             let note = (params.resolution > asked).then(|| {
                 format!(

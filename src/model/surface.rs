@@ -15,7 +15,7 @@
 //! Both are built in parallel over planes of the grid (rayon) and can be cancelled between
 //! planes. Positions and radii are bohr.
 
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 
 use glam::DVec3;
 use rayon::prelude::*;
@@ -147,15 +147,30 @@ pub struct Surface {
     pub phases: Vec<(&'static str, f64)>,
 }
 
-/// Seconds per phase, as the build goes.
-struct Phases {
+/// Seconds per phase, as the build goes; each phase's end also moves the build's progress on.
+struct Phases<'a> {
     list: Vec<(&'static str, f64)>,
     last: std::time::Instant,
+    progress: &'a AtomicU32,
 }
 
-impl Phases {
-    fn new() -> Self {
-        Self { list: Vec::new(), last: std::time::Instant::now() }
+/// Thousandths of a build done when each phase ends: their shares of the time measured for
+/// 10⁵ atoms (SES at 0.92 Å: 221, 236, 65, 554 and 100 ms; a Gaussian surface spends about
+/// three quarters on its Gaussians).
+const PROGRESS_AT: [(&str, u32); 6] = [
+    ("accessible spheres", 190),
+    ("distance transform", 390),
+    ("estimate", 440),
+    ("exact distances", 915),
+    ("gaussians", 750),
+    ("marching cubes", 1000),
+];
+
+impl<'a> Phases<'a> {
+    fn new(progress: &'a AtomicU32) -> Self {
+        // Started: at least one thousandth, so a reader tells it from "not building".
+        progress.store(1, Ordering::Relaxed);
+        Self { list: Vec::new(), last: std::time::Instant::now(), progress }
     }
 
     /// Ends the phase called `name`.
@@ -163,11 +178,25 @@ impl Phases {
         let now = std::time::Instant::now();
         self.list.push((name, (now - self.last).as_secs_f64()));
         self.last = now;
+        if let Some((_, at)) = PROGRESS_AT.iter().find(|(n, _)| *n == name) {
+            self.progress.store(*at, Ordering::Relaxed);
+        }
     }
 }
 
 /// Builds the surface of `spheres`. `cancel` is polled between planes.
 pub fn build(spheres: &[Sphere], params: &SurfaceParams, cancel: &AtomicBool) -> Result<Surface, SurfaceError> {
+    build_reporting(spheres, params, cancel, &AtomicU32::new(0))
+}
+
+/// [`build`], storing in `progress` the thousandths done as each phase ends (for a progress
+/// bar).
+pub fn build_reporting(
+    spheres: &[Sphere],
+    params: &SurfaceParams,
+    cancel: &AtomicBool,
+    progress: &AtomicU32,
+) -> Result<Surface, SurfaceError> {
     if spheres.is_empty() {
         return Err(SurfaceError::NoAtoms);
     }
@@ -204,7 +233,7 @@ pub fn build(spheres: &[Sphere], params: &SurfaceParams, cancel: &AtomicBool) ->
         });
     }
     let spec = GridSpec::spaced(lo, hi, h);
-    let mut phases = Phases::new();
+    let mut phases = Phases::new(progress);
     let (values, level) = match params.kind {
         SurfaceKind::Gaussian => {
             let values = gaussian_field(&spec, spheres, params.smoothness, cancel)?;
@@ -337,7 +366,7 @@ fn ses_field(
     spheres: &[Sphere],
     probe: f64,
     cancel: &AtomicBool,
-    phases: &mut Phases,
+    phases: &mut Phases<'_>,
 ) -> Result<Vec<f32>, SurfaceError> {
     let (o, h) = (spec.origin(), spec.step(0).x);
     let [nx, ny, nz] = spec.dims;
@@ -793,5 +822,25 @@ mod tests {
             build(&atom, &SurfaceParams::auto(SurfaceKind::Gaussian, &atom), &yes).unwrap_err(),
             SurfaceError::Cancelled
         );
+    }
+
+    #[test]
+    fn progress_runs_to_a_thousandth_per_thousandth_and_stops_short_when_cancelled() {
+        let atoms: Vec<Sphere> =
+            (0..6).map(|i| Sphere { centre: DVec3::new(2.5 * i as f64, 0.0, 0.0), radius: 3.2 }).collect();
+        for kind in [SurfaceKind::SolventExcluded, SurfaceKind::Gaussian] {
+            let progress = AtomicU32::new(0);
+            build_reporting(&atoms, &SurfaceParams::auto(kind, &atoms), &AtomicBool::new(false), &progress).unwrap();
+            assert_eq!(progress.load(Ordering::Relaxed), 1000, "{kind:?}");
+            let stopped = AtomicU32::new(0);
+            let err = build_reporting(&atoms, &SurfaceParams::auto(kind, &atoms), &AtomicBool::new(true), &stopped);
+            assert_eq!(err.unwrap_err(), SurfaceError::Cancelled);
+            assert!((1..1000).contains(&stopped.load(Ordering::Relaxed)), "{kind:?}");
+        }
+        // The shares rise phase by phase.
+        let ses = ["accessible spheres", "distance transform", "estimate", "exact distances", "marching cubes"];
+        let at = |n: &str| PROGRESS_AT.iter().find(|(p, _)| *p == n).unwrap().1;
+        assert!(ses.windows(2).all(|w| at(w[0]) < at(w[1])));
+        assert!(at("gaussians") < at("marching cubes"));
     }
 }
