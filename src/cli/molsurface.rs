@@ -210,6 +210,25 @@ pub fn bench(args: &SurfaceBench) -> Result<()> {
         let (full_ms, full, _) = draw(None)?;
         let lod_px = args.surface.lod_px;
         let (lod_ms, lod, stats) = draw(Some(lod_px))?;
+        // The CPU's share of a frame with the level of detail: walking the octree (what a
+        // GPU traversal would take over).
+        let tree = orbcloud::model::octree::SurfaceOctree::build(&s.mesh, orbcloud::gpu::isosurface::LEAF_SIZE);
+        let view = orbcloud::model::octree::LodView {
+            clip_from_object: renderer.clip_from_world(&camera, args.bench.size),
+            eye: camera.eye(),
+            height_px: args.bench.size[1] as f32,
+            threshold_px: lod_px,
+            back_faces: true,
+        };
+        let mut selection = Default::default();
+        let walks: Vec<f64> = (0..20)
+            .map(|_| {
+                let t = Instant::now();
+                tree.select(&view, &mut selection);
+                t.elapsed().as_secs_f64() * 1e3
+            })
+            .collect();
+        let walk_ms = walks.iter().copied().fold(f64::INFINITY, f64::min);
         let (mean, covered) = super::surface_cli::image_error(&full, &lod, &settings.background);
         if let Some(dir) = &args.images {
             std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
@@ -225,7 +244,7 @@ pub fn bench(args: &SurfaceBench) -> Result<()> {
             "surface={:?} resolution_angstrom={:.2} grid={:?} triangles={triangles} area_angstrom2={:.1} volume_angstrom3={:.1} \
              build_ms_median={:.1} build_ms_min={:.1} ({}x{}) frame_ms_all_triangles={full_ms:.1} \
              frame_ms_lod={lod_ms:.1} lod_px={lod_px} lod_triangles={} lod_points={} speedup={:.2} \
-             lod_error_mean={mean:.2}/255 lod_error_covered={covered:.2}/255",
+             lod_error_mean={mean:.2}/255 lod_error_covered={covered:.2}/255 lod_walk_ms={walk_ms:.2}",
             params.kind,
             params.resolution / BOHR_PER_ANGSTROM,
             s.grid.dims,

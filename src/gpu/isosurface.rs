@@ -83,7 +83,7 @@ pub struct LodStats {
 }
 
 /// The octree's leaves: about an atom's size (3 Å), in bohr.
-const LEAF_SIZE: f32 = 5.7;
+pub const LEAF_SIZE: f32 = 5.7;
 
 /// The LOD threshold (pixels) of a surface drawn with a level of detail: opaque ones that ask.
 fn lod_threshold(look: &SurfaceLook) -> Option<f32> {

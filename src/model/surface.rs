@@ -384,9 +384,10 @@ fn ses_field(
             let sas = s.radius + probe;
             for_each_in_disc(s, sas + margin, x, (o, h, ny, nz), |j, k, d2| {
                 let p = j * nz + k;
-                let depth = (d2.sqrt() - sas) as f32;
-                if depth < out[p] {
-                    out[p] = depth;
+                // depth < out[p] ⇔ d² < (sas + out[p])²: most points fail without a root.
+                let beat = sas + out[p] as f64;
+                if beat > 0.0 && d2 < beat * beat {
+                    out[p] = (d2.sqrt() - sas) as f32;
                     near[p] = index;
                 }
             });
@@ -581,18 +582,20 @@ impl<'a> NearSurface<'a> {
         this
     }
 
+    /// Within reach of the outside point and on or outside every blocker (squared distances:
+    /// this runs for every candidate of every point refined).
     fn exposed(&self, c: DVec3) -> bool {
-        (c - self.near.0).length() <= self.near.1
-            && self.blockers.iter().all(|s| (c - s.centre).length() >= s.radius * (1.0 - 1e-9))
+        (c - self.near.0).length_squared() <= self.near.1 * self.near.1
+            && self.blockers.iter().all(|s| (c - s.centre).length_squared() >= (s.radius * (1.0 - 1e-9)).powi(2))
     }
 
     /// The distance from `x` to the nearest candidate; infinite when none qualifies.
     fn distance(&self, x: DVec3) -> f64 {
-        let mut best = self.corners.iter().map(|&c| (x - c).length()).fold(f64::INFINITY, f64::min);
+        let mut best = self.corners.iter().map(|&c| (x - c).length_squared()).fold(f64::INFINITY, f64::min);
         let mut consider = |c: DVec3| {
-            let d = (x - c).length();
-            if d < best && self.exposed(c) {
-                best = d;
+            let d2 = (x - c).length_squared();
+            if d2 < best && self.exposed(c) {
+                best = d2;
             }
         };
         for s in self.set {
@@ -606,7 +609,7 @@ impl<'a> NearSurface<'a> {
             let radial = if v.length() > 1e-12 { v.normalize() } else { n.any_orthonormal_vector() };
             consider(m + radial * r);
         }
-        best
+        best.sqrt()
     }
 }
 
