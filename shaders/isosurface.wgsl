@@ -70,8 +70,9 @@ fn lit(world: vec3<f32>, normal: vec3<f32>, tint: vec3<f32>) -> vec3<f32> {
 }
 
 // Seed 002's points: a cell of the surface too small on screen to be worth its triangles,
-// drawn as a disc facing the eye at the cell's centre, big enough to cover the cell (so no
-// holes open between cells), lit with the cell's mean normal.
+// drawn as a disc facing the eye at the cell's centre, big enough that neighbouring discs
+// overlap (no holes) and small enough not to spill far past the silhouette, lit with the
+// cell's mean normal (`lit_spread`).
 struct SplatOut {
     @builtin(position) clip: vec4<f32>,
     // −1..1 across the disc
@@ -107,9 +108,28 @@ fn fs_splat(in: SplatOut) -> FragOut {
         discard;
     }
     var out: FragOut;
-    out.color = vec4<f32>(lit(in.world, in.normal, in.tint), 1.0);
+    out.color = vec4<f32>(lit_spread(in.world, in.normal, in.tint), 1.0);
     out.id = u.pick.x;
     return out;
+}
+
+// `lit` for a cell whose unit normals spread around their mean `mean` (shorter than 1 the more
+// they spread): lit with the mean's direction, but its highlight covers only part of a spread
+// cell (the share of a cap of half-angle θ, cos θ = 2|mean| − 1, that a lobe of about 0.22 rad
+// covers). Diffuse light from the shortened mean measured darker than the triangles.
+fn lit_spread(world: vec3<f32>, mean: vec3<f32>, tint: vec3<f32>) -> vec3<f32> {
+    let flat = clamp(length(mean), 1e-4, 1.0);
+    let view = normalize(u.eye.xyz - world);
+    let n = mean / flat;
+    let l = u.light.xyz;
+    let diffuse = max(dot(n, l), 0.0);
+    let h = normalize(l + view);
+    let theta = acos(clamp(2.0 * flat - 1.0, -1.0, 1.0));
+    let share = min(1.0, pow(0.22 / max(theta, 1e-3), 2.0));
+    let specular = pow(max(dot(n, h), 0.0), 40.0) * share;
+    let rim = pow(1.0 - max(dot(n, view), 0.0), 3.0);
+    let base = u.color.rgb * tint;
+    return base * (0.25 + 0.75 * diffuse) + vec3<f32>(0.3 * specular + 0.06 * rim);
 }
 
 // Translucent surfaces: every fragment in front of the opaque scene is appended to its
