@@ -33,6 +33,13 @@ struct Globals {
     // Depth cue: x, y: the clip w where darkening starts and where it is full; z: how much the
     // farthest darkens (0: off)
     cue: vec4<f32>,
+    // Clip z and w of the eye (x, y) and of the view direction (z, w): a point r along the
+    // view direction from p has clip z, w = clip(p).zw − r·(z, w).
+    clip_zw: vec4<f32>,
+    // Clip z and w of the pixel rays' parts (ray_f0 − eye, ray_fx; then ray_fy): the ray
+    // through ndc reaches clip zw = clip_zw.xy + t·(ray_zw.xy + ndc.x·ray_zw.zw + ndc.y·ray_zw_y.xy).
+    ray_zw: vec4<f32>,
+    ray_zw_y: vec4<f32>,
 };
 
 // Words before the lists in `lists`: the spheres' and the bonds' indirect draws, then the cell

@@ -47,9 +47,14 @@ struct Screen {
     // x, y: pixel position of the centre; z: projected radius (px); w: 0 culled, 1 splat,
     // 2 quad, 3 quad through the eye's plane
     p: vec4<f32>,
+    // The centre (bohr) and the radius the rasteriser draws (never under half a pixel)
+    centre: vec3<f32>,
+    radius: f32,
+    // The centre's clip z and w
+    zw: vec2<f32>,
 };
 
-// Where atom i lands on screen, and how it is drawn.
+// Where atom i lands on screen, and how it is drawn: each atom's clip position once.
 fn screen_of(i: u32) -> Screen {
     var s: Screen;
     s.p = vec4<f32>(0.0);
@@ -57,7 +62,10 @@ fn screen_of(i: u32) -> Screen {
     if (r <= 0.0) {
         return s;
     }
-    let c = g.clip_from_world * vec4<f32>(positions[i].xyz, 1.0);
+    s.centre = positions[i].xyz;
+    let c = g.clip_from_world * vec4<f32>(s.centre, 1.0);
+    s.zw = c.zw;
+    s.radius = max(r, 0.5 * c.w / g.viewport.z);
     if (c.w <= r) {
         // At or behind the eye's plane: a quad (clipped by the rasteriser) if in front at all,
         // with no screen position to test or occlude with.
@@ -85,14 +93,19 @@ fn footprint(s: Screen) -> vec4<i32> {
     return vec4<i32>(lo, min(hi, lo + MAX_SIDE));
 }
 
-// The depth key of atom i at pixel (x, y): larger is nearer; 0 where the ray misses.
-fn key_at(i: u32, x: i32, y: i32) -> u32 {
-    let d = ray_through(vec2<f32>(f32(x) + 0.5, f32(y) + 0.5));
-    let t = hit_sphere(d, positions[i].xyz, splat_radius(i));
+// The depth key of a screen's sphere at pixel (x, y): larger is nearer; 0 where the ray
+// misses. The hit's clip z and w are linear in the ray parameter along the pixel's ray
+// (`clip_zw`, `ray_zw`: no matrix per pixel).
+fn key_at(s: Screen, x: i32, y: i32) -> u32 {
+    let px = vec2<f32>(f32(x) + 0.5, f32(y) + 0.5);
+    let ndc = vec2<f32>(2.0 * px.x / g.viewport.x - 1.0, 1.0 - 2.0 * px.y / g.viewport.y);
+    let d = g.ray_f0.xyz + ndc.x * g.ray_fx.xyz + ndc.y * g.ray_fy.xyz - g.eye.xyz;
+    let t = hit_sphere(d, s.centre, s.radius);
     if (t < 0.0) {
         return 0u;
     }
-    let depth = depth_of(g.eye.xyz + d * t);
+    let zw = g.clip_zw.xy + t * (g.ray_zw.xy + ndc.x * g.ray_zw.zw + ndc.y * g.ray_zw_y.xy);
+    let depth = zw.x / zw.y;
     if (depth < 0.0 || depth > 1.0) {
         return 0u;
     }
@@ -282,6 +295,12 @@ fn cs_depth_blocks(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_w
     coarse_store(blocks_at() + u32(k), far);
 }
 
+// The depth key of a screen's sphere's nearest depth (as nearest_key, from its clip z and w).
+fn front_key_of(s: Screen) -> u32 {
+    let zw = s.zw - s.radius * g.clip_zw.zw;
+    return 0xffffffffu - bitcast<u32>(clamp(zw.x / zw.y, 0.0, 1.0));
+}
+
 // The depth key of a sphere's nearest depth (its centre moved by its radius along the view
 // direction; depth grows with the distance along it): no pixel of it can be nearer.
 fn nearest_key(centre: vec3<f32>, radius: f32) -> u32 {
@@ -289,9 +308,6 @@ fn nearest_key(centre: vec3<f32>, radius: f32) -> u32 {
     return 0xffffffffu - bitcast<u32>(clamp(depth_of(front), 0.0, 1.0));
 }
 
-fn front_key(i: u32) -> u32 {
-    return nearest_key(positions[i].xyz, splat_radius(i));
-}
 
 // Whether every pixel of the footprint already holds something nearer than `key` (occluded:
 // nothing to draw): from the coarse depths when they are built (`coarse`), else pixel by
@@ -317,7 +333,7 @@ fn hidden(f: vec4<i32>, key: u32, coarse: bool) -> bool {
 fn big_sphere(i: u32, s: Screen, coarse: bool) {
     let e = max(s.p.z, 0.5) * 1.05 + 0.02;
     let whole = 2.0 * e + 1.0 <= f32(MAX_SIDE);
-    if (whole && s.p.w == 2.0 && hidden(footprint(s), front_key(i), coarse)) {
+    if (whole && s.p.w == 2.0 && hidden(footprint(s), front_key_of(s), coarse)) {
         return;
     }
     let k = atomicAdd(&lists[1], 1u);
@@ -326,7 +342,7 @@ fn big_sphere(i: u32, s: Screen, coarse: bool) {
     if (h < 1.0 || h > f32(MAX_OCCLUDER) || s.p.w != 2.0) {
         return;
     }
-    let key = 0xffffffffu - bitcast<u32>(clamp(depth_of(positions[i].xyz), 0.0, 1.0));
+    let key = 0xffffffffu - bitcast<u32>(clamp(s.zw.x / s.zw.y, 0.0, 1.0));
     let lo = max(vec2<i32>(ceil(s.p.xy - 0.5 - h)), vec2<i32>(0));
     let hi = min(vec2<i32>(floor(s.p.xy - 0.5 + h)), vec2<i32>(g.viewport.xy) - 1);
     let w = i32(g.viewport.x);
@@ -352,13 +368,13 @@ fn rasterise(i: u32, coarse: bool) {
         return;
     }
     let f = footprint(s);
-    if (hidden(f, front_key(i), coarse)) {
+    if (hidden(f, front_key_of(s), coarse)) {
         return;
     }
     let w = i32(g.viewport.x);
     for (var y = f.y; y <= f.w; y++) {
         for (var x = f.x; x <= f.z; x++) {
-            draw_depth(u32(y * w + x), key_at(i, x, y), i + 1u);
+            draw_depth(u32(y * w + x), key_at(s, x, y), i + 1u);
         }
     }
 }
@@ -369,13 +385,13 @@ fn write_id(i: u32) {
         return;
     }
     let f = footprint(s);
-    if (hidden(f, front_key(i), true)) {
+    if (hidden(f, front_key_of(s), true)) {
         return;
     }
     let w = i32(g.viewport.x);
     for (var y = f.y; y <= f.w; y++) {
         for (var x = f.x; x <= f.z; x++) {
-            draw_id(u32(y * w + x), key_at(i, x, y), i + 1u);
+            draw_id(u32(y * w + x), key_at(s, x, y), i + 1u);
         }
     }
 }

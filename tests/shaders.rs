@@ -121,7 +121,10 @@ fn rust_mirrors_match_the_wgsl_layouts() {
                 sticks,
                 cells,
                 cell_lists,
-                cue
+                cue,
+                clip_zw,
+                ray_zw,
+                ray_zw_y
             ]
         ),
         mirror!(

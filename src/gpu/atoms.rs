@@ -43,8 +43,13 @@ pub struct AtomGlobals {
     pub cell_lists: [u32; 4],
     /// Depth cueing: the nearest and farthest clip w of the molecule's box, and the strength.
     pub cue: [f32; 4],
+    /// Clip z and w of the eye and of the view direction (the shader's depth without a matrix).
+    pub clip_zw: [f32; 4],
+    /// Clip z and w of the pixel rays' parts: ray_f0 − eye and ray_fx, then ray_fy.
+    pub ray_zw: [f32; 4],
+    pub ray_zw_y: [f32; 4],
 }
-const _: () = assert!(std::mem::size_of::<AtomGlobals>() == 272);
+const _: () = assert!(std::mem::size_of::<AtomGlobals>() == 320);
 
 /// Ball radius as a fraction of the van der Waals radius in ball-and-stick.
 const BALL_FRACTION: f32 = 0.24;
@@ -704,6 +709,16 @@ impl AtomsPass {
             p.truncate() / p.w
         };
         let f0 = far(0.0, 0.0);
+        // Clip z and w of points and directions: the shader's per-pixel depth is linear in them.
+        let zw = |v: Vec4| {
+            let c = clip * v;
+            glam::Vec2::new(c.z, c.w)
+        };
+        let eye_zw = zw(view.eye.extend(1.0));
+        let view_zw = zw((f0 - view.eye).normalize_or_zero().extend(0.0));
+        let ray0 = zw((f0 - view.eye).extend(0.0));
+        let ray_x = zw((far(1.0, 0.0) - f0).extend(0.0));
+        let ray_y = zw((far(0.0, 1.0) - f0).extend(0.0));
         let (atoms, bonds) = self.data.as_ref().map_or((0, 0), |d| (d.atoms, d.bond_count));
         // Cells in view, nearest first: the compute passes walk them in this order.
         let order = match &self.data {
@@ -735,6 +750,9 @@ impl AtomsPass {
             cells: [order.len() as u32, order_at, cells_at, self.frame],
             cell_lists,
             cue: self.cue(clip),
+            clip_zw: [eye_zw.x, eye_zw.y, view_zw.x, view_zw.y],
+            ray_zw: [ray0.x, ray0.y, ray_x.x, ray_x.y],
+            ray_zw_y: [ray_y.x, ray_y.y, 0.0, 0.0],
         };
         ctx.queue.write_buffer(&self.globals, 0, bytemuck::bytes_of(&g));
         let Some(d) = &mut self.data else { return };
