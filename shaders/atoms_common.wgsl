@@ -10,7 +10,8 @@ struct Globals {
     // xyz: camera up vector
     up: vec4<f32>,
     // x: high bits of this object's atom pick ids; the atom index is added; y: 1 when the
-    // compute rasteriser's pixels are packed 64-bit words (atoms_splat_packed.wgsl)
+    // compute rasteriser's pixels are packed 64-bit words (atoms_splat_packed.wgsl); z: 1 to walk
+    // each cell's atoms backwards (they are sorted along the axis nearest the view direction)
     pick: vec4<u32>,
     // x, y: viewport size (px); z: pixels per bohr at unit clip w; w: largest radius (px)
     // the compute rasteriser draws (larger spheres are impostor quads)

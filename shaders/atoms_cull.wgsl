@@ -406,7 +406,7 @@ fn cell_pass(wid: vec3<u32>, lane: u32, count: u32, at: u32, which: u32, coarse:
         let first = cell_data[CELL_WORDS * cell];
         let atoms = cell_data[CELL_WORDS * cell + 1u];
         for (var k = lane; k < atoms; k += 64u) {
-            let i = cell_data[g.cells.z + first + k];
+            let i = cell_data[g.cells.z + first + select(k, atoms - 1u - k, g.pick.z != 0u)];
             if (which == 0u) {
                 rasterise(i, coarse);
             } else {

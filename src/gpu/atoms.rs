@@ -24,7 +24,8 @@ pub struct AtomGlobals {
     pub light: [f32; 4],
     pub up: [f32; 4],
     /// x: the high bits of this object's atom pick ids ([`PickId::atom_base`]); y: 1 when the
-    /// splat pixels are packed 64-bit words ([`SplatWords`]).
+    /// splat pixels are packed 64-bit words ([`SplatWords`]); z: 1 to walk each cell's atoms
+    /// backwards ([`Cells::walk`]).
     pub pick: [u32; 4],
     /// Viewport width and height (px), pixels per bohr at unit clip w, the splat threshold (px).
     pub viewport: [f32; 4],
@@ -94,12 +95,13 @@ const CELL_WORDS: usize = 6;
 
 /// Atoms binned into cubic cells: the GPU's `cell_data` ([`CELL_WORDS`] per cell: first,
 /// count and the sphere around its atom centres, centre and radius as f32 bits; then the atom
-/// indices cell by cell) and each cell's sphere (centre, radius) for the CPU, which culls and
-/// orders cells every frame. The atoms' own radius pads these spheres as the style asks.
+/// indices cell by cell, three times: each cell's sorted along x, y and z) and each cell's
+/// sphere (centre, radius) for the CPU, which culls and orders cells every frame. The atoms' own radius pads these spheres as the style asks.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Cells {
     pub data: Vec<u32>,
     pub spheres: Vec<[f32; 4]>,
+    atoms: usize,
 }
 
 impl Cells {
@@ -154,8 +156,32 @@ impl Cells {
                 spheres.push(sphere);
             }
         }
-        data.extend(atoms);
-        Self { data, spheres }
+        // Each cell's atoms sorted along x, along y and along z: a frame walks them in the order
+        // of the axis nearest its view direction, nearer atoms first, so the ones behind find
+        // their pixels already taken.
+        for axis in 0..3 {
+            let mut sorted = atoms.clone();
+            for c in 0..total {
+                let run = &mut sorted[start[c] as usize..start[c + 1] as usize];
+                run.sort_unstable_by(|&i, &j| p(i as usize)[axis].total_cmp(&p(j as usize)[axis]));
+            }
+            data.extend(sorted);
+        }
+        Self { data, spheres, atoms: n }
+    }
+
+    /// Where the atom indices sorted along the axis nearest `view_dir` start in `data`, and
+    /// whether to walk them backwards (nearest first either way).
+    pub fn walk(&self, view_dir: Vec3) -> (u32, bool) {
+        let a = view_dir.abs();
+        let axis = if a.x >= a.y && a.x >= a.z {
+            0
+        } else if a.y >= a.z {
+            1
+        } else {
+            2
+        };
+        ((CELL_WORDS * self.len() + axis * self.atoms) as u32, view_dir[axis] < 0.0)
     }
 
     pub fn len(&self) -> usize {
@@ -727,7 +753,7 @@ impl AtomsPass {
         };
         let order_at = LIST_HEADER as u32 + atoms + bonds;
         let total_cells = self.data.as_ref().map_or(0, |d| d.cells.len() as u32);
-        let cells_at = CELL_WORDS as u32 * total_cells;
+        let (cells_at, backwards) = self.data.as_ref().map_or((0, false), |d| d.cells.walk(view.view_dir));
         let cell_lists = [1, 2, 3, 4].map(|k| order_at + k * total_cells);
         self.frame += 1;
         let (stick, style) = style_flags(self.style);
@@ -740,7 +766,7 @@ impl AtomsPass {
             eye: view.eye.extend(1.0).to_array(),
             light: view.light.extend(0.0).to_array(),
             up: view.up.extend(0.0).to_array(),
-            pick: [PickId::atom_base(object), (self.shared.words == SplatWords::Packed) as u32, 0, 0],
+            pick: [PickId::atom_base(object), (self.shared.words == SplatWords::Packed) as u32, backwards as u32, 0],
             viewport: [size[0] as f32, size[1] as f32, pixels_per_bohr, self.splat_radius_px],
             ray_f0: f0.extend(0.0).to_array(),
             ray_fx: (far(1.0, 0.0) - f0).extend(0.0).to_array(),
@@ -924,17 +950,24 @@ mod tests {
         let positions: Vec<[f32; 4]> = m.atoms.iter().map(|a| a.position.as_vec3().extend(0.0).to_array()).collect();
         let cells = Cells::new(&positions);
         let k = cells.len();
-        let mut seen: Vec<u32> = cells.data[CELL_WORDS * k..].to_vec();
-        seen.sort_unstable();
-        assert_eq!(seen, (0..5_000).collect::<Vec<u32>>());
-        for c in 0..k {
-            let (first, count) = (cells.data[CELL_WORDS * c] as usize, cells.data[CELL_WORDS * c + 1] as usize);
-            let s = cells.spheres[c];
-            assert_eq!(f32::from_bits(cells.data[CELL_WORDS * c + 5]), s[3]);
-            let atoms = CELL_WORDS * k + first;
-            for &i in &cells.data[atoms..atoms + count] {
-                let p = Vec3::from_slice(&positions[i as usize][..3]);
-                assert!(p.distance(Vec3::new(s[0], s[1], s[2])) <= s[3] * 1.0001, "atom {i} outside its cell");
+        // Three orders of the same atoms, each along its axis within every cell.
+        for (axis, view) in [(0, Vec3::X), (1, Vec3::NEG_Y), (2, Vec3::Z)] {
+            let (at, backwards) = cells.walk(view);
+            assert_eq!((at as usize, backwards), (CELL_WORDS * k + axis * 5_000, view[axis] < 0.0));
+            let block = &cells.data[at as usize..at as usize + 5_000];
+            let mut seen = block.to_vec();
+            seen.sort_unstable();
+            assert_eq!(seen, (0..5_000).collect::<Vec<u32>>());
+            for c in 0..k {
+                let (first, count) = (cells.data[CELL_WORDS * c] as usize, cells.data[CELL_WORDS * c + 1] as usize);
+                let s = cells.spheres[c];
+                assert_eq!(f32::from_bits(cells.data[CELL_WORDS * c + 5]), s[3]);
+                let run = &block[first..first + count];
+                for &i in run {
+                    let p = Vec3::from_slice(&positions[i as usize][..3]);
+                    assert!(p.distance(Vec3::new(s[0], s[1], s[2])) <= s[3] * 1.0001, "atom {i} outside its cell");
+                }
+                assert!(run.windows(2).all(|w| positions[w[0] as usize][axis] <= positions[w[1] as usize][axis]));
             }
         }
         let eye = Vec3::new(0.0, 0.0, 200.0);
