@@ -70,9 +70,13 @@ fn lit(world: vec3<f32>, normal: vec3<f32>, tint: vec3<f32>) -> vec3<f32> {
 }
 
 // Seed 002's points: a cell of the surface too small on screen to be worth its triangles,
-// drawn as a disc facing the eye at the cell's centre, big enough that neighbouring discs
-// overlap (no holes) and small enough not to spill far past the silhouette, lit with the
-// cell's mean normal (`lit_spread`).
+// drawn as a disc at the cell's centre, lit with the cell's mean normal (`lit_spread`). The
+// disc lies across that normal (a surfel: seen edge-on at a silhouette it narrows instead of
+// spilling past it, and neighbours overlap in depth as the surface does), turned towards the
+// eye by SURFEL_TILT so that no disc is seen exactly edge-on, and big enough that neighbours
+// overlap (no holes). A cell whose normals spread too far for a mean faces the eye.
+const SURFEL_TILT: f32 = 0.5;
+
 struct SplatOut {
     @builtin(position) clip: vec4<f32>,
     // −1..1 across the disc
@@ -93,8 +97,20 @@ fn vs_splat(
     // A triangle strip: (−1, −1), (1, −1), (−1, 1), (1, 1).
     let corner = vec2<f32>(f32(vertex & 1u) * 2.0 - 1.0, f32(vertex >> 1u) * 2.0 - 1.0);
     var out: SplatOut;
-    out.clip = u.clip_from_world * vec4<f32>(centre, 1.0);
-    out.clip = vec4<f32>(out.clip.xy + corner * radius * u.splat.xy, out.clip.zw);
+    let v = normalize(u.eye.xyz - centre);
+    let flat = length(normal);
+    var facing = v;
+    if (flat > 1e-3) {
+        facing = normalize(normal / flat + SURFEL_TILT * v);
+    }
+    var t1 = cross(facing, vec3<f32>(0.0, 1.0, 0.0));
+    if (dot(t1, t1) < 1e-6) {
+        t1 = cross(facing, vec3<f32>(1.0, 0.0, 0.0));
+    }
+    t1 = normalize(t1);
+    let t2 = cross(facing, t1);
+    let world = centre + radius * (corner.x * t1 + corner.y * t2);
+    out.clip = u.clip_from_world * vec4<f32>(world, 1.0);
     out.corner = corner;
     out.world = centre;
     out.normal = normal;
