@@ -289,6 +289,20 @@ mod tests {
     use super::*;
 
     #[test]
+    fn big_structures_open_space_filling_depth_cued_and_by_chain() {
+        let small = RenderSettings::default().for_structure(BIG_STRUCTURE_ATOMS, 4);
+        assert_eq!(small, RenderSettings::default());
+        let big = RenderSettings::default().for_structure(BIG_STRUCTURE_ATOMS + 1, 4);
+        assert_eq!((big.atoms, big.atom_colors), (AtomStyle::SpaceFilling, AtomColoring::Chain));
+        assert_eq!(big.depth_cue, BIG_STRUCTURE_DEPTH_CUE);
+        // What the user chose stays: a style other than the default, a stronger cue.
+        let chosen = RenderSettings { atoms: AtomStyle::Licorice, depth_cue: 0.9, ..RenderSettings::default() };
+        assert_eq!(chosen.for_structure(1_000_000, 4), chosen);
+        let one_chain = RenderSettings::default().for_structure(BIG_STRUCTURE_ATOMS + 1, 1);
+        assert_eq!(one_chain.atom_colors, AtomColoring::Element);
+    }
+
+    #[test]
     fn nested_levels_run_from_cool_to_warm_for_a_density_and_pale_for_an_orbital() {
         let base = IsosurfaceSettings { translucent: true, ..Default::default() };
         let outer = base.nested(IsoLevel::Absolute(0.01), 0, 4);
