@@ -2,13 +2,13 @@
 // (ordered on the CPU), and one invocation per bond. Occlusion culling in two phases: the cells
 // seen last frame are rasterised first; a coarse depth pyramid (the farthest depth of 8×8-pixel
 // tiles and of 8×8-tile blocks) is built from them; every other cell whose bounds it hides is
-// skipped, the rest rasterised; after a second pyramid only the cells that may show write ids. Seed 002's screen-size level of detail: a
+// skipped, the rest rasterised; after a second pyramid only the cells that may show write ids
+// (or, with packed words, are only marked seen). Seed 002's screen-size level of detail: a
 // sphere whose projected radius is at most `viewport.w` pixels is rasterised here exactly (per
-// pixel ray–sphere test, nearest wins through an atomic maximum of the inverted depth, then its
-// id written where it won), after a test that skips it when every pixel it could cover already
-// holds something nearer (occlusion culling: nearer cells ran first); bigger spheres are
-// appended to the list the impostor quads draw. Bonds thinner than a third of a pixel are left
-// to the atoms.
+// pixel ray–sphere test, nearest wins through an atomic maximum of the inverted depth), after a
+// test that skips it when every pixel it could cover already holds something nearer (nearer
+// cells and atoms ran first); bigger spheres are appended to the list the impostor quads draw.
+// Bonds thinner than a third of a pixel are left to the atoms.
 
 // The splat buffer (binding 1 of group 1) and how a pixel's depth key and atom id are kept in
 // it come from atoms_splat_pair.wgsl or atoms_splat_packed.wgsl: depth_key, draw_depth, draw_id,
@@ -136,28 +136,22 @@ fn blocks_at() -> u32 {
 // holds something nearer than `key`: read from tiles where few enough cover it, else from
 // blocks; unknown (false) for a rectangle wider still.
 fn coarse_hidden(f: vec4<i32>, key: u32) -> bool {
-    let t0 = f.xy / TILE;
-    let t1 = f.zw / TILE;
-    if (all(t1 - t0 < vec2<i32>(COARSE_SPAN))) {
-        let w = tiles().x;
-        for (var y = t0.y; y <= t1.y; y++) {
-            for (var x = t0.x; x <= t1.x; x++) {
-                if (coarse_load(u32(y * w + x)) <= key) {
-                    return false;
-                }
-            }
+    var lo = f.xy / TILE;
+    var hi = f.zw / TILE;
+    var at = 0u;
+    var w = tiles().x;
+    if (any(hi - lo >= vec2<i32>(COARSE_SPAN))) {
+        lo /= BLOCK;
+        hi /= BLOCK;
+        at = blocks_at();
+        w = blocks().x;
+        if (any(hi - lo >= vec2<i32>(COARSE_SPAN))) {
+            return false;
         }
-        return true;
     }
-    let b0 = t0 / BLOCK;
-    let b1 = t1 / BLOCK;
-    if (any(b1 - b0 >= vec2<i32>(COARSE_SPAN))) {
-        return false;
-    }
-    let w = blocks().x;
-    for (var y = b0.y; y <= b1.y; y++) {
-        for (var x = b0.x; x <= b1.x; x++) {
-            if (coarse_load(blocks_at() + u32(y * w + x)) <= key) {
+    for (var y = lo.y; y <= hi.y; y++) {
+        for (var x = lo.x; x <= hi.x; x++) {
+            if (coarse_load(at + u32(y * w + x)) <= key) {
                 return false;
             }
         }
@@ -186,7 +180,7 @@ fn cell_may_show(cell: u32) -> bool {
         return false;
     }
     let rect = vec4<i32>(lo, hi);
-    let key = nearest_key(centre, radius);
+    let key = nearest_key(c.zw, radius);
     if (coarse_hidden(rect, key)) {
         return false;
     }
@@ -295,19 +289,13 @@ fn cs_depth_blocks(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_w
     coarse_store(blocks_at() + u32(k), far);
 }
 
-// The depth key of a screen's sphere's nearest depth (as nearest_key, from its clip z and w).
-fn front_key_of(s: Screen) -> u32 {
-    let zw = s.zw - s.radius * g.clip_zw.zw;
-    return 0xffffffffu - bitcast<u32>(clamp(zw.x / zw.y, 0.0, 1.0));
+// The depth key of a sphere's nearest depth, from its centre's clip z and w: the centre moved
+// by its radius towards the eye along the view direction (depth grows with the distance along
+// it), so no pixel of it can be nearer. Radius 0: the centre's own key.
+fn nearest_key(zw: vec2<f32>, radius: f32) -> u32 {
+    let front = zw - radius * g.clip_zw.zw;
+    return 0xffffffffu - bitcast<u32>(clamp(front.x / front.y, 0.0, 1.0));
 }
-
-// The depth key of a sphere's nearest depth (its centre moved by its radius along the view
-// direction; depth grows with the distance along it): no pixel of it can be nearer.
-fn nearest_key(centre: vec3<f32>, radius: f32) -> u32 {
-    let front = centre - normalize(g.ray_f0.xyz - g.eye.xyz) * radius;
-    return 0xffffffffu - bitcast<u32>(clamp(depth_of(front), 0.0, 1.0));
-}
-
 
 // Whether every pixel of the footprint already holds something nearer than `key` (occluded:
 // nothing to draw): from the coarse depths when they are built (`coarse`), else pixel by
@@ -333,7 +321,7 @@ fn hidden(f: vec4<i32>, key: u32, coarse: bool) -> bool {
 fn big_sphere(i: u32, s: Screen, coarse: bool) {
     let e = max(s.p.z, 0.5) * 1.05 + 0.02;
     let whole = 2.0 * e + 1.0 <= f32(MAX_SIDE);
-    if (whole && s.p.w == 2.0 && hidden(footprint(s), front_key_of(s), coarse)) {
+    if (whole && s.p.w == 2.0 && hidden(footprint(s), nearest_key(s.zw, s.radius), coarse)) {
         return;
     }
     let k = atomicAdd(&lists[1], 1u);
@@ -342,7 +330,7 @@ fn big_sphere(i: u32, s: Screen, coarse: bool) {
     if (h < 1.0 || h > f32(MAX_OCCLUDER) || s.p.w != 2.0) {
         return;
     }
-    let key = 0xffffffffu - bitcast<u32>(clamp(s.zw.x / s.zw.y, 0.0, 1.0));
+    let key = nearest_key(s.zw, 0.0);
     let lo = max(vec2<i32>(ceil(s.p.xy - 0.5 - h)), vec2<i32>(0));
     let hi = min(vec2<i32>(floor(s.p.xy - 0.5 + h)), vec2<i32>(g.viewport.xy) - 1);
     let w = i32(g.viewport.x);
@@ -368,7 +356,7 @@ fn rasterise(i: u32, coarse: bool) {
         return;
     }
     let f = footprint(s);
-    if (hidden(f, front_key_of(s), coarse)) {
+    if (hidden(f, nearest_key(s.zw, s.radius), coarse)) {
         return;
     }
     let w = i32(g.viewport.x);
@@ -385,7 +373,7 @@ fn write_id(i: u32) {
         return;
     }
     let f = footprint(s);
-    if (hidden(f, front_key_of(s), true)) {
+    if (hidden(f, nearest_key(s.zw, s.radius), true)) {
         return;
     }
     let w = i32(g.viewport.x);

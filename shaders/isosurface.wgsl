@@ -11,8 +11,6 @@ struct SurfaceUniforms {
     color: vec4<f32>,
     // x: pick id
     pick: vec4<u32>,
-    // xy: clip-space x and y per object unit at w = 1 (the projection's scales), for splats
-    splat: vec4<f32>,
 };
 
 @group(0) @binding(0) var<uniform> u: SurfaceUniforms;
@@ -60,13 +58,18 @@ fn lit(world: vec3<f32>, normal: vec3<f32>, tint: vec3<f32>) -> vec3<f32> {
         n = -n;
         inner = 0.6;
     }
+    return shade(n, view, tint, 1.0) * inner;
+}
+
+// Headlight diffuse, specular (times `highlight`) and rim of the surface's colour times `tint`,
+// with unit normal `n` and unit direction to the eye `view`.
+fn shade(n: vec3<f32>, view: vec3<f32>, tint: vec3<f32>, highlight: f32) -> vec3<f32> {
     let l = u.light.xyz;
     let diffuse = max(dot(n, l), 0.0);
     let h = normalize(l + view);
-    let specular = pow(max(dot(n, h), 0.0), 40.0);
+    let specular = pow(max(dot(n, h), 0.0), 40.0) * highlight;
     let rim = pow(1.0 - max(dot(n, view), 0.0), 3.0);
-    let base = u.color.rgb * tint * inner;
-    return base * (0.25 + 0.75 * diffuse) + vec3<f32>(0.3 * specular + 0.06 * rim) * inner;
+    return u.color.rgb * tint * (0.25 + 0.75 * diffuse) + vec3<f32>(0.3 * specular + 0.06 * rim);
 }
 
 // Seed 002's points: a cell of the surface too small on screen to be worth its triangles,
@@ -135,17 +138,9 @@ fn fs_splat(in: SplatOut) -> FragOut {
 // covers). Diffuse light from the shortened mean measured darker than the triangles.
 fn lit_spread(world: vec3<f32>, mean: vec3<f32>, tint: vec3<f32>) -> vec3<f32> {
     let flat = clamp(length(mean), 1e-4, 1.0);
-    let view = normalize(u.eye.xyz - world);
-    let n = mean / flat;
-    let l = u.light.xyz;
-    let diffuse = max(dot(n, l), 0.0);
-    let h = normalize(l + view);
     let theta = acos(clamp(2.0 * flat - 1.0, -1.0, 1.0));
     let share = min(1.0, pow(0.22 / max(theta, 1e-3), 2.0));
-    let specular = pow(max(dot(n, h), 0.0), 40.0) * share;
-    let rim = pow(1.0 - max(dot(n, view), 0.0), 3.0);
-    let base = u.color.rgb * tint;
-    return base * (0.25 + 0.75 * diffuse) + vec3<f32>(0.3 * specular + 0.06 * rim);
+    return shade(mean / flat, normalize(u.eye.xyz - world), tint, share);
 }
 
 // Translucent surfaces: every fragment in front of the opaque scene is appended to its

@@ -127,12 +127,7 @@ fn rust_mirrors_match_the_wgsl_layouts() {
                 ray_zw_y
             ]
         ),
-        mirror!(
-            "isosurface.wgsl",
-            "SurfaceUniforms",
-            SurfaceUniforms,
-            [clip_from_world, eye, light, color, pick, splat]
-        ),
+        mirror!("isosurface.wgsl", "SurfaceUniforms", SurfaceUniforms, [clip_from_world, eye, light, color, pick]),
         mirror!("isosurface.wgsl", "ListInfo", ListInfo, [width, capacity, surfaces, _pad]),
         mirror!("resolve.wgsl", "SurfaceOptics", GpuOptics, [a, b, c, d, f, g, glow_d, glow_f, glow_g, same_object]),
         mirror!("gto_fill.wgsl", "FillParams", FillParams, [world_from_grid, dims]),

@@ -69,8 +69,9 @@ const STYLE_UNBONDED_ONLY: u32 = 2;
 /// Radii per atomic number come first in the looks buffer, then the palette.
 const PALETTE_AT: usize = 128;
 /// u32s before the lists: the sphere and the bond indirect draw arguments, then the counts of
-/// the cell lists.
+/// the cell lists (FIRST, LEFT, REST, IDS in atoms_cull.wgsl) from [`CELL_COUNTS_AT`].
 const LIST_HEADER: usize = 12;
+const CELL_COUNTS_AT: usize = 8;
 /// Words per cell in the lists: this frame's order, three cell lists and the frame it was seen.
 const LIST_WORDS_PER_CELL: usize = 5;
 /// The cell lists' indirect dispatches (x, y, z, unused), reset every frame: seen last frame,
@@ -79,16 +80,23 @@ const DISPATCH_ARGS: [u32; 12] = [0, 1, 1, 0, 0, 1, 1, 0, 0, 1, 1, 0];
 /// Coarse depth: pixels per tile side and tiles per block side (atoms_cull.wgsl).
 const DEPTH_TILE: u32 = 8;
 const DEPTH_BLOCK: u32 = 8;
+
+/// Tiles and blocks of the coarse depth across a frame of `size` pixels.
+fn coarse_depth_dims(size: [u32; 2]) -> ([u32; 2], [u32; 2]) {
+    let tiles = size.map(|v| v.div_ceil(DEPTH_TILE));
+    (tiles, tiles.map(|v| v.div_ceil(DEPTH_BLOCK)))
+}
 const WORKGROUP: u32 = 64;
 /// Bytes a splat buffer takes per pixel: a depth key and an atom id.
 const SPLAT_BYTES_PER_PIXEL: u64 = 8;
 
 /// Atoms a spatial cell holds on average; a cell is culled, ordered nearest first and
-/// rasterised by one workgroup. Measured on lavapipe (10⁶ atoms, 800×600): 48 atoms per cell
-/// spend more on launching workgroups than they save by finer order, 480 lose occlusion;
-/// 256 was fastest for space filling and ball and stick alike.
+/// rasterised by one workgroup. Measured on lavapipe (10⁶ atoms, 800×600): with every cell in
+/// view dispatched, 256 was fastest (48 spent more on launching workgroups); once hidden cells
+/// cost no workgroup (two-phase occlusion culling), 64 was (32 and 128 slower).
 const CELL_ATOMS: f32 = 64.0;
-/// The largest atom radius any style draws (bohr), padding cells' bounds for culling.
+/// The largest atom radius any style draws (bohr), padding cells' bounds for the CPU's frustum
+/// culling (the GPU's occlusion tests pad by the largest radius drawn).
 const MAX_ATOM_RADIUS: f32 = 5.0;
 /// Header words per cell in `cell_data`.
 const CELL_WORDS: usize = 6;
@@ -96,7 +104,8 @@ const CELL_WORDS: usize = 6;
 /// Atoms binned into cubic cells: the GPU's `cell_data` ([`CELL_WORDS`] per cell: first,
 /// count and the sphere around its atom centres, centre and radius as f32 bits; then the atom
 /// indices cell by cell, three times: each cell's sorted along x, y and z) and each cell's
-/// sphere (centre, radius) for the CPU, which culls and orders cells every frame. The atoms' own radius pads these spheres as the style asks.
+/// sphere (centre, radius) for the CPU, which culls and orders cells every frame. The atoms' own
+/// radius pads these spheres as the style asks.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Cells {
     pub data: Vec<u32>,
@@ -689,14 +698,8 @@ impl AtomsPass {
         let Some(d) = self.drawn() else { return Ok(CellCounts::default()) };
         let words = super::readback::read_buffer(&ctx.device, &ctx.queue, &d.lists, LIST_HEADER as u64 * 4)?;
         let w: &[u32] = bytemuck::cast_slice(&words);
-        Ok(CellCounts {
-            total: d.cells.len() as u32,
-            in_view: d.visible_cells,
-            first: w[8],
-            tested: w[9],
-            rest: w[10],
-            shown: w[11],
-        })
+        let [first, tested, rest, shown] = std::array::from_fn(|k| w[CELL_COUNTS_AT + k]);
+        Ok(CellCounts { total: d.cells.len() as u32, in_view: d.visible_cells, first, tested, rest, shown })
     }
 
     /// The depth cue's globals: the clip w where darkening starts (the molecule box's nearest
@@ -735,6 +738,7 @@ impl AtomsPass {
             p.truncate() / p.w
         };
         let f0 = far(0.0, 0.0);
+        let (fx, fy) = (far(1.0, 0.0) - f0, far(0.0, 1.0) - f0);
         // Clip z and w of points and directions: the shader's per-pixel depth is linear in them.
         let zw = |v: Vec4| {
             let c = clip * v;
@@ -743,8 +747,8 @@ impl AtomsPass {
         let eye_zw = zw(view.eye.extend(1.0));
         let view_zw = zw((f0 - view.eye).normalize_or_zero().extend(0.0));
         let ray0 = zw((f0 - view.eye).extend(0.0));
-        let ray_x = zw((far(1.0, 0.0) - f0).extend(0.0));
-        let ray_y = zw((far(0.0, 1.0) - f0).extend(0.0));
+        let ray_x = zw(fx.extend(0.0));
+        let ray_y = zw(fy.extend(0.0));
         let (atoms, bonds) = self.data.as_ref().map_or((0, 0), |d| (d.atoms, d.bond_count));
         // Cells in view, nearest first: the compute passes walk them in this order.
         let order = match &self.data {
@@ -769,8 +773,8 @@ impl AtomsPass {
             pick: [PickId::atom_base(object), (self.shared.words == SplatWords::Packed) as u32, backwards as u32, 0],
             viewport: [size[0] as f32, size[1] as f32, pixels_per_bohr, self.splat_radius_px],
             ray_f0: f0.extend(0.0).to_array(),
-            ray_fx: (far(1.0, 0.0) - f0).extend(0.0).to_array(),
-            ray_fy: (far(0.0, 1.0) - f0).extend(0.0).to_array(),
+            ray_fx: fx.extend(0.0).to_array(),
+            ray_fy: fy.extend(0.0).to_array(),
             counts: [atoms, bonds, style, dispatch(bonds).1],
             sticks: [stick, largest, 0.0, 0.0],
             cells: [order.len() as u32, order_at, cells_at, self.frame],
@@ -799,8 +803,7 @@ impl AtomsPass {
         });
         let d = &*d;
         if self.splat.as_ref().is_none_or(|(_, s)| *s != size) {
-            let tiles = size.map(|v| v.div_ceil(DEPTH_TILE));
-            let blocks = tiles.map(|v| v.div_ceil(DEPTH_BLOCK));
+            let (tiles, blocks) = coarse_depth_dims(size);
             // A word per coarse depth, 64-bit when the pixels are.
             let coarse = (tiles[0] * tiles[1] + blocks[0] * blocks[1]) as u64 * 8;
             let bytes = size[0] as u64 * size[1] as u64 * SPLAT_BYTES_PER_PIXEL + coarse;
@@ -868,9 +871,7 @@ impl Draw for AtomsPass {
                 pass.set_pipeline(pipeline);
                 pass.dispatch_workgroups(x, y, 1);
             };
-            let [w, h] = self.splat.as_ref().map_or([1, 1], |(_, s)| *s);
-            let tiles = [w.div_ceil(DEPTH_TILE), h.div_ceil(DEPTH_TILE)];
-            let blocks = tiles.map(|v| v.div_ceil(DEPTH_BLOCK));
+            let (tiles, blocks) = coarse_depth_dims(self.splat.as_ref().map_or([1, 1], |(_, s)| *s));
             let coarse = |pass: &mut wgpu::ComputePass<'_>| {
                 run(pass, &p.depth_tiles, dispatch(tiles[0] * tiles[1]).0);
                 run(pass, &p.depth_blocks, dispatch(blocks[0] * blocks[1]).0);

@@ -21,10 +21,8 @@ pub struct SurfaceUniforms {
     pub light: [f32; 4],
     pub color: [f32; 4],
     pub pick: [u32; 4],
-    /// Clip-space x and y per object unit at w = 1 (for splats).
-    pub splat: [f32; 4],
 }
-const _: () = assert!(std::mem::size_of::<SurfaceUniforms>() == 144);
+const _: () = assert!(std::mem::size_of::<SurfaceUniforms>() == 128);
 
 /// One splat as the instance buffer holds it (mirror of `vs_splat`'s inputs).
 #[repr(C)]
@@ -383,9 +381,6 @@ impl IsosurfacePass {
         first_translucent: usize,
         lists: Option<(&wgpu::BindGroup, Transparency)>,
     ) {
-        let m = view.clip_from_object;
-        let scale = |row: usize| glam::Vec3::new(m.x_axis[row], m.y_axis[row], m.z_axis[row]).length();
-        let splat = [scale(0), scale(1), 0.0, 0.0];
         self.lists = lists.map(|(l, _)| l.clone());
         self.transparency = lists.map_or(Transparency::Exact, |(_, t)| t);
         let mut next = first_translucent;
@@ -401,7 +396,6 @@ impl IsosurfacePass {
                 light: view.light.extend(0.0).to_array(),
                 color: [s.color[0], s.color[1], s.color[2], 1.0],
                 pick: [PickId::Surface { object, index: s.pick }.encode(), s.translucent.unwrap_or(0), 0, 0],
-                splat,
             };
             queue.write_buffer(&s.uniforms, 0, bytemuck::bytes_of(&u));
             if let Some(lod) = &mut s.lod {
