@@ -154,3 +154,88 @@ fn a_surface_coloured_by_a_volume_shows_the_sign_of_its_values() {
     assert!(zero.iter().all(|&c| c > 0.99), "zero is white: {zero:?}");
     assert_eq!(outside, [0.5; 3], "outside the grid: grey");
 }
+
+/// Occlusion culling of a big surface (two phases, into indirect draws) keeps the picture: three
+/// compact blobs one behind another, drawn with every triangle the level of detail chose and
+/// with the culling, give the same pixels and picks, cold, warm and after a turn; once the front
+/// blob was seen, most of the hidden ones are not drawn at all.
+#[test]
+fn occlusion_culling_draws_less_and_keeps_the_picture() {
+    use glam::DVec3;
+    use orbcloud::model::surface::{self, Sphere, SurfaceKind, SurfaceParams};
+    let ctx = common::lavapipe();
+    // A blob: the solvent-excluded surface of 6×6×6 carbon-sized atoms 2.5 bohr apart.
+    let spheres: Vec<Sphere> = (0..216)
+        .map(|k| Sphere { centre: DVec3::new((k % 6) as f64, (k / 6 % 6) as f64, (k / 36) as f64) * 2.5, radius: 3.2 })
+        .collect();
+    let mut params = SurfaceParams::auto(SurfaceKind::SolventExcluded, &spheres);
+    params.resolution = 0.3;
+    let blob = surface::build(&spheres, &params, &AtomicBool::new(false)).unwrap().mesh;
+    let (lo, hi) = blob
+        .positions
+        .iter()
+        .fold((glam::Vec3::INFINITY, glam::Vec3::NEG_INFINITY), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+    let camera = Camera::framing(lo, hi);
+    // Copies behind the first along the view, each a little to the side so part of it shows.
+    let back = (camera.target - camera.eye()).normalize();
+    let side = back.cross(camera.up()).normalize();
+    let size = (hi - lo).length();
+    let lattice = |blobs: usize| {
+        let mut lattice = Mesh::default();
+        for k in 0..blobs {
+            let shift = (back + side * 0.1) * size * k as f32;
+            let base = lattice.positions.len() as u32;
+            lattice.positions.extend(blob.positions.iter().map(|p| *p + shift));
+            lattice.normals.extend_from_slice(&blob.normals);
+            lattice.indices.extend(blob.indices.iter().map(|i| i + base));
+        }
+        lattice
+    };
+    let mut renderer = Renderer::new(&ctx);
+    let look = SurfaceLook { lod_px: Some(0.0), ..SurfaceSettings::default().color.into() };
+    orbcloud::headless::show_meshes(&ctx, renderer.main(), &[(lattice(3), look)]);
+    let center = [SIZE[0] / 2, SIZE[1] / 2];
+    let frame = |renderer: &mut Renderer, camera: &Camera, culled: bool| {
+        renderer.main().surfaces.set_occlusion_culling(culled);
+        let (image, _) = draw(&ctx, renderer, camera);
+        let stats = renderer.main().surfaces.occlusion_stats(&ctx).unwrap();
+        (image, stats, renderer.pick(&ctx, center).unwrap())
+    };
+    let (every, _, every_pick) = frame(&mut renderer, &camera, false);
+    assert!(matches!(every_pick, Some(PickId::Surface { object: 0, index: 0 })), "{every_pick:?}");
+    let (cold, cold_stats, cold_pick) = frame(&mut renderer, &camera, true);
+    assert_eq!(mean_difference(&every, &cold), 0.0, "the first culled frame");
+    assert_eq!(cold_pick, every_pick);
+    // Cold, nothing was seen before: every batch waits for the test, and with nothing drawn
+    // yet the test hides none.
+    assert_eq!((cold_stats.first, cold_stats.second), (0, cold_stats.chosen), "{cold_stats:?}");
+    // The same view again: everything was seen, so everything is drawn first, and the test
+    // after it marks only what shows. From the third frame on the hidden copies are skipped,
+    // and nothing is left to draw after the test.
+    let (again, again_stats, _) = frame(&mut renderer, &camera, true);
+    assert_eq!(mean_difference(&every, &again), 0.0, "the second culled frame");
+    assert_eq!((again_stats.first, again_stats.second), (again_stats.chosen, 0), "{again_stats:?}");
+    let (warm, warm_stats, _) = frame(&mut renderer, &camera, true);
+    assert_eq!(mean_difference(&every, &warm), 0.0, "the third culled frame");
+    assert_eq!(warm_stats.second, 0, "{warm_stats:?}");
+    // Turned a little: the batches that come into view are drawn after the test.
+    let mut turned = camera;
+    turned.orbit(0.25, 0.1);
+    let (culled, turned_stats, culled_pick) = frame(&mut renderer, &turned, true);
+    let (every, _, every_pick) = frame(&mut renderer, &turned, false);
+    assert_eq!(mean_difference(&every, &culled), 0.0, "after a turn");
+    assert_eq!(culled_pick, every_pick);
+    assert!(
+        turned_stats.second > 0 && turned_stats.first + turned_stats.second < turned_stats.chosen,
+        "{turned_stats:?}"
+    );
+    // The front blob alone: its own far side is hidden too, and the two blobs behind it add
+    // little to what is drawn.
+    orbcloud::headless::show_meshes(&ctx, renderer.main(), &[(lattice(1), look)]);
+    let alone = (0..3).map(|_| frame(&mut renderer, &camera, true).1).last().unwrap();
+    assert!(alone.first * 10 < alone.chosen * 6, "{alone:?}");
+    assert!(warm_stats.first * 10 < alone.first * 11, "{warm_stats:?} against the front blob alone {alone:?}");
+    eprintln!(
+        "occlusion culling: cold {cold_stats:?}, warm {warm_stats:?}, turned {turned_stats:?}, front alone {alone:?}"
+    );
+}

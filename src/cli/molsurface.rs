@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
-use orbcloud::gpu::isosurface::LodStats;
+use orbcloud::gpu::isosurface::{LodStats, OcclusionStats};
 use orbcloud::headless::molecular_surface;
 use orbcloud::model::Document;
 use orbcloud::model::isosurface::Mesh;
@@ -154,11 +154,15 @@ pub struct SurfaceBench {
     /// Write each surface's last frame with and without the level of detail here.
     #[arg(long)]
     images: Option<std::path::PathBuf>,
+    /// Draw the level of detail's triangles without occlusion culling (the picture is the same).
+    #[arg(long)]
+    no_occlusion: bool,
 }
 
 /// `orbcloud bench surface`: the build time of each surface (or the one `--surface` names),
 /// its size, and ms per frame drawing it at the given size, turning a little each frame, with
-/// every triangle and with seed 002's level of detail, and how far apart the two images are.
+/// every triangle and with seed 002's level of detail (occlusion culled unless asked not to), and
+/// how far apart the two images are.
 pub fn bench(args: &SurfaceBench) -> Result<()> {
     use orbcloud::gpu::{FrameInput, OffscreenTarget, Renderer};
     use orbcloud::scene::{AtomStyle, Camera, RenderSettings};
@@ -193,9 +197,10 @@ pub fn bench(args: &SurfaceBench) -> Result<()> {
         camera.zoom(1.0 / args.zoom.max(1e-3));
         let target = OffscreenTarget::new(&ctx.device, args.bench.size);
         let settings = RenderSettings::default();
-        let mut draw = |lod_px: Option<f32>| -> Result<(f64, image::RgbaImage, LodStats)> {
+        let mut draw = |lod_px: Option<f32>| -> Result<(f64, image::RgbaImage, LodStats, OcclusionStats)> {
             let look = SurfaceLook { lod_px, ..color.into() };
             orbcloud::headless::show_meshes(&ctx, renderer.main(), &[(s.mesh.clone(), look)]);
+            renderer.main().surfaces.set_occlusion_culling(!args.no_occlusion);
             let frames = super::time_frames(&ctx, &mut renderer, &camera, args.bench.size, args.bench.frames)?;
             // The last frame again, into a target to read.
             let mut last = camera;
@@ -205,11 +210,12 @@ pub fn bench(args: &SurfaceBench) -> Result<()> {
             renderer.render(&ctx, &mut encoder, &target.color_view, &frame);
             ctx.queue.submit([encoder.finish()]);
             let image = target.read_rgba(&ctx.device, &ctx.queue)?;
-            Ok((frames[frames.len() / 2], image, renderer.main().surfaces.lod_stats()))
+            let occlusion = renderer.main().surfaces.occlusion_stats(&ctx)?;
+            Ok((frames[frames.len() / 2], image, renderer.main().surfaces.lod_stats(), occlusion))
         };
-        let (full_ms, full, _) = draw(None)?;
+        let (full_ms, full, _, _) = draw(None)?;
         let lod_px = args.surface.lod_px;
-        let (lod_ms, lod, stats) = draw(Some(lod_px))?;
+        let (lod_ms, lod, stats, occlusion) = draw(Some(lod_px))?;
         // The CPU's share of a frame with the level of detail: walking the octree (what a
         // GPU traversal would take over).
         let tree = orbcloud::model::octree::SurfaceOctree::build(&s.mesh, orbcloud::gpu::isosurface::LEAF_SIZE);
@@ -244,7 +250,8 @@ pub fn bench(args: &SurfaceBench) -> Result<()> {
             "surface={:?} resolution_angstrom={:.2} grid={:?} triangles={triangles} area_angstrom2={:.1} volume_angstrom3={:.1} \
              build_ms_median={:.1} build_ms_min={:.1} ({}x{}) frame_ms_all_triangles={full_ms:.1} \
              frame_ms_lod={lod_ms:.1} lod_px={lod_px} lod_triangles={} lod_points={} speedup={:.2} \
-             lod_error_mean={mean:.2}/255 lod_error_covered={covered:.2}/255 lod_walk_ms={walk_ms:.2}",
+             lod_error_mean={mean:.2}/255 lod_error_covered={covered:.2}/255 lod_walk_ms={walk_ms:.2} \
+             lod_drawn_first={} lod_drawn_after_occlusion_test={}",
             params.kind,
             params.resolution / BOHR_PER_ANGSTROM,
             s.grid.dims,
@@ -256,7 +263,9 @@ pub fn bench(args: &SurfaceBench) -> Result<()> {
             args.bench.size[1],
             stats.triangles,
             stats.splats,
-            full_ms / lod_ms
+            full_ms / lod_ms,
+            occlusion.first,
+            occlusion.second,
         );
     }
     Ok(())

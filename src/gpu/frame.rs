@@ -22,6 +22,9 @@ pub enum Target {
     Ids,
     /// Each atom layer's culled draw lists and compute-rasterised small spheres.
     Splats,
+    /// The depth pyramid of the first opaque draws, and the draws of what it does not hide
+    /// ([`super::occlusion`]).
+    Visible,
     /// Per-pixel lists of translucent surface fragments ([`super::oit`]).
     Fragments,
     /// The caller's 8-bit sRGB view.
@@ -34,7 +37,14 @@ pub enum Phase {
     /// Compute work before drawing: frustum culling, level of detail, small spheres rasterised.
     Cull,
     /// Opaque geometry (atoms, isosurfaces): clears colour, depth and ids, writes all three.
+    /// Big surfaces draw only the parts seen last frame here.
     Opaque,
+    /// Compute: a depth pyramid from the opaque depth, and big surfaces' parts tested against it
+    /// (skipped when no pass asks).
+    Occlusion,
+    /// The parts of big surfaces not drawn yet that the pyramid does not hide, over what the
+    /// opaque phase drew.
+    OpaqueLate,
     /// Translucent clouds back to front: blends over colour, tests depth without writing it.
     Translucent,
     /// Translucent surfaces append their fragments in front of the opaque depth to per-pixel
@@ -55,14 +65,22 @@ pub struct PhaseNode {
     pub writes: &'static [Target],
 }
 
-/// The frame every host draws: culling and small spheres (compute), opaque geometry, then
-/// translucent clouds over it, translucent surfaces into fragment lists, then resolve.
+/// The frame every host draws: culling and small spheres (compute), opaque geometry, the
+/// occlusion test and what it leaves of big surfaces, then translucent clouds over it,
+/// translucent surfaces into fragment lists, then resolve.
 pub const STANDARD_FRAME: &[PhaseNode] = &[
     PhaseNode { phase: Phase::Cull, label: "cull and splat", reads: &[], writes: &[Target::Splats] },
     PhaseNode {
         phase: Phase::Opaque,
         label: "opaque",
         reads: &[Target::Splats],
+        writes: &[Target::Color, Target::Depth, Target::Ids],
+    },
+    PhaseNode { phase: Phase::Occlusion, label: "occlusion test", reads: &[Target::Depth], writes: &[Target::Visible] },
+    PhaseNode {
+        phase: Phase::OpaqueLate,
+        label: "opaque, not hidden",
+        reads: &[Target::Visible, Target::Depth],
         writes: &[Target::Color, Target::Depth, Target::Ids],
     },
     PhaseNode {
@@ -101,6 +119,14 @@ pub trait Draw {
     fn draw(&self, phase: Phase, pass: &mut wgpu::RenderPass<'_>);
     /// Records its compute work of [`Phase::Cull`].
     fn compute(&self, _encoder: &mut wgpu::CommandEncoder) {}
+    /// Whether this frame it has draws the depth pyramid may hide: then the frame builds the
+    /// pyramid and opens [`Phase::OpaqueLate`].
+    fn culls_by_depth(&self) -> bool {
+        false
+    }
+    /// Records its occlusion tests of [`Phase::Occlusion`] against the depth pyramid (the
+    /// group [`super::occlusion::DepthPyramid::build`] returns).
+    fn occlude(&self, _encoder: &mut wgpu::CommandEncoder, _pyramid: &wgpu::BindGroup) {}
 }
 
 /// The frame's camera as one object sees it: every vector in the object's own frame, so a
@@ -214,6 +240,7 @@ impl FrameTargets {
         node: &PhaseNode,
         background: [f32; 3],
     ) -> wgpu::RenderPass<'e> {
+        // The opaque phase starts the frame; every later one draws over it.
         let clear = node.phase == Phase::Opaque;
         let attachment = |view, clear_to: wgpu::Color| wgpu::RenderPassColorAttachment {
             view,
@@ -229,10 +256,10 @@ impl FrameTargets {
         if node.writes.contains(&Target::Ids) {
             colors.push(Some(attachment(&self.ids_view, wgpu::Color::TRANSPARENT)));
         }
-        let depth_ops = node
-            .writes
-            .contains(&Target::Depth)
-            .then_some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store });
+        let depth_ops = node.writes.contains(&Target::Depth).then_some(wgpu::Operations {
+            load: if clear { wgpu::LoadOp::Clear(1.0) } else { wgpu::LoadOp::Load },
+            store: wgpu::StoreOp::Store,
+        });
         // A phase that only reads depth opens it read-only; the fragment lists read it as a
         // texture instead.
         let depth = (node.phase != Phase::Fragments).then_some(wgpu::RenderPassDepthStencilAttachment {

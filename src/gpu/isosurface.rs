@@ -7,6 +7,7 @@ use wgpu::util::DeviceExt;
 
 use super::GpuContext;
 use super::frame::{Draw, ObjectView, Phase, PickId, opaque_depth, opaque_targets};
+use super::occlusion::{BatchCuller, CulledBatches};
 use super::oit::Transparency;
 use crate::model::isosurface::Mesh;
 use crate::model::octree::{LodView, Selection, SurfaceOctree};
@@ -64,6 +65,8 @@ struct GpuSurface {
 struct Lod {
     tree: SurfaceOctree,
     threshold_px: f32,
+    /// The selection's batches on the GPU, drawn in two phases with occlusion culling.
+    batches: CulledBatches,
     /// Room for a splat per cell.
     splats: wgpu::Buffer,
     selection: Selection,
@@ -71,13 +74,22 @@ struct Lod {
     staged: Vec<SplatInstance>,
 }
 
-/// What the last frame drew of the surfaces with a level of detail: triangles, points and
-/// triangles in all.
+/// What the last frame drew of the surfaces with a level of detail: triangles chosen, points,
+/// and triangles in all.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct LodStats {
     pub triangles: u64,
     pub splats: u64,
     pub total_triangles: u64,
+}
+
+/// Of the triangles the level of detail chose last frame: those drawn first (their cluster
+/// was seen the frame before), and those drawn after the occlusion test; the rest it hid.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct OcclusionStats {
+    pub chosen: u64,
+    pub first: u64,
+    pub second: u64,
 }
 
 /// The octree's leaves: about an atom's size (3 Å), in bohr.
@@ -107,14 +119,18 @@ pub struct IsosurfacePass {
     weighted: wgpu::RenderPipeline,
     transparency: Transparency,
     layout: wgpu::BindGroupLayout,
+    culler: BatchCuller,
+    /// Whether big surfaces are occlusion culled (tests compare frames without it).
+    occlusion: bool,
     surfaces: Vec<GpuSurface>,
     /// The frame's fragment lists (set in `prepare` when a surface is translucent).
     lists: Option<wgpu::BindGroup>,
 }
 
 impl IsosurfacePass {
-    /// `lists`: the layout of the fragment lists' collect group.
-    pub fn new(ctx: &GpuContext, lists: &wgpu::BindGroupLayout) -> Self {
+    /// `lists`: the layout of the fragment lists' collect group; `pyramid`: of the depth
+    /// pyramid's read group.
+    pub fn new(ctx: &GpuContext, lists: &wgpu::BindGroupLayout, pyramid: &wgpu::BindGroupLayout) -> Self {
         let device = &ctx.device;
         let module = super::shader_module(device, "isosurface.wgsl");
         let (layout, pipeline_layout) = super::uniform_layouts(device, "isosurface");
@@ -245,6 +261,8 @@ impl IsosurfacePass {
             collect,
             weighted,
             layout,
+            culler: BatchCuller::new(ctx, pyramid),
+            occlusion: true,
             surfaces: Vec::new(),
             lists: None,
             transparency: Transparency::Exact,
@@ -300,6 +318,7 @@ impl IsosurfacePass {
                         usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
                         mapped_at_creation: false,
                     }),
+                    batches: CulledBatches::new(ctx, &self.culler, tree.cells.len()),
                     tree,
                     threshold_px,
                     selection: Selection::default(),
@@ -345,6 +364,8 @@ impl IsosurfacePass {
             collect: self.collect.clone(),
             weighted: self.weighted.clone(),
             layout: self.layout.clone(),
+            culler: self.culler.clone(),
+            occlusion: self.occlusion,
             surfaces: Vec::new(),
             lists: None,
             transparency: Transparency::Exact,
@@ -362,6 +383,25 @@ impl IsosurfacePass {
         stats
     }
 
+    /// Whether big surfaces are occlusion culled from the next frame on (on by default; the
+    /// picture is the same either way).
+    pub fn set_occlusion_culling(&mut self, on: bool) {
+        self.occlusion = on;
+    }
+
+    /// How the last frame's occlusion test split the triangles of the surfaces drawn with a
+    /// level of detail (read back from the GPU).
+    pub fn occlusion_stats(&self, ctx: &GpuContext) -> Result<OcclusionStats, super::GpuError> {
+        let mut stats = OcclusionStats::default();
+        for lod in self.surfaces.iter().filter_map(|s| s.lod.as_ref()) {
+            let (first, second) = lod.batches.read_drawn(ctx)?;
+            stats.chosen += lod.selection.triangles as u64;
+            stats.first += first;
+            stats.second += second;
+        }
+        Ok(stats)
+    }
+
     /// The optics of the translucent surfaces, in the order [`Self::prepare`] numbers them.
     pub fn translucent(&self) -> impl Iterator<Item = Optics> + '_ {
         self.surfaces.iter().filter_map(|s| s.optics)
@@ -374,7 +414,7 @@ impl IsosurfacePass {
     /// fragment lists, and how they are composited.
     pub fn prepare(
         &mut self,
-        queue: &wgpu::Queue,
+        ctx: &GpuContext,
         view: &ObjectView,
         object: u32,
         (size, lod_scale): ([u32; 2], f32),
@@ -397,7 +437,7 @@ impl IsosurfacePass {
                 color: [s.color[0], s.color[1], s.color[2], 1.0],
                 pick: [PickId::Surface { object, index: s.pick }.encode(), s.translucent.unwrap_or(0), 0, 0],
             };
-            queue.write_buffer(&s.uniforms, 0, bytemuck::bytes_of(&u));
+            ctx.queue.write_buffer(&s.uniforms, 0, bytemuck::bytes_of(&u));
             if let Some(lod) = &mut s.lod {
                 let lod_view = LodView {
                     clip_from_object: view.clip_from_object,
@@ -415,7 +455,39 @@ impl IsosurfacePass {
                     tint: p.color.to_array(),
                 }));
                 if !lod.staged.is_empty() {
-                    queue.write_buffer(&lod.splats, 0, bytemuck::cast_slice(&lod.staged));
+                    ctx.queue.write_buffer(&lod.splats, 0, bytemuck::cast_slice(&lod.staged));
+                }
+                lod.batches.prepare(ctx, &self.culler, view.clip_from_object, &lod.selection.batches);
+            }
+        }
+    }
+}
+
+impl IsosurfacePass {
+    /// The surfaces drawn with a level of detail, with what they draw this frame.
+    fn lods(&self) -> impl Iterator<Item = (&GpuSurface, &Lod)> {
+        self.surfaces.iter().filter_map(|s| Some((s, s.lod.as_ref()?)))
+    }
+
+    /// Binds a surface's mesh for its triangles.
+    fn bind_mesh(s: &GpuSurface, pass: &mut wgpu::RenderPass<'_>) {
+        pass.set_bind_group(0, &s.bind_group, &[]);
+        pass.set_vertex_buffer(0, s.vertices.slice(..));
+        pass.set_index_buffer(s.indices.slice(..), wgpu::IndexFormat::Uint32);
+    }
+
+    /// The chosen triangles of the surfaces drawn with a level of detail: in the opaque phase
+    /// those seen last frame (all of them without occlusion culling), in the late one those
+    /// the occlusion test left.
+    fn draw_lod_triangles(&self, pass: &mut wgpu::RenderPass<'_>, late: bool) {
+        pass.set_pipeline(&self.closed);
+        for (s, lod) in self.lods() {
+            Self::bind_mesh(s, pass);
+            if self.occlusion {
+                lod.batches.draw(pass, late);
+            } else if !late {
+                for b in &lod.selection.batches {
+                    pass.draw_indexed(3 * b.triangles.start..3 * b.triangles.end, 0, 0..1);
                 }
             }
         }
@@ -424,10 +496,33 @@ impl IsosurfacePass {
 
 impl Draw for IsosurfacePass {
     fn phases(&self) -> &'static [Phase] {
-        &[Phase::Opaque, Phase::Fragments]
+        &[Phase::Cull, Phase::Opaque, Phase::OpaqueLate, Phase::Fragments]
+    }
+
+    fn compute(&self, encoder: &mut wgpu::CommandEncoder) {
+        if self.occlusion {
+            for (_, lod) in self.lods() {
+                lod.batches.split(&self.culler, encoder);
+            }
+        }
+    }
+
+    fn culls_by_depth(&self) -> bool {
+        self.occlusion && self.lods().next().is_some()
+    }
+
+    fn occlude(&self, encoder: &mut wgpu::CommandEncoder, pyramid: &wgpu::BindGroup) {
+        for (_, lod) in self.lods() {
+            lod.batches.cull(&self.culler, encoder, pyramid);
+        }
     }
 
     fn draw(&self, phase: Phase, pass: &mut wgpu::RenderPass<'_>) {
+        match phase {
+            Phase::OpaqueLate => return self.draw_lod_triangles(pass, true),
+            Phase::Opaque => self.draw_lod_triangles(pass, false),
+            _ => {}
+        }
         let translucent = phase == Phase::Fragments;
         if translucent {
             let Some(lists) = &self.lists else { return };
@@ -439,27 +534,13 @@ impl Draw for IsosurfacePass {
         } else {
             pass.set_pipeline(&self.pipeline);
         }
-        for s in self.surfaces.iter().filter(|s| s.translucent.is_some() == translucent) {
-            pass.set_bind_group(0, &s.bind_group, &[]);
-            pass.set_vertex_buffer(0, s.vertices.slice(..));
-            pass.set_index_buffer(s.indices.slice(..), wgpu::IndexFormat::Uint32);
-            match &s.lod {
-                None => pass.draw_indexed(0..s.index_count, 0, 0..1),
-                Some(lod) => {
-                    pass.set_pipeline(&self.closed);
-                    for r in &lod.selection.ranges {
-                        pass.draw_indexed(3 * r.start..3 * r.end, 0, 0..1);
-                    }
-                    pass.set_pipeline(&self.pipeline);
-                }
-            }
+        for s in self.surfaces.iter().filter(|s| s.translucent.is_some() == translucent && s.lod.is_none()) {
+            Self::bind_mesh(s, pass);
+            pass.draw_indexed(0..s.index_count, 0, 0..1);
         }
         if !translucent {
-            for (s, lod) in self.surfaces.iter().filter_map(|s| Some((s, s.lod.as_ref()?))) {
-                if lod.staged.is_empty() {
-                    continue;
-                }
-                pass.set_pipeline(&self.splat);
+            pass.set_pipeline(&self.splat);
+            for (s, lod) in self.lods().filter(|(_, lod)| !lod.staged.is_empty()) {
                 pass.set_bind_group(0, &s.bind_group, &[]);
                 pass.set_vertex_buffer(0, lod.splats.slice(..));
                 pass.draw(0..4, 0..lod.staged.len() as u32);

@@ -9,6 +9,7 @@ pub mod context;
 pub mod frame;
 pub mod gto;
 pub mod isosurface;
+pub mod occlusion;
 pub mod oit;
 pub mod readback;
 pub mod renderer;
@@ -47,6 +48,9 @@ pub const SHADERS: &[(&str, &str)] = &[
     ("oit_sort.wgsl", include_str!("../../shaders/oit_sort.wgsl")),
     ("resolve.wgsl", include_str!("../../shaders/resolve.wgsl")),
     ("isosurface.wgsl", include_str!("../../shaders/isosurface.wgsl")),
+    ("depth_pyramid_common.wgsl", include_str!("../../shaders/depth_pyramid_common.wgsl")),
+    ("depth_pyramid.wgsl", include_str!("../../shaders/depth_pyramid.wgsl")),
+    ("surface_cull.wgsl", include_str!("../../shaders/surface_cull.wgsl")),
     ("gto_common.wgsl", include_str!("../../shaders/gto_common.wgsl")),
     ("gto_fill.wgsl", include_str!("../../shaders/gto_fill.wgsl")),
 ];
@@ -74,6 +78,8 @@ pub const SHADER_MODULES: &[(&str, &[&str])] = &[
     ("atoms_splat_pair.wgsl", &["atoms_common.wgsl", "atoms_cull.wgsl", "atoms_splat_pair.wgsl"]),
     ("atoms_splat_packed.wgsl", &["atoms_common.wgsl", "atoms_cull.wgsl", "atoms_splat_packed.wgsl"]),
     ("isosurface.wgsl", &["oit_common.wgsl", "isosurface.wgsl"]),
+    ("depth_pyramid.wgsl", &["depth_pyramid_common.wgsl", "depth_pyramid.wgsl"]),
+    ("surface_cull.wgsl", &["depth_pyramid_common.wgsl", "surface_cull.wgsl"]),
     ("resolve.wgsl", &["fullscreen.wgsl", "oit_common.wgsl", "oit_sort.wgsl", "resolve.wgsl"]),
 ];
 

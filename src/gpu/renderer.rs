@@ -5,6 +5,7 @@ use glam::{Mat4, Vec3};
 use super::atoms::AtomsPass;
 use super::frame::{Draw, FrameTargets, ObjectView, Phase, PhaseNode, PickId, STANDARD_FRAME};
 use super::isosurface::IsosurfacePass;
+use super::occlusion::DepthPyramid;
 use super::oit::{FragmentDump, FragmentLists, FragmentStats, MAX_BANDS, Transparency};
 use super::resolve::{Lists, ResolvePass, Rows};
 use super::volume::{VolumePass, VolumeTexture};
@@ -153,6 +154,8 @@ pub struct Renderer {
     resolve: ResolvePass,
     /// The translucent surfaces' fragment lists, shared by every layer.
     lists: FragmentLists,
+    /// The depth pyramid big surfaces' occlusion tests read.
+    pyramid: DepthPyramid,
     transparency: Transparency,
     lod_scale: f32,
     frame: &'static [PhaseNode],
@@ -173,9 +176,10 @@ impl Renderer {
 
     fn with_lists(ctx: &GpuContext, lists: FragmentLists) -> Self {
         let resolve = ResolvePass::new(ctx, &lists.composite_layout, &lists.weighted_layout);
+        let pyramid = DepthPyramid::new(ctx);
         let layer = Layer {
             atoms: AtomsPass::new(ctx),
-            surfaces: IsosurfacePass::new(ctx, &lists.collect_layout),
+            surfaces: IsosurfacePass::new(ctx, &lists.collect_layout, &pyramid.read_layout),
             volume: VolumePass::new(ctx, &resolve.layout, &lists.composite_layout),
             world_from_object: Mat4::IDENTITY,
             visible: true,
@@ -185,6 +189,7 @@ impl Renderer {
             layers: vec![layer],
             resolve,
             lists,
+            pyramid,
             transparency: Transparency::Exact,
             lod_scale: 1.0,
             frame: STANDARD_FRAME,
@@ -288,6 +293,7 @@ impl Renderer {
         if resized {
             let targets = FrameTargets::new(&ctx.device, frame.size);
             let bind = self.resolve.bind(&ctx.device, &targets.color_view);
+            self.pyramid.resize(ctx, targets.size, &targets.depth_view);
             self.targets = Some((targets, bind));
         }
         let cam = frame.camera;
@@ -320,7 +326,7 @@ impl Renderer {
             layer.atoms.prepare(ctx, &view, n as u32, frame.size);
             let layer_lists = lists.filter(|_| layer.visible).map(|l| (l, self.transparency));
             let lod = (frame.size, self.lod_scale);
-            layer.surfaces.prepare(&ctx.queue, &view, n as u32, lod, first_translucent, layer_lists);
+            layer.surfaces.prepare(ctx, &view, n as u32, lod, first_translucent, layer_lists);
             if layer.visible {
                 first_translucent += layer.surfaces.translucent().count();
             }
@@ -374,7 +380,16 @@ impl Renderer {
                         self.lists.end_band(encoder, 0);
                     }
                 }
-                Phase::Cull | Phase::Opaque if later_tile => {}
+                Phase::Cull | Phase::Opaque | Phase::Occlusion | Phase::OpaqueLate if later_tile => {}
+                Phase::Occlusion | Phase::OpaqueLate if !self.culls_by_depth() => {}
+                Phase::Occlusion => {
+                    let Some(pyramid) = self.pyramid.build(encoder) else { continue };
+                    for layer in self.layers.iter().filter(|l| l.visible) {
+                        for drawer in layer.drawers().into_iter().filter(|d| d.culls_by_depth()) {
+                            drawer.occlude(encoder, pyramid);
+                        }
+                    }
+                }
                 Phase::Cull => {
                     for layer in self.layers.iter().filter(|l| l.visible) {
                         for drawer in layer.drawers().into_iter().filter(|d| d.phases().contains(&Phase::Cull)) {
@@ -423,6 +438,11 @@ impl Renderer {
             multiview_mask: None,
         });
         self.draw_phase(Phase::Fragments, &mut pass);
+    }
+
+    /// Whether a visible layer draws something this frame that the depth pyramid may hide.
+    fn culls_by_depth(&self) -> bool {
+        self.layers.iter().filter(|l| l.visible).any(|l| l.drawers().iter().any(|d| d.culls_by_depth()))
     }
 
     /// Every visible layer's drawers of `phase`, layer by layer, into the open pass.
