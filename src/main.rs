@@ -580,7 +580,9 @@ fn time_frames(
             &orbcloud::gpu::FrameInput::single(&cam, &settings, size),
         );
         ctx.queue.submit([encoder.finish()]);
+        let cpu = t.elapsed().as_secs_f64() * 1e3;
         ctx.device.poll(wgpu::PollType::wait_indefinitely())?;
+        if std::env::var("ORB_SPLIT").is_ok() { eprintln!("cpu {cpu:.1} total {:.1}", t.elapsed().as_secs_f64() * 1e3); }
         if f >= 2 {
             times.push(t.elapsed().as_secs_f64() * 1e3);
         }

@@ -19,7 +19,7 @@ const MODULE_RULES: &[(&str, &[&str])] = &[
 /// For each layer, the external crates (of Cargo.toml's dependencies) it may name; the table in
 /// ARCHITECTURE.md says the same.
 const CRATE_RULES: &[(&str, &[&str])] = &[
-    ("model", &["glam", "serde", "rayon", "thiserror"]),
+    ("model", &["glam", "serde", "rayon", "thiserror", "bytemuck", "meshopt"]),
     ("formats", &["glam", "serde", "rayon", "thiserror", "flate2", "fast_float2", "toml", "bytemuck"]),
     ("scene", &["glam", "serde"]),
     ("gpu", &["glam", "thiserror", "wgpu", "bytemuck", "half", "image", "pollster", "log"]),

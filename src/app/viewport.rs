@@ -14,7 +14,6 @@ use crate::gpu::{FrameInput, GpuContext, GpuError, OffscreenTarget, Renderer, Ti
 use crate::headless::scan::ScanScene;
 use crate::headless::{Evaluated, WavefunctionView, evaluate_within, isosurfaces_within, molecular_surface};
 use crate::model::isosurface::Mesh;
-use crate::model::octree::SurfaceOctree;
 use crate::model::{Document, VolumeGrid};
 use crate::scene::translucency::SurfaceLook;
 use crate::scene::{IsosurfaceSettings, ObjectState, RenderSettings, SurfaceChoice, SurfaceSettings, VolumeSettings};
@@ -71,7 +70,7 @@ type Evaluation = Result<(Option<Evaluated>, Option<String>), GpuError>;
 /// cut from a coarser grid.
 pub type Meshes = (Vec<(Mesh, SurfaceLook)>, Option<String>);
 /// Meshes with the octrees they are drawn with, built in the same job.
-type Prepared = (Vec<(Mesh, SurfaceLook)>, Vec<Option<SurfaceOctree>>, Option<String>);
+type Prepared = (Vec<(Mesh, SurfaceLook)>, Vec<Option<crate::gpu::isosurface::LodLevels>>, Option<String>);
 
 fn prepared((meshes, note): Meshes) -> Prepared {
     let trees = crate::gpu::isosurface::lod_trees(&meshes);

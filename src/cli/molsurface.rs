@@ -251,7 +251,7 @@ pub fn bench(args: &SurfaceBench) -> Result<()> {
              build_ms_median={:.1} build_ms_min={:.1} ({}x{}) frame_ms_all_triangles={full_ms:.1} \
              frame_ms_lod={lod_ms:.1} lod_px={lod_px} lod_triangles={} lod_points={} speedup={:.2} \
              lod_error_mean={mean:.2}/255 lod_error_covered={covered:.2}/255 lod_walk_ms={walk_ms:.2} \
-             lod_drawn_first={} lod_drawn_after_occlusion_test={}",
+             lod_drawn_first={} lod_drawn_after_occlusion_test={} lod_level={}",
             params.kind,
             params.resolution / BOHR_PER_ANGSTROM,
             s.grid.dims,
@@ -266,6 +266,7 @@ pub fn bench(args: &SurfaceBench) -> Result<()> {
             full_ms / lod_ms,
             occlusion.first,
             occlusion.second,
+            stats.level,
         );
     }
     Ok(())

@@ -10,7 +10,7 @@ use super::frame::{Draw, ObjectView, Phase, PickId, opaque_depth, opaque_targets
 use super::occlusion::{BatchCuller, CulledBatches};
 use super::oit::Transparency;
 use crate::model::isosurface::Mesh;
-use crate::model::octree::{LodView, Selection, SurfaceOctree};
+use crate::model::octree::{LodLevel, LodView, Selection};
 use crate::scene::translucency::{MAX_TRANSLUCENT_SURFACES, Optics, SurfaceLook};
 
 /// Mirror of `SurfaceUniforms` in isosurface.wgsl.
@@ -57,13 +57,19 @@ struct GpuSurface {
     optics: Option<Optics>,
     /// This frame: its index among the frame's translucent surfaces (`None`: drawn opaque).
     translucent: Option<u32>,
-    /// Seed 002's level of detail (big opaque surfaces): the mesh's octree (its reordered
-    /// indices are the index buffer) and what this frame draws of it.
+    /// Seed 002's level of detail (big opaque surfaces): the octrees of the mesh and of its
+    /// coarser versions (their reordered indices, one after another, are the index buffer)
+    /// and what this frame draws of them.
     lod: Option<Lod>,
 }
 
 struct Lod {
-    tree: SurfaceOctree,
+    /// Finest (the mesh itself) first.
+    levels: LodLevels,
+    /// Where each level's triangles and cells start among all levels'.
+    starts: Vec<(u32, u32)>,
+    /// The level drawn this frame.
+    level: usize,
     threshold_px: f32,
     /// The selection's batches on the GPU, drawn in two phases with occlusion culling.
     batches: CulledBatches,
@@ -75,13 +81,17 @@ struct Lod {
 }
 
 /// What the last frame drew of the surfaces with a level of detail: triangles chosen, points,
-/// and triangles in all.
+/// triangles in all (of the mesh itself), and the coarsest version drawn (0: the mesh).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct LodStats {
     pub triangles: u64,
     pub splats: u64,
     pub total_triangles: u64,
+    pub level: usize,
 }
+
+/// A mesh's levels of detail, finest (the mesh itself) first.
+pub type LodLevels = Vec<LodLevel>;
 
 /// Of the triangles the level of detail chose last frame: those drawn first (their cluster
 /// was seen the frame before), and those drawn after the occlusion test; the rest it hid.
@@ -95,20 +105,32 @@ pub struct OcclusionStats {
 /// The octree's leaves: about an atom's size (3 Å), in bohr.
 pub const LEAF_SIZE: f32 = 5.7;
 
+/// The first coarser version's error bound (bohr; each next one doubles it), and how many
+/// versions at most.
+pub const FIRST_ERROR: f32 = 0.05;
+pub const COARSER_VERSIONS: usize = 4;
+
+/// A coarser version is drawn where the view shows its error under this many pixels (times
+/// the level-of-detail factor while dragging), at the mesh's nearest corner.
+pub const MAX_ERROR_PX: f32 = 0.5;
+
 /// The LOD threshold (pixels) of a surface drawn with a level of detail: opaque ones that ask.
 fn lod_threshold(look: &SurfaceLook) -> Option<f32> {
     look.lod_px.filter(|_| look.optics.is_none())
 }
 
-/// The octree each mesh is drawn with (`None` where it has no level of detail): plain CPU
-/// work, for a background job.
-pub fn lod_trees(meshes: &[(Mesh, SurfaceLook)]) -> Vec<Option<SurfaceOctree>> {
+/// The levels of detail each mesh is drawn with (`None` where it has none): its coarser
+/// versions and every level's octree. Plain CPU work, for a background job.
+pub fn lod_trees(meshes: &[(Mesh, SurfaceLook)]) -> Vec<Option<LodLevels>> {
     meshes
         .iter()
-        .map(|(mesh, look)| {
-            lod_threshold(look).filter(|_| !mesh.is_empty()).map(|_| SurfaceOctree::build(mesh, LEAF_SIZE))
-        })
+        .map(|(mesh, look)| lod_threshold(look).filter(|_| !mesh.is_empty()).map(|_| lod_levels(mesh)))
         .collect()
+}
+
+/// `mesh`'s levels of detail: its own octree, then its coarser versions'.
+pub fn lod_levels(mesh: &Mesh) -> LodLevels {
+    LodLevel::all(mesh, LEAF_SIZE, (FIRST_ERROR, COARSER_VERSIONS))
 }
 
 pub struct IsosurfacePass {
@@ -282,7 +304,7 @@ impl IsosurfacePass {
         &mut self,
         ctx: &GpuContext,
         meshes: &[(Mesh, SurfaceLook)],
-        trees: Vec<Option<SurfaceOctree>>,
+        trees: Vec<Option<LodLevels>>,
     ) {
         let device = &ctx.device;
         let mut trees = trees.into_iter();
@@ -304,25 +326,44 @@ impl IsosurfacePass {
                     contents: bytemuck::cast_slice(&vertices),
                     usage: wgpu::BufferUsages::VERTEX,
                 });
-                // Drawn with a level of detail: the octree's order of the triangles.
-                let tree = tree.zip(lod_threshold(look));
+                // Drawn with a level of detail: each level's octree order of its triangles, one
+                // level after another.
+                let levels = tree.filter(|l| !l.is_empty()).zip(lod_threshold(look));
+                let contents: Vec<u32> = match &levels {
+                    Some((levels, _)) => levels.iter().flat_map(|l| l.tree.indices.iter().copied()).collect(),
+                    None => mesh.indices.clone(),
+                };
                 let indices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                     label: Some("isosurface indices"),
-                    contents: bytemuck::cast_slice(tree.as_ref().map_or(&mesh.indices, |(t, _)| &t.indices)),
+                    contents: bytemuck::cast_slice(&contents),
                     usage: wgpu::BufferUsages::INDEX,
                 });
-                let lod = tree.map(|(tree, threshold_px)| Lod {
-                    splats: device.create_buffer(&wgpu::BufferDescriptor {
-                        label: Some("surface splats"),
-                        size: (tree.cells.len().max(1) * std::mem::size_of::<SplatInstance>()) as u64,
-                        usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
-                        mapped_at_creation: false,
-                    }),
-                    batches: CulledBatches::new(ctx, &self.culler, tree.cells.len()),
-                    tree,
-                    threshold_px,
-                    selection: Selection::default(),
-                    staged: Vec::new(),
+                let lod = levels.map(|(levels, threshold_px)| {
+                    let starts: Vec<(u32, u32)> = levels
+                        .iter()
+                        .scan((0u32, 0u32), |at, l| {
+                            let start = *at;
+                            *at = (at.0 + l.tree.indices.len() as u32 / 3, at.1 + l.tree.cells.len() as u32);
+                            Some(start)
+                        })
+                        .collect();
+                    let cells: usize = levels.iter().map(|l| l.tree.cells.len()).sum();
+                    let most = levels.iter().map(|l| l.tree.cells.len()).max().unwrap_or(1);
+                    Lod {
+                        splats: device.create_buffer(&wgpu::BufferDescriptor {
+                            label: Some("surface splats"),
+                            size: (most.max(1) * std::mem::size_of::<SplatInstance>()) as u64,
+                            usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+                            mapped_at_creation: false,
+                        }),
+                        batches: CulledBatches::new(ctx, &self.culler, cells),
+                        levels,
+                        starts,
+                        level: 0,
+                        threshold_px,
+                        selection: Selection::default(),
+                        staged: Vec::new(),
+                    }
                 });
                 let uniforms = super::uniform_buffer(device, "isosurface uniforms", size_of::<SurfaceUniforms>());
                 let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -378,7 +419,8 @@ impl IsosurfacePass {
         for lod in self.surfaces.iter().filter_map(|s| s.lod.as_ref()) {
             stats.triangles += lod.selection.triangles as u64;
             stats.splats += lod.staged.len() as u64;
-            stats.total_triangles += lod.tree.indices.len() as u64 / 3;
+            stats.total_triangles += lod.levels[0].tree.indices.len() as u64 / 3;
+            stats.level = stats.level.max(lod.level);
         }
         stats
     }
@@ -446,7 +488,16 @@ impl IsosurfacePass {
                     threshold_px: lod.threshold_px * lod_scale,
                     back_faces: true,
                 };
-                lod.tree.select(&lod_view, &mut lod.selection);
+                let root = &lod.levels[0].tree.cells[0];
+                let errors = lod.levels.iter().map(|l| l.error);
+                lod.level = lod_view.coarsest_within(errors, (root.lo, root.hi), MAX_ERROR_PX * lod_scale);
+                lod.levels[lod.level].tree.select(&lod_view, &mut lod.selection);
+                // Batches of this level, in the index buffer and the seen flags of all levels.
+                let (triangles, cells) = lod.starts[lod.level];
+                for b in &mut lod.selection.batches {
+                    b.triangles = b.triangles.start + triangles..b.triangles.end + triangles;
+                    b.cluster += cells;
+                }
                 lod.staged.clear();
                 lod.staged.extend(lod.selection.splats.iter().map(|p| SplatInstance {
                     centre: p.centre.to_array(),

@@ -20,6 +20,7 @@ pub mod octree;
 pub mod orbitals;
 pub mod overlap;
 pub mod scan;
+pub mod simplify;
 pub mod solid_harmonics;
 pub mod structure;
 pub mod surface;

@@ -104,6 +104,58 @@ pub struct Batch {
     pub cluster: u32,
 }
 
+impl LodView {
+    /// Pixels per object unit at clip w = 1: the projection's y scale times half the height
+    /// (Size = r·(n/z_eye)·(h/(t − b)), seed 002).
+    pub fn px_per_unit(&self) -> f32 {
+        let m = self.clip_from_object;
+        Vec3::new(m.x_axis.y, m.y_axis.y, m.z_axis.y).length() * 0.5 * self.height_px
+    }
+
+    /// The coarsest of the versions whose errors (object units, growing) are given that this
+    /// view shows under `max_px` pixels anywhere in the box `lo..hi`: measured at its nearest
+    /// corner. 0 (the mesh itself) when the eye is in the box's plane or nearer.
+    pub fn coarsest_within(&self, errors: impl IntoIterator<Item = f32>, (lo, hi): (Vec3, Vec3), max_px: f32) -> usize {
+        let nearest = (0..8)
+            .map(|k| {
+                let p = Vec3::new([lo.x, hi.x][k & 1], [lo.y, hi.y][(k >> 1) & 1], [lo.z, hi.z][k >> 2]);
+                (self.clip_from_object * p.extend(1.0)).w
+            })
+            .fold(f32::INFINITY, f32::min);
+        if nearest <= 0.0 {
+            return 0;
+        }
+        let px_per_unit = self.px_per_unit() / nearest;
+        errors.into_iter().take_while(|e| e * px_per_unit <= max_px).count().saturating_sub(1)
+    }
+}
+
+/// One level of a surface's detail: the octree of a version of its mesh (the mesh itself
+/// first, then coarser ones) and how far at most that version lies from the mesh.
+#[derive(Debug, Clone, Default)]
+pub struct LodLevel {
+    pub tree: SurfaceOctree,
+    pub error: f32,
+}
+
+impl LodLevel {
+    /// `mesh`'s own octree, then its coarser versions' ([`super::simplify::levels`]: `versions`
+    /// at most, from an error bound of `first_error`), cells of `leaf_size`. The versions are
+    /// made while the mesh's own tree is built.
+    pub fn all(mesh: &Mesh, leaf_size: f32, (first_error, versions): (f32, usize)) -> Vec<LodLevel> {
+        let (own, coarser) = rayon::join(
+            || SurfaceOctree::build(mesh, leaf_size),
+            || super::simplify::levels(mesh, first_error, versions),
+        );
+        let mut levels = vec![LodLevel { tree: own, error: 0.0 }];
+        levels.par_extend(coarser.into_par_iter().map(|v| LodLevel {
+            tree: SurfaceOctree::build_with(mesh, &v.indices, leaf_size),
+            error: v.error,
+        }));
+        levels
+    }
+}
+
 /// What one frame draws of a mesh.
 #[derive(Debug, Clone, Default)]
 pub struct Selection {
@@ -178,11 +230,17 @@ impl SurfaceOctree {
     /// Bins `mesh`'s triangles into cells split at their midpoints until a cell's side is at most
     /// `leaf_size` (an atom's size) or the tree is [`MAX_DEPTH`] deep; empty cells are never made.
     pub fn build(mesh: &Mesh, leaf_size: f32) -> Self {
-        let n = mesh.triangle_count();
+        Self::build_with(mesh, &mesh.indices, leaf_size)
+    }
+
+    /// [`Self::build`] for other triangles over `mesh`'s vertices (a coarser version of it):
+    /// the cells split the same box as the mesh's own tree.
+    pub fn build_with(mesh: &Mesh, indices: &[u32], leaf_size: f32) -> Self {
+        let n = indices.len() / 3;
         if n == 0 {
             return Self::default();
         }
-        let tri = |t: usize| std::array::from_fn::<Vec3, 3, _>(|c| mesh.positions[mesh.indices[3 * t + c] as usize]);
+        let tri = |t: usize| std::array::from_fn::<Vec3, 3, _>(|c| mesh.positions[indices[3 * t + c] as usize]);
         let (lo, hi) =
             mesh.positions.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
         let side = (hi - lo).max_element().max(1e-6);
@@ -201,7 +259,7 @@ impl SurfaceOctree {
             .collect();
         keyed.par_sort_unstable();
         let indices: Vec<u32> =
-            keyed.iter().flat_map(|&(_, t)| (0..3).map(move |c| mesh.indices[3 * t as usize + c])).collect();
+            keyed.iter().flat_map(|&(_, t)| (0..3).map(move |c| indices[3 * t as usize + c])).collect();
         let codes: Vec<u32> = keyed.iter().map(|&(k, _)| k).collect();
         let mut tree = Self { cells: Vec::new(), indices };
         // Breadth first: a cell's children are made together, so they sit side by side, after
@@ -312,10 +370,7 @@ impl SurfaceOctree {
             return;
         }
         let m = view.clip_from_object;
-        // Pixels per object unit at clip w = 1: the projection's y scale times half the height
-        // (Size = r·(n/z_eye)·(h/(t − b)), seed 002).
-        let sy = Vec3::new(m.x_axis.y, m.y_axis.y, m.z_axis.y).length();
-        let px_per_unit = sy * 0.5 * view.height_px;
+        let px_per_unit = view.px_per_unit();
         // (cell, its cluster: the topmost cell on its path with few enough triangles)
         let cluster_of = |c: u32, parent: Option<u32>| {
             let (s, e) = self.cells[c as usize].triangles;
@@ -325,7 +380,11 @@ impl SurfaceOctree {
         while let Some((c, cluster)) = stack.pop() {
             out.visited += 1;
             let cell = &self.cells[c as usize];
-            if outside_frustum(&m, cell.lo, cell.hi) || (view.back_faces && faces_away(cell, view.eye)) {
+            // Within a cluster a cell facing away stays: skipping it would split the cluster's
+            // run into more draws, each costing more than the rasteriser's own culling of its
+            // triangles (and the occlusion test hides a closed surface's far side whole).
+            let within = cluster.is_some_and(|k| k != c);
+            if outside_frustum(&m, cell.lo, cell.hi) || (view.back_faces && !within && faces_away(cell, view.eye)) {
                 continue;
             }
             let centre = 0.5 * (cell.lo + cell.hi);
