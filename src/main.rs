@@ -556,8 +556,8 @@ struct BenchFrames {
     lavapipe: bool,
 }
 
-/// Draws `frames` frames (after two warm-up frames) at `size`, the camera turning a little each
-/// frame as in the viewer, waiting for each; returns the milliseconds of each, sorted.
+/// ms per frame drawing `camera`'s view at `size`, turning a little each frame, after two
+/// warm-up frames; sorted.
 fn time_frames(
     ctx: &GpuContext,
     renderer: &mut orbcloud::gpu::Renderer,
@@ -565,29 +565,43 @@ fn time_frames(
     size: [u32; 2],
     frames: u32,
 ) -> Result<Vec<f64>> {
+    Ok(time_frames_of(ctx, &mut [renderer], camera, size, frames)?.remove(0))
+}
+
+/// [`time_frames`] for several renderers taking turns frame by frame, so that a machine whose
+/// speed drifts slows them alike: one sorted list per renderer.
+fn time_frames_of(
+    ctx: &GpuContext,
+    renderers: &mut [&mut orbcloud::gpu::Renderer],
+    camera: &Camera,
+    size: [u32; 2],
+    frames: u32,
+) -> Result<Vec<Vec<f64>>> {
     let target = orbcloud::gpu::OffscreenTarget::new(&ctx.device, size);
     let settings = RenderSettings::default();
-    let mut times = Vec::new();
+    let mut times = vec![Vec::new(); renderers.len()];
     for f in 0..frames.max(1) + 2 {
         let mut cam = *camera;
         cam.orbit(0.02 * f as f32, 0.01 * f as f32);
-        let t = Instant::now();
-        let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        renderer.render(
-            ctx,
-            &mut encoder,
-            &target.color_view,
-            &orbcloud::gpu::FrameInput::single(&cam, &settings, size),
-        );
-        ctx.queue.submit([encoder.finish()]);
-        let cpu = t.elapsed().as_secs_f64() * 1e3;
-        ctx.device.poll(wgpu::PollType::wait_indefinitely())?;
-        if std::env::var("ORB_SPLIT").is_ok() { eprintln!("cpu {cpu:.1} total {:.1}", t.elapsed().as_secs_f64() * 1e3); }
-        if f >= 2 {
-            times.push(t.elapsed().as_secs_f64() * 1e3);
+        for (renderer, times) in renderers.iter_mut().zip(&mut times) {
+            let t = Instant::now();
+            let mut encoder = ctx.device.create_command_encoder(&Default::default());
+            renderer.render(
+                ctx,
+                &mut encoder,
+                &target.color_view,
+                &orbcloud::gpu::FrameInput::single(&cam, &settings, size),
+            );
+            ctx.queue.submit([encoder.finish()]);
+            ctx.device.poll(wgpu::PollType::wait_indefinitely())?;
+            if f >= 2 {
+                times.push(t.elapsed().as_secs_f64() * 1e3);
+            }
         }
     }
-    times.sort_by(f64::total_cmp);
+    for t in &mut times {
+        t.sort_by(f64::total_cmp);
+    }
     Ok(times)
 }
 

@@ -10,10 +10,14 @@ use orbcloud::gpu::frame::PickId;
 use orbcloud::gpu::{FrameInput, OffscreenTarget, Renderer};
 use orbcloud::headless::molecular_surface;
 use orbcloud::model::isosurface::Mesh;
+use orbcloud::model::octree::{LodLevel, SurfaceOctree};
 use orbcloud::scene::translucency::SurfaceLook;
 use orbcloud::scene::{AtomStyle, Camera, RenderSettings, SurfaceChoice, SurfaceSettings};
 
 const SIZE: [u32; 2] = [256, 192];
+
+/// A threshold at which this small fragment has parts drawn as points.
+const POINTS_PX: f32 = 3.0;
 
 fn fragment() -> (orbcloud::model::Document, Mesh) {
     let pdb = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/structures/4e43_excerpt.pdb");
@@ -64,16 +68,18 @@ fn far_parts_become_points_within_two_levels_of_every_triangle() {
     assert_eq!(stats.total_triangles, 0, "no level of detail asked for");
     common::assert_golden("surface_ses_fragment", &full);
 
-    // Seed 002's level of detail at the viewer's threshold: some cells are points, the rest
+    // Seed 002's level of detail at 3 px: some cells are points, the rest
     // triangles, the picture within 2/255.
-    let look = SurfaceLook { lod_px: Some(SurfaceSettings::LOD_PX), ..color.into() };
+    let look = SurfaceLook { lod_px: Some(POINTS_PX), ..color.into() };
     orbcloud::headless::show_meshes(&ctx, renderer.main(), &[(mesh.clone(), look)]);
     let (lod, stats) = draw(&ctx, &mut renderer, &camera);
     let n = mesh.triangle_count() as u64;
     assert_eq!(stats.total_triangles, n);
     assert!(stats.splats > 0 && stats.triangles < n, "{stats:?}");
+    // Framed small, it draws a coarser version of the mesh.
+    assert!(stats.level > 0, "{stats:?}");
     let mean = mean_difference(&full, &lod);
-    eprintln!("level of detail at {} px: {stats:?}, mean difference {mean:.3}/255", SurfaceSettings::LOD_PX);
+    eprintln!("level of detail at {POINTS_PX} px: {stats:?}, mean difference {mean:.3}/255");
     assert!(mean < 2.0, "mean difference {mean}/255");
     // Where the frame shows the surface, picking says so, points included.
     let covered = full.enumerate_pixels().filter(|(_, _, p)| p[0] > 100).count();
@@ -193,7 +199,14 @@ fn occlusion_culling_draws_less_and_keeps_the_picture() {
     };
     let mut renderer = Renderer::new(&ctx);
     let look = SurfaceLook { lod_px: Some(0.0), ..SurfaceSettings::default().color.into() };
-    orbcloud::headless::show_meshes(&ctx, renderer.main(), &[(lattice(3), look)]);
+    // Only the mesh itself as its level of detail: a turn that changed the version drawn would
+    // start its batches unseen.
+    let show = |renderer: &mut Renderer, mesh: Mesh| {
+        let tree = SurfaceOctree::build(&mesh, orbcloud::gpu::isosurface::LEAF_SIZE);
+        let levels = vec![Some(vec![LodLevel { tree, error: 0.0 }])];
+        renderer.main().surfaces.set_meshes_with_trees(&ctx, &[(mesh, look)], levels);
+    };
+    show(&mut renderer, lattice(3));
     let center = [SIZE[0] / 2, SIZE[1] / 2];
     let frame = |renderer: &mut Renderer, camera: &Camera, culled: bool| {
         renderer.main().surfaces.set_occlusion_culling(culled);
@@ -231,7 +244,7 @@ fn occlusion_culling_draws_less_and_keeps_the_picture() {
     );
     // The front blob alone: its own far side is hidden too, and the two blobs behind it add
     // little to what is drawn.
-    orbcloud::headless::show_meshes(&ctx, renderer.main(), &[(lattice(1), look)]);
+    show(&mut renderer, lattice(1));
     let alone = (0..3).map(|_| frame(&mut renderer, &camera, true).1).last().unwrap();
     assert!(alone.first * 10 < alone.chosen * 6, "{alone:?}");
     assert!(warm_stats.first * 10 < alone.first * 11, "{warm_stats:?} against the front blob alone {alone:?}");

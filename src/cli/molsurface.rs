@@ -6,7 +6,6 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
-use orbcloud::gpu::isosurface::{LodStats, OcclusionStats};
 use orbcloud::headless::molecular_surface;
 use orbcloud::model::Document;
 use orbcloud::model::isosurface::Mesh;
@@ -157,6 +156,9 @@ pub struct SurfaceBench {
     /// Draw the level of detail's triangles without occlusion culling (the picture is the same).
     #[arg(long)]
     no_occlusion: bool,
+    /// Draw the level of detail with the mesh's own triangles only, no coarser versions.
+    #[arg(long)]
+    no_coarser: bool,
 }
 
 /// `orbcloud bench surface`: the build time of each surface (or the one `--surface` names),
@@ -188,37 +190,57 @@ pub fn bench(args: &SurfaceBench) -> Result<()> {
         }
         times.sort_by(f64::total_cmp);
         let s = built.context("no surface was built")?;
-        // Drawn alone, opaque, as the viewer draws a surface: every triangle, then with seed
-        // 002's level of detail, the same frames.
-        let mut renderer = Renderer::new(&ctx);
-        renderer.main().set_molecule(&ctx, &doc.molecule, AtomStyle::Hidden);
+        // Drawn alone, opaque, as the viewer draws a surface: with every triangle and with
+        // seed 002's level of detail, one renderer each, taking turns frame by frame.
+        let lod_px = args.surface.lod_px;
+        let mut renderers = [None, Some(lod_px)].map(|lod_px| {
+            let mut renderer = Renderer::new(&ctx);
+            renderer.main().set_molecule(&ctx, &doc.molecule, AtomStyle::Hidden);
+            let look = SurfaceLook { lod_px, ..color.into() };
+            let meshes = [(s.mesh.clone(), look)];
+            let mut levels = orbcloud::gpu::isosurface::lod_trees(&meshes);
+            if args.no_coarser {
+                levels.iter_mut().flatten().for_each(|l| l.truncate(1));
+            }
+            renderer.main().surfaces.set_meshes_with_trees(&ctx, &meshes, levels);
+            renderer.main().surfaces.set_occlusion_culling(!args.no_occlusion);
+            renderer
+        });
         let (lo, hi) = s.grid.bounds();
         let mut camera = Camera::framing(lo.as_vec3(), hi.as_vec3());
         camera.zoom(1.0 / args.zoom.max(1e-3));
+        let [full, lod] = &mut renderers;
+        let frames = super::time_frames_of(&ctx, &mut [full, lod], &camera, args.bench.size, args.bench.frames)?;
+        let [full_ms, lod_ms] = [0, 1].map(|k| frames[k][frames[k].len() / 2]);
+        // The last frame again, into a target to read.
         let target = OffscreenTarget::new(&ctx.device, args.bench.size);
         let settings = RenderSettings::default();
-        let mut draw = |lod_px: Option<f32>| -> Result<(f64, image::RgbaImage, LodStats, OcclusionStats)> {
-            let look = SurfaceLook { lod_px, ..color.into() };
-            orbcloud::headless::show_meshes(&ctx, renderer.main(), &[(s.mesh.clone(), look)]);
-            renderer.main().surfaces.set_occlusion_culling(!args.no_occlusion);
-            let frames = super::time_frames(&ctx, &mut renderer, &camera, args.bench.size, args.bench.frames)?;
-            // The last frame again, into a target to read.
-            let mut last = camera;
-            last.orbit(0.02 * (args.bench.frames.max(1) + 1) as f32, 0.01 * (args.bench.frames.max(1) + 1) as f32);
+        let mut last = camera;
+        let turns = (args.bench.frames.max(1) + 1) as f32;
+        last.orbit(0.02 * turns, 0.01 * turns);
+        let image = |renderer: &mut Renderer| -> Result<image::RgbaImage> {
             let mut encoder = ctx.device.create_command_encoder(&Default::default());
-            let frame = FrameInput::single(&last, &settings, args.bench.size);
-            renderer.render(&ctx, &mut encoder, &target.color_view, &frame);
+            renderer.render(
+                &ctx,
+                &mut encoder,
+                &target.color_view,
+                &FrameInput::single(&last, &settings, args.bench.size),
+            );
             ctx.queue.submit([encoder.finish()]);
-            let image = target.read_rgba(&ctx.device, &ctx.queue)?;
-            let occlusion = renderer.main().surfaces.occlusion_stats(&ctx)?;
-            Ok((frames[frames.len() / 2], image, renderer.main().surfaces.lod_stats(), occlusion))
+            Ok(target.read_rgba(&ctx.device, &ctx.queue)?)
         };
-        let (full_ms, full, _, _) = draw(None)?;
-        let lod_px = args.surface.lod_px;
-        let (lod_ms, lod, stats, occlusion) = draw(Some(lod_px))?;
+        let [full, lod] = [image(&mut renderers[0])?, image(&mut renderers[1])?];
+        let renderer = &mut renderers[1];
+        let (stats, occlusion) =
+            (renderer.main().surfaces.lod_stats(), renderer.main().surfaces.occlusion_stats(&ctx)?);
         // The CPU's share of a frame with the level of detail: walking the octree (what a
         // GPU traversal would take over).
-        let tree = orbcloud::model::octree::SurfaceOctree::build(&s.mesh, orbcloud::gpu::isosurface::LEAF_SIZE);
+        // Building the levels of detail (what the viewer does in the background after the
+        // surface): the coarser versions and every level's octree.
+        let t = Instant::now();
+        let levels = orbcloud::gpu::isosurface::lod_levels(&s.mesh);
+        let levels_ms = t.elapsed().as_secs_f64() * 1e3;
+        let tree = &levels[stats.level].tree;
         let view = orbcloud::model::octree::LodView {
             clip_from_object: renderer.clip_from_world(&camera, args.bench.size),
             eye: camera.eye(),
@@ -251,7 +273,8 @@ pub fn bench(args: &SurfaceBench) -> Result<()> {
              build_ms_median={:.1} build_ms_min={:.1} ({}x{}) frame_ms_all_triangles={full_ms:.1} \
              frame_ms_lod={lod_ms:.1} lod_px={lod_px} lod_triangles={} lod_points={} speedup={:.2} \
              lod_error_mean={mean:.2}/255 lod_error_covered={covered:.2}/255 lod_walk_ms={walk_ms:.2} \
-             lod_drawn_first={} lod_drawn_after_occlusion_test={} lod_level={}",
+             lod_drawn_first={} lod_drawn_after_occlusion_test={} lod_level={} lod_levels={} lod_levels_triangles={} \
+             lod_levels_build_ms={levels_ms:.0}",
             params.kind,
             params.resolution / BOHR_PER_ANGSTROM,
             s.grid.dims,
@@ -267,6 +290,8 @@ pub fn bench(args: &SurfaceBench) -> Result<()> {
             occlusion.first,
             occlusion.second,
             stats.level,
+            levels.len(),
+            levels.iter().map(|l| (l.tree.indices.len() / 3).to_string()).collect::<Vec<_>>().join("/"),
         );
     }
     Ok(())

@@ -131,7 +131,8 @@ impl LodView {
 }
 
 /// One level of a surface's detail: the octree of a version of its mesh (the mesh itself
-/// first, then coarser ones) and how far at most that version lies from the mesh.
+/// first, then coarser ones) and that version's error against the mesh
+/// ([`super::simplify::Simplified::error`]).
 #[derive(Debug, Clone, Default)]
 pub struct LodLevel {
     pub tree: SurfaceOctree,
@@ -140,18 +141,19 @@ pub struct LodLevel {
 
 impl LodLevel {
     /// `mesh`'s own octree, then its coarser versions' ([`super::simplify::levels`]: `versions`
-    /// at most, from an error bound of `first_error`), cells of `leaf_size`. The versions are
-    /// made while the mesh's own tree is built.
-    pub fn all(mesh: &Mesh, leaf_size: f32, (first_error, versions): (f32, usize)) -> Vec<LodLevel> {
+    /// at most, each keeping `keep` of the previous one's triangles, within `max_error`), cells
+    /// of `leaf_size`. The versions are made while the mesh's own tree is built.
+    pub fn all(mesh: &Mesh, leaf_size: f32, (keep, max_error, versions): (f32, f32, usize)) -> Vec<LodLevel> {
         let (own, coarser) = rayon::join(
             || SurfaceOctree::build(mesh, leaf_size),
-            || super::simplify::levels(mesh, first_error, versions),
+            || super::simplify::levels(mesh, keep, max_error, versions),
         );
         let mut levels = vec![LodLevel { tree: own, error: 0.0 }];
-        levels.par_extend(coarser.into_par_iter().map(|v| LodLevel {
-            tree: SurfaceOctree::build_with(mesh, &v.indices, leaf_size),
-            error: v.error,
-        }));
+        levels.par_extend(
+            coarser
+                .into_par_iter()
+                .map(|v| LodLevel { tree: SurfaceOctree::build_with(mesh, &v.indices, leaf_size), error: v.error }),
+        );
         levels
     }
 }
@@ -589,6 +591,28 @@ mod tests {
     }
 
     #[test]
+    fn the_coarsest_version_whose_error_shows_under_the_limit_is_drawn() {
+        let errors = [0.0, 0.1, 0.2, 0.4, 0.8];
+        let unit_box = (Vec3::splat(-1.0), Vec3::splat(1.0));
+        let at = |z: f32| looking_at_origin(Vec3::new(0.0, 0.0, z), 600.0, 0.0);
+        for z in [5.0f32, 50.0, 500.0, 5000.0] {
+            let view = at(z);
+            // Pixels per unit at the box's nearest corner (its w is the distance to the face).
+            let px = view.px_per_unit() / (z - 1.0);
+            let level = view.coarsest_within(errors, unit_box, 0.5);
+            assert!(errors[level] * px <= 0.5, "z {z}: level {level}");
+            if level + 1 < errors.len() {
+                assert!(errors[level + 1] * px > 0.5, "z {z}: level {level} is not the coarsest");
+            }
+        }
+        assert_eq!(at(5.0).coarsest_within(errors, unit_box, 0.5), 0);
+        assert_eq!(at(500.0).coarsest_within(errors, unit_box, 0.5), 2);
+        assert_eq!(at(5000.0).coarsest_within(errors, unit_box, 0.5), 4);
+        // The eye inside the box: the mesh itself.
+        assert_eq!(at(0.5).coarsest_within(errors, unit_box, 100.0), 0);
+    }
+
+    #[test]
     fn back_facing_cells_of_a_closed_surface_are_skipped() {
         let mesh = mesh();
         let tree = SurfaceOctree::build(&mesh, 1.0);
@@ -597,7 +621,9 @@ mod tests {
         let mut sel = Selection::default();
         tree.select(&view, &mut sel);
         let n = mesh.triangle_count() as u32;
-        assert!(sel.triangles < n * 3 / 4 && sel.triangles > n / 3, "{} of {n}", sel.triangles);
+        // Cells within a cluster are drawn whatever way they face (one draw for the cluster),
+        // so only whole clusters facing away are skipped.
+        assert!(sel.triangles < n * 9 / 10 && sel.triangles > n / 3, "{} of {n}", sel.triangles);
         // Every triangle left out faces away from the eye.
         let mut drawn = vec![false; n as usize];
         for b in &sel.batches {
