@@ -202,8 +202,9 @@ impl Renderer {
         self.transparency = transparency;
     }
 
-    /// Multiplies every surface's level-of-detail threshold (seed 002): above 1 while the user
-    /// drags, so more of a big surface is drawn as points and the view keeps up.
+    /// Multiplies every surface's level-of-detail threshold (seed 002) and the error its coarser
+    /// versions may show: above 1 while the user drags, so more of a big surface is drawn as
+    /// points or coarser and the view keeps up.
     pub fn set_lod_scale(&mut self, scale: f32) {
         self.lod_scale = scale;
     }
