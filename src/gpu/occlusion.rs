@@ -322,27 +322,33 @@ impl CulledBatches {
 
     /// Before drawing: the batches seen last frame become the first draws.
     pub fn split(&self, culler: &BatchCuller, encoder: &mut wgpu::CommandEncoder) {
-        if self.count == 0 {
-            return;
-        }
-        let mut pass = encoder
-            .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("surface split"), timestamp_writes: None });
-        pass.set_pipeline(&culler.split);
-        pass.set_bind_group(0, &self.group, &[]);
-        pass.dispatch_workgroups(self.count.div_ceil(WORKGROUP), 1, 1);
+        self.dispatch(encoder, "surface split", &culler.split, None);
     }
 
     /// After the first draws and the pyramid: the batches it does not hide are seen, and those
     /// not drawn yet become the second draws.
     pub fn cull(&self, culler: &BatchCuller, encoder: &mut wgpu::CommandEncoder, pyramid: &wgpu::BindGroup) {
+        self.dispatch(encoder, "surface cull", &culler.cull, Some(pyramid));
+    }
+
+    /// One invocation per batch of `pipeline`, the pyramid bound as group 1 where given.
+    fn dispatch(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        label: &str,
+        pipeline: &wgpu::ComputePipeline,
+        pyramid: Option<&wgpu::BindGroup>,
+    ) {
         if self.count == 0 {
             return;
         }
-        let mut pass = encoder
-            .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("surface cull"), timestamp_writes: None });
-        pass.set_pipeline(&culler.cull);
+        let mut pass =
+            encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(label), timestamp_writes: None });
+        pass.set_pipeline(pipeline);
         pass.set_bind_group(0, &self.group, &[]);
-        pass.set_bind_group(1, pyramid, &[]);
+        if let Some(pyramid) = pyramid {
+            pass.set_bind_group(1, pyramid, &[]);
+        }
         pass.dispatch_workgroups(self.count.div_ceil(WORKGROUP), 1, 1);
     }
 
