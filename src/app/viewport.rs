@@ -558,7 +558,11 @@ impl Viewport {
                             let _ = self.ctx.device.poll(wgpu::PollType::wait_indefinitely());
                             let per_row = band.elapsed().as_secs_f64() / rows as f64;
                             p.next_row += rows;
-                            p.rows = ((BAND_TIME.as_secs_f64() / per_row.max(1e-6)) as u32).clamp(1, size[1]);
+                            // At most twice the band before: one band measured fast (its GPU
+                            // work overlapping the last) must not turn the rest of the frame
+                            // into one band that holds the window for seconds.
+                            let most = (2 * rows).min(size[1]);
+                            p.rows = ((BAND_TIME.as_secs_f64() / per_row.max(1e-6)) as u32).clamp(1, most);
                         }
                         self.band_rows = p.rows;
                         if p.next_row >= size[1] {
