@@ -192,17 +192,22 @@ pub fn bench(args: &SurfaceBench) -> Result<()> {
         let s = built.context("no surface was built")?;
         // Drawn alone, opaque, as the viewer draws a surface: with every triangle and with
         // seed 002's level of detail, one renderer each, taking turns frame by frame.
+        // Building the levels of detail (what the viewer does in the background after the
+        // surface): the coarser versions and every level's octree.
+        let t = Instant::now();
+        let mut levels = orbcloud::gpu::isosurface::lod_levels(&s.mesh);
+        let levels_ms = t.elapsed().as_secs_f64() * 1e3;
+        if args.no_coarser {
+            levels.truncate(1);
+        }
         let lod_px = args.surface.lod_px;
         let mut renderers = [None, Some(lod_px)].map(|lod_px| {
             let mut renderer = Renderer::new(&ctx);
             renderer.main().set_molecule(&ctx, &doc.molecule, AtomStyle::Hidden);
             let look = SurfaceLook { lod_px, ..color.into() };
             let meshes = [(s.mesh.clone(), look)];
-            let mut levels = orbcloud::gpu::isosurface::lod_trees(&meshes);
-            if args.no_coarser {
-                levels.iter_mut().flatten().for_each(|l| l.truncate(1));
-            }
-            renderer.main().surfaces.set_meshes_with_trees(&ctx, &meshes, levels);
+            let trees = vec![lod_px.map(|_| levels.clone())];
+            renderer.main().surfaces.set_meshes_with_trees(&ctx, &meshes, trees);
             renderer.main().surfaces.set_occlusion_culling(!args.no_occlusion);
             renderer
         });
@@ -233,13 +238,7 @@ pub fn bench(args: &SurfaceBench) -> Result<()> {
         let renderer = &mut renderers[1];
         let (stats, occlusion) =
             (renderer.main().surfaces.lod_stats(), renderer.main().surfaces.occlusion_stats(&ctx)?);
-        // The CPU's share of a frame with the level of detail: walking the octree (what a
-        // GPU traversal would take over).
-        // Building the levels of detail (what the viewer does in the background after the
-        // surface): the coarser versions and every level's octree.
-        let t = Instant::now();
-        let levels = orbcloud::gpu::isosurface::lod_levels(&s.mesh);
-        let levels_ms = t.elapsed().as_secs_f64() * 1e3;
+        // The CPU's share of a frame with the level of detail: walking the octree.
         let tree = &levels[stats.level].tree;
         let view = orbcloud::model::octree::LodView {
             clip_from_object: renderer.clip_from_world(&camera, args.bench.size),

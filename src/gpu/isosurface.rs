@@ -455,8 +455,9 @@ impl IsosurfacePass {
     }
 
     /// This frame's camera, in the frame of the object the surfaces belong to; their pick ids
-    /// name `object`. `size` and `lod_scale`: the frame's pixels and the factor on each level of
-    /// detail's threshold. Translucent surfaces are numbered from `first_translucent` among the
+    /// name `object`. `lod`: the frame's pixels and the factor on each level of detail's
+    /// threshold (`None` keeps what the last call chose: a later tile of the same frame).
+    /// Translucent surfaces are numbered from `first_translucent` among the
     /// frame's; past [`MAX_TRANSLUCENT_SURFACES`] they are drawn opaque. `lists`: the frame's
     /// fragment lists, and how they are composited.
     pub fn prepare(
@@ -464,7 +465,7 @@ impl IsosurfacePass {
         ctx: &GpuContext,
         view: &ObjectView,
         object: u32,
-        (size, lod_scale): ([u32; 2], f32),
+        lod: Option<([u32; 2], f32)>,
         first_translucent: usize,
         lists: Option<(&wgpu::BindGroup, Transparency)>,
     ) {
@@ -485,7 +486,7 @@ impl IsosurfacePass {
                 pick: [PickId::Surface { object, index: s.pick }.encode(), s.translucent.unwrap_or(0), 0, 0],
             };
             ctx.queue.write_buffer(&s.uniforms, 0, bytemuck::bytes_of(&u));
-            if let Some(lod) = &mut s.lod {
+            if let (Some(lod), Some((size, lod_scale))) = (&mut s.lod, lod) {
                 let lod_view = LodView {
                     clip_from_object: view.clip_from_object,
                     eye: view.eye,

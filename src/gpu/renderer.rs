@@ -12,6 +12,7 @@ use super::volume::{VolumePass, VolumeTexture};
 use super::{GpuContext, GpuError};
 use crate::model::GridSpec;
 use crate::model::cartesian::CartesianExpansion;
+use crate::model::octree::box_corners;
 use crate::model::{Molecule, VolumeGrid};
 use crate::scene::translucency::TranslucentSurface;
 use crate::scene::{AtomColors, AtomStyle, Camera, RenderSettings, VolumeSettings};
@@ -126,7 +127,7 @@ impl Layer {
     /// The world-space box around everything the layer draws.
     fn bounds(&self) -> Option<(Vec3, Vec3)> {
         let volume = self.volume.volume().map(|v| v.grid_box.corners().to_vec()).unwrap_or_default();
-        let atoms = self.molecule_bounds.map(|(lo, hi)| corners(lo, hi)).unwrap_or_default();
+        let atoms = self.molecule_bounds.map(|(lo, hi)| box_corners(lo, hi).to_vec()).unwrap_or_default();
         let points: Vec<Vec3> =
             volume.into_iter().chain(atoms).map(|p| self.world_from_object.transform_point3(p)).collect();
         let first = *points.first()?;
@@ -137,10 +138,6 @@ impl Layer {
     fn drawers(&self) -> [&dyn Draw; 3] {
         [&self.atoms, &self.surfaces, &self.volume]
     }
-}
-
-fn corners(lo: Vec3, hi: Vec3) -> Vec<Vec3> {
-    (0..8).map(|i| Vec3::new([lo.x, hi.x][i & 1], [lo.y, hi.y][(i >> 1) & 1], [lo.z, hi.z][i >> 2])).collect()
 }
 
 /// Most objects one scene draws: the object field of a [`PickId`] has 6 bits.
@@ -321,12 +318,19 @@ impl Renderer {
         }
         let lists = (self.lists.surfaces > 0).then(|| self.lists.collect_bind()).flatten();
         let hidden = VolumeSettings { visible: false, ..VolumeSettings::default() };
+        // A later tile keeps what the first drew: only the clouds inside it are added, and the
+        // fragment lists of a frame drawn in one band.
+        let later_tile = frame.tile.is_some_and(|t| !t.first);
         let mut first_translucent = 0;
         for (n, layer) in self.layers.iter_mut().enumerate() {
             let view = ObjectView::new(&world, layer.world_from_object);
-            layer.atoms.prepare(ctx, &view, n as u32, frame.size);
+            // A later tile draws nothing opaque: the first tile's culling and level of detail
+            // stand (preparing them again would count frames the seen-last-frame lists skip).
+            if !later_tile {
+                layer.atoms.prepare(ctx, &view, n as u32, frame.size);
+            }
             let layer_lists = lists.filter(|_| layer.visible).map(|l| (l, self.transparency));
-            let lod = (frame.size, self.lod_scale);
+            let lod = (!later_tile).then_some((frame.size, self.lod_scale));
             layer.surfaces.prepare(ctx, &view, n as u32, lod, first_translucent, layer_lists);
             if layer.visible {
                 first_translucent += layer.surfaces.translucent().count();
@@ -341,9 +345,6 @@ impl Renderer {
         if !weighted {
             self.lists.bands = bands;
         }
-        // A later tile keeps what the first drew: only the clouds inside it are added, and the
-        // fragment lists of a frame drawn in one band.
-        let later_tile = frame.tile.is_some_and(|t| !t.first);
         let collects = oit && (bands > 1 || !later_tile);
         if collects && !weighted {
             self.lists.begin_frame(encoder);

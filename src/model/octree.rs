@@ -89,7 +89,8 @@ pub struct LodView {
 
 /// Most triangles a cluster holds: the topmost cells with at most this many are the units the
 /// GPU's occlusion test keeps or drops whole. Smaller ones are culled more finely but each
-/// costs a draw; measured on the 10⁵-atom SES (lavapipe), 512 was the fastest of 128–2048.
+/// costs a draw; measured on the 10⁵-atom SES (lavapipe), 128–1024 drew equally fast within
+/// the runs' spread.
 pub const CLUSTER_TRIANGLES: u32 = 256;
 
 /// A run of triangles drawn together: neighbouring leaves of one cluster.
@@ -116,12 +117,8 @@ impl LodView {
     /// view shows under `max_px` pixels anywhere in the box `lo..hi`: measured at its nearest
     /// corner. 0 (the mesh itself) when the eye is in the box's plane or nearer.
     pub fn coarsest_within(&self, errors: impl IntoIterator<Item = f32>, (lo, hi): (Vec3, Vec3), max_px: f32) -> usize {
-        let nearest = (0..8)
-            .map(|k| {
-                let p = Vec3::new([lo.x, hi.x][k & 1], [lo.y, hi.y][(k >> 1) & 1], [lo.z, hi.z][k >> 2]);
-                (self.clip_from_object * p.extend(1.0)).w
-            })
-            .fold(f32::INFINITY, f32::min);
+        let nearest =
+            box_corners(lo, hi).iter().map(|p| (self.clip_from_object * p.extend(1.0)).w).fold(f32::INFINITY, f32::min);
         if nearest <= 0.0 {
             return 0;
         }
@@ -426,16 +423,14 @@ impl SurfaceOctree {
     }
 }
 
+/// The eight corners of the box `lo..hi` (bit 0 of the index picks x, bit 1 y, bit 2 z).
+pub fn box_corners(lo: Vec3, hi: Vec3) -> [Vec3; 8] {
+    std::array::from_fn(|k| Vec3::new([lo.x, hi.x][k & 1], [lo.y, hi.y][(k >> 1) & 1], [lo.z, hi.z][k >> 2]))
+}
+
 /// Whether the box lies wholly outside one of the view's six clip planes.
 fn outside_frustum(m: &Mat4, lo: Vec3, hi: Vec3) -> bool {
-    let corners: [glam::Vec4; 8] = std::array::from_fn(|k| {
-        let p = Vec3::new(
-            if k & 1 == 0 { lo.x } else { hi.x },
-            if k & 2 == 0 { lo.y } else { hi.y },
-            if k & 4 == 0 { lo.z } else { hi.z },
-        );
-        *m * p.extend(1.0)
-    });
+    let corners = box_corners(lo, hi).map(|p| *m * p.extend(1.0));
     let all = |f: &dyn Fn(&glam::Vec4) -> bool| corners.iter().all(f);
     all(&|c| c.x < -c.w)
         || all(&|c| c.x > c.w)
@@ -453,12 +448,7 @@ fn faces_away(cell: &Cell, eye: Vec3) -> bool {
         return false;
     }
     let sin = (1.0 - cell.cone * cell.cone).max(0.0).sqrt();
-    (0..8).all(|k| {
-        let corner = Vec3::new(
-            if k & 1 == 0 { cell.lo.x } else { cell.hi.x },
-            if k & 2 == 0 { cell.lo.y } else { cell.hi.y },
-            if k & 4 == 0 { cell.lo.z } else { cell.hi.z },
-        );
+    box_corners(cell.lo, cell.hi).iter().all(|&corner| {
         let to_eye = (eye - corner).normalize_or_zero();
         cell.normal.dot(to_eye) < -sin
     })

@@ -46,25 +46,24 @@ pub fn levels(mesh: &Mesh, keep: f32, max_error: f32, count: usize) -> Vec<Simpl
         let c = (mesh.positions[t[0] as usize] + mesh.positions[t[1] as usize] + mesh.positions[t[2] as usize]) / 3.0;
         usize::from(c.x > mid.x) | usize::from(c.y > mid.y) << 1 | usize::from(c.z > mid.z) << 2
     };
-    // A vertex is on a cut when triangles of two octants use it.
-    let mut first_octant = vec![u8::MAX; mesh.positions.len()];
-    let mut locks = vec![false; mesh.positions.len()];
-    for t in mesh.indices.chunks_exact(3) {
-        let o = octant(t) as u8;
-        for &v in t {
-            match first_octant[v as usize] {
-                u8::MAX => first_octant[v as usize] = o,
-                seen if seen != o => locks[v as usize] = true,
-                _ => {}
-            }
-        }
-    }
     let mut out: Vec<Simplified> = Vec::new();
     while out.len() < count {
         let (previous, spent) = out.last().map_or((&mesh.indices, 0.0), |s| (&s.indices, s.error));
+        // A vertex is on a cut when triangles of two octants use it: found anew for each
+        // version, whose bigger triangles straddle vertices the finer one did not.
         let mut pieces = vec![Vec::new(); 8];
+        let mut first_octant = vec![u8::MAX; mesh.positions.len()];
+        let mut locks = vec![false; mesh.positions.len()];
         for t in previous.chunks_exact(3) {
-            pieces[octant(t)].extend_from_slice(t);
+            let o = octant(t);
+            pieces[o].extend_from_slice(t);
+            for &v in t {
+                match first_octant[v as usize] {
+                    u8::MAX => first_octant[v as usize] = o as u8,
+                    seen if usize::from(seen) != o => locks[v as usize] = true,
+                    _ => {}
+                }
+            }
         }
         let simplified: Vec<(Vec<u32>, f32)> = pieces
             .par_iter()
