@@ -63,8 +63,8 @@ macro_rules! mirror {
 #[test]
 fn rust_mirrors_match_the_wgsl_layouts() {
     use orbcloud::gpu::{
-        atoms::AtomGlobals, gto::FillParams, gto::GpuShell, isosurface::SurfaceUniforms, oit::GpuOptics, oit::ListInfo,
-        volume::VolumeUniforms,
+        atoms::AtomGlobals, gto::FillParams, gto::GpuShell, isosurface::SurfaceUniforms, occlusion::CullUniforms,
+        occlusion::GpuBatch, occlusion::PyramidSize, oit::GpuOptics, oit::ListInfo, volume::VolumeUniforms,
     };
     let mirrors = [
         mirror!(
@@ -128,6 +128,9 @@ fn rust_mirrors_match_the_wgsl_layouts() {
             ]
         ),
         mirror!("isosurface.wgsl", "SurfaceUniforms", SurfaceUniforms, [clip_from_world, eye, light, color, pick]),
+        mirror!("surface_cull.wgsl", "CullUniforms", CullUniforms, [clip_from_object, counts]),
+        mirror!("surface_cull.wgsl", "Batch", GpuBatch, [lo, first_index, hi, index_count, cluster]),
+        mirror!("depth_pyramid.wgsl", "PyramidSize", PyramidSize, [frame]),
         mirror!("isosurface.wgsl", "ListInfo", ListInfo, [width, capacity, surfaces, _pad]),
         mirror!("resolve.wgsl", "SurfaceOptics", GpuOptics, [a, b, c, d, f, g, glow_d, glow_f, glow_g, same_object]),
         mirror!("gto_fill.wgsl", "FillParams", FillParams, [world_from_grid, dims]),

@@ -13,8 +13,8 @@ use crate::model::octree::Batch;
 /// Mirror of `PyramidSize` in depth_pyramid_common.wgsl.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
-struct PyramidSize {
-    frame: [u32; 4],
+pub struct PyramidSize {
+    pub frame: [u32; 4],
 }
 
 /// Pixels on a tile's side, and tiles on a block's (`PYRAMID_TILE`, `PYRAMID_BLOCK`).
@@ -168,20 +168,20 @@ fn compute_pipeline(
 /// Mirror of `CullUniforms` in surface_cull.wgsl.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
-struct CullUniforms {
-    clip_from_object: [[f32; 4]; 4],
-    counts: [u32; 4],
+pub struct CullUniforms {
+    pub clip_from_object: [[f32; 4]; 4],
+    pub counts: [u32; 4],
 }
 
 /// Mirror of `Batch` in surface_cull.wgsl.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
-struct GpuBatch {
-    lo: [f32; 3],
-    first_index: u32,
-    hi: [f32; 3],
-    index_count: u32,
-    cluster: [u32; 4],
+pub struct GpuBatch {
+    pub lo: [f32; 3],
+    pub first_index: u32,
+    pub hi: [f32; 3],
+    pub index_count: u32,
+    pub cluster: [u32; 4],
 }
 
 /// Bytes of one indexed indirect draw (`DrawArgs`).
