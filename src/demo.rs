@@ -7,7 +7,7 @@ use crate::formats::scan::ScanFile;
 use crate::formats::{self, LoadError};
 use crate::model::Document;
 use crate::model::orbitals::{Quantity, Spin};
-use crate::scene::{IsoLevel, IsosurfaceSettings, ObjectState, OpticsPreset};
+use crate::scene::{IsoLevel, IsosurfaceSettings, ObjectState, OpticsPreset, QuantityState, Source, VolumeSettings};
 
 /// Formaldehyde's HOMO on a 48³ grid, written by scripts/make_assets.py (PySCF).
 const DEMO_CUBE_GZ: &[u8] = include_bytes!("../assets/demo.cube.gz");
@@ -69,32 +69,53 @@ pub const CYCLOADDITION_NAME: &str = "diene + SO₂ (bundled)";
 /// the side and a little above, the diene's π lobes rising to SO₂'s.
 pub const CYCLOADDITION_VIEW: (f32, f32) = (0.5, -1.35);
 
-/// The diene + SO₂ scene: butadiene's HOMO and SO₂'s LUMO as translucent isosurfaces, each
-/// molecule its own object in one frame, so where the lobes meet they glow.
+/// The diene + SO₂ scene as Koide & Miyata draw it: each molecule its own object in one frame,
+/// showing its total density and its frontier orbital (butadiene's HOMO, SO₂'s LUMO) as
+/// translucent isosurfaces, no clouds; where the orbitals meet they glow.
 pub fn cycloaddition() -> Result<Vec<(Document, ObjectState)>, LoadError> {
     let parts = [
         ("butadiene.molden.gz", BUTADIENE_MOLDEN_GZ, false, [0.9, 0.2, 0.12], [0.15, 0.35, 0.95]),
         ("so2.molden.gz", SO2_MOLDEN_GZ, true, [0.95, 0.7, 0.15], [0.2, 0.8, 0.4]),
     ];
+    let surface = |level, positive_color, negative_color, density_color| IsosurfaceSettings {
+        visible: true,
+        level: IsoLevel::Absolute(level),
+        positive_color,
+        negative_color,
+        density_color,
+        translucent: true,
+        optics: OpticsPreset::Koide,
+        ..IsosurfaceSettings::default()
+    };
     parts
         .into_iter()
         .map(|(name, bytes, lumo, positive, negative)| {
             let doc = formats::load_bytes(Path::new(name), bytes)?;
             let wf = doc.wavefunction.as_ref();
             let orbital = wf.and_then(|wf| if lumo { wf.lumo(Spin::Alpha) } else { wf.homo(Spin::Alpha) });
-            let mut state = ObjectState { quantity: orbital.map(Quantity::Orbital), ..ObjectState::default() };
-            let s = &mut state.settings;
-            s.volume.visible = false;
-            s.iso = IsosurfaceSettings {
+            let quantity = |source, iso| QuantityState {
+                source,
                 visible: true,
-                level: IsoLevel::Absolute(0.03),
-                positive_color: positive,
-                negative_color: negative,
-                translucent: true,
-                optics: OpticsPreset::Koide,
-                ..IsosurfaceSettings::default()
+                cloud: VolumeSettings { visible: false, ..VolumeSettings::default() },
+                isosurfaces: vec![iso],
             };
+            let density = quantity(
+                Source::Wavefunction(Quantity::Density),
+                surface(DEMO_DENSITY_LEVEL, positive, negative, [0.62, 0.66, 0.72]),
+            );
+            let mut state = ObjectState { quantities: vec![density], ..ObjectState::default() };
+            if let Some(i) = orbital {
+                let iso = surface(DEMO_ORBITAL_LEVEL, positive, negative, positive);
+                state.quantities.push(quantity(Source::Wavefunction(Quantity::Orbital(i)), iso));
+                state.selected = 1;
+            }
             Ok((doc, state))
         })
         .collect()
 }
+
+/// The demo's density surface (a.u.): close around the nuclei, so the orbitals' lobes stand out
+/// of it.
+const DEMO_DENSITY_LEVEL: f32 = 0.08;
+/// The demo's orbital surfaces, ψ = ±value (a.u.).
+const DEMO_ORBITAL_LEVEL: f32 = 0.03;

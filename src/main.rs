@@ -23,6 +23,8 @@ use rayon::prelude::*;
 
 #[path = "cli/molsurface.rs"]
 mod molsurface_cli;
+#[path = "cli/quantities.rs"]
+mod quantities_cli;
 #[path = "cli/scan.rs"]
 mod scan_cli;
 #[path = "cli/structure.rs"]
@@ -612,7 +614,9 @@ fn gpu(lavapipe: bool) -> Result<GpuContext> {
 
 fn main() -> Result<()> {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
-    let cli = Cli::parse();
+    // Each quantity after the first comes with its own options ([`quantities_cli`]).
+    let (line, later) = quantities_cli::split(std::env::args_os().collect())?;
+    let cli = Cli::parse_from(line);
     match cli.command {
         None => Ok(orbcloud::app::run(cli.files, cli.demo.map(DemoArg::demo))?),
         Some(Command::Viewer { files, demo }) => Ok(orbcloud::app::run(files, demo.map(DemoArg::demo))?),
@@ -632,6 +636,17 @@ fn main() -> Result<()> {
             // Arguments that depend on the file are checked before any GPU work.
             let camera = args.view.camera(&doc)?;
             let volume = args.view.volume_index(&doc)?;
+            if !later.is_empty() {
+                let later = quantities_cli::parse_later(&later)?;
+                if args.pick.is_some() {
+                    bail!("--pick reads one quantity's picture: give one quantity option");
+                }
+                let ctx = gpu(args.lavapipe)?;
+                let img = quantities_cli::render(&ctx, doc, &args, &later, &camera)?;
+                img.save(&args.output).with_context(|| format!("writing {}", args.output.display()))?;
+                eprintln!("wrote {} ({}x{}, {})", args.output.display(), img.width(), img.height(), ctx.describe());
+                return Ok(());
+            }
             let ctx = gpu(args.lavapipe)?;
             let mut settings = args.view.settings();
             let mut h = Headless::new(&ctx, &doc, volume, &settings, args.view.size)?;

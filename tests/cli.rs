@@ -456,3 +456,64 @@ fn molecular_surfaces_are_written_and_rendered() {
         "{said}"
     );
 }
+
+/// Benzene's RHF/6-31G* wavefunction (tests/fixtures/wavefunctions).
+fn benzene() -> String {
+    concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/wavefunctions/benzene_631gs.molden").to_string()
+}
+
+fn render_png(args: &[&str]) -> (image::RgbaImage, String) {
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("out.png");
+    let mut all = vec!["render", "--lavapipe", "-o", png.to_str().unwrap()];
+    all.extend_from_slice(args);
+    let out = orbcloud(&all);
+    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+    assert!(out.status.success(), "{args:?}: {stderr}");
+    (image::open(&png).unwrap().to_rgba8(), stderr)
+}
+
+/// Mean absolute difference per channel, 0..255.
+fn mean_difference(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
+    assert_eq!(a.dimensions(), b.dimensions());
+    let sum: u64 =
+        a.pixels().zip(b.pixels()).map(|(p, q)| (0..3).map(|k| p[k].abs_diff(q[k]) as u64).sum::<u64>()).sum();
+    sum as f64 / (3 * a.width() * a.height()) as f64
+}
+
+#[test]
+fn render_draws_several_quantities_of_one_file_and_panes_side_by_side() {
+    let file = benzene();
+    let size = ["--size", "160x120"];
+    let one = |q: &[&str]| render_png(&[&[file.as_str()][..], &size, q].concat()).0;
+    // The density's translucent surface with the HOMO's inside it: both quantities are drawn.
+    let surfaces = ["--iso", "0.05", "--translucent", "--no-volume"];
+    let density = one(&[&["--density"][..], &surfaces].concat());
+    let homo = one(&[&["--orbital", "homo"][..], &surfaces].concat());
+    let (both, said) = render_png(
+        &[&[file.as_str()][..], &size, &["--density"], &surfaces, &["--orbital", "homo"], &surfaces].concat(),
+    );
+    assert!(said.contains("pane 1: total density + HOMO"), "{said}");
+    assert!(mean_difference(&both, &density) > 1.0, "the HOMO shows: {}", mean_difference(&both, &density));
+    assert!(mean_difference(&both, &homo) > 1.0, "the density shows: {}", mean_difference(&both, &homo));
+    // Clouds of both: each quantity's own options (here the HOMO's colours) are its own.
+    let (clouds, _) = render_png(&[&[file.as_str()][..], &size, &["--density", "--orbital", "homo"]].concat());
+    let (recoloured, _) =
+        render_png(&[&[file.as_str()][..], &size, &["--density", "--orbital", "homo", "--colors", "gold"]].concat());
+    assert!(mean_difference(&clouds, &recoloured) > 0.5, "the second quantity's colours apply to it");
+    // HOMO | LUMO side by side, one camera: each pane is what its quantity alone draws.
+    let (beside, said) =
+        render_png(&[file.as_str(), "--size", "320x120", "--orbital", "homo", "--beside", "--orbital", "lumo"]);
+    assert!(said.contains("pane 1: HOMO") && said.contains("pane 2: LUMO"), "{said}");
+    assert_eq!(beside.dimensions(), (320, 120));
+    let left = image::imageops::crop_imm(&beside, 0, 0, 160, 120).to_image();
+    let right = image::imageops::crop_imm(&beside, 160, 0, 160, 120).to_image();
+    let (lumo, homo) = (one(&["--orbital", "lumo"]), one(&["--orbital", "homo"]));
+    assert!(mean_difference(&left, &homo) < 0.5, "left pane: {}", mean_difference(&left, &homo));
+    assert!(mean_difference(&right, &lumo) < 0.5, "right pane: {}", mean_difference(&right, &lumo));
+    assert!(mean_difference(&left, &right) > 2.0, "HOMO and LUMO differ");
+    // Options of the whole picture after the second quantity are refused, with the reason.
+    let out = orbcloud(&["render", &file, "-o", "x.png", "--orbital", "homo", "--orbital", "lumo", "--size", "9x9"]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--size applies to the whole picture"));
+}

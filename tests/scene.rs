@@ -9,7 +9,7 @@ use orbcloud::gpu::frame::PickId;
 use orbcloud::gpu::{FrameInput, GpuContext, OffscreenTarget, Renderer};
 use orbcloud::headless::show_object;
 use orbcloud::model::Document;
-use orbcloud::scene::{Camera, IsoLevel, ObjectState, Placement, RenderSettings, VolumeSettings};
+use orbcloud::scene::{Camera, IsoLevel, ObjectState, Placement, RenderSettings, Source, VolumeSettings};
 
 const SIZE: [u32; 2] = [256, 144];
 
@@ -17,12 +17,14 @@ const SIZE: [u32; 2] = [256, 144];
 /// turned 90° about y.
 fn two_objects() -> (Document, [ObjectState; 2]) {
     let doc = scene(Some(p_orbital(40, false)));
-    let mut surfaces = ObjectState::default();
-    surfaces.settings.volume.visible = false;
-    surfaces.settings.iso.visible = true;
-    surfaces.settings.iso.level = IsoLevel::Absolute(0.3);
-    let mut cloud = ObjectState::default();
-    cloud.settings.volume.slices = 96;
+    let mut s = RenderSettings::default();
+    s.volume.visible = false;
+    s.iso.visible = true;
+    s.iso.level = IsoLevel::Absolute(0.3);
+    let surfaces = ObjectState::of_settings(Some(Source::Volume(0)), &s);
+    let mut s = RenderSettings::default();
+    s.volume.slices = 96;
+    let mut cloud = ObjectState::of_settings(Some(Source::Volume(0)), &s);
     cloud.placement = Placement { offset: [14.0, 0.0, 0.0], rotation_deg: [0.0, 90.0, 0.0] };
     (doc, [surfaces, cloud])
 }
@@ -76,7 +78,7 @@ fn two_placed_objects_draw_and_pick_in_one_frame() {
         assert_eq!(triangles > 0, n == 0, "object {n}: isosurfaces only where asked");
     }
     assert_eq!(renderer.layer_count(), 2);
-    let clouds = [states[0].settings.volume, states[1].settings.volume];
+    let clouds = [states[0].quantities[0].cloud, states[1].quantities[0].cloud];
     let img = draw(&ctx, &mut renderer, &clouds);
     assert_golden("scene_two_objects", &img);
     let (left, right) = halves(&img);
@@ -146,7 +148,7 @@ fn a_placed_cloud_matches_the_same_cloud_moved_in_its_grid() {
     let mut moved = Renderer::new(&ctx);
     let plain = ObjectState { placement: Placement::default(), ..states[1].clone() };
     show_object(&ctx, moved.main(), &shifted_doc, &plain).unwrap();
-    let clouds = [states[1].settings.volume];
+    let clouds = [states[1].quantities[0].cloud];
     let (a, b) = (draw(&ctx, &mut placed, &clouds), draw(&ctx, &mut moved, &clouds));
     let diff: f64 =
         a.pixels().zip(b.pixels()).map(|(p, q)| (0..3).map(|c| p[c].abs_diff(q[c]) as f64).sum::<f64>()).sum::<f64>()
@@ -193,7 +195,7 @@ fn a_frame_drawn_in_bands_equals_the_frame_drawn_at_once() {
     for (n, state) in states.iter().enumerate() {
         show_object(&ctx, renderer.layer_mut(&ctx, n), &doc, state).unwrap();
     }
-    let clouds = [states[0].settings.volume, states[1].settings.volume];
+    let clouds = [states[0].quantities[0].cloud, states[1].quantities[0].cloud];
     let whole = draw(&ctx, &mut renderer, &clouds);
     let target = OffscreenTarget::new(&ctx.device, SIZE);
     let camera = camera();

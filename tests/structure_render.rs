@@ -85,7 +85,16 @@ fn a_selection_shows_only_what_it_names() {
         let target = OffscreenTarget::new(&ctx.device, SIZE);
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
         let cam = default_camera(&doc);
-        r.render(&ctx, &mut encoder, &target.color_view, &FrameInput::single(&cam, &state.settings, SIZE));
+        r.render(
+            &ctx,
+            &mut encoder,
+            &target.color_view,
+            &FrameInput::single(
+                &cam,
+                &state.render_settings(0, orbcloud::scene::RenderSettings::default().background),
+                SIZE,
+            ),
+        );
         ctx.queue.submit([encoder.finish()]);
         (target.read_rgba(&ctx.device, &ctx.queue).unwrap(), r)
     };

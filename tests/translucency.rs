@@ -47,11 +47,9 @@ fn translucent(level: f32, color: [f32; 3]) -> IsosurfaceSettings {
 }
 
 fn object(iso: IsosurfaceSettings, atoms: AtomStyle) -> ObjectState {
-    let mut state = ObjectState::default();
-    state.settings.iso = iso;
-    state.settings.volume.visible = false;
-    state.settings.atoms = atoms;
-    state
+    let mut settings = orbcloud::scene::RenderSettings { atoms, iso, ..Default::default() };
+    settings.volume.visible = false;
+    ObjectState::of_settings(Some(orbcloud::scene::Source::Volume(0)), &settings)
 }
 
 fn camera() -> Camera {
@@ -214,9 +212,10 @@ fn surfaces_inside_a_cloud_match_a_cpu_reference_that_walks_both() {
     let mut iso = translucent(0.3 * max, [0.85, 0.1, 0.08]);
     iso.negative_color = [0.08, 0.25, 0.85];
     let mut state = object(iso, AtomStyle::Hidden);
-    state.settings.volume.visible = true;
-    state.settings.volume.slices = 48;
-    state.settings.volume.k1 = 0.5;
+    let cloud = &mut state.quantities[0].cloud;
+    cloud.visible = true;
+    cloud.slices = 48;
+    cloud.k1 = 0.5;
     let mut renderer = Renderer::new(&ctx);
     show_object(&ctx, renderer.main(), &doc, &state).expect("orbital");
     let cam = camera();
@@ -224,7 +223,7 @@ fn surfaces_inside_a_cloud_match_a_cpu_reference_that_walks_both() {
     let frame = FrameInput {
         camera: &cam,
         background: BACKGROUND,
-        clouds: std::slice::from_ref(&state.settings.volume),
+        clouds: std::slice::from_ref(&state.quantities[0].cloud),
         size: SIZE,
         tile: None,
     };
@@ -232,7 +231,7 @@ fn surfaces_inside_a_cloud_match_a_cpu_reference_that_walks_both() {
     let gpu = target.read_rgba(&ctx.device, &ctx.queue).expect("read back");
     let (dump, _) = renderer.read_translucency(&ctx).expect("fragments read back");
     let clip = renderer.clip_from_world(&cam, SIZE).as_dmat4();
-    let settings = orbcloud::scene::RenderSettings { background: BACKGROUND, ..state.settings };
+    let settings = state.render_settings(0, BACKGROUND);
     let cloud = CloudReference::new(&grid, &cam, &settings);
     // `interleaved`: each sample after the fragments nearer than it; else every fragment in
     // front of the cloud (what compositing the surfaces over the finished cloud would give).
@@ -284,10 +283,15 @@ fn the_diene_so2_demo_and_nested_shells_match_their_golden_images() {
     let ctx = lavapipe();
     let size = [240, 180];
     let scene = orbcloud::demo::cycloaddition().expect("the bundled demo loads");
-    let quantities: Vec<_> = scene.iter().map(|(_, s)| s.quantity).collect();
-    // Butadiene's HOMO is MO 15, SO₂'s LUMO MO 17 (scripts/make_cycloaddition_demo.py).
-    use orbcloud::model::orbitals::Quantity::Orbital;
-    assert_eq!(quantities, [Some(Orbital(14)), Some(Orbital(16))]);
+    let quantities: Vec<Vec<_>> = scene.iter().map(|(_, s)| s.quantities.iter().map(|q| q.source).collect()).collect();
+    // Butadiene's HOMO is MO 15, SO₂'s LUMO MO 17 (scripts/make_cycloaddition_demo.py); each
+    // inside its molecule's total density.
+    use orbcloud::model::orbitals::Quantity::{Density, Orbital};
+    use orbcloud::scene::Source::Wavefunction;
+    assert_eq!(
+        quantities,
+        [[Wavefunction(Density), Wavefunction(Orbital(14))], [Wavefunction(Density), Wavefunction(Orbital(16))]]
+    );
     let mut renderer = Renderer::new(&ctx);
     let (clouds, bounds) = show_scene(&ctx, &mut renderer, &scene, 48).expect("scene shown");
     let (lo, hi) = bounds.expect("bounds");
@@ -298,7 +302,7 @@ fn the_diene_so2_demo_and_nested_shells_match_their_golden_images() {
     let frame = FrameInput { camera: &cam, background: BACKGROUND, clouds: &clouds, size, tile: None };
     let stats = draw_exact(&ctx, &mut renderer, &target.color_view, &frame).expect("translucent surfaces");
     let (dump, _) = renderer.read_translucency(&ctx).expect("fragments");
-    assert_eq!(dump.surfaces.len(), 4, "± lobes of two orbitals");
+    assert_eq!(dump.surfaces.len(), 6, "two densities, and the ± lobes of two orbitals");
     assert!(stats.fits() && stats.deep_pixels == 0, "{stats:?}");
     common::assert_golden("translucent_diene_so2", &target.read_rgba(&ctx.device, &ctx.queue).expect("read back"));
 

@@ -57,21 +57,24 @@ fn starts_on_the_demo_and_changes_controls() {
     let app = h.state();
     assert_eq!(app.doc().volumes.len(), 1, "the demo cube has one orbital");
     assert_eq!(app.doc().molecule.atoms.len(), 4, "formaldehyde");
-    assert_eq!(app.view.settings.volume.mode, SliceMode::ViewAligned);
+    assert_eq!(app.selected_quantity().unwrap().cloud.mode, SliceMode::ViewAligned);
 
     h.get_by_label("axis stacks").click();
     h.run_steps(2);
-    assert_eq!(h.state().view.settings.volume.mode, SliceMode::AxisAligned);
+    assert_eq!(h.state().selected_quantity().unwrap().cloud.mode, SliceMode::AxisAligned);
 
+    // Below the isosurfaces: scrolled into view first, as a user would.
+    h.get_by_label("Transfer function").scroll_to_me();
+    h.run_steps(20);
     h.get_by_label("Transfer function").click();
     h.run_steps(2);
     h.get_by_label("shapes").click();
     h.run_steps(2);
-    assert_eq!(h.state().view.settings.volume.transfer.kind, TransferKind::Shaped);
+    assert_eq!(h.state().selected_quantity().unwrap().cloud.transfer.kind, TransferKind::Shaped);
 
     h.get_by_label("show cloud").click();
     h.run_steps(2);
-    assert!(!h.state().view.settings.volume.visible);
+    assert!(!h.state().selected_quantity().unwrap().cloud.visible);
 }
 
 #[test]
@@ -114,6 +117,7 @@ fn a_bad_file_reports_an_error_and_keeps_the_open_document() {
 #[test]
 fn a_molden_file_opens_on_its_homo_and_the_browser_switches_orbitals() {
     use orbcloud::model::orbitals::Quantity;
+    use orbcloud::scene::Source::Wavefunction;
     let Some(dir) = common::refdata("viewer::a_molden_file_opens_on_its_homo_and_the_browser_switches_orbitals") else {
         return;
     };
@@ -135,17 +139,19 @@ fn a_molden_file_opens_on_its_homo_and_the_browser_switches_orbitals() {
     assert!(app.error.is_none(), "{:?}", app.error);
     let wf = app.doc().wavefunction.as_ref().expect("the Molden file loaded");
     let homo = wf.homo(orbcloud::model::Spin::Alpha).unwrap();
-    assert_eq!(app.orbitals.shown, Quantity::Orbital(homo), "opens on the HOMO");
+    let shown = |app: &OrbApp| app.selected_quantity().map(|q| q.source);
+    assert_eq!(shown(app), Some(Wavefunction(Quantity::Orbital(homo))), "opens on the HOMO");
     let lumo = wf.lumo(orbcloud::model::Spin::Alpha).unwrap();
     h.get_by_label_contains(&format!("MO {} ", lumo + 1)).click();
     h.run_steps(2);
-    assert_eq!(h.state().orbitals.shown, Quantity::Orbital(lumo));
+    assert_eq!(shown(h.state()), Some(Wavefunction(Quantity::Orbital(lumo))));
+    assert_eq!(h.state().active_object().unwrap().state.quantities.len(), 1, "a click switches, it does not add");
     h.get_by_label("per sample (direct)").click();
     h.run_steps(2);
-    assert!(h.state().orbitals.direct);
+    assert!(h.state().active_object().unwrap().state.evaluation.direct);
     h.get_by_label("total density").click();
     h.run_steps(2);
-    assert_eq!(h.state().orbitals.shown, Quantity::Density);
+    assert_eq!(shown(h.state()), Some(Wavefunction(Quantity::Density)));
     assert!(h.state().error.is_none(), "{:?}", h.state().error);
 }
 
@@ -269,7 +275,7 @@ fn isosurfaces_follow_the_slider_and_atoms_are_picked_and_measured() {
     h.run_steps(2);
     h.get_by_label("show ψ = ±value").click();
     wait_loaded(&mut h);
-    assert!(h.state().view.settings.iso.visible);
+    assert!(h.state().selected_quantity().unwrap().isosurfaces[0].visible);
     let first = h.state().status.clone();
     assert!(first.starts_with("isosurfaces: ") && !first.starts_with("isosurfaces: 0 "), "{first}");
     // Dragging the iso value changes the surfaces.
@@ -281,7 +287,7 @@ fn isosurfaces_follow_the_slider_and_atoms_are_picked_and_measured() {
     h.run_steps(1);
     h.drop_at(from + egui::vec2(slider.width() * 0.2, 0.0));
     wait_loaded(&mut h);
-    let level = h.state().view.settings.iso.level;
+    let level = h.state().selected_quantity().unwrap().isosurfaces[0].level;
     assert_ne!(level, orbcloud::scene::IsoLevel::Absolute(0.05), "the slider moved");
     assert_ne!(h.state().status, first, "the surfaces were cut anew: {}", h.state().status);
 
@@ -347,11 +353,11 @@ fn files_join_the_scene_are_measured_across_and_a_session_reopens_them() {
     assert!(offset[0] as f64 + lo.x > hi.x, "placed beside the first: {offset:?}");
     assert_eq!(app.world().molecule.atoms.len(), 8);
 
-    // Hide the active object's cloud from the scene panel; the other keeps its own.
-    h.get_by_label("cloud").click();
+    // Hide the active object's cloud; the other keeps its own.
+    h.get_by_label("show cloud").click();
     h.run_steps(2);
-    assert!(!h.state().objects[1].state.settings.volume.visible);
-    assert!(h.state().objects[0].state.settings.volume.visible);
+    assert!(!h.state().objects[1].state.quantities[0].cloud.visible);
+    assert!(h.state().objects[0].state.quantities[0].cloud.visible);
     // An oxygen of each molecule: the distance between them is the placement's offset.
     let (o1, o2) = (h.state().atom_on_screen(1).unwrap(), h.state().atom_on_screen(5).unwrap());
     click_at(&mut h, o1, false);
@@ -362,12 +368,12 @@ fn files_join_the_scene_are_measured_across_and_a_session_reopens_them() {
     // A second isosurface for object 2.
     h.get_by_label("+ isosurface").click();
     wait_loaded(&mut h);
-    assert_eq!(h.state().objects[1].state.isosurfaces.len(), 1);
+    assert_eq!(h.state().objects[1].state.quantities[0].isosurfaces.len(), 2);
     assert!(h.state().status.starts_with("isosurfaces: "), "{}", h.state().status);
 
     // Move object 2 and turn it; save; replace the scene with the demo file; reopen.
     let moved = orbcloud::scene::Placement { offset: [20.0, 1.0, 0.0], rotation_deg: [0.0, 0.0, 45.0] };
-    h.state_mut().place(1, moved);
+    h.state_mut().objects[1].state.placement = moved;
     h.run_steps(1);
     let session = dir.path().join("scene.orbcloud.toml");
     h.state_mut().save_session(&session);
@@ -386,14 +392,14 @@ fn files_join_the_scene_are_measured_across_and_a_session_reopens_them() {
 
     // Closing keeps the scene; the next start takes its settings for new files and offers it.
     let last = dir.path().join("config/last.orbcloud.toml");
-    h.state_mut().view.settings.background = [0.9, 0.9, 0.9];
-    h.state_mut().view.settings.volume.k1 = 0.55;
+    h.state_mut().view.background = [0.9, 0.9, 0.9];
+    h.state_mut().objects[1].state.quantities[0].cloud.k1 = 0.55;
     h.state_mut().keep_session_in(last.clone());
     h.state_mut().save_last_session();
     let mut next = harness();
     next.state_mut().keep_session_in(last.clone());
     let app = next.state();
-    assert_eq!(app.view.settings.background, [0.9, 0.9, 0.9]);
+    assert_eq!(app.view.background, [0.9, 0.9, 0.9]);
     assert_eq!(app.defaults.volume.k1, 0.55, "new files start with the last settings");
     assert_eq!(orbcloud::app::session::read(&last).unwrap().objects.len(), 2);
     next.run_steps(2);
@@ -511,10 +517,10 @@ fn direct_mode_draws_in_bands_and_the_window_keeps_answering() {
     let ctx = h.ctx.clone();
     h.state_mut().open_as(benzene, orbcloud::app::Opening::Replace, &ctx);
     wait_loaded(&mut h);
-    h.state_mut().view.settings.volume.slices = 48;
+    h.state_mut().objects[0].state.quantities[0].cloud.slices = 48;
     h.get_by_label("per sample (direct)").click();
     wait_loaded(&mut h);
-    assert!(h.state().orbitals.direct);
+    assert!(h.state().objects[0].state.evaluation.direct);
     // 96 basis functions per sample: the frame is drawn band by band, each UI frame short.
     let (mut steps, mut slowest, mut seen) = (0, 0.0f64, Vec::new());
     h.run_steps(1);
@@ -592,8 +598,12 @@ fn the_translucent_demo_opens_two_molecules_in_exact_order_from_the_demos_menu()
     let note = app.fragment_note().unwrap();
     assert!(note.contains("exact order"), "{note}");
     for object in &app.objects {
-        let iso = object.state.settings.iso;
-        assert!(iso.visible && iso.translucent, "{:?}", object.doc.source);
+        let sources: Vec<_> = object.state.quantities.iter().map(|q| q.source).collect();
+        assert_eq!(sources.len(), 2, "{:?}: its density and its orbital, {sources:?}", object.doc.source);
+        for q in &object.state.quantities {
+            let iso = q.isosurfaces[0];
+            assert!(iso.visible && iso.translucent && !q.cloud.visible, "{:?}", object.doc.source);
+        }
     }
     // The translucent controls of the active object's isosurface.
     h.get_by_label("translucent");
@@ -627,7 +637,7 @@ fn a_lost_device_brings_the_scene_back_on_a_new_device_without_reading_files_aga
     assert!(Arc::ptr_eq(&resumed[0], &docs[0]), "the document itself, not read again");
     assert_eq!(app.view.camera, camera);
     // And it draws: the view holds the cube's cloud on the new device.
-    next.get_by_label("cloud");
+    next.get_by_label("show cloud");
 }
 
 #[test]
@@ -648,7 +658,7 @@ fn a_structure_gets_a_molecular_surface_from_the_scene_panel_that_follows_its_se
     let state = h.state().objects[0].state.surface;
     assert_eq!(state.choice, orbcloud::scene::SurfaceChoice::SolventExcluded);
     let all = h.state().status.clone();
-    assert!(all.starts_with("isosurfaces: ") && !all.starts_with("isosurfaces: 0 "), "{all}");
+    assert!(all.starts_with("molecular surface: ") && !all.starts_with("molecular surface: 0 "), "{all}");
     // The surface covers the atoms: what lies under an atom's centre is the surface.
     let atom = h.state().atom_on_screen(0).expect("an atom on screen");
     h.hover_at(atom);
@@ -656,9 +666,8 @@ fn a_structure_gets_a_molecular_surface_from_the_scene_panel_that_follows_its_se
     assert!(matches!(h.state().hovered(), Some(PickId::Surface { object: 0, .. })), "{:?}", h.state().hovered());
     // Leaving the waters out wraps fewer atoms: fewer triangles.
     h.state_mut().objects[0].state.selection = "not resn HOH".into();
-    h.state_mut().refresh_isosurfaces(0);
     wait_loaded(&mut h);
-    let count = |s: &str| s.split_whitespace().nth(1).and_then(|n| n.parse::<usize>().ok()).expect(s);
+    let count = |s: &str| s.split_whitespace().nth(2).and_then(|n| n.parse::<usize>().ok()).expect(s);
     let protein = h.state().status.clone();
     assert!(count(&protein) < count(&all), "{protein} vs {all}");
     // Turning it off leaves no surface.

@@ -3,7 +3,7 @@
 //! a CPU rasteriser fewer pixels too, which the texture filter scales up. The full picture
 //! returns with the first frame after.
 
-use crate::scene::RenderSettings;
+use crate::scene::VolumeSettings;
 
 /// Slices per view at most while interacting.
 pub const INTERACTIVE_SLICES: u32 = 64;
@@ -100,10 +100,10 @@ impl Detail {
         size.map(|s| ((s as f64 * scale).floor() as u32).max(1))
     }
 
-    /// `settings` with the slice count capped.
-    pub fn apply(&self, mut settings: RenderSettings) -> RenderSettings {
-        settings.volume.slices = settings.volume.slices.min(self.max_slices);
-        settings
+    /// `cloud` with the slice count capped.
+    pub fn cloud(&self, mut cloud: VolumeSettings) -> VolumeSettings {
+        cloud.slices = cloud.slices.min(self.max_slices);
+        cloud
     }
 }
 
@@ -122,13 +122,13 @@ mod tests {
         let d = Detail::for_frame(false, wgpu::DeviceType::Cpu, 2);
         assert_eq!(d, Detail::FULL);
         assert_eq!(d.render_size([1000, 700]), [1000, 700]);
-        assert_eq!(d.apply(RenderSettings::default()).volume.slices, RenderSettings::default().volume.slices);
+        assert_eq!(d.cloud(VolumeSettings::default()).slices, VolumeSettings::default().slices);
     }
 
     #[test]
     fn a_cpu_adapter_draws_fewer_pixels_while_interacting() {
         let d = Detail::for_frame(true, wgpu::DeviceType::Cpu, 2);
-        assert_eq!(d.apply(RenderSettings::default()).volume.slices, INTERACTIVE_SLICES);
+        assert_eq!(d.cloud(VolumeSettings::default()).slices, INTERACTIVE_SLICES);
         let [w, h] = d.render_size([510, 510]);
         assert!(w * h <= CPU_INTERACTIVE_PIXELS / 2 && w * h > CPU_INTERACTIVE_PIXELS / 2 - 2 * 256, "{w}x{h}");
         assert_eq!(w, h, "aspect kept");
@@ -156,6 +156,6 @@ mod tests {
     fn a_gpu_draws_every_pixel_with_fewer_slices() {
         let d = Detail::for_frame(true, wgpu::DeviceType::DiscreteGpu, 1);
         assert_eq!(d.render_size([2560, 1440]), [2560, 1440]);
-        assert_eq!(d.apply(RenderSettings::default()).volume.slices, INTERACTIVE_SLICES);
+        assert_eq!(d.cloud(VolumeSettings::default()).slices, INTERACTIVE_SLICES);
     }
 }

@@ -19,13 +19,12 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use crate::gpu::{GpuContext, context::device_descriptor};
-use crate::headless::WavefunctionView;
 use crate::headless::default_camera;
 use crate::model::{Atom, Document, Molecule};
 use crate::scene::{ObjectState, RenderSettings, ViewPreset};
 use loader::LoadJob;
 use scan::{ScanFailure, ScanJob, ScanSource, ScanView};
-pub use state::{OrbitalView, ViewState};
+pub use state::ViewState;
 use viewport::Viewport;
 
 /// A bundled demo the viewer can open.
@@ -126,9 +125,16 @@ pub fn wgpu_setup(lavapipe: bool) -> egui_wgpu::WgpuSetup {
 pub struct SceneObject {
     /// Shared with the background jobs that evaluate and cut it.
     pub doc: Arc<Document>,
+    /// The one source of truth for what the object shows: the panels edit it in place.
     pub state: ObjectState,
-    /// The orbital browser's choices (documents with a wavefunction).
-    pub orbitals: OrbitalView,
+}
+
+/// A change to the scene's list of objects, asked for in a panel and made after the frame's
+/// edits are applied (so the states compared before and after are those of the same objects).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SceneEdit {
+    Select(usize),
+    Remove(usize),
 }
 
 /// How a file being loaded joins the scene.
@@ -171,13 +177,15 @@ pub struct OrbApp {
     pub objects: Vec<SceneObject>,
     /// The object the side panel and the orbital browser edit.
     pub active: usize,
-    /// The camera, and the active object's settings as the side panel edits them (written back
-    /// to the object every frame).
+    /// The camera, the background and the labels: what is the scene's, not an object's.
     pub view: ViewState,
-    /// The active object's orbital browser.
-    pub orbitals: OrbitalView,
     /// What a newly opened object starts with (kept between runs).
     pub defaults: RenderSettings,
+    /// Changes to the list of objects asked for this frame ([`SceneEdit`]).
+    pub pending: Vec<SceneEdit>,
+    /// Each object's state as the GPU shows it: what the next frame's edits are compared with
+    /// ([`Self::apply_changes`]), wherever they came from (a panel, a test, a script).
+    applied: Vec<ObjectState>,
     /// Whether *Open…* and dropped files replace the scene instead of adding to it.
     pub open_replaces: bool,
     scroll_to_frontier: bool,
@@ -344,8 +352,9 @@ impl OrbApp {
             objects: Vec::new(),
             active: 0,
             view: ViewState::default(),
-            orbitals: OrbitalView::default(),
             defaults: RenderSettings::default(),
+            pending: Vec::new(),
+            applied: Vec::new(),
             open_replaces: false,
             scroll_to_frontier: false,
             viewport,
@@ -387,14 +396,34 @@ impl OrbApp {
         &self.world
     }
 
-    /// The σ of the grid the active object shows (what isosurface levels in σ refer to) and
-    /// whether its values are signed (an orbital: two surfaces).
+    /// The values the active object's selected quantity shows, once they are there.
+    pub fn shown_values(&self) -> Option<&crate::model::VolumeGrid> {
+        let o = self.objects.get(self.active)?;
+        self.viewport.as_ref()?.shown_grid(self.active, o.state.selected, &o.doc, &o.state)
+    }
+
+    /// The σ of the grid the active object's selected quantity shows (what isosurface levels
+    /// in σ refer to) and whether its values are signed (an orbital: two surfaces).
     pub fn shown_grid(&self) -> (Option<f64>, bool) {
-        let computed = self.viewport.as_ref().and_then(|vp| vp.computed_grid(self.active));
-        match computed.or(self.doc().volumes.get(self.view.volume)) {
+        let signed = |q: &crate::scene::QuantityState| match q.source {
+            crate::scene::Source::Wavefunction(crate::model::orbitals::Quantity::Orbital(_)) => true,
+            crate::scene::Source::Wavefunction(_) => false,
+            crate::scene::Source::Volume(_) => true,
+        };
+        match self.shown_values() {
             Some(g) => (Some(g.stats.sigma), g.kind == crate::model::grid::ValueKind::Signed),
-            None => (None, true),
+            None => (None, self.objects.get(self.active).and_then(|o| o.state.selected_quantity()).is_none_or(signed)),
         }
+    }
+
+    /// The active object, when there is one.
+    pub fn active_object(&self) -> Option<&SceneObject> {
+        self.objects.get(self.active)
+    }
+
+    /// The quantity the side panel edits: the active object's selected one.
+    pub fn selected_quantity(&self) -> Option<&crate::scene::QuantityState> {
+        self.active_object()?.state.selected_quantity()
     }
 
     /// Where atom `atom` of the scene (numbered through every object, [`World`]) is drawn in
@@ -499,62 +528,56 @@ impl OrbApp {
     fn add_shared_object(&mut self, doc: Arc<Document>, how: Opening) {
         let restoring = matches!(how, Opening::Restore(_));
         let replace = how == Opening::Replace;
+        let defaults = self.defaults;
         let mut state = match how {
-            Opening::Restore(state) => *state,
+            Opening::Restore(mut state) => {
+                state.fit_to(&doc, &defaults);
+                *state
+            }
             _ => ObjectState {
                 path: (!doc.source.is_empty()).then(|| PathBuf::from(&doc.source)).filter(|p| p.exists()),
-                settings: RenderSettings { background: self.view.settings.background, ..self.defaults }.for_structure(
-                    doc.molecule.atoms.len(),
-                    doc.structure.as_ref().map_or(0, |s| s.structure.chains.len()),
-                ),
-                ..ObjectState::default()
+                ..ObjectState::opening(&doc, &defaults)
             },
         };
-        let keep = if replace { 0 } else { self.objects.len() };
+        if replace {
+            self.clear_scene();
+        }
+        let keep = self.objects.len();
         if !restoring && keep > 0 {
             // Beside the scene: 4 bohr past its largest x.
             let right = self.world.molecule.bounds().map_or(0.0, |(_, hi)| hi.x as f32);
             let lo = doc.bounds().map_or(glam::Vec3::ZERO, |(lo, _)| lo.as_vec3());
             state.placement = crate::scene::Placement::beside(right, lo, 4.0);
         }
-        if keep >= crate::gpu::renderer::MAX_LAYERS {
-            self.error = Some(format!("{}: a scene holds at most {} objects", doc.source, keep));
+        let Some(vp) = &mut self.viewport else { return };
+        if vp.room() < 1 + state.quantities.len() {
+            self.error = Some(format!("{}: the scene is full ({} objects and their quantities)", doc.source, keep));
             return;
         }
-        let Some(vp) = &mut self.viewport else { return };
         let note = match vp.set_object(keep, &doc, &state) {
             Ok(note) => note,
             Err(e) => {
+                vp.remove_object(keep);
                 self.error = Some(format!("{}: {e}", doc.source));
                 return;
             }
         };
-        if replace {
-            vp.truncate(1);
-        }
-        self.commit_active();
-        if replace {
-            self.objects.clear();
-            self.measurements = measure::Measurements::default();
-        }
         self.scan = None;
         self.status = note.unwrap_or_else(|| format!("opened {}", doc.source));
-        let mut orbitals = doc.wavefunction.as_ref().map(OrbitalView::for_wavefunction).unwrap_or_default();
-        if let Some(q) = state.quantity {
-            orbitals.shown = q;
-        }
         if let Some(path) = &state.path {
             files::remember(&mut self.recent, path, RECENT_FILES);
         }
-        self.objects.push(SceneObject { doc, state, orbitals });
-        self.load_active(self.objects.len() - 1);
-        self.auto_opacity(self.objects.len() - 1);
+        self.applied.push(state.clone());
+        self.objects.push(SceneObject { doc, state });
+        self.active = self.objects.len() - 1;
+        for k in 0..self.objects[self.active].state.quantities.len() {
+            self.auto_opacity(self.active, k);
+        }
         self.world = World::of(&self.objects);
         if !restoring {
             self.view.camera = self.scene_camera();
         }
         self.scroll_to_frontier = true;
-        self.show_wavefunction();
     }
 
     /// A camera that frames every object where it is placed, looking at the first one as a new
@@ -614,33 +637,11 @@ impl OrbApp {
         }
     }
 
-    /// Writes the panels' working copies (settings, volume, orbital choice) into the active
-    /// object.
-    fn commit_active(&mut self) {
-        if let Some(o) = self.objects.get_mut(self.active) {
-            o.state.settings = RenderSettings { background: self.view.settings.background, ..self.view.settings };
-            o.state.volume = self.view.volume;
-            o.state.quantity = Some(self.orbitals.shown);
-            o.orbitals = self.orbitals.clone();
-        }
-    }
-
     /// Makes object `n` the one the panels edit.
     pub fn select(&mut self, n: usize) {
         if n < self.objects.len() {
-            self.commit_active();
-            self.load_active(n);
+            self.active = n;
             self.scroll_to_frontier = true;
-        }
-    }
-
-    /// Points the panels' working copies at object `n` (without writing the old ones back).
-    fn load_active(&mut self, n: usize) {
-        self.active = n.min(self.objects.len().saturating_sub(1));
-        if let Some(o) = self.objects.get(self.active) {
-            self.view.settings = RenderSettings { background: self.view.settings.background, ..o.state.settings };
-            self.view.volume = o.state.volume;
-            self.orbitals = o.orbitals.clone();
         }
     }
 
@@ -649,66 +650,81 @@ impl OrbApp {
         if n >= self.objects.len() {
             return;
         }
-        self.commit_active();
         self.objects.remove(n);
+        self.applied.remove(n);
         if let Some(vp) = &mut self.viewport {
             vp.remove_object(n);
         }
         self.measurements = measure::Measurements::default();
         self.world = World::of(&self.objects);
-        let active = if n < self.active { self.active - 1 } else { self.active };
-        self.load_active(active);
+        self.active = if n < self.active { self.active - 1 } else { self.active };
+        self.active = self.active.min(self.objects.len().saturating_sub(1));
     }
 
-    /// Moves object `n` to `placement`.
-    pub fn place(&mut self, n: usize, placement: crate::scene::Placement) {
-        let Some(o) = self.objects.get_mut(n) else { return };
-        o.state.placement = placement;
-        if let Some(vp) = &mut self.viewport {
-            vp.set_placement(n, &placement);
+    /// Makes what the GPU shows follow each object's state after the edits since the last
+    /// call, as [`crate::scene::changes`] decides; called once a frame, after the panels.
+    pub fn apply_changes(&mut self) {
+        let mut moved = false;
+        for n in 0..self.objects.len().min(self.applied.len()) {
+            let (Some(vp), Some(o)) = (&mut self.viewport, self.objects.get(n)) else { break };
+            let was = std::mem::replace(&mut self.applied[n], o.state.clone());
+            let was = &was;
+            let changes = crate::scene::changes(was, &o.state);
+            if changes.is_empty() {
+                continue;
+            }
+            let mut notes = Vec::new();
+            if changes.layers {
+                notes.push(vp.relayout_quantities(n, &o.doc, was, &o.state));
+            }
+            for (k, q) in changes.quantities.iter().enumerate() {
+                if q.values {
+                    notes.push(vp.set_quantity(n, k, &o.doc, &o.state));
+                } else if q.isosurfaces {
+                    vp.update_isosurfaces(n, k, &o.doc, &o.state);
+                }
+            }
+            if changes.atoms {
+                vp.set_atom_look(n, &o.doc, &o.state);
+            }
+            if changes.surface {
+                vp.update_surface(n, &o.doc, &o.state);
+            }
+            if changes.placement || changes.visibility {
+                vp.set_visibility(n, &o.state);
+            }
+            moved |= changes.placement;
+            for note in notes {
+                match note {
+                    Ok(Some(note)) => self.status = note,
+                    Ok(None) => {}
+                    Err(e) => self.error = Some(format!("{}: {e}", o.doc.source)),
+                }
+            }
+            let refit: Vec<usize> = match changes.layers {
+                true => (0..o.state.quantities.len()).collect(),
+                false => (changes.quantities.iter().enumerate())
+                    .filter(|(_, q)| q.values || q.opacity)
+                    .map(|(k, _)| k)
+                    .collect(),
+            };
+            for k in refit {
+                self.auto_opacity(n, k);
+            }
         }
-        self.world = World::of(&self.objects);
-    }
-
-    /// Shows or hides object `n` whole.
-    pub fn set_visible(&mut self, n: usize, visible: bool) {
-        let Some(o) = self.objects.get_mut(n) else { return };
-        o.state.visible = visible;
-        if let Some(vp) = &mut self.viewport {
-            vp.set_visible(n, visible);
+        if moved {
+            self.world = World::of(&self.objects);
         }
     }
 
-    /// Redraws object `n`'s isosurfaces from its state (after an edit in the scene panel).
-    pub fn refresh_isosurfaces(&mut self, n: usize) {
-        if n == self.active {
-            self.commit_active();
+    /// Makes the object list changes the panels asked for.
+    fn apply_scene_edits(&mut self) {
+        for edit in std::mem::take(&mut self.pending) {
+            match edit {
+                SceneEdit::Select(n) => self.select(n),
+                SceneEdit::Remove(n) => self.remove_object(n),
+            }
         }
-        let (Some(vp), Some(o)) = (&mut self.viewport, self.objects.get(n)) else { return };
-        vp.update_isosurfaces(n, &o.doc, &o.state);
-    }
-
-    /// Shows object `n`'s atoms in its state's style and colouring.
-    pub fn restyle_atoms(&mut self, n: usize) {
-        if n == self.active {
-            self.commit_active();
-        }
-        let (Some(vp), Some(o)) = (&mut self.viewport, self.objects.get(n)) else { return };
-        vp.set_atom_look(n, &o.doc, &o.state);
-    }
-
-    /// Computes what the active object's orbital browser asks for and hands it to the viewport.
-    fn show_wavefunction(&mut self) {
-        self.commit_active();
-        let (Some(vp), Some(o)) = (&mut self.viewport, self.objects.get(self.active)) else { return };
-        let ov = &self.orbitals;
-        let view = WavefunctionView {
-            quantity: ov.shown,
-            direct: ov.direct,
-            points: ov.grid_points,
-            shells: ov.ao_filter.then(|| ov.shell_mask.clone()),
-        };
-        vp.show_wavefunction(self.active, &o.doc, view);
     }
 
     /// After a failed load with nothing open and nothing else coming, opens the bundled demo:
@@ -775,26 +791,20 @@ impl OrbApp {
                     Err(e) => self.error = Some(e),
                 }
             }
-            if shown {
-                evaluated.push(n);
-            }
+            evaluated.extend(shown.into_iter().map(|k| (n, k)));
         }
-        for n in evaluated {
-            self.auto_opacity(n);
+        for (n, k) in evaluated {
+            self.auto_opacity(n, k);
         }
     }
 
-    /// Chooses object `n`'s k1 from the grid it shows, when its cloud asks for that.
-    fn auto_opacity(&mut self, n: usize) {
-        if n == self.active {
-            self.commit_active();
-        }
+    /// Chooses the k1 of object `n`'s quantity `k` from the values it shows, when its cloud
+    /// asks for that.
+    fn auto_opacity(&mut self, n: usize, k: usize) {
         let (Some(vp), Some(o)) = (&self.viewport, self.objects.get_mut(n)) else { return };
-        if let Some(grid) = vp.computed_grid(n).or(o.doc.volumes.get(o.state.volume)) {
-            crate::headless::auto_opacity(&mut o.state.settings.volume, grid);
-        }
-        if n == self.active {
-            self.view.settings.volume.k1 = self.objects[n].state.settings.volume.k1;
+        let grid = vp.shown_grid(n, k, &o.doc, &o.state);
+        if let (Some(grid), Some(q)) = (grid, o.state.quantities.get_mut(k)) {
+            crate::headless::auto_opacity(&mut q.cloud, grid);
         }
     }
 
@@ -905,43 +915,6 @@ impl OrbApp {
         }
     }
 
-    /// Applies a change the side panel made to the active object, and writes it back.
-    fn apply(&mut self, before: &ViewState) {
-        self.commit_active();
-        let n = self.active;
-        let (Some(vp), Some(o)) = (&mut self.viewport, self.objects.get(n)) else {
-            if before.settings.atoms != self.view.settings.atoms
-                && let Some(scan) = &mut self.scan
-            {
-                scan::restyle(scan);
-            }
-            return;
-        };
-        let (was, now) = (&before.settings.volume, &self.view.settings.volume);
-        let law_changed = was.k2 != now.k2 || was.density_scale != now.density_scale || (now.auto_k1 && !was.auto_k1);
-        if before.volume != self.view.volume {
-            match vp.set_volume(n, &o.doc, &o.state) {
-                Ok(Some(note)) => self.status = note,
-                Ok(None) => {}
-                Err(e) => self.error = Some(e.to_string()),
-            }
-            self.auto_opacity(n);
-        } else if law_changed {
-            self.auto_opacity(n);
-        }
-        let (Some(vp), Some(o)) = (&mut self.viewport, self.objects.get(n)) else { return };
-        if before.settings.iso != self.view.settings.iso {
-            vp.update_isosurfaces(n, &o.doc, &o.state);
-        }
-        let look = |s: &crate::scene::RenderSettings| (s.atoms, s.atom_colors, s.depth_cue);
-        if look(&before.settings) != look(&self.view.settings) {
-            vp.set_atom_look(n, &o.doc, &o.state);
-            if let Some(scan) = &mut self.scan {
-                scan::restyle(scan);
-            }
-        }
-    }
-
     /// Renders the current view (each scan view side by side) and writes it to `path` as PNG.
     pub fn save_png(&mut self, path: &Path) {
         let Some(vp) = &mut self.viewport else { return };
@@ -980,18 +953,15 @@ impl eframe::App for OrbApp {
         let ctx = ui.ctx().clone();
         self.tick_rehearsal(&ctx);
         self.poll_job(&ctx);
-        let before = self.view;
         let action = panels::top_bar(ui, self);
         panels::status_bar(ui, self);
         panels::side_panel(ui, self);
-        let orbitals_before = self.orbitals.clone();
-        if let Some(o) = self.objects.get(self.active) {
-            orbitals::panel(ui, &o.doc, &mut self.orbitals, &mut self.scroll_to_frontier);
+        let defaults = self.defaults;
+        if let Some(o) = self.objects.get_mut(self.active) {
+            orbitals::panel(ui, &o.doc, &mut o.state, &defaults, &mut self.scroll_to_frontier);
         }
-        if self.orbitals != orbitals_before {
-            self.show_wavefunction();
-        }
-        self.apply(&before);
+        self.apply_changes();
+        self.apply_scene_edits();
         if let Some(model) = models::tick(&ctx, self) {
             self.show_model(model);
         }
@@ -1049,8 +1019,11 @@ impl eframe::App for OrbApp {
                     vp.detail = detail::Detail::for_frame(interacting, vp.ctx.info.device_type, 1);
                     let picture_ms = vp.take_picture_ms();
                     vp.detail.lod_scale = vp.lod_budget.next(interacting, picture_ms);
-                    vp.clouds = self.objects.iter().map(|o| o.state.settings.volume).collect();
-                    vp.show(ui, rs, &mut self.view);
+                    vp.set_clouds(&self.objects.iter().map(|o| &o.state).collect::<Vec<_>>());
+                    let clip = (self.objects.get_mut(self.active))
+                        .and_then(|o| o.state.selected_quantity_mut())
+                        .map(|q| &mut q.cloud.clip);
+                    vp.show(ui, rs, &mut self.view, clip);
                     if let Some(click) = vp.click.take() {
                         let said = self.measurements.click(click, &self.world);
                         if !said.is_empty() {

@@ -48,8 +48,7 @@ pub fn controls(ui: &mut egui::Ui, app: &mut OrbApp) -> Option<usize> {
 /// The *show* field of a structure: which of its atoms are drawn (`chain A resi 30-50`,
 /// `not resn HOH`; empty: all). A query that does not parse shows what it expected.
 pub fn selection(ui: &mut egui::Ui, app: &mut OrbApp) {
-    let n = app.active;
-    let Some(o) = app.objects.get_mut(n).filter(|o| o.doc.structure.is_some()) else { return };
+    let Some(o) = app.objects.get_mut(app.active).filter(|o| o.doc.structure.is_some()) else { return };
     let mut query = o.state.selection.clone();
     let changed = ui
         .horizontal(|ui| {
@@ -63,13 +62,8 @@ pub fn selection(ui: &mut egui::Ui, app: &mut OrbApp) {
         ui.label(RichText::new(format!("expected {expected}")).small().color(ui.visuals().error_fg_color));
     }
     if changed {
+        // The frame's changes restyle the atoms and wrap the molecular surface around them.
         o.state.selection = query;
-        let surface = o.state.surface.choice != crate::scene::SurfaceChoice::Off;
-        app.restyle_atoms(n);
-        if surface {
-            // The molecular surface wraps the atoms shown.
-            app.refresh_isosurfaces(n);
-        }
     }
 }
 
@@ -103,10 +97,11 @@ impl OrbApp {
         self.measurements.selection.clear();
         self.measurements.list.clear();
         if let Some(vp) = &mut self.viewport {
-            vp.set_atoms(n, &self.objects[n].doc, &self.objects[n].state);
-        }
-        if self.objects[n].state.surface.choice != crate::scene::SurfaceChoice::Off {
-            self.refresh_isosurfaces(n);
+            let o = &self.objects[n];
+            vp.set_atoms(n, &o.doc, &o.state);
+            if o.state.surface.choice != crate::scene::SurfaceChoice::Off {
+                vp.update_surface(n, &o.doc, &o.state);
+            }
         }
         self.world = World::of(&self.objects);
     }

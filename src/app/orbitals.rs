@@ -3,20 +3,37 @@
 
 use egui::{RichText, ScrollArea};
 
-use super::state::OrbitalView;
 use crate::model::orbitals::Quantity;
 use crate::model::orbitals::{Spin, Wavefunction};
 use crate::model::units::EV_PER_HARTREE;
 use crate::model::{Document, basis::ShellKind};
+use crate::scene::{ObjectState, QuantityState, RenderSettings, Source};
 
 /// Residual of CᵀSC − I above which the orbitals are flagged as not orthonormal.
 pub const ORTHONORMAL_TOLERANCE: f64 = 1e-5;
 
 const SHELL_LETTERS: [&str; 6] = ["s", "p", "d", "f", "g", "h"];
 
+/// What a click in the browser does with a wavefunction quantity.
+enum Pick {
+    /// The selected quantity shows it instead (or the object's first, when it has none).
+    Switch(Quantity),
+    /// It joins the object as another quantity, selected.
+    Add(Quantity),
+}
+
+/// The orbital browser of the object `state` describes: it edits `state` in place (the
+/// selected quantity's orbital or density, the spin listed, how orbitals are evaluated).
 /// `scroll_to_frontier` brings the HOMO's row into view once (after a file opens).
-pub fn panel(ui: &mut egui::Ui, doc: &Document, view: &mut OrbitalView, scroll_to_frontier: &mut bool) {
+pub fn panel(
+    ui: &mut egui::Ui,
+    doc: &Document,
+    state: &mut ObjectState,
+    defaults: &RenderSettings,
+    scroll_to_frontier: &mut bool,
+) {
     let Some(wf) = &doc.wavefunction else { return };
+    let mut pick = None;
     egui::Panel::right("orbitals").exact_size(360.0).show(ui, |ui| {
         ui.heading("Orbitals");
         let n = &wf.normalization;
@@ -38,57 +55,137 @@ pub fn panel(ui: &mut egui::Ui, doc: &Document, view: &mut OrbitalView, scroll_t
                     .color(ui.visuals().warn_fg_color),
             );
         }
+        let shown = shown_quantity(state);
+        if !wf.restricted {
+            ui.horizontal(|ui| {
+                ui.label("orbitals of spin");
+                for (spin, name) in [(Spin::Alpha, "α"), (Spin::Beta, "β")] {
+                    if ui.selectable_label(state.evaluation.spin == spin, name).clicked()
+                        && state.evaluation.spin != spin
+                    {
+                        state.evaluation.spin = spin;
+                        // The orbital shown follows: the same place relative to the frontier.
+                        if let Some(Quantity::Orbital(i)) = shown
+                            && let Some(j) = same_role(wf, i, spin)
+                        {
+                            pick = Some(Pick::Switch(Quantity::Orbital(j)));
+                        }
+                    }
+                }
+            });
+        }
         ui.horizontal(|ui| {
+            ui.label("show");
+            let mut densities = vec![(Quantity::Density, "total density")];
             if !wf.restricted {
-                ui.selectable_value(&mut view.spin, Spin::Alpha, "α");
-                ui.selectable_value(&mut view.spin, Spin::Beta, "β");
-                ui.separator();
+                densities.push((Quantity::SpinDensity, "spin density"));
             }
-            ui.selectable_value(&mut view.shown, Quantity::Density, "total density");
-            if !wf.restricted {
-                ui.selectable_value(&mut view.shown, Quantity::SpinDensity, "spin density");
+            for (q, name) in densities {
+                if ui.selectable_label(shown == Some(q), name).clicked() {
+                    pick = Some(Pick::Switch(q));
+                }
+                if ui
+                    .small_button("+")
+                    .on_hover_text(format!("add the {name} to the object beside what it shows"))
+                    .clicked()
+                {
+                    pick = Some(Pick::Add(q));
+                }
             }
         });
         ui.horizontal(|ui| {
+            let e = &mut state.evaluation;
             ui.label("evaluate");
-            ui.selectable_value(&mut view.direct, false, "on a GPU grid").on_hover_text(
+            ui.selectable_value(&mut e.direct, false, "on a GPU grid").on_hover_text(
                 "a compute pass fills a 3D texture; the slices sample it (fast to view, switch in one pass)",
             );
-            ui.selectable_value(&mut view.direct, true, "per sample (direct)").on_hover_text(
-                "Jang & Varetto's direct mode: every slice fragment evaluates the orbital from the basis functions, no grid",
+            ui.selectable_value(&mut e.direct, true, "per sample (direct)").on_hover_text(
+                "every slice fragment evaluates the orbital from the basis functions, no grid (Jang & Varetto)",
             );
         });
-        keyboard(ui, wf, view);
-        orbital_table(ui, wf, view, scroll_to_frontier);
-        ao_selector(ui, doc, wf, view);
+        if let Some(p) = keyboard(ui, wf, state.evaluation.spin, shown) {
+            pick = Some(p);
+        }
+        if let Some(p) = orbital_table(ui, wf, state.evaluation.spin, shown, scroll_to_frontier) {
+            pick = Some(p);
+        }
+        ao_selector(ui, doc, wf, state);
     });
+    match pick {
+        Some(Pick::Switch(q)) => {
+            match state.selected_quantity_mut().filter(|s| matches!(s.source, Source::Wavefunction(_))) {
+                Some(selected) => selected.source = Source::Wavefunction(q),
+                None => add(state, q, defaults),
+            }
+        }
+        Some(Pick::Add(q)) => add(state, q, defaults),
+        None => {}
+    }
 }
 
-/// Up/down move through the orbitals of the shown spin by energy.
-fn keyboard(ui: &egui::Ui, wf: &Wavefunction, view: &mut OrbitalView) {
+/// Adds `q` to the object as a new quantity, selected.
+fn add(state: &mut ObjectState, q: Quantity, defaults: &RenderSettings) {
+    state.quantities.push(QuantityState::new(Source::Wavefunction(q), defaults));
+    state.selected = state.quantities.len() - 1;
+}
+
+/// The wavefunction quantity the selected quantity shows, if it is one.
+fn shown_quantity(state: &ObjectState) -> Option<Quantity> {
+    match state.selected_quantity()?.source {
+        Source::Wavefunction(q) => Some(q),
+        Source::Volume(_) => None,
+    }
+}
+
+/// The orbital of `spin` at the same place relative to the frontier as orbital `i` (HOMO−1 α →
+/// HOMO−1 β).
+fn same_role(wf: &Wavefunction, i: usize, spin: Spin) -> Option<usize> {
+    let from = wf.orbitals.get(i)?.spin;
+    let (homo_from, homo_to) = (wf.homo(from)?, wf.homo(spin)?);
+    let (a, b) = (wf.by_energy(from), wf.by_energy(spin));
+    let offset = a.iter().position(|&k| k == i)? as isize - a.iter().position(|&k| k == homo_from)? as isize;
+    let target = b.iter().position(|&k| k == homo_to)? as isize + offset;
+    b.get(target.clamp(0, b.len() as isize - 1) as usize).copied()
+}
+
+/// Shift + up/down move through the orbitals of the listed spin by energy.
+fn keyboard(ui: &egui::Ui, wf: &Wavefunction, spin: Spin, shown: Option<Quantity>) -> Option<Pick> {
     if ui.ctx().egui_wants_keyboard_input() {
-        return;
+        return None;
     }
     let (up, down) = ui.input(|i| (i.key_pressed(egui::Key::ArrowUp), i.key_pressed(egui::Key::ArrowDown)));
     if !(up || down) || !ui.input(|i| i.modifiers.shift) {
-        return;
+        return None;
     }
-    let order = wf.by_energy(view.spin_of(wf));
-    let Quantity::Orbital(current) = view.shown else { return };
-    if let Some(pos) = order.iter().position(|&i| i == current) {
-        let next = if up { pos + 1 } else { pos.saturating_sub(1) };
-        if let Some(&i) = order.get(next) {
-            view.shown = Quantity::Orbital(i);
-        }
-    }
+    let order = wf.by_energy(spin_of(wf, spin));
+    let Some(Quantity::Orbital(current)) = shown else { return None };
+    let pos = order.iter().position(|&i| i == current)?;
+    let next = if up { pos + 1 } else { pos.saturating_sub(1) };
+    order.get(next).map(|&i| Pick::Switch(Quantity::Orbital(i)))
 }
 
-fn orbital_table(ui: &mut egui::Ui, wf: &Wavefunction, view: &mut OrbitalView, scroll_to_frontier: &mut bool) {
-    let spin = view.spin_of(wf);
+/// The spin whose orbitals are listed (restricted wavefunctions have only alpha).
+fn spin_of(wf: &Wavefunction, spin: Spin) -> Spin {
+    if wf.restricted { Spin::Alpha } else { spin }
+}
+
+fn orbital_table(
+    ui: &mut egui::Ui,
+    wf: &Wavefunction,
+    spin: Spin,
+    shown: Option<Quantity>,
+    scroll_to_frontier: &mut bool,
+) -> Option<Pick> {
+    let spin = spin_of(wf, spin);
+    let mut pick = None;
     // Highest energy at the top, as in an orbital diagram.
     let mut order = wf.by_energy(spin);
     order.reverse();
-    ui.label(RichText::new("click a row to show it; Shift + up/down arrows to step").small().weak());
+    ui.label(
+        RichText::new("click a row to show it, + to add it beside what is shown; Shift + up/down arrows to step")
+            .small()
+            .weak(),
+    );
     // One monospace line per orbital: the whole row is the button, and the header above the
     // scrolled list lines up with it and stays in view.
     ui.label(RichText::new(row_text("", "", "sym", "E / Eh", "E / eV", "occ")).monospace().strong());
@@ -96,7 +193,7 @@ fn orbital_table(ui: &mut egui::Ui, wf: &Wavefunction, view: &mut OrbitalView, s
         for i in order {
             let o = &wf.orbitals[i];
             let number = wf.of_spin(o.spin).position(|(j, _)| j == i).map_or(0, |p| p + 1);
-            let selected = view.shown == Quantity::Orbital(i);
+            let selected = shown == Some(Quantity::Orbital(i));
             let text = row_text(
                 &format!("MO {number}"),
                 &wf.frontier_label(i, 5).unwrap_or_default(),
@@ -105,28 +202,37 @@ fn orbital_table(ui: &mut egui::Ui, wf: &Wavefunction, view: &mut OrbitalView, s
                 &format!("{:.3}", o.energy * EV_PER_HARTREE),
                 &format!("{:.2}", o.occupation),
             );
-            let row = ui.add(
-                egui::Button::selectable(selected, RichText::new(text).monospace())
-                    .min_size(egui::vec2(ui.available_width(), 0.0)),
-            );
-            if row.clicked() {
-                view.shown = Quantity::Orbital(i);
-            }
-            if *scroll_to_frontier && Some(i) == wf.homo(spin) {
-                row.scroll_to_me(Some(egui::Align::Center));
-                *scroll_to_frontier = false;
-            }
+            ui.horizontal(|ui| {
+                let add = ui.small_button("+").on_hover_text("add this orbital to the object beside what it shows");
+                let row = ui.add(
+                    egui::Button::selectable(selected, RichText::new(text).monospace())
+                        .min_size(egui::vec2(ui.available_width(), 0.0)),
+                );
+                if row.clicked() {
+                    pick = Some(Pick::Switch(Quantity::Orbital(i)));
+                }
+                if add.clicked() {
+                    pick = Some(Pick::Add(Quantity::Orbital(i)));
+                }
+                if *scroll_to_frontier && Some(i) == wf.homo(spin) {
+                    row.scroll_to_me(Some(egui::Align::Center));
+                    *scroll_to_frontier = false;
+                }
+            });
         }
     });
+    pick
 }
 
 /// One line of the orbital table, columns padded to fixed widths.
 fn row_text(name: &str, label: &str, sym: &str, eh: &str, ev: &str, occ: &str) -> String {
-    format!("{name:<6}{label:<7}{sym:<4}{eh:>9}{ev:>8}{occ:>5}")
+    // Wide enough that a core orbital's energies (-20.57911, -559.986) stay apart.
+    format!("{name:<6}{label:<7}{sym:<4}{eh:>10}{ev:>10}{occ:>5}")
 }
 
 /// Seed 004's atomic-orbital selector: restrict the shown orbital to chosen shells.
-fn ao_selector(ui: &mut egui::Ui, doc: &Document, wf: &Wavefunction, view: &mut OrbitalView) {
+fn ao_selector(ui: &mut egui::Ui, doc: &Document, wf: &Wavefunction, state: &mut ObjectState) {
+    let view = &mut state.evaluation;
     ui.collapsing("Atomic orbitals", |ui| {
         ui.checkbox(&mut view.ao_filter, "show only the selected shells' part of the orbital");
         if view.shell_mask.len() != wf.basis.shells.len() {

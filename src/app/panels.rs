@@ -4,13 +4,12 @@ use egui::{ComboBox, RichText, Slider};
 
 use super::Demo;
 use super::OrbApp;
-use crate::model::orbitals::Quantity;
 use crate::model::units::ANGSTROM_PER_BOHR;
 use crate::scene::transfer::{Lobe, PRESETS};
 use crate::scene::translucency::OpticsTuning;
 use crate::scene::{
     AtomColoring, AtomStyle, ClipPlane, DensityScale, IsoLevel, IsosurfaceSettings, OpticsPreset, Shape, SliceMode,
-    Transfer, TransferKind, ViewPreset,
+    Source, Transfer, TransferKind, ViewPreset,
 };
 
 /// The side panel's width, points.
@@ -143,7 +142,8 @@ fn status_line(ui: &mut egui::Ui, app: &OrbApp, cancel: &mut bool, dismiss: &mut
                 ui.separator();
                 ui.label(RichText::new(note).weak());
             }
-            if let (Some(wf), Quantity::Orbital(i)) = (&app.doc().wavefunction, app.orbitals.shown) {
+            let selected = app.active_object().and_then(|o| o.state.selected_quantity()).map(|q| q.source);
+            if let (Some(wf), Some(i)) = (&app.doc().wavefunction, selected.and_then(Source::orbital)) {
                 let o = &wf.orbitals[i];
                 ui.separator();
                 ui.label(format!(
@@ -156,7 +156,7 @@ fn status_line(ui: &mut egui::Ui, app: &OrbApp, cancel: &mut bool, dismiss: &mut
                     o.occupation
                 ));
             }
-            if let Some(g) = app.doc().volumes.get(app.view.volume) {
+            if let Some(g) = app.shown_values() {
                 ui.separator();
                 let h: Vec<String> = (0..3).map(|a| format!("{:.3}", g.step(a).length())).collect();
                 ui.label(format!(
@@ -186,12 +186,9 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
                 ui.separator();
             }
             let (grid_sigma, grid_signed) = app.shown_grid();
-            let no_document = crate::model::Document::default();
-            let doc = app.objects.get(app.active).map_or(&no_document, |o| &o.doc);
-            let view = &mut app.view;
-            ui.heading("Volume");
-            if let Some(scan) = &app.scan {
+            if let Some(scan) = &mut app.scan {
                 let g = scan.scene.grid.dims;
+                ui.heading("Volume");
                 ui.label(format!(
                     "{} key volumes of {}×{}×{} points ({:.1} MiB resident)",
                     scan.scene.slots() * scan.scene.scan.frames.len(),
@@ -200,106 +197,53 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
                     g[2],
                     scan.scene.bytes as f64 / 1048576.0
                 ));
-            } else if doc.volumes.is_empty() {
-                ui.label(if doc.wavefunction.is_some() {
-                    "computed from the basis set: choose it under Orbitals"
-                } else {
-                    "no volume in this file"
-                });
-            } else {
-                let label = ui.label("data set");
-                ComboBox::from_id_salt("data set")
-                    .width(220.0)
-                    .selected_text(doc.volumes.get(view.volume).map(|v| v.label.as_str()).unwrap_or("?"))
-                    .show_ui(ui, |ui| {
-                        for (i, v) in doc.volumes.iter().enumerate() {
-                            ui.selectable_value(&mut view.volume, i, &v.label);
+                cloud_editor(ui, &mut scan.settings.volume, true);
+                ui.separator();
+                // A scan's isosurfaces are cut from the orbital at θ; levels are absolute there.
+                ui.heading("Isosurface");
+                isosurface_editor(ui, &mut scan.settings.iso, true, None);
+                ui.separator();
+                ui.heading("Atoms");
+                let s = &mut scan.settings;
+                atoms_editor(ui, &mut s.atoms, &mut s.atom_colors, &mut s.depth_cue);
+            } else if let Some(o) = app.objects.get_mut(app.active) {
+                let doc = o.doc.clone();
+                let state = &mut o.state;
+                match state.selected_quantity_mut() {
+                    Some(q) => {
+                        ui.heading(q.source.name(&doc));
+                        if doc.volumes.len() > 1 && matches!(q.source, Source::Volume(_)) {
+                            data_set_choice(ui, &doc, &mut q.source);
                         }
-                    })
-                    .response
-                    .labelled_by(label.id);
-            }
-            let vs = &mut view.settings.volume;
-            ui.checkbox(&mut vs.visible, "show cloud");
-            ui.horizontal(|ui| {
-                ui.label("slices");
-                ui.selectable_value(&mut vs.mode, SliceMode::ViewAligned, "view-aligned");
-                ui.selectable_value(&mut vs.mode, SliceMode::AxisAligned, "axis stacks");
-            });
-            ui.add(Slider::new(&mut vs.slices, 16..=512).text("slice count"));
-            ui.horizontal(|ui| {
-                // Room for the value, the name and the auto box within the panel.
-                ui.spacing_mut().slider_width = 70.0;
-                let k1 = ui.add(Slider::new(&mut vs.k1, 0.0..=2.0).logarithmic(true).text("k1 (opacity)"));
-                if k1.changed() {
-                    vs.auto_k1 = false;
-                }
-                ui.checkbox(&mut vs.auto_k1, "auto")
-                    .on_hover_text("k1 from the grid: its densest lines of sight reach an optical depth of 2.5");
-            });
-            ui.add(Slider::new(&mut vs.k2, 0.1..=3.0).text("k2 (shape)"));
-            let signed = grid_signed;
-            if !signed {
-                density_scale_editor(ui, &mut vs.density_scale);
-            }
-            let (pos, neg) = if signed { ("ψ > 0", "ψ < 0") } else { ("dense", "thin") };
-            ui.horizontal(|ui| {
-                ui.color_edit_button_rgb(&mut vs.positive_color);
-                ui.label(pos);
-                ui.color_edit_button_rgb(&mut vs.negative_color);
-                ui.label(neg);
-            });
-            let law = if signed {
-                "α = k1·ρ^k2 per grid step, ρ = ψ² scaled to its maximum"
-            } else {
-                "α = k1·t^k2 per grid step, t = the density on the scale above"
-            };
-            ui.label(RichText::new(law).small().weak());
-            ComboBox::from_label("colour preset").selected_text("choose…").show_ui(ui, |ui| {
-                for (name, pos, neg) in PRESETS {
-                    if ui.selectable_label(false, *name).clicked() {
-                        vs.positive_color = *pos;
-                        vs.negative_color = *neg;
+                        // Isosurfaces first: for orbitals the most used, and never below the fold.
+                        isosurfaces_editor(ui, &mut q.isosurfaces, grid_signed, grid_sigma);
+                        ui.separator();
+                        ui.heading("Cloud");
+                        cloud_editor(ui, &mut q.cloud, grid_signed);
                     }
+                    None if doc.wavefunction.is_some() => {
+                        ui.label("nothing of the wavefunction is shown: choose it under Orbitals");
+                    }
+                    None => {}
                 }
-            });
-            transfer_editor(ui, &mut vs.transfer, signed);
-            clip_editor(ui, &mut vs.clip);
-
-            ui.separator();
-            // A scan's isosurfaces are cut from the orbital at θ; levels are absolute there.
-            let sigma = if app.scan.is_none() { grid_sigma } else { None };
-            isosurface_editor(ui, &mut view.settings.iso, grid_signed, sigma);
-
-            ui.separator();
-            ui.heading("Atoms");
-            ComboBox::from_label("style").selected_text(view.settings.atoms.name()).show_ui(ui, |ui| {
-                for style in AtomStyle::ALL {
-                    ui.selectable_value(&mut view.settings.atoms, style, style.name());
-                }
-            });
+                ui.separator();
+                ui.heading("Atoms");
+                let a = &mut state.atoms;
+                atoms_editor(ui, &mut a.style, &mut a.colors, &mut a.depth_cue);
+            }
             if let Some(model) = super::models::controls(ui, app) {
                 app.show_model(model);
             }
-            let view = &mut app.view;
-            ComboBox::from_label("colour by").selected_text(view.settings.atom_colors.name()).show_ui(ui, |ui| {
-                for coloring in AtomColoring::ALL {
-                    ui.selectable_value(&mut view.settings.atom_colors, coloring, coloring.name());
-                }
-            });
             super::models::selection(ui, app);
             let view = &mut app.view;
-            ui.add(Slider::new(&mut view.settings.depth_cue, 0.0..=1.0).text("depth cue"))
-                .on_hover_text("Darkens atoms with depth, so the front of a big structure reads from its back");
             ui.horizontal(|ui| {
-                ui.color_edit_button_rgb(&mut view.settings.background);
+                ui.color_edit_button_rgb(&mut view.background);
                 ui.label("background");
             });
             ui.checkbox(&mut view.labels, "atom labels");
             if app.scan.is_none() {
                 view_presets(ui, app);
             }
-
             ui.separator();
             match &app.scan {
                 // The measured values follow θ.
@@ -341,6 +285,120 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
             ui.label(RichText::new(help).small().weak());
         });
     });
+}
+
+/// Which of a file's data sets a quantity shows (cube files with several).
+fn data_set_choice(ui: &mut egui::Ui, doc: &crate::model::Document, source: &mut Source) {
+    let label = ui.label("data set");
+    let Source::Volume(shown) = source else { return };
+    ComboBox::from_id_salt("data set")
+        .width(220.0)
+        .selected_text(doc.volumes.get(*shown).map(|v| v.label.as_str()).unwrap_or("?"))
+        .show_ui(ui, |ui| {
+            for (i, v) in doc.volumes.iter().enumerate() {
+                ui.selectable_value(shown, i, &v.label);
+            }
+        })
+        .response
+        .labelled_by(label.id);
+}
+
+/// A cloud's settings: shown or not, slicing, opacity law, colours, transfer function and
+/// clipping plane. `signed`: an orbital's two signs (else a density's scale).
+fn cloud_editor(ui: &mut egui::Ui, vs: &mut crate::scene::VolumeSettings, signed: bool) {
+    ui.checkbox(&mut vs.visible, "show cloud");
+    ui.horizontal(|ui| {
+        ui.label("slices");
+        ui.selectable_value(&mut vs.mode, SliceMode::ViewAligned, "view-aligned");
+        ui.selectable_value(&mut vs.mode, SliceMode::AxisAligned, "axis stacks");
+    });
+    ui.add(Slider::new(&mut vs.slices, 16..=512).text("slice count"));
+    ui.horizontal(|ui| {
+        // Room for the value, the name and the auto box within the panel.
+        ui.spacing_mut().slider_width = 70.0;
+        let k1 = ui.add(Slider::new(&mut vs.k1, 0.0..=2.0).logarithmic(true).text("k1 (opacity)"));
+        if k1.changed() {
+            vs.auto_k1 = false;
+        }
+        ui.checkbox(&mut vs.auto_k1, "auto")
+            .on_hover_text("k1 from the grid: its densest lines of sight reach an optical depth of 2.5");
+    });
+    ui.add(Slider::new(&mut vs.k2, 0.1..=3.0).text("k2 (shape)"));
+    if !signed {
+        density_scale_editor(ui, &mut vs.density_scale);
+    }
+    let (pos, neg) = if signed { ("ψ > 0", "ψ < 0") } else { ("dense", "thin") };
+    ui.horizontal(|ui| {
+        ui.color_edit_button_rgb(&mut vs.positive_color);
+        ui.label(pos);
+        ui.color_edit_button_rgb(&mut vs.negative_color);
+        ui.label(neg);
+    });
+    let law = if signed {
+        "α = k1·ρ^k2 per grid step, ρ = ψ² scaled to its maximum"
+    } else {
+        "α = k1·t^k2 per grid step, t = the density on the scale above"
+    };
+    ui.label(RichText::new(law).small().weak());
+    ComboBox::from_label("colour preset").selected_text("choose…").show_ui(ui, |ui| {
+        for (name, pos, neg) in PRESETS {
+            if ui.selectable_label(false, *name).clicked() {
+                vs.positive_color = *pos;
+                vs.negative_color = *neg;
+            }
+        }
+    });
+    transfer_editor(ui, &mut vs.transfer, signed);
+    clip_editor(ui, &mut vs.clip);
+}
+
+/// Every isosurface of a quantity, each with its own controls, and *+ isosurface*.
+fn isosurfaces_editor(ui: &mut egui::Ui, list: &mut Vec<IsosurfaceSettings>, signed: bool, sigma: Option<f64>) {
+    ui.heading("Isosurfaces");
+    let mut remove = None;
+    for (k, iso) in list.iter_mut().enumerate() {
+        ui.push_id(k, |ui| {
+            egui::Frame::group(ui.style()).show(ui, |ui| {
+                isosurface_editor(ui, iso, signed, sigma);
+                if ui.small_button("remove").on_hover_text("remove this isosurface").clicked() {
+                    remove = Some(k);
+                }
+            });
+        });
+    }
+    if let Some(k) = remove {
+        list.remove(k);
+    }
+    if ui.button("+ isosurface").on_hover_text("another value of the same quantity (nested shells)").clicked() {
+        list.push(another_isosurface(list));
+    }
+}
+
+/// A new isosurface at half the value of the last one (the next shell out), shown.
+pub fn another_isosurface(list: &[IsosurfaceSettings]) -> IsosurfaceSettings {
+    let last = list.last().copied().unwrap_or_default();
+    let level = match last.level {
+        IsoLevel::Absolute(v) if list.is_empty() => IsoLevel::Absolute(v),
+        IsoLevel::Absolute(v) => IsoLevel::Absolute(v * 0.5),
+        IsoLevel::Sigma(s) => IsoLevel::Sigma(s * 0.5),
+    };
+    IsosurfaceSettings { visible: true, level, ..last }
+}
+
+/// How atoms are drawn: style, colouring, depth cue.
+fn atoms_editor(ui: &mut egui::Ui, style: &mut AtomStyle, colors: &mut AtomColoring, depth_cue: &mut f32) {
+    ComboBox::from_label("style").selected_text(style.name()).show_ui(ui, |ui| {
+        for s in AtomStyle::ALL {
+            ui.selectable_value(style, s, s.name());
+        }
+    });
+    ComboBox::from_label("colour by").selected_text(colors.name()).show_ui(ui, |ui| {
+        for coloring in AtomColoring::ALL {
+            ui.selectable_value(colors, coloring, coloring.name());
+        }
+    });
+    ui.add(Slider::new(depth_cue, 0.0..=1.0).text("depth cue"))
+        .on_hover_text("Darkens atoms with depth, so the front of a big structure reads from its back");
 }
 
 /// The view presets: as a new file opens, along the axes, down a bond or onto a plane of the
@@ -493,7 +551,6 @@ fn clip_editor(ui: &mut egui::Ui, clip: &mut ClipPlane) {
 
 /// Isosurface controls: shown or not, the value (absolute, or in σ of a cube's grid), colours.
 fn isosurface_editor(ui: &mut egui::Ui, iso: &mut IsosurfaceSettings, signed: bool, sigma: Option<f64>) {
-    ui.heading("Isosurface");
     ui.checkbox(&mut iso.visible, if signed { "show ψ = ±value" } else { "show ρ = value" });
     ui.horizontal(|ui| {
         let absolute = matches!(iso.level, IsoLevel::Absolute(_));

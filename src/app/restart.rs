@@ -41,7 +41,6 @@ impl OrbApp {
     /// viewer has no way to open another window (then it only says what happened).
     pub(super) fn carry_away(&mut self, reason: &str, ctx: &egui::Context) -> bool {
         let Some(slot) = self.restart.clone() else { return false };
-        self.commit_active();
         let carried = Carried {
             objects: self.objects.iter().map(|o| (Arc::clone(&o.doc), o.state.clone())).collect(),
             active: self.active,
@@ -79,10 +78,8 @@ impl OrbApp {
         for (doc, state) in carried.objects {
             app.add_shared_object(doc, Opening::Restore(Box::new(state)));
         }
-        if carried.active < app.objects.len() {
-            app.load_active(carried.active);
-        }
-        app.view.camera = carried.view.camera;
+        app.select(carried.active);
+        app.view = carried.view;
         if let Some(source) = carried.scan {
             app.open_scan(source, &cc.egui_ctx);
         }

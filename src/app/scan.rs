@@ -20,7 +20,7 @@ use crate::headless::isosurfaces_within;
 use crate::headless::scan::{KeyOptions, ScanScene, ScanSceneError, mix};
 use crate::model::scan::Follow;
 use crate::model::units::EV_PER_HARTREE;
-use crate::scene::Interpolation;
+use crate::scene::{AtomStyle, Interpolation, RenderSettings};
 
 /// Where a scan comes from.
 #[derive(Debug, Clone, PartialEq)]
@@ -129,6 +129,10 @@ pub struct ScanView {
     pub(super) views: Vec<Viewport>,
     /// Where the scan came from (to open it again, following orbitals another way).
     pub source: ScanSource,
+    /// How its views draw the orbitals at θ: cloud, isosurface, atoms (the side panel edits it).
+    pub settings: RenderSettings,
+    /// The atom style the views were last shown with.
+    styled: AtomStyle,
 }
 
 impl ScanView {
@@ -149,6 +153,8 @@ impl ScanView {
             direction: 1.0,
             views,
             source,
+            settings: RenderSettings::default(),
+            styled: AtomStyle::default(),
         }
     }
 
@@ -160,6 +166,7 @@ impl ScanView {
         self.looping = old.looping;
         self.speed = old.speed;
         self.drag_twists = old.drag_twists;
+        self.settings = old.settings;
     }
 
     /// Where atom `atom` of the skeleton at θ is drawn in view `view` (for tests and overlays).
@@ -355,7 +362,11 @@ pub fn views(
     let (lo, hi) = scan.scene.scan.range();
     let n = scan.views.len().max(1);
     let mut dragged = 0.0;
-    let style = view.settings.atoms;
+    if scan.styled != scan.settings.atoms {
+        restyle(scan);
+        scan.styled = scan.settings.atoms;
+    }
+    let style = scan.settings.atoms;
     // All views share one device, so one detail serves them.
     let detail = scan
         .views
@@ -371,11 +382,11 @@ pub fn views(
                 ui.label(RichText::new(format!("θ = {:.1}°", scan.theta)).weak());
             });
             // Isosurfaces of the orbital at θ, cut in the background from the two key volumes.
-            let wanted = view.settings.iso.visible.then_some((scan.theta, view.settings.iso));
+            let wanted = scan.settings.iso.visible.then_some((scan.theta, scan.settings.iso));
             if vp.scan_iso != wanted {
                 vp.scan_iso = wanted;
                 let (a, b, k) = scan.scene.bracket_grids(slot, scan.theta);
-                let iso = view.settings.iso;
+                let iso = scan.settings.iso;
                 vp.request_meshes(0, move |max_bytes| isosurfaces_within(&mix(&a, &b, k), &[iso], max_bytes));
             }
             match vp.poll_meshes(0) {
@@ -390,7 +401,8 @@ pub fn views(
                 _ => {}
             }
             vp.detail = detail;
-            dragged += vp.show_twistable(ui, render_state, view, Some(twist));
+            vp.clouds = vec![scan.settings.volume];
+            dragged += vp.show_twistable(ui, render_state, view, Some(&mut scan.settings.volume.clip), Some(twist));
             let world = World::single(scan.scene.scan.geometry_at(scan.theta));
             if let Some(click) = vp.click.take() {
                 let text = measurements.click(click, &world);

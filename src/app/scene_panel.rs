@@ -1,99 +1,136 @@
-//! The scene panel: every object with its representations (atoms, cloud, isosurfaces), shown
-//! or hidden, added and removed, and its placement. The active object's atoms, cloud and first
-//! isosurface are the side panel's working copy (`app.view.settings`); its further isosurfaces
-//! and every placement are edited here directly.
+//! The scene panel: every object with its quantities (each shown or hidden, selected for the
+//! side panel, added and removed), its atoms, molecular surface and placement. Everything is
+//! edited in the objects' states in place; adding or removing objects waits for the frame's
+//! end ([`super::SceneEdit`]).
 
-use egui::{ComboBox, DragValue, RichText, Slider};
+use egui::{ComboBox, DragValue, RichText};
 
-use super::OrbApp;
+use super::{OrbApp, SceneEdit};
+use crate::model::Document;
+use crate::model::orbitals::{Quantity, Spin};
 use crate::model::units::{ANGSTROM_PER_BOHR, BOHR_PER_ANGSTROM};
-use crate::scene::{AtomColoring, AtomStyle, IsoLevel, IsosurfaceSettings, Placement, SurfaceChoice, SurfaceSettings};
-
-/// What the user asked for in the panel this frame, applied after it is drawn.
-enum Edit {
-    Select(usize),
-    Remove(usize),
-    Visible(usize, bool),
-    Place(usize, Placement),
-    Isosurfaces,
-}
+use crate::scene::{
+    AtomColoring, AtomStyle, ObjectState, Placement, QuantityState, RenderSettings, Source, SurfaceChoice,
+    SurfaceSettings,
+};
 
 pub fn section(ui: &mut egui::Ui, app: &mut OrbApp) {
     if app.scan.is_some() || app.objects.is_empty() {
         return;
     }
     ui.heading("Scene");
-    let mut edits = Vec::new();
-    for (n, object) in app.objects.iter().enumerate() {
+    let active = app.active;
+    for (n, object) in app.objects.iter_mut().enumerate() {
         ui.horizontal(|ui| {
-            let mut visible = object.state.visible;
-            if ui.checkbox(&mut visible, "").on_hover_text("show or hide the whole object").changed() {
-                edits.push(Edit::Visible(n, visible));
-            }
-            let name = object.doc.source.rsplit(['/', '\\']).next().unwrap_or("object");
-            if ui.selectable_label(n == app.active, format!("{} {name}", n + 1)).clicked() && n != app.active {
-                edits.push(Edit::Select(n));
-            }
+            // The remove button first: a long file name never pushes it out of the panel.
             if ui.small_button("×").on_hover_text("remove from the scene").clicked() {
-                edits.push(Edit::Remove(n));
+                app.pending.push(SceneEdit::Remove(n));
+            }
+            ui.checkbox(&mut object.state.visible, "").on_hover_text("show or hide the whole object");
+            let name = object.doc.source.rsplit(['/', '\\']).next().unwrap_or("object");
+            let label = egui::Button::selectable(n == active, format!("{} {name}", n + 1)).truncate();
+            if ui.add(label).on_hover_text(&object.doc.source).clicked() && n != active {
+                app.pending.push(SceneEdit::Select(n));
             }
         });
     }
-    let n = app.active;
-    if let Some(object) = app.objects.get_mut(n) {
+    let defaults = app.defaults;
+    if let Some(object) = app.objects.get_mut(active) {
+        let doc = object.doc.clone();
+        let state = &mut object.state;
         ui.indent("representations", |ui| {
-            let s = &mut app.view.settings;
+            quantities(ui, &doc, state, &defaults);
             ui.horizontal(|ui| {
-                let mut shown = s.atoms != AtomStyle::Hidden;
+                let s = &mut state.atoms.style;
+                let mut shown = *s != AtomStyle::Hidden;
                 let checkbox = ui.checkbox(&mut shown, "atoms");
                 if checkbox.changed() {
-                    s.atoms = if shown { AtomStyle::BallAndStick } else { AtomStyle::Hidden };
+                    *s = if shown { AtomStyle::BallAndStick } else { AtomStyle::Hidden };
                 }
-                atom_style(ui, &mut s.atoms, checkbox.id);
+                atom_style(ui, s, checkbox.id);
             });
-            ui.checkbox(&mut s.volume.visible, "cloud");
-            ui.checkbox(&mut s.iso.visible, format!("isosurface {}", level_text(s.iso.level)));
-            let mut remove = None;
-            let mut changed = false;
-            for (k, iso) in object.state.isosurfaces.iter_mut().enumerate() {
-                ui.horizontal(|ui| {
-                    changed |= ui.checkbox(&mut iso.visible, "").changed();
-                    changed |= level_slider(ui, &mut iso.level);
-                    changed |= ui.color_edit_button_rgb(&mut iso.positive_color).changed();
-                    changed |= ui.color_edit_button_rgb(&mut iso.negative_color).changed();
-                    changed |= super::panels::translucency_editor(ui, iso);
-                    if ui.small_button("×").on_hover_text("remove this isosurface").clicked() {
-                        remove = Some(k);
-                    }
-                });
-            }
-            if let Some(k) = remove {
-                object.state.isosurfaces.remove(k);
-                changed = true;
-            }
-            if ui.button("+ isosurface").on_hover_text("another value of the same volume (nested shells)").clicked() {
-                object.state.isosurfaces.push(another_isosurface(s.iso, &object.state.isosurfaces));
-                changed = true;
-            }
-            changed |= surface_editor(ui, &mut object.state.surface);
-            if changed {
-                edits.push(Edit::Isosurfaces);
-            }
-            if let Some(p) = placement_editor(ui, object.state.placement) {
-                edits.push(Edit::Place(n, p));
+            surface_editor(ui, &mut state.surface);
+            if let Some(p) = placement_editor(ui, state.placement) {
+                state.placement = p;
             }
         });
     }
     ui.label(RichText::new("opened files join the scene beside it (tick “replace” to swap)").small().weak());
-    for edit in edits {
-        match edit {
-            Edit::Select(k) => app.select(k),
-            Edit::Remove(k) => app.remove_object(k),
-            Edit::Visible(k, v) => app.set_visible(k, v),
-            Edit::Place(k, p) => app.place(k, p),
-            Edit::Isosurfaces => app.refresh_isosurfaces(n),
+}
+
+/// The object's quantities: each shown or hidden, selected (the side panel edits it),
+/// removed; *+ quantity* adds another of the file's.
+fn quantities(ui: &mut egui::Ui, doc: &Document, state: &mut ObjectState, defaults: &RenderSettings) {
+    let mut remove = None;
+    for (k, q) in state.quantities.iter_mut().enumerate() {
+        ui.horizontal(|ui| {
+            if ui.small_button("×").on_hover_text("remove this quantity").clicked() {
+                remove = Some(k);
+            }
+            ui.checkbox(&mut q.visible, "").on_hover_text("show or hide its cloud and isosurfaces");
+            let what = representations(q);
+            let text = format!("{} · {what}", q.source.name(doc));
+            if ui.add(egui::Button::selectable(k == state.selected, text).truncate()).clicked() {
+                state.selected = k;
+            }
+        });
+    }
+    if let Some(k) = remove {
+        state.quantities.remove(k);
+        state.selected = state.selected.min(state.quantities.len().saturating_sub(1));
+    }
+    let choices = quantity_choices(doc);
+    if choices.is_empty() {
+        return;
+    }
+    ComboBox::from_id_salt("add quantity").selected_text("+ quantity").show_ui(ui, |ui| {
+        for (source, name) in choices {
+            if ui.selectable_label(false, name).clicked() {
+                state.quantities.push(QuantityState::new(source, defaults));
+                state.selected = state.quantities.len() - 1;
+            }
+        }
+    });
+}
+
+/// What a quantity draws, in words: "cloud", "cloud + 2 isosurfaces", "hidden".
+fn representations(q: &QuantityState) -> String {
+    let surfaces = q.isosurfaces.iter().filter(|i| i.visible).count();
+    let parts: Vec<String> = [
+        q.cloud.visible.then(|| "cloud".to_string()),
+        (surfaces > 0).then(|| format!("{surfaces} isosurface{}", if surfaces > 1 { "s" } else { "" })),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    if parts.is_empty() || !q.visible { "hidden".into() } else { parts.join(" + ") }
+}
+
+/// What a file offers to add as a quantity: its data sets, or its wavefunction's frontier
+/// orbitals and densities.
+pub fn quantity_choices(doc: &Document) -> Vec<(Source, String)> {
+    let mut choices: Vec<(Source, String)> =
+        (0..doc.volumes.len()).map(|i| (Source::Volume(i), Source::Volume(i).name(doc))).collect();
+    if let Some(wf) = &doc.wavefunction {
+        let spins: &[Spin] = if wf.restricted { &[Spin::Alpha] } else { &[Spin::Alpha, Spin::Beta] };
+        for &spin in spins {
+            // HOMO−1, HOMO, LUMO, LUMO+1 of each spin.
+            let order = wf.by_energy(spin);
+            let at = |i: Option<usize>| i.and_then(|i| order.iter().position(|&k| k == i));
+            let (homo, lumo) = (at(wf.homo(spin)), at(wf.lumo(spin)));
+            for p in [homo.and_then(|p| p.checked_sub(1)), homo, lumo, lumo.map(|p| p + 1)].into_iter().flatten() {
+                if let Some(&i) = order.get(p) {
+                    let source = Source::Wavefunction(Quantity::Orbital(i));
+                    choices.push((source, source.name(doc)));
+                }
+            }
+        }
+        choices.push((Source::Wavefunction(Quantity::Density), "total density".into()));
+        if !wf.restricted {
+            choices.push((Source::Wavefunction(Quantity::SpinDensity), "spin density".into()));
         }
     }
+    choices
 }
 
 /// The molecular surface: which kind, its grid spacing and probe or smoothness, its colour
@@ -179,30 +216,6 @@ fn atom_style(ui: &mut egui::Ui, style: &mut AtomStyle, label: egui::Id) {
         })
         .response
         .labelled_by(label);
-}
-
-fn level_text(level: IsoLevel) -> String {
-    match level {
-        IsoLevel::Absolute(v) => format!("{v:.3} a.u."),
-        IsoLevel::Sigma(s) => format!("{s:.2} σ"),
-    }
-}
-
-fn level_slider(ui: &mut egui::Ui, level: &mut IsoLevel) -> bool {
-    match level {
-        IsoLevel::Absolute(v) => ui.add(Slider::new(v, 1e-4..=0.5).logarithmic(true).text("a.u.")).changed(),
-        IsoLevel::Sigma(s) => ui.add(Slider::new(s, 0.1..=20.0).logarithmic(true).text("σ")).changed(),
-    }
-}
-
-/// A new isosurface at half the value of the last one (the next shell out), shown.
-fn another_isosurface(first: IsosurfaceSettings, more: &[IsosurfaceSettings]) -> IsosurfaceSettings {
-    let last = more.last().copied().unwrap_or(first);
-    let level = match last.level {
-        IsoLevel::Absolute(v) => IsoLevel::Absolute(v * 0.5),
-        IsoLevel::Sigma(s) => IsoLevel::Sigma(s * 0.5),
-    };
-    IsosurfaceSettings { visible: true, level, ..last }
 }
 
 /// Offset (Å) and rotation (degrees) of an object; the new placement when it was edited.

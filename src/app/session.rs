@@ -4,8 +4,8 @@
 use std::path::{Path, PathBuf};
 
 use super::{Opening, OrbApp};
+use crate::scene::Session;
 use crate::scene::objects::SESSION_SUFFIX;
-use crate::scene::{RenderSettings, Session};
 
 /// `path` ending in `.orbcloud.toml` (a dialog may have dropped the double suffix).
 pub fn with_suffix(path: PathBuf) -> PathBuf {
@@ -45,10 +45,9 @@ impl OrbApp {
     /// The scene as a session: every object read from a file (the bundled demo is left out),
     /// the camera and the background.
     pub fn session(&mut self) -> Session {
-        self.commit_active();
         Session {
             camera: self.view.camera,
-            background: Some(self.view.settings.background),
+            background: Some(self.view.background),
             objects: self.objects.iter().filter(|o| o.state.path.is_some()).map(|o| o.state.clone()).collect(),
             recent: self.recent.clone(),
         }
@@ -86,7 +85,7 @@ impl OrbApp {
         self.clear_scene();
         self.view.camera = session.camera;
         if let Some(bg) = session.background {
-            self.view.settings.background = bg;
+            self.view.background = bg;
         }
         super::files::remember(&mut self.recent, path, super::RECENT_FILES);
         self.queue.extend(files.into_iter().rev());
@@ -97,11 +96,12 @@ impl OrbApp {
     /// Empties the scene (what is loading still arrives).
     pub fn clear_scene(&mut self) {
         self.objects.clear();
+        self.applied.clear();
         self.active = 0;
         self.scan = None;
         self.measurements = Default::default();
         if let Some(vp) = &mut self.viewport {
-            vp.truncate(0);
+            vp.clear();
         }
         self.world = super::World::default();
     }
@@ -112,13 +112,13 @@ impl OrbApp {
     pub fn keep_session_in(&mut self, path: PathBuf) {
         if let Ok(session) = read(&path) {
             if let Some(last) = session.objects.last() {
-                self.defaults = RenderSettings { background: self.defaults.background, ..last.settings };
+                self.defaults = last.render_settings(last.selected, self.defaults.background);
                 // New files open without the last file's isosurfaces or hidden cloud.
                 self.defaults.iso.visible = false;
                 self.defaults.volume.visible = true;
             }
             if let Some(bg) = session.background {
-                self.view.settings.background = bg;
+                self.view.background = bg;
                 self.defaults.background = bg;
             }
             self.recent = session.recent;
@@ -139,16 +139,23 @@ impl OrbApp {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::{IsoLevel, ObjectState, Placement};
+    use crate::model::orbitals::Quantity;
+    use crate::scene::{
+        AtomLook, IsoLevel, IsosurfaceSettings, ObjectState, Placement, QuantityState, RenderSettings, Source,
+    };
 
     #[test]
     fn sessions_round_trip_through_toml() {
         let mut object = ObjectState { path: Some("/data/water.molden".into()), ..Default::default() };
         object.placement = Placement { offset: [8.0, 0.0, -1.5], rotation_deg: [0.0, 90.0, 0.0] };
-        object.settings.iso.visible = true;
-        object.settings.iso.level = IsoLevel::Sigma(2.5);
-        object.isosurfaces.push(Default::default());
-        object.quantity = Some(crate::model::orbitals::Quantity::Orbital(4));
+        let shell = IsosurfaceSettings { visible: true, level: IsoLevel::Sigma(2.5), ..Default::default() };
+        let homo = Source::Wavefunction(crate::model::orbitals::Quantity::Orbital(4));
+        let mut orbital = QuantityState::new(homo, &RenderSettings::default());
+        orbital.isosurfaces = vec![shell, Default::default()];
+        orbital.cloud.visible = false;
+        let density = Source::Wavefunction(crate::model::orbitals::Quantity::Density);
+        object.quantities = vec![QuantityState::new(density, &RenderSettings::default()), orbital];
+        object.selected = 1;
         let session = Session { background: Some([1.0, 1.0, 1.0]), objects: vec![object], ..Default::default() };
         let dir = std::env::temp_dir().join(format!("orbcloud-session-{}", std::process::id()));
         let path = dir.join(format!("scene{SESSION_SUFFIX}"));
@@ -161,5 +168,65 @@ mod tests {
         assert_eq!(with_suffix("a/b.toml".into()), PathBuf::from("a/b.orbcloud.toml"));
         assert_eq!(with_suffix("b".into()), PathBuf::from("b.orbcloud.toml"));
         assert_eq!(with_suffix("b.orbcloud.toml".into()), PathBuf::from("b.orbcloud.toml"));
+    }
+
+    /// An object as sessions wrote it before objects held several quantities: one cloud, the
+    /// first isosurface in `settings.iso`, the rest in `isosurfaces`, the orbital in `quantity`.
+    #[derive(serde::Serialize)]
+    struct OldObject {
+        path: PathBuf,
+        visible: bool,
+        placement: Placement,
+        settings: RenderSettings,
+        isosurfaces: Vec<IsosurfaceSettings>,
+        volume: usize,
+        quantity: Option<Quantity>,
+        selection: String,
+    }
+
+    fn old_session_object() -> String {
+        let mut settings =
+            RenderSettings { atoms: crate::scene::AtomStyle::Licorice, depth_cue: 0.25, ..Default::default() };
+        settings.volume.visible = false;
+        settings.volume.slices = 128;
+        settings.volume.k1 = 0.3;
+        settings.iso = IsosurfaceSettings { visible: true, level: IsoLevel::Sigma(2.5), ..Default::default() };
+        let shell = IsosurfaceSettings {
+            visible: true,
+            level: IsoLevel::Absolute(0.02),
+            translucent: true,
+            ..Default::default()
+        };
+        toml::to_string_pretty(&OldObject {
+            path: "/data/water.molden".into(),
+            visible: true,
+            placement: Placement { offset: [8.0, 0.0, -1.5], rotation_deg: [0.0, 90.0, 0.0] },
+            settings,
+            isosurfaces: vec![shell],
+            volume: 0,
+            quantity: Some(Quantity::Orbital(4)),
+            selection: String::new(),
+        })
+        .unwrap()
+    }
+
+    #[test]
+    fn an_object_saved_before_quantities_opens_as_one_quantity_with_all_its_isosurfaces() {
+        let old: ObjectState = toml::from_str(&old_session_object()).expect("an old session object reads");
+        assert_eq!(
+            old.atoms,
+            AtomLook { style: crate::scene::AtomStyle::Licorice, depth_cue: 0.25, ..Default::default() }
+        );
+        assert_eq!(old.placement.offset, [8.0, 0.0, -1.5]);
+        assert_eq!(old.quantities.len(), 1);
+        let q = &old.quantities[0];
+        assert_eq!(q.source, Source::Wavefunction(Quantity::Orbital(4)));
+        assert!(!q.cloud.visible && q.cloud.slices == 128 && q.cloud.k1 == 0.3);
+        let levels: Vec<_> = q.isosurfaces.iter().map(|i| (i.level, i.translucent)).collect();
+        assert_eq!(levels, [(IsoLevel::Sigma(2.5), false), (IsoLevel::Absolute(0.02), true)]);
+        // Written again, it is today's form and reads back the same.
+        let text = toml::to_string_pretty(&old).unwrap();
+        assert!(!text.contains("[settings") && text.contains("[[quantities]]"), "{text}");
+        assert_eq!(toml::from_str::<ObjectState>(&text).unwrap(), old);
     }
 }

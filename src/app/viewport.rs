@@ -15,8 +15,11 @@ use crate::headless::scan::ScanScene;
 use crate::headless::{Evaluated, WavefunctionView, evaluate_within, isosurfaces_within, molecular_surface};
 use crate::model::isosurface::Mesh;
 use crate::model::{Document, VolumeGrid};
+use crate::scene::objects::Part;
 use crate::scene::translucency::SurfaceLook;
-use crate::scene::{IsosurfaceSettings, ObjectState, RenderSettings, SurfaceChoice, SurfaceSettings, VolumeSettings};
+use crate::scene::{
+    ClipPlane, IsosurfaceSettings, ObjectState, Source, SurfaceChoice, SurfaceSettings, VolumeSettings,
+};
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -53,9 +56,9 @@ struct Progress {
     rows: u32,
 }
 
-/// The note for a document's volume shown at every `step`-th point (`None` when whole).
-fn coarser(doc: &Document, state: &ObjectState, step: usize) -> Option<String> {
-    let grid = doc.volumes.get(state.volume).filter(|_| step > 1)?;
+/// The note for a document's data set `i` shown at every `step`-th point (`None` when whole).
+fn coarser(doc: &Document, i: usize, step: usize) -> Option<String> {
+    let grid = doc.volumes.get(i).filter(|_| step > 1)?;
     Some(crate::headless::coarser_note(&doc.source, grid.dims, step))
 }
 
@@ -77,15 +80,16 @@ fn prepared((meshes, note): Meshes) -> Prepared {
     (meshes, trees, note)
 }
 
-/// What the viewport keeps per object besides its renderer layer.
-struct ObjectJobs {
-    /// Values on the grid shown when computed from a basis (cube files' grids stay in the
+/// What the viewport keeps per renderer layer besides the layer.
+struct LayerJobs {
+    /// A quantity's values on its grid when computed from a basis (cube files' grids stay in the
     /// document): isosurfaces are cut from it.
     computed: Option<Arc<VolumeGrid>>,
     /// Orbitals filled on the GPU and densities evaluated on the CPU, with a note when the grid
     /// had to be coarser than asked.
     evaluation: Latest<Evaluation>,
-    /// Marching cubes over the grid shown, and the molecular surface.
+    /// A quantity's isosurfaces (marching cubes over its grid), or an atoms layer's molecular
+    /// surface.
     extraction: Latest<Prepared>,
     /// The last molecular surface built, kept while only its look changes (an isosurface
     /// slider moving does not build it again).
@@ -133,12 +137,14 @@ pub struct Viewport {
     drawn: Option<Drawn>,
     /// Bumped whenever the renderer's data changes.
     generation: u64,
-    /// Per object: its computed grid and its background jobs.
-    slots: Vec<ObjectJobs>,
+    /// Which object and part each renderer layer draws ([`layer_parts`]); empty for a view of
+    /// one layer (a scan's).
+    parts: Vec<(usize, Part)>,
+    /// Per renderer layer: its computed grid and its background jobs.
+    slots: Vec<LayerJobs>,
     /// Wakes the window when a job ends.
     repaint: Arc<dyn Fn() + Send + Sync>,
-    /// Each object's cloud settings (set by the caller each frame); empty: one layer drawn with
-    /// the view's settings (scan views).
+    /// Each layer's cloud settings (set by the caller each frame, [`Self::set_clouds`]).
     pub clouds: Vec<VolumeSettings>,
     /// The last click, until the caller takes it.
     pub click: Option<Click>,
@@ -182,6 +188,7 @@ impl Viewport {
             picture_ms: None,
             drawn: None,
             generation: 0,
+            parts: Vec::new(),
             slots: Vec::new(),
             repaint: Arc::new(|| {}),
             clouds: Vec::new(),
@@ -199,90 +206,200 @@ impl Viewport {
         }
     }
 
-    /// Uploads object `n` of the scene: its molecule, the volume its state chooses and its
-    /// placement; its isosurfaces are cut in the background. Returns a note when the volume is
-    /// more than the GPU holds and is shown coarser.
+    /// The renderer layer that draws `part` of object `n`.
+    fn layer_of(&self, n: usize, part: Part) -> Option<usize> {
+        self.parts.iter().position(|&p| p == (n, part))
+    }
+
+    /// The layers that draw object `n`.
+    fn layers_of(&self, n: usize) -> std::ops::Range<usize> {
+        let first = self.parts.iter().position(|&(o, _)| o == n).unwrap_or(self.parts.len());
+        let count = self.parts.iter().filter(|&&(o, _)| o == n).count();
+        first..first + count
+    }
+
+    /// Inserts an empty layer at `l` drawing `part` of object `n`, with jobs of its own.
+    fn insert_layer(&mut self, l: usize, n: usize, part: Part) {
+        self.renderer.insert(&self.ctx, l);
+        self.parts.insert(l, (n, part));
+        let slot = self.new_slot();
+        self.slots.insert(l.min(self.slots.len()), slot);
+        self.generation += 1;
+    }
+
+    /// Removes layer `l` and its jobs.
+    fn remove_layer(&mut self, l: usize) {
+        self.renderer.remove(&self.ctx, l);
+        self.parts.remove(l);
+        if l < self.slots.len() {
+            let mut slot = self.slots.remove(l);
+            slot.evaluation.cancel();
+            slot.extraction.cancel();
+        }
+        self.generation += 1;
+    }
+
+    /// Puts object `n` of the scene on the GPU, in place of what it showed (or after the last
+    /// object): its atoms with its placement, and each of its quantities ([`Self::set_quantity`];
+    /// orbitals, densities and isosurfaces follow in the background). Returns a note when a data
+    /// set is more than the GPU holds and is shown coarser.
     pub fn set_object(
         &mut self,
         n: usize,
         doc: &Arc<Document>,
         state: &ObjectState,
     ) -> Result<Option<String>, GpuError> {
-        let (ctx, layer) = (&self.ctx, self.renderer.layer_mut(&self.ctx, n));
-        let step = guarded(&ctx.device, || crate::headless::show_document(ctx, layer, doc, state))?;
-        let slot = self.slot(n);
-        slot.evaluation.cancel();
-        slot.computed = None;
-        self.generation += 1;
-        self.update_isosurfaces(n, doc, state);
-        Ok(coarser(doc, state, step))
+        let old = self.layers_of(n);
+        let at = old.start;
+        for l in old.rev() {
+            self.remove_layer(l);
+        }
+        self.insert_layer(at, n, Part::Atoms);
+        let (ctx, layer) = (&self.ctx, self.renderer.layer_mut(&self.ctx, at));
+        guarded(&ctx.device, || {
+            crate::headless::show_object_atoms(ctx, layer, doc, state);
+            Ok(())
+        })?;
+        self.update_surface(n, doc, state);
+        let mut notes = Vec::new();
+        for k in 0..state.quantities.len() {
+            self.insert_layer(at + 1 + k, n, Part::Quantity(k));
+            notes.extend(self.set_quantity(n, k, doc, state)?);
+        }
+        Ok(notes.into_iter().reduce(|a, b| format!("{a}; {b}")))
     }
 
-    /// Shows the volume object `n`'s state chooses (a note when it is shown coarser).
-    pub fn set_volume(
+    /// Makes object `n`'s quantity layers follow its quantities after some were added or
+    /// removed (`before` → `state`): layers of quantities kept at the start and the end stay
+    /// with their values and jobs; those between are made anew.
+    pub fn relayout_quantities(
         &mut self,
         n: usize,
         doc: &Arc<Document>,
+        before: &ObjectState,
         state: &ObjectState,
     ) -> Result<Option<String>, GpuError> {
-        let (ctx, layer) = (&self.ctx, self.renderer.layer_mut(&self.ctx, n));
-        let step = guarded(&ctx.device, || layer.set_volume(ctx, doc.volumes.get(state.volume)))?;
-        self.generation += 1;
-        self.update_isosurfaces(n, doc, state);
-        Ok(coarser(doc, state, step))
+        let (old, new) = (&before.quantities, &state.quantities);
+        let same = |a: &crate::scene::QuantityState, b: &crate::scene::QuantityState| a.source == b.source;
+        let prefix = old.iter().zip(new).take_while(|(a, b)| same(a, b)).count();
+        let room = old.len().min(new.len()) - prefix;
+        let suffix = old.iter().rev().zip(new.iter().rev()).take(room).take_while(|(a, b)| same(a, b)).count();
+        let Some(atoms) = self.layer_of(n, Part::Atoms) else { return self.set_object(n, doc, state) };
+        for k in (prefix..old.len() - suffix).rev() {
+            self.remove_layer(atoms + 1 + k);
+        }
+        for k in prefix..new.len() - suffix {
+            self.insert_layer(atoms + 1 + k, n, Part::Quantity(k));
+        }
+        // The layers after the change draw quantities renumbered.
+        for k in 0..new.len() {
+            self.parts[atoms + 1 + k] = (n, Part::Quantity(k));
+        }
+        let mut notes = Vec::new();
+        for k in prefix..new.len() - suffix {
+            notes.extend(self.set_quantity(n, k, doc, state)?);
+        }
+        self.set_visibility(n, state);
+        Ok(notes.into_iter().reduce(|a, b| format!("{a}; {b}")))
     }
 
-    /// Evaluates a wavefunction's orbital or density for object `n` in the background
-    /// ([`crate::headless::evaluate_wavefunction`]); [`Self::poll`] shows it when it is done.
-    pub fn show_wavefunction(&mut self, n: usize, doc: &Arc<Document>, view: WavefunctionView) {
-        if doc.wavefunction.is_none() {
-            return;
+    /// Shows quantity `k` of object `n`: a data set of the document at once (a note when it is
+    /// shown coarser), an orbital or density of its wavefunction evaluated in the background
+    /// ([`crate::headless::evaluate_wavefunction`]; [`Self::poll`] shows it when it is done). Its
+    /// isosurfaces follow.
+    pub fn set_quantity(
+        &mut self,
+        n: usize,
+        k: usize,
+        doc: &Arc<Document>,
+        state: &ObjectState,
+    ) -> Result<Option<String>, GpuError> {
+        let (Some(l), Some(q)) = (self.layer_of(n, Part::Quantity(k)), state.quantities.get(k)) else {
+            return Ok(None);
+        };
+        let (ctx, layer) = (&self.ctx, self.renderer.layer_mut(&self.ctx, l));
+        crate::headless::place_layer(layer, state, Part::Quantity(k));
+        self.generation += 1;
+        match q.source {
+            Source::Volume(i) => {
+                let step = guarded(&ctx.device, || layer.set_volume(ctx, doc.volumes.get(i)))?;
+                let slot = &mut self.slots[l];
+                slot.evaluation.cancel();
+                slot.computed = None;
+                self.update_isosurfaces(n, k, doc, state);
+                Ok(coarser(doc, i, step))
+            }
+            Source::Wavefunction(quantity) => {
+                let e = &state.evaluation;
+                let view = WavefunctionView { quantity, direct: e.direct, points: e.grid_points, shells: e.shells() };
+                let ctx = self.ctx.clone();
+                let fill = self.fill.get_or_insert_with(|| Arc::new(GtoFillPass::new(&ctx))).clone();
+                let doc = doc.clone();
+                self.slots[l].evaluation.request(move |_| {
+                    let limits = ctx.device.limits();
+                    evaluate_within(&ctx, &fill, &doc, &view, &limits)
+                });
+                Ok(None)
+            }
         }
-        let ctx = self.ctx.clone();
-        let fill = self.fill.get_or_insert_with(|| Arc::new(GtoFillPass::new(&ctx))).clone();
+    }
+
+    /// Cuts every isosurface of object `n`'s quantity `k` from its grid in the background;
+    /// [`Self::poll`] shows them when they are done.
+    pub fn update_isosurfaces(&mut self, n: usize, k: usize, doc: &Arc<Document>, state: &ObjectState) {
+        let (Some(l), Some(q)) = (self.layer_of(n, Part::Quantity(k)), state.quantities.get(k)) else { return };
+        let computed = self.slots[l].computed.clone();
         let doc = doc.clone();
-        self.slot(n).evaluation.request(move |_| {
-            let limits = ctx.device.limits();
-            evaluate_within(&ctx, &fill, &doc, &view, &limits)
+        let volume = match q.source {
+            Source::Volume(i) => Some(i),
+            Source::Wavefunction(_) => None,
+        };
+        let levels = q.isosurfaces.clone();
+        let max_bytes = self.ctx.device.limits().max_buffer_size;
+        self.slots[l].extraction.request(move |_| {
+            let grid = computed.as_deref().or(volume.and_then(|i| doc.volumes.get(i)));
+            prepared(grid.map(|g| isosurfaces_within(g, &levels, max_bytes)).unwrap_or_default())
         });
     }
 
-    /// Cuts every isosurface object `n`'s state asks for, from the grid it shows, in the
-    /// background; [`Self::poll`] shows them when they are done.
-    pub fn update_isosurfaces(&mut self, n: usize, doc: &Arc<Document>, state: &ObjectState) {
-        let computed = self.slot(n).computed.clone();
-        let cache = self.slot(n).surface.clone();
-        let progress = self.slot(n).surface_progress.clone();
-        let (doc, volume) = (doc.clone(), state.volume);
-        let levels: Vec<IsosurfaceSettings> = state.all_isosurfaces().copied().collect();
+    /// Builds (or colours anew) object `n`'s molecular surface in the background, around the
+    /// atoms it shows; coloured by the values of its selected quantity when it asks for that.
+    pub fn update_surface(&mut self, n: usize, doc: &Arc<Document>, state: &ObjectState) {
+        let Some(l) = self.layer_of(n, Part::Atoms) else { return };
+        let shown = self.layer_of(n, Part::Quantity(state.selected)).and_then(|q| self.slots[q].computed.clone());
+        let volume = state.selected_quantity().and_then(|q| match q.source {
+            Source::Volume(i) => Some(i),
+            Source::Wavefunction(_) => None,
+        });
+        let slot = &self.slots[l];
+        let (cache, progress) = (slot.surface.clone(), slot.surface_progress.clone());
+        let doc = doc.clone();
         let (surface, selection) = (state.surface, state.selection.clone());
         let max_bytes = self.ctx.device.limits().max_buffer_size;
-        self.slot(n).extraction.request(move |cancel| {
-            let grid = computed.as_deref().or(doc.volumes.get(volume));
-            let (mut meshes, note) = grid.map(|g| isosurfaces_within(g, &levels, max_bytes)).unwrap_or_default();
+        self.slots[l].extraction.request(move |cancel| {
+            let grid = shown.as_deref().or(volume.and_then(|i| doc.volumes.get(i)));
             let shown = (&*doc, &surface, selection.as_str(), grid);
-            let (built, surface_note) = molecular_surface_cached(&cache, shown, max_bytes, (cancel, &progress));
+            let (built, note) = molecular_surface_cached(&cache, shown, max_bytes, (cancel, &progress));
             progress.store(0, Ordering::Relaxed);
-            meshes.extend(built);
-            prepared((meshes, note.into_iter().chain(surface_note).reduce(|a, b| format!("{a}; {b}"))))
+            prepared((built.into_iter().collect(), note))
         });
     }
 
-    /// Makes object `n`'s isosurfaces with `make` in the background (the newest request wins);
+    /// Makes layer `l`'s isosurfaces with `make` in the background (the newest request wins);
     /// `make` gets the largest buffer this device makes (bytes). [`Self::poll_meshes`] shows
     /// them when they are done.
-    pub fn request_meshes(&mut self, n: usize, make: impl FnOnce(u64) -> Meshes + Send + 'static) {
+    pub fn request_meshes(&mut self, l: usize, make: impl FnOnce(u64) -> Meshes + Send + 'static) {
         let max_bytes = self.ctx.device.limits().max_buffer_size;
-        self.slot(n).extraction.request(move |_| prepared(make(max_bytes)));
+        self.slot(l).extraction.request(move |_| prepared(make(max_bytes)));
     }
 
-    /// Shows object `n`'s isosurfaces if their job finished: `Ok` with the triangle count and
+    /// Shows layer `l`'s isosurfaces if their job finished: `Ok` with the triangle count and
     /// any note, or the failure.
-    pub fn poll_meshes(&mut self, n: usize) -> Option<Result<(usize, Option<String>), String>> {
-        let result = self.slot(n).extraction.poll()?;
+    pub fn poll_meshes(&mut self, l: usize) -> Option<Result<(usize, Option<String>), String>> {
+        let result = self.slot(l).extraction.poll()?;
         self.generation += 1;
         Some(result.and_then(|(meshes, trees, note)| {
-            let (ctx, layer) = (&self.ctx, self.renderer.layer_mut(&self.ctx, n));
+            let (ctx, layer) = (&self.ctx, self.renderer.layer_mut(&self.ctx, l));
             guarded(&ctx.device, || {
                 layer.surfaces.set_meshes_with_trees(ctx, &meshes, trees);
                 Ok(())
@@ -293,37 +410,52 @@ impl Viewport {
     }
 
     /// Shows what object `n`'s finished jobs made; returns what to tell the user (`Err`: a
-    /// failure) and whether a newly evaluated grid is shown.
-    pub fn poll(&mut self, n: usize, doc: &Arc<Document>, state: &ObjectState) -> (Vec<Result<String, String>>, bool) {
+    /// failure) and the quantities whose newly evaluated values are shown.
+    pub fn poll(
+        &mut self,
+        n: usize,
+        doc: &Arc<Document>,
+        state: &ObjectState,
+    ) -> (Vec<Result<String, String>>, Vec<usize>) {
         let mut said = Vec::new();
-        let mut evaluated = false;
-        if let Some(result) = self.slot(n).evaluation.poll() {
+        let mut evaluated = Vec::new();
+        for l in self.layers_of(n) {
+            let Some(result) = self.slots[l].evaluation.poll() else { continue };
+            let Part::Quantity(k) = self.parts[l].1 else { continue };
             let result = result.and_then(|r| r.map_err(|e| e.to_string()));
             if let Ok((_, Some(note))) = &result {
                 said.push(Ok(note.clone()));
             }
             let shown = result.and_then(|(evaluated, _)| {
                 let Some(evaluated) = evaluated else { return Ok(None) };
-                let (ctx, layer) = (&self.ctx, self.renderer.layer_mut(&self.ctx, n));
+                let (ctx, layer) = (&self.ctx, self.renderer.layer_mut(&self.ctx, l));
                 guarded(&ctx.device, || evaluated.show(ctx, layer)).map(Some).map_err(|e| e.to_string())
             });
             match shown {
                 Ok(grid) => {
-                    evaluated = grid.is_some();
-                    self.slot(n).computed = grid.map(Arc::new);
+                    if grid.is_some() {
+                        evaluated.push(k);
+                    }
+                    self.slots[l].computed = grid.map(Arc::new);
                     self.generation += 1;
-                    self.update_isosurfaces(n, doc, state);
+                    self.update_isosurfaces(n, k, doc, state);
+                    if k == state.selected && state.surface.color_by_volume {
+                        self.update_surface(n, doc, state);
+                    }
                 }
                 Err(e) => said.push(Err(format!("{}: {e}", doc.source))),
             }
         }
-        match self.poll_meshes(n) {
-            Some(Ok((0, _))) | None => {}
-            Some(Ok((triangles, note))) => said
-                .push(Ok(note.map_or(format!("isosurfaces: {triangles} triangles"), |note| {
-                    format!("{note}: {triangles} triangles")
-                }))),
-            Some(Err(e)) => said.push(Err(format!("{}: isosurfaces: {e}", doc.source))),
+        for l in self.layers_of(n) {
+            let what = if self.parts[l].1 == Part::Atoms { "molecular surface" } else { "isosurfaces" };
+            match self.poll_meshes(l) {
+                Some(Ok((0, _))) | None => {}
+                Some(Ok((triangles, note))) => said
+                    .push(Ok(note.map_or(format!("{what}: {triangles} triangles"), |note| {
+                        format!("{note}: {triangles} triangles")
+                    }))),
+                Some(Err(e)) => said.push(Err(format!("{}: {what}: {e}", doc.source))),
+            }
         }
         (said, evaluated)
     }
@@ -356,78 +488,124 @@ impl Viewport {
         self.picture_ms.take()
     }
 
-    /// Object `n`'s values on the grid it shows, when they are not one of its document's (an
-    /// orbital or density computed from a basis): isosurfaces are cut from it.
-    pub fn computed_grid(&self, n: usize) -> Option<&VolumeGrid> {
-        self.slots.get(n)?.computed.as_deref()
+    /// Object `n`'s quantity `k` on its grid, when computed from a basis (an orbital or
+    /// density; a data set stays in the document): isosurfaces are cut from it.
+    pub fn computed_grid(&self, n: usize, k: usize) -> Option<&VolumeGrid> {
+        self.slots.get(self.layer_of(n, Part::Quantity(k))?)?.computed.as_deref()
     }
 
-    fn slot(&mut self, n: usize) -> &mut ObjectJobs {
-        while self.slots.len() <= n {
-            let repaint = self.repaint.clone();
-            let again = self.repaint.clone();
-            self.slots.push(ObjectJobs {
-                computed: None,
-                evaluation: Latest::new("evaluating the orbital", move || repaint()),
-                extraction: Latest::new("cutting isosurfaces", move || again()),
-                surface: Arc::default(),
-                surface_progress: Arc::default(),
-            });
+    /// The values object `n`'s quantity `k` shows: computed, or the document's data set.
+    pub fn shown_grid<'a>(
+        &'a self,
+        n: usize,
+        k: usize,
+        doc: &'a Document,
+        state: &ObjectState,
+    ) -> Option<&'a VolumeGrid> {
+        match state.quantities.get(k)?.source {
+            Source::Volume(i) => doc.volumes.get(i),
+            Source::Wavefunction(_) => self.computed_grid(n, k),
         }
-        &mut self.slots[n]
+    }
+
+    fn new_slot(&self) -> LayerJobs {
+        let repaint = self.repaint.clone();
+        let again = self.repaint.clone();
+        LayerJobs {
+            computed: None,
+            evaluation: Latest::new("evaluating the orbital", move || repaint()),
+            extraction: Latest::new("cutting isosurfaces", move || again()),
+            surface: Arc::default(),
+            surface_progress: Arc::default(),
+        }
+    }
+
+    /// Layer `l`'s jobs (made for a view of one layer, a scan's).
+    fn slot(&mut self, l: usize) -> &mut LayerJobs {
+        while self.slots.len() <= l {
+            let slot = self.new_slot();
+            self.slots.push(slot);
+        }
+        &mut self.slots[l]
     }
 
     /// Restyles, recolours and reselects object `n`'s atoms (positions stay on the GPU).
-    pub fn set_atom_look(&mut self, n: usize, doc: &Document, state: &crate::scene::ObjectState) {
-        let look = crate::headless::atom_look(doc, &state.settings, &state.selection);
-        let atoms = &mut self.renderer.layer_mut(&self.ctx, n).atoms;
-        atoms.set_look(&self.ctx, state.settings.atoms, &look);
-        atoms.depth_cue = state.settings.depth_cue;
+    pub fn set_atom_look(&mut self, n: usize, doc: &Document, state: &ObjectState) {
+        let Some(l) = self.layer_of(n, Part::Atoms) else { return };
+        let look = crate::headless::atom_look(doc, &state.atoms, &state.selection);
+        let atoms = &mut self.renderer.layer_mut(&self.ctx, l).atoms;
+        atoms.set_look(&self.ctx, state.atoms.style, &look);
+        atoms.depth_cue = state.atoms.depth_cue;
         self.generation += 1;
     }
 
     /// Puts object `n`'s molecule anew (another model or frame of a structure).
-    pub fn set_atoms(&mut self, n: usize, doc: &Document, state: &crate::scene::ObjectState) {
-        crate::headless::show_atoms(
-            &self.ctx,
-            self.renderer.layer_mut(&self.ctx, n),
-            doc,
-            &state.settings,
-            &state.selection,
-        );
+    pub fn set_atoms(&mut self, n: usize, doc: &Document, state: &ObjectState) {
+        let Some(l) = self.layer_of(n, Part::Atoms) else { return };
+        let layer = self.renderer.layer_mut(&self.ctx, l);
+        crate::headless::show_atoms(&self.ctx, layer, doc, &state.atoms, &state.selection);
         self.generation += 1;
     }
 
-    /// Moves object `n` to `placement`.
-    pub fn set_placement(&mut self, n: usize, placement: &crate::scene::Placement) {
-        self.renderer.layer_mut(&self.ctx, n).world_from_object = placement.world_from_object();
-        self.generation += 1;
+    /// Moves every layer of object `n` where its state places it.
+    pub fn set_placement(&mut self, n: usize, state: &ObjectState) {
+        self.set_visibility(n, state);
     }
 
-    /// Shows or hides object `n` whole.
-    pub fn set_visible(&mut self, n: usize, visible: bool) {
-        self.renderer.layer_mut(&self.ctx, n).visible = visible;
-        self.generation += 1;
-    }
-
-    /// Keeps the first `n` objects, dropping the GPU data and jobs of the rest (the first
-    /// layer is emptied when `n` is 0).
-    pub fn truncate(&mut self, n: usize) {
-        self.renderer.truncate(n);
-        self.slots.truncate(n);
-        if n == 0 {
-            self.renderer.main().clear(&self.ctx);
+    /// Gives every layer of object `n` its placement and visibility (the object's, and each
+    /// quantity's).
+    pub fn set_visibility(&mut self, n: usize, state: &ObjectState) {
+        for l in self.layers_of(n) {
+            let part = self.parts[l].1;
+            crate::headless::place_layer(self.renderer.layer_mut(&self.ctx, l), state, part);
         }
+        self.generation += 1;
+    }
+
+    /// Each layer's cloud for the next frames: a quantity layer's own, none for atoms.
+    pub fn set_clouds(&mut self, states: &[&ObjectState]) {
+        let hidden = VolumeSettings { visible: false, ..VolumeSettings::default() };
+        self.clouds = self
+            .parts
+            .iter()
+            .map(|&(n, part)| match part {
+                Part::Atoms => hidden,
+                Part::Quantity(k) => states.get(n).and_then(|s| s.quantities.get(k)).map_or(hidden, |q| q.cloud),
+            })
+            .collect();
+    }
+
+    /// Drops every object's GPU data and jobs.
+    pub fn clear(&mut self) {
+        for l in (0..self.parts.len()).rev() {
+            self.remove_layer(l);
+        }
+        self.renderer.truncate(1);
+        self.renderer.main().clear(&self.ctx);
+        self.slots.clear();
         self.generation += 1;
     }
 
     /// Removes object `n`; the objects after it move down by one.
     pub fn remove_object(&mut self, n: usize) {
-        self.renderer.remove(&self.ctx, n);
-        if n < self.slots.len() {
-            self.slots.remove(n);
+        for l in self.layers_of(n).rev() {
+            self.remove_layer(l);
         }
-        self.generation += 1;
+        for p in &mut self.parts {
+            if p.0 > n {
+                p.0 -= 1;
+            }
+        }
+    }
+
+    /// The object a pick id's layer belongs to, in place of the layer (views of one layer
+    /// keep it).
+    fn object_of(&self, id: PickId) -> PickId {
+        let object = |l: u32| self.parts.get(l as usize).map_or(l, |&(n, _)| n as u32);
+        match id {
+            PickId::Atom { object: l, index } => PickId::Atom { object: object(l), index },
+            PickId::Surface { object: l, index } => PickId::Surface { object: object(l), index },
+        }
     }
 
     /// Shows slot `slot` of a scan at θ (both key volumes and the twisted skeleton).
@@ -446,8 +624,15 @@ impl Viewport {
 
     /// Shows the view in the remaining space of `ui`, applying mouse and keyboard input to
     /// `view.camera`.
-    pub fn show(&mut self, ui: &mut egui::Ui, render_state: &egui_wgpu::RenderState, view: &mut ViewState) {
-        self.show_twistable(ui, render_state, view, None);
+    /// `view.camera`; Ctrl + drag moves `clip` (the edited cloud's clipping plane) when it is on.
+    pub fn show(
+        &mut self,
+        ui: &mut egui::Ui,
+        render_state: &egui_wgpu::RenderState,
+        view: &mut ViewState,
+        clip: Option<&mut ClipPlane>,
+    ) {
+        self.show_twistable(ui, render_state, view, clip, None);
     }
 
     /// [`Self::show`] for a scan view: returns the twist dragged this frame, as a fraction of
@@ -457,6 +642,7 @@ impl Viewport {
         ui: &mut egui::Ui,
         render_state: &egui_wgpu::RenderState,
         view: &mut ViewState,
+        clip: Option<&mut ClipPlane>,
         twist: Option<TwistInput>,
     ) -> f32 {
         let rect = ui.available_rect_before_wrap();
@@ -481,10 +667,10 @@ impl Viewport {
             }
         }
         if !self.twisting {
-            handle_input(ui, &response, view);
+            handle_input(ui, &response, view, clip);
         }
         self.shown_size = Some(size);
-        let drawn = ViewState { settings: self.detail.apply(view.settings), ..*view };
+        let drawn = *view;
         let size = self.detail.render_size(size);
         if self.target.as_ref().is_none_or(|(t, _)| t.size != size) {
             let target = OffscreenTarget::new(&self.ctx.device, size);
@@ -508,14 +694,7 @@ impl Viewport {
             self.target = Some((target, id));
             self.drawn = None;
         }
-        let clouds: Vec<VolumeSettings> = if self.clouds.is_empty() {
-            vec![drawn.settings.volume]
-        } else {
-            self.clouds
-                .iter()
-                .map(|&volume| self.detail.apply(RenderSettings { volume, ..drawn.settings }).volume)
-                .collect()
-        };
+        let clouds: Vec<VolumeSettings> = self.clouds.iter().map(|&c| self.detail.cloud(c)).collect();
         self.renderer.set_lod_scale(self.detail.lod_scale);
         let key = (drawn, clouds, size, self.generation, self.detail.lod_scale.to_bits());
         if let Some((target, id)) = &self.target {
@@ -532,7 +711,7 @@ impl Viewport {
             if changed || self.progress.is_some() {
                 let frame = FrameInput {
                     camera: &key.0.camera,
-                    background: key.0.settings.background,
+                    background: key.0.background,
                     clouds: &key.1,
                     size,
                     tile: None,
@@ -666,7 +845,15 @@ impl Viewport {
     fn pick_at(&self, pos: egui::Pos2) -> Result<Option<PickId>, GpuError> {
         let Some((rect, size)) = self.layout else { return Ok(None) };
         let rel = (pos - rect.min) / rect.size();
-        self.renderer.pick(&self.ctx, [(rel.x * size[0] as f32) as u32, (rel.y * size[1] as f32) as u32])
+        let picked =
+            self.renderer.pick(&self.ctx, [(rel.x * size[0] as f32) as u32, (rel.y * size[1] as f32) as u32])?;
+        Ok(picked.map(|id| self.object_of(id)))
+    }
+
+    /// How many more layers the scene can take (each object one for its atoms and one per
+    /// quantity).
+    pub fn room(&self) -> usize {
+        (crate::gpu::renderer::MAX_LAYERS - 1).saturating_sub(self.parts.len())
     }
 
     /// Where world point `p` (bohr) lies on screen in the last frame laid out.
@@ -684,14 +871,8 @@ impl Viewport {
         let target = OffscreenTarget::new(&self.ctx.device, size);
         let mut encoder =
             self.ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("snapshot") });
-        let clouds = if self.clouds.is_empty() { vec![view.settings.volume] } else { self.clouds.clone() };
-        let frame = FrameInput {
-            camera: &view.camera,
-            background: view.settings.background,
-            clouds: &clouds,
-            size,
-            tile: None,
-        };
+        let frame =
+            FrameInput { camera: &view.camera, background: view.background, clouds: &self.clouds, size, tile: None };
         self.renderer.render(&self.ctx, &mut encoder, &target.color_view, &frame);
         self.ctx.queue.submit([encoder.finish()]);
         // The viewport's own frame must be redrawn: the renderer's buffers changed size.
@@ -723,12 +904,14 @@ fn distance_to_segment(p: egui::Pos2, a: egui::Pos2, b: egui::Pos2) -> f32 {
     (p - (a + t * ab)).length()
 }
 
-fn handle_input(ui: &egui::Ui, response: &egui::Response, view: &mut ViewState) {
-    let clip_drag = ui.input(|i| i.modifiers.command) && view.settings.volume.clip.enabled;
-    if clip_drag && response.dragged_by(PointerButton::Primary) {
+fn handle_input(ui: &egui::Ui, response: &egui::Response, view: &mut ViewState, clip: Option<&mut ClipPlane>) {
+    let clip = clip.filter(|c| c.enabled && ui.input(|i| i.modifiers.command));
+    if let Some(clip) = clip
+        && response.dragged_by(PointerButton::Primary)
+    {
         // Ctrl + drag moves the clipping plane: a view height of drag is the camera distance.
         let h = response.rect.height().max(1.0);
-        view.settings.volume.clip.offset -= response.drag_delta().y / h * view.camera.distance * 0.5;
+        clip.offset -= response.drag_delta().y / h * view.camera.distance * 0.5;
         return;
     }
     let cam = &mut view.camera;

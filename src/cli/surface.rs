@@ -87,23 +87,19 @@ impl IsoArgs {
         abs.chain(self.sigmas.iter().map(|&s| IsoLevel::Sigma(s))).collect()
     }
 
-    /// Puts these levels (when any were given) in place of an object's isosurfaces: the first as
-    /// its first isosurface, the others as further ones, told apart by colour
-    /// ([`IsosurfaceSettings::nested`]).
-    pub fn apply_to(&self, state: &mut orbcloud::scene::ObjectState) {
+    /// Puts these levels (when any were given) in place of a quantity's isosurfaces, drawn as
+    /// its first one is and told apart by colour ([`IsosurfaceSettings::nested`]).
+    pub fn apply_to(&self, quantity: &mut orbcloud::scene::QuantityState) {
         let mut levels = self.levels();
         if levels.is_empty() {
             return;
         }
         levels.sort_by(|a, b| a.value(1.0).total_cmp(&b.value(1.0)));
-        let own = state.settings.iso;
+        let own = quantity.isosurfaces.first().copied().unwrap_or_default();
         let tuning = if self.tuning.is_empty() { own.tuning } else { self.tuning() };
         let first = IsosurfaceSettings { translucent: own.translucent || self.translucent, tuning, ..own };
         let count = levels.len();
-        let all: Vec<IsosurfaceSettings> =
-            levels.into_iter().enumerate().map(|(n, level)| first.nested(level, n, count)).collect();
-        state.settings.iso = all[0];
-        state.isosurfaces = all[1..].to_vec();
+        quantity.isosurfaces = levels.into_iter().enumerate().map(|(n, level)| first.nested(level, n, count)).collect();
     }
 
     /// The settings every level starts from: translucent or not.
@@ -475,7 +471,7 @@ pub fn render_scene(
     use orbcloud::headless::{draw_exact, show_scene};
     use orbcloud::scene::{Camera, RenderSettings};
     for (_, state) in &mut scene {
-        iso.apply_to(state);
+        state.quantities.iter_mut().for_each(|q| iso.apply_to(q));
     }
     let mut renderer = Renderer::new(ctx);
     let (clouds, bounds) = show_scene(ctx, &mut renderer, &scene, 64)?;

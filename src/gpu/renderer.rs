@@ -216,18 +216,32 @@ impl Renderer {
     pub fn layer_mut(&mut self, ctx: &GpuContext, n: usize) -> &mut Layer {
         let n = n.min(MAX_LAYERS - 1);
         while self.layers.len() <= n {
-            let first = &self.layers[0];
-            let layer = Layer {
-                atoms: first.atoms.instance(ctx),
-                surfaces: first.surfaces.instance(),
-                volume: first.volume.instance(ctx),
-                world_from_object: Mat4::IDENTITY,
-                visible: true,
-                molecule_bounds: None,
-            };
+            let layer = self.empty_layer(ctx);
             self.layers.push(layer);
         }
         &mut self.layers[n]
+    }
+
+    /// A layer that draws nothing, sharing the first layer's pipelines.
+    fn empty_layer(&self, ctx: &GpuContext) -> Layer {
+        let first = &self.layers[0];
+        Layer {
+            atoms: first.atoms.instance(ctx),
+            surfaces: first.surfaces.instance(),
+            volume: first.volume.instance(ctx),
+            world_from_object: Mat4::IDENTITY,
+            visible: true,
+            molecule_bounds: None,
+        }
+    }
+
+    /// Inserts an empty layer at `n` (at the end when past it); the layers from `n` on move up
+    /// by one. A renderer of [`MAX_LAYERS`] layers takes no more.
+    pub fn insert(&mut self, ctx: &GpuContext, n: usize) {
+        if self.layers.len() < MAX_LAYERS {
+            let layer = self.empty_layer(ctx);
+            self.layers.insert(n.min(self.layers.len()), layer);
+        }
     }
 
     /// The first layer: the whole scene of a single-document host.

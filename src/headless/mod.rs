@@ -22,9 +22,12 @@ use crate::model::surface::{self, Sphere, SurfaceError};
 use crate::model::units::ANGSTROM_PER_BOHR;
 use crate::model::{Document, VolumeGrid};
 use crate::scene::coloring::{AtomColors, atom_colors};
+use crate::scene::objects::{Part, layer_parts};
 use crate::scene::selection::Selection;
 use crate::scene::translucency::SurfaceLook;
-use crate::scene::{Camera, IsosurfaceSettings, ObjectState, RenderSettings, SurfaceSettings, ViewPreset};
+use crate::scene::{
+    AtomLook, Camera, Evaluation, IsosurfaceSettings, ObjectState, RenderSettings, Source, SurfaceSettings, ViewPreset,
+};
 
 /// Space (bohr) around the atoms in which orbitals are evaluated.
 pub const ORBITAL_MARGIN: f64 = 4.5;
@@ -367,89 +370,140 @@ pub fn coarser_note(what: &str, dims: [usize; 3], step: usize) -> String {
     )
 }
 
-/// Puts `doc`'s atoms into `layer` in the settings' style and colouring, those `selection`
-/// leaves out hidden.
-pub fn show_atoms(ctx: &GpuContext, layer: &mut Layer, doc: &Document, settings: &RenderSettings, selection: &str) {
-    layer.set_atoms(ctx, &doc.molecule, settings.atoms, Some(&atom_look(doc, settings, selection)));
-    layer.atoms.depth_cue = settings.depth_cue;
+/// Puts `doc`'s atoms into `layer` as `look` says, those `selection` leaves out hidden.
+pub fn show_atoms(ctx: &GpuContext, layer: &mut Layer, doc: &Document, look: &AtomLook, selection: &str) {
+    layer.set_atoms(ctx, &doc.molecule, look.style, Some(&atom_look(doc, look, selection)));
+    layer.atoms.depth_cue = look.depth_cue;
 }
 
 /// The colours of `doc`'s atoms, and which are shown: all when `selection` does not parse (the
 /// panel says why).
-pub fn atom_look(doc: &Document, settings: &RenderSettings, selection: &str) -> AtomColors {
-    let mut colors = atom_colors(&doc.molecule, doc.structure.as_ref(), settings.atom_colors);
+pub fn atom_look(doc: &Document, look: &AtomLook, selection: &str) -> AtomColors {
+    let mut colors = atom_colors(&doc.molecule, doc.structure.as_ref(), look.colors);
     if let Some(mask) = shown_atoms(doc, selection) {
         colors.shown = mask;
     }
     colors
 }
 
-/// Puts `doc` into `layer` as `state` shows it, all but its isosurfaces (none until they are
-/// cut): the molecule in the state's atom style, the volume it chooses, placement and
-/// visibility. Returns the step the volume is shown at (1: every point; see
-/// [`Layer::set_volume`]).
-pub fn show_document(
-    ctx: &GpuContext,
-    layer: &mut Layer,
-    doc: &Document,
-    state: &ObjectState,
-) -> Result<usize, GpuError> {
-    let step = layer.set_volume(ctx, doc.volumes.get(state.volume))?;
-    show_atoms(ctx, layer, doc, &state.settings, &state.selection);
+/// Puts `doc`'s atoms into `layer` as `state` shows them, with its placement and visibility;
+/// the layer's cloud and surfaces are emptied (an object's atoms layer: its molecular surface
+/// is added when built, its quantities have layers of their own).
+pub fn show_object_atoms(ctx: &GpuContext, layer: &mut Layer, doc: &Document, state: &ObjectState) {
+    show_atoms(ctx, layer, doc, &state.atoms, &state.selection);
+    layer.volume.set_texture(ctx, None);
     layer.surfaces.clear();
-    layer.world_from_object = state.placement.world_from_object();
-    layer.visible = state.visible;
-    Ok(step)
+    place_layer(layer, state, Part::Atoms);
 }
 
-/// Puts `doc` into `layer` as `state` shows it: its molecule in the state's atom style, the
-/// volume it chooses (none past the document's volumes) with every isosurface of it, its
-/// placement and visibility. Returns the isosurfaces' triangle count.
+/// Gives `layer`, which draws `part` of the object `state` describes, the object's placement
+/// and whether it is drawn (the object's visibility, and the quantity's).
+pub fn place_layer(layer: &mut Layer, state: &ObjectState, part: Part) {
+    layer.world_from_object = state.placement.world_from_object();
+    layer.visible = state.visible
+        && match part {
+            Part::Atoms => true,
+            Part::Quantity(k) => state.quantities.get(k).is_some_and(|q| q.visible),
+        };
+}
+
+/// Puts one layer's worth of `doc` into `layer` as `state` shows it: the atoms, and the
+/// selected quantity when it is one of the document's data sets, with its isosurfaces. For
+/// hosts that draw an object in one layer (tests, single-file renders); the window and
+/// [`show_scene`] give each quantity a layer of its own. Returns the isosurfaces' triangle count.
 pub fn show_object(
     ctx: &GpuContext,
     layer: &mut Layer,
     doc: &Document,
     state: &ObjectState,
 ) -> Result<usize, GpuError> {
-    show_document(ctx, layer, doc, state)?;
-    let meshes: Vec<_> = match doc.volumes.get(state.volume) {
-        Some(grid) => state.all_isosurfaces().flat_map(|iso| isosurfaces(grid, iso)).collect(),
-        None => Vec::new(),
+    show_object_atoms(ctx, layer, doc, state);
+    let quantity = state.selected_quantity();
+    let grid = quantity.and_then(|q| match q.source {
+        Source::Volume(i) => doc.volumes.get(i),
+        Source::Wavefunction(_) => None,
+    });
+    layer.set_volume(ctx, grid)?;
+    let meshes: Vec<_> = match (grid, quantity) {
+        (Some(grid), Some(q)) => q.isosurfaces.iter().flat_map(|iso| isosurfaces(grid, iso)).collect(),
+        _ => Vec::new(),
     };
     Ok(show_meshes(ctx, layer, &meshes))
 }
 
-/// Each object's cloud settings, and the scene's bounds (bohr).
+/// Puts quantity `k` of the object `state` describes into `layer`: a data set of `doc` as it
+/// is, or its wavefunction's orbital or density evaluated on a grid of `points` per side
+/// (`fill` caches the compute pipeline), then its isosurfaces. Returns the values shown (what
+/// the cloud's opacity is scaled to), `None` when `doc` does not hold the quantity.
+pub fn show_quantity(
+    ctx: &GpuContext,
+    layer: &mut Layer,
+    fill: &mut Option<GtoFillPass>,
+    doc: &Document,
+    state: &ObjectState,
+    k: usize,
+) -> Result<Option<VolumeGrid>, GpuError> {
+    layer.clear(ctx);
+    place_layer(layer, state, Part::Quantity(k));
+    let Some(q) = state.quantities.get(k) else { return Ok(None) };
+    let grid = match q.source {
+        Source::Volume(i) => {
+            let grid = doc.volumes.get(i).cloned();
+            layer.set_volume(ctx, grid.as_ref())?;
+            grid
+        }
+        Source::Wavefunction(quantity) => {
+            let e = &state.evaluation;
+            let view = WavefunctionView { quantity, direct: e.direct, points: e.grid_points, shells: e.shells() };
+            show_wavefunction(ctx, layer, fill, doc, &view)?
+        }
+    };
+    if let Some(grid) = &grid {
+        let meshes: Vec<_> = q.isosurfaces.iter().flat_map(|iso| isosurfaces(grid, iso)).collect();
+        show_meshes(ctx, layer, &meshes);
+    }
+    Ok(grid)
+}
+
+/// Each layer's cloud settings, and the scene's bounds (bohr).
 pub type ShownScene = (Vec<crate::scene::VolumeSettings>, Option<(glam::DVec3, glam::DVec3)>);
 
-/// Puts each object of `scene` into its layer of `renderer`: its atoms and placement, its
-/// wavefunction's orbital or density (the state's quantity; the density when none) evaluated on
-/// a grid of `points` per side, or its document's volume, and every isosurface of its state.
-/// Returns each object's cloud settings (opacity scaled to its grid) and the scene's bounds.
-pub fn show_scene(
+/// Puts each object of `scene` into `renderer`, its layers as [`layer_parts`] orders them (its
+/// atoms, then each quantity: a data set, or its wavefunction's orbital or density evaluated on
+/// a grid of `points` per side, with every isosurface of it). Returns each layer's cloud
+/// settings (opacity scaled to its grid) and the scene's bounds.
+pub fn show_scene<D: std::borrow::Borrow<Document>>(
     ctx: &GpuContext,
     renderer: &mut Renderer,
-    scene: &[(Document, ObjectState)],
+    scene: &[(D, ObjectState)],
     points: usize,
 ) -> Result<ShownScene, GpuError> {
     let mut fill = None;
     let mut clouds = Vec::new();
     let mut bounds: Option<(glam::DVec3, glam::DVec3)> = None;
-    for (n, (doc, state)) in scene.iter().enumerate() {
+    let parts = layer_parts(scene.iter().map(|(_, s)| s));
+    renderer.truncate(parts.len());
+    for (n, &(object, part)) in parts.iter().enumerate() {
+        let (doc, state) = (scene[object].0.borrow(), &scene[object].1);
         let layer = renderer.layer_mut(ctx, n);
-        show_document(ctx, layer, doc, state)?;
-        let quantity = state.quantity.unwrap_or(Quantity::Density);
-        let view = WavefunctionView { quantity, direct: false, points, shells: None };
-        let evaluated = show_wavefunction(ctx, layer, &mut fill, doc, &view)?;
-        let mut cloud = state.settings.volume;
-        if let Some(grid) = evaluated.as_ref().or(doc.volumes.get(state.volume)) {
-            auto_opacity(&mut cloud, grid);
-            let meshes: Vec<_> = state.all_isosurfaces().flat_map(|iso| isosurfaces(grid, iso)).collect();
-            show_meshes(ctx, layer, &meshes);
-        }
-        clouds.push(cloud);
-        if let Some((lo, hi)) = doc.bounds() {
-            bounds = Some(bounds.map_or((lo, hi), |(l, h)| (l.min(lo), h.max(hi))));
+        match part {
+            Part::Atoms => {
+                show_object_atoms(ctx, layer, doc, state);
+                clouds.push(crate::scene::VolumeSettings { visible: false, ..Default::default() });
+                if let Some((lo, hi)) = doc.bounds() {
+                    bounds = Some(bounds.map_or((lo, hi), |(l, h)| (l.min(lo), h.max(hi))));
+                }
+            }
+            Part::Quantity(k) => {
+                let evaluation = Evaluation { grid_points: points, ..state.evaluation.clone() };
+                let state = ObjectState { evaluation, ..state.clone() };
+                let grid = show_quantity(ctx, layer, &mut fill, doc, &state, k)?;
+                let mut cloud = state.quantities[k].cloud;
+                if let Some(grid) = &grid {
+                    auto_opacity(&mut cloud, grid);
+                }
+                clouds.push(cloud);
+            }
         }
     }
     Ok((clouds, bounds))
@@ -472,7 +526,7 @@ impl Headless {
     ) -> Result<Self, GpuError> {
         let mut renderer = Renderer::new(ctx);
         let layer = renderer.main();
-        show_atoms(ctx, layer, doc, settings, "");
+        show_atoms(ctx, layer, doc, &AtomLook::of(settings), "");
         let grid = volume_index.and_then(|i| doc.volumes.get(i));
         layer.set_volume(ctx, grid)?;
         if let Some(grid) = grid {

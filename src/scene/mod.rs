@@ -5,6 +5,7 @@ pub mod coloring;
 pub mod molsurface;
 pub mod objects;
 pub mod opacity;
+pub mod quantity;
 pub mod selection;
 pub mod settings;
 pub mod slicing;
@@ -15,8 +16,9 @@ pub mod view;
 pub use camera::Camera;
 pub use coloring::AtomColors;
 pub use molsurface::{SurfaceChoice, SurfaceSettings};
-pub use objects::{ObjectState, Placement, Session};
+pub use objects::{Changes, ObjectState, Placement, QuantityChanges, Session, changes};
 pub use opacity::DensityScale;
+pub use quantity::{AtomLook, Evaluation, QuantityState, Source};
 pub use settings::{
     AtomColoring, AtomStyle, Interpolation, IsoLevel, IsosurfaceSettings, RenderSettings, SliceMode, VolumeSettings,
 };

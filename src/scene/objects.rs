@@ -4,9 +4,11 @@
 use glam::{EulerRot, Mat4, Quat, Vec3};
 use serde::{Deserialize, Serialize};
 
+use crate::model::Document;
 use crate::model::orbitals::Quantity;
 
-use super::{Camera, IsosurfaceSettings, RenderSettings, SurfaceSettings};
+use super::quantity::{AtomLook, Evaluation, QuantityState, Source, first_source};
+use super::{Camera, IsosurfaceSettings, RenderSettings, SurfaceChoice, SurfaceSettings};
 
 /// Where an object sits in the scene: a rigid placement (rotation about the object's own
 /// origin, then a translation), so distances and the clouds' opacity per path are unchanged.
@@ -36,26 +38,23 @@ impl Placement {
     }
 }
 
-/// What an object shows and how: plain data, saved in sessions.
-///
-/// `settings` holds the object's atoms (style, `AtomStyle::Hidden` to hide them), its cloud
-/// (`settings.volume`, hidden with `visible`) and its first isosurface (`settings.iso`);
-/// `isosurfaces` holds any further ones (nested density shells, several orbital values).
+/// What an object shows and how: plain data, saved in sessions. The one source of truth for
+/// the object: panels edit it in place, and [`changes`] tells the GPU side what to redo.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[serde(default, from = "StoredObject")]
 pub struct ObjectState {
     /// The file it was read from; `None` for the bundled demo.
     pub path: Option<std::path::PathBuf>,
     /// Whether the object is drawn at all.
     pub visible: bool,
     pub placement: Placement,
-    pub settings: RenderSettings,
-    pub isosurfaces: Vec<IsosurfaceSettings>,
-    /// Which of the file's volumes is shown (cube files with several).
-    pub volume: usize,
-    /// The orbital, density or spin density shown, for files with a wavefunction (`None`: the
-    /// HOMO, as a new file opens).
-    pub quantity: Option<Quantity>,
+    pub atoms: AtomLook,
+    /// Its quantities (orbitals, densities, data sets), each with its cloud and isosurfaces.
+    pub quantities: Vec<QuantityState>,
+    /// The quantity the panels edit.
+    pub selected: usize,
+    /// How its wavefunction's quantities are evaluated.
+    pub evaluation: Evaluation,
     /// Which atoms of a structure are shown ([`super::selection::Selection`]; empty: all).
     pub selection: String,
     /// A molecular surface around the atoms shown.
@@ -68,10 +67,10 @@ impl Default for ObjectState {
             path: None,
             visible: true,
             placement: Placement::default(),
-            settings: RenderSettings::default(),
-            isosurfaces: Vec::new(),
-            volume: 0,
-            quantity: None,
+            atoms: AtomLook::default(),
+            quantities: Vec::new(),
+            selected: 0,
+            evaluation: Evaluation::default(),
             selection: String::new(),
             surface: SurfaceSettings::default(),
         }
@@ -79,9 +78,220 @@ impl Default for ObjectState {
 }
 
 impl ObjectState {
-    /// Every isosurface of the object, shown or not: the first, then the further ones.
+    /// A newly opened `doc` as `defaults` show it: its first quantity ([`first_source`]), big
+    /// structures space filling.
+    pub fn opening(doc: &Document, defaults: &RenderSettings) -> Self {
+        let chains = doc.structure.as_ref().map_or(0, |s| s.structure.chains.len());
+        let settings = defaults.for_structure(doc.molecule.atoms.len(), chains);
+        let mut state = Self { atoms: AtomLook::of(&settings), ..Self::default() };
+        state.quantities.extend(first_source(doc).map(|s| QuantityState::new(s, &settings)));
+        state.fit_to(doc, defaults);
+        state
+    }
+
+    /// An object drawn as `settings` say: their atoms, and `source` (when given) with their cloud
+    /// and their isosurface (the state of one renderer layer, as tests and single renders use).
+    pub fn of_settings(source: Option<Source>, settings: &RenderSettings) -> Self {
+        let quantities = source.map(|s| QuantityState::new(s, settings)).into_iter().collect();
+        Self { atoms: AtomLook::of(settings), quantities, ..Self::default() }
+    }
+
+    /// The quantity the panels edit, if the object has any.
+    pub fn selected_quantity(&self) -> Option<&QuantityState> {
+        self.quantities.get(self.selected)
+    }
+
+    pub fn selected_quantity_mut(&mut self) -> Option<&mut QuantityState> {
+        self.quantities.get_mut(self.selected)
+    }
+
+    /// Makes the state fit `doc` (a session saved for a file that has changed since, or one
+    /// written before quantities existed): quantities `doc` does not hold are dropped (a
+    /// data set that is not there becomes the file's first quantity), the selection points at
+    /// one that is, and the shell mask has one entry per shell.
+    pub fn fit_to(&mut self, doc: &Document, defaults: &RenderSettings) {
+        for q in &mut self.quantities {
+            if let (Source::Volume(_), false) = (q.source, q.source.exists_in(doc)) {
+                q.source = first_source(doc).unwrap_or(q.source);
+            }
+        }
+        self.quantities.retain(|q| q.source.exists_in(doc));
+        if self.quantities.is_empty()
+            && let Some(source) = first_source(doc)
+        {
+            self.quantities.push(QuantityState::new(source, defaults));
+        }
+        self.selected = self.selected.min(self.quantities.len().saturating_sub(1));
+        if let Some(wf) = &doc.wavefunction
+            && self.evaluation.shell_mask.len() != wf.basis.shells.len()
+        {
+            self.evaluation.shell_mask = vec![true; wf.basis.shells.len()];
+        }
+    }
+
+    /// Every isosurface of every visible quantity, shown or not.
     pub fn all_isosurfaces(&self) -> impl Iterator<Item = &IsosurfaceSettings> {
-        std::iter::once(&self.settings.iso).chain(&self.isosurfaces)
+        self.quantities.iter().filter(|q| q.visible).flat_map(|q| &q.isosurfaces)
+    }
+
+    /// The settings one renderer layer draws quantity `k` with (its cloud, its first
+    /// isosurface, the object's atoms) over `background`.
+    pub fn render_settings(&self, k: usize, background: [f32; 3]) -> RenderSettings {
+        let base = RenderSettings { background, ..RenderSettings::default() };
+        let mut settings = self.atoms.onto(base);
+        if let Some(q) = self.quantities.get(k) {
+            settings.volume = q.cloud;
+            settings.iso = q.isosurfaces.first().copied().unwrap_or_default();
+        }
+        settings
+    }
+}
+
+/// What an object's renderer layers must redo after its state changed ([`changes`]).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Changes {
+    /// Quantities were added, removed or reordered: the object's quantity layers are made anew.
+    pub layers: bool,
+    /// Style, colouring, depth cue or which atoms are shown.
+    pub atoms: bool,
+    pub placement: bool,
+    /// The object's or a quantity's visibility.
+    pub visibility: bool,
+    /// The molecular surface is built (or coloured) again.
+    pub surface: bool,
+    /// Per quantity (when `layers` is false): what to redo.
+    pub quantities: Vec<QuantityChanges>,
+}
+
+/// What one quantity's layer must redo.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct QuantityChanges {
+    /// Its values: another data set or orbital, or other evaluation options.
+    pub values: bool,
+    /// Its isosurfaces are cut again.
+    pub isosurfaces: bool,
+    /// The law its automatic opacity follows changed: k1 is chosen again.
+    pub opacity: bool,
+}
+
+impl QuantityChanges {
+    pub fn any(&self) -> bool {
+        self.values || self.isosurfaces || self.opacity
+    }
+}
+
+impl Changes {
+    /// Whether nothing needs to be redone.
+    pub fn is_empty(&self) -> bool {
+        !(self.layers || self.atoms || self.placement || self.visibility || self.surface)
+            && self.quantities.iter().all(|q| !q.any())
+    }
+}
+
+/// Which part of an object one renderer layer draws.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Part {
+    /// Its atoms and molecular surface.
+    Atoms,
+    /// Its quantity `k`: cloud and isosurfaces.
+    Quantity(usize),
+}
+
+/// The renderer layers of a scene's objects, in order: each object's atoms, then one layer per
+/// quantity. Each entry names the object (its index) and the part.
+pub fn layer_parts<'a>(states: impl IntoIterator<Item = &'a ObjectState>) -> Vec<(usize, Part)> {
+    states
+        .into_iter()
+        .enumerate()
+        .flat_map(|(n, s)| {
+            std::iter::once((n, Part::Atoms)).chain((0..s.quantities.len()).map(move |k| (n, Part::Quantity(k))))
+        })
+        .collect()
+}
+
+/// What the GPU side must redo for an object whose state went from `before` to `after` (one
+/// frame's edits): the one place that decides it.
+pub fn changes(before: &ObjectState, after: &ObjectState) -> Changes {
+    let layers = before.quantities.len() != after.quantities.len();
+    let evaluation = before.evaluation.direct != after.evaluation.direct
+        || before.evaluation.grid_points != after.evaluation.grid_points
+        || before.evaluation.shells() != after.evaluation.shells();
+    let quantities = if layers {
+        Vec::new()
+    } else {
+        before
+            .quantities
+            .iter()
+            .zip(&after.quantities)
+            .map(|(a, b)| {
+                let wavefunction = matches!(b.source, Source::Wavefunction(_));
+                let (was, now) = (&a.cloud, &b.cloud);
+                QuantityChanges {
+                    values: a.source != b.source || (wavefunction && evaluation),
+                    isosurfaces: a.isosurfaces != b.isosurfaces,
+                    opacity: was.k2 != now.k2
+                        || was.density_scale != now.density_scale
+                        || (now.auto_k1 && !was.auto_k1),
+                }
+            })
+            .collect()
+    };
+    let visible = |s: &ObjectState| (s.visible, s.quantities.iter().map(|q| q.visible).collect::<Vec<_>>());
+    Changes {
+        layers,
+        atoms: before.atoms != after.atoms || before.selection != after.selection,
+        placement: before.placement != after.placement,
+        visibility: visible(before) != visible(after),
+        surface: before.surface != after.surface
+            || (after.surface.choice != SurfaceChoice::Off && before.selection != after.selection),
+        quantities,
+    }
+}
+
+/// An object state as sessions store it: today's fields, and those of sessions written before
+/// objects held several quantities (one cloud in `settings.volume`, the first isosurface in
+/// `settings.iso`, the rest in `isosurfaces`, the data set in `volume`, the orbital in
+/// `quantity`), turned into one quantity.
+#[derive(Deserialize, Default)]
+#[serde(default)]
+struct StoredObject {
+    path: Option<std::path::PathBuf>,
+    visible: Option<bool>,
+    placement: Placement,
+    atoms: Option<AtomLook>,
+    quantities: Vec<QuantityState>,
+    selected: usize,
+    evaluation: Evaluation,
+    selection: String,
+    surface: SurfaceSettings,
+    settings: Option<RenderSettings>,
+    isosurfaces: Vec<IsosurfaceSettings>,
+    volume: usize,
+    quantity: Option<Quantity>,
+}
+
+impl From<StoredObject> for ObjectState {
+    fn from(s: StoredObject) -> Self {
+        let mut quantities = s.quantities;
+        if quantities.is_empty()
+            && let Some(settings) = &s.settings
+        {
+            // A file with a wavefunction resolves `Volume` to its first quantity ([`ObjectState::fit_to`]).
+            let source = s.quantity.map_or(Source::Volume(s.volume), Source::Wavefunction);
+            let isosurfaces = std::iter::once(settings.iso).chain(s.isosurfaces).collect();
+            quantities.push(QuantityState { source, visible: true, cloud: settings.volume, isosurfaces });
+        }
+        Self {
+            path: s.path,
+            visible: s.visible.unwrap_or(true),
+            placement: s.placement,
+            atoms: s.atoms.or(s.settings.as_ref().map(AtomLook::of)).unwrap_or_default(),
+            quantities,
+            selected: s.selected,
+            evaluation: s.evaluation,
+            selection: s.selection,
+            surface: s.surface,
+        }
     }
 }
 
@@ -117,5 +327,87 @@ mod tests {
         let beside = Placement::beside(5.0, Vec3::new(-3.0, 0.0, 0.0), 4.0);
         assert_eq!(beside.offset, [12.0, 0.0, 0.0], "the new box starts 4 bohr past x = 5");
         assert!(Placement::default().is_identity() && !p.is_identity());
+    }
+
+    #[test]
+    fn a_state_fits_the_file_it_is_opened_with() {
+        use crate::model::orbitals::{MolecularOrbital, Spin, Wavefunction};
+        let orbital = |occupation| MolecularOrbital {
+            energy: occupation - 1.0,
+            occupation,
+            spin: Spin::Alpha,
+            symmetry: String::new(),
+            coefficients: vec![],
+        };
+        let wf = Wavefunction { orbitals: vec![orbital(2.0), orbital(0.0)], restricted: true, ..Default::default() };
+        let doc = Document { wavefunction: Some(wf), ..Default::default() };
+        let fresh = ObjectState::opening(&doc, &RenderSettings::default());
+        assert_eq!(fresh.quantities.len(), 1, "a new file shows its HOMO");
+        assert_eq!(fresh.quantities[0].source, Source::Wavefunction(Quantity::Orbital(0)));
+        // A session naming an orbital the file lacks, and a data set (an old session without an
+        // orbital): the first is dropped, the second becomes the file's first quantity.
+        let mut restored = fresh.clone();
+        restored.quantities[0].source = Source::Volume(0);
+        restored
+            .quantities
+            .push(QuantityState::new(Source::Wavefunction(Quantity::Orbital(7)), &RenderSettings::default()));
+        restored.selected = 1;
+        restored.fit_to(&doc, &RenderSettings::default());
+        assert_eq!(restored.quantities.iter().map(|q| q.source).collect::<Vec<_>>(), [fresh.quantities[0].source]);
+        assert_eq!(restored.selected, 0);
+    }
+
+    #[test]
+    fn changes_name_what_the_gpu_must_redo_and_nothing_else() {
+        let defaults = RenderSettings::default();
+        let homo = QuantityState::new(Source::Wavefunction(Quantity::Orbital(3)), &defaults);
+        let density = QuantityState::new(Source::Wavefunction(Quantity::Density), &defaults);
+        let before = ObjectState { quantities: vec![density, homo], ..Default::default() };
+        assert!(changes(&before, &before).is_empty());
+        // k1 moves with every frame's automatic opacity: nothing to redo.
+        let mut after = before.clone();
+        after.quantities[1].cloud.k1 = 0.9;
+        after.quantities[1].cloud.clip.offset = 2.0;
+        assert!(changes(&before, &after).is_empty());
+        after.quantities[1].isosurfaces[0].visible = true;
+        let c = changes(&before, &after);
+        assert_eq!(c.quantities[1], QuantityChanges { isosurfaces: true, ..Default::default() });
+        assert!(!c.quantities[0].any() && !c.atoms && !c.layers);
+        after.quantities[1].source = Source::Wavefunction(Quantity::Orbital(4));
+        after.quantities[0].cloud.k2 = 1.2;
+        let c = changes(&before, &after);
+        assert!(c.quantities[1].values && c.quantities[0].opacity && !c.quantities[0].values);
+        // Evaluation options re-evaluate every wavefunction quantity.
+        let mut direct = before.clone();
+        direct.evaluation.direct = true;
+        assert!(changes(&before, &direct).quantities.iter().all(|q| q.values));
+        // A quantity added: the layers are laid out again.
+        let mut more = before.clone();
+        more.quantities.push(more.quantities[0].clone());
+        assert!(changes(&before, &more).layers);
+        let mut moved = before.clone();
+        moved.placement.offset[0] = 1.0;
+        moved.quantities[0].visible = false;
+        let c = changes(&before, &moved);
+        assert!(c.placement && c.visibility && !c.atoms && !c.surface);
+        // Which atoms are shown restyles them, and wraps a molecular surface anew.
+        let mut selected = before.clone();
+        selected.surface.choice = SurfaceChoice::Gaussian;
+        let mut narrower = selected.clone();
+        narrower.selection = "chain A".into();
+        let c = changes(&selected, &narrower);
+        assert!(c.atoms && c.surface);
+    }
+
+    #[test]
+    fn each_object_draws_in_an_atoms_layer_and_one_layer_per_quantity() {
+        let defaults = RenderSettings::default();
+        let q = QuantityState::new(Source::Volume(0), &defaults);
+        let two = ObjectState { quantities: vec![q.clone(), q], ..Default::default() };
+        let none = ObjectState::default();
+        assert_eq!(
+            layer_parts([&two, &none]),
+            [(0, Part::Atoms), (0, Part::Quantity(0)), (0, Part::Quantity(1)), (1, Part::Atoms)]
+        );
     }
 }

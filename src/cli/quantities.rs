@@ -1,0 +1,226 @@
+//! Several quantities of one file on the `render` command line: each quantity option
+//! (`--orbital X`, `--density`, `--spin-density`, `--volume N`) after the first starts another
+//! quantity, and the representation options after it (`--iso`, `--translucent`, `--no-volume`,
+//! transfer function, colours) are its own; `--beside` puts the next quantity in a pane of its
+//! own, side by side with the same camera.
+
+use std::ffi::OsString;
+
+use anyhow::{Result, bail};
+use clap::Parser;
+use orbcloud::gpu::{FrameInput, GpuContext, OffscreenTarget, Renderer};
+use orbcloud::headless::{draw_exact, show_scene};
+use orbcloud::model::Document;
+use orbcloud::scene::{Camera, Evaluation, ObjectState, QuantityState, RenderSettings, Source};
+
+use super::{Cli, Command, RenderArgs};
+
+/// The options that start a quantity.
+const STARTS: [&str; 4] = ["--orbital", "--density", "--spin-density", "--volume"];
+/// The option that puts the next quantity beside the ones before, in a pane of its own.
+const BESIDE: &str = "--beside";
+/// Options that belong to the whole picture, not to a quantity: given after the second
+/// quantity option they are refused (they would silently apply to nothing).
+const WHOLE_PICTURE: [&str; 17] = [
+    "--output",
+    "-o",
+    "--size",
+    "--view",
+    "--yaw",
+    "--pitch",
+    "--zoom",
+    "--atoms",
+    "--color",
+    "--depth-cue",
+    "--lavapipe",
+    "--pick",
+    "--demo",
+    "--grid-points",
+    "--direct",
+    "--surface",
+    "--probe",
+];
+
+/// A quantity given after the first, with the options that followed it.
+pub struct Later {
+    /// Whether `--beside` came before it: it starts a new pane.
+    pub beside: bool,
+    pub args: Vec<OsString>,
+}
+
+fn option_name(arg: &OsString) -> String {
+    let s = arg.to_string_lossy();
+    s.split('=').next().unwrap_or_default().to_string()
+}
+
+/// Splits `args` (a whole command line) of a `render` command at each quantity option after the
+/// first one: the first part parses as today's `render`; each later quantity comes with its own
+/// options. Other commands are returned whole.
+pub fn split(args: Vec<OsString>) -> Result<(Vec<OsString>, Vec<Later>)> {
+    let Some(at) = args.iter().position(|a| a == "render") else { return Ok((args, Vec::new())) };
+    let mut first: Vec<OsString> = args[..=at].to_vec();
+    let mut later: Vec<Later> = Vec::new();
+    let (mut seen, mut beside) = (false, false);
+    for arg in args.into_iter().skip(at + 1) {
+        let name = option_name(&arg);
+        if name == BESIDE {
+            beside = true;
+            continue;
+        }
+        if STARTS.contains(&name.as_str()) {
+            if seen || beside {
+                later.push(Later { beside, args: Vec::new() });
+                beside = false;
+            }
+            seen = true;
+        }
+        match later.last_mut() {
+            Some(l) => {
+                if WHOLE_PICTURE.contains(&name.as_str()) || name.starts_with("--surface") {
+                    bail!("{name} applies to the whole picture: give it before the second quantity option");
+                }
+                l.args.push(arg);
+            }
+            None => first.push(arg),
+        }
+    }
+    if beside {
+        bail!("--beside must be followed by the quantity to show beside (--orbital X, --density, …)");
+    }
+    Ok((first, later))
+}
+
+/// One quantity of the file as `args` asks for it (its quantity option, cloud and isosurfaces).
+pub fn quantity(args: &RenderArgs, doc: &Document) -> Result<Option<QuantityState>> {
+    let settings = args.view.settings();
+    let source = match &doc.wavefunction {
+        Some(wf) => Source::Wavefunction(args.wavefunction.what.resolve(wf)?),
+        None => match args.view.volume_index(doc)? {
+            Some(i) => Source::Volume(i),
+            None => return Ok(None),
+        },
+    };
+    let mut q = QuantityState::new(source, &settings);
+    q.isosurfaces = vec![args.iso.base()];
+    args.iso.apply_to(&mut q);
+    if args.iso.levels().is_empty() {
+        q.isosurfaces.clear();
+    }
+    Ok(Some(q))
+}
+
+/// The later quantities' own options, parsed as `render` parses them.
+pub fn parse_later(later: &[Later]) -> Result<Vec<(bool, RenderArgs)>> {
+    later
+        .iter()
+        .map(|l| {
+            let line = ["orbcloud", "render", "-o", "unused.png"].map(OsString::from).into_iter().chain(l.args.clone());
+            match Cli::try_parse_from(line) {
+                Ok(Cli { command: Some(Command::Render(args)), .. }) => Ok((l.beside, args)),
+                Ok(_) => bail!("expected the options of a quantity"),
+                Err(e) => bail!("{}", e.to_string().trim()),
+            }
+        })
+        .collect()
+}
+
+/// Renders `doc`'s quantities, the first from `first` and the rest from `later`, each pane side
+/// by side (a quantity after `--beside` starts a pane) with one camera; the image is `size`
+/// whole, its width shared by the panes. Each pane's quantities are said on stderr.
+pub fn render(
+    ctx: &GpuContext,
+    doc: Document,
+    first: &RenderArgs,
+    later: &[(bool, RenderArgs)],
+    camera: &Camera,
+) -> Result<image::RgbaImage> {
+    let base = first.view.settings();
+    let mut object = ObjectState {
+        atoms: orbcloud::scene::AtomLook::of(&base),
+        evaluation: Evaluation {
+            direct: first.wavefunction.direct,
+            grid_points: first.wavefunction.grid_points.clamp(8, 512),
+            ..Evaluation::default()
+        },
+        ..ObjectState::default()
+    };
+    // Which pane each quantity is drawn in.
+    let mut panes = Vec::new();
+    let mut pane = 0;
+    for (beside, args) in std::iter::once((false, first)).chain(later.iter().map(|(b, a)| (*b, a))) {
+        pane += beside as usize;
+        if let Some(q) = quantity(args, &doc)? {
+            object.quantities.push(q);
+            panes.push(pane);
+        }
+    }
+    let count = pane + 1;
+    let [width, height] = first.view.size;
+    let pane_width = (width / count as u32).max(1);
+    let mut image = image::RgbaImage::new(pane_width * count as u32, height);
+    let background = RenderSettings::default().background;
+    for p in 0..count {
+        let mut state = object.clone();
+        let mut k = 0;
+        state.quantities.retain(|_| {
+            k += 1;
+            panes[k - 1] == p
+        });
+        let names: Vec<String> = state.quantities.iter().map(|q| describe(&doc, q.source)).collect();
+        eprintln!("pane {}: {}", p + 1, if names.is_empty() { "atoms".into() } else { names.join(" + ") });
+        let pane_scene = [(&doc, state)];
+        let mut renderer = Renderer::new(ctx);
+        let points = first.wavefunction.grid_points.clamp(8, 512);
+        let (clouds, _) = show_scene(ctx, &mut renderer, &pane_scene, points)?;
+        let target = OffscreenTarget::new(&ctx.device, [pane_width, height]);
+        let frame = FrameInput { camera, background, clouds: &clouds, size: [pane_width, height], tile: None };
+        draw_exact(ctx, &mut renderer, &target.color_view, &frame);
+        let picture = target.read_rgba(&ctx.device, &ctx.queue)?;
+        image::imageops::replace(&mut image, &picture, (p as u32 * pane_width) as i64, 0);
+    }
+    Ok(image)
+}
+
+/// A quantity in words, with an orbital's energy: "HOMO: E = -0.24666 Eh, occupation 2.00"
+/// ("HOMO β" for a beta orbital of an unrestricted wavefunction).
+fn describe(doc: &Document, source: Source) -> String {
+    let name = source.name(doc);
+    match (source.orbital(), &doc.wavefunction) {
+        (Some(i), Some(wf)) => {
+            let o = &wf.orbitals[i];
+            format!("{name}: E = {:.5} Eh, occupation {:.2}", o.energy, o.occupation)
+        }
+        _ => name,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn line(s: &str) -> Vec<OsString> {
+        s.split_whitespace().map(OsString::from).collect()
+    }
+
+    #[test]
+    fn quantity_options_split_the_command_line() {
+        let (first, later) =
+            split(line("orbcloud render f.molden -o x.png --density --iso 0.05 --orbital homo --iso 0.02")).unwrap();
+        assert_eq!(first, line("orbcloud render f.molden -o x.png --density --iso 0.05"));
+        assert_eq!(later.len(), 1);
+        assert_eq!(later[0].args, line("--orbital homo --iso 0.02"));
+        assert!(!later[0].beside);
+        let (_, later) = split(line("orbcloud render f -o x.png --orbital homo --beside --orbital lumo")).unwrap();
+        assert!(later[0].beside && later[0].args == line("--orbital lumo"));
+        // One quantity: today's command line, whole.
+        let (first, later) = split(line("orbcloud render f -o x.png --orbital=homo --iso 0.1")).unwrap();
+        assert!(later.is_empty() && first.len() == 8);
+        assert!(split(line("orbcloud render f --orbital homo --orbital lumo --size 10x10")).is_err());
+        assert!(split(line("orbcloud render f --orbital homo --beside")).is_err());
+        // `--beside` before any quantity option: the default quantity, then the next beside it.
+        let (_, later) = split(line("orbcloud render f -o x.png --beside --orbital lumo")).unwrap();
+        assert!(later.len() == 1 && later[0].beside);
+        let (whole, later) = split(line("orbcloud info f --density")).unwrap();
+        assert!(later.is_empty() && whole.len() == 4);
+    }
+}

@@ -1,0 +1,206 @@
+//! The quantities an object shows: each orbital, density or data set of its file with its own
+//! representations (a cloud, any number of isosurfaces). Plain, serialisable data.
+
+use serde::{Deserialize, Serialize};
+
+use crate::model::Document;
+use crate::model::orbitals::{Quantity, Spin, Wavefunction};
+
+use super::{AtomColoring, AtomStyle, IsosurfaceSettings, RenderSettings, VolumeSettings};
+
+/// Where a quantity's values come from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Source {
+    /// A data set of the file (cube files may hold several), by index.
+    Volume(usize),
+    /// An orbital or density evaluated from the file's wavefunction.
+    Wavefunction(Quantity),
+}
+
+impl Source {
+    /// Whether `doc` holds what this source names.
+    pub fn exists_in(self, doc: &Document) -> bool {
+        match self {
+            Source::Volume(i) => i < doc.volumes.len(),
+            Source::Wavefunction(q) => doc.wavefunction.as_ref().is_some_and(|wf| match q {
+                Quantity::Orbital(i) => i < wf.orbitals.len(),
+                Quantity::Density => true,
+                Quantity::SpinDensity => !wf.restricted,
+            }),
+        }
+    }
+
+    /// The orbital it shows, if it is one.
+    pub fn orbital(self) -> Option<usize> {
+        match self {
+            Source::Wavefunction(Quantity::Orbital(i)) => Some(i),
+            _ => None,
+        }
+    }
+
+    /// A short name: "HOMO", "LUMO+1 β", "MO 12", "total density", a data set's label.
+    pub fn name(self, doc: &Document) -> String {
+        match self {
+            Source::Volume(i) => doc.volumes.get(i).map_or_else(|| format!("data set {}", i + 1), |v| v.label.clone()),
+            Source::Wavefunction(Quantity::Density) => "total density".into(),
+            Source::Wavefunction(Quantity::SpinDensity) => "spin density".into(),
+            Source::Wavefunction(Quantity::Orbital(i)) => match &doc.wavefunction {
+                Some(wf) => orbital_name(wf, i),
+                None => format!("MO {}", i + 1),
+            },
+        }
+    }
+}
+
+/// "HOMO", "LUMO+2", or "MO 12" away from the frontier; " β" after a beta orbital of an
+/// unrestricted wavefunction.
+pub fn orbital_name(wf: &Wavefunction, i: usize) -> String {
+    let Some(o) = wf.orbitals.get(i) else { return format!("MO {}", i + 1) };
+    let number = wf.of_spin(o.spin).position(|(j, _)| j == i).map_or(0, |p| p + 1);
+    let name = wf.frontier_label(i, 5).unwrap_or_else(|| format!("MO {number}"));
+    match (wf.restricted, o.spin) {
+        (false, Spin::Beta) => format!("{name} β"),
+        (false, Spin::Alpha) => format!("{name} α"),
+        _ => name,
+    }
+}
+
+/// One quantity of an object and how it is shown.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct QuantityState {
+    pub source: Source,
+    /// Whether any of its representations is drawn.
+    #[serde(default = "yes")]
+    pub visible: bool,
+    /// Its cloud (hidden with `cloud.visible`).
+    #[serde(default)]
+    pub cloud: VolumeSettings,
+    /// Every isosurface of it, shown or not (an orbital's ±v pairs, a density's nested shells).
+    #[serde(default)]
+    pub isosurfaces: Vec<IsosurfaceSettings>,
+}
+
+fn yes() -> bool {
+    true
+}
+
+impl QuantityState {
+    /// A quantity as `defaults` shows a new one: their cloud and one isosurface (hidden unless
+    /// they show it).
+    pub fn new(source: Source, defaults: &RenderSettings) -> Self {
+        Self { source, visible: true, cloud: defaults.volume, isosurfaces: vec![defaults.iso] }
+    }
+
+    /// Whether any isosurface of it is drawn translucent.
+    pub fn has_translucent(&self) -> bool {
+        self.isosurfaces.iter().any(|i| i.visible && i.translucent)
+    }
+}
+
+/// How an object's atoms are drawn.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
+#[serde(default)]
+pub struct AtomLook {
+    pub style: AtomStyle,
+    pub colors: AtomColoring,
+    /// How much the farthest atoms darken (0: off).
+    pub depth_cue: f32,
+}
+
+impl AtomLook {
+    /// The atoms of `settings`.
+    pub fn of(settings: &RenderSettings) -> Self {
+        Self { style: settings.atoms, colors: settings.atom_colors, depth_cue: settings.depth_cue }
+    }
+
+    /// `settings` with these atoms.
+    pub fn onto(self, settings: RenderSettings) -> RenderSettings {
+        RenderSettings { atoms: self.style, atom_colors: self.colors, depth_cue: self.depth_cue, ..settings }
+    }
+}
+
+/// How an object's wavefunction is evaluated for display (the orbital browser's options).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Evaluation {
+    /// Whose orbitals the browser lists (unrestricted wavefunctions).
+    pub spin: Spin,
+    /// Evaluate orbitals per slice sample instead of on a GPU-filled grid.
+    pub direct: bool,
+    /// Restrict orbitals to the shells ticked in `shell_mask` (the atomic-orbital selector).
+    pub ao_filter: bool,
+    pub shell_mask: Vec<bool>,
+    /// Points per axis of the evaluation grid.
+    pub grid_points: usize,
+}
+
+impl Default for Evaluation {
+    fn default() -> Self {
+        Self { spin: Spin::Alpha, direct: false, ao_filter: false, shell_mask: Vec::new(), grid_points: 72 }
+    }
+}
+
+impl Evaluation {
+    /// The shells an orbital is restricted to, when the filter is on.
+    pub fn shells(&self) -> Option<Vec<bool>> {
+        self.ao_filter.then(|| self.shell_mask.clone())
+    }
+}
+
+/// What a file shows first: a wavefunction's HOMO (α), a cube's first data set, nothing for a
+/// structure.
+pub fn first_source(doc: &Document) -> Option<Source> {
+    if let Some(wf) = &doc.wavefunction {
+        return Some(Source::Wavefunction(wf.homo(Spin::Alpha).map_or(Quantity::Density, Quantity::Orbital)));
+    }
+    (!doc.volumes.is_empty()).then_some(Source::Volume(0))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::VolumeGrid;
+    use crate::model::orbitals::MolecularOrbital;
+
+    fn wavefunction(restricted: bool) -> Wavefunction {
+        let orbital = |energy, occupation, spin| MolecularOrbital {
+            energy,
+            occupation,
+            spin,
+            symmetry: String::new(),
+            coefficients: vec![],
+        };
+        let mut orbitals = vec![orbital(-0.5, 1.0, Spin::Alpha), orbital(0.1, 0.0, Spin::Alpha)];
+        if !restricted {
+            orbitals.extend([orbital(-0.4, 1.0, Spin::Beta), orbital(0.2, 0.0, Spin::Beta)]);
+        }
+        Wavefunction { orbitals, restricted, ..Default::default() }
+    }
+
+    #[test]
+    fn sources_name_what_they_show_and_know_whether_a_file_holds_them() {
+        let doc = Document { wavefunction: Some(wavefunction(false)), ..Default::default() };
+        assert_eq!(first_source(&doc), Some(Source::Wavefunction(Quantity::Orbital(0))));
+        assert_eq!(Source::Wavefunction(Quantity::Orbital(0)).name(&doc), "HOMO α");
+        assert_eq!(Source::Wavefunction(Quantity::Orbital(3)).name(&doc), "LUMO β");
+        assert!(Source::Wavefunction(Quantity::SpinDensity).exists_in(&doc));
+        assert!(!Source::Wavefunction(Quantity::Orbital(4)).exists_in(&doc));
+        assert!(!Source::Volume(0).exists_in(&doc));
+        let closed = Document { wavefunction: Some(wavefunction(true)), ..Default::default() };
+        assert_eq!(Source::Wavefunction(Quantity::Orbital(1)).name(&closed), "LUMO");
+        assert!(!Source::Wavefunction(Quantity::SpinDensity).exists_in(&closed));
+        let grid = VolumeGrid::new("MO 7", [2, 2, 2], glam::DMat4::IDENTITY, vec![0.0; 8]);
+        let cube = Document { volumes: vec![grid], ..Default::default() };
+        assert_eq!(first_source(&cube), Some(Source::Volume(0)));
+        assert_eq!(Source::Volume(0).name(&cube), "MO 7");
+        assert_eq!(first_source(&Document::default()), None);
+    }
+
+    #[test]
+    fn atom_looks_move_between_render_settings() {
+        let settings = RenderSettings { atoms: AtomStyle::Licorice, depth_cue: 0.4, ..RenderSettings::default() };
+        let look = AtomLook::of(&settings);
+        assert_eq!(look.style, AtomStyle::Licorice);
+        assert_eq!(look.onto(RenderSettings::default()), settings);
+    }
+}
