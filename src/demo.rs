@@ -98,6 +98,7 @@ pub fn cycloaddition() -> Result<Vec<(Document, ObjectState)>, LoadError> {
                 visible: true,
                 cloud: VolumeSettings { visible: false, ..VolumeSettings::default() },
                 isosurfaces: vec![iso],
+                pane: None,
             };
             let density = quantity(
                 Source::Wavefunction(Quantity::Density),

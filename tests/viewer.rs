@@ -2,11 +2,14 @@
 //! and keeps what it shows when a file fails to load.
 
 mod common;
+#[path = "common/viewer.rs"]
+mod viewer_support;
 
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use orbcloud::app::{OrbApp, wgpu_setup};
 use orbcloud::scene::{SliceMode, TransferKind};
+use viewer_support::{click_at, wait_loaded};
 
 fn harness() -> Harness<'static, OrbApp> {
     let h = Harness::builder()
@@ -255,20 +258,6 @@ fn a_scan_too_large_for_the_gpu_offers_a_coarser_grid() {
     assert!(scan.scene.bytes <= 1 << 20, "{} bytes", scan.scene.bytes);
 }
 
-/// A primary click at `pos`, with Shift held when `shift`.
-fn click_at(h: &mut Harness<'static, OrbApp>, pos: egui::Pos2, shift: bool) {
-    let modifiers = if shift { egui::Modifiers::SHIFT } else { egui::Modifiers::NONE };
-    h.event(egui::Event::ModifiersChanged(modifiers));
-    h.hover_at(pos);
-    let button = |pressed| egui::Event::PointerButton { pos, button: egui::PointerButton::Primary, pressed, modifiers };
-    h.event(button(true));
-    h.run_steps(1);
-    h.event(button(false));
-    h.run_steps(1);
-    h.event(egui::Event::ModifiersChanged(egui::Modifiers::NONE));
-    h.run_steps(1);
-}
-
 #[test]
 fn isosurfaces_follow_the_slider_and_atoms_are_picked_and_measured() {
     let mut h = harness();
@@ -311,19 +300,6 @@ fn isosurfaces_follow_the_slider_and_atoms_are_picked_and_measured() {
     click_at(&mut h, egui::pos2(985.0, 100.0), false);
     assert!(h.state().measurements.selection.is_empty());
     assert_eq!(h.state().measurements.list.len(), 1);
-}
-
-/// Steps the app until nothing is loading (failing after a minute).
-fn wait_loaded(h: &mut Harness<'static, OrbApp>) {
-    let start = std::time::Instant::now();
-    h.run_steps(1);
-    while h.state().is_loading() {
-        assert!(start.elapsed().as_secs() < 60, "still loading after a minute");
-        std::thread::sleep(std::time::Duration::from_millis(20));
-        h.run_steps(1);
-    }
-    h.run_steps(2);
-    assert!(h.state().error.is_none(), "{:?}", h.state().error);
 }
 
 #[test]

@@ -8,6 +8,7 @@ pub mod measure;
 pub mod models;
 mod orbitals;
 mod panels;
+pub mod panes;
 pub mod restart;
 pub mod scan;
 mod scene_panel;
@@ -186,6 +187,8 @@ pub struct OrbApp {
     /// Each object's state as the GPU shows it: what the next frame's edits are compared with
     /// ([`Self::apply_changes`]), wherever they came from (a panel, a test, a script).
     applied: Vec<ObjectState>,
+    /// A session's measurements, kept until its files have loaded.
+    restoring_measurements: Option<Vec<crate::model::measure::Measurement>>,
     /// Whether *Open…* and dropped files replace the scene instead of adding to it.
     pub open_replaces: bool,
     scroll_to_frontier: bool,
@@ -355,6 +358,7 @@ impl OrbApp {
             defaults: RenderSettings::default(),
             pending: Vec::new(),
             applied: Vec::new(),
+            restoring_measurements: None,
             open_replaces: false,
             scroll_to_frontier: false,
             viewport,
@@ -421,6 +425,16 @@ impl OrbApp {
         self.objects.get(self.active)
     }
 
+    /// How many of the active object's atoms its selection shows.
+    pub fn shown_atoms(&self) -> usize {
+        let Some(o) = self.active_object() else { return 0 };
+        if o.state.selection.is_empty() {
+            return o.doc.molecule.atoms.len();
+        }
+        let look = crate::headless::atom_look(&o.doc, &o.state.atoms, &o.state.selection);
+        look.shown.iter().filter(|&&s| s).count()
+    }
+
     /// The quantity the side panel edits: the active object's selected one.
     pub fn selected_quantity(&self) -> Option<&crate::scene::QuantityState> {
         self.active_object()?.state.selected_quantity()
@@ -452,6 +466,11 @@ impl OrbApp {
     /// Each view shown: (size on screen, size of its last frame), pixels. The frame is smaller
     /// while a drag or the animation runs on a CPU adapter ([`detail`]).
     pub fn view_sizes(&self) -> Vec<([u32; 2], [u32; 2])> {
+        if self.scan.is_none()
+            && let Some(panes) = self.viewport.as_ref().map(Viewport::pane_sizes).filter(|p| !p.is_empty())
+        {
+            return panes;
+        }
         let views: Vec<&Viewport> = match &self.scan {
             Some(scan) => scan.views.iter().collect(),
             None => self.viewport.iter().collect(),
@@ -580,6 +599,12 @@ impl OrbApp {
         self.scroll_to_frontier = true;
     }
 
+    /// Frames what the scene shows, keeping the direction the camera looks from.
+    pub fn reframe(&mut self) {
+        let framed = self.framing_camera();
+        (self.view.camera.target, self.view.camera.distance) = (framed.target, framed.distance);
+    }
+
     /// A camera that frames every object where it is placed, looking at the first one as a new
     /// file opens ([`ViewPreset::Auto`]: its principal axes, tilted).
     pub fn scene_camera(&self) -> crate::scene::Camera {
@@ -611,14 +636,17 @@ impl OrbApp {
         }
     }
 
-    /// A camera that frames every object where it is placed, from the default direction.
+    /// A camera that frames every object where it is placed (the atoms a selection shows),
+    /// from the default direction.
     fn framing_camera(&self) -> crate::scene::Camera {
         match self.objects.as_slice() {
             [] => crate::scene::Camera::default(),
-            [only] if only.state.placement.is_identity() => default_camera(&only.doc),
+            [only] if only.state.placement.is_identity() && only.state.selection.is_empty() => {
+                default_camera(&only.doc)
+            }
             objects => {
                 let boxes = objects.iter().filter_map(|o| {
-                    let (lo, hi) = crate::headless::framing_box(&o.doc)?;
+                    let (lo, hi) = crate::headless::framing_box_of(&o.doc, &o.state.selection)?;
                     let m = o.state.placement.world_from_object();
                     let corners = [lo, hi];
                     let points: Vec<glam::Vec3> = (0..8)
@@ -715,6 +743,14 @@ impl OrbApp {
         if moved {
             self.world = World::of(&self.objects);
         }
+    }
+
+    /// Puts back a session's measurements once its files have loaded (those naming atoms the
+    /// scene does not have are left out).
+    fn restore_measurements(&mut self) {
+        let Some(list) = self.restoring_measurements.take() else { return };
+        let atoms = self.world.molecule.atoms.len();
+        self.measurements.list = list.into_iter().filter(|m| m.atoms.iter().all(|&a| a < atoms)).collect();
     }
 
     /// Makes the object list changes the panels asked for.
@@ -904,6 +940,9 @@ impl OrbApp {
         {
             self.open_as(next, how, ctx);
         }
+        if self.job.is_none() && self.queue.is_empty() {
+            self.restore_measurements();
+        }
         let dropped: Vec<PathBuf> = ctx.input(|i| {
             i.raw.dropped_files.iter().map(|f| f.path().to_path_buf()).filter(|p| !p.as_os_str().is_empty()).collect()
         });
@@ -934,6 +973,18 @@ impl OrbApp {
                 }
                 result.map(|()| out)
             }
+            // A split view: its panes side by side, as drawn.
+            None if !vp.pane_sizes().is_empty() => {
+                let pictures: Result<Vec<_>, _> = (0..vp.pane_sizes().len()).map(|p| vp.pane_picture(p)).collect();
+                pictures.map(|pictures| {
+                    let (w, h) = pictures.first().map_or((1, 1), |p| p.dimensions());
+                    let mut out = image::RgbaImage::new(w * pictures.len() as u32, h);
+                    for (n, picture) in pictures.iter().enumerate() {
+                        image::imageops::replace(&mut out, picture, (n as u32 * w) as i64, 0);
+                    }
+                    out
+                })
+            }
             None => vp.snapshot(&self.view, size),
         };
         match shot.map(|img| img.save(path)) {
@@ -957,8 +1008,17 @@ impl eframe::App for OrbApp {
         panels::status_bar(ui, self);
         panels::side_panel(ui, self);
         let defaults = self.defaults;
-        if let Some(o) = self.objects.get_mut(self.active) {
-            orbitals::panel(ui, &o.doc, &mut o.state, &defaults, &mut self.scroll_to_frontier);
+        // A scan shows its own orbitals; the browser belongs to the scene's objects.
+        if let Some(o) = self.objects.get_mut(self.active).filter(|_| self.scan.is_none()) {
+            let view = &mut self.view;
+            orbitals::panel(
+                ui,
+                &o.doc,
+                &mut o.state,
+                &defaults,
+                (&mut view.panes, &view.camera),
+                &mut self.scroll_to_frontier,
+            );
         }
         self.apply_changes();
         self.apply_scene_edits();
@@ -1019,11 +1079,25 @@ impl eframe::App for OrbApp {
                     vp.detail = detail::Detail::for_frame(interacting, vp.ctx.info.device_type, 1);
                     let picture_ms = vp.take_picture_ms();
                     vp.detail.lod_scale = vp.lod_budget.next(interacting, picture_ms);
-                    vp.set_clouds(&self.objects.iter().map(|o| &o.state).collect::<Vec<_>>());
-                    let clip = (self.objects.get_mut(self.active))
-                        .and_then(|o| o.state.selected_quantity_mut())
-                        .map(|q| &mut q.cloud.clip);
-                    vp.show(ui, rs, &mut self.view, clip);
+                    let states: Vec<&ObjectState> = self.objects.iter().map(|o| &o.state).collect();
+                    vp.set_clouds(&states);
+                    let count = self.view.panes.count;
+                    if count > 1 {
+                        let panes: Vec<viewport::Pane> = (0..count)
+                            .map(|p| viewport::Pane {
+                                camera: self.view.camera,
+                                layers: vp.pane_layers(&states, p, count),
+                                label: panes::label(&self.objects, p, count),
+                            })
+                            .collect();
+                        vp.show_split(ui, rs, &mut self.view, &panes);
+                    } else {
+                        vp.unsplit();
+                        let clip = (self.objects.get_mut(self.active))
+                            .and_then(|o| o.state.selected_quantity_mut())
+                            .map(|q| &mut q.cloud.clip);
+                        vp.show(ui, rs, &mut self.view, clip);
+                    }
                     if let Some(click) = vp.click.take() {
                         let said = self.measurements.click(click, &self.world);
                         if !said.is_empty() {

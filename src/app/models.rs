@@ -50,20 +50,29 @@ pub fn controls(ui: &mut egui::Ui, app: &mut OrbApp) -> Option<usize> {
 pub fn selection(ui: &mut egui::Ui, app: &mut OrbApp) {
     let Some(o) = app.objects.get_mut(app.active).filter(|o| o.doc.structure.is_some()) else { return };
     let mut query = o.state.selection.clone();
-    let changed = ui
+    let (changed, done) = ui
         .horizontal(|ui| {
             let edit = egui::TextEdit::singleline(&mut query).hint_text("chain A resi 30-50").desired_width(170.0);
-            let changed = ui.add(edit).changed();
+            let field = ui.add(edit);
             ui.label("show");
-            changed
+            (field.changed(), field.lost_focus())
         })
         .inner;
+    let total = o.doc.molecule.atoms.len();
+    let shown = crate::headless::atom_look(&o.doc, &o.state.atoms, &query).shown.iter().filter(|&&s| s).count();
+    if shown < total {
+        ui.label(RichText::new(format!("{shown} of {total} atoms shown")).small().weak());
+    }
     if let Err(expected) = Selection::parse(&query) {
         ui.label(RichText::new(format!("expected {expected}")).small().color(ui.visuals().error_fg_color));
     }
     if changed {
         // The frame's changes restyle the atoms and wrap the molecular surface around them.
         o.state.selection = query;
+    }
+    // The view frames what is shown once the query is entered (not at every key).
+    if done && Selection::parse(&o.state.selection).is_ok() {
+        app.reframe();
     }
 }
 

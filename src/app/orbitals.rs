@@ -7,7 +7,7 @@ use crate::model::orbitals::Quantity;
 use crate::model::orbitals::{Spin, Wavefunction};
 use crate::model::units::EV_PER_HARTREE;
 use crate::model::{Document, basis::ShellKind};
-use crate::scene::{ObjectState, QuantityState, RenderSettings, Source};
+use crate::scene::{Camera, ObjectState, Panes, QuantityState, RenderSettings, Source};
 
 /// Residual of CᵀSC − I above which the orbitals are flagged as not orthonormal.
 pub const ORTHONORMAL_TOLERANCE: f64 = 1e-5;
@@ -20,6 +20,8 @@ enum Pick {
     Switch(Quantity),
     /// It joins the object as another quantity, selected.
     Add(Quantity),
+    /// It joins the object in a new pane beside what is shown.
+    Beside(Quantity),
 }
 
 /// The orbital browser of the object `state` describes: it edits `state` in place (the
@@ -30,6 +32,7 @@ pub fn panel(
     doc: &Document,
     state: &mut ObjectState,
     defaults: &RenderSettings,
+    (panes, camera): (&mut Panes, &Camera),
     scroll_to_frontier: &mut bool,
 ) {
     let Some(wf) = &doc.wavefunction else { return };
@@ -56,6 +59,13 @@ pub fn panel(
             );
         }
         let shown = shown_quantity(state);
+        // The list is of the shown orbital's spin (a session reopened on a β orbital lists β).
+        if let Some(o) = shown.and_then(|q| match q {
+            Quantity::Orbital(i) => wf.orbitals.get(i),
+            _ => None,
+        }) {
+            state.evaluation.spin = o.spin;
+        }
         if !wf.restricted {
             ui.horizontal(|ui| {
                 ui.label("orbitals of spin");
@@ -74,21 +84,23 @@ pub fn panel(
                 }
             });
         }
+        let mut densities = vec![(Quantity::Density, "total density")];
+        if !wf.restricted {
+            densities.push((Quantity::SpinDensity, "spin density"));
+        }
         ui.horizontal(|ui| {
             ui.label("show");
-            let mut densities = vec![(Quantity::Density, "total density")];
-            if !wf.restricted {
-                densities.push((Quantity::SpinDensity, "spin density"));
-            }
-            for (q, name) in densities {
+            for &(q, name) in &densities {
                 if ui.selectable_label(shown == Some(q), name).clicked() {
                     pick = Some(Pick::Switch(q));
                 }
-                if ui
-                    .small_button("+")
-                    .on_hover_text(format!("add the {name} to the object beside what it shows"))
-                    .clicked()
-                {
+            }
+        });
+        ui.horizontal(|ui| {
+            ui.label("add");
+            for &(q, name) in &densities {
+                let hint = format!("the {name} joins what is shown (an orbital inside its density)");
+                if ui.button(format!("+ {name}")).on_hover_text(hint).clicked() {
                     pick = Some(Pick::Add(q));
                 }
             }
@@ -119,6 +131,17 @@ pub fn panel(
             }
         }
         Some(Pick::Add(q)) => add(state, q, defaults),
+        Some(Pick::Beside(q)) => {
+            if panes.count == 1 {
+                // What was shown stays in the first pane; the new one goes beside it.
+                state.quantities.iter_mut().filter(|q| q.pane.is_none()).for_each(|q| q.pane = Some(0));
+            }
+            let pane = panes.add(*camera);
+            add(state, q, defaults);
+            if let Some(added) = state.quantities.last_mut() {
+                added.pane = Some(pane);
+            }
+        }
         None => {}
     }
 }
@@ -182,7 +205,7 @@ fn orbital_table(
     let mut order = wf.by_energy(spin);
     order.reverse();
     ui.label(
-        RichText::new("click a row to show it, + to add it beside what is shown; Shift + up/down arrows to step")
+        RichText::new("click a row to show it, + to add it to what is shown, right-click to show it beside in a pane of its own; Shift + up/down arrows to step")
             .small()
             .weak(),
     );
@@ -211,6 +234,16 @@ fn orbital_table(
                 if row.clicked() {
                     pick = Some(Pick::Switch(Quantity::Orbital(i)));
                 }
+                row.context_menu(|ui| {
+                    if ui.button("show beside (a pane of its own)").clicked() {
+                        pick = Some(Pick::Beside(Quantity::Orbital(i)));
+                        ui.close();
+                    }
+                    if ui.button("add to this view").clicked() {
+                        pick = Some(Pick::Add(Quantity::Orbital(i)));
+                        ui.close();
+                    }
+                });
                 if add.clicked() {
                     pick = Some(Pick::Add(Quantity::Orbital(i)));
                 }
@@ -257,4 +290,13 @@ fn ao_selector(ui: &mut egui::Ui, doc: &Document, wf: &Wavefunction, state: &mut
             }
         });
     });
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn a_core_orbitals_energies_stay_apart() {
+        let row = super::row_text("MO 1", "", "", "-20.57911", "-559.986", "2.00");
+        assert!(row.contains("-20.57911 ") && row.contains(" -559.986"), "{row:?}");
+    }
 }

@@ -138,6 +138,10 @@ fn status_line(ui: &mut egui::Ui, app: &OrbApp, cancel: &mut bool, dismiss: &mut
             }
             let m = &app.doc().molecule;
             ui.label(format!("{} atoms ({}), {} bonds", m.atoms.len(), m.formula(), m.bonds.len()));
+            let shown = app.shown_atoms();
+            if shown < m.atoms.len() {
+                ui.label(format!("· {shown} shown"));
+            }
             if let Some(note) = app.fragment_note() {
                 ui.separator();
                 ui.label(RichText::new(note).weak());

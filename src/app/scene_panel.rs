@@ -35,11 +35,14 @@ pub fn section(ui: &mut egui::Ui, app: &mut OrbApp) {
         });
     }
     let defaults = app.defaults;
+    let view = &mut app.view;
+    super::panes::controls(ui, &mut view.panes, &view.camera);
+    let panes = view.panes.count;
     if let Some(object) = app.objects.get_mut(active) {
         let doc = object.doc.clone();
         let state = &mut object.state;
         ui.indent("representations", |ui| {
-            quantities(ui, &doc, state, &defaults);
+            quantities(ui, &doc, state, &defaults, panes);
             ui.horizontal(|ui| {
                 let s = &mut state.atoms.style;
                 let mut shown = *s != AtomStyle::Hidden;
@@ -60,7 +63,7 @@ pub fn section(ui: &mut egui::Ui, app: &mut OrbApp) {
 
 /// The object's quantities: each shown or hidden, selected (the side panel edits it),
 /// removed; *+ quantity* adds another of the file's.
-fn quantities(ui: &mut egui::Ui, doc: &Document, state: &mut ObjectState, defaults: &RenderSettings) {
+fn quantities(ui: &mut egui::Ui, doc: &Document, state: &mut ObjectState, defaults: &RenderSettings, panes: usize) {
     let mut remove = None;
     for (k, q) in state.quantities.iter_mut().enumerate() {
         ui.horizontal(|ui| {
@@ -68,6 +71,7 @@ fn quantities(ui: &mut egui::Ui, doc: &Document, state: &mut ObjectState, defaul
                 remove = Some(k);
             }
             ui.checkbox(&mut q.visible, "").on_hover_text("show or hide its cloud and isosurfaces");
+            super::panes::choice(ui, q, panes);
             let what = representations(q);
             let text = format!("{} · {what}", q.source.name(doc));
             if ui.add(egui::Button::selectable(k == state.selected, text).truncate()).clicked() {

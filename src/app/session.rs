@@ -47,6 +47,8 @@ impl OrbApp {
     pub fn session(&mut self) -> Session {
         Session {
             camera: self.view.camera,
+            panes: self.view.panes,
+            measurements: self.measurements.list.clone(),
             background: Some(self.view.background),
             objects: self.objects.iter().filter(|o| o.state.path.is_some()).map(|o| o.state.clone()).collect(),
             recent: self.recent.clone(),
@@ -84,6 +86,9 @@ impl OrbApp {
         }
         self.clear_scene();
         self.view.camera = session.camera;
+        self.view.panes = session.panes;
+        // Measurements number the scene's atoms: they come back once every file has loaded.
+        self.restoring_measurements = Some(session.measurements);
         if let Some(bg) = session.background {
             self.view.background = bg;
         }

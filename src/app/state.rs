@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::scene::{Camera, RenderSettings};
+use crate::scene::{Camera, Panes, RenderSettings};
 
 /// What the window shows of the scene as a whole: the camera, the background and whether
 /// atoms are labelled. Each object's settings live in its own state.
@@ -14,11 +14,19 @@ pub struct ViewState {
     /// Element and number beside every atom.
     #[serde(default)]
     pub labels: bool,
+    /// How the view is split into panes.
+    #[serde(default)]
+    pub panes: Panes,
 }
 
 impl Default for ViewState {
     fn default() -> Self {
-        Self { camera: Camera::default(), background: RenderSettings::default().background, labels: false }
+        Self {
+            camera: Camera::default(),
+            background: RenderSettings::default().background,
+            labels: false,
+            panes: Panes::default(),
+        }
     }
 }
 

@@ -35,6 +35,27 @@ pub struct Click {
     pub shift: bool,
 }
 
+/// One pane of a split view, as the caller describes it each frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Pane {
+    pub camera: crate::scene::Camera,
+    /// Which renderer layers it draws ([`Viewport::pane_layers`]).
+    pub layers: Vec<bool>,
+    /// What it shows, in words (written at its top).
+    pub label: String,
+}
+
+/// What a pane's picture was drawn from: its pane, clouds, size, background and the scene's
+/// generation; drawn again when any of them changes.
+type PaneDrawn = (Pane, Vec<VolumeSettings>, [u32; 2], [f32; 3], u64);
+
+/// A pane's picture on the GPU and in egui.
+struct PaneTarget {
+    target: OffscreenTarget,
+    id: egui::TextureId,
+    drawn: Option<PaneDrawn>,
+}
+
 /// How a drag in a scan view twists the dihedral (seed 000: horizontal drag changes θ).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct TwistInput {
@@ -166,6 +187,10 @@ pub struct Viewport {
     awaiting_fragments: bool,
     /// The last frame's fragment counts, when it had translucent surfaces.
     fragments: Option<FragmentStats>,
+    /// The panes of a split view (none while the view is one).
+    split: Vec<PaneTarget>,
+    /// Where each pane was laid out, and the size it was drawn at.
+    pane_layout: Vec<(egui::Rect, [u32; 2])>,
 }
 
 impl Viewport {
@@ -203,6 +228,8 @@ impl Viewport {
             scan_iso: None,
             awaiting_fragments: false,
             fragments: None,
+            split: Vec::new(),
+            pane_layout: Vec::new(),
         }
     }
 
@@ -573,6 +600,183 @@ impl Viewport {
                 Part::Quantity(k) => states.get(n).and_then(|s| s.quantities.get(k)).map_or(hidden, |q| q.cloud),
             })
             .collect();
+    }
+
+    /// Which of the renderer's layers pane `pane` of `count` draws: every object's atoms, and
+    /// the quantities drawn in that pane ([`crate::scene::QuantityState::in_pane`]), while the
+    /// object and the quantity are shown.
+    pub fn pane_layers(&self, states: &[&ObjectState], pane: usize, count: usize) -> Vec<bool> {
+        self.parts
+            .iter()
+            .map(|&(n, part)| {
+                let Some(s) = states.get(n) else { return false };
+                s.visible
+                    && match part {
+                        Part::Atoms => true,
+                        Part::Quantity(k) => s.quantities.get(k).is_some_and(|q| q.visible && q.in_pane(pane, count)),
+                    }
+            })
+            .collect()
+    }
+
+    /// Shows `panes` side by side in the remaining space of `ui`, each drawn whole whenever what
+    /// it shows changes. A drag or the keys move the camera of the pane under the pointer
+    /// (`view.camera` for the first, `view.panes.cameras` for the others; one camera when
+    /// linked); a click picks in the pane clicked ([`Self::click`]).
+    pub fn show_split(
+        &mut self,
+        ui: &mut egui::Ui,
+        render_state: &egui_wgpu::RenderState,
+        view: &mut ViewState,
+        panes: &[Pane],
+    ) {
+        let rect = ui.available_rect_before_wrap();
+        let response = ui.allocate_rect(rect, Sense::click_and_drag());
+        let count = panes.len().max(1);
+        let width = rect.width() / count as f32;
+        let rects: Vec<egui::Rect> = (0..count)
+            .map(|p| {
+                egui::Rect::from_min_size(
+                    rect.min + egui::vec2(p as f32 * width, 0.0),
+                    egui::vec2(width, rect.height()),
+                )
+            })
+            .collect();
+        let pointer = response.interact_pointer_pos().or(response.hover_pos());
+        let under = pointer.and_then(|pos| rects.iter().position(|r| r.contains(pos))).unwrap_or(0);
+        if view.panes.linked || under == 0 {
+            handle_input(ui, &response, view, None);
+        } else {
+            let mut own = ViewState { camera: view.panes.cameras[under], ..*view };
+            handle_input(ui, &response, &mut own, None);
+            view.panes.cameras[under] = own.camera;
+        }
+        let ppp = ui.ctx().pixels_per_point();
+        let shown = [(width * ppp).round().max(1.0) as u32, (rect.height() * ppp).round().max(1.0) as u32];
+        let size = self.detail.render_size(shown);
+        let clouds: Vec<VolumeSettings> = self.clouds.iter().map(|&c| self.detail.cloud(c)).collect();
+        for gone in self.split.drain(count.min(self.split.len())..) {
+            render_state.renderer.write().free_texture(&gone.id);
+        }
+        self.pane_layout.clear();
+        self.renderer.set_lod_scale(self.detail.lod_scale);
+        for (p, pane) in panes.iter().enumerate() {
+            let pane = Pane { camera: view.panes.camera(p, &view.camera), ..pane.clone() };
+            let key = (pane, clouds.clone(), size, view.background, self.generation);
+            if self.split.get(p).is_none_or(|t| t.target.size != size) {
+                let target = OffscreenTarget::new(&self.ctx.device, size);
+                let mut egui_renderer = render_state.renderer.write();
+                let filter = wgpu::FilterMode::Linear;
+                let id = match self.split.get(p) {
+                    Some(old) => {
+                        egui_renderer.update_egui_texture_from_wgpu_texture(
+                            &self.ctx.device,
+                            &target.encoded_view,
+                            filter,
+                            old.id,
+                        );
+                        old.id
+                    }
+                    None => egui_renderer.register_native_texture(&self.ctx.device, &target.encoded_view, filter),
+                };
+                let slot = PaneTarget { target, id, drawn: None };
+                if p < self.split.len() {
+                    self.split[p] = slot;
+                } else {
+                    self.split.push(slot);
+                }
+            }
+            if self.split[p].drawn.as_ref() != Some(&key) {
+                self.draw_pane(&key.0, &clouds, view.background, p);
+                self.split[p].drawn = Some(key);
+                // The single view's frame is stale: the renderer's targets were drawn for panes.
+                self.drawn = None;
+            }
+            let uv = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
+            ui.painter().image(self.split[p].id, rects[p], uv, egui::Color32::WHITE);
+            ui.painter().text(
+                rects[p].left_top() + egui::vec2(8.0, 6.0),
+                egui::Align2::LEFT_TOP,
+                &panes[p].label,
+                egui::FontId::proportional(14.0),
+                egui::Color32::from_white_alpha(230),
+            );
+            if p > 0 {
+                let x = rects[p].left();
+                let stroke = egui::Stroke::new(1.0, ui.visuals().widgets.noninteractive.bg_stroke.color);
+                ui.painter().vline(x, rect.y_range(), stroke);
+            }
+            self.pane_layout.push((rects[p], size));
+        }
+        self.shown_size = Some(shown);
+        // Overlays (measurements, labels) are drawn on the first pane.
+        self.layout = self.pane_layout.first().copied();
+        self.hovered = None;
+        if response.clicked_by(PointerButton::Primary)
+            && let Some(pos) = response.interact_pointer_pos()
+            && let Some(p) = rects.iter().position(|r| r.contains(pos))
+        {
+            let shift = ui.input(|i| i.modifiers.shift);
+            let pane = Pane { camera: view.panes.camera(p, &view.camera), ..panes[p].clone() };
+            match self.pick_in_pane(&pane, &clouds, view.background, p, pos) {
+                Ok(picked) => self.click = Some(Click { picked, shift }),
+                Err(e) => log::warn!("picking failed: {e}"),
+            }
+        }
+    }
+
+    /// Draws `pane` into its target whole (translucent surfaces settled, in bands if need be),
+    /// with only its layers shown; the layers' own visibility is kept.
+    fn draw_pane(&mut self, pane: &Pane, clouds: &[VolumeSettings], background: [f32; 3], p: usize) {
+        let kept: Vec<bool> =
+            (0..pane.layers.len()).map(|l| self.renderer.layer(l).is_some_and(|l| l.visible)).collect();
+        for (l, &v) in pane.layers.iter().enumerate() {
+            self.renderer.layer_mut(&self.ctx, l).visible = v;
+        }
+        let size = self.split[p].target.size;
+        let frame = FrameInput { camera: &pane.camera, background, clouds, size, tile: None };
+        crate::headless::draw_exact(&self.ctx, &mut self.renderer, &self.split[p].target.color_view, &frame);
+        for (l, v) in kept.into_iter().enumerate() {
+            self.renderer.layer_mut(&self.ctx, l).visible = v;
+        }
+    }
+
+    /// What pane `p` shows at window position `pos` (the pane drawn again, for its pick ids).
+    fn pick_in_pane(
+        &mut self,
+        pane: &Pane,
+        clouds: &[VolumeSettings],
+        background: [f32; 3],
+        p: usize,
+        pos: egui::Pos2,
+    ) -> Result<Option<PickId>, GpuError> {
+        let Some(&(rect, size)) = self.pane_layout.get(p) else { return Ok(None) };
+        self.draw_pane(pane, clouds, background, p);
+        let rel = (pos - rect.min) / rect.size();
+        let picked =
+            self.renderer.pick(&self.ctx, [(rel.x * size[0] as f32) as u32, (rel.y * size[1] as f32) as u32])?;
+        Ok(picked.map(|id| self.object_of(id)))
+    }
+
+    /// Each pane's (size on screen, size drawn) of the last split frame; empty for one view.
+    pub fn pane_sizes(&self) -> Vec<([u32; 2], [u32; 2])> {
+        let shown = self.shown_size.unwrap_or_default();
+        self.split.iter().take(self.pane_layout.len()).map(|t| (shown, t.target.size)).collect()
+    }
+
+    /// Pane `p`'s last picture, read back (tests, screenshots of a split view).
+    pub fn pane_picture(&self, p: usize) -> Result<image::RgbaImage, GpuError> {
+        let t = self.split.get(p).ok_or_else(|| GpuError::Readback(format!("no pane {p}")))?;
+        t.target.read_rgba(&self.ctx.device, &self.ctx.queue)
+    }
+
+    /// Leaves a split view (its panes' targets are kept for the next split, drawn anew).
+    pub fn unsplit(&mut self) {
+        if !self.pane_layout.is_empty() {
+            self.pane_layout.clear();
+            self.split.iter_mut().for_each(|t| t.drawn = None);
+            self.drawn = None;
+        }
     }
 
     /// Drops every object's GPU data and jobs.

@@ -59,6 +59,17 @@ pub fn framing_box(doc: &Document) -> Option<(glam::Vec3, glam::Vec3)> {
     bounds.map(|(lo, hi)| (lo.as_vec3(), hi.as_vec3()))
 }
 
+/// [`framing_box`], or the box of the atoms `selection` shows (padded by the largest atom's
+/// radius) when it names some of them.
+pub fn framing_box_of(doc: &Document, selection: &str) -> Option<(glam::Vec3, glam::Vec3)> {
+    let Some(mask) = shown_atoms(doc, selection) else { return framing_box(doc) };
+    let shown = doc.molecule.atoms.iter().zip(&mask).filter(|(_, m)| **m).map(|(a, _)| a.position.as_vec3());
+    let (lo, hi) = shown.fold(None, |b: Option<(glam::Vec3, glam::Vec3)>, p| {
+        Some(b.map_or((p, p), |(lo, hi)| (lo.min(p), hi.max(p))))
+    })?;
+    Some((lo - glam::Vec3::splat(4.0), hi + glam::Vec3::splat(4.0)))
+}
+
 /// The grid a wavefunction's `quantity` is evaluated on, `points` per axis: the box where it
 /// decays to 1 % of its largest |value| ([`crate::model::extent::quantity_box`]).
 pub fn orbital_geometry(doc: &Document, quantity: Quantity, points: usize) -> Option<GridSpec> {

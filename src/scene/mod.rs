@@ -16,7 +16,7 @@ pub mod view;
 pub use camera::Camera;
 pub use coloring::AtomColors;
 pub use molsurface::{SurfaceChoice, SurfaceSettings};
-pub use objects::{Changes, ObjectState, Placement, QuantityChanges, Session, changes};
+pub use objects::{Changes, ObjectState, Panes, Placement, QuantityChanges, Session, changes};
 pub use opacity::DensityScale;
 pub use quantity::{AtomLook, Evaluation, QuantityState, Source};
 pub use settings::{

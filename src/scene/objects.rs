@@ -236,7 +236,7 @@ pub fn changes(before: &ObjectState, after: &ObjectState) -> Changes {
             })
             .collect()
     };
-    let visible = |s: &ObjectState| (s.visible, s.quantities.iter().map(|q| q.visible).collect::<Vec<_>>());
+    let visible = |s: &ObjectState| (s.visible, s.quantities.iter().map(|q| (q.visible, q.pane)).collect::<Vec<_>>());
     Changes {
         layers,
         atoms: before.atoms != after.atoms || before.selection != after.selection,
@@ -279,7 +279,7 @@ impl From<StoredObject> for ObjectState {
             // A file with a wavefunction resolves `Volume` to its first quantity ([`ObjectState::fit_to`]).
             let source = s.quantity.map_or(Source::Volume(s.volume), Source::Wavefunction);
             let isosurfaces = std::iter::once(settings.iso).chain(s.isosurfaces).collect();
-            quantities.push(QuantityState { source, visible: true, cloud: settings.volume, isosurfaces });
+            quantities.push(QuantityState { source, visible: true, cloud: settings.volume, isosurfaces, pane: None });
         }
         Self {
             path: s.path,
@@ -295,11 +295,53 @@ impl From<StoredObject> for ObjectState {
     }
 }
 
+/// Most panes a view is split into.
+pub const MAX_PANES: usize = 4;
+
+/// How the view is split: panes side by side, each showing the quantities assigned to it
+/// ([`QuantityState::pane`]) with every object's atoms, from one camera or each from its own.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Panes {
+    /// 1 (one view) to [`MAX_PANES`].
+    pub count: usize,
+    /// Every pane seen from the first pane's camera (the scene's camera).
+    pub linked: bool,
+    /// The cameras of unlinked panes (the first pane's is the scene's camera).
+    pub cameras: [Camera; MAX_PANES],
+}
+
+impl Default for Panes {
+    fn default() -> Self {
+        Self { count: 1, linked: true, cameras: [Camera::default(); MAX_PANES] }
+    }
+}
+
+impl Panes {
+    /// Pane `p`'s camera, `first` being the scene's.
+    pub fn camera(&self, p: usize, first: &Camera) -> Camera {
+        if self.linked || p == 0 { *first } else { self.cameras[p.min(MAX_PANES - 1)] }
+    }
+
+    /// Adds a pane (up to [`MAX_PANES`]) seen from `camera` when unlinked; returns its index.
+    pub fn add(&mut self, camera: Camera) -> usize {
+        if self.count < MAX_PANES {
+            self.cameras[self.count] = camera;
+            self.count += 1;
+        }
+        self.count - 1
+    }
+}
+
 /// A saved scene (`*.orbcloud.toml`): the camera, the background and every object.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 #[serde(default)]
 pub struct Session {
     pub camera: Camera,
+    /// How the view is split into panes.
+    pub panes: Panes,
+    /// Distances, angles and dihedrals measured, by atom numbered through the scene's objects.
+    pub measurements: Vec<crate::model::measure::Measurement>,
     /// Linear RGB.
     pub background: Option<[f32; 3]>,
     pub objects: Vec<ObjectState>,

@@ -78,6 +78,9 @@ pub struct QuantityState {
     /// Every isosurface of it, shown or not (an orbital's ±v pairs, a density's nested shells).
     #[serde(default)]
     pub isosurfaces: Vec<IsosurfaceSettings>,
+    /// The pane of a split view it is drawn in (`None`: every pane; past the last pane: the last).
+    #[serde(default)]
+    pub pane: Option<usize>,
 }
 
 fn yes() -> bool {
@@ -88,7 +91,12 @@ impl QuantityState {
     /// A quantity as `defaults` shows a new one: their cloud and one isosurface (hidden unless
     /// they show it).
     pub fn new(source: Source, defaults: &RenderSettings) -> Self {
-        Self { source, visible: true, cloud: defaults.volume, isosurfaces: vec![defaults.iso] }
+        Self { source, visible: true, cloud: defaults.volume, isosurfaces: vec![defaults.iso], pane: None }
+    }
+
+    /// Whether it is drawn in pane `pane` of a view split into `count`.
+    pub fn in_pane(&self, pane: usize, count: usize) -> bool {
+        self.pane.is_none_or(|p| p.min(count.max(1) - 1) == pane)
     }
 
     /// Whether any isosurface of it is drawn translucent.

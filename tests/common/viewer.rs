@@ -1,0 +1,33 @@
+//! Shared by the viewer's tests (egui_kittest on lavapipe): waiting for files and jobs, and
+//! clicking in the view.
+#![allow(dead_code)]
+
+use egui_kittest::Harness;
+use orbcloud::app::OrbApp;
+
+/// Steps the app until nothing is loading (failing after a minute).
+pub fn wait_loaded(h: &mut Harness<'static, OrbApp>) {
+    let start = std::time::Instant::now();
+    h.run_steps(1);
+    while h.state().is_loading() {
+        assert!(start.elapsed().as_secs() < 60, "still loading after a minute");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+        h.run_steps(1);
+    }
+    h.run_steps(2);
+    assert!(h.state().error.is_none(), "{:?}", h.state().error);
+}
+
+/// A primary click at `pos`, with Shift held when `shift`.
+pub fn click_at(h: &mut Harness<'static, OrbApp>, pos: egui::Pos2, shift: bool) {
+    let modifiers = if shift { egui::Modifiers::SHIFT } else { egui::Modifiers::NONE };
+    h.event(egui::Event::ModifiersChanged(modifiers));
+    h.hover_at(pos);
+    let button = |pressed| egui::Event::PointerButton { pos, button: egui::PointerButton::Primary, pressed, modifiers };
+    h.event(button(true));
+    h.run_steps(1);
+    h.event(button(false));
+    h.run_steps(1);
+    h.event(egui::Event::ModifiersChanged(egui::Modifiers::NONE));
+    h.run_steps(1);
+}

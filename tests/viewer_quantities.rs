@@ -1,0 +1,323 @@
+//! Several quantities of one molecule in the viewer (egui_kittest on lavapipe): a density joins
+//! an orbital from the orbital browser and is shown, hidden and removed; HOMO and LUMO side by
+//! side in linked panes; sessions keep quantities, panes and measurements (and old sessions
+//! still open); the panels show exactly the selected object's quantities.
+
+mod common;
+#[path = "common/viewer.rs"]
+mod viewer_support;
+
+use std::path::{Path, PathBuf};
+
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
+use orbcloud::app::{OrbApp, wgpu_setup};
+use orbcloud::model::orbitals::{Quantity, Spin};
+use orbcloud::scene::Source::{self, Wavefunction};
+use viewer_support::{click_at, wait_loaded};
+
+fn fixture(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures").join(name)
+}
+
+/// The viewer at 1280×800 (the size the panels are laid out for) with `files` open.
+fn open(files: Vec<PathBuf>) -> Harness<'static, OrbApp> {
+    let mut h = Harness::builder()
+        .with_size([1280.0, 800.0])
+        .wgpu_setup(wgpu_setup(true))
+        .build_eframe(move |cc| OrbApp::new(cc, files));
+    wait_loaded(&mut h);
+    h
+}
+
+fn sources(app: &OrbApp) -> Vec<Source> {
+    app.objects[app.active].state.quantities.iter().map(|q| q.source).collect()
+}
+
+/// The view as a PNG would save it.
+fn picture(h: &mut Harness<'static, OrbApp>, dir: &Path, name: &str) -> image::RgbaImage {
+    let path = dir.join(format!("{name}.png"));
+    h.state_mut().save_png(&path);
+    image::open(&path).expect("the view was saved").to_rgba8()
+}
+
+fn mean_difference(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
+    assert_eq!(a.dimensions(), b.dimensions());
+    let sum: u64 =
+        a.pixels().zip(b.pixels()).map(|(p, q)| (0..3).map(|k| p[k].abs_diff(q[k]) as u64).sum::<u64>()).sum();
+    sum as f64 / (3 * a.width() * a.height()) as f64
+}
+
+#[test]
+fn a_density_joins_the_homo_from_the_orbital_browser_and_is_shown_hidden_and_removed() {
+    let mut h = open(vec![fixture("wavefunctions/benzene_631gs.molden")]);
+    let dir = tempfile::tempdir().unwrap();
+    let wf = h.state().doc().wavefunction.clone().expect("a wavefunction");
+    let homo = wf.homo(Spin::Alpha).unwrap();
+    assert_eq!(sources(h.state()), [Wavefunction(Quantity::Orbital(homo))], "opens on the HOMO alone");
+    let alone = picture(&mut h, dir.path(), "homo");
+
+    h.get_by_label("+ total density").click();
+    wait_loaded(&mut h);
+    assert_eq!(sources(h.state()), [Wavefunction(Quantity::Orbital(homo)), Wavefunction(Quantity::Density)]);
+    assert_eq!(h.state().objects[0].state.selected, 1, "the new quantity is the one the panels edit");
+    assert!(h.query_by_label("total density · cloud").is_some(), "the scene panel lists it");
+    let both = picture(&mut h, dir.path(), "both");
+    assert!(mean_difference(&alone, &both) > 1.0, "the density's cloud shows: {}", mean_difference(&alone, &both));
+
+    // Hidden, the picture is the HOMO's alone again; shown, it is back.
+    h.state_mut().objects[0].state.quantities[1].visible = false;
+    h.run_steps(2);
+    assert_eq!(mean_difference(&alone, &picture(&mut h, dir.path(), "hidden")), 0.0, "hidden");
+    h.state_mut().objects[0].state.quantities[1].visible = true;
+    h.run_steps(2);
+    assert_eq!(mean_difference(&both, &picture(&mut h, dir.path(), "shown")), 0.0, "shown again");
+
+    // Removed with its × in the scene panel (the first × removes the object, then one per
+    // quantity): the HOMO stays, drawn as before.
+    let removes = h.state().objects[0].state.quantities.len();
+    assert_eq!(h.get_all_by_label("×").count(), 1 + removes);
+    h.get_all_by_label("×").nth(2).expect("the density's ×").click();
+    wait_loaded(&mut h);
+    assert_eq!(sources(h.state()), [Wavefunction(Quantity::Orbital(homo))]);
+    assert_eq!(mean_difference(&alone, &picture(&mut h, dir.path(), "removed")), 0.0, "the HOMO alone again");
+
+    // A row of the browser switches the selected quantity; its menu adds an orbital instead.
+    let lumo = wf.lumo(Spin::Alpha).unwrap();
+    h.get_by_label_contains(&format!("MO {} ", lumo + 1)).click_secondary();
+    h.run_steps(2);
+    h.get_by_label("add to this view").click();
+    wait_loaded(&mut h);
+    assert_eq!(sources(h.state()), [Wavefunction(Quantity::Orbital(homo)), Wavefunction(Quantity::Orbital(lumo))]);
+}
+
+#[test]
+fn homo_and_lumo_of_one_file_side_by_side_in_linked_panes_and_a_session_keeps_them() {
+    let benzene = fixture("wavefunctions/benzene_631gs.molden");
+    let mut h = open(vec![benzene.clone()]);
+    let dir = tempfile::tempdir().unwrap();
+    let wf = h.state().doc().wavefunction.clone().unwrap();
+    let (homo, lumo) = (wf.homo(Spin::Alpha).unwrap(), wf.lumo(Spin::Alpha).unwrap());
+    h.get_by_label_contains(&format!("MO {} ", lumo + 1)).click_secondary();
+    h.run_steps(2);
+    h.get_by_label("show beside (a pane of its own)").click();
+    wait_loaded(&mut h);
+    let app = h.state();
+    assert_eq!(app.view.panes.count, 2);
+    let state = &app.objects[0].state;
+    let placed: Vec<_> = state.quantities.iter().map(|q| (q.source, q.pane)).collect();
+    assert_eq!(
+        placed,
+        [(Wavefunction(Quantity::Orbital(homo)), Some(0)), (Wavefunction(Quantity::Orbital(lumo)), Some(1))]
+    );
+    let sizes = app.view_sizes();
+    assert_eq!(sizes.len(), 2, "two panes drawn: {sizes:?}");
+    // Each pane is labelled with its orbital and energy.
+    let labels: Vec<String> = (0..2).map(|p| orbcloud::app::panes::label(&app.objects, p, 2)).collect();
+    assert!(labels[0].starts_with("HOMO  E = ") && labels[1].starts_with("LUMO  E = "), "{labels:?}");
+    let split = picture(&mut h, dir.path(), "split");
+    let w = split.width() / 2;
+    let (left, right) = (
+        image::imageops::crop_imm(&split, 0, 0, w, split.height()).to_image(),
+        image::imageops::crop_imm(&split, w, 0, w, split.height()).to_image(),
+    );
+    assert!(mean_difference(&left, &right) > 2.0, "HOMO and LUMO differ: {}", mean_difference(&left, &right));
+
+    // Linked: a drag in the right pane turns both.
+    let yaw = h.state().view.camera.yaw;
+    // The view lies between the side panel (290 points) and the orbital browser (360): its
+    // right pane spans about 605..920.
+    let from = egui::pos2(760.0, 420.0);
+    drag(&mut h, from, 80.0);
+    assert!((h.state().view.camera.yaw - yaw).abs() > 0.2, "the shared camera turned");
+    let turned = picture(&mut h, dir.path(), "turned");
+    let (l2, r2) = (
+        image::imageops::crop_imm(&turned, 0, 0, w, turned.height()).to_image(),
+        image::imageops::crop_imm(&turned, w, 0, w, turned.height()).to_image(),
+    );
+    assert!(mean_difference(&left, &l2) > 0.5 && mean_difference(&right, &r2) > 0.5, "both panes turned");
+
+    // Unlinked: the right pane turns alone.
+    h.get_by_label("one camera").click();
+    h.run_steps(2);
+    let (shared, own) = (h.state().view.camera, h.state().view.panes.cameras[1]);
+    drag(&mut h, from, -80.0);
+    assert_eq!(h.state().view.camera, shared, "the first pane's camera stays");
+    assert!((h.state().view.panes.cameras[1].yaw - own.yaw).abs() > 0.2, "the second pane's camera turned");
+    h.get_by_label("one camera").click();
+    h.run_steps(2);
+
+    // Two atoms measured in the first pane; the session keeps quantities, panes and the
+    // measurement; reopened after the scene was replaced, everything is as it was.
+    let (a, b) = (h.state().atom_on_screen(0).unwrap(), h.state().atom_on_screen(1).unwrap());
+    click_at(&mut h, a, false);
+    click_at(&mut h, b, true);
+    assert_eq!(h.state().measurements.list.len(), 1, "{}", h.state().status);
+    let session = dir.path().join("split.orbcloud.toml");
+    h.state_mut().save_session(&session);
+    let saved = (h.state().objects[0].state.clone(), h.state().view.panes, h.state().measurements.list.clone());
+    let ctx = h.ctx.clone();
+    h.state_mut().open_as(fixture("wavefunctions/h2o_cart_631gs.molden"), orbcloud::app::Opening::Replace, &ctx);
+    wait_loaded(&mut h);
+    assert!(h.state().measurements.list.is_empty());
+    h.state_mut().open(session, &ctx);
+    wait_loaded(&mut h);
+    let app = h.state();
+    assert_eq!((app.objects[0].state.clone(), app.view.panes, app.measurements.list.clone()), saved);
+    assert_eq!(app.view_sizes().len(), 2, "split again");
+}
+
+/// A primary-button drag `dx` points to the right from `from`.
+fn drag(h: &mut Harness<'static, OrbApp>, from: egui::Pos2, dx: f32) {
+    h.hover_at(from);
+    h.drag_at(from);
+    h.run_steps(1);
+    for i in 1..=4 {
+        h.hover_at(from + egui::vec2(dx * i as f32 / 4.0, 0.0));
+        h.run_steps(1);
+    }
+    h.drop_at(from + egui::vec2(dx, 0.0));
+    h.run_steps(2);
+}
+
+#[test]
+fn a_session_written_before_quantities_still_opens() {
+    let benzene = fixture("wavefunctions/benzene_631gs.molden");
+    let dir = tempfile::tempdir().unwrap();
+    let session = dir.path().join("old.orbcloud.toml");
+    // As sessions were written when an object held one quantity (the first isosurface in
+    // `settings.iso`, the orbital in `quantity`).
+    let text = format!(
+        r#"background = [0.1, 0.1, 0.1]
+recent = []
+
+[camera]
+target = [0.0, 0.0, 0.0]
+distance = 25.0
+yaw = 0.4
+pitch = 0.3
+fov_y = 0.6
+
+[[objects]]
+path = "{}"
+visible = true
+volume = 0
+quantity = {{ Orbital = 19 }}
+selection = ""
+
+[objects.placement]
+offset = [0.0, 0.0, 0.0]
+rotation_deg = [0.0, 0.0, 0.0]
+
+[objects.settings]
+atoms = "Sticks"
+atom_colors = "Element"
+background = [0.1, 0.1, 0.1]
+depth_cue = 0.0
+
+[objects.settings.volume]
+visible = false
+mode = "ViewAligned"
+slices = 100
+k1 = 0.2
+k2 = 0.6
+positive_color = [0.9, 0.12, 0.1]
+negative_color = [0.1, 0.3, 0.95]
+
+[objects.settings.volume.transfer]
+kind = "PowerLaw"
+shading = false
+boundary = 0.0
+gradient_power = 0.0
+positive = {{ shape = "Gaussian", center = 0.5, width = 0.1, opacity = 0.5 }}
+negative = {{ shape = "Gaussian", center = 0.5, width = 0.1, opacity = 0.5 }}
+
+[objects.settings.volume.clip]
+enabled = false
+normal = [0.0, 0.0, 1.0]
+offset = 0.0
+
+[objects.settings.iso]
+visible = true
+level = {{ Absolute = 0.04 }}
+positive_color = [0.85, 0.1, 0.08]
+negative_color = [0.08, 0.25, 0.85]
+density_color = [0.55, 0.62, 0.75]
+"#,
+        benzene.display()
+    );
+    std::fs::write(&session, text).unwrap();
+    let mut h = open(vec![fixture("wavefunctions/h2o_cart_631gs.molden")]);
+    let ctx = h.ctx.clone();
+    h.state_mut().open(session, &ctx);
+    wait_loaded(&mut h);
+    let app = h.state();
+    assert_eq!(app.objects.len(), 1);
+    let state = &app.objects[0].state;
+    assert_eq!(state.atoms.style, orbcloud::scene::AtomStyle::Sticks);
+    assert_eq!(state.quantities.len(), 1);
+    let q = &state.quantities[0];
+    assert_eq!(q.source, Wavefunction(Quantity::Orbital(19)));
+    assert!(!q.cloud.visible && q.cloud.slices == 100);
+    assert_eq!(q.isosurfaces[0].level, orbcloud::scene::IsoLevel::Absolute(0.04));
+    assert!(app.status.starts_with("isosurfaces: "), "its isosurface is cut: {}", app.status);
+}
+
+#[test]
+fn the_panels_follow_the_scene() {
+    // An unrestricted file: β in the browser shows the β orbital of the same place, and a
+    // reopened β orbital lists β.
+    let mut h = open(vec![fixture("wavefunctions/h2o_cation_uhf_631gs.molden")]);
+    let wf = h.state().doc().wavefunction.clone().unwrap();
+    h.get_by_label("β").click();
+    wait_loaded(&mut h);
+    let shown = h.state().selected_quantity().unwrap().source.orbital().expect("an orbital");
+    assert_eq!(shown, wf.homo(Spin::Beta).unwrap(), "β switches to the β HOMO");
+    h.get_by_label("α").click();
+    wait_loaded(&mut h);
+    assert_eq!(h.state().selected_quantity().unwrap().source.orbital(), wf.homo(Spin::Alpha));
+    let beta_lumo = wf.lumo(Spin::Beta).unwrap();
+    h.state_mut().objects[0].state.quantities[0].source = Wavefunction(Quantity::Orbital(beta_lumo));
+    wait_loaded(&mut h);
+    assert_eq!(h.state().objects[0].state.evaluation.spin, Spin::Beta, "the list follows the orbital shown");
+    // Spins and densities are separate, labelled rows.
+    assert!(h.query_by_label("orbitals of spin").is_some() && h.query_by_label("show").is_some());
+
+    // A long file name keeps its × inside the panel; *+ isosurface* is on screen at 1280×800.
+    let dir = tempfile::tempdir().unwrap();
+    let long = dir.path().join(format!("{}.molden", "a_very_long_name_of_a_calculation_".repeat(4)));
+    std::fs::copy(fixture("wavefunctions/h2o_cart_631gs.molden"), &long).unwrap();
+    let h = open(vec![long]);
+    let remove = h.get_all_by_label("×").next().expect("the object's ×").rect();
+    assert!(remove.right() < 300.0, "× at {remove:?}");
+    let add = h.get_by_label("+ isosurface").rect();
+    assert!(add.bottom() < 800.0, "+ isosurface at {add:?}");
+
+    // A protein: no cloud or isosurface controls, and a selection says how many atoms it shows
+    // and frames them when entered.
+    let mut h = open(vec![fixture("structures/4e43_excerpt.pdb")]);
+    assert!(h.query_by_label("show cloud").is_none() && h.query_by_label("+ isosurface").is_none());
+    let distance = h.state().view.camera.distance;
+    let total = h.state().doc().molecule.atoms.len();
+    h.state_mut().objects[0].state.selection = "resi 30-34".into();
+    h.run_steps(2);
+    let shown = h.state().shown_atoms();
+    assert!(shown > 0 && shown < total, "{shown} of {total}");
+    assert!(h.query_by_label_contains(&format!("{shown} of {total} atoms shown")).is_some());
+    h.state_mut().reframe();
+    assert!(h.state().view.camera.distance < distance, "framed closer on the atoms shown");
+
+    // After a scan opens, the previous file's orbital browser is gone.
+    let mut h = open(vec![fixture("wavefunctions/h2o_cart_631gs.molden")]);
+    assert!(h.query_by_label("Orbitals").is_some());
+    let ctx = h.ctx.clone();
+    h.state_mut().open_demo(orbcloud::app::Demo::Scan, &ctx);
+    let start = std::time::Instant::now();
+    while h.state().scan.is_none() {
+        assert!(start.elapsed().as_secs() < 300, "no scan: {:?}", h.state().error);
+        std::thread::sleep(std::time::Duration::from_millis(50));
+        h.run_steps(1);
+    }
+    h.run_steps(2);
+    assert!(h.query_by_label("Orbitals").is_none(), "the orbital browser left with its file");
+}
