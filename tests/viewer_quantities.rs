@@ -125,8 +125,8 @@ fn homo_and_lumo_of_one_file_side_by_side_in_linked_panes_and_a_session_keeps_th
 
     // Linked: a drag in the right pane turns both.
     let yaw = h.state().view.camera.yaw;
-    // The view lies between the side panel (290 points) and the orbital browser (360): its
-    // right pane spans about 605..920.
+    // The view lies between the side panel (290 points) and the orbital browser (400): its
+    // right pane spans about 585..880.
     let from = egui::pos2(760.0, 420.0);
     drag(&mut h, from, 80.0);
     assert!((h.state().view.camera.yaw - yaw).abs() > 0.2, "the shared camera turned");

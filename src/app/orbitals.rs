@@ -12,6 +12,9 @@ use crate::scene::{Camera, ObjectState, Panes, QuantityState, RenderSettings, So
 /// Residual of CᵀSC − I above which the orbitals are flagged as not orthonormal.
 pub const ORTHONORMAL_TOLERANCE: f64 = 1e-5;
 
+/// The orbital browser's width, points: a row (its + and the 41 monospace columns) fits.
+const ORBITALS_PANEL_WIDTH: f32 = 400.0;
+
 const SHELL_LETTERS: [&str; 6] = ["s", "p", "d", "f", "g", "h"];
 
 /// What a click in the browser does with a wavefunction quantity.
@@ -37,7 +40,7 @@ pub fn panel(
 ) {
     let Some(wf) = &doc.wavefunction else { return };
     let mut pick = None;
-    egui::Panel::right("orbitals").exact_size(360.0).show(ui, |ui| {
+    egui::Panel::right("orbitals").exact_size(ORBITALS_PANEL_WIDTH).show(ui, |ui| {
         ui.heading("Orbitals");
         let n = &wf.normalization;
         ui.label(
@@ -136,11 +139,12 @@ pub fn panel(
                 // What was shown stays in the first pane; the new one goes beside it.
                 state.quantities.iter_mut().filter(|q| q.pane.is_none()).for_each(|q| q.pane = Some(0));
             }
+            // In a pane of its own, in the same colours as the orbital it is compared with.
             let pane = panes.add(*camera);
-            add(state, q, defaults);
-            if let Some(added) = state.quantities.last_mut() {
-                added.pane = Some(pane);
-            }
+            state
+                .quantities
+                .push(QuantityState { pane: Some(pane), ..QuantityState::new(Source::Wavefunction(q), defaults) });
+            state.selected = state.quantities.len() - 1;
         }
         None => {}
     }
@@ -148,7 +152,9 @@ pub fn panel(
 
 /// Adds `q` to the object as a new quantity, selected.
 fn add(state: &mut ObjectState, q: Quantity, defaults: &RenderSettings) {
-    state.quantities.push(QuantityState::new(Source::Wavefunction(q), defaults));
+    // In the same pane as the others: colours of its own.
+    let joining = QuantityState::joining(Source::Wavefunction(q), defaults, &state.quantities);
+    state.quantities.push(joining);
     state.selected = state.quantities.len() - 1;
 }
 
@@ -260,7 +266,7 @@ fn orbital_table(
 /// One line of the orbital table, columns padded to fixed widths.
 fn row_text(name: &str, label: &str, sym: &str, eh: &str, ev: &str, occ: &str) -> String {
     // Wide enough that a core orbital's energies (-20.57911, -559.986) stay apart.
-    format!("{name:<6}{label:<7}{sym:<4}{eh:>10}{ev:>10}{occ:>5}")
+    format!("{name:<6}{label:<7}{sym:<4}{eh:>10}{ev:>9}{occ:>5}")
 }
 
 /// Seed 004's atomic-orbital selector: restrict the shown orbital to chosen shells.

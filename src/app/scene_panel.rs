@@ -90,7 +90,8 @@ fn quantities(ui: &mut egui::Ui, doc: &Document, state: &mut ObjectState, defaul
     ComboBox::from_id_salt("add quantity").selected_text("+ quantity").show_ui(ui, |ui| {
         for (source, name) in choices {
             if ui.selectable_label(false, name).clicked() {
-                state.quantities.push(QuantityState::new(source, defaults));
+                let joining = QuantityState::joining(source, defaults, &state.quantities);
+                state.quantities.push(joining);
                 state.selected = state.quantities.len() - 1;
             }
         }

@@ -661,7 +661,7 @@ impl Viewport {
         self.pane_layout.clear();
         self.renderer.set_lod_scale(self.detail.lod_scale);
         for (p, pane) in panes.iter().enumerate() {
-            let pane = Pane { camera: view.panes.camera(p, &view.camera), ..pane.clone() };
+            let pane = Pane { camera: fit_width(view.panes.camera(p, &view.camera), size), ..pane.clone() };
             let key = (pane, clouds.clone(), size, view.background, self.generation);
             if self.split.get(p).is_none_or(|t| t.target.size != size) {
                 let target = OffscreenTarget::new(&self.ctx.device, size);
@@ -717,7 +717,7 @@ impl Viewport {
             && let Some(p) = rects.iter().position(|r| r.contains(pos))
         {
             let shift = ui.input(|i| i.modifiers.shift);
-            let pane = Pane { camera: view.panes.camera(p, &view.camera), ..panes[p].clone() };
+            let pane = Pane { camera: fit_width(view.panes.camera(p, &view.camera), size), ..panes[p].clone() };
             match self.pick_in_pane(&pane, &clouds, view.background, p, pos) {
                 Ok(picked) => self.click = Some(Click { picked, shift }),
                 Err(e) => log::warn!("picking failed: {e}"),
@@ -1063,7 +1063,9 @@ impl Viewport {
     /// Where world point `p` (bohr) lies on screen in the last frame laid out.
     pub fn to_screen(&self, camera: &crate::scene::Camera, p: glam::Vec3) -> Option<egui::Pos2> {
         let (rect, size) = self.layout?;
-        let c = self.renderer.clip_from_world(camera, size) * p.extend(1.0);
+        // A split view's first pane is drawn from its camera stood back to fit the pane's width.
+        let camera = if self.pane_layout.is_empty() { *camera } else { fit_width(*camera, size) };
+        let c = self.renderer.clip_from_world(&camera, size) * p.extend(1.0);
         (c.w > 1e-6).then(|| {
             let ndc = c.truncate() / c.w;
             rect.min + egui::vec2((ndc.x * 0.5 + 0.5) * rect.width(), (0.5 - ndc.y * 0.5) * rect.height())
@@ -1100,6 +1102,16 @@ impl Viewport {
     pub fn rendered_size(&self) -> Option<[u32; 2]> {
         self.target.as_ref().map(|(t, _)| t.size)
     }
+}
+
+/// `camera` stood back so that what fits its height fits a view of `size` narrower than it is
+/// tall (a pane of a split view): the panes show the whole molecule, not a slice of it.
+fn fit_width(mut camera: crate::scene::Camera, size: [u32; 2]) -> crate::scene::Camera {
+    let aspect = size[0] as f32 / size[1].max(1) as f32;
+    if aspect < 1.0 {
+        camera.distance /= aspect.max(0.2);
+    }
+    camera
 }
 
 fn distance_to_segment(p: egui::Pos2, a: egui::Pos2, b: egui::Pos2) -> f32 {

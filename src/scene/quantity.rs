@@ -99,6 +99,22 @@ impl QuantityState {
         self.pane.is_none_or(|p| p.min(count.max(1) - 1) == pane)
     }
 
+    /// A new quantity of an object that already shows `others`: the cloud and isosurface
+    /// colours of the first preset none of them uses, so each quantity reads as its own.
+    pub fn joining(source: Source, defaults: &RenderSettings, others: &[QuantityState]) -> Self {
+        let mut q = Self::new(source, defaults);
+        let used = |c: [f32; 3]| others.iter().any(|o| o.cloud.positive_color == c);
+        if let Some(&(_, positive, negative)) = super::transfer::PRESETS.iter().find(|(_, p, _)| !used(*p))
+            && !others.is_empty()
+        {
+            (q.cloud.positive_color, q.cloud.negative_color) = (positive, negative);
+            for iso in &mut q.isosurfaces {
+                (iso.positive_color, iso.negative_color, iso.density_color) = (positive, negative, positive);
+            }
+        }
+        q
+    }
+
     /// Whether any isosurface of it is drawn translucent.
     pub fn has_translucent(&self) -> bool {
         self.isosurfaces.iter().any(|i| i.visible && i.translucent)
@@ -202,6 +218,18 @@ mod tests {
         assert_eq!(first_source(&cube), Some(Source::Volume(0)));
         assert_eq!(Source::Volume(0).name(&cube), "MO 7");
         assert_eq!(first_source(&Document::default()), None);
+    }
+
+    #[test]
+    fn a_quantity_joining_others_takes_colours_none_of_them_uses() {
+        let defaults = RenderSettings::default();
+        let first = QuantityState::joining(Source::Volume(0), &defaults, &[]);
+        assert_eq!(first.cloud.positive_color, defaults.volume.positive_color, "alone: the defaults");
+        let second = QuantityState::joining(Source::Volume(1), &defaults, std::slice::from_ref(&first));
+        let third = QuantityState::joining(Source::Volume(2), &defaults, &[first.clone(), second.clone()]);
+        let colours = [first.cloud.positive_color, second.cloud.positive_color, third.cloud.positive_color];
+        assert!(colours[0] != colours[1] && colours[1] != colours[2] && colours[0] != colours[2], "{colours:?}");
+        assert_eq!(second.isosurfaces[0].positive_color, second.cloud.positive_color);
     }
 
     #[test]
