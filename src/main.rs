@@ -130,7 +130,7 @@ enum Command {
     Bench(BenchCommand),
 }
 
-#[derive(Args)]
+#[derive(Args, Clone)]
 struct WhatArgs {
     /// homo, lumo, homo-N, lumo+N, or a 1-based orbital number of the chosen spin.
     #[arg(long, default_value = "homo", allow_hyphen_values = true)]
@@ -199,6 +199,36 @@ impl WhatArgs {
         wf.resolve(self.orbital, spin)
             .map(Quantity::Orbital)
             .ok_or_else(|| anyhow::anyhow!("no orbital {:?} of spin {spin:?} in this file", self.orbital))
+    }
+
+    /// A short name for what is asked for: `homo`, `lumo+1`, `mo12_beta`, `density`.
+    fn short_name(&self) -> String {
+        if self.density {
+            return "density".into();
+        }
+        if self.spin_density {
+            return "spin_density".into();
+        }
+        let name = match self.orbital {
+            OrbitalSpec::Homo(0) => "homo".to_string(),
+            OrbitalSpec::Homo(n) => format!("homo-{n}"),
+            OrbitalSpec::Lumo(0) => "lumo".to_string(),
+            OrbitalSpec::Lumo(n) => format!("lumo+{n}"),
+            OrbitalSpec::Index(n) => format!("mo{n}"),
+        };
+        match self.spin {
+            SpinArg::Alpha => name,
+            SpinArg::Beta => format!("{name}_beta"),
+        }
+    }
+
+    /// The quantity option as given, for messages: `--orbital lumo+1`, `--density`.
+    fn describe(&self) -> String {
+        match self.short_name().as_str() {
+            "density" => "--density".into(),
+            "spin_density" => "--spin-density".into(),
+            name => format!("--orbital {name}"),
+        }
     }
 
     fn label(&self, q: &Quantity, wf: &Wavefunction) -> String {
@@ -739,7 +769,7 @@ fn main() -> Result<()> {
             Ok(())
         }
         Some(Command::Scan(command)) => scan_cli::run(command),
-        Some(Command::Mesh(args)) => surface_cli::mesh(&args),
+        Some(Command::Mesh(args)) => surface_cli::mesh(&args, &quantities_cli::parse_later_meshes(&later)?),
         Some(Command::Bench(BenchCommand::Keyvolumes(args))) => scan_cli::bench_keyvolumes(args),
         Some(Command::Bench(BenchCommand::Isosurface(args))) => surface_cli::bench(&args),
         Some(Command::Bench(BenchCommand::Load(args))) => structure_cli::bench_load(&args),

@@ -512,8 +512,46 @@ fn render_draws_several_quantities_of_one_file_and_panes_side_by_side() {
     assert!(mean_difference(&left, &homo) < 0.5, "left pane: {}", mean_difference(&left, &homo));
     assert!(mean_difference(&right, &lumo) < 0.5, "right pane: {}", mean_difference(&right, &lumo));
     assert!(mean_difference(&left, &right) > 2.0, "HOMO and LUMO differ");
-    // Options of the whole picture after the second quantity are refused, with the reason.
-    let out = orbcloud(&["render", &file, "-o", "x.png", "--orbital", "homo", "--orbital", "lumo", "--size", "9x9"]);
-    assert!(!out.status.success());
-    assert!(String::from_utf8_lossy(&out.stderr).contains("--size applies to the whole picture"));
+    // Options of the whole picture may come after the second quantity too.
+    let (late, _) =
+        render_png(&[file.as_str(), "--orbital", "homo", "--beside", "--orbital", "lumo", "--size", "320x120"]);
+    assert_eq!(mean_difference(&late, &beside), 0.0, "--size after the quantities");
+}
+
+#[test]
+fn mesh_writes_each_quantitys_surfaces_named_after_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = dir.path().join("both.obj");
+    let file = benzene();
+    let out = orbcloud(&[
+        "mesh",
+        &file,
+        "--grid-points",
+        "40",
+        "--density",
+        "--iso",
+        "0.1",
+        "--orbital",
+        "homo",
+        "--iso",
+        "0.05",
+        "--iso",
+        "0.02",
+        "-o",
+        obj.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = std::fs::read_to_string(&obj).unwrap();
+    let objects: Vec<&str> = text.lines().filter_map(|l| l.strip_prefix("o ")).collect();
+    assert_eq!(
+        objects,
+        ["density_0.1", "homo_plus_0.02", "homo_minus_0.02", "homo_plus_0.05", "homo_minus_0.05"],
+        "each quantity's surfaces, its levels in increasing order"
+    );
+    // A quantity without levels of its own, or --beside, is refused with the reason.
+    let out = orbcloud(&["mesh", &file, "--density", "--iso", "0.1", "--orbital", "homo", "-o", obj.to_str().unwrap()]);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--orbital homo: each quantity needs its own --iso"));
+    let out =
+        orbcloud(&["mesh", &file, "--iso", "0.1", "--beside", "--orbital", "lumo", "--iso", "0.1", "-o", "x.obj"]);
+    assert!(!out.status.success() && String::from_utf8_lossy(&out.stderr).contains("`mesh` does not"));
 }

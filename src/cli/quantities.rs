@@ -19,9 +19,10 @@ use super::{Cli, Command, RenderArgs};
 const STARTS: [&str; 4] = ["--orbital", "--density", "--spin-density", "--volume"];
 /// The option that puts the next quantity beside the ones before, in a pane of its own.
 const BESIDE: &str = "--beside";
-/// Options that belong to the whole picture, not to a quantity: given after the second
-/// quantity option they are refused (they would silently apply to nothing).
-const WHOLE_PICTURE: [&str; 17] = [
+/// Options that belong to the whole picture or file, not to a quantity: wherever they are
+/// given, they join the first part of the command line (`mesh FILE --density --iso 0.1
+/// --orbital homo --iso 0.05 -o out.glb`).
+const WHOLE_PICTURE: [&str; 21] = [
     "--output",
     "-o",
     "--size",
@@ -38,8 +39,14 @@ const WHOLE_PICTURE: [&str; 17] = [
     "--grid-points",
     "--direct",
     "--surface",
+    "--surface-resolution",
+    "--surface-color",
     "--probe",
+    "--smoothness",
+    "--lod-px",
 ];
+/// Those of them that take no value.
+const WHOLE_PICTURE_FLAGS: [&str; 2] = ["--lavapipe", "--direct"];
 
 /// A quantity given after the first, with the options that followed it.
 pub struct Later {
@@ -53,15 +60,23 @@ fn option_name(arg: &OsString) -> String {
     s.split('=').next().unwrap_or_default().to_string()
 }
 
-/// Splits `args` (a whole command line) of a `render` command at each quantity option after the
-/// first one: the first part parses as today's `render`; each later quantity comes with its own
-/// options. Other commands are returned whole.
+/// Splits `args` (a whole command line) of a `render` or `mesh` command at each quantity option
+/// after the first one: the first part parses as that command always did; each later quantity
+/// comes with its own options. Other commands are returned whole.
 pub fn split(args: Vec<OsString>) -> Result<(Vec<OsString>, Vec<Later>)> {
-    let Some(at) = args.iter().position(|a| a == "render") else { return Ok((args, Vec::new())) };
+    let Some(at) = args.iter().position(|a| a == "render" || a == "mesh") else { return Ok((args, Vec::new())) };
+    let mesh = args[at] == "mesh";
     let mut first: Vec<OsString> = args[..=at].to_vec();
     let mut later: Vec<Later> = Vec::new();
     let (mut seen, mut beside) = (false, false);
+    // The value of a whole-picture option moved to the first part follows it there.
+    let mut moving_value = false;
     for arg in args.into_iter().skip(at + 1) {
+        if moving_value {
+            first.push(arg);
+            moving_value = false;
+            continue;
+        }
         let name = option_name(&arg);
         if name == BESIDE {
             beside = true;
@@ -75,17 +90,19 @@ pub fn split(args: Vec<OsString>) -> Result<(Vec<OsString>, Vec<Later>)> {
             seen = true;
         }
         match later.last_mut() {
-            Some(l) => {
-                if WHOLE_PICTURE.contains(&name.as_str()) || name.starts_with("--surface") {
-                    bail!("{name} applies to the whole picture: give it before the second quantity option");
-                }
-                l.args.push(arg);
+            Some(_) if WHOLE_PICTURE.contains(&name.as_str()) => {
+                moving_value = !WHOLE_PICTURE_FLAGS.contains(&name.as_str()) && !arg.to_string_lossy().contains('=');
+                first.push(arg);
             }
+            Some(l) => l.args.push(arg),
             None => first.push(arg),
         }
     }
     if beside {
         bail!("--beside must be followed by the quantity to show beside (--orbital X, --density, …)");
+    }
+    if mesh && later.iter().any(|l| l.beside) {
+        bail!("--beside places a quantity in a picture's pane: `render` takes it, `mesh` does not");
     }
     Ok((first, later))
 }
@@ -117,6 +134,21 @@ pub fn parse_later(later: &[Later]) -> Result<Vec<(bool, RenderArgs)>> {
             let line = ["orbcloud", "render", "-o", "unused.png"].map(OsString::from).into_iter().chain(l.args.clone());
             match Cli::try_parse_from(line) {
                 Ok(Cli { command: Some(Command::Render(args)), .. }) => Ok((l.beside, args)),
+                Ok(_) => bail!("expected the options of a quantity"),
+                Err(e) => bail!("{}", e.to_string().trim()),
+            }
+        })
+        .collect()
+}
+
+/// The later quantities' own options, parsed as `mesh` parses them.
+pub fn parse_later_meshes(later: &[Later]) -> Result<Vec<super::surface_cli::MeshArgs>> {
+    later
+        .iter()
+        .map(|l| {
+            let head = ["orbcloud", "mesh", "unused", "-o", "unused.obj"].map(OsString::from);
+            match Cli::try_parse_from(head.into_iter().chain(l.args.clone())) {
+                Ok(Cli { command: Some(Command::Mesh(args)), .. }) => Ok(args),
                 Ok(_) => bail!("expected the options of a quantity"),
                 Err(e) => bail!("{}", e.to_string().trim()),
             }
@@ -215,7 +247,13 @@ mod tests {
         // One quantity: today's command line, whole.
         let (first, later) = split(line("orbcloud render f -o x.png --orbital=homo --iso 0.1")).unwrap();
         assert!(later.is_empty() && first.len() == 8);
-        assert!(split(line("orbcloud render f --orbital homo --orbital lumo --size 10x10")).is_err());
+        // Options of the whole picture join the first part wherever they are given.
+        let (first, later) =
+            split(line("orbcloud mesh f --density --iso 0.1 --orbital homo --iso 0.05 -o x.obj --lavapipe")).unwrap();
+        assert_eq!(first, line("orbcloud mesh f --density --iso 0.1 -o x.obj --lavapipe"));
+        assert_eq!(later[0].args, line("--orbital homo --iso 0.05"));
+        let (first, _) = split(line("orbcloud render f --orbital homo --orbital lumo --size=10x10")).unwrap();
+        assert_eq!(first.last().unwrap(), "--size=10x10");
         assert!(split(line("orbcloud render f --orbital homo --beside")).is_err());
         // `--beside` before any quantity option: the default quantity, then the next beside it.
         let (_, later) = split(line("orbcloud render f -o x.png --beside --orbital lumo")).unwrap();

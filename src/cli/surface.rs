@@ -128,12 +128,40 @@ impl IsoArgs {
     /// Each level's surfaces with their colours ([`IsosurfaceSettings::nested`]), so nested ones tell
     /// apart; the order the levels were given in changes nothing.
     pub fn meshes(&self, grid: &VolumeGrid, base: &IsosurfaceSettings) -> Vec<(Mesh, SurfaceLook)> {
+        self.named_meshes(grid, base, None).into_iter().map(|(_, mesh, look)| (mesh, look)).collect()
+    }
+
+    /// [`Self::meshes`], each named for a mesh file: `psi_plus_0.05`, `psi_minus_0.05` (an
+    /// orbital's two signs), `density_0.002`; `stem` in place of `psi` or `density` when given
+    /// (`homo_plus_0.05`).
+    pub fn named_meshes(
+        &self,
+        grid: &VolumeGrid,
+        base: &IsosurfaceSettings,
+        stem: Option<&str>,
+    ) -> Vec<(String, Mesh, SurfaceLook)> {
         let sigma = grid.stats.sigma;
+        let signed = grid.kind == orbcloud::model::grid::ValueKind::Signed;
         let mut levels = self.levels();
         levels.sort_by(|a, b| a.value(sigma).total_cmp(&b.value(sigma)));
         levels.dedup_by(|a, b| a.value(sigma) == b.value(sigma));
         let count = levels.len();
-        levels.into_iter().enumerate().flat_map(|(n, level)| isosurfaces(grid, &base.nested(level, n, count))).collect()
+        levels
+            .into_iter()
+            .enumerate()
+            .flat_map(|(n, level)| {
+                let v = level.value(sigma);
+                let stem = stem.unwrap_or(if signed { "psi" } else { "density" });
+                let names = match signed {
+                    true => vec![format!("{stem}_plus_{v}"), format!("{stem}_minus_{v}")],
+                    false => vec![format!("{stem}_{v}")],
+                };
+                names
+                    .into_iter()
+                    .zip(isosurfaces(grid, &base.nested(level, n, count)))
+                    .map(|(name, (m, l))| (name, m, l))
+            })
+            .collect()
     }
 }
 
@@ -198,7 +226,7 @@ pub fn parse_pixel(s: &str) -> Result<[u32; 2], String> {
 }
 
 /// What `mesh` and `bench isosurface` cut surfaces from.
-#[derive(Args)]
+#[derive(Args, Clone)]
 pub struct GridArgs {
     /// Which volume of a cube file with several.
     #[arg(long, default_value_t = 0)]
@@ -243,11 +271,16 @@ pub struct MeshArgs {
     output: PathBuf,
 }
 
-pub fn mesh(args: &MeshArgs) -> Result<()> {
+/// Writes the surfaces `args` asks for; `later` are further quantities of the same file
+/// ([`super::quantities_cli`]), each with its own levels, their surfaces named after them.
+pub fn mesh(args: &MeshArgs, later: &[MeshArgs]) -> Result<()> {
     let format = MeshFormat::from_path(&args.output)
         .with_context(|| format!("{}: the extension must be .obj, .ply or .glb", args.output.display()))?;
     if args.iso.levels().is_empty() && args.molsurface.surface.is_none() {
         bail!("give at least one --iso VALUE or --iso-sigma S, or --surface gaussian|ses");
+    }
+    if let Some(q) = later.iter().find(|q| q.iso.levels().is_empty()) {
+        bail!("{}: each quantity needs its own --iso VALUE or --iso-sigma S", q.grid.what.describe());
     }
     let doc = load(Some(&args.file))?;
     let (meshes, names) = if args.molsurface.surface.is_some() {
@@ -256,8 +289,22 @@ pub fn mesh(args: &MeshArgs) -> Result<()> {
         let built = args.molsurface.mesh(&doc, false, grid.as_ref())?;
         (built.into_iter().collect(), vec![args.molsurface.name().to_string()])
     } else {
-        let grid = args.grid.grid(&doc)?;
-        (args.iso.meshes(&grid, &IsosurfaceSettings::default()), surface_names(&grid, &args.iso))
+        let mut meshes = Vec::new();
+        let mut names = Vec::new();
+        for q in std::iter::once(args).chain(later) {
+            let grid = GridArgs { grid_points: args.grid.grid_points, ..q.grid.clone() }.grid(&doc)?;
+            // With several quantities, each surface is named after its quantity.
+            let stem = match (later.is_empty(), doc.wavefunction.is_some()) {
+                (true, _) => None,
+                (false, true) => Some(q.grid.what.short_name()),
+                (false, false) => Some(file_name(&grid.label)),
+            };
+            for (name, mesh, look) in q.iso.named_meshes(&grid, &IsosurfaceSettings::default(), stem.as_deref()) {
+                names.push(name);
+                meshes.push((mesh, look));
+            }
+        }
+        (meshes, names)
     };
     let meshes: Vec<(Mesh, SurfaceLook)> = meshes.into_iter().map(|(m, c)| (m.welded(), c)).collect();
     let named: Vec<NamedMesh> =
@@ -278,20 +325,13 @@ pub fn mesh(args: &MeshArgs) -> Result<()> {
     Ok(())
 }
 
-/// Object names in mesh files: `psi_plus_0.05`, `psi_minus_0.05`, `density_0.002`.
-fn surface_names(grid: &VolumeGrid, iso: &IsoArgs) -> Vec<String> {
-    let signed = grid.kind == orbcloud::model::grid::ValueKind::Signed;
-    let mut names = Vec::new();
-    for level in iso.levels() {
-        let v = level.value(grid.stats.sigma);
-        if signed {
-            names.push(format!("psi_plus_{v}"));
-            names.push(format!("psi_minus_{v}"));
-        } else {
-            names.push(format!("density_{v}"));
-        }
-    }
-    names
+/// `label` as part of a name in a mesh file: lower case, `_` for anything but letters, digits,
+/// `+` and `-` ("LUMO+1" → "lumo+1", "total electron density" → "total_electron_density").
+fn file_name(label: &str) -> String {
+    label
+        .chars()
+        .map(|c| if c.is_alphanumeric() || c == '+' || c == '-' { c.to_ascii_lowercase() } else { '_' })
+        .collect()
 }
 
 #[derive(Args)]
