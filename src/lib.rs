@@ -1,12 +1,17 @@
 //! orbcloud: molecular orbitals and electron densities as GPU-rendered clouds.
 //!
-//! Layers (see ARCHITECTURE.md): `model` ← `formats`, `scene` ← `gpu` ← `headless` ← `app` ← `main`.
+//! Layers (see ARCHITECTURE.md): `model` ← `formats`, `scene` ← `gpu` ← `meshes`, `evaluate` ←
+//! `layers` ← `headless`, `key_volumes` ← `app` ← `main`.
 
 pub mod app;
 pub mod demo;
+pub mod evaluate;
 pub mod formats;
 pub mod gpu;
 pub mod headless;
 pub mod info;
+pub mod key_volumes;
+pub mod layers;
+pub mod meshes;
 pub mod model;
 pub mod scene;

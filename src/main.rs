@@ -6,14 +6,17 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use glam::DVec3;
+use orbcloud::evaluate::WavefunctionView;
 use orbcloud::formats::cube_write;
 use orbcloud::gpu::{AdapterPreference, GpuContext};
-use orbcloud::headless::{Headless, WavefunctionView, camera_for, show_wavefunction};
+use orbcloud::headless::Headless;
+use orbcloud::layers::show_wavefunction;
 use orbcloud::model::Document;
 use orbcloud::model::GridSpec;
 use orbcloud::model::VolumeGrid;
 use orbcloud::model::gto::PreparedBasis;
 use orbcloud::model::orbitals::{OrbitalSpec, Quantity, Spin, Wavefunction};
+use orbcloud::scene::framing::camera_for;
 use orbcloud::scene::transfer::PRESETS;
 use orbcloud::scene::{
     AtomColoring, AtomStyle, Camera, ClipPlane, RenderSettings, Shape, SliceMode, TransferKind, ViewPreset,
@@ -683,7 +686,7 @@ fn main() -> Result<()> {
             let computed = args.wavefunction.apply(&ctx, &mut h, &doc)?.map(|(_, g)| g);
             let grid = computed.as_ref().or(volume.and_then(|i| doc.volumes.get(i)));
             if let Some(grid) = grid {
-                orbcloud::headless::auto_opacity(&mut settings.volume, grid);
+                orbcloud::evaluate::auto_opacity(&mut settings.volume, grid);
             }
             let molsurface = args.molsurface.mesh(&doc, args.iso.translucent, grid)?;
             surface_cli::show(&ctx, &mut h.renderer, grid, &args.iso, molsurface);

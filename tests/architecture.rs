@@ -6,13 +6,20 @@ use std::path::{Path, PathBuf};
 
 /// For each layer (a directory or file under src/), the crate modules it must not name.
 const MODULE_RULES: &[(&str, &[&str])] = &[
-    ("model", &["formats", "scene", "gpu", "headless", "app", "demo", "info"]),
-    ("formats", &["scene", "gpu", "headless", "app", "demo", "info"]),
-    ("scene", &["formats", "gpu", "headless", "app", "demo", "info"]),
-    ("gpu", &["formats", "headless", "app", "demo", "info"]),
-    ("headless", &["formats", "app", "demo", "info"]),
-    ("info.rs", &["gpu", "headless", "app", "demo"]),
-    ("demo.rs", &["gpu", "headless", "app", "info"]),
+    (
+        "model",
+        &["formats", "scene", "gpu", "meshes", "evaluate", "layers", "headless", "key_volumes", "app", "demo", "info"],
+    ),
+    ("formats", &["scene", "gpu", "meshes", "evaluate", "layers", "headless", "key_volumes", "app", "demo", "info"]),
+    ("scene", &["formats", "gpu", "meshes", "evaluate", "layers", "headless", "key_volumes", "app", "demo", "info"]),
+    ("gpu", &["formats", "meshes", "evaluate", "layers", "headless", "key_volumes", "app", "demo", "info"]),
+    ("meshes.rs", &["formats", "gpu", "evaluate", "layers", "headless", "key_volumes", "app", "demo", "info"]),
+    ("evaluate.rs", &["formats", "meshes", "layers", "headless", "key_volumes", "app", "demo", "info"]),
+    ("layers.rs", &["formats", "headless", "key_volumes", "app", "demo", "info"]),
+    ("headless.rs", &["formats", "key_volumes", "app", "demo", "info"]),
+    ("key_volumes.rs", &["formats", "headless", "app", "demo", "info"]),
+    ("info.rs", &["gpu", "meshes", "evaluate", "layers", "headless", "key_volumes", "app", "demo"]),
+    ("demo.rs", &["gpu", "meshes", "evaluate", "layers", "headless", "key_volumes", "app", "info"]),
     ("app", &[]),
 ];
 
@@ -23,7 +30,11 @@ const CRATE_RULES: &[(&str, &[&str])] = &[
     ("formats", &["glam", "serde", "rayon", "thiserror", "flate2", "fast_float2", "toml", "bytemuck"]),
     ("scene", &["glam", "serde"]),
     ("gpu", &["glam", "thiserror", "wgpu", "bytemuck", "half", "image", "pollster", "log"]),
-    ("headless", &["glam", "thiserror", "wgpu", "image"]),
+    ("meshes.rs", &["glam"]),
+    ("evaluate.rs", &["wgpu"]),
+    ("layers.rs", &["glam"]),
+    ("headless.rs", &["wgpu", "image"]),
+    ("key_volumes.rs", &["thiserror", "wgpu", "image"]),
     ("info.rs", &["glam", "serde", "serde_json"]),
     ("demo.rs", &["flate2"]),
     ("app", &["glam", "serde", "toml", "wgpu", "image", "log", "egui", "eframe", "egui_wgpu", "egui_plot", "rfd"]),

@@ -148,7 +148,7 @@ fn scan_export_writes_the_interpolated_orbital_and_render_writes_both_views() {
     let doc = orbcloud::formats::load(&cube).unwrap();
     let file = orbcloud::formats::scan::load_scan(std::path::Path::new(manifest)).unwrap();
     let tracks = file.scan.track(orbcloud::model::scan::Follow::Index).unwrap();
-    let grid = file.scan.key_grid(&tracks, orbcloud::headless::ORBITAL_MARGIN, 24);
+    let grid = file.scan.key_grid(&tracks, orbcloud::scene::framing::ORBITAL_MARGIN, 24);
     let want = file.scan.interpolated_values(&tracks, 0, -97.5, &grid);
     let got = &doc.volumes[0];
     assert_eq!(got.dims, grid.dims);

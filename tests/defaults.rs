@@ -4,9 +4,11 @@
 
 mod common;
 
+use orbcloud::evaluate::{WavefunctionView, auto_opacity, evaluate_wavefunction};
 use orbcloud::gpu::gto::GtoFillPass;
-use orbcloud::headless::{Headless, WavefunctionView, auto_opacity, camera_for, evaluate_wavefunction};
+use orbcloud::headless::Headless;
 use orbcloud::model::orbitals::{Quantity, Spin};
+use orbcloud::scene::framing::camera_for;
 use orbcloud::scene::{AtomStyle, DensityScale, RenderSettings, ViewPreset};
 
 const SIZE: [u32; 2] = [160, 120];

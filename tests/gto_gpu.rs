@@ -123,7 +123,7 @@ fn gpu_fill_of_real_orbitals_matches_the_cpu_evaluator() {
         let prepared = PreparedBasis::new(&wf.basis);
         for i in [wf.homo(orbcloud::model::Spin::Alpha).unwrap(), wf.lumo(orbcloud::model::Spin::Alpha).unwrap()] {
             let quantity = orbcloud::model::orbitals::Quantity::Orbital(i);
-            let geometry = orbcloud::headless::orbital_geometry(&doc, quantity, 28).unwrap();
+            let geometry = orbcloud::evaluate::orbital_geometry(&doc, quantity, 28).unwrap();
             let spec = geometry;
             let c = &wf.orbitals[i].coefficients;
             let e = CartesianExpansion::from_coefficients(&prepared, c);

@@ -79,7 +79,7 @@ fn a_scans_key_grid_holds_every_key_orbital() {
     let file = orbcloud::demo::scan().unwrap();
     let scan = &file.scan;
     let tracks = scan.track(Follow::Index).unwrap();
-    let grid = scan.key_grid(&tracks, orbcloud::headless::ORBITAL_MARGIN, 40);
+    let grid = scan.key_grid(&tracks, orbcloud::scene::framing::ORBITAL_MARGIN, 40);
     let mut worst: f64 = 0.0;
     for slot in 0..scan.orbitals.len() {
         for frame in 0..scan.frames.len() {

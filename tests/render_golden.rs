@@ -4,7 +4,8 @@
 mod common;
 
 use common::{assert_golden, coverage, lavapipe, p_orbital, scene};
-use orbcloud::headless::{default_camera, render_document};
+use orbcloud::headless::render_document;
+use orbcloud::scene::framing::default_camera;
 use orbcloud::scene::{AtomStyle, RenderSettings, SliceMode};
 
 const SIZE: [u32; 2] = [192, 144];

@@ -11,7 +11,7 @@ use orbcloud::formats::cube_write;
 use orbcloud::formats::scan::{init, load_scan};
 use orbcloud::gpu::volume::VolumeTexture;
 use orbcloud::gpu::{FrameInput, OffscreenTarget, Renderer};
-use orbcloud::headless::scan::{KeyOptions, ScanScene};
+use orbcloud::key_volumes::{KeyOptions, ScanScene};
 use orbcloud::model::VolumeGrid;
 use orbcloud::model::scan::{Follow, Scan, Tracks, measure};
 use orbcloud::scene::{Interpolation, RenderSettings};
@@ -92,7 +92,7 @@ fn the_skeleton_follows_theta_and_the_charge_moves_at_minus_90() {
     // Seed 000's picture at −90°: HOMO on the C=N side, LUMO on the allyl side. Partition ψ² by
     // nearest atom on the common grid.
     let tracks = scan.track(Follow::Index).unwrap();
-    let grid = scan.common_grid(orbcloud::headless::ORBITAL_MARGIN, 48);
+    let grid = scan.common_grid(orbcloud::scene::framing::ORBITAL_MARGIN, 48);
     let f = scan.frames.iter().position(|f| f.angle == -90.0).unwrap();
     let atoms = &scan.frames[f].molecule.atoms;
     let moving: Vec<bool> = (0..atoms.len()).map(|i| scan.moving.contains(&i)).collect();
@@ -139,7 +139,7 @@ fn held_out_error(scan: &Scan, held: usize, slot: usize, points: usize) -> (f64,
     let truth_frame = frames.remove(held);
     let without = Scan::new(scan.title.clone(), scan.dihedral, scan.orbitals.clone(), frames).unwrap();
     let tracks: Tracks = without.track(Follow::Index).unwrap();
-    let grid = scan.common_grid(orbcloud::headless::ORBITAL_MARGIN, points);
+    let grid = scan.common_grid(orbcloud::scene::framing::ORBITAL_MARGIN, points);
     let interpolated = without.interpolated_values(&tracks, slot, truth_frame.angle, &grid);
     let full = scan.track(Follow::Index).unwrap();
     let mut truth = scan.key_values(&full, slot, held, &grid);
@@ -355,7 +355,7 @@ fn cube_series_must_share_one_grid() {
     let dir = tempfile::tempdir().unwrap();
     let scan = psb3();
     let tracks = scan.track(Follow::Index).unwrap();
-    let grid = scan.common_grid(orbcloud::headless::ORBITAL_MARGIN, 16);
+    let grid = scan.common_grid(orbcloud::scene::framing::ORBITAL_MARGIN, 16);
     let mut names = Vec::new();
     for (f, frame) in scan.frames.iter().enumerate().take(3) {
         let values = scan.key_values(&tracks, 0, f, &grid);
@@ -450,7 +450,7 @@ fn key_volumes_respect_the_budget_and_can_be_cancelled() {
     let e = ScanScene::build(&ctx, psb3(), &options, &mut |_, _| true).err().expect("1 MiB cannot hold 30 volumes");
     let msg = e.to_string();
     assert!(msg.contains("30 key volumes") && msg.contains("points along the longest side fits"), "{msg}");
-    let orbcloud::headless::scan::ScanSceneError::OverBudget { fits, .. } = e else { panic!("{e}") };
+    let orbcloud::key_volumes::ScanSceneError::OverBudget { fits, .. } = e else { panic!("{e}") };
     // The grid offered does fit.
     let options = KeyOptions { points: fits, budget: Some(1 << 20), ..KeyOptions::default() };
     let scene = ScanScene::build(&ctx, psb3(), &options, &mut |_, _| true).expect("the offered grid fits");
@@ -464,7 +464,7 @@ fn key_volumes_respect_the_budget_and_can_be_cancelled() {
     })
     .err()
     .expect("cancelled");
-    assert!(matches!(e, orbcloud::headless::scan::ScanSceneError::Cancelled), "{e}");
+    assert!(matches!(e, orbcloud::key_volumes::ScanSceneError::Cancelled), "{e}");
     assert_eq!(calls, 3, "stops at the first refusal");
 }
 
@@ -524,7 +524,7 @@ fn per_point_fchk_files_with_optimisation_histories_make_a_scan() {
     // The same orbitals as the bundled Molden frames at these angles.
     let molden = psb3();
     let molden_tracks = molden.track(Follow::Index).unwrap();
-    let grid = molden.common_grid(orbcloud::headless::ORBITAL_MARGIN, 24);
+    let grid = molden.common_grid(orbcloud::scene::framing::ORBITAL_MARGIN, 24);
     for (f, angle) in [-120.0, -90.0, -60.0].into_iter().enumerate() {
         let m = molden.frames.iter().position(|fr| fr.angle == angle).unwrap();
         for slot in 0..2 {

@@ -4,8 +4,9 @@
 mod common;
 
 use common::{assert_golden, lavapipe};
-use orbcloud::headless::{default_camera, render_document};
+use orbcloud::headless::render_document;
 use orbcloud::model::Document;
+use orbcloud::scene::framing::default_camera;
 use orbcloud::scene::{AtomColoring, AtomStyle, RenderSettings};
 
 const SIZE: [u32; 2] = [200, 160];
@@ -81,7 +82,7 @@ fn a_selection_shows_only_what_it_names() {
     let draw = |selection: &str| {
         let state = ObjectState { selection: selection.into(), ..ObjectState::default() };
         let mut r = Renderer::new(&ctx);
-        orbcloud::headless::show_object(&ctx, r.main(), &doc, &state).unwrap();
+        orbcloud::layers::show_object(&ctx, r.main(), &doc, &state).unwrap();
         let target = OffscreenTarget::new(&ctx.device, SIZE);
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
         let cam = default_camera(&doc);

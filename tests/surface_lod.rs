@@ -8,7 +8,7 @@ use std::sync::atomic::AtomicBool;
 
 use orbcloud::gpu::frame::PickId;
 use orbcloud::gpu::{FrameInput, OffscreenTarget, Renderer};
-use orbcloud::headless::molecular_surface;
+use orbcloud::meshes::molecular_surface;
 use orbcloud::model::isosurface::Mesh;
 use orbcloud::model::octree::{LodLevel, SurfaceOctree};
 use orbcloud::scene::translucency::SurfaceLook;
@@ -63,7 +63,7 @@ fn far_parts_become_points_within_two_levels_of_every_triangle() {
     let color = SurfaceSettings::default().color;
 
     // Every triangle: the golden picture.
-    orbcloud::headless::show_meshes(&ctx, renderer.main(), &[(mesh.clone(), color.into())]);
+    orbcloud::layers::show_meshes(&ctx, renderer.main(), &[(mesh.clone(), color.into())]);
     let (full, stats) = draw(&ctx, &mut renderer, &camera);
     assert_eq!(stats.total_triangles, 0, "no level of detail asked for");
     common::assert_golden("surface_ses_fragment", &full);
@@ -71,7 +71,7 @@ fn far_parts_become_points_within_two_levels_of_every_triangle() {
     // Seed 002's level of detail at 3 px: some cells are points, the rest
     // triangles, the picture within 2/255.
     let look = SurfaceLook { lod_px: Some(POINTS_PX), ..color.into() };
-    orbcloud::headless::show_meshes(&ctx, renderer.main(), &[(mesh.clone(), look)]);
+    orbcloud::layers::show_meshes(&ctx, renderer.main(), &[(mesh.clone(), look)]);
     let (lod, stats) = draw(&ctx, &mut renderer, &camera);
     let n = mesh.triangle_count() as u64;
     assert_eq!(stats.total_triangles, n);
@@ -113,7 +113,7 @@ fn a_surface_coloured_by_element_takes_each_vertex_from_its_nearest_atom() {
         color_by: Some(AtomColoring::Element),
         ..Default::default()
     };
-    orbcloud::headless::color_surface(&mut mesh, &doc, &settings, "not resn HOH", None);
+    orbcloud::meshes::color_surface(&mut mesh, &doc, &settings, "not resn HOH", None);
     assert_eq!(mesh.colors.len(), mesh.positions.len());
     let selection = orbcloud::scene::selection::Selection::parse("not resn HOH").unwrap();
     let mask = selection.mask(&doc.molecule, doc.structure.as_ref());
@@ -153,7 +153,7 @@ fn a_surface_coloured_by_a_volume_shows_the_sign_of_its_values() {
     );
     let points =
         [Vec3::new(-4.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0), Vec3::new(4.0, 0.0, 0.0), Vec3::new(9.0, 0.0, 0.0)];
-    let colors = orbcloud::headless::color_by_values(&points, &grid);
+    let colors = orbcloud::meshes::color_by_values(&points, &grid);
     let [neg, zero, pos, outside] = [colors[0], colors[1], colors[2], colors[3]];
     assert!(neg[0] > 0.8 && neg[2] < 0.3, "negative is red: {neg:?}");
     assert!(pos[2] > 0.8 && pos[0] < 0.3, "positive is blue: {pos:?}");

@@ -7,9 +7,10 @@ mod common;
 use common::cloud::{CloudReference, srgb_encode};
 use common::{lavapipe, p_orbital, scene};
 use glam::DVec3;
-use orbcloud::headless::{default_camera, render_document};
+use orbcloud::headless::render_document;
 use orbcloud::model::VolumeGrid;
 use orbcloud::model::grid::ValueKind;
+use orbcloud::scene::framing::default_camera;
 use orbcloud::scene::{AtomStyle, Camera, RenderSettings, Shape, SliceMode, TransferKind};
 
 const SIZE: [u32; 2] = [96, 72];

@@ -20,8 +20,8 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use crate::gpu::{GpuContext, context::device_descriptor};
-use crate::headless::default_camera;
 use crate::model::{Atom, Document, Molecule};
+use crate::scene::framing::default_camera;
 use crate::scene::{ObjectState, RenderSettings, ViewPreset};
 use loader::LoadJob;
 use scan::{ScanFailure, ScanJob, ScanSource, ScanView};
@@ -368,7 +368,7 @@ impl OrbApp {
             status: String::new(),
             scan: None,
             scan_job: None,
-            scan_points: crate::headless::scan::DEFAULT_SCAN_POINTS,
+            scan_points: crate::key_volumes::DEFAULT_SCAN_POINTS,
             scan_retry: None,
             scan_budget: None,
             measurements: measure::Measurements::default(),
@@ -431,7 +431,7 @@ impl OrbApp {
         if o.state.selection.is_empty() {
             return o.doc.molecule.atoms.len();
         }
-        let look = crate::headless::atom_look(&o.doc, &o.state.atoms, &o.state.selection);
+        let look = crate::layers::atom_look(&o.doc, &o.state.atoms, &o.state.selection);
         look.shown.iter().filter(|&&s| s).count()
     }
 
@@ -524,11 +524,8 @@ impl OrbApp {
             job.cancel();
         }
         let ctx = ctx.clone();
-        let options = crate::headless::scan::KeyOptions {
-            points: self.scan_points,
-            budget: self.scan_budget,
-            ..Default::default()
-        };
+        let options =
+            crate::key_volumes::KeyOptions { points: self.scan_points, budget: self.scan_budget, ..Default::default() };
         self.scan_job = Some(ScanJob::start(gpu, source, options, follow, move || ctx.request_repaint()));
     }
 
@@ -646,7 +643,7 @@ impl OrbApp {
             }
             objects => {
                 let boxes = objects.iter().filter_map(|o| {
-                    let (lo, hi) = crate::headless::framing_box_of(&o.doc, &o.state.selection)?;
+                    let (lo, hi) = crate::scene::framing::framing_box_of(&o.doc, &o.state.selection)?;
                     let m = o.state.placement.world_from_object();
                     let corners = [lo, hi];
                     let points: Vec<glam::Vec3> = (0..8)
@@ -840,7 +837,7 @@ impl OrbApp {
         let (Some(vp), Some(o)) = (&self.viewport, self.objects.get_mut(n)) else { return };
         let grid = vp.shown_grid(n, k, &o.doc, &o.state);
         if let (Some(grid), Some(q)) = (grid, o.state.quantities.get_mut(k)) {
-            crate::headless::auto_opacity(&mut q.cloud, grid);
+            crate::evaluate::auto_opacity(&mut q.cloud, grid);
         }
     }
 

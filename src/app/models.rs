@@ -59,7 +59,7 @@ pub fn selection(ui: &mut egui::Ui, app: &mut OrbApp) {
         })
         .inner;
     let total = o.doc.molecule.atoms.len();
-    let shown = crate::headless::atom_look(&o.doc, &o.state.atoms, &query).shown.iter().filter(|&&s| s).count();
+    let shown = crate::layers::atom_look(&o.doc, &o.state.atoms, &query).shown.iter().filter(|&&s| s).count();
     if shown < total {
         ui.label(RichText::new(format!("{shown} of {total} atoms shown")).small().weak());
     }

@@ -6,13 +6,14 @@ use egui::{Key, PointerButton, Sense};
 use super::detail::Detail;
 use super::jobs::Latest;
 use super::state::{DRAG_ROTATE, KEY_ROTATE, KEY_ZOOM, ViewState};
+use crate::evaluate::{Evaluated, WavefunctionView, evaluate_within};
 use crate::gpu::context::guarded;
 use crate::gpu::frame::PickId;
 use crate::gpu::gto::GtoFillPass;
 use crate::gpu::oit::FragmentStats;
 use crate::gpu::{FrameInput, GpuContext, GpuError, OffscreenTarget, Renderer, Tile};
-use crate::headless::scan::ScanScene;
-use crate::headless::{Evaluated, WavefunctionView, evaluate_within, isosurfaces_within, molecular_surface};
+use crate::key_volumes::ScanScene;
+use crate::meshes::{isosurfaces_within, molecular_surface};
 use crate::model::isosurface::Mesh;
 use crate::model::{Document, VolumeGrid};
 use crate::scene::objects::Part;
@@ -80,7 +81,7 @@ struct Progress {
 /// The note for a document's data set `i` shown at every `step`-th point (`None` when whole).
 fn coarser(doc: &Document, i: usize, step: usize) -> Option<String> {
     let grid = doc.volumes.get(i).filter(|_| step > 1)?;
-    Some(crate::headless::coarser_note(&doc.source, grid.dims, step))
+    Some(crate::layers::coarser_note(&doc.source, grid.dims, step))
 }
 
 /// Screen distance (points) within which a press grabs the rotatable bond.
@@ -284,7 +285,7 @@ impl Viewport {
         self.insert_layer(at, n, Part::Atoms);
         let (ctx, layer) = (&self.ctx, self.renderer.layer_mut(&self.ctx, at));
         guarded(&ctx.device, || {
-            crate::headless::show_object_atoms(ctx, layer, doc, state);
+            crate::layers::show_object_atoms(ctx, layer, doc, state);
             Ok(())
         })?;
         self.update_surface(n, doc, state);
@@ -332,7 +333,7 @@ impl Viewport {
 
     /// Shows quantity `k` of object `n`: a data set of the document at once (a note when it is
     /// shown coarser), an orbital or density of its wavefunction evaluated in the background
-    /// ([`crate::headless::evaluate_wavefunction`]; [`Self::poll`] shows it when it is done). Its
+    /// ([`crate::evaluate::evaluate_wavefunction`]; [`Self::poll`] shows it when it is done). Its
     /// isosurfaces follow.
     pub fn set_quantity(
         &mut self,
@@ -345,7 +346,7 @@ impl Viewport {
             return Ok(None);
         };
         let (ctx, layer) = (&self.ctx, self.renderer.layer_mut(&self.ctx, l));
-        crate::headless::place_layer(layer, state, Part::Quantity(k));
+        crate::layers::place_layer(layer, state, Part::Quantity(k));
         self.generation += 1;
         match q.source {
             Source::Volume(i) => {
@@ -559,7 +560,7 @@ impl Viewport {
     /// Restyles, recolours and reselects object `n`'s atoms (positions stay on the GPU).
     pub fn set_atom_look(&mut self, n: usize, doc: &Document, state: &ObjectState) {
         let Some(l) = self.layer_of(n, Part::Atoms) else { return };
-        let look = crate::headless::atom_look(doc, &state.atoms, &state.selection);
+        let look = crate::layers::atom_look(doc, &state.atoms, &state.selection);
         let atoms = &mut self.renderer.layer_mut(&self.ctx, l).atoms;
         atoms.set_look(&self.ctx, state.atoms.style, &look);
         atoms.depth_cue = state.atoms.depth_cue;
@@ -570,7 +571,7 @@ impl Viewport {
     pub fn set_atoms(&mut self, n: usize, doc: &Document, state: &ObjectState) {
         let Some(l) = self.layer_of(n, Part::Atoms) else { return };
         let layer = self.renderer.layer_mut(&self.ctx, l);
-        crate::headless::show_atoms(&self.ctx, layer, doc, &state.atoms, &state.selection);
+        crate::layers::show_atoms(&self.ctx, layer, doc, &state.atoms, &state.selection);
         self.generation += 1;
     }
 
@@ -584,7 +585,7 @@ impl Viewport {
     pub fn set_visibility(&mut self, n: usize, state: &ObjectState) {
         for l in self.layers_of(n) {
             let part = self.parts[l].1;
-            crate::headless::place_layer(self.renderer.layer_mut(&self.ctx, l), state, part);
+            crate::layers::place_layer(self.renderer.layer_mut(&self.ctx, l), state, part);
         }
         self.generation += 1;
     }
@@ -1193,6 +1194,6 @@ fn molecular_surface_cached(
     }
     let built = cache.as_ref().expect("just built");
     let mut mesh = built.mesh.clone();
-    crate::headless::color_surface(&mut mesh, doc, settings, selection, grid);
+    crate::meshes::color_surface(&mut mesh, doc, settings, selection, grid);
     (Some((mesh, settings.look())), built.note.clone())
 }

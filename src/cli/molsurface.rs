@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
-use orbcloud::headless::molecular_surface;
+use orbcloud::meshes::molecular_surface;
 use orbcloud::model::Document;
 use orbcloud::model::isosurface::Mesh;
 use orbcloud::model::surface::{self, Sphere, SurfaceParams};
@@ -113,7 +113,7 @@ impl MolSurfaceArgs {
                 doc.source
             );
         }
-        orbcloud::headless::color_surface(&mut mesh, doc, &settings, "", grid);
+        orbcloud::meshes::color_surface(&mut mesh, doc, &settings, "", grid);
         eprintln!(
             "{} surface: {} triangles, area {:.1} Å², volume {:.1} Å³, {:.0} ms",
             settings.choice.name(),

@@ -9,7 +9,8 @@ use std::ffi::OsString;
 use anyhow::{Result, bail};
 use clap::Parser;
 use orbcloud::gpu::{FrameInput, GpuContext, OffscreenTarget, Renderer};
-use orbcloud::headless::{draw_exact, show_scene};
+use orbcloud::headless::draw_exact;
+use orbcloud::layers::show_scene;
 use orbcloud::model::Document;
 use orbcloud::scene::{Camera, Evaluation, ObjectState, QuantityState, RenderSettings, Source};
 

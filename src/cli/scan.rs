@@ -9,7 +9,7 @@ use orbcloud::formats::cube_write;
 use orbcloud::formats::scan::{Follow, ScanFile, init, load_scan};
 use orbcloud::gpu::volume::{VolumeTexture, residency_budget, texel_bytes};
 use orbcloud::gpu::{GpuContext, OffscreenTarget, Renderer};
-use orbcloud::headless::scan::{DEFAULT_SCAN_POINTS, KeyOptions, ScanScene};
+use orbcloud::key_volumes::{DEFAULT_SCAN_POINTS, KeyOptions, ScanScene};
 use orbcloud::model::VolumeGrid;
 use orbcloud::model::scan::Scan;
 use orbcloud::scene::Interpolation;
@@ -270,7 +270,7 @@ pub fn run(command: ScanCommand) -> Result<()> {
             let slot = slot_of(s, &orbital)?;
             check_angle(s, angle)?;
             let tracks = s.track(follow)?;
-            let grid = s.key_grid(&tracks, orbcloud::headless::ORBITAL_MARGIN, keys.points.clamp(8, 512));
+            let grid = s.key_grid(&tracks, orbcloud::scene::framing::ORBITAL_MARGIN, keys.points.clamp(8, 512));
             let label = format!("{orbital} at {angle} deg (interpolated)");
             let volume = s.interpolated_grid(&tracks, slot, angle, &grid, &label);
             let molecule = s.geometry_at(angle);
@@ -315,7 +315,7 @@ pub fn bench_keyvolumes(args: KeyVolumeBench) -> Result<()> {
     };
     let s = &file.scan;
     let tracks = s.track(file.follow)?;
-    let grid = s.key_grid(&tracks, orbcloud::headless::ORBITAL_MARGIN, args.points.clamp(8, 512));
+    let grid = s.key_grid(&tracks, orbcloud::scene::framing::ORBITAL_MARGIN, args.points.clamp(8, 512));
     // The real key volumes of the first orbital, cycled to make K distinct textures.
     let sources: Vec<VolumeGrid> = (0..s.frames.len())
         .map(|f| {

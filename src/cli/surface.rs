@@ -6,10 +6,12 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
+use orbcloud::evaluate::orbital_geometry;
 use orbcloud::formats::mesh_write::{self, MeshFormat, NamedMesh};
 use orbcloud::gpu::frame::PickId;
 use orbcloud::gpu::{GpuContext, Renderer};
-use orbcloud::headless::{isosurfaces, orbital_geometry, show_meshes};
+use orbcloud::layers::show_meshes;
+use orbcloud::meshes::isosurfaces;
 use orbcloud::model::gto::PreparedBasis;
 use orbcloud::model::isosurface::{self, Level, Mesh};
 use orbcloud::model::units::BOHR_PER_ANGSTROM;
@@ -406,8 +408,9 @@ struct Timed {
 pub fn bench_translucent(args: &TranslucentBench) -> Result<()> {
     use orbcloud::gpu::oit::Transparency;
     use orbcloud::gpu::{FrameInput, OffscreenTarget};
-    use orbcloud::headless::{default_camera, draw_exact};
+    use orbcloud::headless::draw_exact;
     use orbcloud::scene::RenderSettings;
+    use orbcloud::scene::framing::default_camera;
     let doc = load(args.file.as_deref())?;
     let grid = doc.volumes.first().context("the file has no volume")?;
     let ctx = super::gpu(args.bench.lavapipe)?;
@@ -508,7 +511,8 @@ pub fn render_scene(
     size: [u32; 2],
 ) -> Result<image::RgbaImage> {
     use orbcloud::gpu::{FrameInput, OffscreenTarget};
-    use orbcloud::headless::{draw_exact, show_scene};
+    use orbcloud::headless::draw_exact;
+    use orbcloud::layers::show_scene;
     use orbcloud::scene::{Camera, RenderSettings};
     for (_, state) in &mut scene {
         state.quantities.iter_mut().for_each(|q| iso.apply_to(q));

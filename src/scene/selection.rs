@@ -2,7 +2,7 @@
 //! residue names, e.g. `chain A B resi 30-50`, `not resn HOH`. Terms are ANDed; `not` negates
 //! the term after it; an empty query shows every atom.
 
-use crate::model::{Molecule, StructureView};
+use crate::model::{Document, Molecule, StructureView};
 
 #[derive(Debug, Clone, PartialEq)]
 enum Field {
@@ -92,6 +92,13 @@ impl Selection {
             })
             .collect()
     }
+}
+
+/// Which of `doc`'s atoms `selection` shows; `None` for all of them (an empty query, or one that
+/// does not parse: the panel says why).
+pub fn shown_atoms(doc: &Document, selection: &str) -> Option<Vec<bool>> {
+    let query = Selection::parse(selection).ok().filter(|q| !q.is_everything())?;
+    Some(query.mask(&doc.molecule, doc.structure.as_ref()))
 }
 
 #[cfg(test)]

@@ -6,7 +6,6 @@ use std::sync::Arc;
 
 use thiserror::Error;
 
-use super::ORBITAL_MARGIN;
 use crate::gpu::gto::{GtoFillPass, read_volume};
 use crate::gpu::volume::{VolumeTexture, residency_budget, texel_bytes};
 use crate::gpu::{FrameInput, GpuContext, GpuError, OffscreenTarget, Renderer};
@@ -15,6 +14,7 @@ use crate::model::cartesian::CartesianExpansion;
 use crate::model::scan::{Bracket, Follow, Scan, ScanError, Tracks};
 use crate::model::units::EV_PER_HARTREE;
 use crate::model::{PreparedBasis, VolumeGrid};
+use crate::scene::framing::ORBITAL_MARGIN;
 use crate::scene::{AtomStyle, Camera, Interpolation, RenderSettings};
 
 /// Points along the longest side of the common grid unless asked otherwise.

@@ -1,0 +1,155 @@
+//! Evaluating a wavefunction's quantities for display: orbitals filled on the GPU (a 3D texture,
+//! read back once for isosurfaces), densities on the CPU, seed 004's direct mode, on grids the
+//! device holds; and the opacity a cloud of the values starts with.
+
+use crate::gpu::gto::{GtoFillPass, read_volume, volume_from_texture};
+use crate::gpu::renderer::Layer;
+use crate::gpu::volume::VolumeTexture;
+use crate::gpu::{GpuContext, GpuError};
+use crate::model::cartesian::CartesianExpansion;
+use crate::model::extent::quantity_box;
+use crate::model::grid::ValueKind;
+use crate::model::gto::{GridSpec, PreparedBasis};
+use crate::model::orbitals::Quantity;
+use crate::model::{Document, VolumeGrid};
+
+/// The grid a wavefunction's `quantity` is evaluated on, `points` per axis: the box where it
+/// decays to 1 % of its largest |value| ([`crate::model::extent::quantity_box`]).
+pub fn orbital_geometry(doc: &Document, quantity: Quantity, points: usize) -> Option<GridSpec> {
+    let (lo, hi) = quantity_box(doc.wavefunction.as_ref()?, &doc.molecule, quantity)?;
+    Some(GridSpec::cube(lo, hi, points))
+}
+
+/// How to show a quantity of a wavefunction.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WavefunctionView {
+    pub quantity: Quantity,
+    /// Seed 004's direct mode (orbitals only): evaluate per slice sample, no grid.
+    pub direct: bool,
+    /// Points per axis of the evaluation grid.
+    pub points: usize,
+    /// Per shell, whether it contributes (the atomic-orbital selector); `None`: all.
+    pub shells: Option<Vec<bool>>,
+}
+
+/// A wavefunction's quantity evaluated for display, ready for a layer. Made by
+/// [`evaluate_wavefunction`], which may run on any thread (the viewer's jobs); shown with
+/// [`Evaluated::show`] on the thread that owns the renderer.
+pub struct Evaluated {
+    /// The values on the evaluation grid: what isosurfaces are cut from and what scales the
+    /// opacity.
+    pub grid: VolumeGrid,
+    cloud: Cloud,
+}
+
+enum Cloud {
+    /// An orbital filled on the GPU, already a texture.
+    Texture(VolumeTexture),
+    /// Seed 004's direct mode: the orbital evaluated per slice sample.
+    Direct(CartesianExpansion, GridSpec),
+    /// Values computed on the CPU (densities), uploaded when shown.
+    Values,
+}
+
+/// Evaluates what `view` asks for of `doc`'s wavefunction: orbitals on the GPU (a filled
+/// texture, read back once for the grid's values), densities on the CPU. `None` when the
+/// document has no wavefunction.
+pub fn evaluate_wavefunction(
+    ctx: &GpuContext,
+    fill: &GtoFillPass,
+    doc: &Document,
+    view: &WavefunctionView,
+) -> Result<Option<Evaluated>, GpuError> {
+    let (Some(wf), Some(geometry)) = (&doc.wavefunction, orbital_geometry(doc, view.quantity, view.points)) else {
+        return Ok(None);
+    };
+    let prepared = PreparedBasis::new(&wf.basis);
+    match view.quantity {
+        Quantity::Orbital(i) => {
+            let mut coefficients = wf.orbitals[i].coefficients.clone();
+            if let Some(mask) = &view.shells {
+                for ((shell, offset), &keep) in wf.basis.shells.iter().zip(wf.basis.shell_offsets()).zip(mask) {
+                    if !keep {
+                        coefficients[offset..offset + shell.n_functions()].fill(0.0);
+                    }
+                }
+            }
+            let expansion = CartesianExpansion::from_coefficients(&prepared, &coefficients);
+            let texture = fill.fill(ctx, &expansion, &geometry)?;
+            // The filled values give the range that scales the opacity (and the gradient scale).
+            let grid = VolumeGrid::new("orbital", geometry.dims, geometry.world_from_grid, read_volume(ctx, &texture)?);
+            let cloud = if view.direct {
+                Cloud::Direct(expansion, geometry)
+            } else {
+                let mut volume = volume_from_texture(texture, &geometry, grid.stats.max_abs);
+                volume.max_grad = grid.max_gradient().max(1e-30) as f32;
+                Cloud::Texture(volume)
+            };
+            Ok(Some(Evaluated { grid, cloud }))
+        }
+        Quantity::Density | Quantity::SpinDensity => {
+            let label = if view.quantity == Quantity::Density { "total density" } else { "spin density" };
+            let values = prepared.quantity_grid_f32(wf, view.quantity, &geometry);
+            let grid = VolumeGrid::new(label, geometry.dims, geometry.world_from_grid, values);
+            Ok(Some(Evaluated { grid, cloud: Cloud::Values }))
+        }
+    }
+}
+
+/// [`evaluate_wavefunction`] on a grid this device holds: `view.points` per side, or fewer when
+/// that many are over `limits` or the device refuses the memory, with a note saying so. Runs
+/// its GPU work in error scopes on the calling thread.
+pub fn evaluate_within(
+    ctx: &GpuContext,
+    fill: &GtoFillPass,
+    doc: &Document,
+    view: &WavefunctionView,
+    limits: &wgpu::Limits,
+) -> Result<(Option<Evaluated>, Option<String>), GpuError> {
+    let requested = view.points;
+    // p³ R32Float values must fit both the 3D texture's side and the memory budget.
+    let mut points = requested;
+    while points > 8 && crate::gpu::volume::fitting_step([points; 3], 4, limits) > 1 {
+        points = points * 7 / 8;
+    }
+    loop {
+        let attempt = WavefunctionView { points, ..view.clone() };
+        match crate::gpu::context::guarded(&ctx.device, || evaluate_wavefunction(ctx, fill, doc, &attempt)) {
+            Err(GpuError::Rejected(_) | GpuError::VolumeTooLarge { .. }) if points > 16 => points = points * 3 / 4,
+            result => {
+                let note = (points < requested).then(|| {
+                    format!(
+                        "{}: {requested} points per side are more than this GPU holds; evaluated on {points}",
+                        doc.source
+                    )
+                });
+                return result.map(|e| (e, note));
+            }
+        }
+    }
+}
+
+impl Evaluated {
+    /// Shows the cloud in `layer`; returns the values on the grid.
+    pub fn show(self, ctx: &GpuContext, layer: &mut Layer) -> Result<VolumeGrid, GpuError> {
+        match self.cloud {
+            Cloud::Texture(volume) => layer.set_volume_texture(ctx, volume),
+            Cloud::Direct(expansion, geometry) => layer.set_direct(ctx, &expansion, &geometry, self.grid.stats.max_abs),
+            Cloud::Values => {
+                layer.set_volume(ctx, Some(&self.grid))?;
+            }
+        }
+        Ok(self.grid)
+    }
+}
+
+/// Sets `volume.k1` from `grid` ([`crate::scene::opacity::auto_k1`]) when `volume.auto_k1`
+/// asks for it: the first picture of any grid has contrast.
+pub fn auto_opacity(volume: &mut crate::scene::VolumeSettings, grid: &VolumeGrid) {
+    if volume.auto_k1 {
+        let signed = grid.kind == ValueKind::Signed;
+        let max = grid.stats.max_abs as f32;
+        volume.k1 =
+            crate::scene::opacity::auto_k1(&grid.values, grid.dims, signed, max, volume.density_scale, volume.k2);
+    }
+}

@@ -1,0 +1,190 @@
+//! Putting a document into the renderer's layers as an object's state says: its atoms (style,
+//! colours, the atoms a selection shows), each quantity in a layer of its own (a data set, or an
+//! orbital or density evaluated), their isosurfaces, placement and visibility.
+
+use crate::evaluate::{WavefunctionView, auto_opacity, evaluate_wavefunction};
+use crate::gpu::gto::GtoFillPass;
+use crate::gpu::renderer::Layer;
+use crate::gpu::{GpuContext, GpuError, Renderer};
+use crate::meshes::isosurfaces;
+use crate::model::isosurface::Mesh;
+use crate::model::{Document, VolumeGrid};
+use crate::scene::coloring::{AtomColors, atom_colors};
+use crate::scene::objects::{Part, layer_parts};
+use crate::scene::selection::shown_atoms;
+use crate::scene::translucency::SurfaceLook;
+use crate::scene::{AtomLook, Evaluation, IsosurfaceSettings, ObjectState, Source};
+
+/// Puts a wavefunction's orbital or density into `layer` ([`evaluate_wavefunction`], then
+/// [`Evaluated::show`]). `fill` caches the compute pipeline between calls. Returns the values on
+/// the grid (what isosurfaces are cut from), or `None` when the document has no wavefunction.
+pub fn show_wavefunction(
+    ctx: &GpuContext,
+    layer: &mut Layer,
+    fill: &mut Option<GtoFillPass>,
+    doc: &Document,
+    view: &WavefunctionView,
+) -> Result<Option<VolumeGrid>, GpuError> {
+    let fill = fill.get_or_insert_with(|| GtoFillPass::new(ctx));
+    evaluate_wavefunction(ctx, fill, doc, view)?.map(|e| e.show(ctx, layer)).transpose()
+}
+
+/// Extracts the isosurfaces of `grid` and shows them in `layer` (none when `iso` is hidden).
+/// Returns the number of triangles.
+pub fn show_isosurfaces(ctx: &GpuContext, layer: &mut Layer, grid: &VolumeGrid, iso: &IsosurfaceSettings) -> usize {
+    show_meshes(ctx, layer, &isosurfaces(grid, iso))
+}
+
+/// Shows `meshes`, each in its colour, as the layer's isosurfaces; returns the triangle count.
+pub fn show_meshes(ctx: &GpuContext, layer: &mut Layer, meshes: &[(Mesh, SurfaceLook)]) -> usize {
+    layer.surfaces.set_meshes(ctx, meshes);
+    meshes.iter().map(|(m, _)| m.triangle_count()).sum()
+}
+
+/// What to tell the user when a grid of `dims` is shown at every `step`-th point.
+pub fn coarser_note(what: &str, dims: [usize; 3], step: usize) -> String {
+    let coarse = dims.map(|d| d.div_ceil(step));
+    format!(
+        "{what}: the grid of {}×{}×{} points is more than this GPU holds; shown with one point in {step} along each axis ({}×{}×{})",
+        dims[0], dims[1], dims[2], coarse[0], coarse[1], coarse[2]
+    )
+}
+
+/// Puts `doc`'s atoms into `layer` as `look` says, those `selection` leaves out hidden.
+pub fn show_atoms(ctx: &GpuContext, layer: &mut Layer, doc: &Document, look: &AtomLook, selection: &str) {
+    layer.set_atoms(ctx, &doc.molecule, look.style, Some(&atom_look(doc, look, selection)));
+    layer.atoms.depth_cue = look.depth_cue;
+}
+
+/// The colours of `doc`'s atoms, and which are shown: all when `selection` does not parse (the
+/// panel says why).
+pub fn atom_look(doc: &Document, look: &AtomLook, selection: &str) -> AtomColors {
+    let mut colors = atom_colors(&doc.molecule, doc.structure.as_ref(), look.colors);
+    if let Some(mask) = shown_atoms(doc, selection) {
+        colors.shown = mask;
+    }
+    colors
+}
+
+/// Puts `doc`'s atoms into `layer` as `state` shows them, with its placement and visibility;
+/// the layer's cloud and surfaces are emptied (an object's atoms layer: its molecular surface
+/// is added when built, its quantities have layers of their own).
+pub fn show_object_atoms(ctx: &GpuContext, layer: &mut Layer, doc: &Document, state: &ObjectState) {
+    show_atoms(ctx, layer, doc, &state.atoms, &state.selection);
+    layer.volume.set_texture(ctx, None);
+    layer.surfaces.clear();
+    place_layer(layer, state, Part::Atoms);
+}
+
+/// Gives `layer`, which draws `part` of the object `state` describes, the object's placement
+/// and whether it is drawn (the object's visibility, and the quantity's).
+pub fn place_layer(layer: &mut Layer, state: &ObjectState, part: Part) {
+    layer.world_from_object = state.placement.world_from_object();
+    layer.visible = state.visible
+        && match part {
+            Part::Atoms => true,
+            Part::Quantity(k) => state.quantities.get(k).is_some_and(|q| q.visible),
+        };
+}
+
+/// Puts one layer's worth of `doc` into `layer` as `state` shows it: the atoms, and the
+/// selected quantity when it is one of the document's data sets, with its isosurfaces. For
+/// hosts that draw an object in one layer (tests, single-file renders); the window and
+/// [`show_scene`] give each quantity a layer of its own. Returns the isosurfaces' triangle count.
+pub fn show_object(
+    ctx: &GpuContext,
+    layer: &mut Layer,
+    doc: &Document,
+    state: &ObjectState,
+) -> Result<usize, GpuError> {
+    show_object_atoms(ctx, layer, doc, state);
+    let quantity = state.selected_quantity();
+    let grid = quantity.and_then(|q| match q.source {
+        Source::Volume(i) => doc.volumes.get(i),
+        Source::Wavefunction(_) => None,
+    });
+    layer.set_volume(ctx, grid)?;
+    let meshes: Vec<_> = match (grid, quantity) {
+        (Some(grid), Some(q)) => q.isosurfaces.iter().flat_map(|iso| isosurfaces(grid, iso)).collect(),
+        _ => Vec::new(),
+    };
+    Ok(show_meshes(ctx, layer, &meshes))
+}
+
+/// Puts quantity `k` of the object `state` describes into `layer`: a data set of `doc` as it
+/// is, or its wavefunction's orbital or density evaluated on a grid of `points` per side
+/// (`fill` caches the compute pipeline), then its isosurfaces. Returns the values shown (what
+/// the cloud's opacity is scaled to), `None` when `doc` does not hold the quantity.
+pub fn show_quantity(
+    ctx: &GpuContext,
+    layer: &mut Layer,
+    fill: &mut Option<GtoFillPass>,
+    doc: &Document,
+    state: &ObjectState,
+    k: usize,
+) -> Result<Option<VolumeGrid>, GpuError> {
+    layer.clear(ctx);
+    place_layer(layer, state, Part::Quantity(k));
+    let Some(q) = state.quantities.get(k) else { return Ok(None) };
+    let grid = match q.source {
+        Source::Volume(i) => {
+            let grid = doc.volumes.get(i).cloned();
+            layer.set_volume(ctx, grid.as_ref())?;
+            grid
+        }
+        Source::Wavefunction(quantity) => {
+            let e = &state.evaluation;
+            let view = WavefunctionView { quantity, direct: e.direct, points: e.grid_points, shells: e.shells() };
+            show_wavefunction(ctx, layer, fill, doc, &view)?
+        }
+    };
+    if let Some(grid) = &grid {
+        let meshes: Vec<_> = q.isosurfaces.iter().flat_map(|iso| isosurfaces(grid, iso)).collect();
+        show_meshes(ctx, layer, &meshes);
+    }
+    Ok(grid)
+}
+
+/// Each layer's cloud settings, and the scene's bounds (bohr).
+pub type ShownScene = (Vec<crate::scene::VolumeSettings>, Option<(glam::DVec3, glam::DVec3)>);
+
+/// Puts each object of `scene` into `renderer`, its layers as [`layer_parts`] orders them (its
+/// atoms, then each quantity: a data set, or its wavefunction's orbital or density evaluated on
+/// a grid of `points` per side, with every isosurface of it). Returns each layer's cloud
+/// settings (opacity scaled to its grid) and the scene's bounds.
+pub fn show_scene<D: std::borrow::Borrow<Document>>(
+    ctx: &GpuContext,
+    renderer: &mut Renderer,
+    scene: &[(D, ObjectState)],
+    points: usize,
+) -> Result<ShownScene, GpuError> {
+    let mut fill = None;
+    let mut clouds = Vec::new();
+    let mut bounds: Option<(glam::DVec3, glam::DVec3)> = None;
+    let parts = layer_parts(scene.iter().map(|(_, s)| s));
+    renderer.truncate(parts.len());
+    for (n, &(object, part)) in parts.iter().enumerate() {
+        let (doc, state) = (scene[object].0.borrow(), &scene[object].1);
+        let layer = renderer.layer_mut(ctx, n);
+        match part {
+            Part::Atoms => {
+                show_object_atoms(ctx, layer, doc, state);
+                clouds.push(crate::scene::VolumeSettings { visible: false, ..Default::default() });
+                if let Some((lo, hi)) = doc.bounds() {
+                    bounds = Some(bounds.map_or((lo, hi), |(l, h)| (l.min(lo), h.max(hi))));
+                }
+            }
+            Part::Quantity(k) => {
+                let evaluation = Evaluation { grid_points: points, ..state.evaluation.clone() };
+                let state = ObjectState { evaluation, ..state.clone() };
+                let grid = show_quantity(ctx, layer, &mut fill, doc, &state, k)?;
+                let mut cloud = state.quantities[k].cloud;
+                if let Some(grid) = &grid {
+                    auto_opacity(&mut cloud, grid);
+                }
+                clouds.push(cloud);
+            }
+        }
+    }
+    Ok((clouds, bounds))
+}

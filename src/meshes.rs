@@ -1,0 +1,143 @@
+//! Building the surfaces a layer draws: isosurfaces of a grid (both signs of an orbital, a
+//! density's shells) within a GPU buffer's size, and a document's molecular surface, coloured
+//! by atoms or by a grid's values.
+
+use std::sync::atomic::{AtomicBool, AtomicU32};
+
+use crate::model::grid::ValueKind;
+use crate::model::isosurface::{self, Level, Mesh};
+use crate::model::surface::{self, Sphere, SurfaceError};
+use crate::model::units::ANGSTROM_PER_BOHR;
+use crate::model::{Document, VolumeGrid};
+use crate::scene::coloring::atom_colors;
+use crate::scene::selection::shown_atoms;
+use crate::scene::translucency::SurfaceLook;
+use crate::scene::{IsosurfaceSettings, SurfaceSettings};
+
+/// The isosurfaces `iso` asks for on `grid`, each with its colour: ψ = +v and ψ = −v for a
+/// signed grid, ρ = v for a density. Empty when `iso` is hidden.
+pub fn isosurfaces(grid: &VolumeGrid, iso: &IsosurfaceSettings) -> Vec<(Mesh, SurfaceLook)> {
+    if !iso.visible {
+        return Vec::new();
+    }
+    let signed = grid.kind == ValueKind::Signed;
+    let levels = Level::pair(iso.level.value(grid.stats.sigma), signed);
+    let colors = if signed { vec![iso.positive_color, iso.negative_color] } else { vec![iso.density_color] };
+    isosurface::extract(grid, &levels).into_iter().zip(colors.into_iter().map(|c| iso.look(c))).collect()
+}
+
+/// Isosurfaces of `grid` at every level of `levels` (each as [`isosurfaces`] cuts it), every
+/// mesh's vertex and index data within `max_bytes` (a GPU buffer's limit): when the whole
+/// grid's meshes would not fit, they are cut from every 2nd, 4th, … point, with a note.
+pub fn isosurfaces_within(
+    grid: &VolumeGrid,
+    levels: &[IsosurfaceSettings],
+    max_bytes: u64,
+) -> (Vec<(Mesh, SurfaceLook)>, Option<String>) {
+    let mut step = 1;
+    loop {
+        let coarse = (step > 1).then(|| grid.subsampled(step));
+        let g = coarse.as_ref().unwrap_or(grid);
+        let meshes: Vec<_> = levels.iter().flat_map(|iso| isosurfaces(g, iso)).collect();
+        let fits = meshes.iter().all(|(m, _)| mesh_fits(m, max_bytes));
+        if fits || step >= 64 {
+            let note = (step > 1).then(|| {
+                format!("isosurfaces cut from one point in {step} along each axis: the whole grid's are more than a GPU buffer holds")
+            });
+            return (meshes, note);
+        }
+        step *= 2;
+    }
+}
+
+/// Whether a mesh fits the GPU buffers of `max_bytes` (24-byte vertices, 4-byte indices).
+fn mesh_fits(m: &Mesh, max_bytes: u64) -> bool {
+    (m.positions.len() as u64 * 24).max(m.indices.len() as u64 * 4) <= max_bytes
+}
+
+/// `doc`'s molecular surface as `s` asks (`None` when it is off), built around the atoms
+/// `selection` shows (all when it is empty or does not parse); built again at twice the
+/// spacing, with a note saying so, while its mesh would not fit a GPU buffer of `max_bytes`.
+/// `cancel` stops it between grid planes; `progress` gets the thousandths built.
+pub fn molecular_surface(
+    doc: &Document,
+    s: &SurfaceSettings,
+    selection: &str,
+    max_bytes: u64,
+    (cancel, progress): (&AtomicBool, &AtomicU32),
+) -> Result<Option<(Mesh, Option<String>)>, SurfaceError> {
+    let mask = shown_atoms(doc, selection);
+    let spheres = Sphere::of_molecule(&doc.molecule, mask.as_deref());
+    let Some(mut params) = s.params(&spheres) else { return Ok(None) };
+    let asked = params.resolution;
+    loop {
+        let built = surface::build_reporting(&spheres, &params, cancel, progress)?;
+        if mesh_fits(&built.mesh, max_bytes) || params.resolution >= 16.0 * asked {
+            let note = (params.resolution > asked).then(|| {
+                format!(
+                    "molecular surface built at {:.2} Å: at {:.2} Å its mesh is more than a GPU buffer holds",
+                    params.resolution * ANGSTROM_PER_BOHR,
+                    asked * ANGSTROM_PER_BOHR
+                )
+            });
+            return Ok(Some((built.mesh, note)));
+        }
+        params.resolution *= 2.0;
+    }
+}
+
+/// Colours `mesh`, `doc`'s molecular surface built around the atoms `selection` shows, by the
+/// atom nearest each vertex as `s.color_by` says (no colours when it says none).
+/// With `s.color_by_volume`, the colours are `grid`'s values instead ([`color_by_values`]).
+pub fn color_surface(mesh: &mut Mesh, doc: &Document, s: &SurfaceSettings, selection: &str, grid: Option<&VolumeGrid>) {
+    mesh.colors.clear();
+    if s.color_by_volume {
+        if let Some(grid) = grid {
+            mesh.colors = color_by_values(&mesh.positions, grid);
+        }
+        return;
+    }
+    let Some(coloring) = s.color_by else { return };
+    let mask = shown_atoms(doc, selection);
+    let (spheres, atoms) = Sphere::of_atoms(&doc.molecule, mask.as_deref());
+    let colors = atom_colors(&doc.molecule, doc.structure.as_ref(), coloring);
+    let reach = s.probe as f64 * crate::model::units::BOHR_PER_ANGSTROM + 2.0;
+    let nearest = surface::nearest_spheres(&spheres, &mesh.positions, reach);
+    mesh.colors = nearest
+        .iter()
+        .map(|&n| match atoms.get(n as usize).and_then(|&a| colors.index.get(a as usize)) {
+            Some(&i) => crate::scene::coloring::linear(colors.palette[i as usize]),
+            None => s.color,
+        })
+        .collect();
+}
+
+/// Linear RGB for `grid`'s value at each point: negative red, zero white, positive blue (the
+/// convention of electrostatic potentials on surfaces), scaled to the 98th percentile of |value|
+/// over the points; grey where a point lies outside the grid.
+pub fn color_by_values(points: &[glam::Vec3], grid: &VolumeGrid) -> Vec<[f32; 3]> {
+    let grid_from_world = grid.world_from_grid.inverse();
+    let values: Vec<Option<f64>> = points
+        .iter()
+        .map(|p| {
+            let g = grid_from_world.transform_point3(p.as_dvec3());
+            let inside = (0..3).all(|a| g[a] >= -1e-9 && g[a] <= (grid.dims[a].max(1) - 1) as f64 + 1e-9);
+            inside.then(|| grid.sample(g))
+        })
+        .collect();
+    let mut magnitudes: Vec<f64> = values.iter().flatten().map(|v| v.abs()).collect();
+    magnitudes.sort_by(f64::total_cmp);
+    let scale = magnitudes.get(magnitudes.len() * 98 / 100).copied().unwrap_or(0.0).max(1e-30);
+    let (red, blue) = ([0.85, 0.08, 0.06], [0.06, 0.2, 0.85]);
+    values
+        .iter()
+        .map(|v| match v {
+            None => [0.5; 3],
+            Some(v) => {
+                let t = (v / scale).clamp(-1.0, 1.0) as f32;
+                let end = if t < 0.0 { red } else { blue };
+                std::array::from_fn(|k| 1.0 + (end[k] - 1.0) * t.abs())
+            }
+        })
+        .collect()
+}
