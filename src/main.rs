@@ -160,7 +160,7 @@ enum SpinArg {
 struct WavefunctionArgs {
     #[command(flatten)]
     what: WhatArgs,
-    /// Evaluate the orbital per slice sample from the basis functions (Jang & Varetto's direct mode)
+    /// Evaluate the orbital per slice sample from the basis functions (direct mode)
     /// instead of on a GPU-filled grid.
     #[arg(long)]
     direct: bool,
@@ -294,7 +294,7 @@ enum BenchCommand {
         #[command(flatten)]
         wavefunction: WavefunctionArgs,
     },
-    /// Frame time against the number of resident key volumes K of a scan (Naka et al.'s Fig. 6).
+    /// Frame time against the number of resident key volumes K of a scan.
     Keyvolumes(scan_cli::KeyVolumeBench),
     /// ms to extract an isosurface (both signs of an orbital) from a grid.
     Isosurface(surface_cli::IsoBench),
@@ -342,7 +342,7 @@ struct RenderArgs {
 enum ModeArg {
     /// Slices perpendicular to the view direction.
     View,
-    /// Naka et al.'s three axis-aligned stacks.
+    /// Three stacks of slices along the grid's axes, the one facing the viewer drawn.
     Axis,
 }
 
@@ -425,7 +425,7 @@ struct ViewArgs {
     /// Hide the volume (atoms only).
     #[arg(long)]
     no_volume: bool,
-    /// Transfer function: Naka et al.'s power law, or one of Jang & Varetto's shapes (both signs).
+    /// Transfer function: the power law α = k1·ρ^k2, or a shape of value (both signs).
     #[arg(long, value_enum, default_value_t = TfArg::Power)]
     tf: TfArg,
     /// Shape centre (iso-value), a fraction of max|value|.

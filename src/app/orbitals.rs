@@ -114,9 +114,8 @@ pub fn panel(
             ui.selectable_value(&mut e.direct, false, "on a GPU grid").on_hover_text(
                 "a compute pass fills a 3D texture; the slices sample it (fast to view, switch in one pass)",
             );
-            ui.selectable_value(&mut e.direct, true, "per sample (direct)").on_hover_text(
-                "every slice fragment evaluates the orbital from the basis functions, no grid (Jang & Varetto)",
-            );
+            ui.selectable_value(&mut e.direct, true, "per sample (direct)")
+                .on_hover_text("every slice fragment evaluates the orbital from the basis functions, no grid");
         });
         if let Some(p) = keyboard(ui, wf, state.evaluation.spin, shown) {
             pick = Some(p);

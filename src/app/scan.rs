@@ -251,8 +251,9 @@ pub fn controls(ui: &mut egui::Ui, scan: &mut ScanView) -> Option<Follow> {
         ui.horizontal(|ui| {
             ui.radio_value(&mut scan.mode, Interpolation::Exact, "exact")
                 .on_hover_text("mix the two key volumes per sample");
-            ui.radio_value(&mut scan.mode, Interpolation::ThreePass, "three-pass")
-                .on_hover_text("Naka et al.'s three blending passes: attenuate, add (1−k)A, add kB per slice");
+            ui.radio_value(&mut scan.mode, Interpolation::ThreePass, "three-pass").on_hover_text(
+                "the real-time approximation: three blending passes per slice (attenuate, add (1−k)A, add kB)",
+            );
             let mut by_overlap = scan.scene.tracks.follow == Follow::Overlap;
             let swaps = scan.scene.tracks.swaps.len();
             if ui

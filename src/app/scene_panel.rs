@@ -153,7 +153,7 @@ fn surface_editor(ui: &mut egui::Ui, s: &mut SurfaceSettings) -> bool {
             })
             .response
             .labelled_by(label.id)
-            .on_hover_text("Gaussian: the atoms' blended density (VMD's QuickSurf); solvent-excluded: where a probe cannot reach (Connolly's)");
+            .on_hover_text("Gaussian: the atoms' blended density (VMD's QuickSurf); solvent-excluded: where a probe sphere rolled over the atoms cannot reach");
         if s.choice != SurfaceChoice::Off && s.color_by.is_none() && !s.color_by_volume {
             ui.color_edit_button_rgb(&mut s.color);
         }
@@ -193,7 +193,7 @@ fn surface_editor(ui: &mut egui::Ui, s: &mut SurfaceSettings) -> bool {
         if !s.translucent {
             ui.horizontal(|ui| {
                 ui.add(DragValue::new(&mut s.lod_px).speed(0.1).range(0.0..=30.0).prefix("points under ").suffix(" px"))
-                    .on_hover_text("seed 002's level of detail: parts smaller than this on screen are drawn as points (0: every triangle); larger while you drag, to keep the view moving");
+                    .on_hover_text("level of detail: parts smaller than this on screen are drawn as points (0: every triangle); larger while you drag, to keep the view moving");
             });
         }
         ui.horizontal(|ui| {

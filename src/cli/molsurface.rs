@@ -18,7 +18,8 @@ use orbcloud::scene::{AtomColoring, SurfaceChoice, SurfaceSettings};
 pub enum SurfaceArg {
     /// Gaussian density of the atoms (VMD's QuickSurf, Mol*'s default).
     Gaussian,
-    /// Solvent-excluded surface (Connolly's), for a probe of radius --probe.
+    /// Solvent-excluded surface: where a probe of radius --probe rolled over the atoms cannot
+    /// reach.
     Ses,
 }
 
@@ -68,7 +69,7 @@ pub struct MolSurfaceArgs {
     /// residue, B-factor or secondary structure.
     #[arg(long, value_enum, default_value_t = SurfaceColorArg::Uniform)]
     pub surface_color: SurfaceColorArg,
-    /// Seed 002's level of detail: parts smaller than this many pixels are drawn as points
+    /// Level of detail: parts smaller than this many pixels are drawn as points
     /// (0: every triangle).
     #[arg(long, default_value_t = SurfaceSettings::LOD_PX)]
     pub lod_px: f32,

@@ -71,7 +71,8 @@ pub enum FollowArg {
 pub enum InterpolationArg {
     /// Both key volumes mixed per sample (the interpolated orbital).
     Exact,
-    /// Naka et al.'s three blending passes per slice.
+    /// The real-time approximation: three blending passes per slice (attenuate, add (1−k)A,
+    /// add kB).
     ThreePass,
 }
 

@@ -31,11 +31,12 @@ pub struct IsoArgs {
     /// Isosurface at S standard deviations of the grid's values; repeatable.
     #[arg(long = "iso-sigma")]
     pub sigmas: Vec<f32>,
-    /// Draw the isosurfaces translucent (seed 003's optics, composited in exact depth order).
+    /// Draw the isosurfaces translucent (each shining and letting light through, composited in
+    /// exact depth order; where one lies inside another object's surface it glows).
     #[arg(long)]
     pub translucent: bool,
     /// The look of translucent surfaces.
-    #[arg(long, value_enum, default_value_t = OpticsArg::Koide)]
+    #[arg(long, value_enum, default_value_t = OpticsArg::Tinted)]
     pub optics: OpticsArg,
     /// Multiply a coefficient of the preset (a, b, c, n, d, f, g, glow_d, glow_f, glow_g) by
     /// R,G,B factors or one factor, e.g. `g=0.5` or `d=1,0.5,0.5`; repeatable.
@@ -64,9 +65,10 @@ fn parse_tuning(s: &str) -> Result<(String, Vec<f32>), String> {
 
 #[derive(Clone, Copy, Default, ValueEnum)]
 pub enum OpticsArg {
-    /// Seed 003's pictures: tinted glass with an emitting rim; overlaps glow.
+    /// Tinted glass with an emitting rim; overlaps glow.
     #[default]
-    Koide,
+    #[value(alias = "koide")]
+    Tinted,
     /// Clear glass with strong highlights.
     Glassy,
     /// Emitting, absorbing smoke.
@@ -76,7 +78,7 @@ pub enum OpticsArg {
 impl OpticsArg {
     pub fn preset(self) -> OpticsPreset {
         match self {
-            OpticsArg::Koide => OpticsPreset::Koide,
+            OpticsArg::Tinted => OpticsPreset::Koide,
             OpticsArg::Glassy => OpticsPreset::Glassy,
             OpticsArg::Smoke => OpticsPreset::Smoke,
         }

@@ -139,7 +139,7 @@ impl Transfer {
 /// Colour presets for the two signs (linear RGB).
 pub const PRESETS: &[(&str, [f32; 3], [f32; 3])] = &[
     ("red / blue", [0.90, 0.12, 0.10], [0.10, 0.30, 0.95]),
-    ("red / white (Naka et al.)", [0.90, 0.10, 0.08], [0.85, 0.85, 0.85]),
+    ("red / white", [0.90, 0.10, 0.08], [0.85, 0.85, 0.85]),
     ("orange / teal", [0.95, 0.45, 0.05], [0.05, 0.55, 0.60]),
     ("gold / purple", [0.85, 0.65, 0.10], [0.45, 0.15, 0.75]),
     ("green / magenta", [0.15, 0.70, 0.20], [0.75, 0.10, 0.60]),

@@ -49,7 +49,7 @@ impl OpticsPreset {
 
     pub fn label(self) -> &'static str {
         match self {
-            OpticsPreset::Koide => "Koide",
+            OpticsPreset::Koide => "tinted glass",
             OpticsPreset::Glassy => "glassy",
             OpticsPreset::Smoke => "smoke",
         }
