@@ -63,8 +63,9 @@ macro_rules! mirror {
 #[test]
 fn rust_mirrors_match_the_wgsl_layouts() {
     use orbcloud::gpu::{
-        atoms::AtomGlobals, gto::FillParams, gto::GpuShell, isosurface::SurfaceUniforms, occlusion::CullUniforms,
-        occlusion::GpuBatch, occlusion::PyramidSize, oit::GpuOptics, oit::ListInfo, volume::VolumeUniforms,
+        atoms::AtomGlobals, basis_buffers::GpuShell, gto::FillParams, isosurface::SurfaceUniforms,
+        occlusion::CullUniforms, occlusion::GpuBatch, occlusion::PyramidSize, oit::GpuOptics, oit::ListInfo,
+        volume::VolumeUniforms,
     };
     let mirrors = [
         mirror!(

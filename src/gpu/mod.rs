@@ -5,6 +5,7 @@
 //! reads files or knows about the UI.
 
 pub mod atoms;
+pub mod basis_buffers;
 pub mod context;
 pub mod frame;
 pub mod gto;

@@ -7,7 +7,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::{DMat4, DVec3, Mat4, Vec3, Vec4};
 use wgpu::util::DeviceExt;
 
-use super::gto::{GtoArrays, GtoBuffers, gto_layout};
+use super::basis_buffers::{GtoArrays, GtoBuffers, gto_layout};
 use super::{DEPTH_FORMAT, GpuContext, GpuError, SCENE_FORMAT};
 use crate::model::GridSpec;
 use crate::model::cartesian::CartesianExpansion;

@@ -2,7 +2,7 @@
 
 use glam::DVec3;
 
-use super::molecule::{Atom, Bond};
+use super::atom::{Atom, Bond};
 use super::neighbours::for_each_near_pair;
 use super::units::BOHR_PER_ANGSTROM;
 
