@@ -5,35 +5,34 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use glam::DVec3;
 use orbcloud::evaluate::WavefunctionView;
-use orbcloud::formats::cube_write;
 use orbcloud::gpu::{AdapterPreference, GpuContext};
 use orbcloud::headless::Headless;
 use orbcloud::layers::show_wavefunction;
 use orbcloud::model::Document;
-use orbcloud::model::GridSpec;
 use orbcloud::model::VolumeGrid;
-use orbcloud::model::gto::PreparedBasis;
 use orbcloud::model::orbitals::{OrbitalSpec, Quantity, Spin, Wavefunction};
 use orbcloud::scene::framing::camera_for;
 use orbcloud::scene::transfer::PRESETS;
 use orbcloud::scene::{
     AtomColoring, AtomStyle, Camera, ClipPlane, RenderSettings, Shape, SliceMode, TransferKind, ViewPreset,
 };
-use orbcloud::{demo, formats, info};
-use rayon::prelude::*;
+use orbcloud::{demo, formats};
 
 #[path = "cli/molsurface.rs"]
 mod molsurface_cli;
 #[path = "cli/quantities.rs"]
 mod quantities_cli;
+#[path = "cli/render.rs"]
+mod render_cli;
 #[path = "cli/scan.rs"]
 mod scan_cli;
 #[path = "cli/structure.rs"]
 mod structure_cli;
 #[path = "cli/surface.rs"]
 mod surface_cli;
+#[path = "cli/values.rs"]
+mod values_cli;
 
 #[derive(Parser)]
 #[command(name = "orbcloud", version, about = "Molecular orbitals and densities as GPU-rendered clouds")]
@@ -251,30 +250,6 @@ fn wavefunction_of(doc: &Document) -> Result<&Wavefunction> {
     doc.wavefunction.as_ref().ok_or_else(|| {
         anyhow::anyhow!("{} holds no basis set or orbitals (a Molden or fchk file is needed)", doc.source)
     })
-}
-
-fn read_points(path: &Path) -> Result<Vec<DVec3>> {
-    let text = if path.as_os_str() == "-" {
-        std::io::read_to_string(std::io::stdin())?
-    } else {
-        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?
-    };
-    let mut points = Vec::new();
-    for (n, line) in text.lines().enumerate() {
-        let line = line.trim();
-        if line.is_empty() || line.starts_with('#') {
-            continue;
-        }
-        let v: Vec<f64> =
-            line.split_whitespace().take(3).map(str::parse).collect::<Result<_, _>>().map_err(|_| {
-                anyhow::anyhow!("{}:{}: expected `x y z` in bohr, found {line:?}", path.display(), n + 1)
-            })?;
-        if v.len() < 3 || v.iter().any(|x| !x.is_finite()) {
-            bail!("{}:{}: expected `x y z` in bohr, found {line:?}", path.display(), n + 1);
-        }
-        points.push(DVec3::new(v[0], v[1], v[2]));
-    }
-    Ok(points)
 }
 
 #[derive(Subcommand)]
@@ -591,55 +566,6 @@ struct BenchFrames {
     lavapipe: bool,
 }
 
-/// ms per frame drawing `camera`'s view at `size`, turning a little each frame, after two
-/// warm-up frames; sorted.
-fn time_frames(
-    ctx: &GpuContext,
-    renderer: &mut orbcloud::gpu::Renderer,
-    camera: &Camera,
-    size: [u32; 2],
-    frames: u32,
-) -> Result<Vec<f64>> {
-    Ok(time_frames_of(ctx, &mut [renderer], camera, size, frames)?.remove(0))
-}
-
-/// [`time_frames`] for several renderers taking turns frame by frame, so that a machine whose
-/// speed drifts slows them alike: one sorted list per renderer.
-fn time_frames_of(
-    ctx: &GpuContext,
-    renderers: &mut [&mut orbcloud::gpu::Renderer],
-    camera: &Camera,
-    size: [u32; 2],
-    frames: u32,
-) -> Result<Vec<Vec<f64>>> {
-    let target = orbcloud::gpu::OffscreenTarget::new(&ctx.device, size);
-    let settings = RenderSettings::default();
-    let mut times = vec![Vec::new(); renderers.len()];
-    for f in 0..frames.max(1) + 2 {
-        let mut cam = *camera;
-        cam.orbit(0.02 * f as f32, 0.01 * f as f32);
-        for (renderer, times) in renderers.iter_mut().zip(&mut times) {
-            let t = Instant::now();
-            let mut encoder = ctx.device.create_command_encoder(&Default::default());
-            renderer.render(
-                ctx,
-                &mut encoder,
-                &target.color_view,
-                &orbcloud::gpu::FrameInput::single(&cam, &settings, size),
-            );
-            ctx.queue.submit([encoder.finish()]);
-            ctx.device.poll(wgpu::PollType::wait_indefinitely())?;
-            if f >= 2 {
-                times.push(t.elapsed().as_secs_f64() * 1e3);
-            }
-        }
-    }
-    for t in &mut times {
-        t.sort_by(f64::total_cmp);
-    }
-    Ok(times)
-}
-
 fn gpu(lavapipe: bool) -> Result<GpuContext> {
     let pref = if lavapipe { AdapterPreference::LavapipeOnly } else { AdapterPreference::HighPerformance };
     Ok(GpuContext::headless(pref)?)
@@ -653,123 +579,11 @@ fn main() -> Result<()> {
     match cli.command {
         None => Ok(orbcloud::app::run(cli.files, cli.demo.map(DemoArg::demo))?),
         Some(Command::Viewer { files, demo }) => Ok(orbcloud::app::run(files, demo.map(DemoArg::demo))?),
-        Some(Command::Render(args)) if matches!(args.demo, Some(DemoArg::Cycloaddition)) => {
-            let ctx = gpu(args.lavapipe)?;
-            let scene = demo::cycloaddition().context("the bundled demo did not load")?;
-            let img = surface_cli::render_scene(&ctx, scene, &args.iso, args.view.size)?;
-            img.save(&args.output).with_context(|| format!("writing {}", args.output.display()))?;
-            eprintln!("wrote {} ({}x{}, {})", args.output.display(), img.width(), img.height(), ctx.describe());
-            Ok(())
-        }
-        Some(Command::Render(args)) => {
-            if matches!(args.demo, Some(DemoArg::Scan)) {
-                bail!("the scan demo renders with `orbcloud scan render`");
-            }
-            let doc = load(args.file.as_deref())?;
-            // Arguments that depend on the file are checked before any GPU work.
-            let camera = args.view.camera(&doc)?;
-            let volume = args.view.volume_index(&doc)?;
-            if !later.is_empty() {
-                let later = quantities_cli::parse_later(&later)?;
-                if args.pick.is_some() {
-                    bail!("--pick reads one quantity's picture: give one quantity option");
-                }
-                let ctx = gpu(args.lavapipe)?;
-                let img = quantities_cli::render(&ctx, doc, &args, &later, &camera)?;
-                img.save(&args.output).with_context(|| format!("writing {}", args.output.display()))?;
-                eprintln!("wrote {} ({}x{}, {})", args.output.display(), img.width(), img.height(), ctx.describe());
-                return Ok(());
-            }
-            let ctx = gpu(args.lavapipe)?;
-            let mut settings = args.view.settings();
-            let mut h = Headless::new(&ctx, &doc, volume, &settings, args.view.size)?;
-            let computed = args.wavefunction.apply(&ctx, &mut h, &doc)?.map(|(_, g)| g);
-            let grid = computed.as_ref().or(volume.and_then(|i| doc.volumes.get(i)));
-            if let Some(grid) = grid {
-                orbcloud::evaluate::auto_opacity(&mut settings.volume, grid);
-            }
-            let molsurface = args.molsurface.mesh(&doc, args.iso.translucent, grid)?;
-            surface_cli::show(&ctx, &mut h.renderer, grid, &args.iso, molsurface);
-            let img = h.render(&ctx, &camera, &settings)?;
-            img.save(&args.output).with_context(|| format!("writing {}", args.output.display()))?;
-            eprintln!("wrote {} ({}x{}, {})", args.output.display(), img.width(), img.height(), ctx.describe());
-            if let Some(pixel) = args.pick {
-                surface_cli::print_pick(&ctx, &h.renderer, &doc, pixel)?;
-            }
-            Ok(())
-        }
-        Some(Command::Info { file, json }) => {
-            let doc = formats::load(&file)?;
-            if json {
-                println!("{}", serde_json::to_string_pretty(&info::describe(&doc))?);
-            } else {
-                print!("{}", info::text(&doc));
-            }
-            Ok(())
-        }
-        Some(Command::Eval { file, what, points }) => {
-            let doc = formats::load(&file)?;
-            let wf = wavefunction_of(&doc)?;
-            let q = what.resolve(wf)?;
-            let prepared = PreparedBasis::new(&wf.basis);
-            let points = read_points(&points)?;
-            let values: Vec<f64> = points
-                .par_iter()
-                .map(|&p| match q {
-                    Quantity::Orbital(i) => prepared.orbital_value(&wf.orbitals[i].coefficients, p),
-                    Quantity::Density => prepared.density(wf, p),
-                    Quantity::SpinDensity => prepared.spin_density(wf, p),
-                })
-                .collect();
-            let mut out = std::io::BufWriter::new(std::io::stdout().lock());
-            use std::io::Write;
-            for (p, v) in points.iter().zip(values) {
-                writeln!(out, "{:.10} {:.10} {:.10} {:.15e}", p.x, p.y, p.z, v)?;
-            }
-            Ok(())
-        }
+        Some(Command::Render(args)) => render_cli::render(args, &later),
+        Some(Command::Info { file, json }) => values_cli::info(&file, json),
+        Some(Command::Eval { file, what, points }) => values_cli::eval(&file, &what, &points),
         Some(Command::Cube { file, what, grid, spacing, margin, output }) => {
-            let doc = formats::load(&file)?;
-            let wf = wavefunction_of(&doc)?;
-            let q = what.resolve(wf)?;
-            let (lo, hi) = match margin {
-                Some(m) => doc.molecule.bounds().map(|(lo, hi)| (lo - DVec3::splat(m), hi + DVec3::splat(m))),
-                None => orbcloud::model::extent::quantity_box(wf, &doc.molecule, q),
-            }
-            .ok_or_else(|| anyhow::anyhow!("{}: no atoms", doc.source))?;
-            let spec = match spacing {
-                Some(h) if h > 0.0 => GridSpec::spaced(lo, hi, h),
-                Some(h) => bail!("--spacing must be positive, got {h}"),
-                // cubegen's convention: the grid spans the box exactly, spacing = extent / (n − 1).
-                None => GridSpec::cube(lo, hi, grid),
-            };
-            let dims = spec.dims;
-            if dims.iter().map(|&d| d as u64).product::<u64>() > formats::MAX_GRID_VALUES {
-                bail!("a {dims:?} grid is too large");
-            }
-            let prepared = PreparedBasis::new(&wf.basis);
-            let t = Instant::now();
-            let values = prepared.quantity_grid_f32(wf, q, &spec);
-            let seconds = t.elapsed().as_secs_f64();
-            let label = what.label(&q, wf);
-            let grid = VolumeGrid::new(&label, dims, spec.world_from_grid, values);
-            let id = match q {
-                Quantity::Orbital(i) => wf.of_spin(wf.orbitals[i].spin).position(|(j, _)| j == i).map_or(0, |p| p + 1),
-                _ => 0,
-            };
-            let file = std::fs::File::create(&output).with_context(|| format!("creating {}", output.display()))?;
-            let mut w = std::io::BufWriter::with_capacity(1 << 20, file);
-            let title = format!("{} {}", doc.source, label);
-            cube_write::write_to(&mut w, &title, &label, &doc.molecule, &[(&grid, id as i64)])
-                .with_context(|| format!("writing {}", output.display()))?;
-            eprintln!(
-                "wrote {} ({}×{}×{}, {label}; evaluated in {seconds:.3} s)",
-                output.display(),
-                dims[0],
-                dims[1],
-                dims[2]
-            );
-            Ok(())
+            values_cli::cube(&file, &what, (grid, spacing, margin), &output)
         }
         Some(Command::Scan(command)) => scan_cli::run(command),
         Some(Command::Mesh(args)) => surface_cli::mesh(&args, &quantities_cli::parse_later_meshes(&later)?),
@@ -780,67 +594,7 @@ fn main() -> Result<()> {
         Some(Command::Bench(BenchCommand::Surfaces(args))) => surface_cli::bench_translucent(&args),
         Some(Command::Bench(BenchCommand::Surface(args))) => molsurface_cli::bench(&args),
         Some(Command::Bench(BenchCommand::Render { file, view, frames, lavapipe, wavefunction })) => {
-            let doc = load(file.as_deref())?;
-            let camera = view.camera(&doc)?;
-            let ctx = gpu(lavapipe)?;
-            let settings = view.settings();
-            let mut h = Headless::new(&ctx, &doc, view.volume_index(&doc)?, &settings, view.size)?;
-            if let Some((seconds, _)) = wavefunction.apply(&ctx, &mut h, &doc)? {
-                let n = wavefunction.grid_points;
-                println!(
-                    "wavefunction_setup_ms={:.1} (grid {n}^3: GPU fill and read-back for the value range)",
-                    seconds * 1e3
-                );
-            }
-            let wait = |ctx: &GpuContext| ctx.device.poll(wgpu::PollType::wait_indefinitely()).map(|_| ());
-            for _ in 0..2 {
-                h.draw(&ctx, &camera, &settings);
-                wait(&ctx)?;
-            }
-            let mut times = Vec::new();
-            for f in 0..frames.max(1) {
-                // Turn the camera a little each frame so the slices are cut anew, as in the viewer.
-                let mut cam = camera;
-                cam.orbit(0.01 * f as f32, 0.0);
-                let t = Instant::now();
-                h.draw(&ctx, &cam, &settings);
-                wait(&ctx)?;
-                times.push(t.elapsed().as_secs_f64() * 1e3);
-            }
-            times.sort_by(f64::total_cmp);
-            let median = times[times.len() / 2];
-            let grid = doc.volumes.get(view.volume).map(|g| format!("{:?}", g.dims)).unwrap_or("none".into());
-            println!("adapter: {}", ctx.describe());
-            println!(
-                "scene: {} atoms, grid {grid}, {}x{}, {:?}, {} slices",
-                doc.molecule.atoms.len(),
-                view.size[0],
-                view.size[1],
-                settings.volume.mode,
-                settings.volume.slices
-            );
-            let eye = camera.eye();
-            println!(
-                "camera: eye={:.4},{:.4},{:.4} target={:.4},{:.4},{:.4} fov_deg={:.2}",
-                eye.x,
-                eye.y,
-                eye.z,
-                camera.target.x,
-                camera.target.y,
-                camera.target.z,
-                camera.fov_y.to_degrees()
-            );
-            if let Some(v) = h.renderer.main().volume.volume() {
-                let s = v.grid_box.slices(settings.volume.mode, settings.volume.slices, eye, -camera.backward());
-                println!("slice_spacing_bohr={:.5}", s.spacing);
-            }
-            println!(
-                "ms_per_frame_median={median:.1} min={:.1} max={:.1} frames={}",
-                times[0],
-                times[times.len() - 1],
-                times.len()
-            );
-            Ok(())
+            render_cli::bench(file.as_deref(), &view, frames, lavapipe, &wavefunction)
         }
     }
 }

@@ -39,8 +39,8 @@ const CRATE_RULES: &[(&str, &[&str])] = &[
     ("demo.rs", &["flate2"]),
     ("app", &["glam", "serde", "toml", "wgpu", "image", "log", "egui", "eframe", "egui_wgpu", "egui_plot", "rfd"]),
     // The binary: main.rs and its subcommands.
-    ("cli", &["wgpu", "glam", "rayon", "clap", "anyhow", "image"]),
-    ("main.rs", &["wgpu", "glam", "rayon", "clap", "anyhow", "serde_json", "env_logger"]),
+    ("cli", &["wgpu", "glam", "rayon", "clap", "anyhow", "image", "serde_json"]),
+    ("main.rs", &["clap", "anyhow", "env_logger"]),
 ];
 
 fn rust_files(path: &Path, out: &mut Vec<PathBuf>) {

@@ -216,7 +216,8 @@ pub fn bench(args: &SurfaceBench) -> Result<()> {
         let mut camera = Camera::framing(lo.as_vec3(), hi.as_vec3());
         camera.zoom(1.0 / args.zoom.max(1e-3));
         let [full, lod] = &mut renderers;
-        let frames = super::time_frames_of(&ctx, &mut [full, lod], &camera, args.bench.size, args.bench.frames)?;
+        let frames =
+            super::render_cli::time_frames_of(&ctx, &mut [full, lod], &camera, args.bench.size, args.bench.frames)?;
         let [full_ms, lod_ms] = [0, 1].map(|k| frames[k][frames[k].len() / 2]);
         // The last frame again, into a target to read.
         let target = OffscreenTarget::new(&ctx.device, args.bench.size);

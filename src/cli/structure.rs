@@ -90,7 +90,7 @@ pub fn bench_spheres(args: &SpheresBench) -> Result<()> {
     renderer.main().atoms.splat_radius_px = args.splat_px;
     let gpu_bytes = renderer.main().atoms.gpu_bytes();
     let camera = Camera::framing(lo.as_vec3(), hi.as_vec3());
-    let times = super::time_frames(&ctx, &mut renderer, &camera, args.bench.size, args.bench.frames)?;
+    let times = super::render_cli::time_frames(&ctx, &mut renderer, &camera, args.bench.size, args.bench.frames)?;
     let n = molecule.atoms.len();
     println!("adapter: {}", ctx.describe());
     println!(

@@ -1,0 +1,182 @@
+//! `render` (an image of a file's quantities, or of a bundled demo scene) and `bench render`
+//! (frame times of one file's scene), and the frame timing the other benchmarks share.
+
+use std::path::Path;
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use orbcloud::demo;
+use orbcloud::gpu::GpuContext;
+use orbcloud::headless::Headless;
+use orbcloud::scene::{Camera, RenderSettings};
+
+use super::quantities_cli::{self, Later};
+use super::{DemoArg, RenderArgs, ViewArgs, WavefunctionArgs, gpu, load, surface_cli};
+
+/// `render`: `args`'s file (or the bundled demo) to a PNG; `later` are further quantities of the
+/// file, each with its options ([`quantities_cli`]).
+pub fn render(args: RenderArgs, later: &[Later]) -> Result<()> {
+    match args.demo {
+        Some(DemoArg::Cycloaddition) => {
+            let ctx = gpu(args.lavapipe)?;
+            let scene = demo::cycloaddition().context("the bundled demo did not load")?;
+            let img = surface_cli::render_scene(&ctx, scene, &args.iso, args.view.size)?;
+            return save(&img, &args.output, &ctx);
+        }
+        Some(DemoArg::Scan) => bail!("the scan demo renders with `orbcloud scan render`"),
+        _ => {}
+    }
+    let doc = load(args.file.as_deref())?;
+    // Arguments that depend on the file are checked before any GPU work.
+    let camera = args.view.camera(&doc)?;
+    let volume = args.view.volume_index(&doc)?;
+    if !later.is_empty() {
+        let later = quantities_cli::parse_later(later)?;
+        if args.pick.is_some() {
+            bail!("--pick reads one quantity's picture: give one quantity option");
+        }
+        let ctx = gpu(args.lavapipe)?;
+        let img = quantities_cli::render(&ctx, doc, &args, &later, &camera)?;
+        return save(&img, &args.output, &ctx);
+    }
+    let ctx = gpu(args.lavapipe)?;
+    let mut settings = args.view.settings();
+    let mut h = Headless::new(&ctx, &doc, volume, &settings, args.view.size)?;
+    let computed = args.wavefunction.apply(&ctx, &mut h, &doc)?.map(|(_, g)| g);
+    let grid = computed.as_ref().or(volume.and_then(|i| doc.volumes.get(i)));
+    if let Some(grid) = grid {
+        orbcloud::evaluate::auto_opacity(&mut settings.volume, grid);
+    }
+    let molsurface = args.molsurface.mesh(&doc, args.iso.translucent, grid)?;
+    surface_cli::show(&ctx, &mut h.renderer, grid, &args.iso, molsurface);
+    let img = h.render(&ctx, &camera, &settings)?;
+    save(&img, &args.output, &ctx)?;
+    if let Some(pixel) = args.pick {
+        surface_cli::print_pick(&ctx, &h.renderer, &doc, pixel)?;
+    }
+    Ok(())
+}
+
+/// Writes `img` to `path` and says so, with the adapter that drew it.
+fn save(img: &image::RgbaImage, path: &Path, ctx: &GpuContext) -> Result<()> {
+    img.save(path).with_context(|| format!("writing {}", path.display()))?;
+    eprintln!("wrote {} ({}x{}, {})", path.display(), img.width(), img.height(), ctx.describe());
+    Ok(())
+}
+
+/// `bench render`: ms per frame of a file's scene (atoms, cloud) at a size and slice count.
+pub fn bench(
+    file: Option<&Path>,
+    view: &ViewArgs,
+    frames: u32,
+    lavapipe: bool,
+    wavefunction: &WavefunctionArgs,
+) -> Result<()> {
+    let doc = load(file)?;
+    let camera = view.camera(&doc)?;
+    let ctx = gpu(lavapipe)?;
+    let settings = view.settings();
+    let mut h = Headless::new(&ctx, &doc, view.volume_index(&doc)?, &settings, view.size)?;
+    if let Some((seconds, _)) = wavefunction.apply(&ctx, &mut h, &doc)? {
+        let n = wavefunction.grid_points;
+        println!("wavefunction_setup_ms={:.1} (grid {n}^3: GPU fill and read-back for the value range)", seconds * 1e3);
+    }
+    let wait = |ctx: &GpuContext| ctx.device.poll(wgpu::PollType::wait_indefinitely()).map(|_| ());
+    for _ in 0..2 {
+        h.draw(&ctx, &camera, &settings);
+        wait(&ctx)?;
+    }
+    let mut times = Vec::new();
+    for f in 0..frames.max(1) {
+        // Turn the camera a little each frame so the slices are cut anew, as in the viewer.
+        let mut cam = camera;
+        cam.orbit(0.01 * f as f32, 0.0);
+        let t = Instant::now();
+        h.draw(&ctx, &cam, &settings);
+        wait(&ctx)?;
+        times.push(t.elapsed().as_secs_f64() * 1e3);
+    }
+    times.sort_by(f64::total_cmp);
+    let median = times[times.len() / 2];
+    let grid = doc.volumes.get(view.volume).map(|g| format!("{:?}", g.dims)).unwrap_or("none".into());
+    println!("adapter: {}", ctx.describe());
+    println!(
+        "scene: {} atoms, grid {grid}, {}x{}, {:?}, {} slices",
+        doc.molecule.atoms.len(),
+        view.size[0],
+        view.size[1],
+        settings.volume.mode,
+        settings.volume.slices
+    );
+    let eye = camera.eye();
+    println!(
+        "camera: eye={:.4},{:.4},{:.4} target={:.4},{:.4},{:.4} fov_deg={:.2}",
+        eye.x,
+        eye.y,
+        eye.z,
+        camera.target.x,
+        camera.target.y,
+        camera.target.z,
+        camera.fov_y.to_degrees()
+    );
+    if let Some(v) = h.renderer.main().volume.volume() {
+        let s = v.grid_box.slices(settings.volume.mode, settings.volume.slices, eye, -camera.backward());
+        println!("slice_spacing_bohr={:.5}", s.spacing);
+    }
+    println!(
+        "ms_per_frame_median={median:.1} min={:.1} max={:.1} frames={}",
+        times[0],
+        times[times.len() - 1],
+        times.len()
+    );
+    Ok(())
+}
+
+/// ms per frame drawing `camera`'s view at `size`, turning a little each frame, after two
+/// warm-up frames; sorted.
+pub fn time_frames(
+    ctx: &GpuContext,
+    renderer: &mut orbcloud::gpu::Renderer,
+    camera: &Camera,
+    size: [u32; 2],
+    frames: u32,
+) -> Result<Vec<f64>> {
+    Ok(time_frames_of(ctx, &mut [renderer], camera, size, frames)?.remove(0))
+}
+
+/// [`time_frames`] for several renderers taking turns frame by frame, so that a machine whose
+/// speed drifts slows them alike: one sorted list per renderer.
+pub fn time_frames_of(
+    ctx: &GpuContext,
+    renderers: &mut [&mut orbcloud::gpu::Renderer],
+    camera: &Camera,
+    size: [u32; 2],
+    frames: u32,
+) -> Result<Vec<Vec<f64>>> {
+    let target = orbcloud::gpu::OffscreenTarget::new(&ctx.device, size);
+    let settings = RenderSettings::default();
+    let mut times = vec![Vec::new(); renderers.len()];
+    for f in 0..frames.max(1) + 2 {
+        let mut cam = *camera;
+        cam.orbit(0.02 * f as f32, 0.01 * f as f32);
+        for (renderer, times) in renderers.iter_mut().zip(&mut times) {
+            let t = Instant::now();
+            let mut encoder = ctx.device.create_command_encoder(&Default::default());
+            renderer.render(
+                ctx,
+                &mut encoder,
+                &target.color_view,
+                &orbcloud::gpu::FrameInput::single(&cam, &settings, size),
+            );
+            ctx.queue.submit([encoder.finish()]);
+            ctx.device.poll(wgpu::PollType::wait_indefinitely())?;
+            if f >= 2 {
+                times.push(t.elapsed().as_secs_f64() * 1e3);
+            }
+        }
+    }
+    for t in &mut times {
+        t.sort_by(f64::total_cmp);
+    }
+    Ok(times)
+}

@@ -1,0 +1,119 @@
+//! `info` (a file described), `eval` (an orbital or density at points) and `cube` (on a grid,
+//! written as a Gaussian cube file).
+
+use std::path::Path;
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use glam::DVec3;
+use orbcloud::formats::{self, cube_write};
+use orbcloud::info;
+use orbcloud::model::gto::PreparedBasis;
+use orbcloud::model::orbitals::Quantity;
+use orbcloud::model::{GridSpec, VolumeGrid};
+use rayon::prelude::*;
+
+use super::{WhatArgs, wavefunction_of};
+
+/// `info`: what `file` holds, as text or JSON.
+pub fn info(file: &Path, json: bool) -> Result<()> {
+    let doc = formats::load(file)?;
+    if json {
+        println!("{}", serde_json::to_string_pretty(&info::describe(&doc))?);
+    } else {
+        print!("{}", info::text(&doc));
+    }
+    Ok(())
+}
+
+/// `eval`: the quantity `what` asks for at each point of `points` (`x y z` in bohr per line).
+pub fn eval(file: &Path, what: &WhatArgs, points: &Path) -> Result<()> {
+    let doc = formats::load(file)?;
+    let wf = wavefunction_of(&doc)?;
+    let q = what.resolve(wf)?;
+    let prepared = PreparedBasis::new(&wf.basis);
+    let points = read_points(points)?;
+    let values: Vec<f64> = points
+        .par_iter()
+        .map(|&p| match q {
+            Quantity::Orbital(i) => prepared.orbital_value(&wf.orbitals[i].coefficients, p),
+            Quantity::Density => prepared.density(wf, p),
+            Quantity::SpinDensity => prepared.spin_density(wf, p),
+        })
+        .collect();
+    let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+    use std::io::Write;
+    for (p, v) in points.iter().zip(values) {
+        writeln!(out, "{:.10} {:.10} {:.10} {:.15e}", p.x, p.y, p.z, v)?;
+    }
+    Ok(())
+}
+
+/// `cube`: the quantity on a grid of `grid` points per side (or `spacing` bohr), over the box
+/// where it decays (or the atoms' box plus `margin`), written to `output`.
+pub fn cube(
+    file: &Path,
+    what: &WhatArgs,
+    (grid, spacing, margin): (usize, Option<f64>, Option<f64>),
+    output: &Path,
+) -> Result<()> {
+    let doc = formats::load(file)?;
+    let wf = wavefunction_of(&doc)?;
+    let q = what.resolve(wf)?;
+    let (lo, hi) = match margin {
+        Some(m) => doc.molecule.bounds().map(|(lo, hi)| (lo - DVec3::splat(m), hi + DVec3::splat(m))),
+        None => orbcloud::model::extent::quantity_box(wf, &doc.molecule, q),
+    }
+    .ok_or_else(|| anyhow::anyhow!("{}: no atoms", doc.source))?;
+    let spec = match spacing {
+        Some(h) if h > 0.0 => GridSpec::spaced(lo, hi, h),
+        Some(h) => bail!("--spacing must be positive, got {h}"),
+        // cubegen's convention: the grid spans the box exactly, spacing = extent / (n − 1).
+        None => GridSpec::cube(lo, hi, grid),
+    };
+    let dims = spec.dims;
+    if dims.iter().map(|&d| d as u64).product::<u64>() > formats::MAX_GRID_VALUES {
+        bail!("a {dims:?} grid is too large");
+    }
+    let prepared = PreparedBasis::new(&wf.basis);
+    let t = Instant::now();
+    let values = prepared.quantity_grid_f32(wf, q, &spec);
+    let seconds = t.elapsed().as_secs_f64();
+    let label = what.label(&q, wf);
+    let grid = VolumeGrid::new(&label, dims, spec.world_from_grid, values);
+    let id = match q {
+        Quantity::Orbital(i) => wf.of_spin(wf.orbitals[i].spin).position(|(j, _)| j == i).map_or(0, |p| p + 1),
+        _ => 0,
+    };
+    let file = std::fs::File::create(output).with_context(|| format!("creating {}", output.display()))?;
+    let mut w = std::io::BufWriter::with_capacity(1 << 20, file);
+    let title = format!("{} {}", doc.source, label);
+    cube_write::write_to(&mut w, &title, &label, &doc.molecule, &[(&grid, id as i64)])
+        .with_context(|| format!("writing {}", output.display()))?;
+    eprintln!("wrote {} ({}×{}×{}, {label}; evaluated in {seconds:.3} s)", output.display(), dims[0], dims[1], dims[2]);
+    Ok(())
+}
+
+fn read_points(path: &Path) -> Result<Vec<DVec3>> {
+    let text = if path.as_os_str() == "-" {
+        std::io::read_to_string(std::io::stdin())?
+    } else {
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?
+    };
+    let mut points = Vec::new();
+    for (n, line) in text.lines().enumerate() {
+        let line = line.trim();
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        let v: Vec<f64> =
+            line.split_whitespace().take(3).map(str::parse).collect::<Result<_, _>>().map_err(|_| {
+                anyhow::anyhow!("{}:{}: expected `x y z` in bohr, found {line:?}", path.display(), n + 1)
+            })?;
+        if v.len() < 3 || v.iter().any(|x| !x.is_finite()) {
+            bail!("{}:{}: expected `x y z` in bohr, found {line:?}", path.display(), n + 1);
+        }
+        points.push(DVec3::new(v[0], v[1], v[2]));
+    }
+    Ok(points)
+}
