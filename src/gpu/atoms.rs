@@ -730,7 +730,7 @@ impl AtomsPass {
 
     /// This frame's camera, in the frame of the object the atoms belong to; their pick ids name
     /// `object`. `size` is the frame's in pixels.
-    pub fn prepare(&mut self, ctx: &GpuContext, view: &ObjectView, object: u32, size: [u32; 2]) {
+    pub fn set_view(&mut self, ctx: &GpuContext, view: &ObjectView, object: u32, size: [u32; 2]) {
         let clip = view.clip_from_object;
         let world_from_clip = clip.inverse();
         let far = |x: f32, y: f32| {
@@ -850,6 +850,12 @@ pub fn projected_radius_px(clip_from_world: Mat4, center: Vec3, radius: f32, hei
 }
 
 impl Draw for AtomsPass {
+    fn prepare(&mut self, f: &super::frame::Prepare<'_>) {
+        if !f.later_tile {
+            self.set_view(f.ctx, f.view, f.layer, f.size);
+        }
+    }
+
     fn phases(&self) -> &'static [Phase] {
         &[Phase::Cull, Phase::Opaque]
     }

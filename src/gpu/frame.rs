@@ -113,6 +113,13 @@ pub fn is_ordered(frame: &[PhaseNode]) -> bool {
 
 /// A representation that draws in some phases of the frame.
 pub trait Draw {
+    /// Takes the frame's camera and settings before any phase is recorded (culling lists,
+    /// uniforms, slices, level of detail).
+    fn prepare(&mut self, _frame: &Prepare<'_>) {}
+    /// How many translucent surfaces it draws this frame (they are numbered across the frame).
+    fn translucent_surfaces(&self) -> usize {
+        0
+    }
     /// The phases it draws in.
     fn phases(&self) -> &'static [Phase];
     /// Records its draws into the open render pass of `phase`.
@@ -127,6 +134,29 @@ pub trait Draw {
     /// Records its occlusion tests of [`Phase::Occlusion`] against the depth pyramid (the
     /// group [`super::occlusion::DepthPyramid::build`] returns).
     fn occlude(&self, _encoder: &mut wgpu::CommandEncoder, _pyramid: &wgpu::BindGroup) {}
+}
+
+/// What each representation of a layer is given every frame ([`Draw::prepare`]).
+pub struct Prepare<'a> {
+    pub ctx: &'a super::GpuContext,
+    /// The camera seen from the layer's object.
+    pub view: &'a ObjectView,
+    /// The layer's number: the object field of its pick ids.
+    pub layer: u32,
+    /// The frame's size in pixels.
+    pub size: [u32; 2],
+    /// A later band of a frame drawn in bands: the first band's culling and level of detail
+    /// stand (preparing them again would count frames the seen-last-frame lists skip).
+    pub later_tile: bool,
+    /// The factor on level-of-detail thresholds (above 1 while the user drags).
+    pub lod_scale: f32,
+    /// The number of the layer's first translucent surface among the frame's.
+    pub first_translucent: usize,
+    /// The fragment lists translucent surfaces append to (when the frame has any and the layer
+    /// is drawn), and how they are composited.
+    pub lists: Option<(&'a wgpu::BindGroup, super::oit::Transparency)>,
+    /// The layer's cloud.
+    pub cloud: &'a crate::scene::VolumeSettings,
 }
 
 /// The frame's camera as one object sees it: every vector in the object's own frame, so a

@@ -460,7 +460,7 @@ impl IsosurfacePass {
     /// Translucent surfaces are numbered from `first_translucent` among the
     /// frame's; past [`MAX_TRANSLUCENT_SURFACES`] they are drawn opaque. `lists`: the frame's
     /// fragment lists, and how they are composited.
-    pub fn prepare(
+    pub fn set_view(
         &mut self,
         ctx: &GpuContext,
         view: &ObjectView,
@@ -552,6 +552,15 @@ impl IsosurfacePass {
 }
 
 impl Draw for IsosurfacePass {
+    fn prepare(&mut self, f: &super::frame::Prepare<'_>) {
+        let lod = (!f.later_tile).then_some((f.size, f.lod_scale));
+        self.set_view(f.ctx, f.view, f.layer, lod, f.first_translucent, f.lists);
+    }
+
+    fn translucent_surfaces(&self) -> usize {
+        self.translucent().count()
+    }
+
     fn phases(&self) -> &'static [Phase] {
         &[Phase::Cull, Phase::Opaque, Phase::OpaqueLate, Phase::Fragments]
     }

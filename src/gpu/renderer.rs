@@ -3,7 +3,7 @@
 use glam::{Mat4, Vec3};
 
 use super::atoms::AtomsPass;
-use super::frame::{Draw, FrameTargets, ObjectView, Phase, PhaseNode, PickId, STANDARD_FRAME};
+use super::frame::{Draw, FrameTargets, ObjectView, Phase, PhaseNode, PickId, Prepare, STANDARD_FRAME};
 use super::isosurface::IsosurfacePass;
 use super::occlusion::DepthPyramid;
 use super::oit::{FragmentDump, FragmentLists, FragmentStats, MAX_BANDS, Transparency};
@@ -137,6 +137,10 @@ impl Layer {
     /// The representations, in the order they draw within a phase.
     fn drawers(&self) -> [&dyn Draw; 3] {
         [&self.atoms, &self.surfaces, &self.volume]
+    }
+
+    fn drawers_mut(&mut self) -> [&mut dyn Draw; 3] {
+        [&mut self.atoms, &mut self.surfaces, &mut self.volume]
     }
 }
 
@@ -338,19 +342,23 @@ impl Renderer {
         let mut first_translucent = 0;
         for (n, layer) in self.layers.iter_mut().enumerate() {
             let view = ObjectView::new(&world, layer.world_from_object);
-            // A later tile draws nothing opaque: the first tile's culling and level of detail
-            // stand (preparing them again would count frames the seen-last-frame lists skip).
-            if !later_tile {
-                layer.atoms.prepare(ctx, &view, n as u32, frame.size);
+            let prepare = Prepare {
+                ctx,
+                view: &view,
+                layer: n as u32,
+                size: frame.size,
+                later_tile,
+                lod_scale: self.lod_scale,
+                first_translucent,
+                lists: lists.filter(|_| layer.visible).map(|l| (l, self.transparency)),
+                cloud: frame.clouds.get(n).unwrap_or(&hidden),
+            };
+            for drawer in layer.drawers_mut() {
+                drawer.prepare(&prepare);
             }
-            let layer_lists = lists.filter(|_| layer.visible).map(|l| (l, self.transparency));
-            let lod = (!later_tile).then_some((frame.size, self.lod_scale));
-            layer.surfaces.prepare(ctx, &view, n as u32, lod, first_translucent, layer_lists);
             if layer.visible {
-                first_translucent += layer.surfaces.translucent().count();
+                first_translucent += layer.drawers().iter().map(|d| d.translucent_surfaces()).sum::<usize>();
             }
-            let cloud = frame.clouds.get(n).unwrap_or(&hidden);
-            layer.volume.prepare(&ctx.device, &ctx.queue, &view, cloud, frame.size);
         }
         let oit = self.lists.surfaces > 0;
         let [width, height] = targets.size;

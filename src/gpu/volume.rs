@@ -578,7 +578,7 @@ impl VolumePass {
     }
 
     /// Cuts this frame's slices and uploads them with the uniforms.
-    pub fn prepare(
+    pub fn set_view(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
@@ -695,6 +695,10 @@ impl VolumePass {
 }
 
 impl super::frame::Draw for VolumePass {
+    fn prepare(&mut self, f: &super::frame::Prepare<'_>) {
+        self.set_view(&f.ctx.device, &f.ctx.queue, f.view, f.cloud, f.size);
+    }
+
     fn phases(&self) -> &'static [super::frame::Phase] {
         &[super::frame::Phase::Translucent]
     }
