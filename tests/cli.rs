@@ -473,14 +473,6 @@ fn render_png(args: &[&str]) -> (image::RgbaImage, String) {
     (image::open(&png).unwrap().to_rgba8(), stderr)
 }
 
-/// Mean absolute difference per channel, 0..255.
-fn mean_difference(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
-    assert_eq!(a.dimensions(), b.dimensions());
-    let sum: u64 =
-        a.pixels().zip(b.pixels()).map(|(p, q)| (0..3).map(|k| p[k].abs_diff(q[k]) as u64).sum::<u64>()).sum();
-    sum as f64 / (3 * a.width() * a.height()) as f64
-}
-
 #[test]
 fn render_draws_several_quantities_of_one_file_and_panes_side_by_side() {
     let file = benzene();
@@ -494,13 +486,21 @@ fn render_draws_several_quantities_of_one_file_and_panes_side_by_side() {
         &[&[file.as_str()][..], &size, &["--density"], &surfaces, &["--orbital", "homo"], &surfaces].concat(),
     );
     assert!(said.contains("pane 1: total density + HOMO"), "{said}");
-    assert!(mean_difference(&both, &density) > 1.0, "the HOMO shows: {}", mean_difference(&both, &density));
-    assert!(mean_difference(&both, &homo) > 1.0, "the density shows: {}", mean_difference(&both, &homo));
+    assert!(
+        common::mean_difference(&both, &density) > 1.0,
+        "the HOMO shows: {}",
+        common::mean_difference(&both, &density)
+    );
+    assert!(
+        common::mean_difference(&both, &homo) > 1.0,
+        "the density shows: {}",
+        common::mean_difference(&both, &homo)
+    );
     // Clouds of both: each quantity's own options (here the HOMO's colours) are its own.
     let (clouds, _) = render_png(&[&[file.as_str()][..], &size, &["--density", "--orbital", "homo"]].concat());
     let (recoloured, _) =
         render_png(&[&[file.as_str()][..], &size, &["--density", "--orbital", "homo", "--colors", "gold"]].concat());
-    assert!(mean_difference(&clouds, &recoloured) > 0.5, "the second quantity's colours apply to it");
+    assert!(common::mean_difference(&clouds, &recoloured) > 0.5, "the second quantity's colours apply to it");
     // HOMO | LUMO side by side, one camera: each pane is what its quantity alone draws.
     let (beside, said) =
         render_png(&[file.as_str(), "--size", "320x120", "--orbital", "homo", "--beside", "--orbital", "lumo"]);
@@ -509,13 +509,13 @@ fn render_draws_several_quantities_of_one_file_and_panes_side_by_side() {
     let left = image::imageops::crop_imm(&beside, 0, 0, 160, 120).to_image();
     let right = image::imageops::crop_imm(&beside, 160, 0, 160, 120).to_image();
     let (lumo, homo) = (one(&["--orbital", "lumo"]), one(&["--orbital", "homo"]));
-    assert!(mean_difference(&left, &homo) < 0.5, "left pane: {}", mean_difference(&left, &homo));
-    assert!(mean_difference(&right, &lumo) < 0.5, "right pane: {}", mean_difference(&right, &lumo));
-    assert!(mean_difference(&left, &right) > 2.0, "HOMO and LUMO differ");
+    assert!(common::mean_difference(&left, &homo) < 0.5, "left pane: {}", common::mean_difference(&left, &homo));
+    assert!(common::mean_difference(&right, &lumo) < 0.5, "right pane: {}", common::mean_difference(&right, &lumo));
+    assert!(common::mean_difference(&left, &right) > 2.0, "HOMO and LUMO differ");
     // Options of the whole picture may come after the second quantity too.
     let (late, _) =
         render_png(&[file.as_str(), "--orbital", "homo", "--beside", "--orbital", "lumo", "--size", "320x120"]);
-    assert_eq!(mean_difference(&late, &beside), 0.0, "--size after the quantities");
+    assert_eq!(common::mean_difference(&late, &beside), 0.0, "--size after the quantities");
 }
 
 #[test]

@@ -45,12 +45,6 @@ fn draw(
     (target.read_rgba(&ctx.device, &ctx.queue).unwrap(), renderer.main().surfaces.lod_stats())
 }
 
-fn mean_difference(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
-    let sum: u64 =
-        a.pixels().zip(b.pixels()).map(|(p, q)| (0..3).map(|k| p[k].abs_diff(q[k]) as u64).sum::<u64>()).sum();
-    sum as f64 / (3 * a.width() * a.height()) as f64
-}
-
 #[test]
 fn far_parts_become_points_within_two_levels_of_every_triangle() {
     let ctx = common::lavapipe();
@@ -78,7 +72,7 @@ fn far_parts_become_points_within_two_levels_of_every_triangle() {
     assert!(stats.splats > 0 && stats.triangles < n, "{stats:?}");
     // Framed small, it draws a coarser version of the mesh.
     assert!(stats.level > 0, "{stats:?}");
-    let mean = mean_difference(&full, &lod);
+    let mean = common::mean_difference(&full, &lod);
     eprintln!("level of detail at {POINTS_PX} px: {stats:?}, mean difference {mean:.3}/255");
     assert!(mean < 2.0, "mean difference {mean}/255");
     // Where the frame shows the surface, picking says so, points included.
@@ -92,7 +86,7 @@ fn far_parts_become_points_within_two_levels_of_every_triangle() {
     renderer.set_lod_scale(4.0);
     let (dragged, coarse) = draw(&ctx, &mut renderer, &camera);
     assert!(coarse.splats > stats.splats && coarse.triangles < stats.triangles, "{coarse:?} vs {stats:?}");
-    let mean = mean_difference(&full, &dragged);
+    let mean = common::mean_difference(&full, &dragged);
     assert!(mean < 8.0, "while dragging: mean difference {mean}/255");
     // Far away, the whole fragment is a handful of points.
     camera.distance *= 40.0;
@@ -217,7 +211,7 @@ fn occlusion_culling_draws_less_and_keeps_the_picture() {
     let (every, _, every_pick) = frame(&mut renderer, &camera, false);
     assert!(matches!(every_pick, Some(PickId::Surface { object: 0, index: 0 })), "{every_pick:?}");
     let (cold, cold_stats, cold_pick) = frame(&mut renderer, &camera, true);
-    assert_eq!(mean_difference(&every, &cold), 0.0, "the first culled frame");
+    assert_eq!(common::mean_difference(&every, &cold), 0.0, "the first culled frame");
     assert_eq!(cold_pick, every_pick);
     // Cold, nothing was seen before: every batch waits for the test, and with nothing drawn
     // yet the test hides none.
@@ -226,17 +220,17 @@ fn occlusion_culling_draws_less_and_keeps_the_picture() {
     // after it marks only what shows. From the third frame on the hidden copies are skipped,
     // and nothing is left to draw after the test.
     let (again, again_stats, _) = frame(&mut renderer, &camera, true);
-    assert_eq!(mean_difference(&every, &again), 0.0, "the second culled frame");
+    assert_eq!(common::mean_difference(&every, &again), 0.0, "the second culled frame");
     assert_eq!((again_stats.first, again_stats.second), (again_stats.chosen, 0), "{again_stats:?}");
     let (warm, warm_stats, _) = frame(&mut renderer, &camera, true);
-    assert_eq!(mean_difference(&every, &warm), 0.0, "the third culled frame");
+    assert_eq!(common::mean_difference(&every, &warm), 0.0, "the third culled frame");
     assert_eq!(warm_stats.second, 0, "{warm_stats:?}");
     // Turned a little: the batches that come into view are drawn after the test.
     let mut turned = camera;
     turned.orbit(0.25, 0.1);
     let (culled, turned_stats, culled_pick) = frame(&mut renderer, &turned, true);
     let (every, _, every_pick) = frame(&mut renderer, &turned, false);
-    assert_eq!(mean_difference(&every, &culled), 0.0, "after a turn");
+    assert_eq!(common::mean_difference(&every, &culled), 0.0, "after a turn");
     assert_eq!(culled_pick, every_pick);
     assert!(
         turned_stats.second > 0 && turned_stats.first + turned_stats.second < turned_stats.chosen,

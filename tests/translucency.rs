@@ -86,12 +86,6 @@ fn srgb(linear: f32) -> f32 {
     if c <= 0.003_130_8 { 12.92 * c } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 }
 }
 
-fn mean_difference(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
-    let sum: u64 =
-        a.pixels().zip(b.pixels()).map(|(p, q)| (0..3).map(|k| p[k].abs_diff(q[k]) as u64).sum::<u64>()).sum();
-    sum as f64 / (3 * a.width() * a.height()) as f64
-}
-
 fn max_difference(a: &image::RgbaImage, b: &image::RgbaImage) -> u8 {
     a.pixels().zip(b.pixels()).flat_map(|(p, q)| (0..3).map(move |k| p[k].abs_diff(q[k]))).max().unwrap_or(0)
 }
@@ -121,7 +115,7 @@ fn exact_order_matches_a_cpu_reference_that_sorts_every_fragment() {
         let px = c.map(|v| (srgb(v) * 255.0).round() as u8);
         reference.put_pixel(n as u32 % SIZE[0], n as u32 / SIZE[0], image::Rgba([px[0], px[1], px[2], 255]));
     }
-    let mean = mean_difference(&img, &reference);
+    let mean = common::mean_difference(&img, &reference);
     let max = max_difference(&img, &reference);
     eprintln!("GPU against the CPU-sorted reference: mean {mean:.4}/255, max {max}/255");
     assert!(mean < 1.0, "mean difference {mean}/255");
@@ -260,7 +254,7 @@ fn surfaces_inside_a_cloud_match_a_cpu_reference_that_walks_both() {
     };
     let cpu = reference(true);
     let inside = dump.lists.iter().filter(|l| !l.is_empty()).count();
-    let mean = mean_difference(&gpu, &cpu);
+    let mean = common::mean_difference(&gpu, &cpu);
     let over = gpu.pixels().zip(cpu.pixels()).filter(|(p, q)| (0..3).any(|k| p[k].abs_diff(q[k]) > 3)).count();
     let n = gpu.pixels().len();
     eprintln!(
@@ -271,13 +265,13 @@ fn surfaces_inside_a_cloud_match_a_cpu_reference_that_walks_both() {
     // buffer rounds every blend, and a ray grazing a slice's edge may see one slice more.
     assert!(mean < 1.0 && over * 100 < n, "mean {mean:.3}/255, {over} pixels > 3/255");
     // Surfaces merely laid over the cloud would be far off.
-    let over_the_cloud = mean_difference(&gpu, &reference(false));
+    let over_the_cloud = common::mean_difference(&gpu, &reference(false));
     assert!(over_the_cloud > 5.0 * mean.max(0.2), "surfaces over the cloud: {over_the_cloud:.3}/255");
     // The cloud veils the surfaces: without it they would look different.
     let mut bare = Renderer::new(&ctx);
     show_object(&ctx, bare.main(), &doc, &object(iso, AtomStyle::Hidden)).expect("orbital");
     let (alone, _) = draw(&ctx, &mut bare);
-    assert!(mean_difference(&alone, &gpu) > 3.0, "the cloud changes the picture");
+    assert!(common::mean_difference(&alone, &gpu) > 3.0, "the cloud changes the picture");
 }
 
 #[test]

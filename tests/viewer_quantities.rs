@@ -41,13 +41,6 @@ fn picture(h: &mut Harness<'static, OrbApp>, dir: &Path, name: &str) -> image::R
     image::open(&path).expect("the view was saved").to_rgba8()
 }
 
-fn mean_difference(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
-    assert_eq!(a.dimensions(), b.dimensions());
-    let sum: u64 =
-        a.pixels().zip(b.pixels()).map(|(p, q)| (0..3).map(|k| p[k].abs_diff(q[k]) as u64).sum::<u64>()).sum();
-    sum as f64 / (3 * a.width() * a.height()) as f64
-}
-
 #[test]
 fn a_density_joins_the_homo_from_the_orbital_browser_and_is_shown_hidden_and_removed() {
     let mut h = open(vec![fixture("wavefunctions/benzene_631gs.molden")]);
@@ -63,15 +56,19 @@ fn a_density_joins_the_homo_from_the_orbital_browser_and_is_shown_hidden_and_rem
     assert_eq!(h.state().objects[0].state.selected, 1, "the new quantity is the one the panels edit");
     assert!(h.query_by_label("total density · cloud").is_some(), "the scene panel lists it");
     let both = picture(&mut h, dir.path(), "both");
-    assert!(mean_difference(&alone, &both) > 1.0, "the density's cloud shows: {}", mean_difference(&alone, &both));
+    assert!(
+        common::mean_difference(&alone, &both) > 1.0,
+        "the density's cloud shows: {}",
+        common::mean_difference(&alone, &both)
+    );
 
     // Hidden, the picture is the HOMO's alone again; shown, it is back.
     h.state_mut().objects[0].state.quantities[1].visible = false;
     h.run_steps(2);
-    assert_eq!(mean_difference(&alone, &picture(&mut h, dir.path(), "hidden")), 0.0, "hidden");
+    assert_eq!(common::mean_difference(&alone, &picture(&mut h, dir.path(), "hidden")), 0.0, "hidden");
     h.state_mut().objects[0].state.quantities[1].visible = true;
     h.run_steps(2);
-    assert_eq!(mean_difference(&both, &picture(&mut h, dir.path(), "shown")), 0.0, "shown again");
+    assert_eq!(common::mean_difference(&both, &picture(&mut h, dir.path(), "shown")), 0.0, "shown again");
 
     // Removed with its × in the scene panel (the first × removes the object, then one per
     // quantity): the HOMO stays, drawn as before.
@@ -80,7 +77,7 @@ fn a_density_joins_the_homo_from_the_orbital_browser_and_is_shown_hidden_and_rem
     h.get_all_by_label("×").nth(2).expect("the density's ×").click();
     wait_loaded(&mut h);
     assert_eq!(sources(h.state()), [Wavefunction(Quantity::Orbital(homo))]);
-    assert_eq!(mean_difference(&alone, &picture(&mut h, dir.path(), "removed")), 0.0, "the HOMO alone again");
+    assert_eq!(common::mean_difference(&alone, &picture(&mut h, dir.path(), "removed")), 0.0, "the HOMO alone again");
 
     // A row of the browser switches the selected quantity; its menu adds an orbital instead.
     let lumo = wf.lumo(Spin::Alpha).unwrap();
@@ -121,7 +118,11 @@ fn homo_and_lumo_of_one_file_side_by_side_in_linked_panes_and_a_session_keeps_th
         image::imageops::crop_imm(&split, 0, 0, w, split.height()).to_image(),
         image::imageops::crop_imm(&split, w, 0, w, split.height()).to_image(),
     );
-    assert!(mean_difference(&left, &right) > 2.0, "HOMO and LUMO differ: {}", mean_difference(&left, &right));
+    assert!(
+        common::mean_difference(&left, &right) > 2.0,
+        "HOMO and LUMO differ: {}",
+        common::mean_difference(&left, &right)
+    );
 
     // Linked: a drag in the right pane turns both.
     let yaw = h.state().view.camera.yaw;
@@ -135,7 +136,10 @@ fn homo_and_lumo_of_one_file_side_by_side_in_linked_panes_and_a_session_keeps_th
         image::imageops::crop_imm(&turned, 0, 0, w, turned.height()).to_image(),
         image::imageops::crop_imm(&turned, w, 0, w, turned.height()).to_image(),
     );
-    assert!(mean_difference(&left, &l2) > 0.5 && mean_difference(&right, &r2) > 0.5, "both panes turned");
+    assert!(
+        common::mean_difference(&left, &l2) > 0.5 && common::mean_difference(&right, &r2) > 0.5,
+        "both panes turned"
+    );
 
     // Unlinked: the right pane turns alone.
     h.get_by_label("one camera").click();

@@ -828,7 +828,6 @@ impl Viewport {
     }
 
     /// Shows the view in the remaining space of `ui`, applying mouse and keyboard input to
-    /// `view.camera`.
     /// `view.camera`; Ctrl + drag moves `clip` (the edited cloud's clipping plane) when it is on.
     pub fn show(
         &mut self,

@@ -154,3 +154,11 @@ pub fn coverage(img: &image::RgbaImage, background: [u8; 3]) -> f64 {
     let covered = img.pixels().filter(|p| (0..3).any(|c| (p[c] as i32 - background[c] as i32).abs() > 6)).count();
     covered as f64 / (img.width() * img.height()) as f64
 }
+
+/// Mean absolute difference of two pictures per colour channel, 0..255.
+pub fn mean_difference(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
+    assert_eq!(a.dimensions(), b.dimensions());
+    let sum: u64 =
+        a.pixels().zip(b.pixels()).map(|(p, q)| (0..3).map(|k| p[k].abs_diff(q[k]) as u64).sum::<u64>()).sum();
+    sum as f64 / (3 * a.width() * a.height()) as f64
+}
