@@ -106,6 +106,12 @@ pub struct DocumentInfo {
     pub grids: Vec<GridInfo>,
     pub wavefunction: Option<WavefunctionInfo>,
     pub structure: Option<StructureInfo>,
+    /// Normal modes of vibration, as the file gives them (empty when it has none).
+    pub modes: Vec<crate::model::vibrations::NormalMode>,
+    /// Where the modes' geometry comes from, when there are modes.
+    pub modes_geometry: Option<String>,
+    /// Parts of the file left out, each saying where and why.
+    pub problems: Vec<String>,
 }
 
 fn structure_info(view: &crate::model::StructureView) -> StructureInfo {
@@ -210,6 +216,9 @@ pub fn describe(doc: &Document) -> DocumentInfo {
             .collect(),
         wavefunction: doc.wavefunction.as_ref().map(wavefunction_info),
         structure: doc.structure.as_ref().map(structure_info),
+        modes: doc.vibrations.as_ref().map(|v| v.modes.clone()).unwrap_or_default(),
+        modes_geometry: doc.vibrations.as_ref().map(|v| v.geometry_from.clone()),
+        problems: doc.problems.clone(),
     }
 }
 
@@ -299,6 +308,30 @@ pub fn text(doc: &Document) -> String {
                 );
             }
         }
+    }
+    if let Some(from) = &info.modes_geometry {
+        let imaginary = info.modes.iter().filter(|m| m.is_imaginary()).count();
+        let _ = writeln!(
+            s,
+            "{} normal modes ({imaginary} imaginary: {}), geometry from {from}",
+            info.modes.len(),
+            match imaginary {
+                0 => "a minimum",
+                1 => "a transition state",
+                _ => "a higher-order saddle point",
+            }
+        );
+        for (k, m) in info.modes.iter().enumerate() {
+            let intensity = m.ir_intensity.map_or("—".to_string(), |i| format!("{i:.2}"));
+            let mark =
+                if m.is_imaginary() { format!("{:.2}i", -m.frequency_cm1) } else { format!("{:.2}", m.frequency_cm1) };
+            let _ = writeln!(s, "  mode {:>3} {:>12} cm⁻¹  IR {:>10} km/mol", k + 1, mark, intensity);
+        }
+    } else if info.wavefunction.as_ref().is_some_and(|w| w.normalization.program == "Q-Chem") {
+        let _ = writeln!(s, "no normal modes: Q-Chem's fchk files carry none");
+    }
+    for p in &info.problems {
+        let _ = writeln!(s, "⚠ {p}");
     }
     s
 }

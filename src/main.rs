@@ -19,6 +19,8 @@ use orbcloud::scene::{
 };
 use orbcloud::{demo, formats};
 
+#[path = "cli/modes.rs"]
+mod modes_cli;
 #[path = "cli/molsurface.rs"]
 mod molsurface_cli;
 #[path = "cli/quantities.rs"]
@@ -124,6 +126,8 @@ enum Command {
     /// Write isosurfaces (both signs of an orbital, or a density's) or a molecular surface
     /// (--surface) as OBJ, PLY or glTF.
     Mesh(surface_cli::MeshArgs),
+    /// Write one period of a normal mode as a multi-frame XYZ file (Å).
+    Modes(modes_cli::ModesArgs),
     /// Dihedral scans: make a manifest, inspect, render or export an angle.
     #[command(subcommand)]
     Scan(scan_cli::ScanCommand),
@@ -311,6 +315,8 @@ struct RenderArgs {
     /// Render a bundled demo scene instead of a file (cycloaddition: several objects).
     #[arg(long, value_enum)]
     demo: Option<DemoArg>,
+    #[command(flatten)]
+    vibration: modes_cli::ModeArgs,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -586,6 +592,7 @@ fn main() -> Result<()> {
             values_cli::cube(&file, &what, (grid, spacing, margin), &output)
         }
         Some(Command::Scan(command)) => scan_cli::run(command),
+        Some(Command::Modes(args)) => modes_cli::write_xyz(&args),
         Some(Command::Mesh(args)) => surface_cli::mesh(&args, &quantities_cli::parse_later_meshes(&later)?),
         Some(Command::Bench(BenchCommand::Keyvolumes(args))) => scan_cli::bench_keyvolumes(args),
         Some(Command::Bench(BenchCommand::Isosurface(args))) => surface_cli::bench(&args),

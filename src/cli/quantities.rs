@@ -23,7 +23,7 @@ const BESIDE: &str = "--beside";
 /// Options that belong to the whole picture or file, not to a quantity: wherever they are
 /// given, they join the first part of the command line (`mesh FILE --density --iso 0.1
 /// --orbital homo --iso 0.05 -o out.glb`).
-const WHOLE_PICTURE: [&str; 21] = [
+const WHOLE_PICTURE: [&str; 24] = [
     "--output",
     "-o",
     "--size",
@@ -45,6 +45,9 @@ const WHOLE_PICTURE: [&str; 21] = [
     "--probe",
     "--smoothness",
     "--lod-px",
+    "--normal-mode",
+    "--phase",
+    "--amplitude",
 ];
 /// Those of them that take no value.
 const WHOLE_PICTURE_FLAGS: [&str; 2] = ["--lavapipe", "--direct"];

@@ -26,7 +26,8 @@ pub fn render(args: RenderArgs, later: &[Later]) -> Result<()> {
         Some(DemoArg::Scan) => bail!("the scan demo renders with `orbcloud scan render`"),
         _ => {}
     }
-    let doc = load(args.file.as_deref())?;
+    let mut doc = load(args.file.as_deref())?;
+    args.vibration.apply(&mut doc)?;
     // Arguments that depend on the file are checked before any GPU work.
     let camera = args.view.camera(&doc)?;
     let volume = args.view.volume_index(&doc)?;

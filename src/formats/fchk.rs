@@ -31,6 +31,7 @@ use super::wavefunction::{OverlapFn, powers, program_named_in, to_model_order, w
 use super::{MAX_Z, ParseError};
 use crate::model::basis::{Basis, MAX_L, Shell, ShellKind, cartesian_powers};
 use crate::model::orbitals::{MolecularOrbital, Spin, Wavefunction};
+use crate::model::vibrations::Vibrations;
 use crate::model::{Atom, Document};
 
 /// Parses fchk text into a document, checking the orbitals with `overlap`.
@@ -93,7 +94,7 @@ impl FchkFile {
 }
 
 /// The records [`FchkFile::parse`] keeps.
-const NEEDED: [&str; 20] = [
+const NEEDED: [&str; 23] = [
     "Number of atoms",
     "Number of electrons",
     "Number of alpha electrons",
@@ -114,6 +115,9 @@ const NEEDED: [&str; 20] = [
     "Alpha MO coefficients",
     "Beta MO coefficients",
     "Multiplicity",
+    "Vib-NDim",
+    "Vib-E2",
+    "Vib-Modes",
 ];
 
 fn error(file: &str, line: usize, expected: impl Into<String>, found: impl Into<String>) -> ParseError {
@@ -509,7 +513,27 @@ impl FchkFile {
             }
         }
         let wf = Wavefunction { basis, orbitals, restricted: !unrestricted, normalization: Default::default() };
-        Ok(wavefunction_document(source, &self.title, atoms, wf, Some(self.writer()), overlap))
+        let positions: Vec<DVec3> = atoms.iter().map(|a| a.position).collect();
+        let mut doc = wavefunction_document(source, &self.title, atoms, wf, Some(self.writer()), overlap);
+        // A malformed mode record leaves the modes out; the orbitals open all the same.
+        match self.vibrations(file, &positions) {
+            Ok(modes) => doc.vibrations = modes,
+            Err(e) => doc.problems.push(format!("normal modes left out: {e}")),
+        }
+        Ok(doc)
+    }
+
+    /// The normal modes of a frequency job (`Vib-NDim`, `Vib-E2`, `Vib-Modes`), at `geometry`;
+    /// `None` when the file has none (Q-Chem's fchk files never do).
+    fn vibrations(&self, file: &str, geometry: &[DVec3]) -> Result<Option<Vibrations>, ParseError> {
+        if !self.records.contains_key("Vib-NDim") {
+            return Ok(None);
+        }
+        let count = usize::try_from(self.int(file, "Vib-NDim")?)
+            .map_err(|_| error(file, self.line_of("Vib-NDim"), "a mode count ≥ 0", "a negative one"))?;
+        let e2 = (self.reals(file, "Vib-E2", None)?, self.line_of("Vib-E2"));
+        let vectors = (self.reals(file, "Vib-Modes", None)?, self.line_of("Vib-Modes"));
+        super::modes::from_fchk(file, count, e2, vectors, geometry).map(Some)
     }
 }
 

@@ -8,6 +8,7 @@ mod error;
 pub mod fchk;
 pub mod mesh_write;
 pub mod mmcif;
+pub mod modes;
 pub mod molden;
 pub mod pdb;
 pub mod scan;

@@ -117,6 +117,10 @@ pub struct MoldenFile {
     pub sections: Vec<String>,
     /// 1-based line of the `[MO]` header (0 when absent).
     pub mo_line: usize,
+    /// The normal-mode sections (`[FREQ]`, `[FR-COORD]`, `[FR-NORM-COORD]`, `[INT]`).
+    pub modes: super::modes::MoldenModes,
+    /// The first malformation in a mode section: the file still opens, without modes.
+    pub modes_error: Option<ParseError>,
 }
 
 fn error(file: &str, line: usize, expected: impl Into<String>, found: impl Into<String>) -> ParseError {
@@ -192,6 +196,12 @@ impl MoldenFile {
                     }
                     out.mo_line = line_no;
                     out.orbitals = parse_mo(file, &lines, i, end)?;
+                }
+                "freq" | "fr-coord" | "fr-norm-coord" | "int" => {
+                    let read = out.modes.read(file, &name, line_no, &lines, (i, end));
+                    if let (Err(e), None) = (read, &out.modes_error) {
+                        out.modes_error = Some(e);
+                    }
                 }
                 "5d" | "5d7f" => {
                     out.pure.d = true;
@@ -330,7 +340,15 @@ impl MoldenFile {
         orbitals.sort_by_key(|o| o.spin == Spin::Beta);
         let restricted = !orbitals.iter().any(|o| o.spin == Spin::Beta);
         let wf = Wavefunction { basis, orbitals, restricted, normalization: Default::default() };
-        Ok(wavefunction_document(source, &self.title, atoms, wf, self.program(), overlap))
+        let positions: Vec<DVec3> = atoms.iter().map(|a| a.position).collect();
+        let program = self.program();
+        let mut doc = wavefunction_document(source, &self.title, atoms, wf, program, overlap);
+        // A malformed mode section leaves the modes out; the orbitals open all the same.
+        match self.modes_error.map_or_else(|| self.modes.into_vibrations(file, &positions), Err) {
+            Ok(modes) => doc.vibrations = modes,
+            Err(e) => doc.problems.push(format!("normal modes left out: {e}")),
+        }
+        Ok(doc)
     }
 }
 

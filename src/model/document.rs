@@ -1,5 +1,6 @@
 //! What one opened file gives the viewer: a molecule and zero or more volumes.
 
+use super::vibrations::Vibrations;
 use super::{Molecule, StructureView, VolumeGrid, Wavefunction};
 
 #[derive(Debug, Clone, Default)]
@@ -15,6 +16,11 @@ pub struct Document {
     /// Residues, chains, models and per-atom annotations (PDB, mmCIF, multi-frame XYZ);
     /// `molecule` is the model it shows.
     pub structure: Option<StructureView>,
+    /// Normal modes of vibration (Molden `[FREQ]`…, fchk `Vib-Modes`).
+    pub vibrations: Option<Vibrations>,
+    /// Parts of the file that could not be read while the rest opened, each saying where and
+    /// what was expected (a malformed mode section).
+    pub problems: Vec<String>,
 }
 
 impl Document {

@@ -27,6 +27,7 @@ pub mod structure;
 pub mod surface;
 pub mod synthetic;
 pub mod units;
+pub mod vibrations;
 
 pub use document::Document;
 pub use grid::{GridSpec, GridStats, VolumeGrid};

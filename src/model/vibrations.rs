@@ -1,0 +1,124 @@
+//! Normal modes of vibration: each mode's frequency, IR intensity and the Cartesian
+//! displacement of every atom, as a frequency calculation gives them; the geometry they belong
+//! to; a mode's displaced geometry and the IR spectrum they make.
+
+use glam::DVec3;
+use serde::Serialize;
+
+/// One normal mode.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct NormalMode {
+    /// Wavenumber in cm⁻¹; an imaginary frequency is negative (as Molden and Gaussian write it).
+    pub frequency_cm1: f64,
+    /// IR intensity in km/mol, where the file gives it.
+    pub ir_intensity: Option<f64>,
+    /// Each atom's displacement, as the file gives it (Cartesian, in the file's normalisation).
+    #[serde(serialize_with = "as_triples")]
+    pub displacement: Vec<DVec3>,
+}
+
+fn as_triples<S: serde::Serializer>(v: &[DVec3], s: S) -> Result<S::Ok, S::Error> {
+    s.collect_seq(v.iter().map(|d| d.to_array()))
+}
+
+impl NormalMode {
+    /// A transition state's mode (or a wrong minimum's): an imaginary frequency.
+    pub fn is_imaginary(&self) -> bool {
+        self.frequency_cm1 < 0.0
+    }
+
+    /// The largest displacement of any atom (what an amplitude is measured against).
+    pub fn largest_displacement(&self) -> f64 {
+        self.displacement.iter().map(|d| d.length()).fold(0.0, f64::max)
+    }
+}
+
+/// The normal modes of a molecule and the geometry (bohr) they were computed at.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Vibrations {
+    pub modes: Vec<NormalMode>,
+    /// The geometry the modes belong to (bohr); one position per atom of the molecule.
+    pub geometry: Vec<DVec3>,
+    /// Where the geometry comes from ("[FR-COORD]", "the molecule's"), for the user.
+    pub geometry_from: String,
+}
+
+impl Vibrations {
+    /// The geometry displaced along mode `mode` at `phase` (radians) of its oscillation, the
+    /// largest atom's displacement `amplitude` bohr at the turning points; `None` for a mode that
+    /// is not there.
+    pub fn displaced(&self, mode: usize, phase: f64, amplitude: f64) -> Option<Vec<DVec3>> {
+        let m = self.modes.get(mode)?;
+        let scale = amplitude * phase.sin() / m.largest_displacement().max(1e-12);
+        Some(self.geometry.iter().zip(&m.displacement).map(|(p, d)| *p + *d * scale).collect())
+    }
+
+    /// The IR spectrum from `from` to `to` cm⁻¹ in `points` steps: every mode with an intensity
+    /// broadened to a Lorentzian (or a Gaussian) of full width `fwhm` cm⁻¹ at half maximum and
+    /// peak height its intensity. Imaginary modes are left out.
+    pub fn ir_spectrum(&self, (from, to): (f64, f64), points: usize, fwhm: f64, lorentzian: bool) -> Vec<[f64; 2]> {
+        let half = (fwhm * 0.5).max(1e-6);
+        let shape = |dx: f64| match lorentzian {
+            true => half * half / (dx * dx + half * half),
+            false => (-std::f64::consts::LN_2 * (dx / half).powi(2)).exp(),
+        };
+        let peaks: Vec<(f64, f64)> = (self.modes.iter())
+            .filter(|m| !m.is_imaginary())
+            .filter_map(|m| Some((m.frequency_cm1, m.ir_intensity?)))
+            .collect();
+        (0..points.max(2))
+            .map(|k| {
+                let x = from + (to - from) * k as f64 / (points.max(2) - 1) as f64;
+                [x, peaks.iter().map(|&(f, i)| i * shape(x - f)).sum()]
+            })
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn water() -> Vibrations {
+        let mode = |f, i, d: [[f64; 3]; 3]| NormalMode {
+            frequency_cm1: f,
+            ir_intensity: i,
+            displacement: d.iter().map(|&v| DVec3::from(v)).collect(),
+        };
+        Vibrations {
+            modes: vec![
+                mode(-250.0, Some(5.0), [[0.0, 0.0, 0.1], [0.0, 0.0, -0.5], [0.0, 0.0, -0.5]]),
+                mode(1600.0, Some(60.0), [[0.0, 0.0, -0.07], [0.0, 0.43, 0.56], [0.0, -0.43, 0.56]]),
+                mode(3700.0, Some(10.0), [[0.0, 0.0, 0.05], [0.0, -0.58, -0.40], [0.0, 0.58, -0.40]]),
+            ],
+            geometry: vec![DVec3::new(0.0, 0.0, 0.22), DVec3::new(0.0, 1.43, -0.89), DVec3::new(0.0, -1.43, -0.89)],
+            geometry_from: "[FR-COORD]".into(),
+        }
+    }
+
+    #[test]
+    fn a_mode_displaces_the_geometry_by_its_amplitude() {
+        let v = water();
+        assert!(v.modes[0].is_imaginary() && !v.modes[1].is_imaginary());
+        let rest = v.displaced(1, 0.0, 0.3).unwrap();
+        assert_eq!(rest, v.geometry, "phase 0: the geometry itself");
+        let turned = v.displaced(1, std::f64::consts::FRAC_PI_2, 0.3).unwrap();
+        let moved: Vec<f64> = turned.iter().zip(&v.geometry).map(|(a, b)| (*a - *b).length()).collect();
+        let most = moved.iter().cloned().fold(0.0, f64::max);
+        assert!((most - 0.3).abs() < 1e-12, "the largest move is the amplitude: {moved:?}");
+        assert!(v.displaced(7, 0.0, 0.3).is_none());
+    }
+
+    #[test]
+    fn the_spectrum_peaks_at_each_real_mode_with_its_intensity() {
+        let v = water();
+        let spectrum = v.ir_spectrum((0.0, 4000.0), 4001, 20.0, true);
+        let at = |x: f64| spectrum[x.round() as usize][1];
+        assert!((at(1600.0) - 60.0).abs() < 0.1, "{}", at(1600.0));
+        assert!((at(3700.0) - 10.0).abs() < 0.1);
+        assert!((at(1610.0) - 30.0).abs() < 0.2, "half height at half the width: {}", at(1610.0));
+        assert!(at(250.0) < 0.1, "the imaginary mode makes no peak");
+        let gauss = v.ir_spectrum((1500.0, 1700.0), 201, 20.0, false);
+        assert!((gauss[100][1] - 60.0).abs() < 1e-6 && (gauss[110][1] - 30.0).abs() < 1e-6);
+    }
+}

@@ -1,0 +1,173 @@
+//! Normal modes: Molden's `[FREQ]`… sections and fchk's `Vib-*` records read back what PySCF
+//! computed (scripts/make_mode_fixtures.py) to the printed precision; malformed sections are
+//! refused with their line while the orbitals still open; `info`, `modes` and
+//! `render --normal-mode` show them.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+mod common;
+
+fn fixture(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/modes").join(name)
+}
+
+fn orbcloud(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_orbcloud")).args(args).output().expect("run orbcloud")
+}
+
+struct Expected {
+    frequency: Vec<f64>,
+    intensity: Vec<f64>,
+    displacement: Vec<Vec<[f64; 3]>>,
+    geometry: Vec<[f64; 3]>,
+}
+
+fn expected(name: &str) -> Expected {
+    let text = std::fs::read_to_string(fixture(&format!("{name}.expected.json"))).unwrap();
+    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let list = |k: &str| v[k].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect::<Vec<_>>();
+    let triple = |x: &serde_json::Value| {
+        let a = x.as_array().unwrap();
+        [a[0].as_f64().unwrap(), a[1].as_f64().unwrap(), a[2].as_f64().unwrap()]
+    };
+    Expected {
+        frequency: list("frequency_cm1"),
+        intensity: list("ir_intensity"),
+        displacement: v["displacement"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|m| m.as_array().unwrap().iter().map(triple).collect())
+            .collect(),
+        geometry: v["geometry_bohr"].as_array().unwrap().iter().map(triple).collect(),
+    }
+}
+
+/// Reads `file` and checks its modes against `name`'s expected values within `tolerance` of
+/// each printed number (absolute for Molden's fixed decimals, relative for fchk's exponents).
+fn check(name: &str, ext: &str, tolerance: impl Fn(f64) -> f64) {
+    let doc = orbcloud::formats::load(&fixture(&format!("{name}.{ext}"))).expect("the file opens");
+    assert!(doc.wavefunction.is_some() && doc.problems.is_empty(), "{:?}", doc.problems);
+    let v = doc.vibrations.as_ref().expect("modes read");
+    let e = expected(name);
+    assert_eq!(v.modes.len(), e.frequency.len());
+    let close = |a: f64, b: f64, what: &str| assert!((a - b).abs() <= tolerance(b), "{name}.{ext} {what}: {a} vs {b}");
+    for (k, m) in v.modes.iter().enumerate() {
+        close(m.frequency_cm1, e.frequency[k], "frequency");
+        assert_eq!(m.is_imaginary(), e.frequency[k] < 0.0);
+        close(m.ir_intensity.expect("an intensity"), e.intensity[k], "intensity");
+        for (d, x) in m.displacement.iter().zip(&e.displacement[k]) {
+            for c in 0..3 {
+                close(d[c], x[c], "displacement");
+            }
+        }
+    }
+    for (p, x) in v.geometry.iter().zip(&e.geometry) {
+        for c in 0..3 {
+            close(p[c], x[c], "geometry");
+        }
+    }
+}
+
+#[test]
+fn molden_and_fchk_modes_agree_with_pyscf_to_the_printed_precision() {
+    for name in ["water_rhf_631g", "nh3_planar_rhf_sto3g"] {
+        // Molden: %12.4f frequencies and intensities, %12.6f displacements, %14.6f geometry.
+        check(name, "molden", |_| 5.1e-5);
+        // fchk: %16.8E everywhere.
+        check(name, "fchk", |x| 5.1e-9 * x.abs().max(1e-300) + 1e-300);
+    }
+    let ts = orbcloud::formats::load(&fixture("nh3_planar_rhf_sto3g.molden")).unwrap();
+    let imaginary = ts.vibrations.unwrap().modes.iter().filter(|m| m.is_imaginary()).count();
+    assert_eq!(imaginary, 1, "planar ammonia is the inversion's transition state");
+}
+
+#[test]
+fn a_malformed_mode_section_is_refused_with_its_line_and_the_orbitals_still_open() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(fixture("water_rhf_631g.molden")).unwrap();
+    let line = text.lines().position(|l| l.starts_with("vibration      2")).unwrap() + 2;
+    let broken: String = text
+        .lines()
+        .enumerate()
+        .map(|(k, l)| if k + 1 == line { "   0.1  zero  0.3".to_string() } else { l.to_string() })
+        .collect::<Vec<_>>()
+        .join("\n");
+    let path = dir.path().join("broken.molden");
+    std::fs::write(&path, broken).unwrap();
+    let doc = orbcloud::formats::load(&path).expect("the orbitals still open");
+    assert!(doc.wavefunction.is_some() && doc.vibrations.is_none());
+    assert_eq!(doc.problems.len(), 1);
+    assert!(doc.problems[0].contains(&format!("broken.molden:{line}")), "{:?}", doc.problems);
+    // A count that does not match: a vibration block one atom short.
+    let cut = text.lines().position(|l| l.starts_with("vibration      1")).unwrap() + 1;
+    let short: String =
+        text.lines().enumerate().filter(|(k, _)| *k != cut).map(|(_, l)| l).collect::<Vec<_>>().join("\n");
+    std::fs::write(&path, short).unwrap();
+    let doc = orbcloud::formats::load(&path).unwrap();
+    assert!(
+        doc.problems[0].contains(&format!(":{cut}:")) && doc.problems[0].contains("3 displacement lines"),
+        "{:?}",
+        doc.problems
+    );
+    // `info` says what was left out.
+    let out = orbcloud(&["info", path.to_str().unwrap()]);
+    assert!(String::from_utf8_lossy(&out.stdout).contains("normal modes left out"));
+}
+
+#[test]
+fn info_lists_the_modes_and_modes_writes_a_period_as_xyz_frames() {
+    let ts = fixture("nh3_planar_rhf_sto3g.fchk");
+    let out = orbcloud(&["info", ts.to_str().unwrap(), "--json"]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let modes = v["modes"].as_array().unwrap();
+    assert_eq!(modes.len(), 6);
+    assert!(modes[0]["frequency_cm1"].as_f64().unwrap() < -1000.0);
+    assert!(modes[0]["ir_intensity"].as_f64().unwrap() > 100.0);
+    assert_eq!(modes[0]["displacement"].as_array().unwrap().len(), 4, "one [x, y, z] per atom");
+    let text = String::from_utf8(orbcloud(&["info", ts.to_str().unwrap()]).stdout).unwrap();
+    assert!(text.contains("6 normal modes (1 imaginary: a transition state)") && text.contains("1117.82i"), "{text}");
+
+    let dir = tempfile::tempdir().unwrap();
+    let xyz = dir.path().join("umbrella.xyz");
+    let out = orbcloud(&["modes", ts.to_str().unwrap(), "--mode", "1", "--frames", "8", "-o", xyz.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let doc = orbcloud::formats::load(&xyz).expect("the XYZ reader takes the frames back");
+    let frames = &doc.structure.as_ref().unwrap().structure.models;
+    assert_eq!(frames.len(), 8);
+    // Frame 1 is the geometry itself; frame 3 (a quarter period) the largest displacement.
+    let fchk = orbcloud::formats::load(&ts).unwrap();
+    let first = doc.molecule.atoms.iter().zip(&fchk.molecule.atoms).map(|(a, b)| (a.position - b.position).length());
+    assert!(first.fold(0.0, f64::max) < 1e-6);
+    let bad = orbcloud(&["modes", ts.to_str().unwrap(), "--mode", "7", "-o", xyz.to_str().unwrap()]);
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("modes 1 to 6"));
+    let none = orbcloud(&[
+        "modes",
+        fixture("../wavefunctions/h2o_cart_631gs.molden").to_str().unwrap(),
+        "--mode",
+        "1",
+        "-o",
+        "x.xyz",
+    ]);
+    assert!(String::from_utf8_lossy(&none.stderr).contains("no normal modes"));
+}
+
+#[test]
+fn render_draws_the_displaced_geometry() {
+    let dir = tempfile::tempdir().unwrap();
+    let ts = fixture("nh3_planar_rhf_sto3g.molden");
+    let draw = |phase: &str| {
+        let png = dir.path().join(format!("p{phase}.png"));
+        let args = ["render", ts.to_str().unwrap(), "--lavapipe", "--no-volume", "--size", "160x120", "--view", "y"];
+        let out = orbcloud(
+            &[&args[..], &["--normal-mode", "1", "--phase", phase, "--amplitude", "0.8", "-o", png.to_str().unwrap()]]
+                .concat(),
+        );
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        image::open(&png).unwrap().to_rgba8()
+    };
+    let (rest, up, down) = (draw("0"), draw("90"), draw("270"));
+    assert!(common::mean_difference(&rest, &up) > 0.2, "the atoms moved: {}", common::mean_difference(&rest, &up));
+    assert!(common::mean_difference(&up, &down) > 0.2, "the other way: {}", common::mean_difference(&up, &down));
+}
