@@ -8,6 +8,7 @@ use crate::model::grid::ValueKind;
 use crate::model::isosurface::{self, Level, Mesh};
 use crate::model::surface::{self, Sphere, SurfaceError};
 use crate::model::units::ANGSTROM_PER_BOHR;
+use crate::model::vibrations::Vibrations;
 use crate::model::{Document, VolumeGrid};
 use crate::scene::coloring::atom_colors;
 use crate::scene::selection::shown_atoms;
@@ -140,4 +141,118 @@ pub fn color_by_values(points: &[glam::Vec3], grid: &VolumeGrid) -> Vec<[f32; 3]
             }
         })
         .collect()
+}
+
+/// Each atom's displacement along mode `mode` of `v` as an arrow from the atom (a cylinder and a
+/// cone), the largest `ARROW_LENGTH_PER_AMPLITUDE` × `amplitude` bohr long, all in one mesh;
+/// atoms that hardly move get none. `None` when the mode is not there.
+pub fn mode_arrows(v: &Vibrations, mode: usize, amplitude: f64) -> Option<(Mesh, SurfaceLook)> {
+    let m = v.modes.get(mode)?;
+    let scale = ARROW_LENGTH_PER_AMPLITUDE * amplitude / m.largest_displacement().max(1e-12);
+    let mut mesh = Mesh::default();
+    for (p, d) in v.geometry.iter().zip(&m.displacement) {
+        let vector = *d * scale;
+        if vector.length() > 0.1 {
+            arrow(&mut mesh, p.as_vec3(), vector.as_vec3());
+        }
+    }
+    Some((mesh, SurfaceLook::from(ARROW_COLOR)))
+}
+
+/// How long the longest arrow is for each bohr of amplitude: longer than the motion, to be seen.
+pub const ARROW_LENGTH_PER_AMPLITUDE: f64 = 5.0;
+/// Linear RGB of the arrows.
+const ARROW_COLOR: [f32; 3] = [0.95, 0.75, 0.1];
+
+/// Appends an arrow from `from` along `vector` to `mesh`: a closed cylinder and cone, outward
+/// normals.
+fn arrow(mesh: &mut Mesh, from: glam::Vec3, vector: glam::Vec3) {
+    const SIDES: u32 = 12;
+    let length = vector.length();
+    let axis = vector / length;
+    let (u, w) = axis.any_orthonormal_pair();
+    let head = (0.4 * length).min(0.6);
+    let (shaft, tip) = (from + axis * (length - head), from + vector);
+    let (r_shaft, r_head) = (0.09f32, 0.22f32);
+    let ring = |k: u32| {
+        let a = std::f32::consts::TAU * k as f32 / SIDES as f32;
+        u * a.cos() + w * a.sin()
+    };
+    let push = |mesh: &mut Mesh, p: glam::Vec3, n: glam::Vec3| {
+        mesh.positions.push(p);
+        mesh.normals.push(n);
+        mesh.positions.len() as u32 - 1
+    };
+    // Each part: two rings of vertices (or a ring and a point) joined by triangles.
+    let band = |mesh: &mut Mesh, a: [(glam::Vec3, f32, glam::Vec3); 2]| {
+        let base = mesh.positions.len() as u32;
+        for k in 0..SIDES {
+            let r = ring(k);
+            for (centre, radius, normal) in a {
+                let n = if normal == glam::Vec3::ZERO { r } else { normal };
+                push(mesh, centre + r * radius, n);
+            }
+        }
+        for k in 0..SIDES {
+            let (i, j) = (base + 2 * k, base + 2 * ((k + 1) % SIDES));
+            mesh.indices.extend([i, j, i + 1, j, j + 1, i + 1]);
+        }
+    };
+    band(mesh, [(from, r_shaft, glam::Vec3::ZERO), (shaft, r_shaft, glam::Vec3::ZERO)]);
+    // The cone's side normals lean towards the tip.
+    let lean = |k: u32| (ring(k) * head + axis * r_head).normalize();
+    let base = mesh.positions.len() as u32;
+    for k in 0..SIDES {
+        let n = lean(k);
+        push(mesh, shaft + ring(k) * r_head, n);
+        push(mesh, tip, n);
+    }
+    for k in 0..SIDES {
+        let (i, j) = (base + 2 * k, base + 2 * ((k + 1) % SIDES));
+        mesh.indices.extend([i, j, i + 1]);
+    }
+    // Flat discs close the shaft's start and the cone's base.
+    for (centre, radius, normal) in [(from, r_shaft, -axis), (shaft, r_head, -axis)] {
+        let c = push(mesh, centre, normal);
+        let first = mesh.positions.len() as u32;
+        for k in 0..SIDES {
+            push(mesh, centre + ring(k) * radius, normal);
+        }
+        for k in 0..SIDES {
+            mesh.indices.extend([c, first + (k + 1) % SIDES, first + k]);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::vibrations::NormalMode;
+    use glam::DVec3;
+
+    #[test]
+    fn a_modes_arrows_start_at_the_atoms_and_the_longest_has_its_length() {
+        let v = Vibrations {
+            modes: vec![NormalMode {
+                frequency_cm1: 1600.0,
+                ir_intensity: None,
+                displacement: vec![DVec3::new(0.0, 0.0, 0.5), DVec3::new(0.001, 0.0, 0.0), DVec3::new(0.0, -0.25, 0.0)],
+            }],
+            geometry: vec![DVec3::ZERO, DVec3::X * 3.0, DVec3::Y * 3.0],
+            geometry_from: String::new(),
+        };
+        let (mesh, _) = mode_arrows(&v, 0, 0.5).expect("the mode is there");
+        assert!(mode_arrows(&v, 1, 0.5).is_none());
+        // Two arrows (the atom that hardly moves has none), each 6 rings of 12 vertices plus caps.
+        assert_eq!(mesh.positions.len(), 2 * (12 * 4 + 2 * 13));
+        assert!(mesh.indices.iter().all(|&i| (i as usize) < mesh.positions.len()));
+        let tip = mesh.positions.iter().map(|p| p.z).fold(f32::MIN, f32::max);
+        assert!((tip - 2.5).abs() < 1e-5, "the longest arrow is 5 × 0.5 bohr: {tip}");
+        let tip = glam::Vec3::new(0.0, 3.0 - 1.25, 0.0);
+        assert!(
+            mesh.positions.iter().any(|p| (*p - tip).length() < 1e-5),
+            "the other arrow half as long, its tip at {tip}"
+        );
+        assert!(mesh.normals.iter().all(|n| (n.length() - 1.0).abs() < 1e-4));
+    }
 }

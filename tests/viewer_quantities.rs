@@ -325,3 +325,50 @@ fn the_panels_follow_the_scene() {
     h.run_steps(2);
     assert!(h.query_by_label("Orbitals").is_none(), "the orbital browser left with its file");
 }
+
+#[test]
+fn a_normal_mode_animates_with_arrows_and_a_click_on_its_band_picks_it() {
+    let ts = fixture("modes/nh3_planar_rhf_sto3g.molden");
+    let mut h = open(vec![ts]);
+    let dir = tempfile::tempdir().unwrap();
+    assert!(h.query_by_label("Vibrations").is_some(), "the modes panel");
+    let still = picture(&mut h, dir.path(), "still");
+    // The imaginary mode, marked with an i.
+    h.get_by_label_contains("1117.82i").click();
+    h.run_steps(3);
+    assert_eq!(h.state().objects[0].state.vibration.mode, Some(0));
+    wait_loaded(&mut h);
+    let a = picture(&mut h, dir.path(), "a");
+    for _ in 0..10 {
+        std::thread::sleep(std::time::Duration::from_millis(30));
+        h.run_steps(1);
+    }
+    let b = picture(&mut h, dir.path(), "b");
+    assert!(common::mean_difference(&still, &a) > 0.05, "the atoms moved and the arrows show");
+    assert!(common::mean_difference(&a, &b) > 0.01, "and keep moving: {}", common::mean_difference(&a, &b));
+
+    // A click on the 1852 cm⁻¹ band picks its mode.
+    let transform = h.state().spectrum.expect("the spectrum is drawn");
+    let band = transform.position_from_point(&egui_plot::PlotPoint::new(1851.99, 3.0));
+    click_at(&mut h, band, false);
+    h.run_steps(2);
+    assert_eq!(h.state().objects[0].state.vibration.mode, Some(1), "the band's mode");
+
+    // The session keeps the mode and its settings; "none" puts the atoms back.
+    h.state_mut().objects[0].state.vibration.amplitude = 0.7;
+    h.run_steps(2);
+    let session = dir.path().join("modes.orbcloud.toml");
+    h.state_mut().save_session(&session);
+    let saved = h.state().objects[0].state.vibration;
+    let ctx = h.ctx.clone();
+    h.state_mut().open_as(fixture("wavefunctions/h2o_cart_631gs.molden"), orbcloud::app::Opening::Replace, &ctx);
+    wait_loaded(&mut h);
+    assert!(h.query_by_label("Vibrations").is_none(), "a file without modes has no modes panel");
+    h.state_mut().open(session, &ctx);
+    wait_loaded(&mut h);
+    assert_eq!(h.state().objects[0].state.vibration, saved);
+    h.get_by_label("none").click();
+    h.run_steps(3);
+    wait_loaded(&mut h);
+    assert_eq!(common::mean_difference(&still, &picture(&mut h, dir.path(), "rest")), 0.0, "back at rest");
+}

@@ -14,6 +14,7 @@ pub mod scan;
 mod scene_panel;
 pub mod session;
 pub mod state;
+pub mod vibrations;
 pub mod viewport;
 
 use std::path::{Path, PathBuf};
@@ -187,6 +188,8 @@ pub struct OrbApp {
     /// Each object's state as the GPU shows it: what the next frame's edits are compared with
     /// ([`Self::apply_changes`]), wherever they came from (a panel, a test, a script).
     applied: Vec<ObjectState>,
+    /// Where the IR spectrum was last drawn (tests click its peaks).
+    pub spectrum: Option<egui_plot::PlotTransform>,
     /// A session's measurements, kept until its files have loaded.
     restoring_measurements: Option<Vec<crate::model::measure::Measurement>>,
     /// Whether *Open…* and dropped files replace the scene instead of adding to it.
@@ -359,6 +362,7 @@ impl OrbApp {
             pending: Vec::new(),
             applied: Vec::new(),
             restoring_measurements: None,
+            spectrum: None,
             open_replaces: false,
             scroll_to_frontier: false,
             viewport,
@@ -715,6 +719,9 @@ impl OrbApp {
             if changes.surface {
                 vp.update_surface(n, &o.doc, &o.state);
             }
+            if changes.rest {
+                vp.set_atoms(n, &o.doc, &o.state);
+            }
             if changes.placement || changes.visibility {
                 vp.set_visibility(n, &o.state);
             }
@@ -740,6 +747,21 @@ impl OrbApp {
         if moved {
             self.world = World::of(&self.objects);
         }
+    }
+
+    /// Moves the atoms of every object that shows a normal mode to where the mode is at
+    /// `seconds` into the animation; whether any mode plays (the window then keeps drawing).
+    fn animate_modes(&mut self, seconds: f64) -> bool {
+        let Some(vp) = &mut self.viewport else { return false };
+        let mut playing = false;
+        for (n, o) in self.objects.iter().enumerate() {
+            let v = o.state.vibration;
+            if v.mode.is_some() && o.doc.vibrations.is_some() {
+                vp.displace_atoms(n, &o.doc, &o.state, v.phase(seconds));
+                playing |= v.playing;
+            }
+        }
+        playing
     }
 
     /// Puts back a session's measurements once its files have loaded (those naming atoms the
@@ -1017,8 +1039,12 @@ impl eframe::App for OrbApp {
                 &mut self.scroll_to_frontier,
             );
         }
+        if let Some(o) = self.objects.get_mut(self.active).filter(|_| self.scan.is_none()) {
+            vibrations::panel(ui, &o.doc, &mut o.state.vibration, &mut self.spectrum);
+        }
         self.apply_changes();
         self.apply_scene_edits();
+        let modes_play = self.animate_modes(ui.input(|i| i.time));
         if let Some(model) = models::tick(&ctx, self) {
             self.show_model(model);
         }
@@ -1072,7 +1098,8 @@ impl eframe::App for OrbApp {
                     }
                 }
                 (None, Some(vp)) => {
-                    let interacting = detail::interacting(ui.ctx(), false);
+                    // A mode playing redraws every frame, as a drag does.
+                    let interacting = detail::interacting(ui.ctx(), modes_play);
                     vp.detail = detail::Detail::for_frame(interacting, vp.ctx.info.device_type, 1);
                     let picture_ms = vp.take_picture_ms();
                     vp.detail.lod_scale = vp.lod_budget.next(interacting, picture_ms);
@@ -1108,6 +1135,9 @@ impl eframe::App for OrbApp {
         });
         if self.is_loading() {
             ctx.request_repaint_after(std::time::Duration::from_millis(100));
+        }
+        if modes_play {
+            ctx.request_repaint();
         }
     }
 }

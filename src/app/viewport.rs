@@ -118,6 +118,8 @@ struct LayerJobs {
     surface: Arc<Mutex<Option<BuiltSurface>>>,
     /// Thousandths of the molecular surface being built (the status line's bar); 0 when none is.
     surface_progress: Arc<AtomicU32>,
+    /// An atoms layer's atoms displaced along a mode: (mode, phase bits, amplitude bits).
+    displaced: Option<(usize, u64, u32)>,
 }
 
 /// A molecular surface with what it was built from: its settings and the atoms' fingerprint.
@@ -401,6 +403,11 @@ impl Viewport {
         });
         let slot = &self.slots[l];
         let (cache, progress) = (slot.surface.clone(), slot.surface_progress.clone());
+        // The shown mode's arrows are drawn with the atoms.
+        let vibration = state.vibration;
+        let arrows = vibration.arrows_key().and_then(|(mode, _)| {
+            crate::meshes::mode_arrows(doc.vibrations.as_ref()?, mode, vibration.amplitude as f64)
+        });
         let doc = doc.clone();
         let (surface, selection) = (state.surface, state.selection.clone());
         let max_bytes = self.ctx.device.limits().max_buffer_size;
@@ -409,7 +416,7 @@ impl Viewport {
             let shown = (&*doc, &surface, selection.as_str(), grid);
             let (built, note) = molecular_surface_cached(&cache, shown, max_bytes, (cancel, &progress));
             progress.store(0, Ordering::Relaxed);
-            prepared((built.into_iter().collect(), note))
+            prepared((built.into_iter().chain(arrows).collect(), note))
         });
     }
 
@@ -545,6 +552,7 @@ impl Viewport {
             extraction: Latest::new("cutting isosurfaces", move || again()),
             surface: Arc::default(),
             surface_progress: Arc::default(),
+            displaced: None,
         }
     }
 
@@ -567,12 +575,39 @@ impl Viewport {
         self.generation += 1;
     }
 
-    /// Puts object `n`'s molecule anew (another model or frame of a structure).
+    /// Puts object `n`'s molecule anew (another model or frame of a structure, or back at the
+    /// file's geometry after a mode).
     pub fn set_atoms(&mut self, n: usize, doc: &Document, state: &ObjectState) {
         let Some(l) = self.layer_of(n, Part::Atoms) else { return };
         let layer = self.renderer.layer_mut(&self.ctx, l);
         crate::layers::show_atoms(&self.ctx, layer, doc, &state.atoms, &state.selection);
+        self.slots[l].displaced = None;
         self.generation += 1;
+    }
+
+    /// Draws object `n`'s atoms displaced along its shown mode at `phase` (radians), when they
+    /// are not there already; the bonds stay the file's. Whether anything was drawn anew.
+    pub fn displace_atoms(&mut self, n: usize, doc: &Document, state: &ObjectState, phase: f64) -> bool {
+        let (Some(l), Some(v), Some(mode)) = (self.layer_of(n, Part::Atoms), &doc.vibrations, state.vibration.mode)
+        else {
+            return false;
+        };
+        let key = (mode, phase.to_bits(), state.vibration.amplitude.to_bits());
+        if self.slots[l].displaced == Some(key) {
+            return false;
+        }
+        let Some(positions) = v.displaced(mode, phase, state.vibration.amplitude as f64) else { return false };
+        let mut molecule = doc.molecule.clone();
+        for (atom, p) in molecule.atoms.iter_mut().zip(positions) {
+            atom.position = p;
+        }
+        let look = crate::layers::atom_look(doc, &state.atoms, &state.selection);
+        let layer = self.renderer.layer_mut(&self.ctx, l);
+        layer.set_atoms(&self.ctx, &molecule, state.atoms.style, Some(&look));
+        layer.atoms.depth_cue = state.atoms.depth_cue;
+        self.slots[l].displaced = Some(key);
+        self.generation += 1;
+        true
     }
 
     /// Moves every layer of object `n` where its state places it.

@@ -53,6 +53,15 @@ impl Vibrations {
         Some(self.geometry.iter().zip(&m.displacement).map(|(p, d)| *p + *d * scale).collect())
     }
 
+    /// The real mode whose band is nearest wavenumber `x`, within `tolerance` cm⁻¹ (a click on
+    /// a spectrum).
+    pub fn mode_at(&self, x: f64, tolerance: f64) -> Option<usize> {
+        (self.modes.iter().enumerate())
+            .filter(|(_, m)| !m.is_imaginary() && (m.frequency_cm1 - x).abs() <= tolerance)
+            .min_by(|a, b| (a.1.frequency_cm1 - x).abs().total_cmp(&(b.1.frequency_cm1 - x).abs()))
+            .map(|(k, _)| k)
+    }
+
     /// The IR spectrum from `from` to `to` cm⁻¹ in `points` steps: every mode with an intensity
     /// broadened to a Lorentzian (or a Gaussian) of full width `fwhm` cm⁻¹ at half maximum and
     /// peak height its intensity. Imaginary modes are left out.
@@ -120,5 +129,8 @@ mod tests {
         assert!(at(250.0) < 0.1, "the imaginary mode makes no peak");
         let gauss = v.ir_spectrum((1500.0, 1700.0), 201, 20.0, false);
         assert!((gauss[100][1] - 60.0).abs() < 1e-6 && (gauss[110][1] - 30.0).abs() < 1e-6);
+        assert_eq!(v.mode_at(1590.0, 20.0), Some(1), "the band nearest the click");
+        assert_eq!(v.mode_at(2500.0, 20.0), None, "nothing within the tolerance");
+        assert_eq!(v.mode_at(-250.0, 20.0), None, "imaginary modes have no band");
     }
 }

@@ -12,6 +12,7 @@ pub mod settings;
 pub mod slicing;
 pub mod transfer;
 pub mod translucency;
+pub mod vibration;
 pub mod view;
 
 pub use camera::Camera;

@@ -8,6 +8,7 @@ use crate::model::Document;
 use crate::model::orbitals::Quantity;
 
 use super::quantity::{AtomLook, Evaluation, QuantityState, Source, first_source};
+use super::vibration::VibrationState;
 use super::{Camera, IsosurfaceSettings, RenderSettings, SurfaceChoice, SurfaceSettings};
 
 /// Where an object sits in the scene: a rigid placement (rotation about the object's own
@@ -59,6 +60,8 @@ pub struct ObjectState {
     pub selection: String,
     /// A molecular surface around the atoms shown.
     pub surface: SurfaceSettings,
+    /// The normal mode shown, how it moves, its arrows and the IR spectrum's broadening.
+    pub vibration: VibrationState,
 }
 
 impl Default for ObjectState {
@@ -73,6 +76,7 @@ impl Default for ObjectState {
             evaluation: Evaluation::default(),
             selection: String::new(),
             surface: SurfaceSettings::default(),
+            vibration: VibrationState::default(),
         }
     }
 }
@@ -157,8 +161,10 @@ pub struct Changes {
     pub placement: bool,
     /// The object's or a quantity's visibility.
     pub visibility: bool,
-    /// The molecular surface is built (or coloured) again.
+    /// The molecular surface (and the mode's arrows, drawn with it) is built again.
     pub surface: bool,
+    /// The atoms go back to the file's geometry (no mode is shown any more).
+    pub rest: bool,
     /// Per quantity (when `layers` is false): what to redo.
     pub quantities: Vec<QuantityChanges>,
 }
@@ -183,7 +189,7 @@ impl QuantityChanges {
 impl Changes {
     /// Whether nothing needs to be redone.
     pub fn is_empty(&self) -> bool {
-        !(self.layers || self.atoms || self.placement || self.visibility || self.surface)
+        !(self.layers || self.atoms || self.placement || self.visibility || self.surface || self.rest)
             && self.quantities.iter().all(|q| !q.any())
     }
 }
@@ -243,7 +249,9 @@ pub fn changes(before: &ObjectState, after: &ObjectState) -> Changes {
         placement: before.placement != after.placement,
         visibility: visible(before) != visible(after),
         surface: before.surface != after.surface
-            || (after.surface.choice != SurfaceChoice::Off && before.selection != after.selection),
+            || (after.surface.choice != SurfaceChoice::Off && before.selection != after.selection)
+            || before.vibration.arrows_key() != after.vibration.arrows_key(),
+        rest: before.vibration.mode.is_some() && after.vibration.mode.is_none(),
         quantities,
     }
 }
@@ -264,6 +272,7 @@ struct StoredObject {
     evaluation: Evaluation,
     selection: String,
     surface: SurfaceSettings,
+    vibration: VibrationState,
     settings: Option<RenderSettings>,
     isosurfaces: Vec<IsosurfaceSettings>,
     volume: usize,
@@ -291,6 +300,7 @@ impl From<StoredObject> for ObjectState {
             evaluation: s.evaluation,
             selection: s.selection,
             surface: s.surface,
+            vibration: s.vibration,
         }
     }
 }

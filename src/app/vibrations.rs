@@ -1,0 +1,123 @@
+//! The normal modes of the active object's file: the list (frequency, IR intensity, imaginary
+//! ones marked), the mode animated with its amplitude, speed and arrows, and the IR spectrum,
+//! wavenumbers descending as chemists plot them, where a click on a band picks its mode.
+
+use egui::{RichText, ScrollArea, Slider};
+use egui_plot::{Line, Plot, PlotPoint, PlotTransform, VLine};
+
+use crate::model::Document;
+use crate::model::vibrations::Vibrations;
+use crate::scene::vibration::VibrationState;
+
+/// The panel's height, points.
+const HEIGHT: f32 = 260.0;
+
+/// Shows the panel when `doc` has modes, editing `v` in place; `spectrum` keeps where the
+/// spectrum was drawn (for tests to click its bands).
+pub fn panel(ui: &mut egui::Ui, doc: &Document, v: &mut VibrationState, spectrum: &mut Option<PlotTransform>) {
+    let Some(modes) = &doc.vibrations else {
+        *spectrum = None;
+        return;
+    };
+    egui::Panel::bottom("vibrations").exact_size(HEIGHT).show(ui, |ui| {
+        ui.columns(2, |columns| {
+            controls(&mut columns[0], modes, v);
+            *spectrum = Some(ir_spectrum(&mut columns[1], modes, v));
+        });
+    });
+}
+
+fn controls(ui: &mut egui::Ui, modes: &Vibrations, v: &mut VibrationState) {
+    ui.heading("Vibrations");
+    let imaginary = modes.modes.iter().filter(|m| m.is_imaginary()).count();
+    let what = match imaginary {
+        0 => "a minimum".to_string(),
+        1 => "1 imaginary: a transition state".to_string(),
+        n => format!("{n} imaginary"),
+    };
+    ui.label(
+        RichText::new(format!("{} modes, {what}; geometry from {}", modes.modes.len(), modes.geometry_from))
+            .small()
+            .weak(),
+    );
+    ui.horizontal(|ui| {
+        if ui.selectable_label(v.mode.is_none(), "none").on_hover_text("the atoms at the file's geometry").clicked() {
+            v.mode = None;
+        }
+        let label = if v.playing { "pause" } else { "play" };
+        if ui.button(label).clicked() {
+            v.playing = !v.playing;
+        }
+        ui.checkbox(&mut v.arrows, "arrows");
+    });
+    ui.horizontal(|ui| {
+        ui.spacing_mut().slider_width = 70.0;
+        ui.add(Slider::new(&mut v.amplitude, 0.05..=1.5).text("bohr"))
+            .on_hover_text("the largest atom's displacement at the turning points");
+        ui.add(Slider::new(&mut v.speed, 0.1..=3.0).text("per s")).on_hover_text("oscillations per second");
+    });
+    ui.label(RichText::new(format!("{:>4} {:>11} {:>9}", "mode", "cm-1", "km/mol")).monospace().strong());
+    ScrollArea::vertical().id_salt("modes").show(ui, |ui| {
+        for (k, m) in modes.modes.iter().enumerate() {
+            let frequency = match m.is_imaginary() {
+                true => format!("{:.2}i", -m.frequency_cm1),
+                false => format!("{:.2}", m.frequency_cm1),
+            };
+            let intensity = m.ir_intensity.map_or("—".to_string(), |i| format!("{i:.1}"));
+            let mut row = RichText::new(format!("{:>4} {:>11} {:>9}", k + 1, frequency, intensity)).monospace();
+            if m.is_imaginary() {
+                row = row.color(ui.visuals().warn_fg_color);
+            }
+            let button =
+                egui::Button::selectable(v.mode == Some(k), row).min_size(egui::vec2(ui.available_width(), 0.0));
+            if ui.add(button).clicked() {
+                v.mode = Some(k);
+            }
+        }
+    });
+}
+
+/// The IR spectrum with its bands broadened as `v` says and a stick per mode; a click picks the
+/// mode of the band under it. Returns where it was drawn.
+fn ir_spectrum(ui: &mut egui::Ui, modes: &Vibrations, v: &mut VibrationState) -> PlotTransform {
+    ui.horizontal(|ui| {
+        ui.spacing_mut().slider_width = 70.0;
+        ui.add(Slider::new(&mut v.fwhm, 2.0..=100.0).text("FWHM"))
+            .on_hover_text("the bands' full width at half maximum, cm-1");
+        ui.selectable_value(&mut v.lorentzian, true, "Lorentz");
+        ui.selectable_value(&mut v.lorentzian, false, "Gauss");
+    });
+    let top = modes.modes.iter().map(|m| m.frequency_cm1).fold(1000.0, f64::max) + 200.0;
+    let curve = modes.ir_spectrum((0.0, top), 1200, v.fwhm as f64, v.lorentzian);
+    let peak = curve.iter().map(|p| p[1]).fold(1.0, f64::max);
+    let response = Plot::new("ir spectrum")
+        .invert_x(true)
+        .x_axis_label("wavenumber (cm-1)")
+        .y_axis_label("IR (km/mol)")
+        .allow_zoom(false)
+        .allow_drag(false)
+        .allow_scroll(false)
+        .allow_boxed_zoom(false)
+        .include_x(0.0)
+        .include_x(top)
+        .include_y(0.0)
+        .include_y(peak * 1.1)
+        .show(ui, |plot| {
+            plot.line(Line::new("spectrum", curve));
+            for m in modes.modes.iter().filter(|m| !m.is_imaginary()) {
+                let i = m.ir_intensity.unwrap_or(0.0);
+                plot.line(Line::new("", vec![[m.frequency_cm1, 0.0], [m.frequency_cm1, i]]).width(1.0));
+            }
+            if let Some(m) = v.mode.and_then(|k| modes.modes.get(k)).filter(|m| !m.is_imaginary()) {
+                plot.vline(VLine::new("shown", m.frequency_cm1));
+            }
+            let clicked = plot.response().clicked();
+            clicked.then(|| plot.pointer_coordinate()).flatten()
+        });
+    if let Some(PlotPoint { x, .. }) = response.inner
+        && let Some(k) = modes.mode_at(x, (v.fwhm as f64).max(top / 100.0))
+    {
+        v.mode = Some(k);
+    }
+    response.transform
+}
