@@ -171,3 +171,36 @@ fn render_draws_the_displaced_geometry() {
     assert!(common::mean_difference(&rest, &up) > 0.2, "the atoms moved: {}", common::mean_difference(&rest, &up));
     assert!(common::mean_difference(&up, &down) > 0.2, "the other way: {}", common::mean_difference(&up, &down));
 }
+
+#[test]
+fn a_modes_arrows_match_their_golden_image() {
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("arrows.png");
+    let ts = fixture("nh3_planar_rhf_sto3g.molden");
+    let args = [
+        "render",
+        ts.to_str().unwrap(),
+        "--lavapipe",
+        "--no-volume",
+        "--size",
+        "200x150",
+        "--view",
+        "y",
+        "--yaw",
+        "70",
+        "--normal-mode",
+        "1",
+        "--phase",
+        "0",
+        "--amplitude",
+        "0.5",
+        "--arrows",
+        "-o",
+        png.to_str().unwrap(),
+    ];
+    let out = orbcloud(&args);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    common::assert_golden("mode_arrows", &image::open(&png).unwrap().to_rgba8());
+    let bad = orbcloud(&["render", ts.to_str().unwrap(), "--arrows", "-o", "x.png"]);
+    assert!(!bad.status.success(), "--arrows needs a mode");
+}

@@ -8,8 +8,10 @@ use std::path::PathBuf;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use orbcloud::model::Document;
+use orbcloud::model::isosurface::Mesh;
 use orbcloud::model::units::ANGSTROM_PER_BOHR;
 use orbcloud::model::vibrations::Vibrations;
+use orbcloud::scene::translucency::SurfaceLook;
 
 /// Which mode to show, where in its oscillation and how far.
 #[derive(Args, Clone)]
@@ -24,6 +26,9 @@ pub struct ModeArgs {
     /// The largest atom's displacement at the turning points, bohr.
     #[arg(long, default_value_t = 0.4)]
     pub amplitude: f64,
+    /// Draw each atom's displacement along the mode as an arrow from the file's geometry.
+    #[arg(long, requires = "normal_mode")]
+    pub arrows: bool,
 }
 
 /// The file's modes and the 0-based index of `mode` (1-based), or an error saying what there is.
@@ -57,6 +62,15 @@ impl ModeArgs {
             atom.position = p;
         }
         Ok(())
+    }
+}
+
+impl ModeArgs {
+    /// The mode's arrows, when `--arrows` asks for them.
+    pub fn arrows(&self, doc: &Document) -> Result<Option<(Mesh, SurfaceLook)>> {
+        let (Some(mode), true) = (self.normal_mode, self.arrows) else { return Ok(None) };
+        let (v, k) = chosen(doc, mode)?;
+        Ok(orbcloud::meshes::mode_arrows(v, k, self.amplitude))
     }
 }
 

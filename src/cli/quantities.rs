@@ -23,7 +23,7 @@ const BESIDE: &str = "--beside";
 /// Options that belong to the whole picture or file, not to a quantity: wherever they are
 /// given, they join the first part of the command line (`mesh FILE --density --iso 0.1
 /// --orbital homo --iso 0.05 -o out.glb`).
-const WHOLE_PICTURE: [&str; 24] = [
+const WHOLE_PICTURE: [&str; 25] = [
     "--output",
     "-o",
     "--size",
@@ -48,9 +48,10 @@ const WHOLE_PICTURE: [&str; 24] = [
     "--normal-mode",
     "--phase",
     "--amplitude",
+    "--arrows",
 ];
 /// Those of them that take no value.
-const WHOLE_PICTURE_FLAGS: [&str; 2] = ["--lavapipe", "--direct"];
+const WHOLE_PICTURE_FLAGS: [&str; 3] = ["--lavapipe", "--direct", "--arrows"];
 
 /// A quantity given after the first, with the options that followed it.
 pub struct Later {

@@ -169,21 +169,21 @@ impl IsoArgs {
     }
 }
 
-/// Puts `--iso` surfaces of `grid` and a molecular surface into the renderer (nothing when
-/// neither was asked for).
+/// Puts `--iso` surfaces of `grid` and `more` (a molecular surface, a mode's arrows) into the
+/// renderer (nothing when none was asked for).
 pub fn show(
     ctx: &GpuContext,
     renderer: &mut Renderer,
     grid: Option<&VolumeGrid>,
     iso: &IsoArgs,
-    molsurface: Option<(Mesh, SurfaceLook)>,
+    more: Vec<(Mesh, SurfaceLook)>,
 ) {
     let mut meshes = match grid {
         Some(grid) if !iso.levels().is_empty() => iso.meshes(grid, &iso.base()),
         _ => Vec::new(),
     };
-    let what = if molsurface.is_some() { "surfaces" } else { "isosurfaces" };
-    meshes.extend(molsurface);
+    let what = if more.is_empty() { "isosurfaces" } else { "surfaces" };
+    meshes.extend(more);
     if meshes.is_empty() {
         return;
     }
