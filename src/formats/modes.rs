@@ -34,6 +34,19 @@ fn numbers(tokens: &[&str]) -> Option<Vec<f64>> {
     tokens.iter().map(|t| parse_real(t)).collect()
 }
 
+/// The first number of each line of `body` (index, text), with its 1-based line.
+fn first_numbers<'a>(
+    file: &str,
+    body: impl Iterator<Item = (usize, &'a &'a str)>,
+    expected: &str,
+) -> Result<Vec<(usize, f64)>, ParseError> {
+    body.map(|(k, l)| {
+        let first = l.split_whitespace().next().and_then(parse_real).filter(|v| v.is_finite());
+        first.map(|v| (k + 1, v)).ok_or_else(|| error(file, k + 1, expected, excerpt(l)))
+    })
+    .collect()
+}
+
 impl MoldenModes {
     /// Reads mode section `name` (lower case) whose header is line `header` (1-based) and whose
     /// body is `lines[start..end]`; other sections are no business of it.
@@ -49,12 +62,7 @@ impl MoldenModes {
         match name {
             "freq" => {
                 self.freq_line = header;
-                for (k, l) in body {
-                    let t: Vec<&str> = l.split_whitespace().collect();
-                    let f = parse_real(t[0]).filter(|f| f.is_finite());
-                    let f = f.ok_or_else(|| error(file, k + 1, "a wavenumber in cm⁻¹", excerpt(l)))?;
-                    self.frequencies.push((k + 1, f));
-                }
+                self.frequencies = first_numbers(file, body, "a wavenumber in cm⁻¹")?;
             }
             "fr-coord" => {
                 self.coord_line = header;
@@ -83,12 +91,8 @@ impl MoldenModes {
             }
             "int" => {
                 self.int_line = header;
-                for (k, l) in body {
-                    let t: Vec<&str> = l.split_whitespace().collect();
-                    let i = parse_real(t[0]).filter(|i| i.is_finite());
-                    let i = i.ok_or_else(|| error(file, k + 1, "an IR intensity in km/mol", excerpt(l)))?;
-                    self.intensities.push((k + 1, i));
-                }
+                // A Raman activity may follow in a second column.
+                self.intensities = first_numbers(file, body, "an IR intensity in km/mol")?;
             }
             _ => {}
         }
