@@ -578,6 +578,13 @@ fn gpu(lavapipe: bool) -> Result<GpuContext> {
 }
 
 fn main() -> Result<()> {
+    // `orbcloud info FILE | head`: a closed output ends the command quietly, as it does any
+    // Unix tool, instead of a panic at the next line printed.
+    #[cfg(unix)]
+    // SAFETY: setting a signal's disposition to its default before any thread starts.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     // Each quantity after the first comes with its own options ([`quantities_cli`]).
     let (line, later) = quantities_cli::split(std::env::args_os().collect())?;

@@ -40,7 +40,7 @@ const CRATE_RULES: &[(&str, &[&str])] = &[
     ("app", &["glam", "serde", "toml", "wgpu", "image", "log", "egui", "eframe", "egui_wgpu", "egui_plot", "rfd"]),
     // The binary: main.rs and its subcommands.
     ("cli", &["wgpu", "glam", "rayon", "clap", "anyhow", "image", "serde_json"]),
-    ("main.rs", &["clap", "anyhow", "env_logger"]),
+    ("main.rs", &["clap", "anyhow", "env_logger", "libc"]),
 ];
 
 fn rust_files(path: &Path, out: &mut Vec<PathBuf>) {

@@ -555,3 +555,27 @@ fn mesh_writes_each_quantitys_surfaces_named_after_it() {
         orbcloud(&["mesh", &file, "--iso", "0.1", "--beside", "--orbital", "lumo", "--iso", "0.1", "-o", "x.obj"]);
     assert!(!out.status.success() && String::from_utf8_lossy(&out.stderr).contains("`mesh` does not"));
 }
+
+#[test]
+fn a_closed_output_ends_a_command_quietly() {
+    use std::io::Read;
+    // `orbcloud info FILE | head -1` of a file whose description is far longer than a pipe holds:
+    // the reader goes away after the first bytes.
+    let dir = tempfile::tempdir().unwrap();
+    let xyz = dir.path().join("many.xyz");
+    let atoms: String =
+        (0..5000).map(|k| format!("C {} {} 0.0\n", (k % 70) as f64 * 1.5, (k / 70) as f64 * 1.5)).collect();
+    std::fs::write(&xyz, format!("5000\nmany carbons\n{atoms}")).unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_orbcloud"))
+        .args(["info", xyz.to_str().unwrap()])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("run orbcloud");
+    let mut first = [0u8; 16];
+    child.stdout.as_mut().unwrap().read_exact(&mut first).unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("panicked") && !stderr.contains("Broken pipe"), "{stderr}");
+}
