@@ -63,11 +63,18 @@ macro_rules! mirror {
 #[test]
 fn rust_mirrors_match_the_wgsl_layouts() {
     use orbcloud::gpu::{
-        atoms::AtomGlobals, basis_buffers::GpuShell, gto::FillParams, isosurface::SurfaceUniforms,
-        occlusion::CullUniforms, occlusion::GpuBatch, occlusion::PyramidSize, oit::GpuOptics, oit::ListInfo,
-        volume::VolumeUniforms,
+        arrows::ArrowUniforms, arrows::GpuArrow, atoms::AtomGlobals, basis_buffers::GpuShell, gto::FillParams,
+        isosurface::SurfaceUniforms, occlusion::CullUniforms, occlusion::GpuBatch, occlusion::PyramidSize,
+        oit::GpuOptics, oit::ListInfo, volume::VolumeUniforms,
     };
     let mirrors = [
+        mirror!(
+            "arrows.wgsl",
+            "Arrow",
+            GpuArrow,
+            [start, shaft_radius, to, head_radius, head_length, pad0, pad1, pad2]
+        ),
+        mirror!("arrows.wgsl", "ArrowUniforms", ArrowUniforms, [clip_from_object, eye, light, color]),
         mirror!(
             "volume_slices.wgsl",
             "VolumeUniforms",

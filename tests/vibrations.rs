@@ -204,3 +204,61 @@ fn a_modes_arrows_match_their_golden_image() {
     let bad = orbcloud(&["render", ts.to_str().unwrap(), "--arrows", "-o", "x.png"]);
     assert!(!bad.status.success(), "--arrows needs a mode");
 }
+
+#[test]
+fn arrow_impostors_cover_what_the_cpu_ray_cast_covers() {
+    use glam::{DVec3, Vec3, Vec4};
+    use orbcloud::gpu::{FrameInput, OffscreenTarget, Renderer};
+    use orbcloud::model::arrow::Arrow;
+    use orbcloud::scene::{Camera, RenderSettings, VolumeSettings};
+    let ctx = common::lavapipe();
+    let size = [160u32, 120];
+    // Thick arrows, so that their edges are a small part of what they cover.
+    let thick = |from: DVec3, v: DVec3| Arrow {
+        shaft_radius: 0.25,
+        head_radius: 0.5,
+        head_length: 0.8,
+        ..Arrow::along(from, v)
+    };
+    let arrows = [
+        thick(DVec3::new(-2.0, 0.0, 0.0), DVec3::new(0.0, 2.5, 0.5)),
+        thick(DVec3::new(1.0, -1.0, 0.5), DVec3::new(2.0, 0.5, -1.0)),
+        thick(DVec3::new(0.0, 0.0, -1.0), DVec3::new(-0.3, -0.4, 2.2)),
+    ];
+    let mut renderer = Renderer::new(&ctx);
+    renderer.main().arrows.set_arrows(&ctx, &arrows, [0.9, 0.7, 0.1]);
+    let mut camera = Camera::framing(Vec3::splat(-3.5), Vec3::splat(3.5));
+    camera.orbit(0.6, 0.35);
+    let background = RenderSettings::default().background;
+    let hidden = [VolumeSettings { visible: false, ..Default::default() }];
+    let target = OffscreenTarget::new(&ctx.device, size);
+    let mut encoder = ctx.device.create_command_encoder(&Default::default());
+    let frame = FrameInput { camera: &camera, background, clouds: &hidden, size, tile: None };
+    renderer.render(&ctx, &mut encoder, &target.color_view, &frame);
+    ctx.queue.submit([encoder.finish()]);
+    let gpu = target.read_rgba(&ctx.device, &ctx.queue).unwrap();
+    let bg = gpu.get_pixel(0, 0).0;
+    // The CPU: a ray from the eye through each pixel's centre, met with every arrow.
+    let world_from_clip = renderer.clip_from_world(&camera, size).inverse();
+    let eye = camera.eye().as_dvec3();
+    let (mut covered, mut differ) = (0, 0);
+    for py in 0..size[1] {
+        for px in 0..size[0] {
+            let ndc = Vec4::new(
+                (px as f32 + 0.5) / size[0] as f32 * 2.0 - 1.0,
+                1.0 - (py as f32 + 0.5) / size[1] as f32 * 2.0,
+                1.0,
+                1.0,
+            );
+            let far = world_from_clip * ndc;
+            let dir = ((far.truncate() / far.w).as_dvec3() - eye).normalize();
+            let cpu = arrows.iter().any(|a| a.hit(eye, dir).is_some());
+            let drawn = (0..3).any(|c| gpu.get_pixel(px, py).0[c].abs_diff(bg[c]) > 4);
+            covered += usize::from(cpu);
+            differ += usize::from(cpu != drawn);
+        }
+    }
+    eprintln!("arrows: {covered} pixels covered by the CPU ray cast, {differ} differ on the GPU");
+    assert!(covered > 500, "{covered} pixels");
+    assert!(differ * 100 <= covered * 3, "{differ} of {covered} pixels differ");
+}

@@ -722,6 +722,9 @@ impl OrbApp {
             if changes.rest {
                 vp.set_atoms(n, &o.doc, &o.state);
             }
+            if changes.arrows {
+                vp.set_arrows(n, &o.doc, &o.state);
+            }
             if changes.placement || changes.visibility {
                 vp.set_visibility(n, &o.state);
             }

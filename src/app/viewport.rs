@@ -291,6 +291,7 @@ impl Viewport {
             Ok(())
         })?;
         self.update_surface(n, doc, state);
+        self.set_arrows(n, doc, state);
         let mut notes = Vec::new();
         for k in 0..state.quantities.len() {
             self.insert_layer(at + 1 + k, n, Part::Quantity(k));
@@ -403,11 +404,6 @@ impl Viewport {
         });
         let slot = &self.slots[l];
         let (cache, progress) = (slot.surface.clone(), slot.surface_progress.clone());
-        // The shown mode's arrows are drawn with the atoms.
-        let vibration = state.vibration;
-        let arrows = vibration.arrows_key().and_then(|(mode, _)| {
-            crate::meshes::mode_arrows(doc.vibrations.as_ref()?, mode, vibration.amplitude as f64)
-        });
         let doc = doc.clone();
         let (surface, selection) = (state.surface, state.selection.clone());
         let max_bytes = self.ctx.device.limits().max_buffer_size;
@@ -416,7 +412,7 @@ impl Viewport {
             let shown = (&*doc, &surface, selection.as_str(), grid);
             let (built, note) = molecular_surface_cached(&cache, shown, max_bytes, (cancel, &progress));
             progress.store(0, Ordering::Relaxed);
-            prepared((built.into_iter().chain(arrows).collect(), note))
+            prepared((built.into_iter().collect(), note))
         });
     }
 
@@ -582,6 +578,19 @@ impl Viewport {
         let layer = self.renderer.layer_mut(&self.ctx, l);
         crate::layers::show_atoms(&self.ctx, layer, doc, &state.atoms, &state.selection);
         self.slots[l].displaced = None;
+        self.generation += 1;
+    }
+
+    /// Draws the arrows of object `n`'s shown mode (none when no mode or no arrows are asked
+    /// for), from the modes' geometry, with its atoms.
+    pub fn set_arrows(&mut self, n: usize, doc: &Document, state: &ObjectState) {
+        let Some(l) = self.layer_of(n, Part::Atoms) else { return };
+        let v = state.vibration;
+        let arrows = v.arrows_key().zip(doc.vibrations.as_ref());
+        let arrows =
+            arrows.and_then(|((mode, _), modes)| crate::model::arrow::mode_arrows(modes, mode, v.amplitude as f64));
+        let layer = self.renderer.layer_mut(&self.ctx, l);
+        layer.arrows.set_arrows(&self.ctx, &arrows.unwrap_or_default(), crate::scene::vibration::ARROW_COLOR);
         self.generation += 1;
     }
 

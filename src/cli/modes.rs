@@ -8,10 +8,9 @@ use std::path::PathBuf;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use orbcloud::model::Document;
-use orbcloud::model::isosurface::Mesh;
+use orbcloud::model::arrow::{Arrow, mode_arrows};
 use orbcloud::model::units::ANGSTROM_PER_BOHR;
 use orbcloud::model::vibrations::Vibrations;
-use orbcloud::scene::translucency::SurfaceLook;
 
 /// Which mode to show, where in its oscillation and how far.
 #[derive(Args, Clone)]
@@ -66,11 +65,11 @@ impl ModeArgs {
 }
 
 impl ModeArgs {
-    /// The mode's arrows, when `--arrows` asks for them.
-    pub fn arrows(&self, doc: &Document) -> Result<Option<(Mesh, SurfaceLook)>> {
-        let (Some(mode), true) = (self.normal_mode, self.arrows) else { return Ok(None) };
+    /// The mode's arrows, when `--arrows` asks for them (none otherwise).
+    pub fn arrows(&self, doc: &Document) -> Result<Vec<Arrow>> {
+        let (Some(mode), true) = (self.normal_mode, self.arrows) else { return Ok(Vec::new()) };
         let (v, k) = chosen(doc, mode)?;
-        Ok(orbcloud::meshes::mode_arrows(v, k, self.amplitude))
+        Ok(mode_arrows(v, k, self.amplitude).unwrap_or_default())
     }
 }
 

@@ -49,8 +49,9 @@ pub fn render(args: RenderArgs, later: &[Later]) -> Result<()> {
         orbcloud::evaluate::auto_opacity(&mut settings.volume, grid);
     }
     let molsurface = args.molsurface.mesh(&doc, args.iso.translucent, grid)?;
+    surface_cli::show(&ctx, &mut h.renderer, grid, &args.iso, molsurface.into_iter().collect());
     let arrows = args.vibration.arrows(&doc)?;
-    surface_cli::show(&ctx, &mut h.renderer, grid, &args.iso, molsurface.into_iter().chain(arrows).collect());
+    h.renderer.main().arrows.set_arrows(&ctx, &arrows, orbcloud::scene::vibration::ARROW_COLOR);
     let img = h.render(&ctx, &camera, &settings)?;
     save(&img, &args.output, &ctx)?;
     if let Some(pixel) = args.pick {

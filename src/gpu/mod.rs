@@ -4,6 +4,7 @@
 //! ([`frame`]); the window, the CLI and the tests all call [`Renderer::render`]. Nothing here
 //! reads files or knows about the UI.
 
+pub mod arrows;
 pub mod atoms;
 pub mod basis_buffers;
 pub mod context;
@@ -54,6 +55,7 @@ pub const SHADERS: &[(&str, &str)] = &[
     ("surface_cull.wgsl", include_str!("../../shaders/surface_cull.wgsl")),
     ("gto_common.wgsl", include_str!("../../shaders/gto_common.wgsl")),
     ("gto_fill.wgsl", include_str!("../../shaders/gto_fill.wgsl")),
+    ("arrows.wgsl", include_str!("../../shaders/arrows.wgsl")),
 ];
 
 /// Shaders that are only complete with others prepended (WGSL has no includes): the module

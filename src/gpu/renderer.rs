@@ -2,6 +2,7 @@
 
 use glam::{Mat4, Vec3};
 
+use super::arrows::ArrowsPass;
 use super::atoms::AtomsPass;
 use super::frame::{Draw, FrameTargets, ObjectView, Phase, PhaseNode, PickId, Prepare, STANDARD_FRAME};
 use super::isosurface::IsosurfacePass;
@@ -59,6 +60,8 @@ impl<'a> FrameInput<'a> {
 /// renderer is the object number its pick ids carry.
 pub struct Layer {
     pub atoms: AtomsPass,
+    /// Arrows (a normal mode's displacements) drawn with the atoms.
+    pub arrows: ArrowsPass,
     pub surfaces: IsosurfacePass,
     pub volume: VolumePass,
     /// A rigid placement (rotation and translation).
@@ -122,6 +125,7 @@ impl Layer {
         self.set_molecule(ctx, &Molecule::default(), AtomStyle::Hidden);
         self.volume.set_texture(ctx, None);
         self.surfaces.clear();
+        self.arrows.clear();
     }
 
     /// The world-space box around everything the layer draws.
@@ -135,12 +139,12 @@ impl Layer {
     }
 
     /// The representations, in the order they draw within a phase.
-    fn drawers(&self) -> [&dyn Draw; 3] {
-        [&self.atoms, &self.surfaces, &self.volume]
+    fn drawers(&self) -> [&dyn Draw; 4] {
+        [&self.atoms, &self.arrows, &self.surfaces, &self.volume]
     }
 
-    fn drawers_mut(&mut self) -> [&mut dyn Draw; 3] {
-        [&mut self.atoms, &mut self.surfaces, &mut self.volume]
+    fn drawers_mut(&mut self) -> [&mut dyn Draw; 4] {
+        [&mut self.atoms, &mut self.arrows, &mut self.surfaces, &mut self.volume]
     }
 }
 
@@ -180,6 +184,7 @@ impl Renderer {
         let pyramid = DepthPyramid::new(ctx);
         let layer = Layer {
             atoms: AtomsPass::new(ctx),
+            arrows: ArrowsPass::new(ctx),
             surfaces: IsosurfacePass::new(ctx, &lists.collect_layout, &pyramid.read_layout),
             volume: VolumePass::new(ctx, &resolve.layout, &lists.composite_layout),
             world_from_object: Mat4::IDENTITY,
@@ -231,6 +236,7 @@ impl Renderer {
         let first = &self.layers[0];
         Layer {
             atoms: first.atoms.instance(ctx),
+            arrows: first.arrows.instance(ctx),
             surfaces: first.surfaces.instance(),
             volume: first.volume.instance(ctx),
             world_from_object: Mat4::IDENTITY,

@@ -3,6 +3,7 @@
 //!
 //! Everything here is in bohr and knows nothing of files, the GPU or the UI.
 
+pub mod arrow;
 pub mod atom;
 pub mod basis;
 pub mod bonds;

@@ -161,8 +161,10 @@ pub struct Changes {
     pub placement: bool,
     /// The object's or a quantity's visibility.
     pub visibility: bool,
-    /// The molecular surface (and the mode's arrows, drawn with it) is built again.
+    /// The molecular surface is built again.
     pub surface: bool,
+    /// The shown mode's arrows are drawn anew (another mode, amplitude, or none).
+    pub arrows: bool,
     /// The atoms go back to the file's geometry (no mode is shown any more).
     pub rest: bool,
     /// Per quantity (when `layers` is false): what to redo.
@@ -189,7 +191,7 @@ impl QuantityChanges {
 impl Changes {
     /// Whether nothing needs to be redone.
     pub fn is_empty(&self) -> bool {
-        !(self.layers || self.atoms || self.placement || self.visibility || self.surface || self.rest)
+        !(self.layers || self.atoms || self.placement || self.visibility || self.surface || self.arrows || self.rest)
             && self.quantities.iter().all(|q| !q.any())
     }
 }
@@ -249,8 +251,8 @@ pub fn changes(before: &ObjectState, after: &ObjectState) -> Changes {
         placement: before.placement != after.placement,
         visibility: visible(before) != visible(after),
         surface: before.surface != after.surface
-            || (after.surface.choice != SurfaceChoice::Off && before.selection != after.selection)
-            || before.vibration.arrows_key() != after.vibration.arrows_key(),
+            || (after.surface.choice != SurfaceChoice::Off && before.selection != after.selection),
+        arrows: before.vibration.arrows_key() != after.vibration.arrows_key(),
         rest: before.vibration.mode.is_some() && after.vibration.mode.is_none(),
         quantities,
     }

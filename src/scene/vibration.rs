@@ -3,6 +3,9 @@
 
 use serde::{Deserialize, Serialize};
 
+/// Linear RGB of a mode's arrows.
+pub const ARROW_COLOR: [f32; 3] = [0.95, 0.75, 0.1];
+
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct VibrationState {
