@@ -52,6 +52,10 @@ pub struct WavefunctionInfo {
     pub homo: Option<OrbitalInfo>,
     pub lumo: Option<OrbitalInfo>,
     pub orbitals: Vec<OrbitalInfo>,
+    /// Natural orbitals (fractional occupations): HOMO and LUMO are found by occupation.
+    pub natural: bool,
+    /// The file's "energies" are its occupations: no energies to show.
+    pub energies_are_occupations: bool,
 }
 
 #[derive(Serialize)]
@@ -176,6 +180,8 @@ fn wavefunction_info(wf: &Wavefunction) -> WavefunctionInfo {
         homo: wf.homo(Spin::Alpha).map(|i| orbital_info(wf, i)),
         lumo: wf.lumo(Spin::Alpha).map(|i| orbital_info(wf, i)),
         orbitals: (0..wf.orbitals.len()).map(|i| orbital_info(wf, i)).collect(),
+        natural: wf.natural(Spin::Alpha),
+        energies_are_occupations: wf.energies_are_occupations(),
     }
 }
 
@@ -294,17 +300,20 @@ pub fn text(doc: &Document) -> String {
             n.residual,
             if n.residual > 1e-5 { "  ⚠ not orthonormal" } else { "" }
         );
+        if w.natural {
+            let energies = if w.energies_are_occupations { "; the file's energies are its occupations" } else { "" };
+            let _ = writeln!(s, "natural orbitals: HOMO and LUMO by occupation{energies}");
+        }
         for (name, o) in [("HOMO", &w.homo), ("LUMO", &w.lumo)] {
             if let Some(o) = o {
+                let energy = match w.energies_are_occupations {
+                    true => "no energy".to_string(),
+                    false => format!("E = {:.6} Eh ({:.3} eV)", o.energy_hartree, o.energy_hartree * EV_PER_HARTREE),
+                };
                 let _ = writeln!(
                     s,
-                    "{name}: MO {} {:?} {} E = {:.6} Eh ({:.3} eV), occupation {:.3}",
-                    o.number,
-                    o.spin,
-                    o.symmetry,
-                    o.energy_hartree,
-                    o.energy_hartree * EV_PER_HARTREE,
-                    o.occupation
+                    "{name}: MO {} {:?} {} {energy}, occupation {:.3}",
+                    o.number, o.spin, o.symmetry, o.occupation
                 );
             }
         }

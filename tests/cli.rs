@@ -579,3 +579,41 @@ fn a_closed_output_ends_a_command_quietly() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(!stderr.contains("panicked") && !stderr.contains("Broken pipe"), "{stderr}");
 }
+
+#[test]
+fn natural_orbitals_have_their_frontier_by_occupation_and_no_energies() {
+    // Water's orbitals written as natural orbitals: fractional occupations, and (as some writers
+    // do) the occupations in place of the energies.
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/fixtures/wavefunctions/h2o_cart_631gs.molden"
+    ))
+    .unwrap();
+    let occupations = [1.9998, 1.993, 1.98, 1.97, 1.96, 0.045, 0.03, 0.012];
+    let mut k = 0;
+    let natural: String = text
+        .lines()
+        .map(|l| {
+            let t = l.trim_start();
+            if t.starts_with("Ene=") || t.starts_with("Occup=") {
+                let occ = occupations.get(k / 2).copied().unwrap_or(0.0);
+                k += 1;
+                format!("{} {occ}", if t.starts_with("Ene=") { "Ene=" } else { "Occup=" })
+            } else {
+                l.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("no.molden");
+    std::fs::write(&path, natural).unwrap();
+    let out = orbcloud(&["info", path.to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("natural orbitals: HOMO and LUMO by occupation; the file's energies are its occupations"),
+        "{text}"
+    );
+    assert!(text.contains("HOMO: MO 5 Alpha A no energy, occupation 1.960"), "{text}");
+    assert!(text.contains("LUMO: MO 6 Alpha A no energy, occupation 0.045"), "{text}");
+}

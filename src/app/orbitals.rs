@@ -216,6 +216,10 @@ fn orbital_table(
     );
     // One monospace line per orbital: the whole row is the button, and the header above the
     // scrolled list lines up with it and stays in view.
+    if wf.natural(spin) {
+        let energies = if wf.energies_are_occupations() { ": the file's energies are its occupations" } else { "" };
+        ui.label(RichText::new(format!("natural orbitals, by occupation{energies}")).strong());
+    }
     ui.label(RichText::new(row_text("", "", "sym", "E / Eh", "E / eV", "occ")).monospace().strong());
     ScrollArea::vertical().max_height(ui.available_height() * 0.6).show(ui, |ui| {
         for i in order {
@@ -226,8 +230,8 @@ fn orbital_table(
                 &format!("MO {number}"),
                 &wf.frontier_label(i, 5).unwrap_or_default(),
                 &o.symmetry,
-                &format!("{:.5}", o.energy),
-                &format!("{:.3}", o.energy * EV_PER_HARTREE),
+                &wf.energy(i).map_or("—".into(), |e| format!("{e:.5}")),
+                &wf.energy(i).map_or("—".into(), |e| format!("{:.3}", e * EV_PER_HARTREE)),
                 &format!("{:.2}", o.occupation),
             );
             ui.horizontal(|ui| {

@@ -151,12 +151,11 @@ fn status_line(ui: &mut egui::Ui, app: &OrbApp, cancel: &mut bool, dismiss: &mut
                 let o = &wf.orbitals[i];
                 ui.separator();
                 ui.label(format!(
-                    "{} {:?} {} E = {:.5} Eh ({:.3} eV), occupation {:.2}",
+                    "{} {:?} {} {}, occupation {:.2}",
                     wf.frontier_label(i, 50).unwrap_or_else(|| format!("MO {}", i + 1)),
                     o.spin,
                     o.symmetry,
-                    o.energy,
-                    o.energy * crate::model::units::EV_PER_HARTREE,
+                    wf.energy_text(i),
                     o.occupation
                 ));
             }

@@ -4,7 +4,6 @@
 use egui::RichText;
 
 use super::SceneObject;
-use crate::model::units::EV_PER_HARTREE;
 use crate::scene::objects::MAX_PANES;
 use crate::scene::{Camera, Panes, QuantityState};
 
@@ -31,13 +30,7 @@ fn describe(o: &SceneObject, q: &QuantityState) -> String {
     let name = q.source.name(&o.doc);
     match (q.source.orbital(), &o.doc.wavefunction) {
         (Some(i), Some(wf)) => {
-            let orbital = &wf.orbitals[i];
-            format!(
-                "{name}  E = {:.5} Eh ({:.3} eV), occ {:.2}",
-                orbital.energy,
-                orbital.energy * EV_PER_HARTREE,
-                orbital.occupation
-            )
+            format!("{name}  {}, occ {:.2}", wf.energy_text(i), wf.orbitals[i].occupation)
         }
         _ => name,
     }

@@ -224,8 +224,7 @@ fn describe(doc: &Document, source: Source) -> String {
     let name = source.name(doc);
     match (source.orbital(), &doc.wavefunction) {
         (Some(i), Some(wf)) => {
-            let o = &wf.orbitals[i];
-            format!("{name}: E = {:.5} Eh, occupation {:.2}", o.energy, o.occupation)
+            format!("{name}: {}, occupation {:.2}", wf.energy_text(i), wf.orbitals[i].occupation)
         }
         _ => name,
     }

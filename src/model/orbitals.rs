@@ -50,16 +50,64 @@ impl Wavefunction {
         self.orbitals.iter().enumerate().filter(move |(_, o)| o.spin == spin)
     }
 
-    /// Index of the highest occupied orbital of a spin (by energy), if any.
+    /// Whether the orbitals of `spin` are natural orbitals (of a CI or CC density): some
+    /// occupation is fractional, not 0, 1 or 2.
+    pub fn natural(&self, spin: Spin) -> bool {
+        self.of_spin(spin).any(|(_, o)| [0.0, 1.0, 2.0].iter().all(|&n| (o.occupation - n).abs() > 1e-3))
+    }
+
+    /// Whether the file's "energies" are its occupations (natural-orbital files write them so):
+    /// then they are no energies to show.
+    pub fn energies_are_occupations(&self) -> bool {
+        !self.orbitals.is_empty() && self.orbitals.iter().all(|o| (o.energy - o.occupation).abs() < 1e-9)
+    }
+
+    /// Orbital `i`'s energy (hartree), when the file gives one: not when its "energies" are
+    /// occupations, nor when it wrote none.
+    pub fn energy(&self, i: usize) -> Option<f64> {
+        let e = self.orbitals.get(i)?.energy;
+        (e.is_finite() && !self.energies_are_occupations()).then_some(e)
+    }
+
+    /// Orbital `i`'s energy in words: "E = -0.31269 Eh (-8.509 eV)", or that the file gives none.
+    pub fn energy_text(&self, i: usize) -> String {
+        match self.energy(i) {
+            Some(e) => format!("E = {e:.5} Eh ({:.3} eV)", e * super::units::EV_PER_HARTREE),
+            None if self.energies_are_occupations() => "no energy (natural orbitals)".into(),
+            None => "no energy in the file".into(),
+        }
+    }
+
+    /// The occupation above which a natural orbital counts as occupied: half of what the
+    /// orbital can hold.
+    fn half_filled(&self) -> f64 {
+        if self.restricted { 1.0 } else { 0.5 }
+    }
+
+    /// Index of the highest occupied orbital of a spin, if any: by energy; for natural orbitals
+    /// the least occupied of those holding more than half an orbital's electrons.
     pub fn homo(&self, spin: Spin) -> Option<usize> {
+        if self.natural(spin) {
+            let half = self.half_filled();
+            return (self.of_spin(spin).filter(|(_, o)| o.occupation > half))
+                .min_by(|a, b| a.1.occupation.total_cmp(&b.1.occupation))
+                .map(|(i, _)| i);
+        }
         self.of_spin(spin)
             .filter(|(_, o)| o.occupation > 1e-6)
             .max_by(|a, b| a.1.energy.total_cmp(&b.1.energy))
             .map(|(i, _)| i)
     }
 
-    /// Index of the lowest unoccupied orbital of a spin (by energy), if any.
+    /// Index of the lowest unoccupied orbital of a spin, if any: by energy; for natural orbitals
+    /// the most occupied of those holding at most half.
     pub fn lumo(&self, spin: Spin) -> Option<usize> {
+        if self.natural(spin) {
+            let half = self.half_filled();
+            return (self.of_spin(spin).filter(|(_, o)| o.occupation <= half))
+                .max_by(|a, b| a.1.occupation.total_cmp(&b.1.occupation))
+                .map(|(i, _)| i);
+        }
         self.of_spin(spin)
             .filter(|(_, o)| o.occupation <= 1e-6)
             .min_by(|a, b| a.1.energy.total_cmp(&b.1.energy))
@@ -118,10 +166,15 @@ impl std::str::FromStr for OrbitalSpec {
 }
 
 impl Wavefunction {
-    /// Indices into `orbitals` of one spin, sorted by energy (stable for equal energies).
+    /// Indices into `orbitals` of one spin, sorted by energy (stable for equal energies); natural
+    /// orbitals, whose energies mean nothing, by falling occupation (the most occupied "lowest").
     pub fn by_energy(&self, spin: Spin) -> Vec<usize> {
         let mut v: Vec<usize> = self.of_spin(spin).map(|(i, _)| i).collect();
-        v.sort_by(|&a, &b| self.orbitals[a].energy.total_cmp(&self.orbitals[b].energy));
+        let o = &self.orbitals;
+        match self.natural(spin) {
+            true => v.sort_by(|&a, &b| o[b].occupation.total_cmp(&o[a].occupation)),
+            false => v.sort_by(|&a, &b| o[a].energy.total_cmp(&o[b].energy)),
+        }
         v
     }
 
@@ -171,6 +224,24 @@ impl Wavefunction {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn natural_orbitals_have_their_frontier_by_occupation() {
+        // A CASSCF-like set: the "energies" are the occupations, in no useful order.
+        let occ = [1.99, 0.02, 1.6, 0.4, 1.95, 0.05];
+        let w = wf(&occ, &occ);
+        assert!(w.natural(Spin::Alpha) && w.energies_are_occupations());
+        assert_eq!(w.homo(Spin::Alpha), Some(2), "the last above 1");
+        assert_eq!(w.lumo(Spin::Alpha), Some(3), "the first below");
+        assert_eq!(w.by_energy(Spin::Alpha), [0, 4, 2, 3, 5, 1], "by falling occupation");
+        assert_eq!(w.resolve(OrbitalSpec::Homo(1), Spin::Alpha), Some(4));
+        assert_eq!(w.resolve(OrbitalSpec::Lumo(1), Spin::Alpha), Some(5));
+        assert_eq!(w.frontier_label(4, 3).as_deref(), Some("HOMO-1"));
+        // A Hartree–Fock set is not natural, its energies are energies.
+        let hf = wf(&[2.0, 2.0, 0.0], &[-0.5, -0.3, 0.1]);
+        assert!(!hf.natural(Spin::Alpha) && !hf.energies_are_occupations());
+        assert_eq!((hf.homo(Spin::Alpha), hf.lumo(Spin::Alpha)), (Some(1), Some(2)));
+    }
 
     fn wf(occupations: &[f64], energies: &[f64]) -> Wavefunction {
         Wavefunction {
