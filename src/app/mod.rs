@@ -584,6 +584,11 @@ impl OrbApp {
         };
         self.scan = None;
         self.status = note.unwrap_or_else(|| format!("opened {}", doc.source));
+        // What the file held that could not be read (a malformed mode section, no orbitals)
+        // stays in the status line until dismissed.
+        if !doc.problems.is_empty() {
+            self.notice = Some(doc.problems.join("; "));
+        }
         if let Some(path) = &state.path {
             files::remember(&mut self.recent, path, RECENT_FILES);
         }

@@ -371,6 +371,11 @@ impl FchkFile {
             });
         }
 
+        // An optimisation's or scan's file without a basis: its geometries, as a trajectory.
+        if !self.records.contains_key("Shell types") {
+            return Ok(self.geometry_document(source, &atoms));
+        }
+
         // Basis.
         let types = self.ints(file, "Shell types", None)?;
         let n_shells = types.len();
@@ -523,6 +528,23 @@ impl FchkFile {
         Ok(doc)
     }
 
+    /// A file with geometries but no orbitals: its current geometry, then every step of its
+    /// `… Geometries` records, as the frames of a trajectory, saying that it holds no orbitals.
+    fn geometry_document(&self, source: &str, atoms: &[Atom]) -> Document {
+        let z: Vec<u8> = atoms.iter().map(|a| a.z as u8).collect();
+        let mut frames = vec![("current geometry".to_string(), atoms.iter().map(|a| a.position).collect())];
+        for set in &self.geometries {
+            let label = set.label.trim();
+            frames.extend(set.frames.iter().enumerate().map(|(k, f)| (format!("{label}, step {}", k + 1), f.clone())));
+        }
+        let mut doc = super::structure::trajectory(source, &self.title, &z, &frames);
+        doc.problems.push(format!(
+            "{source}: holds no orbitals (no basis set: a geometry-only fchk); its {} geometries open as frames",
+            frames.len()
+        ));
+        doc
+    }
+
     /// The normal modes of a frequency job (`Vib-NDim`, `Vib-E2`, `Vib-Modes`), at `geometry`;
     /// `None` when the file has none (Q-Chem's fchk files never do).
     fn vibrations(&self, file: &str, geometry: &[DVec3]) -> Result<Option<Vibrations>, ParseError> {
@@ -617,6 +639,23 @@ mod tests {
 
     fn doc(text: &str) -> Document {
         parse("t.fchk", text, None).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    #[test]
+    fn a_file_without_a_basis_opens_its_geometries_as_frames() {
+        let mut t =
+            String::from("water opt\nFOpt      RHF                                                         STO-3G\n");
+        t += &int("Number of atoms", 2);
+        t += &ints("Atomic numbers", &[8, 1]);
+        t += &reals("Current cartesian coordinates", &[0.0, 0.0, 0.0, 0.0, 0.0, 1.8]);
+        t += &reals("Opt point       1 Geometries", &[0.0, 0.0, 0.0, 0.0, 0.0, 1.95, 0.0, 0.0, 0.0, 0.0, 0.0, 1.85]);
+        let d = doc(&t);
+        assert!(d.wavefunction.is_none());
+        let models = &d.structure.as_ref().expect("a trajectory").structure.models;
+        assert_eq!(models.len(), 3, "the current geometry, then each step");
+        assert_eq!(d.molecule.atoms[1].position.z, 1.8);
+        assert!(d.problems[0].contains("holds no orbitals"), "{:?}", d.problems);
+        assert_eq!(d.molecule.bonds.len(), 1);
     }
 
     #[test]
