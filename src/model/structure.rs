@@ -213,20 +213,28 @@ impl Structure {
 
     /// The atoms of `model` a viewer shows: in each residue, atoms without an alternate
     /// location and those of the first one the residue names (all altlocs stay in the arrays).
+    /// An atom written with no alternate location beside the same atom with one (a writer's
+    /// slip for the first conformer: blank and `B`) is one site: the blank one is shown, never
+    /// both.
     pub fn shown_atoms(&self, model: usize) -> Vec<u32> {
         let Some(m) = self.models.get(model) else { return Vec::new() };
         let mut out = Vec::with_capacity(m.atoms.len());
         let mut residue = u32::MAX;
         let mut first_alt = 0u8;
+        let mut blank_names = Vec::new();
         for i in m.atoms.clone() {
             let r = self.residue[i as usize];
             if r != residue {
                 residue = r;
                 let atoms = self.residues[r as usize].atoms.clone();
-                first_alt = atoms.map(|j| self.altloc[j as usize]).find(|&a| a != 0).unwrap_or(0);
+                blank_names =
+                    atoms.clone().filter(|&j| self.altloc[j as usize] == 0).map(|j| self.name[j as usize]).collect();
+                let partner = |j: u32| blank_names.contains(&self.name[j as usize]);
+                first_alt =
+                    atoms.filter(|&j| !partner(j)).map(|j| self.altloc[j as usize]).find(|&a| a != 0).unwrap_or(0);
             }
             let alt = self.altloc[i as usize];
-            if alt == 0 || alt == first_alt {
+            if alt == 0 || (alt == first_alt && !blank_names.contains(&self.name[i as usize])) {
                 out.push(i);
             }
         }
@@ -417,6 +425,18 @@ mod tests {
         let pairs: Vec<(u32, u32)> = m.bonds.iter().map(|b| (b.a, b.b)).collect();
         assert_eq!(pairs, vec![(0, 1), (1, 2), (2, 3)], "peptide C–N linked, the water left alone");
         assert_eq!(s.describe(4), "A SER 2 OG alt B");
+    }
+
+    #[test]
+    fn a_blank_alternate_location_beside_its_b_partner_is_one_site() {
+        let mut s = Structure::default();
+        s.push(&record("SER", 2, "N", 7, 0.0, 0));
+        s.push(&record("SER", 2, "OG", 8, 1.4, 0));
+        s.push(&record("SER", 2, "OG", 8, 1.5, b'B'));
+        s.push(&record("SER", 2, "CB", 6, 2.8, b'A'));
+        s.push(&record("SER", 2, "CB", 6, 2.9, b'B'));
+        assert_eq!(s.shown_atoms(0), vec![0, 1, 3], "the blank OG, not its B partner; CB's first conformer");
+        assert_eq!(s.z.len(), 5, "every conformer is kept");
     }
 
     #[test]
