@@ -3,6 +3,7 @@
 //! orbital or density evaluated), their isosurfaces, placement and visibility.
 
 use crate::evaluate::{WavefunctionView, auto_opacity, evaluate_wavefunction};
+use crate::gpu::atoms::AtomSizes;
 use crate::gpu::gto::GtoFillPass;
 use crate::gpu::renderer::Layer;
 use crate::gpu::{GpuContext, GpuError, Renderer};
@@ -52,8 +53,14 @@ pub fn coarser_note(what: &str, dims: [usize; 3], step: usize) -> String {
 
 /// Puts `doc`'s atoms into `layer` as `look` says, those `selection` leaves out hidden.
 pub fn show_atoms(ctx: &GpuContext, layer: &mut Layer, doc: &Document, look: &AtomLook, selection: &str) {
+    layer.atoms.sizes = sizes(look);
     layer.set_atoms(ctx, &doc.molecule, look.style, Some(&atom_look(doc, look, selection)));
     layer.atoms.depth_cue = look.depth_cue;
+}
+
+/// The factors on the ball and stick radii `look` asks for.
+pub fn sizes(look: &AtomLook) -> AtomSizes {
+    AtomSizes { ball: look.ball_scale, stick: look.stick_scale }
 }
 
 /// The colours of `doc`'s atoms, and which are shown: all when `selection` does not parse (the

@@ -403,6 +403,12 @@ struct ViewArgs {
     /// at 0.6): the front of a big structure reads from its back.
     #[arg(long, default_value_t = 0.0)]
     depth_cue: f32,
+    /// Factor on the style's ball radii (0.3 to 3).
+    #[arg(long, default_value_t = 1.0)]
+    ball_scale: f32,
+    /// Factor on the style's stick radius (0.3 to 3).
+    #[arg(long, default_value_t = 1.0)]
+    stick_scale: f32,
     /// Hide the volume (atoms only).
     #[arg(long)]
     no_volume: bool,
@@ -530,6 +536,8 @@ impl ViewArgs {
             ColorArg::Secondary => AtomColoring::Secondary,
         };
         s.depth_cue = self.depth_cue.clamp(0.0, 1.0);
+        s.ball_scale = self.ball_scale.clamp(0.3, 3.0);
+        s.stick_scale = self.stick_scale.clamp(0.3, 3.0);
         s
     }
 

@@ -617,3 +617,18 @@ fn natural_orbitals_have_their_frontier_by_occupation_and_no_energies() {
     assert!(text.contains("HOMO: MO 5 Alpha A no energy, occupation 1.960"), "{text}");
     assert!(text.contains("LUMO: MO 6 Alpha A no energy, occupation 0.045"), "{text}");
 }
+
+#[test]
+fn ball_and_stick_sizes_change_the_picture() {
+    let file = benzene();
+    let base = [file.as_str(), "--size", "160x120", "--no-volume"];
+    let (plain, _) = render_png(&base);
+    let (balls, _) = render_png(&[&base[..], &["--ball-scale", "2"]].concat());
+    let (sticks, _) = render_png(&[&base[..], &["--stick-scale", "2.5"]].concat());
+    let lit = |img: &image::RgbaImage| {
+        common::coverage(img, [img.get_pixel(0, 0)[0], img.get_pixel(0, 0)[1], img.get_pixel(0, 0)[2]])
+    };
+    assert!(lit(&balls) > 1.3 * lit(&plain), "bigger balls cover more: {} vs {}", lit(&balls), lit(&plain));
+    assert!(lit(&sticks) > lit(&plain), "thicker sticks cover more: {} vs {}", lit(&sticks), lit(&plain));
+    assert!(common::mean_difference(&sticks, &balls) > 0.5);
+}

@@ -233,6 +233,8 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
                 ui.heading("Atoms");
                 let a = &mut state.atoms;
                 atoms_editor(ui, &mut a.style, &mut a.colors, &mut a.depth_cue);
+                ui.add(Slider::new(&mut a.ball_scale, 0.3..=3.0).text("ball size (×)"));
+                ui.add(Slider::new(&mut a.stick_scale, 0.3..=3.0).text("stick radius (×)"));
             }
             if let Some(model) = super::models::controls(ui, app) {
                 app.show_model(model);

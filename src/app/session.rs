@@ -153,6 +153,8 @@ mod tests {
     fn sessions_round_trip_through_toml() {
         let mut object = ObjectState { path: Some("/data/water.molden".into()), ..Default::default() };
         object.placement = Placement { offset: [8.0, 0.0, -1.5], rotation_deg: [0.0, 90.0, 0.0] };
+        object.atoms.ball_scale = 1.6;
+        object.atoms.stick_scale = 0.5;
         let shell = IsosurfaceSettings { visible: true, level: IsoLevel::Sigma(2.5), ..Default::default() };
         let homo = Source::Wavefunction(crate::model::orbitals::Quantity::Orbital(4));
         let mut orbital = QuantityState::new(homo, &RenderSettings::default());

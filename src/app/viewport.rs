@@ -566,6 +566,7 @@ impl Viewport {
         let Some(l) = self.layer_of(n, Part::Atoms) else { return };
         let look = crate::layers::atom_look(doc, &state.atoms, &state.selection);
         let atoms = &mut self.renderer.layer_mut(&self.ctx, l).atoms;
+        atoms.sizes = crate::layers::sizes(&state.atoms);
         atoms.set_look(&self.ctx, state.atoms.style, &look);
         atoms.depth_cue = state.atoms.depth_cue;
         self.generation += 1;
@@ -612,6 +613,7 @@ impl Viewport {
         }
         let look = crate::layers::atom_look(doc, &state.atoms, &state.selection);
         let layer = self.renderer.layer_mut(&self.ctx, l);
+        layer.atoms.sizes = crate::layers::sizes(&state.atoms);
         layer.set_atoms(&self.ctx, &molecule, state.atoms.style, Some(&look));
         layer.atoms.depth_cue = state.atoms.depth_cue;
         self.slots[l].displaced = Some(key);

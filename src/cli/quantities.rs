@@ -23,7 +23,7 @@ const BESIDE: &str = "--beside";
 /// Options that belong to the whole picture or file, not to a quantity: wherever they are
 /// given, they join the first part of the command line (`mesh FILE --density --iso 0.1
 /// --orbital homo --iso 0.05 -o out.glb`).
-const WHOLE_PICTURE: [&str; 25] = [
+const WHOLE_PICTURE: [&str; 27] = [
     "--output",
     "-o",
     "--size",
@@ -49,6 +49,8 @@ const WHOLE_PICTURE: [&str; 25] = [
     "--phase",
     "--amplitude",
     "--arrows",
+    "--ball-scale",
+    "--stick-scale",
 ];
 /// Those of them that take no value.
 const WHOLE_PICTURE_FLAGS: [&str; 3] = ["--lavapipe", "--direct", "--arrows"];

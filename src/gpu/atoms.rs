@@ -286,9 +286,10 @@ impl AtomData {
     }
 }
 
-/// The style's radius per atomic number (bohr), then the palette (linear RGB).
-pub fn looks(style: AtomStyle, colors: &AtomColors) -> Vec<[f32; 4]> {
-    let radii = (0..PALETTE_AT).map(|z| [radius(style, z as u32), 0.0, 0.0, 0.0]);
+/// The style's radius per atomic number (bohr, times `sizes.ball`), then the palette (linear RGB).
+pub fn looks(style: AtomStyle, sizes: AtomSizes, colors: &AtomColors) -> Vec<[f32; 4]> {
+    // Never past the cells' padding for the frustum culling.
+    let radii = (0..PALETTE_AT).map(|z| [(radius(style, z as u32) * sizes.ball).min(MAX_ATOM_RADIUS), 0.0, 0.0, 0.0]);
     radii.chain(colors.palette.iter().map(|&c| linear_color(c))).collect()
 }
 
@@ -376,6 +377,22 @@ pub struct AtomsPass {
     /// How much the farthest atoms darken (0: none), QuteMol's depth cue: it tells front from
     /// back in a big structure.
     pub depth_cue: f32,
+    /// Factors on the style's ball and stick radii (1: as the style draws them), taken by the
+    /// next [`Self::set_molecule`] or [`Self::set_look`].
+    pub sizes: AtomSizes,
+}
+
+/// Factors on a style's ball and stick radii.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AtomSizes {
+    pub ball: f32,
+    pub stick: f32,
+}
+
+impl Default for AtomSizes {
+    fn default() -> Self {
+        Self { ball: 1.0, stick: 1.0 }
+    }
 }
 
 struct Pipelines {
@@ -566,6 +583,7 @@ impl AtomsPass {
             splat_radius_px: SPLAT_RADIUS_PX,
             frame: 0,
             depth_cue: 0.0,
+            sizes: AtomSizes::default(),
         }
     }
 
@@ -594,7 +612,7 @@ impl AtomsPass {
         let usage = wgpu::BufferUsages::empty();
         let positions = storage(ctx, "atom positions", bytemuck::cast_slice(&data.positions), usage);
         let attrs = storage(ctx, "atom attributes", bytemuck::cast_slice(&data.attrs), usage);
-        let looks = storage(ctx, "atom looks", bytemuck::cast_slice(&looks(style, colors)), usage);
+        let looks = storage(ctx, "atom looks", bytemuck::cast_slice(&looks(style, self.sizes, colors)), usage);
         let bonds = storage(ctx, "bonds", bytemuck::cast_slice(&data.bonds), usage);
         let list_words = LIST_HEADER + data.positions.len() + data.bonds.len() + LIST_WORDS_PER_CELL * data.cells.len();
         let lists = storage(
@@ -680,7 +698,7 @@ impl AtomsPass {
 
     fn write_looks(&mut self, ctx: &GpuContext, style: AtomStyle, colors: &AtomColors) {
         let Some(d) = &mut self.data else { return };
-        let bytes: Vec<u8> = bytemuck::cast_slice(&looks(style, colors)).to_vec();
+        let bytes: Vec<u8> = bytemuck::cast_slice(&looks(style, self.sizes, colors)).to_vec();
         if bytes.len() as u64 > d.looks.size() {
             // A bigger palette: a new buffer, and the bind group that names it.
             let looks = storage(ctx, "atom looks", &bytes, wgpu::BufferUsages::empty());
@@ -761,8 +779,11 @@ impl AtomsPass {
         let cell_lists = [1, 2, 3, 4].map(|k| order_at + k * total_cells);
         self.frame += 1;
         let (stick, style) = style_flags(self.style);
-        let largest =
-            self.data.as_ref().map_or(0.0, |d| d.elements.iter().map(|&z| radius(self.style, z)).fold(0.0, f32::max));
+        let stick = stick * self.sizes.stick;
+        let ball = self.sizes.ball;
+        let largest = self.data.as_ref().map_or(0.0, |d| {
+            d.elements.iter().map(|&z| (radius(self.style, z) * ball).min(MAX_ATOM_RADIUS)).fold(0.0, f32::max)
+        });
         let size = size.map(|v| v.max(1));
         let pixels_per_bohr = clip.row(1).truncate().length() * 0.5 * size[1] as f32;
         let g = AtomGlobals {
@@ -943,10 +964,12 @@ mod tests {
         assert_eq!(colors.palette[(d.attrs[1] >> 16) as usize], crate::model::elements::element(8).color);
         assert_eq!(d.bonds, vec![[0, 1]]);
         assert!(d.gpu_bytes() / 3 <= 64, "{} bytes per atom", d.gpu_bytes() / 3);
-        let ball = looks(AtomStyle::BallAndStick, &colors);
-        let fill = looks(AtomStyle::SpaceFilling, &colors);
+        let ball = looks(AtomStyle::BallAndStick, AtomSizes::default(), &colors);
+        let fill = looks(AtomStyle::SpaceFilling, AtomSizes::default(), &colors);
+        let bigger = looks(AtomStyle::BallAndStick, AtomSizes { ball: 1.5, stick: 1.0 }, &colors);
+        assert!((bigger[6][0] - 1.5 * ball[6][0]).abs() < 1e-6, "the ball scale multiplies every radius");
         assert!(fill[6][0] > 3.0 * ball[6][0]);
-        assert_eq!(looks(AtomStyle::Hidden, &colors)[6][0], 0.0);
+        assert_eq!(looks(AtomStyle::Hidden, AtomSizes::default(), &colors)[6][0], 0.0);
         assert_eq!(ball.len(), PALETTE_AT + colors.palette.len());
         assert_eq!(style_flags(AtomStyle::Lines).1, STYLE_UNBONDED_ONLY);
     }

@@ -122,24 +122,46 @@ impl QuantityState {
 }
 
 /// How an object's atoms are drawn.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct AtomLook {
     pub style: AtomStyle,
     pub colors: AtomColoring,
     /// How much the farthest atoms darken (0: off).
     pub depth_cue: f32,
+    /// Factors on the style's ball and stick radii (1: as the style draws them).
+    pub ball_scale: f32,
+    pub stick_scale: f32,
+}
+
+impl Default for AtomLook {
+    fn default() -> Self {
+        Self::of(&RenderSettings::default())
+    }
 }
 
 impl AtomLook {
     /// The atoms of `settings`.
     pub fn of(settings: &RenderSettings) -> Self {
-        Self { style: settings.atoms, colors: settings.atom_colors, depth_cue: settings.depth_cue }
+        Self {
+            style: settings.atoms,
+            colors: settings.atom_colors,
+            depth_cue: settings.depth_cue,
+            ball_scale: settings.ball_scale,
+            stick_scale: settings.stick_scale,
+        }
     }
 
     /// `settings` with these atoms.
     pub fn onto(self, settings: RenderSettings) -> RenderSettings {
-        RenderSettings { atoms: self.style, atom_colors: self.colors, depth_cue: self.depth_cue, ..settings }
+        RenderSettings {
+            atoms: self.style,
+            atom_colors: self.colors,
+            depth_cue: self.depth_cue,
+            ball_scale: self.ball_scale,
+            stick_scale: self.stick_scale,
+            ..settings
+        }
     }
 }
 

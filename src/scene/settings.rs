@@ -249,6 +249,9 @@ pub struct RenderSettings {
     /// How much the farthest atoms darken (0: off; big structures open at
     /// [`BIG_STRUCTURE_DEPTH_CUE`]).
     pub depth_cue: f32,
+    /// Factors on the atom style's ball and stick radii (1: as the style draws them).
+    pub ball_scale: f32,
+    pub stick_scale: f32,
 }
 
 /// Above this many atoms a file opens space filling (ball and stick is sub-pixel noise at that
@@ -280,6 +283,8 @@ impl Default for RenderSettings {
             iso: IsosurfaceSettings::default(),
             background: [0.02, 0.02, 0.03],
             depth_cue: 0.0,
+            ball_scale: 1.0,
+            stick_scale: 1.0,
         }
     }
 }
