@@ -621,11 +621,6 @@ impl Viewport {
         true
     }
 
-    /// Moves every layer of object `n` where its state places it.
-    pub fn set_placement(&mut self, n: usize, state: &ObjectState) {
-        self.set_visibility(n, state);
-    }
-
     /// Gives every layer of object `n` its placement and visibility (the object's, and each
     /// quantity's).
     pub fn set_visibility(&mut self, n: usize, state: &ObjectState) {

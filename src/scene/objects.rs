@@ -133,11 +133,6 @@ impl ObjectState {
         }
     }
 
-    /// Every isosurface of every visible quantity, shown or not.
-    pub fn all_isosurfaces(&self) -> impl Iterator<Item = &IsosurfaceSettings> {
-        self.quantities.iter().filter(|q| q.visible).flat_map(|q| &q.isosurfaces)
-    }
-
     /// The settings one renderer layer draws quantity `k` with (its cloud, its first
     /// isosurface, the object's atoms) over `background`.
     pub fn render_settings(&self, k: usize, background: [f32; 3]) -> RenderSettings {

@@ -114,11 +114,6 @@ impl QuantityState {
         }
         q
     }
-
-    /// Whether any isosurface of it is drawn translucent.
-    pub fn has_translucent(&self) -> bool {
-        self.isosurfaces.iter().any(|i| i.visible && i.translucent)
-    }
 }
 
 /// How an object's atoms are drawn.
