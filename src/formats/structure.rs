@@ -36,29 +36,34 @@ pub(crate) fn document(source: &str, title: &str, structure: Structure) -> Docum
     }
 }
 
+/// An atom with an element and a position only (bohr), as XYZ and trajectory frames give them.
+pub(crate) fn bare_atom(symbol: &str, z: u8, position: glam::DVec3) -> crate::model::structure::AtomRecord {
+    use crate::model::structure::{AtomName, AtomRecord};
+    AtomRecord {
+        chain: Default::default(),
+        residue: Default::default(),
+        number: 0,
+        insertion: 0,
+        hetero: false,
+        name: AtomName::new(symbol).unwrap_or_default(),
+        altloc: 0,
+        z,
+        position,
+        occupancy: 1.0,
+        b_factor: 0.0,
+        serial: -1,
+    }
+}
+
 /// The document of a trajectory: atoms of atomic numbers `z` at each frame's positions (bohr),
 /// each frame a model titled as given; the first shown.
 pub(crate) fn trajectory(source: &str, title: &str, z: &[u8], frames: &[(String, Vec<glam::DVec3>)]) -> Document {
-    use crate::model::structure::{AtomName, AtomRecord};
     let mut s = Structure::default();
     for (k, (name, positions)) in frames.iter().enumerate() {
         s.begin_model(k as i32 + 1, name.clone());
         for (&z, &position) in z.iter().zip(positions) {
             let symbol = crate::model::elements::element(z as u32).symbol;
-            s.push(&AtomRecord {
-                chain: Default::default(),
-                residue: Default::default(),
-                number: 0,
-                insertion: 0,
-                hetero: false,
-                name: AtomName::new(symbol).unwrap_or_default(),
-                altloc: 0,
-                z,
-                position,
-                occupancy: 1.0,
-                b_factor: 0.0,
-                serial: -1,
-            });
+            s.push(&bare_atom(symbol, z, position));
         }
     }
     document(source, title, s)

@@ -5,9 +5,8 @@
 use glam::DVec3;
 
 use super::ParseError;
-use super::structure::{document, element_of};
+use super::structure::{bare_atom, document, element_of};
 use super::text::{Lines, excerpt};
-use crate::model::structure::{AtomName, AtomRecord};
 use crate::model::units::BOHR_PER_ANGSTROM;
 use crate::model::{Document, Structure};
 
@@ -55,20 +54,7 @@ pub fn parse(file: &str, text: &str) -> Result<Document, ParseError> {
                 *v = super::text::parse_real(t)
                     .ok_or_else(|| lines.error("x, y and z coordinates after the element", &excerpt(line)))?;
             }
-            s.push(&AtomRecord {
-                chain: Default::default(),
-                residue: Default::default(),
-                number: 0,
-                insertion: 0,
-                hetero: false,
-                name: AtomName::new(symbol).unwrap_or_default(),
-                altloc: 0,
-                z,
-                position: DVec3::from_array(xyz) * BOHR_PER_ANGSTROM,
-                occupancy: 1.0,
-                b_factor: 0.0,
-                serial: -1,
-            });
+            s.push(&bare_atom(symbol, z, DVec3::from_array(xyz) * BOHR_PER_ANGSTROM));
         }
     }
     if s.is_empty() {
