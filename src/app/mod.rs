@@ -129,6 +129,16 @@ pub struct SceneObject {
     pub doc: Arc<Document>,
     /// The one source of truth for what the object shows: the panels edit it in place.
     pub state: ObjectState,
+    /// How many of its atoms its selection shows (counted when the selection or the model
+    /// changes, not every frame).
+    pub shown_atoms: usize,
+}
+
+impl SceneObject {
+    fn count_shown_atoms(&mut self) {
+        let mask = crate::scene::selection::shown_atoms(&self.doc, &self.state.selection);
+        self.shown_atoms = mask.map_or(self.doc.molecule.atoms.len(), |m| m.iter().filter(|&&s| s).count());
+    }
 }
 
 /// A change to the scene's list of objects, asked for in a panel and made after the frame's
@@ -431,12 +441,7 @@ impl OrbApp {
 
     /// How many of the active object's atoms its selection shows.
     pub fn shown_atoms(&self) -> usize {
-        let Some(o) = self.active_object() else { return 0 };
-        if o.state.selection.is_empty() {
-            return o.doc.molecule.atoms.len();
-        }
-        let look = crate::layers::atom_look(&o.doc, &o.state.atoms, &o.state.selection);
-        look.shown.iter().filter(|&&s| s).count()
+        self.active_object().map_or(0, |o| o.shown_atoms)
     }
 
     /// The quantity the side panel edits: the active object's selected one.
@@ -593,7 +598,9 @@ impl OrbApp {
             files::remember(&mut self.recent, path, RECENT_FILES);
         }
         self.applied.push(state.clone());
-        self.objects.push(SceneObject { doc, state });
+        let mut object = SceneObject { doc, state, shown_atoms: 0 };
+        object.count_shown_atoms();
+        self.objects.push(object);
         self.active = self.objects.len() - 1;
         for k in 0..self.objects[self.active].state.quantities.len() {
             self.auto_opacity(self.active, k);
@@ -701,6 +708,9 @@ impl OrbApp {
         let mut moved = false;
         for n in 0..self.objects.len().min(self.applied.len()) {
             let (Some(vp), Some(o)) = (&mut self.viewport, self.objects.get(n)) else { break };
+            if self.applied[n] == o.state {
+                continue;
+            }
             let was = std::mem::replace(&mut self.applied[n], o.state.clone());
             let was = &was;
             let changes = crate::scene::changes(was, &o.state);
@@ -750,6 +760,9 @@ impl OrbApp {
             };
             for k in refit {
                 self.auto_opacity(n, k);
+            }
+            if changes.atoms {
+                self.objects[n].count_shown_atoms();
             }
         }
         if moved {

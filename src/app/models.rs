@@ -58,8 +58,7 @@ pub fn selection(ui: &mut egui::Ui, app: &mut OrbApp) {
             (field.changed(), field.lost_focus())
         })
         .inner;
-    let total = o.doc.molecule.atoms.len();
-    let shown = crate::layers::atom_look(&o.doc, &o.state.atoms, &query).shown.iter().filter(|&&s| s).count();
+    let (total, shown) = (o.doc.molecule.atoms.len(), o.shown_atoms);
     if shown < total {
         ui.label(RichText::new(format!("{shown} of {total} atoms shown")).small().weak());
     }
@@ -112,6 +111,7 @@ impl OrbApp {
                 vp.update_surface(n, &o.doc, &o.state);
             }
         }
+        self.objects[n].count_shown_atoms();
         self.world = World::of(&self.objects);
     }
 }
