@@ -5,7 +5,7 @@ use crate::gpu::oit::FragmentStats;
 use crate::gpu::{FrameInput, GpuContext, GpuError, OffscreenTarget, Renderer};
 use crate::layers::{show_atoms, show_isosurfaces};
 use crate::model::Document;
-use crate::scene::{AtomLook, Camera, RenderSettings};
+use crate::scene::{AtomLook, Camera, RenderSettings, VolumeSettings};
 
 /// A renderer with an offscreen target of a fixed size.
 pub struct Headless {
@@ -72,6 +72,21 @@ pub fn draw_exact(
         }
         last_bands = stats.bands;
     }
+}
+
+/// Draws `renderer`'s scene from `camera` over `background` into `target` (every translucent
+/// fragment kept, [`draw_exact`]) and reads the picture back, with the fragment counts.
+pub fn picture(
+    ctx: &GpuContext,
+    renderer: &mut Renderer,
+    target: &OffscreenTarget,
+    camera: &Camera,
+    background: [f32; 3],
+    clouds: &[VolumeSettings],
+) -> Result<(image::RgbaImage, Option<FragmentStats>), GpuError> {
+    let frame = FrameInput { camera, background, clouds, size: target.size, tile: None };
+    let stats = draw_exact(ctx, renderer, &target.color_view, &frame);
+    Ok((target.read_rgba(&ctx.device, &ctx.queue)?, stats))
 }
 
 /// Renders a document once: the whole pipeline in one call.

@@ -4,6 +4,8 @@
 
 use std::sync::Arc;
 
+use glam::DVec3;
+
 use thiserror::Error;
 
 use crate::gpu::gto::{GtoFillPass, read_volume};
@@ -65,6 +67,9 @@ pub struct ScanScene {
     /// Largest |ψ| per slot over all frames: one opacity scale for the whole scan, so the
     /// cloud does not brighten or fade between frames for nothing.
     pub scale: Vec<f64>,
+    /// The box a camera frames to show the whole sweep: every frame's atoms and where each
+    /// slot's orbital is visible in any frame (bohr).
+    pub visible: (DVec3, DVec3),
     /// Memory the key volumes take, and the budget they had to fit.
     pub bytes: u64,
     pub budget: u64,
@@ -130,6 +135,7 @@ impl ScanScene {
                 }
             }
         }
+        let visible = visible_box(&scan, &grids);
         let mut keys = Vec::with_capacity(slots);
         let mut scale = Vec::with_capacity(slots);
         for slot_grids in &grids {
@@ -152,7 +158,7 @@ impl ScanScene {
             scale.push(max_abs);
         }
         let key_grids = grids.into_iter().map(|g| g.into_iter().map(Arc::new).collect()).collect();
-        Ok(Self { scan, tracks, grid, keys, key_grids, scale, bytes: needed, budget })
+        Ok(Self { scan, tracks, grid, keys, key_grids, scale, visible, bytes: needed, budget })
     }
 
     pub fn slots(&self) -> usize {
@@ -177,10 +183,10 @@ impl ScanScene {
         layer.set_molecule(ctx, &self.scan.geometry_at(theta), style);
     }
 
-    /// A camera framing the common grid, looking at the first key frame's skeleton along its
-    /// principal axes, tilted ([`crate::scene::view::first_view`]).
+    /// A camera framing what the sweep shows ([`ScanScene::visible`]), looking at the first key
+    /// frame's skeleton along its principal axes, tilted ([`crate::scene::view::first_view`]).
     pub fn camera(&self) -> Camera {
-        let (lo, hi) = self.grid.bounds();
+        let (lo, hi) = self.visible;
         let mut camera = Camera::framing(lo.as_vec3(), hi.as_vec3());
         if let Some(frame) = self.scan.frames.first() {
             let view = crate::scene::view::first_view(&frame.molecule);
@@ -201,19 +207,7 @@ impl ScanScene {
         settings: &RenderSettings,
         size: [u32; 2],
     ) -> Result<image::RgbaImage, GpuError> {
-        let mut out = image::RgbaImage::new(size[0] * slots.len() as u32, size[1]);
-        let mut renderer = Renderer::new(ctx);
-        let target = OffscreenTarget::new(&ctx.device, size);
-        for (n, &slot) in slots.iter().enumerate() {
-            self.show(ctx, &mut renderer, slot, theta, mode, settings.atoms);
-            let mut encoder =
-                ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("scan frame") });
-            renderer.render(ctx, &mut encoder, &target.color_view, &FrameInput::single(camera, settings, size));
-            ctx.queue.submit([encoder.finish()]);
-            let view = target.read_rgba(&ctx.device, &ctx.queue)?;
-            image::imageops::replace(&mut out, &view, (n as u32 * size[0]) as i64, 0);
-        }
-        Ok(out)
+        ScanPainter::new(ctx, size).paint(self, ctx, slots, theta, mode, camera, settings)
     }
 
     /// A slot's key volume in one frame.
@@ -233,6 +227,11 @@ impl ScanScene {
         }
     }
 
+    /// The coordinate at θ in words: "dihedral 1-2-3-4 = 45.0°".
+    pub fn coordinate_label(&self, theta: f64) -> String {
+        format!("dihedral {} = {theta:.1}°", self.scan.dihedral_label())
+    }
+
     /// The two key volumes' values around θ and the weight k of the second: slot `slot` at θ
     /// is (1−k)·a + k·b ([`mix`]).
     pub fn bracket_grids(&self, slot: usize, theta: f64) -> (Arc<VolumeGrid>, Arc<VolumeGrid>, f32) {
@@ -247,6 +246,76 @@ impl ScanScene {
         self.scan.interpolated_grid(&self.tracks, slot, theta, &self.grid, label)
     }
 }
+
+/// Draws a scan's views one picture after another with one renderer and target: what
+/// [`ScanScene::render`] does once, a movie does per frame.
+pub struct ScanPainter {
+    renderer: Renderer,
+    target: OffscreenTarget,
+}
+
+impl ScanPainter {
+    /// A painter of views `size` each.
+    pub fn new(ctx: &GpuContext, size: [u32; 2]) -> Self {
+        Self { renderer: Renderer::new(ctx), target: OffscreenTarget::new(&ctx.device, size) }
+    }
+
+    /// `slots` of `scene` at θ side by side (left to right), each the painter's size.
+    #[allow(clippy::too_many_arguments)]
+    pub fn paint(
+        &mut self,
+        scene: &ScanScene,
+        ctx: &GpuContext,
+        slots: &[usize],
+        theta: f64,
+        mode: Interpolation,
+        camera: &Camera,
+        settings: &RenderSettings,
+    ) -> Result<image::RgbaImage, GpuError> {
+        let size = self.target.size;
+        let mut out = image::RgbaImage::new(size[0] * slots.len() as u32, size[1]);
+        for (n, &slot) in slots.iter().enumerate() {
+            scene.show(ctx, &mut self.renderer, slot, theta, mode, settings.atoms);
+            let mut encoder =
+                ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("scan frame") });
+            let frame = FrameInput::single(camera, settings, size);
+            self.renderer.render(ctx, &mut encoder, &self.target.color_view, &frame);
+            ctx.queue.submit([encoder.finish()]);
+            let view = self.target.read_rgba(&ctx.device, &ctx.queue)?;
+            image::imageops::replace(&mut out, &view, (n as u32 * size[0]) as i64, 0);
+        }
+        Ok(out)
+    }
+}
+
+/// Where a sweep is visible: every key frame's atoms (padded by a ball's radius) and the points
+/// where each slot's orbital reaches a twentieth of its largest |ψ| in any frame.
+fn visible_box(scan: &Scan, grids: &[Vec<VolumeGrid>]) -> (DVec3, DVec3) {
+    let mut lo = DVec3::splat(f64::INFINITY);
+    let mut hi = DVec3::splat(f64::NEG_INFINITY);
+    for frame in &scan.frames {
+        if let Some((a, b)) = frame.molecule.bounds() {
+            lo = lo.min(a - DVec3::splat(2.0));
+            hi = hi.max(b + DVec3::splat(2.0));
+        }
+    }
+    for slot in grids {
+        let max_abs = slot.iter().map(|g| g.stats.max_abs).fold(0.0, f64::max);
+        for g in slot {
+            let Some((a, b)) = g.active_bounds((VISIBLE_FRACTION * max_abs) as f32) else { continue };
+            for corner in 0..8 {
+                let pick = |axis: usize| if corner >> axis & 1 == 0 { a[axis] } else { b[axis] } as f64;
+                let p = g.world_from_grid.transform_point3(DVec3::new(pick(0), pick(1), pick(2)));
+                lo = lo.min(p);
+                hi = hi.max(p);
+            }
+        }
+    }
+    if lo.x > hi.x { (DVec3::splat(-5.0), DVec3::splat(5.0)) } else { (lo, hi) }
+}
+
+/// The fraction of an orbital's largest |ψ| below which its cloud is too faint to frame.
+const VISIBLE_FRACTION: f64 = 0.05;
 
 /// (1−k)·a + k·b on their common grid: a scan's orbital between two key volumes, as the exact
 /// interpolation mode draws it.

@@ -6,6 +6,7 @@
 pub mod app;
 pub mod demo;
 pub mod evaluate;
+pub mod figure;
 pub mod formats;
 pub mod gpu;
 pub mod headless;
@@ -14,4 +15,5 @@ pub mod key_volumes;
 pub mod layers;
 pub mod meshes;
 pub mod model;
+pub mod movie;
 pub mod scene;

@@ -23,6 +23,8 @@ use orbcloud::{demo, formats};
 mod modes_cli;
 #[path = "cli/molsurface.rs"]
 mod molsurface_cli;
+#[path = "cli/movie.rs"]
+mod movie_cli;
 #[path = "cli/quantities.rs"]
 mod quantities_cli;
 #[path = "cli/render.rs"]
@@ -128,6 +130,9 @@ enum Command {
     Mesh(surface_cli::MeshArgs),
     /// Write one period of a normal mode as a multi-frame XYZ file (Å).
     Modes(modes_cli::ModesArgs),
+    /// A movie: a scan's coordinate swept, a file or session turning (--turntable), or a
+    /// vibration (--normal-mode K), as PNG frames, GIF, animated PNG, MP4 or WebM.
+    Movie(Box<movie_cli::MovieArgs>),
     /// Dihedral scans: make a manifest, inspect, render or export an angle.
     #[command(subcommand)]
     Scan(scan_cli::ScanCommand),
@@ -304,6 +309,8 @@ struct RenderArgs {
     #[arg(long)]
     lavapipe: bool,
     #[command(flatten)]
+    figure: FigureArgs,
+    #[command(flatten)]
     wavefunction: WavefunctionArgs,
     #[command(flatten)]
     iso: surface_cli::IsoArgs,
@@ -317,6 +324,23 @@ struct RenderArgs {
     demo: Option<DemoArg>,
     #[command(flatten)]
     vibration: modes_cli::ModeArgs,
+}
+
+/// How a picture is made: supersampled, with a transparent background.
+#[derive(Args, Clone, Copy)]
+struct FigureArgs {
+    /// Draw at K× the size and filter down (1 to 4): smooth edges on atoms and thin sticks.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=4))]
+    scale: u32,
+    /// A transparent background (PNG alpha), for figures laid over other material.
+    #[arg(long)]
+    transparent: bool,
+}
+
+impl FigureArgs {
+    fn figure(&self) -> orbcloud::figure::Figure {
+        orbcloud::figure::Figure { scale: self.scale, transparent: self.transparent }
+    }
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -542,10 +566,15 @@ impl ViewArgs {
     }
 
     fn camera(&self, doc: &Document) -> Result<Camera> {
-        let mut cam = camera_for(doc, self.view).map_err(|e| anyhow::anyhow!("--view {e}"))?;
-        cam.orbit(self.yaw.to_radians(), self.pitch.to_radians());
-        cam.zoom(1.0 / self.zoom.max(1e-3));
-        Ok(cam)
+        let cam = camera_for(doc, self.view).map_err(|e| anyhow::anyhow!("--view {e}"))?;
+        Ok(self.orbit(cam))
+    }
+
+    /// `camera` turned by `--yaw` and `--pitch` and zoomed by `--zoom`.
+    fn orbit(&self, mut camera: Camera) -> Camera {
+        camera.orbit(self.yaw.to_radians(), self.pitch.to_radians());
+        camera.zoom(1.0 / self.zoom.max(1e-3));
+        camera
     }
 
     fn volume_index(&self, doc: &Document) -> Result<Option<usize>> {
@@ -608,6 +637,7 @@ fn main() -> Result<()> {
         }
         Some(Command::Scan(command)) => scan_cli::run(command),
         Some(Command::Modes(args)) => modes_cli::write_xyz(&args),
+        Some(Command::Movie(args)) => movie_cli::movie(*args),
         Some(Command::Mesh(args)) => surface_cli::mesh(&args, &quantities_cli::parse_later_meshes(&later)?),
         Some(Command::Bench(BenchCommand::Keyvolumes(args))) => scan_cli::bench_keyvolumes(args),
         Some(Command::Bench(BenchCommand::Isosurface(args))) => surface_cli::bench(&args),

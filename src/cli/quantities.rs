@@ -8,13 +8,13 @@ use std::ffi::OsString;
 
 use anyhow::{Result, bail};
 use clap::Parser;
-use orbcloud::gpu::{FrameInput, GpuContext, OffscreenTarget, Renderer};
-use orbcloud::headless::draw_exact;
+use orbcloud::gpu::{GpuContext, OffscreenTarget, Renderer};
 use orbcloud::layers::show_scene;
 use orbcloud::model::Document;
-use orbcloud::scene::{Camera, Evaluation, ObjectState, QuantityState, RenderSettings, Source};
+use orbcloud::scene::{Camera, Evaluation, ObjectState, QuantityState, Source};
 
-use super::{Cli, Command, RenderArgs};
+use super::surface_cli::IsoArgs;
+use super::{Cli, Command, RenderArgs, ViewArgs, WavefunctionArgs};
 
 /// The options that start a quantity.
 const STARTS: [&str; 4] = ["--orbital", "--density", "--spin-density", "--volume"];
@@ -23,7 +23,7 @@ const BESIDE: &str = "--beside";
 /// Options that belong to the whole picture or file, not to a quantity: wherever they are
 /// given, they join the first part of the command line (`mesh FILE --density --iso 0.1
 /// --orbital homo --iso 0.05 -o out.glb`).
-const WHOLE_PICTURE: [&str; 27] = [
+const WHOLE_PICTURE: [&str; 29] = [
     "--output",
     "-o",
     "--size",
@@ -51,9 +51,11 @@ const WHOLE_PICTURE: [&str; 27] = [
     "--arrows",
     "--ball-scale",
     "--stick-scale",
+    "--scale",
+    "--transparent",
 ];
 /// Those of them that take no value.
-const WHOLE_PICTURE_FLAGS: [&str; 3] = ["--lavapipe", "--direct", "--arrows"];
+const WHOLE_PICTURE_FLAGS: [&str; 4] = ["--lavapipe", "--direct", "--arrows", "--transparent"];
 
 /// A quantity given after the first, with the options that followed it.
 pub struct Later {
@@ -116,18 +118,29 @@ pub fn split(args: Vec<OsString>) -> Result<(Vec<OsString>, Vec<Later>)> {
 
 /// One quantity of the file as `args` asks for it (its quantity option, cloud and isosurfaces).
 pub fn quantity(args: &RenderArgs, doc: &Document) -> Result<Option<QuantityState>> {
-    let settings = args.view.settings();
+    quantity_of(doc, &args.view, &args.wavefunction, &args.iso)
+}
+
+/// The quantity `what` names (or the data set `view` picks) with `view`'s cloud and `iso`'s
+/// isosurfaces.
+pub fn quantity_of(
+    doc: &Document,
+    view: &ViewArgs,
+    what: &WavefunctionArgs,
+    iso: &IsoArgs,
+) -> Result<Option<QuantityState>> {
+    let settings = view.settings();
     let source = match &doc.wavefunction {
-        Some(wf) => Source::Wavefunction(args.wavefunction.what.resolve(wf)?),
-        None => match args.view.volume_index(doc)? {
+        Some(wf) => Source::Wavefunction(what.what.resolve(wf)?),
+        None => match view.volume_index(doc)? {
             Some(i) => Source::Volume(i),
             None => return Ok(None),
         },
     };
     let mut q = QuantityState::new(source, &settings);
-    q.isosurfaces = vec![args.iso.base()];
-    args.iso.apply_to(&mut q);
-    if args.iso.levels().is_empty() {
+    q.isosurfaces = vec![iso.base()];
+    iso.apply_to(&mut q);
+    if iso.levels().is_empty() {
         q.isosurfaces.clear();
     }
     Ok(Some(q))
@@ -168,10 +181,12 @@ pub fn parse_later_meshes(later: &[Later]) -> Result<Vec<super::surface_cli::Mes
 /// whole, its width shared by the panes. Each pane's quantities are said on stderr.
 pub fn render(
     ctx: &GpuContext,
-    doc: Document,
+    doc: &Document,
     first: &RenderArgs,
     later: &[(bool, RenderArgs)],
     camera: &Camera,
+    size: [u32; 2],
+    background: [f32; 3],
 ) -> Result<image::RgbaImage> {
     let base = first.view.settings();
     let mut object = ObjectState {
@@ -188,16 +203,15 @@ pub fn render(
     let mut pane = 0;
     for (beside, args) in std::iter::once((false, first)).chain(later.iter().map(|(b, a)| (*b, a))) {
         pane += beside as usize;
-        if let Some(q) = quantity(args, &doc)? {
+        if let Some(q) = quantity(args, doc)? {
             object.quantities.push(q);
             panes.push(pane);
         }
     }
     let count = pane + 1;
-    let [width, height] = first.view.size;
+    let [width, height] = size;
     let pane_width = (width / count as u32).max(1);
     let mut image = image::RgbaImage::new(pane_width * count as u32, height);
-    let background = RenderSettings::default().background;
     for p in 0..count {
         let mut state = object.clone();
         let mut k = 0;
@@ -205,16 +219,14 @@ pub fn render(
             k += 1;
             panes[k - 1] == p
         });
-        let names: Vec<String> = state.quantities.iter().map(|q| describe(&doc, q.source)).collect();
+        let names: Vec<String> = state.quantities.iter().map(|q| describe(doc, q.source)).collect();
         eprintln!("pane {}: {}", p + 1, if names.is_empty() { "atoms".into() } else { names.join(" + ") });
-        let pane_scene = [(&doc, state)];
+        let pane_scene = [(doc, state)];
         let mut renderer = Renderer::new(ctx);
         let points = first.wavefunction.grid_points.clamp(8, 512);
         let (clouds, _) = show_scene(ctx, &mut renderer, &pane_scene, points)?;
         let target = OffscreenTarget::new(&ctx.device, [pane_width, height]);
-        let frame = FrameInput { camera, background, clouds: &clouds, size: [pane_width, height], tile: None };
-        draw_exact(ctx, &mut renderer, &target.color_view, &frame);
-        let picture = target.read_rgba(&ctx.device, &ctx.queue)?;
+        let (picture, _) = orbcloud::headless::picture(ctx, &mut renderer, &target, camera, background, &clouds)?;
         image::imageops::replace(&mut image, &picture, (p as u32 * pane_width) as i64, 0);
     }
     Ok(image)

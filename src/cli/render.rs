@@ -6,21 +6,28 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use orbcloud::demo;
+use orbcloud::figure::Figure;
 use orbcloud::gpu::GpuContext;
 use orbcloud::headless::Headless;
-use orbcloud::scene::{Camera, RenderSettings};
+use orbcloud::model::Document;
+use orbcloud::scene::{Camera, Evaluation, ObjectState, RenderSettings};
 
 use super::quantities_cli::{self, Later};
+use super::surface_cli::IsoArgs;
 use super::{DemoArg, RenderArgs, ViewArgs, WavefunctionArgs, gpu, load, surface_cli};
 
 /// `render`: `args`'s file (or the bundled demo) to a PNG; `later` are further quantities of the
 /// file, each with its options ([`quantities_cli`]).
 pub fn render(args: RenderArgs, later: &[Later]) -> Result<()> {
+    let figure = args.figure.figure();
+    let size = figure.drawn_size(args.view.size);
     match args.demo {
         Some(DemoArg::Cycloaddition) => {
             let ctx = gpu(args.lavapipe)?;
             let scene = demo::cycloaddition().context("the bundled demo did not load")?;
-            let img = surface_cli::render_scene(&ctx, scene, &args.iso, args.view.size)?;
+            let background = RenderSettings::default().background;
+            let mut shown = surface_cli::SceneShown::new(&ctx, scene, &args.iso, size)?;
+            let img = figure.draw(background, |bg| shown.draw(&ctx, bg))?;
             return save(&img, &args.output, &ctx);
         }
         Some(DemoArg::Scan) => bail!("the scan demo renders with `orbcloud scan render`"),
@@ -37,12 +44,16 @@ pub fn render(args: RenderArgs, later: &[Later]) -> Result<()> {
             bail!("--pick reads one quantity's picture: give one quantity option");
         }
         let ctx = gpu(args.lavapipe)?;
-        let img = quantities_cli::render(&ctx, doc, &args, &later, &camera)?;
+        let background = RenderSettings::default().background;
+        let img = figure.draw(background, |bg| quantities_cli::render(&ctx, &doc, &args, &later, &camera, size, bg))?;
         return save(&img, &args.output, &ctx);
+    }
+    if args.pick.is_some() && figure != Figure::default() {
+        bail!("--pick reads the picture as drawn: leave out --scale and --transparent");
     }
     let ctx = gpu(args.lavapipe)?;
     let mut settings = args.view.settings();
-    let mut h = Headless::new(&ctx, &doc, volume, &settings, args.view.size)?;
+    let mut h = Headless::new(&ctx, &doc, volume, &settings, size)?;
     let computed = args.wavefunction.apply(&ctx, &mut h, &doc)?.map(|(_, g)| g);
     let grid = computed.as_ref().or(volume.and_then(|i| doc.volumes.get(i)));
     if let Some(grid) = grid {
@@ -52,12 +63,32 @@ pub fn render(args: RenderArgs, later: &[Later]) -> Result<()> {
     surface_cli::show(&ctx, &mut h.renderer, grid, &args.iso, molsurface.into_iter().collect());
     let arrows = args.vibration.arrows(&doc)?;
     h.renderer.main().arrows.set_arrows(&ctx, &arrows, orbcloud::scene::vibration::ARROW_COLOR);
-    let img = h.render(&ctx, &camera, &settings)?;
+    let img = figure.draw(settings.background, |bg| {
+        let settings = RenderSettings { background: bg, ..settings.clone() };
+        h.render(&ctx, &camera, &settings)
+    })?;
     save(&img, &args.output, &ctx)?;
     if let Some(pixel) = args.pick {
         surface_cli::print_pick(&ctx, &h.renderer, &doc, pixel)?;
     }
     Ok(())
+}
+
+/// The object a movie of one file shows: its atoms as `view` asks, and the quantity `what` names
+/// (or the file's data set) with `iso`'s isosurfaces.
+pub fn object_of(doc: &Document, view: &ViewArgs, what: &WavefunctionArgs, iso: &IsoArgs) -> Result<ObjectState> {
+    let settings = view.settings();
+    let mut object = ObjectState {
+        atoms: orbcloud::scene::AtomLook::of(&settings),
+        evaluation: Evaluation {
+            direct: what.direct,
+            grid_points: what.grid_points.clamp(8, 512),
+            ..Evaluation::default()
+        },
+        ..ObjectState::default()
+    };
+    object.quantities.extend(quantities_cli::quantity_of(doc, view, what, iso)?);
+    Ok(object)
 }
 
 /// Writes `img` to `path` and says so, with the adapter that drew it.

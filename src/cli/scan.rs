@@ -9,12 +9,12 @@ use orbcloud::formats::cube_write;
 use orbcloud::formats::scan::{Follow, ScanFile, init, load_scan};
 use orbcloud::gpu::volume::{VolumeTexture, residency_budget, texel_bytes};
 use orbcloud::gpu::{GpuContext, OffscreenTarget, Renderer};
-use orbcloud::key_volumes::{DEFAULT_SCAN_POINTS, KeyOptions, ScanScene};
+use orbcloud::key_volumes::{DEFAULT_SCAN_POINTS, KeyOptions, ScanPainter, ScanScene};
 use orbcloud::model::VolumeGrid;
 use orbcloud::model::scan::Scan;
 use orbcloud::scene::Interpolation;
 
-use super::{ViewArgs, gpu};
+use super::{FigureArgs, ViewArgs, gpu};
 
 #[derive(Subcommand)]
 pub enum ScanCommand {
@@ -88,8 +88,9 @@ impl From<InterpolationArg> for Interpolation {
 #[derive(Args)]
 pub struct ScanRenderArgs {
     scan: PathBuf,
-    #[arg(long, allow_hyphen_values = true)]
-    angle: f64,
+    /// The coordinate's value (degrees for a dihedral).
+    #[arg(long, alias = "angle", allow_hyphen_values = true)]
+    at: f64,
     #[arg(long = "interpolation", value_enum, default_value_t = InterpolationArg::Exact)]
     interpolation: InterpolationArg,
     /// Only this orbital (as the manifest names it); default: all, left to right.
@@ -99,6 +100,11 @@ pub struct ScanRenderArgs {
     keys: KeyArgs,
     #[command(flatten)]
     view: ViewArgs,
+    #[command(flatten)]
+    figure: FigureArgs,
+    /// Leave out the captions (each view's orbital and energy, the coordinate's value).
+    #[arg(long)]
+    no_captions: bool,
     /// Use the CPU Vulkan adapter (lavapipe) even when a GPU is present.
     #[arg(long)]
     lavapipe: bool,
@@ -124,7 +130,7 @@ fn follow_of(arg: Option<FollowArg>, file: &ScanFile) -> Follow {
 }
 
 /// Loads a scan and makes its key volumes, reporting progress on stderr.
-fn build(ctx: &GpuContext, file: ScanFile, keys: &KeyArgs) -> Result<ScanScene> {
+pub fn build(ctx: &GpuContext, file: ScanFile, keys: &KeyArgs) -> Result<ScanScene> {
     let options = KeyOptions {
         points: keys.points.clamp(8, 512),
         follow: follow_of(keys.follow, &file),
@@ -162,11 +168,20 @@ fn slot_of(scan: &Scan, name: &str) -> Result<usize> {
     })
 }
 
+/// Captions each view of a scan picture (views `width` wide, side by side) with its orbital and
+/// energy and the coordinate's value at θ, as the viewer's scan panel shows them.
+pub fn scan_caption(image: &mut image::RgbaImage, scene: &ScanScene, slots: &[usize], theta: f64, width: u32) {
+    for (n, &slot) in slots.iter().enumerate() {
+        let lines = [scene.label(slot, theta), scene.coordinate_label(theta)];
+        orbcloud::figure::caption(image, n as u32 * width, width, &lines);
+    }
+}
+
 /// Refuses an angle outside the scan's range (it would be drawn at the nearest end).
 fn check_angle(scan: &Scan, angle: f64) -> Result<()> {
     let (lo, hi) = scan.range();
     if !(lo..=hi).contains(&angle) {
-        bail!("--angle {angle} is outside the scan's {lo}°..{hi}°");
+        bail!("{angle} is outside the scan's {lo}°..{hi}°");
     }
     Ok(())
 }
@@ -241,25 +256,23 @@ pub fn run(command: ScanCommand) -> Result<()> {
                 Some(name) => vec![slot_of(&file.scan, name)?],
                 None => (0..file.scan.orbitals.len()).collect(),
             };
-            check_angle(&file.scan, args.angle)?;
+            check_angle(&file.scan, args.at)?;
             let ctx = gpu(args.lavapipe)?;
             let scene = build(&ctx, file, &args.keys)?;
-            let settings = args.view.settings();
-            let mut camera = scene.camera();
-            camera.orbit(args.view.yaw.to_radians(), args.view.pitch.to_radians());
-            camera.zoom(1.0 / args.view.zoom.max(1e-3));
-            let image = scene.render(
-                &ctx,
-                &slots,
-                args.angle,
-                args.interpolation.into(),
-                &camera,
-                &settings,
-                args.view.size,
-            )?;
+            let mut settings = args.view.settings();
+            let camera = args.view.orbit(scene.camera());
+            let figure = args.figure.figure();
+            let mut painter = ScanPainter::new(&ctx, figure.drawn_size(args.view.size));
+            let mut image = figure.draw(settings.background, |bg| {
+                settings.background = bg;
+                painter.paint(&scene, &ctx, &slots, args.at, args.interpolation.into(), &camera, &settings)
+            })?;
+            if !args.no_captions {
+                scan_caption(&mut image, &scene, &slots, args.at, args.view.size[0]);
+            }
             image.save(&args.output).with_context(|| format!("writing {}", args.output.display()))?;
             for &slot in &slots {
-                eprintln!("{}", scene.label(slot, args.angle));
+                eprintln!("{}", scene.label(slot, args.at));
             }
             eprintln!("wrote {}", args.output.display());
             Ok(())

@@ -503,33 +503,43 @@ pub fn image_error(a: &image::RgbaImage, b: &image::RgbaImage, background: &[f32
     (all as f64 / (3 * a.width() * a.height()) as f64, covered as f64 / (3 * n_covered.max(1)) as f64)
 }
 
-/// Draws a scene of several objects (a bundled demo), framed as the demo's view
+/// A scene of several objects (a bundled demo) shown in a renderer, framed as the demo's view
 /// ([`orbcloud::demo::CYCLOADDITION_VIEW`]). `--iso` values, when given, replace each object's
 /// isosurface levels (drawn as its first isosurface is, told apart by colour).
-pub fn render_scene(
-    ctx: &GpuContext,
-    mut scene: Vec<(Document, orbcloud::scene::ObjectState)>,
-    iso: &IsoArgs,
-    size: [u32; 2],
-) -> Result<image::RgbaImage> {
-    use orbcloud::gpu::{FrameInput, OffscreenTarget};
-    use orbcloud::headless::draw_exact;
-    use orbcloud::layers::show_scene;
-    use orbcloud::scene::{Camera, RenderSettings};
-    for (_, state) in &mut scene {
-        state.quantities.iter_mut().for_each(|q| iso.apply_to(q));
+pub struct SceneShown {
+    renderer: Renderer,
+    clouds: Vec<orbcloud::scene::VolumeSettings>,
+    camera: orbcloud::scene::Camera,
+    target: orbcloud::gpu::OffscreenTarget,
+}
+
+impl SceneShown {
+    pub fn new(
+        ctx: &GpuContext,
+        mut scene: Vec<(Document, orbcloud::scene::ObjectState)>,
+        iso: &IsoArgs,
+        size: [u32; 2],
+    ) -> Result<Self> {
+        for (_, state) in &mut scene {
+            state.quantities.iter_mut().for_each(|q| iso.apply_to(q));
+        }
+        let mut renderer = Renderer::new(ctx);
+        let (clouds, bounds) = orbcloud::layers::show_scene(ctx, &mut renderer, &scene, 64)?;
+        let (lo, hi) = bounds.context("the scene is empty")?;
+        let mut camera = orbcloud::scene::Camera::framing(lo.as_vec3(), hi.as_vec3());
+        let (yaw, pitch) = orbcloud::demo::CYCLOADDITION_VIEW;
+        camera.orbit(yaw, pitch);
+        let target = orbcloud::gpu::OffscreenTarget::new(&ctx.device, size);
+        Ok(Self { renderer, clouds, camera, target })
     }
-    let mut renderer = Renderer::new(ctx);
-    let (clouds, bounds) = show_scene(ctx, &mut renderer, &scene, 64)?;
-    let (lo, hi) = bounds.context("the scene is empty")?;
-    let mut camera = Camera::framing(lo.as_vec3(), hi.as_vec3());
-    let (yaw, pitch) = orbcloud::demo::CYCLOADDITION_VIEW;
-    camera.orbit(yaw, pitch);
-    let target = OffscreenTarget::new(&ctx.device, size);
-    let background = RenderSettings::default().background;
-    let frame = FrameInput { camera: &camera, background, clouds: &clouds, size, tile: None };
-    if let Some(s) = draw_exact(ctx, &mut renderer, &target.color_view, &frame) {
-        eprintln!("translucent surfaces: {} fragments in {} band(s), exact order", s.needed, s.bands);
+
+    /// The picture over `background`.
+    pub fn draw(&mut self, ctx: &GpuContext, background: [f32; 3]) -> Result<image::RgbaImage> {
+        let (img, stats) =
+            orbcloud::headless::picture(ctx, &mut self.renderer, &self.target, &self.camera, background, &self.clouds)?;
+        if let Some(s) = stats {
+            eprintln!("translucent surfaces: {} fragments in {} band(s), exact order", s.needed, s.bands);
+        }
+        Ok(img)
     }
-    Ok(target.read_rgba(&ctx.device, &ctx.queue)?)
 }

@@ -1,0 +1,231 @@
+//! `movie`: a scan's coordinate swept, a turntable, or a vibration's period, frame after frame
+//! through the same renderer as `render` and `scan render`, written as PNG frames, a GIF, an
+//! animated PNG or (through ffmpeg) a video.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use orbcloud::formats::scan::load_scan;
+use orbcloud::gpu::{OffscreenTarget, Renderer};
+use orbcloud::headless::picture;
+use orbcloud::key_volumes::ScanPainter;
+use orbcloud::layers::{show_atoms, show_scene};
+use orbcloud::model::Document;
+use orbcloud::movie::{MovieFormat, MovieWriter, full_turn, sweep};
+use orbcloud::scene::{Camera, ObjectState};
+
+use super::scan_cli::{InterpolationArg, KeyArgs, build, scan_caption};
+use super::{FigureArgs, ViewArgs, WavefunctionArgs, gpu, modes_cli, render_cli, surface_cli};
+
+#[derive(Args)]
+pub struct MovieArgs {
+    /// A scan manifest (.scan.toml: its coordinate is swept), a file of any format `render`
+    /// reads, or a session (.orbcloud.toml); the bundled scan when omitted.
+    input: Option<PathBuf>,
+    /// Where the movie goes: a folder (`DIR/`, numbered PNG frames), `.gif`, `.apng` (or
+    /// `.png`), or `.mp4`/`.webm` through ffmpeg.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Frames: over the scan's range (ends included), over a full turn, or over one period.
+    #[arg(long, default_value_t = 24)]
+    frames: usize,
+    /// Frames per second.
+    #[arg(long, default_value_t = 12.0)]
+    fps: f64,
+    /// Turn the view a full circle about the screen's vertical axis.
+    #[arg(long)]
+    turntable: bool,
+    /// Where a scan's sweep starts (the coordinate's unit; default: the first key frame).
+    #[arg(long, allow_hyphen_values = true)]
+    from: Option<f64>,
+    /// Where a scan's sweep ends (default: the last key frame).
+    #[arg(long, allow_hyphen_values = true)]
+    to: Option<f64>,
+    /// Sweep there and back, so the movie loops.
+    #[arg(long)]
+    bounce: bool,
+    #[arg(long = "interpolation", value_enum, default_value_t = InterpolationArg::Exact)]
+    interpolation: InterpolationArg,
+    #[command(flatten)]
+    keys: KeyArgs,
+    #[command(flatten)]
+    figure: FigureArgs,
+    #[command(flatten)]
+    view: ViewArgs,
+    #[command(flatten)]
+    wavefunction: WavefunctionArgs,
+    #[command(flatten)]
+    iso: surface_cli::IsoArgs,
+    /// One period of this normal mode (1-based, as `info` lists them), the atoms moving along it.
+    #[arg(long)]
+    normal_mode: Option<usize>,
+    /// The largest atom's displacement at the turning points, bohr.
+    #[arg(long, default_value_t = 0.4)]
+    amplitude: f64,
+    /// Draw each atom's displacement along the mode as an arrow.
+    #[arg(long, requires = "normal_mode")]
+    arrows: bool,
+    /// Use the CPU Vulkan adapter (lavapipe) even when a GPU is present.
+    #[arg(long)]
+    lavapipe: bool,
+}
+
+fn is_scan(path: &Path) -> bool {
+    path.to_string_lossy().to_lowercase().ends_with(".scan.toml")
+}
+
+fn is_session(path: &Path) -> bool {
+    path.to_string_lossy().to_lowercase().ends_with(orbcloud::scene::objects::SESSION_SUFFIX)
+}
+
+pub fn movie(args: MovieArgs) -> Result<()> {
+    // Everything that can be refused is, before any frame is drawn.
+    MovieFormat::of(&args.output)?.check(&args.output)?;
+    if args.frames == 0 || args.frames > 100_000 {
+        bail!("--frames {} must be 1 to 100000", args.frames);
+    }
+    let scan_input = args.input.as_deref().is_none_or(is_scan);
+    match (scan_input, args.turntable, args.normal_mode) {
+        (true, _, Some(_)) => bail!("--normal-mode animates a file's vibration; a scan sweeps its coordinate"),
+        (false, false, None) => {
+            bail!("a file or session moves with --turntable or --normal-mode K (a scan manifest sweeps its coordinate)")
+        }
+        (false, true, Some(_)) => bail!("choose one: --turntable or --normal-mode"),
+        _ => {}
+    }
+    let started = Instant::now();
+    let written = if scan_input && !args.turntable { scan_sweep(&args)? } else { file_movie(&args, scan_input)? };
+    let per_frame = started.elapsed().as_secs_f64() / written.max(1) as f64;
+    eprintln!("wrote {} ({written} frames, {:.2} s per frame with setup)", args.output.display(), per_frame);
+    Ok(())
+}
+
+/// Opens the movie and writes `frames` pictures made by `draw(k)`, saying how far it got.
+fn write_frames(
+    args: &MovieArgs,
+    size: [u32; 2],
+    frames: usize,
+    mut draw: impl FnMut(usize) -> Result<image::RgbaImage>,
+) -> Result<usize> {
+    let mut writer = MovieWriter::create(&args.output, size, args.fps, frames)?;
+    for k in 0..frames {
+        let picture = draw(k)?;
+        writer.push(&picture)?;
+        eprint!("\rframe {}/{frames}", k + 1);
+    }
+    eprintln!();
+    let n = writer.written();
+    writer.finish()?;
+    Ok(n)
+}
+
+/// A scan's coordinate swept from `--from` to `--to`: every view side by side, each captioned,
+/// frame k equal to `scan render --at θk`.
+fn scan_sweep(args: &MovieArgs) -> Result<usize> {
+    let file = match &args.input {
+        Some(path) => load_scan(path)?,
+        None => orbcloud::demo::scan()?,
+    };
+    let (lo, hi) = file.scan.range();
+    let (from, to) = (args.from.unwrap_or(lo), args.to.unwrap_or(hi));
+    for (name, v) in [("--from", from), ("--to", to)] {
+        if !(lo..=hi).contains(&v) {
+            bail!("{name} {v} is outside the scan's {lo}..{hi}");
+        }
+    }
+    let values = sweep(from, to, args.frames, args.bounce);
+    let ctx = gpu(args.lavapipe)?;
+    let scene = build(&ctx, file, &args.keys)?;
+    let slots: Vec<usize> = (0..scene.slots()).collect();
+    let mut settings = args.view.settings();
+    let camera = args.view.orbit(scene.camera());
+    let figure = args.figure.figure();
+    let size = args.view.size;
+    let mut painter = ScanPainter::new(&ctx, figure.drawn_size(size));
+    let background = settings.background;
+    write_frames(args, [size[0] * slots.len() as u32, size[1]], values.len(), |k| {
+        let theta = values[k];
+        let mut picture = figure.draw(background, |bg| {
+            settings.background = bg;
+            painter.paint(&scene, &ctx, &slots, theta, args.interpolation.into(), &camera, &settings)
+        })?;
+        scan_caption(&mut picture, &scene, &slots, theta, size[0]);
+        Ok(picture)
+    })
+}
+
+/// A file or session turning a full circle, or a file's vibration over one period.
+fn file_movie(args: &MovieArgs, scan_input: bool) -> Result<usize> {
+    if scan_input {
+        bail!("--turntable turns a file or session; a scan manifest sweeps its coordinate (leave out --turntable)");
+    }
+    let input = args.input.as_deref().context("a file or session is needed")?;
+    let ctx = gpu(args.lavapipe)?;
+    let figure = args.figure.figure();
+    let size = figure.drawn_size(args.view.size);
+    let (mut scene, mut camera, background) = if is_session(input) {
+        session_scene(input)?
+    } else {
+        let doc = orbcloud::formats::load(input)?;
+        let camera = args.view.camera(&doc)?;
+        let object = render_cli::object_of(&doc, &args.view, &args.wavefunction, &args.iso)?;
+        (vec![(doc, object)], camera, args.view.settings().background)
+    };
+    if is_session(input) {
+        camera = args.view.orbit(camera);
+    }
+    let mut renderer = Renderer::new(&ctx);
+    let points = args.wavefunction.grid_points.clamp(8, 512);
+    let (clouds, _) = show_scene(&ctx, &mut renderer, &scene, points)?;
+    let mode = match args.normal_mode {
+        Some(n) => {
+            let vibration = modes_cli::ModeArgs {
+                normal_mode: Some(n),
+                phase: 0.0,
+                amplitude: args.amplitude,
+                arrows: args.arrows,
+            };
+            let arrows = vibration.arrows(&scene[0].0)?;
+            renderer.layer_mut(&ctx, 0).arrows.set_arrows(&ctx, &arrows, orbcloud::scene::vibration::ARROW_COLOR);
+            Some(vibration)
+        }
+        None => None,
+    };
+    let steps = full_turn(args.frames);
+    let original = scene[0].0.molecule.clone();
+    let target = OffscreenTarget::new(&ctx.device, size);
+    write_frames(args, args.view.size, steps.len(), |k| {
+        let mut cam = camera;
+        match &mode {
+            Some(vibration) => {
+                let moved = modes_cli::ModeArgs { phase: steps[k].to_degrees(), ..vibration.clone() };
+                scene[0].0.molecule = original.clone();
+                moved.apply_quietly(&mut scene[0].0)?;
+                let (doc, state) = &scene[0];
+                show_atoms(&ctx, renderer.layer_mut(&ctx, 0), doc, &state.atoms, &state.selection);
+            }
+            None => cam.orbit(steps[k] as f32, 0.0),
+        }
+        figure.draw(background, |bg| Ok(picture(&ctx, &mut renderer, &target, &cam, bg, &clouds)?.0))
+    })
+}
+
+/// A session's objects (each file loaded), its camera and background.
+fn session_scene(path: &Path) -> Result<(Vec<(Document, ObjectState)>, Camera, [f32; 3])> {
+    let session = orbcloud::app::session::read(path).map_err(anyhow::Error::msg)?;
+    let mut scene = Vec::new();
+    for mut state in session.objects {
+        let Some(file) = state.path.clone() else { continue };
+        let doc = orbcloud::formats::load(&file)
+            .with_context(|| format!("{}: opening {}", path.display(), file.display()))?;
+        state.fit_to(&doc, &orbcloud::scene::RenderSettings::default());
+        scene.push((doc, state));
+    }
+    if scene.is_empty() {
+        bail!("{}: the session opens no files", path.display());
+    }
+    let background = session.background.unwrap_or(orbcloud::scene::RenderSettings::default().background);
+    Ok((scene, session.camera, background))
+}
