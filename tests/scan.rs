@@ -204,8 +204,7 @@ fn settings() -> RenderSettings {
 fn three_pass_stays_close_to_exact_and_equals_it_at_key_angles() {
     let ctx = common::lavapipe();
     let scene = small_scene(&ctx);
-    let mut camera = scene.camera();
-    camera.zoom(1.0 / 1.6);
+    let camera = scene.camera();
     let size = [160, 120];
     let s = settings();
     let render = |theta: f64, mode| scene.render(&ctx, &[0, 1], theta, mode, &camera, &s, size).unwrap();
@@ -264,8 +263,7 @@ fn the_gpu_mix_matches_the_cpu_interpolated_grid() {
 fn golden_psb3_at_minus_90() {
     let ctx = common::lavapipe();
     let scene = small_scene(&ctx);
-    let mut camera = scene.camera();
-    camera.zoom(1.0 / 1.6);
+    let camera = scene.camera();
     let img = scene.render(&ctx, &[0, 1], -90.0, Interpolation::Exact, &camera, &settings(), [200, 150]).unwrap();
     common::assert_golden("scan_psb3_m90", &img);
 }

@@ -200,7 +200,9 @@ fn file_movie(args: &MovieArgs, scan_input: bool) -> Result<usize> {
         let mut cam = camera;
         match &mode {
             Some(vibration) => {
-                let moved = modes_cli::ModeArgs { phase: steps[k].to_degrees(), ..vibration.clone() };
+                // In degrees as `render --phase` takes them, so frame k is that picture exactly.
+                let phase = 360.0 * k as f64 / steps.len() as f64;
+                let moved = modes_cli::ModeArgs { phase, ..vibration.clone() };
                 scene[0].0.molecule = original.clone();
                 moved.apply_quietly(&mut scene[0].0)?;
                 let (doc, state) = &scene[0];

@@ -34,9 +34,10 @@ pub fn render(args: RenderArgs, later: &[Later]) -> Result<()> {
         _ => {}
     }
     let mut doc = load(args.file.as_deref())?;
-    args.vibration.apply(&mut doc)?;
-    // Arguments that depend on the file are checked before any GPU work.
+    // Arguments that depend on the file are checked before any GPU work. The camera frames the
+    // file's geometry, so pictures of a vibration's phases line up.
     let camera = args.view.camera(&doc)?;
+    args.vibration.apply(&mut doc)?;
     let volume = args.view.volume_index(&doc)?;
     if !later.is_empty() {
         let later = quantities_cli::parse_later(later)?;
