@@ -17,3 +17,4 @@ pub mod meshes;
 pub mod model;
 pub mod movie;
 pub mod scene;
+pub mod shots;

@@ -3,21 +3,19 @@
 //! animated PNG or (through ffmpeg) a video.
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use orbcloud::formats::scan::load_scan;
-use orbcloud::gpu::{OffscreenTarget, Renderer};
-use orbcloud::headless::picture;
-use orbcloud::key_volumes::ScanPainter;
-use orbcloud::layers::{show_atoms, show_scene};
 use orbcloud::model::Document;
-use orbcloud::movie::{MovieFormat, MovieWriter, full_turn, sweep};
+use orbcloud::movie::{MovieFormat, MovieWriter, sweep};
 use orbcloud::scene::{Camera, ObjectState};
+use orbcloud::shots::{Motion, Progress, ScanShots, SceneShots, ShotError, record};
 
-use super::scan_cli::{InterpolationArg, KeyArgs, build, scan_caption};
-use super::{FigureArgs, ViewArgs, WavefunctionArgs, gpu, modes_cli, render_cli, surface_cli};
+use super::scan_cli::{InterpolationArg, KeyArgs, build};
+use super::{FigureArgs, ViewArgs, WavefunctionArgs, gpu, render_cli, surface_cli};
 
 #[derive(Args)]
 pub struct MovieArgs {
@@ -102,23 +100,21 @@ pub fn movie(args: MovieArgs) -> Result<()> {
     Ok(())
 }
 
-/// Opens the movie and writes `frames` pictures made by `draw(k)`, saying how far it got.
+/// Writes `count` frames drawn by `frame(k)`, saying how far it got.
 fn write_frames(
     args: &MovieArgs,
     size: [u32; 2],
-    frames: usize,
-    mut draw: impl FnMut(usize) -> Result<image::RgbaImage>,
+    count: usize,
+    mut frame: impl FnMut(usize) -> Result<image::RgbaImage, ShotError>,
 ) -> Result<usize> {
-    let mut writer = MovieWriter::create(&args.output, size, args.fps, frames)?;
-    for k in 0..frames {
-        let picture = draw(k)?;
-        writer.push(&picture)?;
-        eprint!("\rframe {}/{frames}", k + 1);
-    }
+    let writer = MovieWriter::create(&args.output, size, args.fps, count)?;
+    let progress = Progress::default();
+    record(writer, count, &progress, |k| {
+        eprint!("\rframe {}/{count}", k + 1);
+        frame(k)
+    })?;
     eprintln!();
-    let n = writer.written();
-    writer.finish()?;
-    Ok(n)
+    Ok(count)
 }
 
 /// A scan's coordinate swept from `--from` to `--to`: every view side by side, each captioned,
@@ -137,23 +133,15 @@ fn scan_sweep(args: &MovieArgs) -> Result<usize> {
     }
     let values = sweep(from, to, args.frames, args.bounce);
     let ctx = gpu(args.lavapipe)?;
-    let scene = build(&ctx, file, &args.keys)?;
-    let slots: Vec<usize> = (0..scene.slots()).collect();
-    let mut settings = args.view.settings();
+    let scene = Arc::new(build(&ctx, file, &args.keys)?);
     let camera = args.view.orbit(scene.camera());
-    let figure = args.figure.figure();
+    let views = scene.slots() as u32;
     let size = args.view.size;
-    let mut painter = ScanPainter::new(&ctx, figure.drawn_size(size));
-    let background = settings.background;
-    write_frames(args, [size[0] * slots.len() as u32, size[1]], values.len(), |k| {
-        let theta = values[k];
-        let mut picture = figure.draw(background, |bg| {
-            settings.background = bg;
-            painter.paint(&scene, &ctx, &slots, theta, args.interpolation.into(), &camera, &settings)
-        })?;
-        scan_caption(&mut picture, &scene, &slots, theta, size[0]);
-        Ok(picture)
-    })
+    let settings = args.view.settings();
+    let figure = args.figure.figure();
+    let mut shots = ScanShots::new(&ctx, scene, values, camera, settings, args.interpolation.into(), figure, size);
+    let count = shots.values.len();
+    write_frames(args, [size[0] * views, size[1]], count, |k| Ok(shots.at(&ctx, shots.values[k])?))
 }
 
 /// A file or session turning a full circle, or a file's vibration over one period.
@@ -162,56 +150,30 @@ fn file_movie(args: &MovieArgs, scan_input: bool) -> Result<usize> {
         bail!("--turntable turns a file or session; a scan manifest sweeps its coordinate (leave out --turntable)");
     }
     let input = args.input.as_deref().context("a file or session is needed")?;
-    let ctx = gpu(args.lavapipe)?;
-    let figure = args.figure.figure();
-    let size = figure.drawn_size(args.view.size);
-    let (mut scene, mut camera, background) = if is_session(input) {
-        session_scene(input)?
+    let (scene, camera, background) = if is_session(input) {
+        let (scene, camera, background) = session_scene(input)?;
+        (scene, args.view.orbit(camera), background)
     } else {
         let doc = orbcloud::formats::load(input)?;
         let camera = args.view.camera(&doc)?;
         let object = render_cli::object_of(&doc, &args.view, &args.wavefunction, &args.iso)?;
         (vec![(doc, object)], camera, args.view.settings().background)
     };
-    if is_session(input) {
-        camera = args.view.orbit(camera);
-    }
-    let mut renderer = Renderer::new(&ctx);
-    let points = args.wavefunction.grid_points.clamp(8, 512);
-    let (clouds, _) = show_scene(&ctx, &mut renderer, &scene, points)?;
-    let mode = match args.normal_mode {
-        Some(n) => {
-            let vibration = modes_cli::ModeArgs {
-                normal_mode: Some(n),
-                phase: 0.0,
-                amplitude: args.amplitude,
-                arrows: args.arrows,
-            };
-            let arrows = vibration.arrows(&scene[0].0)?;
-            renderer.layer_mut(&ctx, 0).arrows.set_arrows(&ctx, &arrows, orbcloud::scene::vibration::ARROW_COLOR);
-            Some(vibration)
-        }
-        None => None,
+    let motion = match args.normal_mode {
+        Some(0) => bail!("--normal-mode counts from 1, as `info` lists the modes"),
+        Some(n) => Motion::Vibration { mode: n - 1, amplitude: args.amplitude },
+        None => Motion::Turntable,
     };
-    let steps = full_turn(args.frames);
-    let original = scene[0].0.molecule.clone();
-    let target = OffscreenTarget::new(&ctx.device, size);
-    write_frames(args, args.view.size, steps.len(), |k| {
-        let mut cam = camera;
-        match &mode {
-            Some(vibration) => {
-                // In degrees as `render --phase` takes them, so frame k is that picture exactly.
-                let phase = 360.0 * k as f64 / steps.len() as f64;
-                let moved = modes_cli::ModeArgs { phase, ..vibration.clone() };
-                scene[0].0.molecule = original.clone();
-                moved.apply_quietly(&mut scene[0].0)?;
-                let (doc, state) = &scene[0];
-                show_atoms(&ctx, renderer.layer_mut(&ctx, 0), doc, &state.atoms, &state.selection);
-            }
-            None => cam.orbit(steps[k] as f32, 0.0),
-        }
-        figure.draw(background, |bg| Ok(picture(&ctx, &mut renderer, &target, &cam, bg, &clouds)?.0))
-    })
+    let ctx = gpu(args.lavapipe)?;
+    let points = args.wavefunction.grid_points.clamp(8, 512);
+    let figure = args.figure.figure();
+    let mut shots =
+        SceneShots::new(&ctx, scene, camera, background, motion, args.frames, figure, args.view.size, points)?;
+    if args.arrows {
+        shots.show_arrows(&ctx);
+    }
+    let count = shots.len();
+    write_frames(args, args.view.size, count, |k| Ok(shots.frame(&ctx, k)?))
 }
 
 /// A session's objects (each file loaded), its camera and background.

@@ -9,10 +9,11 @@ use orbcloud::formats::cube_write;
 use orbcloud::formats::scan::{Follow, ScanFile, init, load_scan};
 use orbcloud::gpu::volume::{VolumeTexture, residency_budget, texel_bytes};
 use orbcloud::gpu::{GpuContext, OffscreenTarget, Renderer};
-use orbcloud::key_volumes::{DEFAULT_SCAN_POINTS, KeyOptions, ScanPainter, ScanScene};
+use orbcloud::key_volumes::{DEFAULT_SCAN_POINTS, KeyOptions, ScanScene};
 use orbcloud::model::VolumeGrid;
 use orbcloud::model::scan::Scan;
 use orbcloud::scene::Interpolation;
+use orbcloud::shots::ScanShots;
 
 use super::{FigureArgs, ViewArgs, gpu};
 
@@ -168,15 +169,6 @@ fn slot_of(scan: &Scan, name: &str) -> Result<usize> {
     })
 }
 
-/// Captions each view of a scan picture (views `width` wide, side by side) with its orbital and
-/// energy and the coordinate's value at θ, as the viewer's scan panel shows them.
-pub fn scan_caption(image: &mut image::RgbaImage, scene: &ScanScene, slots: &[usize], theta: f64, width: u32) {
-    for (n, &slot) in slots.iter().enumerate() {
-        let lines = [scene.label(slot, theta), scene.coordinate_label(theta)];
-        orbcloud::figure::caption(image, n as u32 * width, width, &lines);
-    }
-}
-
 /// Refuses an angle outside the scan's range (it would be drawn at the nearest end).
 fn check_angle(scan: &Scan, angle: f64) -> Result<()> {
     let (lo, hi) = scan.range();
@@ -259,17 +251,15 @@ pub fn run(command: ScanCommand) -> Result<()> {
             check_angle(&file.scan, args.at)?;
             let ctx = gpu(args.lavapipe)?;
             let scene = build(&ctx, file, &args.keys)?;
-            let mut settings = args.view.settings();
             let camera = args.view.orbit(scene.camera());
+            let scene = std::sync::Arc::new(scene);
+            let (settings, mode) = (args.view.settings(), args.interpolation.into());
             let figure = args.figure.figure();
-            let mut painter = ScanPainter::new(&ctx, figure.drawn_size(args.view.size));
-            let mut image = figure.draw(settings.background, |bg| {
-                settings.background = bg;
-                painter.paint(&scene, &ctx, &slots, args.at, args.interpolation.into(), &camera, &settings)
-            })?;
-            if !args.no_captions {
-                scan_caption(&mut image, &scene, &slots, args.at, args.view.size[0]);
-            }
+            let mut shots =
+                ScanShots::new(&ctx, scene.clone(), vec![args.at], camera, settings, mode, figure, args.view.size);
+            shots.captions = !args.no_captions;
+            shots.slots = slots.clone();
+            let image = shots.at(&ctx, args.at)?;
             image.save(&args.output).with_context(|| format!("writing {}", args.output.display()))?;
             for &slot in &slots {
                 eprintln!("{}", scene.label(slot, args.at));
