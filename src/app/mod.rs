@@ -9,6 +9,7 @@ pub mod models;
 mod orbitals;
 mod panels;
 pub mod panes;
+pub mod record;
 pub mod restart;
 pub mod scan;
 mod scene_panel;
@@ -245,6 +246,11 @@ pub struct OrbApp {
     /// A message that stays in the status line until dismissed (the scene came back on a new
     /// device).
     pub notice: Option<String>,
+    /// The *Record…* window's choices, and the recording under way.
+    pub record: record::RecordDialog,
+    pub recording: Option<record::Recording>,
+    /// The folder a picture or movie was last saved in.
+    pub last_folder: Option<PathBuf>,
 }
 
 /// The scene's atoms in world space, numbered object after object: what measurements index.
@@ -396,6 +402,9 @@ impl OrbApp {
             restart: None,
             rehearsal: None,
             notice: None,
+            record: record::RecordDialog::default(),
+            recording: None,
+            last_folder: None,
         };
         if app.viewport.is_none() {
             app.error = Some("no wgpu render state: the viewer needs eframe's wgpu backend".into());
@@ -821,11 +830,10 @@ impl OrbApp {
                 files::Native::Missing => self.native_dialogs = false,
             }
         }
-        let dir = self
-            .recent
-            .first()
-            .and_then(|p| p.parent())
-            .map(Path::to_path_buf)
+        // Pictures go where the last one went; files open from where the last one came.
+        let last_saved = self.last_folder.clone().filter(|_| purpose == files::Purpose::SavePng);
+        let dir = last_saved
+            .or_else(|| self.recent.first().and_then(|p| p.parent()).map(Path::to_path_buf))
             .or_else(|| std::env::current_dir().ok())
             .unwrap_or_else(|| PathBuf::from("/"));
         self.browser = Some(files::FileBrowser::new(purpose, dir, file_name));
@@ -1028,7 +1036,10 @@ impl OrbApp {
             None => vp.snapshot(&self.view, size),
         };
         match shot.map(|img| img.save(path)) {
-            Ok(Ok(())) => self.status = format!("saved {}", path.display()),
+            Ok(Ok(())) => {
+                self.status = format!("saved {}", path.display());
+                self.last_folder = path.parent().map(Path::to_path_buf);
+            }
             Ok(Err(e)) => self.error = Some(format!("{}: {e}", path.display())),
             Err(e) => self.error = Some(e.to_string()),
         }
@@ -1044,8 +1055,10 @@ impl eframe::App for OrbApp {
         let ctx = ui.ctx().clone();
         self.tick_rehearsal(&ctx);
         self.poll_job(&ctx);
+        self.poll_recording();
         let action = panels::top_bar(ui, self);
         panels::status_bar(ui, self);
+        record::record_window(&ctx, self);
         panels::side_panel(ui, self);
         let defaults = self.defaults;
         // A scan shows its own orbitals; the browser belongs to the scene's objects.
@@ -1086,11 +1099,16 @@ impl eframe::App for OrbApp {
                     self.open_session(&path, &ctx);
                 }
             }
+            panels::Action::Record => self.open_record_dialog(),
             panels::Action::Screenshot => {
-                let name = format!(
-                    "orbcloud-{}.png",
-                    std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_secs())
-                );
+                let name = match &self.scan {
+                    Some(scan) => record::picture_name(&scan.scene.scan.title, Some(&format!("{:.0}deg", scan.theta))),
+                    None => {
+                        let quantity = (self.objects.get(self.active))
+                            .and_then(|o| o.state.quantities.get(o.state.selected).map(|q| q.source.name(&o.doc)));
+                        record::picture_name(&self.doc().source, quantity.as_deref())
+                    }
+                };
                 // Cancelling the dialog means no file: nothing is written anywhere.
                 if let Some(path) = self.choose(files::Purpose::SavePng, &name) {
                     self.save_png(&path);
@@ -1154,7 +1172,7 @@ impl eframe::App for OrbApp {
                 (None, None) => {}
             }
         });
-        if self.is_loading() {
+        if self.is_loading() || self.recording.is_some() {
             ctx.request_repaint_after(std::time::Duration::from_millis(100));
         }
         if modes_play {

@@ -21,6 +21,7 @@ pub enum Action {
     SaveSession,
     ReopenLast,
     Screenshot,
+    Record,
     ResetView,
     Demo(Demo),
 }
@@ -46,6 +47,10 @@ pub fn top_bar(ui: &mut egui::Ui, app: &mut OrbApp) -> Action {
             }
             if ui.button("Save PNG").clicked() {
                 action = Action::Screenshot;
+            }
+            if ui.button("Record…").on_hover_text("a movie: the scan swept, the scene turning, a vibration").clicked()
+            {
+                action = Action::Record;
             }
             if ui.button("Reset view").clicked() {
                 action = Action::ResetView;
@@ -110,6 +115,7 @@ fn status_line(ui: &mut egui::Ui, app: &OrbApp, cancel: &mut bool, dismiss: &mut
                 }
                 ui.separator();
             }
+            super::record::record_status(ui, app);
             if let Some(job) = &app.scan_job {
                 let (done, total) = job.progress();
                 let f = if total == 0 { 0.0 } else { done as f32 / total as f32 };

@@ -114,7 +114,7 @@ impl ScanJob {
 
 /// An open scan: its resident key volumes, θ, and one view per orbital.
 pub struct ScanView {
-    pub scene: ScanScene,
+    pub scene: Arc<ScanScene>,
     /// Degrees, within the scan's range.
     pub theta: f64,
     pub mode: Interpolation,
@@ -143,7 +143,7 @@ impl ScanView {
         let (lo, hi) = scene.scan.range();
         let theta = scene.scan.frames[scene.scan.nearest_frame(0.5 * (lo + hi))].angle;
         Self {
-            scene,
+            scene: Arc::new(scene),
             theta,
             mode: Interpolation::Exact,
             playing: false,
