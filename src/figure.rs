@@ -105,9 +105,9 @@ fn blend(p: &mut Rgba<u8>, over: [u8; 3], a: f32) {
     if out_a <= 0.0 {
         return;
     }
-    for c in 0..3 {
-        let v = (over[c] as f32 * a + p.0[c] as f32 * below * (1.0 - a)) / out_a;
-        p.0[c] = v.round().clamp(0.0, 255.0) as u8;
+    for (channel, &o) in p.0.iter_mut().zip(&over) {
+        let v = (o as f32 * a + *channel as f32 * below * (1.0 - a)) / out_a;
+        *channel = v.round().clamp(0.0, 255.0) as u8;
     }
     p.0[3] = (out_a * 255.0).round() as u8;
 }

@@ -8,12 +8,7 @@ use std::process::Command;
 mod common;
 
 fn orbcloud(args: &[&str]) -> std::process::Output {
-    let out = Command::new(env!("CARGO_BIN_EXE_orbcloud"))
-        .args(args)
-        .env("NODEVICE_SELECT", "1")
-        .output()
-        .expect("run orbcloud");
-    out
+    Command::new(env!("CARGO_BIN_EXE_orbcloud")).args(args).env("NODEVICE_SELECT", "1").output().expect("run orbcloud")
 }
 
 fn ok(args: &[&str]) {

@@ -94,19 +94,26 @@ pub fn movie(args: MovieArgs) -> Result<()> {
         _ => {}
     }
     let started = Instant::now();
-    let written = if scan_input && !args.turntable { scan_sweep(&args)? } else { file_movie(&args, scan_input)? };
-    let per_frame = started.elapsed().as_secs_f64() / written.max(1) as f64;
-    eprintln!("wrote {} ({written} frames, {:.2} s per frame with setup)", args.output.display(), per_frame);
+    let (written, drawing) =
+        if scan_input && !args.turntable { scan_sweep(&args)? } else { file_movie(&args, scan_input)? };
+    let setup = started.elapsed().as_secs_f64() - drawing;
+    eprintln!(
+        "wrote {} ({written} frames, {:.3} s per frame drawn and written; setup {setup:.1} s)",
+        args.output.display(),
+        drawing / written.max(1) as f64
+    );
     Ok(())
 }
 
-/// Writes `count` frames drawn by `frame(k)`, saying how far it got.
+/// Writes `count` frames drawn by `frame(k)`, saying how far it got; returns the count and the
+/// seconds they took.
 fn write_frames(
     args: &MovieArgs,
     size: [u32; 2],
     count: usize,
     mut frame: impl FnMut(usize) -> Result<image::RgbaImage, ShotError>,
-) -> Result<usize> {
+) -> Result<(usize, f64)> {
+    let started = Instant::now();
     let writer = MovieWriter::create(&args.output, size, args.fps, count)?;
     let progress = Progress::default();
     record(writer, count, &progress, |k| {
@@ -114,12 +121,12 @@ fn write_frames(
         frame(k)
     })?;
     eprintln!();
-    Ok(count)
+    Ok((count, started.elapsed().as_secs_f64()))
 }
 
 /// A scan's coordinate swept from `--from` to `--to`: every view side by side, each captioned,
 /// frame k equal to `scan render --at θk`.
-fn scan_sweep(args: &MovieArgs) -> Result<usize> {
+fn scan_sweep(args: &MovieArgs) -> Result<(usize, f64)> {
     let file = match &args.input {
         Some(path) => load_scan(path)?,
         None => orbcloud::demo::scan()?,
@@ -145,7 +152,7 @@ fn scan_sweep(args: &MovieArgs) -> Result<usize> {
 }
 
 /// A file or session turning a full circle, or a file's vibration over one period.
-fn file_movie(args: &MovieArgs, scan_input: bool) -> Result<usize> {
+fn file_movie(args: &MovieArgs, scan_input: bool) -> Result<(usize, f64)> {
     if scan_input {
         bail!("--turntable turns a file or session; a scan manifest sweeps its coordinate (leave out --turntable)");
     }
@@ -176,8 +183,11 @@ fn file_movie(args: &MovieArgs, scan_input: bool) -> Result<usize> {
     write_frames(args, args.view.size, count, |k| Ok(shots.frame(&ctx, k)?))
 }
 
+/// A scene's objects, each a document and what it shows.
+type Objects = Vec<(Document, ObjectState)>;
+
 /// A session's objects (each file loaded), its camera and background.
-fn session_scene(path: &Path) -> Result<(Vec<(Document, ObjectState)>, Camera, [f32; 3])> {
+fn session_scene(path: &Path) -> Result<(Objects, Camera, [f32; 3])> {
     let session = orbcloud::app::session::read(path).map_err(anyhow::Error::msg)?;
     let mut scene = Vec::new();
     for mut state in session.objects {

@@ -65,7 +65,7 @@ pub fn render(args: RenderArgs, later: &[Later]) -> Result<()> {
     let arrows = args.vibration.arrows(&doc)?;
     h.renderer.main().arrows.set_arrows(&ctx, &arrows, orbcloud::scene::vibration::ARROW_COLOR);
     let img = figure.draw(settings.background, |bg| {
-        let settings = RenderSettings { background: bg, ..settings.clone() };
+        let settings = RenderSettings { background: bg, ..settings };
         h.render(&ctx, &camera, &settings)
     })?;
     save(&img, &args.output, &ctx)?;

@@ -36,7 +36,7 @@ pub enum ScanCommand {
         follow: Option<FollowArg>,
     },
     /// Render the scan's orbitals at an angle, side by side, to a PNG.
-    Render(ScanRenderArgs),
+    Render(Box<ScanRenderArgs>),
     /// Write the exactly interpolated orbital at an angle as a cube file.
     Export {
         scan: PathBuf,
