@@ -142,6 +142,35 @@ pub fn caption(img: &mut RgbaImage, x0: u32, width: u32, lines: &[String]) {
     }
 }
 
+/// A vertical colour bar at the right edge of `img`: `color(t)` (sRGB) for t from −1 at the
+/// bottom to 1 at the top, `ticks` (bottom, middle, top) written beside it and `title` above.
+pub fn color_bar(img: &mut RgbaImage, color: impl Fn(f32) -> [u8; 3], ticks: [&str; 3], title: &str) {
+    let (w, h) = (img.width() as f32, img.height() as f32);
+    let px = caption_px(img.height());
+    let pad = (px * 0.5).ceil();
+    let bar_w = (px * 0.8).ceil();
+    let bar_h = (h * 0.55).round();
+    let label_w = ticks.iter().map(|t| text_width(t, px)).fold(0.0, f32::max);
+    let title_w = text_width(title, px);
+    let panel_w = (label_w + bar_w + 3.0 * pad).max(title_w + 2.0 * pad);
+    let (x0, y0) = (w - panel_w - pad, (h - bar_h) * 0.5 - px * 1.4);
+    let panel_h = bar_h + px * 1.4 + px + 2.0 * pad;
+    shade(img, x0 as i64, (y0 - pad) as i64, panel_w.ceil() as i64, panel_h.ceil() as i64, [0, 0, 0], 0.55);
+    draw_text(img, title, x0 + panel_w - pad - title_w, y0, px, [235, 235, 235]);
+    let bar_x = x0 + panel_w - pad - bar_w;
+    let bar_top = y0 + px * 1.4;
+    for row in 0..bar_h as i64 {
+        let t = 1.0 - 2.0 * row as f32 / (bar_h - 1.0).max(1.0);
+        let c = color(t);
+        shade(img, bar_x as i64, (bar_top as i64) + row, bar_w as i64, 1, c, 1.0);
+    }
+    for (n, tick) in ticks.iter().enumerate() {
+        // Bottom, middle, top; each label centred on its place along the bar.
+        let y = bar_top + bar_h * (1.0 - n as f32 * 0.5) - px * 0.6;
+        draw_text(img, tick, bar_x - pad * 0.6 - text_width(tick, px), y, px, [235, 235, 235]);
+    }
+}
+
 /// sRGB-encoded byte to linear light.
 fn linear(v: u8) -> f32 {
     let c = v as f32 / 255.0;
@@ -149,7 +178,7 @@ fn linear(v: u8) -> f32 {
 }
 
 /// Linear light to an sRGB-encoded byte.
-fn encoded(c: f32) -> u8 {
+pub fn encoded(c: f32) -> u8 {
     let c = c.clamp(0.0, 1.0);
     let v = if c <= 0.0031308 { c * 12.92 } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 };
     (v * 255.0).round() as u8
@@ -216,6 +245,18 @@ mod tests {
         assert!(lit > 20, "the glyphs are drawn ({lit} light pixels)");
         assert_eq!(img.get_pixel(199, 99).0, [40, 80, 160, 255], "outside the band nothing changes");
         assert!(text_width("HOMO", 20.0) > text_width("H", 20.0));
+    }
+
+    #[test]
+    fn a_colour_bar_runs_from_its_bottom_colour_to_its_top_colour() {
+        let mut img = RgbaImage::from_pixel(300, 200, Rgba([0, 0, 0, 255]));
+        let color = |t: f32| if t < 0.0 { [255, 0, 0] } else { [0, 0, 255] };
+        color_bar(&mut img, color, ["-0.05", "0", "+0.05"], "ψ (a.u.)");
+        let column: Vec<[u8; 4]> = (0..200).map(|y| img.get_pixel(img.width() - 16, y).0).collect();
+        let top = column.iter().position(|p| p[2] == 255 && p[0] == 0).expect("blue at the top");
+        let bottom = column.iter().rposition(|p| p[0] == 255 && p[2] == 0).expect("red at the bottom");
+        assert!(top < bottom);
+        assert_eq!(img.get_pixel(5, 5).0, [0, 0, 0, 255], "the left of the picture is untouched");
     }
 
     #[test]

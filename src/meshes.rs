@@ -9,6 +9,7 @@ use crate::model::isosurface::{self, Level, Mesh};
 use crate::model::surface::{self, Sphere, SurfaceError};
 use crate::model::units::ANGSTROM_PER_BOHR;
 use crate::model::{Document, VolumeGrid};
+use crate::scene::coloring::ValueMap;
 use crate::scene::coloring::atom_colors;
 use crate::scene::selection::shown_atoms;
 use crate::scene::translucency::SurfaceLook;
@@ -88,16 +89,22 @@ pub fn molecular_surface(
 
 /// Colours `mesh`, `doc`'s molecular surface built around the atoms `selection` shows, by the
 /// atom nearest each vertex as `s.color_by` says (no colours when it says none).
-/// With `s.color_by_volume`, the colours are `grid`'s values instead ([`color_by_values`]).
-pub fn color_surface(mesh: &mut Mesh, doc: &Document, s: &SurfaceSettings, selection: &str, grid: Option<&VolumeGrid>) {
+/// With `s.color_by_volume`, the colours are `grid`'s values instead ([`color_by_values`]), and
+/// the map they were coloured with is returned (for its colour bar).
+pub fn color_surface(
+    mesh: &mut Mesh,
+    doc: &Document,
+    s: &SurfaceSettings,
+    selection: &str,
+    grid: Option<&VolumeGrid>,
+) -> Option<ValueMap> {
     mesh.colors.clear();
     if s.color_by_volume {
-        if let Some(grid) = grid {
-            mesh.colors = color_by_values(&mesh.positions, grid);
-        }
-        return;
+        let (colors, map) = color_by_values(&mesh.positions, grid?);
+        mesh.colors = colors;
+        return Some(map);
     }
-    let Some(coloring) = s.color_by else { return };
+    let coloring = s.color_by?;
     let mask = shown_atoms(doc, selection);
     let (spheres, atoms) = Sphere::of_atoms(&doc.molecule, mask.as_deref());
     let colors = atom_colors(&doc.molecule, doc.structure.as_ref(), coloring);
@@ -110,12 +117,13 @@ pub fn color_surface(mesh: &mut Mesh, doc: &Document, s: &SurfaceSettings, selec
             None => s.color,
         })
         .collect();
+    None
 }
 
-/// Linear RGB for `grid`'s value at each point: negative red, zero white, positive blue (the
-/// convention of electrostatic potentials on surfaces), scaled to the 98th percentile of |value|
-/// over the points; grey where a point lies outside the grid.
-pub fn color_by_values(points: &[glam::Vec3], grid: &VolumeGrid) -> Vec<[f32; 3]> {
+/// Linear RGB for `grid`'s value at each point on a diverging map ([`ValueMap`]) whose range is
+/// the 98th percentile of |value| over the points (robust to a few points near a nucleus); grey
+/// where a point lies outside the grid. Returns the map too.
+pub fn color_by_values(points: &[glam::Vec3], grid: &VolumeGrid) -> (Vec<[f32; 3]>, ValueMap) {
     let grid_from_world = grid.world_from_grid.inverse();
     let values: Vec<Option<f64>> = points
         .iter()
@@ -127,17 +135,7 @@ pub fn color_by_values(points: &[glam::Vec3], grid: &VolumeGrid) -> Vec<[f32; 3]
         .collect();
     let mut magnitudes: Vec<f64> = values.iter().flatten().map(|v| v.abs()).collect();
     magnitudes.sort_by(f64::total_cmp);
-    let scale = magnitudes.get(magnitudes.len() * 98 / 100).copied().unwrap_or(0.0).max(1e-30);
-    let (red, blue) = ([0.85, 0.08, 0.06], [0.06, 0.2, 0.85]);
-    values
-        .iter()
-        .map(|v| match v {
-            None => [0.5; 3],
-            Some(v) => {
-                let t = (v / scale).clamp(-1.0, 1.0) as f32;
-                let end = if t < 0.0 { red } else { blue };
-                std::array::from_fn(|k| 1.0 + (end[k] - 1.0) * t.abs())
-            }
-        })
-        .collect()
+    let map = ValueMap { range: magnitudes.get(magnitudes.len() * 98 / 100).copied().unwrap_or(0.0).max(1e-30) };
+    let colors = values.iter().map(|v| v.map_or([0.5; 3], |v| map.color(v))).collect();
+    (colors, map)
 }

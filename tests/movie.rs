@@ -206,3 +206,18 @@ fn figures_are_supersampled_and_transparent() {
     let out = orbcloud(&["render", &cube, "--scale", "9", "-o", "x.png"]);
     assert!(!out.status.success() && String::from_utf8_lossy(&out.stderr).contains("--scale"));
 }
+
+#[test]
+fn a_surface_coloured_by_a_volume_carries_its_colour_bar() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = asset("tests/fixtures/modes/nh3_planar_rhf_sto3g.molden");
+    let out = dir.path().join("map.png");
+    let args = ["render", &file, "--orbital", "homo", "--no-volume", "--surface", "ses", "--lavapipe"];
+    ok(&[&args[..], &["--surface-color", "volume", "--size", "240x180", "-o", s(&out)]].concat());
+    let img = png(&out);
+    // Down a column through the bar: the map's positive end (blue) above its negative end (red).
+    let column: Vec<[u8; 4]> = (0..180).map(|y| img.get_pixel(240 - 16, y).0).collect();
+    let blue = column.iter().position(|p| p[2] > 150 && p[0] < 120).expect("the bar's blue end");
+    let red = column.iter().rposition(|p| p[0] > 150 && p[2] < 120).expect("the bar's red end");
+    assert!(blue < red, "blue at {blue}, red at {red}");
+}

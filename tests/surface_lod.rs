@@ -147,7 +147,7 @@ fn a_surface_coloured_by_a_volume_shows_the_sign_of_its_values() {
     );
     let points =
         [Vec3::new(-4.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0), Vec3::new(4.0, 0.0, 0.0), Vec3::new(9.0, 0.0, 0.0)];
-    let colors = orbcloud::meshes::color_by_values(&points, &grid);
+    let (colors, _) = orbcloud::meshes::color_by_values(&points, &grid);
     let [neg, zero, pos, outside] = [colors[0], colors[1], colors[2], colors[3]];
     assert!(neg[0] > 0.8 && neg[2] < 0.3, "negative is red: {neg:?}");
     assert!(pos[2] > 0.8 && pos[0] < 0.3, "positive is blue: {pos:?}");

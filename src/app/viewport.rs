@@ -1234,6 +1234,6 @@ fn molecular_surface_cached(
     }
     let built = cache.as_ref().expect("just built");
     let mut mesh = built.mesh.clone();
-    crate::meshes::color_surface(&mut mesh, doc, settings, selection, grid);
+    let _ = crate::meshes::color_surface(&mut mesh, doc, settings, selection, grid);
     (Some((mesh, settings.look())), built.note.clone())
 }

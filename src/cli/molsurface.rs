@@ -11,6 +11,7 @@ use orbcloud::model::Document;
 use orbcloud::model::isosurface::Mesh;
 use orbcloud::model::surface::{self, Sphere, SurfaceParams};
 use orbcloud::model::units::BOHR_PER_ANGSTROM;
+use orbcloud::scene::coloring::ValueMap;
 use orbcloud::scene::translucency::SurfaceLook;
 use orbcloud::scene::{AtomColoring, SurfaceChoice, SurfaceSettings};
 
@@ -95,14 +96,14 @@ impl MolSurfaceArgs {
         }
     }
 
-    /// The surface asked for, if any, with its look (coloured by `grid` when asked), telling
-    /// what was built and how long it took.
+    /// The surface asked for, if any, with its look (coloured by `grid` when asked, with the
+    /// map of its values), telling what was built and how long it took.
     pub fn mesh(
         &self,
         doc: &Document,
         translucent: bool,
         grid: Option<&orbcloud::model::VolumeGrid>,
-    ) -> Result<Option<(Mesh, SurfaceLook)>> {
+    ) -> Result<Option<(Mesh, SurfaceLook, Option<ValueMap>)>> {
         let settings = self.settings(translucent);
         let t = Instant::now();
         let built = molecular_surface(doc, &settings, "", u64::MAX, (&AtomicBool::new(false), &Default::default()))
@@ -114,7 +115,7 @@ impl MolSurfaceArgs {
                 doc.source
             );
         }
-        orbcloud::meshes::color_surface(&mut mesh, doc, &settings, "", grid);
+        let map = orbcloud::meshes::color_surface(&mut mesh, doc, &settings, "", grid);
         eprintln!(
             "{} surface: {} triangles, area {:.1} Å², volume {:.1} Å³, {:.0} ms",
             settings.choice.name(),
@@ -123,7 +124,7 @@ impl MolSurfaceArgs {
             mesh.volume() / BOHR_PER_ANGSTROM.powi(3),
             t.elapsed().as_secs_f64() * 1e3
         );
-        Ok(Some((mesh, settings.look())))
+        Ok(Some((mesh, settings.look(), map)))
     }
 
     /// What mesh files call it.

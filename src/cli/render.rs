@@ -10,6 +10,7 @@ use orbcloud::figure::Figure;
 use orbcloud::gpu::GpuContext;
 use orbcloud::headless::Headless;
 use orbcloud::model::Document;
+use orbcloud::scene::coloring::ValueMap;
 use orbcloud::scene::{Camera, Evaluation, ObjectState, RenderSettings};
 
 use super::quantities_cli::{self, Later};
@@ -61,13 +62,19 @@ pub fn render(args: RenderArgs, later: &[Later]) -> Result<()> {
         orbcloud::evaluate::auto_opacity(&mut settings.volume, grid);
     }
     let molsurface = args.molsurface.mesh(&doc, args.iso.translucent, grid)?;
-    surface_cli::show(&ctx, &mut h.renderer, grid, &args.iso, molsurface.into_iter().collect());
+    let map = molsurface.as_ref().and_then(|(_, _, map)| *map);
+    let meshes = molsurface.into_iter().map(|(mesh, look, _)| (mesh, look)).collect();
+    surface_cli::show(&ctx, &mut h.renderer, grid, &args.iso, meshes);
     let arrows = args.vibration.arrows(&doc)?;
     h.renderer.main().arrows.set_arrows(&ctx, &arrows, orbcloud::scene::vibration::ARROW_COLOR);
     let img = figure.draw(settings.background, |bg| {
         let settings = RenderSettings { background: bg, ..settings };
         h.render(&ctx, &camera, &settings)
     })?;
+    let mut img = img;
+    if let (Some(map), Some(grid)) = (map, grid) {
+        value_bar(&mut img, &map, &grid.label);
+    }
     save(&img, &args.output, &ctx)?;
     if let Some(pixel) = args.pick {
         surface_cli::print_pick(&ctx, &h.renderer, &doc, pixel)?;
@@ -90,6 +97,17 @@ pub fn object_of(doc: &Document, view: &ViewArgs, what: &WavefunctionArgs, iso: 
     };
     object.quantities.extend(quantities_cli::quantity_of(doc, view, what, iso)?);
     Ok(object)
+}
+
+/// The colour bar of a surface coloured by a volume's values: the map's range, in atomic
+/// units, titled with the volume's name.
+pub fn value_bar(img: &mut image::RgbaImage, map: &ValueMap, name: &str) {
+    let color = |t: f32| map.at(t).map(orbcloud::figure::encoded);
+    let r = map.range;
+    let text = |v: f64| if v.abs() >= 0.01 { format!("{v:.3}") } else { format!("{v:.2e}") };
+    let (lo, hi) = (format!("−{}", text(r)), format!("+{}", text(r)));
+    let title = if name.is_empty() { "value (a.u.)".to_string() } else { format!("{name} (a.u.)") };
+    orbcloud::figure::color_bar(img, color, [&lo, "0", &hi], &title);
 }
 
 /// Writes `img` to `path` and says so, with the adapter that drew it.

@@ -291,7 +291,7 @@ pub fn mesh(args: &MeshArgs, later: &[MeshArgs]) -> Result<()> {
         let by_volume = matches!(args.molsurface.surface_color, super::molsurface_cli::SurfaceColorArg::Volume);
         let grid = by_volume.then(|| args.grid.grid(&doc)).transpose()?;
         let built = args.molsurface.mesh(&doc, false, grid.as_ref())?;
-        (built.into_iter().collect(), vec![args.molsurface.name().to_string()])
+        (built.into_iter().map(|(mesh, look, _)| (mesh, look)).collect(), vec![args.molsurface.name().to_string()])
     } else {
         let mut meshes = Vec::new();
         let mut names = Vec::new();

@@ -17,6 +17,31 @@ pub struct AtomColors {
 }
 
 /// An sRGB colour as linear RGB.
+/// A diverging map of values symmetric about zero: −range red, zero white, +range blue (the
+/// convention of electrostatic potentials on surfaces), what a surface coloured by a volume and
+/// its colour bar both use.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ValueMap {
+    /// The |value| at which the colours saturate.
+    pub range: f64,
+}
+
+impl ValueMap {
+    const NEGATIVE: [f32; 3] = [0.85, 0.08, 0.06];
+    const POSITIVE: [f32; 3] = [0.06, 0.2, 0.85];
+
+    /// Linear RGB of `value`.
+    pub fn color(&self, value: f64) -> [f32; 3] {
+        self.at((value / self.range.max(1e-30)).clamp(-1.0, 1.0) as f32)
+    }
+
+    /// Linear RGB at `t` in −1..1 of the range.
+    pub fn at(&self, t: f32) -> [f32; 3] {
+        let end = if t < 0.0 { Self::NEGATIVE } else { Self::POSITIVE };
+        std::array::from_fn(|k| 1.0 + (end[k] - 1.0) * t.abs().min(1.0))
+    }
+}
+
 pub fn linear(srgb: [u8; 3]) -> [f32; 3] {
     srgb.map(|c| {
         let c = c as f32 / 255.0;
