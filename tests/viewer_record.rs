@@ -86,3 +86,27 @@ fn record_starts_and_cancels_while_the_window_answers() {
     }
     assert_eq!(n, 6);
 }
+
+#[test]
+fn save_png_writes_any_size_supersampled_and_transparent() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = harness();
+    viewer_support::wait_loaded(&mut h);
+    h.get_by_label("Save PNG").click();
+    h.run_steps(2);
+    assert!(h.state().picture.open, "the Save PNG window opens");
+    assert_eq!(h.state().picture.size, h.state().view_sizes().first().map(|(s, _)| *s), "at the view's size");
+    {
+        let d = &mut h.state_mut().picture;
+        d.size = Some([200, 150]);
+        d.scale = 2;
+        d.transparent = true;
+    }
+    let path = dir.path().join("figure.png");
+    h.state_mut().save_png(&path);
+    assert!(h.state().error.is_none(), "{:?}", h.state().error);
+    let img = image::open(&path).unwrap().to_rgba8();
+    assert_eq!(img.dimensions(), (200, 150));
+    assert_eq!(img.get_pixel(0, 0).0[3], 0, "the background is transparent");
+    assert!(img.pixels().any(|p| p.0[3] == 255), "the molecule is opaque");
+}

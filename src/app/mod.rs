@@ -3,12 +3,14 @@
 pub mod detail;
 pub mod files;
 pub mod jobs;
+mod legend;
 mod loader;
 pub mod measure;
 pub mod models;
 mod orbitals;
 mod panels;
 pub mod panes;
+pub mod picture;
 pub mod record;
 pub mod restart;
 pub mod scan;
@@ -248,6 +250,8 @@ pub struct OrbApp {
     pub notice: Option<String>,
     /// The *Record…* window's choices, and the recording under way.
     pub record: record::RecordDialog,
+    /// The *Save PNG* window's choices.
+    pub picture: picture::PictureDialog,
     pub recording: Option<record::Recording>,
     /// The folder a picture or movie was last saved in.
     pub last_folder: Option<PathBuf>,
@@ -403,6 +407,7 @@ impl OrbApp {
             rehearsal: None,
             notice: None,
             record: record::RecordDialog::default(),
+            picture: picture::PictureDialog::default(),
             recording: None,
             last_folder: None,
         };
@@ -1001,49 +1006,6 @@ impl OrbApp {
             self.queue.push((path, if n == 0 && count > 0 { first.clone() } else { Opening::Add }));
         }
     }
-
-    /// Renders the current view (each scan view side by side) and writes it to `path` as PNG.
-    pub fn save_png(&mut self, path: &Path) {
-        let Some(vp) = &mut self.viewport else { return };
-        let mut size = vp.size().unwrap_or([1280, 800]);
-        if let Some(scan) = &self.scan {
-            size = scan.views.first().and_then(|v| v.size()).unwrap_or([640, 600]);
-        }
-        let shot = match &mut self.scan {
-            Some(scan) => {
-                let mut out = image::RgbaImage::new(size[0] * scan.views.len() as u32, size[1]);
-                let mut result = Ok(());
-                for (n, v) in scan.views.iter_mut().enumerate() {
-                    match v.snapshot(&self.view, size) {
-                        Ok(img) => image::imageops::replace(&mut out, &img, (n as u32 * size[0]) as i64, 0),
-                        Err(e) => result = Err(e),
-                    }
-                }
-                result.map(|()| out)
-            }
-            // A split view: its panes side by side, as drawn.
-            None if !vp.pane_sizes().is_empty() => {
-                let pictures: Result<Vec<_>, _> = (0..vp.pane_sizes().len()).map(|p| vp.pane_picture(p)).collect();
-                pictures.map(|pictures| {
-                    let (w, h) = pictures.first().map_or((1, 1), |p| p.dimensions());
-                    let mut out = image::RgbaImage::new(w * pictures.len() as u32, h);
-                    for (n, picture) in pictures.iter().enumerate() {
-                        image::imageops::replace(&mut out, picture, (n as u32 * w) as i64, 0);
-                    }
-                    out
-                })
-            }
-            None => vp.snapshot(&self.view, size),
-        };
-        match shot.map(|img| img.save(path)) {
-            Ok(Ok(())) => {
-                self.status = format!("saved {}", path.display());
-                self.last_folder = path.parent().map(Path::to_path_buf);
-            }
-            Ok(Err(e)) => self.error = Some(format!("{}: {e}", path.display())),
-            Err(e) => self.error = Some(e.to_string()),
-        }
-    }
 }
 
 impl eframe::App for OrbApp {
@@ -1059,6 +1021,7 @@ impl eframe::App for OrbApp {
         let action = panels::top_bar(ui, self);
         panels::status_bar(ui, self);
         record::record_window(&ctx, self);
+        picture::picture_window(&ctx, self);
         panels::side_panel(ui, self);
         let defaults = self.defaults;
         // A scan shows its own orbitals; the browser belongs to the scene's objects.
@@ -1100,20 +1063,7 @@ impl eframe::App for OrbApp {
                 }
             }
             panels::Action::Record => self.open_record_dialog(),
-            panels::Action::Screenshot => {
-                let name = match &self.scan {
-                    Some(scan) => record::picture_name(&scan.scene.scan.title, Some(&format!("{:.0}deg", scan.theta))),
-                    None => {
-                        let quantity = (self.objects.get(self.active))
-                            .and_then(|o| o.state.quantities.get(o.state.selected).map(|q| q.source.name(&o.doc)));
-                        record::picture_name(&self.doc().source, quantity.as_deref())
-                    }
-                };
-                // Cancelling the dialog means no file: nothing is written anywhere.
-                if let Some(path) = self.choose(files::Purpose::SavePng, &name) {
-                    self.save_png(&path);
-                }
-            }
+            panels::Action::Screenshot => self.open_picture_dialog(),
             panels::Action::ResetView => {
                 self.view.camera = match &self.scan {
                     Some(scan) => scan.scene.camera(),
@@ -1160,6 +1110,12 @@ impl eframe::App for OrbApp {
                             .and_then(|o| o.state.selected_quantity_mut())
                             .map(|q| &mut q.cloud.clip);
                         vp.show(ui, rs, &mut self.view, clip);
+                    }
+                    if let Some(o) = self.objects.get(self.active).filter(|o| o.state.surface.color_by_volume) {
+                        if let Some(map) = vp.surface_map(self.active) {
+                            let name = o.state.selected_quantity().map(|q| q.source.name(&o.doc)).unwrap_or_default();
+                            legend::value_bar(ui, ui.min_rect(), &map, &name);
+                        }
                     }
                     if let Some(click) = vp.click.take() {
                         let said = self.measurements.click(click, &self.world);

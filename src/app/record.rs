@@ -2,7 +2,7 @@
 //! the active object's vibration), drawn in the background on a target of its own while the
 //! window stays live, with its progress and *Cancel* in the status line.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::Ordering;
 
@@ -73,31 +73,9 @@ impl Recording {
     }
 }
 
-/// A file-name word from a quantity's name: "HOMO β" → "homo_beta", "LUMO+1" → "lumo+1".
-fn name_word(name: &str) -> String {
-    let word: String = name
-        .replace('β', "beta")
-        .replace('α', "alpha")
-        .chars()
-        .map(|c| if c.is_alphanumeric() || c == '+' || c == '-' { c.to_ascii_lowercase() } else { '_' })
-        .collect();
-    word.trim_matches('_').to_string()
-}
-
-/// A name for a picture of `source`'s quantity: `benzene_homo.png`.
-pub fn picture_name(source: &str, quantity: Option<&str>) -> String {
-    let stem = Path::new(source).file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let stem = stem.split('.').next().filter(|s| !s.is_empty()).unwrap_or("orbcloud");
-    match quantity.map(name_word).filter(|w| !w.is_empty()) {
-        Some(q) => format!("{stem}_{q}.png"),
-        None => format!("{stem}.png"),
-    }
-}
-
 /// A name for the movie from what is shown: `psb3_sweep.gif`, `benzene_turntable.gif`.
 fn proposed_name(source: &str, what: RecordWhat) -> String {
-    let stem = Path::new(source).file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let stem = stem.split('.').next().filter(|s| !s.is_empty()).unwrap_or("orbcloud");
+    let stem = super::picture::file_stem(source);
     let what = match what {
         RecordWhat::Sweep => "sweep",
         RecordWhat::Turntable => "turntable",
@@ -307,8 +285,5 @@ mod tests {
         assert_eq!(proposed_name("/data/benzene.molden", RecordWhat::Turntable), "benzene_turntable.gif");
         assert_eq!(proposed_name("psb3.scan.toml", RecordWhat::Sweep), "psb3_sweep.gif");
         assert_eq!(proposed_name("", RecordWhat::Vibration), "orbcloud_vibration.gif");
-        assert_eq!(picture_name("/x/benzene.molden.gz", Some("HOMO")), "benzene_homo.png");
-        assert_eq!(picture_name("water.fchk", Some("LUMO+1 β")), "water_lumo+1_beta.png");
-        assert_eq!(picture_name("a.cube", None), "a.png");
     }
 }

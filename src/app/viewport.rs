@@ -128,6 +128,8 @@ struct BuiltSurface {
     atoms: (usize, [u64; 3]),
     mesh: Mesh,
     note: Option<String>,
+    /// The map of values it was last coloured with (for the view's colour bar).
+    map: Option<crate::scene::coloring::ValueMap>,
 }
 
 /// Enough of the atoms shown to tell when a surface must be built again (another model,
@@ -391,6 +393,14 @@ impl Viewport {
             let grid = computed.as_deref().or(volume.and_then(|i| doc.volumes.get(i)));
             prepared(grid.map(|g| isosurfaces_within(g, &levels, max_bytes)).unwrap_or_default())
         });
+    }
+
+    /// The map object `n`'s molecular surface is coloured with, when it is coloured by a
+    /// volume's values.
+    pub fn surface_map(&self, n: usize) -> Option<crate::scene::coloring::ValueMap> {
+        let l = self.layer_of(n, Part::Atoms)?;
+        let cache = self.slots[l].surface.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+        cache.as_ref().and_then(|b| b.map)
     }
 
     /// Builds (or colours anew) object `n`'s molecular surface in the background, around the
@@ -1116,15 +1126,18 @@ impl Viewport {
     /// Renders the current view at `size` and reads it back (for screenshots).
     pub fn snapshot(&mut self, view: &ViewState, size: [u32; 2]) -> Result<image::RgbaImage, GpuError> {
         let target = OffscreenTarget::new(&self.ctx.device, size);
-        let mut encoder =
-            self.ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("snapshot") });
-        let frame =
-            FrameInput { camera: &view.camera, background: view.background, clouds: &self.clouds, size, tile: None };
-        self.renderer.render(&self.ctx, &mut encoder, &target.color_view, &frame);
-        self.ctx.queue.submit([encoder.finish()]);
+        // Every translucent fragment kept, as `render` draws it.
+        let (picture, _) = crate::headless::picture(
+            &self.ctx,
+            &mut self.renderer,
+            &target,
+            &view.camera,
+            view.background,
+            &self.clouds,
+        )?;
         // The viewport's own frame must be redrawn: the renderer's buffers changed size.
         self.drawn = None;
-        target.read_rgba(&self.ctx.device, &self.ctx.queue)
+        Ok(picture)
     }
 
     /// How much of a frame drawn in bands is done (0..1); `None` when none is under way.
@@ -1227,13 +1240,13 @@ fn molecular_surface_cached(
     let fresh = cache.as_ref().is_some_and(|b| b.atoms == atoms && b.settings.same_geometry(settings));
     if !fresh {
         match molecular_surface(doc, settings, selection, max_bytes, (cancel, progress)) {
-            Ok(Some((mesh, note))) => *cache = Some(BuiltSurface { settings: *settings, atoms, mesh, note }),
+            Ok(Some((mesh, note))) => *cache = Some(BuiltSurface { settings: *settings, atoms, mesh, note, map: None }),
             Ok(None) => return (None, None),
             Err(e) => return (None, Some(format!("molecular surface: {e}"))),
         }
     }
-    let built = cache.as_ref().expect("just built");
+    let built = cache.as_mut().expect("just built");
     let mut mesh = built.mesh.clone();
-    let _ = crate::meshes::color_surface(&mut mesh, doc, settings, selection, grid);
+    built.map = crate::meshes::color_surface(&mut mesh, doc, settings, selection, grid);
     (Some((mesh, settings.look())), built.note.clone())
 }
