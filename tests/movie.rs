@@ -221,3 +221,27 @@ fn a_surface_coloured_by_a_volume_carries_its_colour_bar() {
     let red = column.iter().rposition(|p| p[0] > 150 && p[2] < 120).expect("the bar's red end");
     assert!(blue < red, "blue at {blue}, red at {red}");
 }
+
+#[test]
+fn a_session_turns_as_saved() {
+    let dir = tempfile::tempdir().unwrap();
+    let session = dir.path().join("scene.orbcloud.toml");
+    let cube = asset("assets/demo.cube.gz");
+    std::fs::write(
+        &session,
+        format!("background = [0.9, 0.9, 0.9]\n[[objects]]\npath = {cube:?}\n[[objects.quantities]]\nsource = {{ Volume = 0 }}\n"),
+    )
+    .unwrap();
+    let frames = dir.path().join("turn/");
+    ok(&["movie", s(&session), "--turntable", "--frames", "3", "--size", "64x48", "--lavapipe", "-o", s(&frames)]);
+    let first = png(&frames.join("frame_0001.png"));
+    assert_eq!(std::fs::read_dir(&frames).unwrap().count(), 3);
+    // The session's light background, not the default dark one.
+    assert!(first.get_pixel(0, 0).0[0] > 200, "{:?}", first.get_pixel(0, 0));
+    assert!(common::mean_difference(&first, &png(&frames.join("frame_0002.png"))) > 0.1, "it turns");
+    let broken = dir.path().join("none.orbcloud.toml");
+    std::fs::write(&broken, "[[objects]]\npath = \"/nonexistent.cube\"\n").unwrap();
+    let out = orbcloud(&["movie", s(&broken), "--turntable", "-o", "x.gif"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("/nonexistent.cube"), "{err}");
+}
