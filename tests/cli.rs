@@ -183,7 +183,7 @@ fn scan_export_writes_the_interpolated_orbital_and_render_writes_both_views() {
     // Wrong arguments are refused before the key volumes are made (seconds of GPU work).
     for (args, says) in [
         (["--angle", "-90", "--orbital", "homo-7"], "--orbital homo-7: the scan shows homo, lumo"),
-        (["--angle", "30", "--orbital", "homo"], "--angle 30 is outside the scan's -180°..0°"),
+        (["--angle", "30", "--orbital", "homo"], "--at 30 is outside the scan's -180°..0°"),
     ] {
         let start = std::time::Instant::now();
         let out = orbcloud(&[&["scan", "render", manifest][..], &args[..], &["-o", "x.png"][..]].concat());

@@ -40,8 +40,9 @@ pub enum ScanCommand {
     /// Write the exactly interpolated orbital at an angle as a cube file.
     Export {
         scan: PathBuf,
-        #[arg(long, allow_hyphen_values = true)]
-        angle: f64,
+        /// The coordinate's value (degrees for a dihedral).
+        #[arg(long, alias = "angle", allow_hyphen_values = true)]
+        at: f64,
         /// Which of the scan's orbitals (as the manifest names them).
         #[arg(long, default_value = "homo", allow_hyphen_values = true)]
         orbital: String,
@@ -173,7 +174,7 @@ fn slot_of(scan: &Scan, name: &str) -> Result<usize> {
 fn check_angle(scan: &Scan, angle: f64) -> Result<()> {
     let (lo, hi) = scan.range();
     if !(lo..=hi).contains(&angle) {
-        bail!("{angle} is outside the scan's {lo}°..{hi}°");
+        bail!("--at {angle} is outside the scan's {lo}°..{hi}°");
     }
     Ok(())
 }
@@ -267,7 +268,7 @@ pub fn run(command: ScanCommand) -> Result<()> {
             eprintln!("wrote {}", args.output.display());
             Ok(())
         }
-        ScanCommand::Export { scan, angle, orbital, keys, output } => {
+        ScanCommand::Export { scan, at: angle, orbital, keys, output } => {
             let file = load_scan(&scan)?;
             let follow = follow_of(keys.follow, &file);
             let s = &file.scan;
