@@ -128,7 +128,7 @@ impl ScanScene {
                     }
                     _ => scan.key_values(&tracks, slot, f, &grid),
                 };
-                let label = format!("{} at {}°", scan.orbitals[slot], frame.angle);
+                let label = format!("{} at {}", scan.orbitals[slot], scan.coordinate.value_text(frame.at));
                 slot_grids.push(VolumeGrid::new(label, grid.dims, grid.world_from_grid, values));
                 if !progress(f * slots + slot + 1, count) {
                     return Err(ScanSceneError::Cancelled);
@@ -227,9 +227,10 @@ impl ScanScene {
         }
     }
 
-    /// The coordinate at θ in words: "dihedral 1-2-3-4 = 45.0°".
+    /// The coordinate at θ in words: "dihedral 1-2-3-4 = 45.0°", "distance 1-2 = 1.200 Å".
     pub fn coordinate_label(&self, theta: f64) -> String {
-        format!("dihedral {} = {theta:.1}°", self.scan.dihedral_label())
+        let c = &self.scan.coordinate;
+        format!("{} = {}", c.label(), c.value_text(theta))
     }
 
     /// The two key volumes' values around θ and the weight k of the second: slot `slot` at θ

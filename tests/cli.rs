@@ -156,7 +156,7 @@ fn scan_export_writes_the_interpolated_orbital_and_render_writes_both_views() {
     let worst = got.values.iter().zip(&want).fold(0f32, |m, (a, b)| m.max((a - b).abs()));
     assert!(worst <= 1e-4 * scale, "exported values differ by {worst} (max |ψ| {scale})");
     // The skeleton in the file is the one at θ.
-    let d = orbcloud::model::scan::measure(&doc.molecule, file.scan.dihedral);
+    let d = file.scan.coordinate.measure(&doc.molecule).unwrap();
     assert!((d + 97.5).abs() < 1e-3, "dihedral in the cube: {d}");
 
     let png = dir.path().join("scan.png");

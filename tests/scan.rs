@@ -13,7 +13,7 @@ use orbcloud::gpu::volume::VolumeTexture;
 use orbcloud::gpu::{FrameInput, OffscreenTarget, Renderer};
 use orbcloud::key_volumes::{KeyOptions, ScanScene};
 use orbcloud::model::VolumeGrid;
-use orbcloud::model::scan::{Follow, Scan, Tracks, measure};
+use orbcloud::model::scan::{Coordinate, Follow, Scan, Tracks};
 use orbcloud::scene::{Interpolation, RenderSettings};
 
 fn psb3() -> Scan {
@@ -82,18 +82,18 @@ fn swapped_orbitals_are_reported_and_followed_by_overlap() {
 fn the_skeleton_follows_theta_and_the_charge_moves_at_minus_90() {
     let scan = psb3();
     for frame in &scan.frames {
-        let m = scan.geometry_at(frame.angle);
+        let m = scan.geometry_at(frame.at);
         for (a, b) in m.atoms.iter().zip(&frame.molecule.atoms) {
-            assert!((a.position - b.position).length() < 1e-9, "key frame {}° not reproduced", frame.angle);
+            assert!((a.position - b.position).length() < 1e-9, "key frame {}° not reproduced", frame.at);
         }
     }
     let m = scan.geometry_at(-97.5);
-    assert!((measure(&m, scan.dihedral) - -97.5).abs() < 1e-6);
+    assert!((scan.coordinate.measure(&m).unwrap() - -97.5).abs() < 1e-6);
     // Seed 000's picture at −90°: HOMO on the C=N side, LUMO on the allyl side. Partition ψ² by
     // nearest atom on the common grid.
     let tracks = scan.track(Follow::Index).unwrap();
     let grid = scan.common_grid(orbcloud::scene::framing::ORBITAL_MARGIN, 48);
-    let f = scan.frames.iter().position(|f| f.angle == -90.0).unwrap();
+    let f = scan.frames.iter().position(|f| f.at == -90.0).unwrap();
     let atoms = &scan.frames[f].molecule.atoms;
     let moving: Vec<bool> = (0..atoms.len()).map(|i| scan.moving.contains(&i)).collect();
     let spec = grid;
@@ -137,10 +137,10 @@ fn the_skeleton_follows_theta_and_the_charge_moves_at_minus_90() {
 fn held_out_error(scan: &Scan, held: usize, slot: usize, points: usize) -> (f64, f64) {
     let mut frames = scan.frames.clone();
     let truth_frame = frames.remove(held);
-    let without = Scan::new(scan.title.clone(), scan.dihedral, scan.orbitals.clone(), frames).unwrap();
+    let without = Scan::new(scan.title.clone(), scan.coordinate, scan.orbitals.clone(), frames).unwrap();
     let tracks: Tracks = without.track(Follow::Index).unwrap();
     let grid = scan.common_grid(orbcloud::scene::framing::ORBITAL_MARGIN, points);
-    let interpolated = without.interpolated_values(&tracks, slot, truth_frame.angle, &grid);
+    let interpolated = without.interpolated_values(&tracks, slot, truth_frame.at, &grid);
     let full = scan.track(Follow::Index).unwrap();
     let mut truth = scan.key_values(&full, slot, held, &grid);
     // The truth's sign as the held-out sequence would align it.
@@ -149,7 +149,7 @@ fn held_out_error(scan: &Scan, held: usize, slot: usize, points: usize) -> (f64,
         truth.iter_mut().for_each(|x| *x = -*x);
     }
     let diff: Vec<f32> = truth.iter().zip(&interpolated).map(|(a, b)| a - b).collect();
-    let nearest = without.nearest_frame(truth_frame.angle);
+    let nearest = without.nearest_frame(truth_frame.at);
     let mut key = without.key_values(&tracks, slot, nearest, &grid);
     let dot: f64 = truth.iter().zip(&key).map(|(&a, &b)| a as f64 * b as f64).sum();
     if dot < 0.0 {
@@ -162,7 +162,7 @@ fn held_out_error(scan: &Scan, held: usize, slot: usize, points: usize) -> (f64,
 #[test]
 fn interpolating_a_held_out_angle_comes_close_to_the_true_orbital() {
     let scan = psb3();
-    let held = scan.frames.iter().position(|f| f.angle == -90.0).unwrap();
+    let held = scan.frames.iter().position(|f| f.at == -90.0).unwrap();
     for slot in 0..2 {
         let (err, nearest) = held_out_error(&scan, held, slot, 48);
         eprintln!(
@@ -221,7 +221,7 @@ fn three_pass_stays_close_to_exact_and_equals_it_at_key_angles() {
         eprintln!("θ = {theta}°: three-pass vs exact: mean {mean:.2}/255, max {max}/255");
         worst = worst.max(mean);
         // Both must differ from the nearer key frame's picture: they interpolate.
-        let key = render(scene.scan.frames[scene.scan.nearest_frame(theta)].angle, Interpolation::Exact);
+        let key = render(scene.scan.frames[scene.scan.nearest_frame(theta)].at, Interpolation::Exact);
         assert!(mean_max_diff(&exact, &key).0 > 0.02, "θ = {theta}: exact shows only a key frame");
     }
     assert!(worst < 2.0, "three-pass strays from exact by {worst}/255 on average");
@@ -365,7 +365,7 @@ fn cube_series_must_share_one_grid() {
         let g = VolumeGrid::new("homo", grid.dims, world, values);
         let name = format!("homo_{f}.cube");
         std::fs::write(dir.path().join(&name), cube_write::write("t", "homo", &frame.molecule, &[(&g, 1)])).unwrap();
-        names.push((frame.angle, name));
+        names.push((frame.at, name));
     }
     let manifest = |n: usize| {
         let mut t = "dihedral = [2, 3, 4, 5]\norbitals = [\"homo\"]\n".to_string();
@@ -390,7 +390,7 @@ fn init_measures_the_most_changing_dihedral_and_sorts() {
     let names = ["psb3_000.molden.gz", "psb3_m180.molden.gz", "psb3_m090.molden.gz", "psb3_m120.molden.gz"];
     copy_frames(dir.path(), &names);
     let made = init(dir.path(), None).unwrap();
-    assert_eq!(made.dihedral, [1, 2, 3, 4], "C2-C3-C4-C5");
+    assert_eq!(made.coordinate, Coordinate::Dihedral([1, 2, 3, 4]), "C2-C3-C4-C5");
     let angles: Vec<f64> = made.frames.iter().map(|f| f.1).collect();
     for (a, want) in angles.iter().zip([-180.0, -120.0, -90.0, 0.0]) {
         assert!((a - want).abs() < 1e-3, "{angles:?}");
@@ -511,7 +511,7 @@ fn per_point_fchk_files_with_optimisation_histories_make_a_scan() {
     let geometries = orbcloud::formats::fchk::geometries("psb3_m090.fchk.gz", &text).unwrap();
     assert_eq!(geometries.len(), 3, "the current geometry and two optimisation steps");
     let made = init(dir.path(), None).unwrap();
-    assert_eq!(made.dihedral, [1, 2, 3, 4]);
+    assert_eq!(made.coordinate, Coordinate::Dihedral([1, 2, 3, 4]));
     let angles: Vec<f64> = made.frames.iter().map(|f| f.1).collect();
     for (a, want) in angles.iter().zip([-120.0, -90.0, -60.0]) {
         assert!((a - want).abs() < 1e-3, "the current geometry is measured, not a step: {angles:?}");
@@ -524,7 +524,7 @@ fn per_point_fchk_files_with_optimisation_histories_make_a_scan() {
     let molden_tracks = molden.track(Follow::Index).unwrap();
     let grid = molden.common_grid(orbcloud::scene::framing::ORBITAL_MARGIN, 24);
     for (f, angle) in [-120.0, -90.0, -60.0].into_iter().enumerate() {
-        let m = molden.frames.iter().position(|fr| fr.angle == angle).unwrap();
+        let m = molden.frames.iter().position(|fr| fr.at == angle).unwrap();
         for slot in 0..2 {
             let (e1, e2) = (tracks.points[slot][f].energy.unwrap(), molden_tracks.points[slot][m].energy.unwrap());
             assert!((e1 - e2).abs() < 1e-6, "{angle}° slot {slot}: {e1} vs {e2}");

@@ -402,7 +402,7 @@ fn a_scan_shows_isosurfaces_at_theta_and_its_measured_dihedral_follows_theta() {
     h.run_steps(3);
 
     // Pick the four atoms of the scanned dihedral in the left view, Shift held after the first.
-    let dihedral = h.state().scan.as_ref().unwrap().scene.scan.dihedral;
+    let dihedral = h.state().scan.as_ref().unwrap().scene.scan.coordinate.atoms().to_vec();
     for (n, &atom) in dihedral.iter().enumerate() {
         let app = h.state();
         let p = app.scan.as_ref().unwrap().atom_on_screen(0, atom, &app.view.camera).expect("on screen");

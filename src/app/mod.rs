@@ -1111,11 +1111,11 @@ impl eframe::App for OrbApp {
                             .map(|q| &mut q.cloud.clip);
                         vp.show(ui, rs, &mut self.view, clip);
                     }
-                    if let Some(o) = self.objects.get(self.active).filter(|o| o.state.surface.color_by_volume) {
-                        if let Some(map) = vp.surface_map(self.active) {
-                            let name = o.state.selected_quantity().map(|q| q.source.name(&o.doc)).unwrap_or_default();
-                            legend::value_bar(ui, ui.min_rect(), &map, &name);
-                        }
+                    if let Some(o) = self.objects.get(self.active).filter(|o| o.state.surface.color_by_volume)
+                        && let Some(map) = vp.surface_map(self.active)
+                    {
+                        let name = o.state.selected_quantity().map(|q| q.source.name(&o.doc)).unwrap_or_default();
+                        legend::value_bar(ui, ui.min_rect(), &map, &name);
                     }
                     if let Some(click) = vp.click.take() {
                         let said = self.measurements.click(click, &self.world);

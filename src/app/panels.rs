@@ -128,13 +128,14 @@ fn status_line(ui: &mut egui::Ui, app: &OrbApp, cancel: &mut bool, dismiss: &mut
             }
             if let Some(scan) = &app.scan {
                 let s = &scan.scene.scan;
+                let c = &s.coordinate;
                 ui.label(format!(
-                    "{}: dihedral {}, {} key frames {:.0}°…{:.0}°",
+                    "{}: {}, {} key frames {}…{}",
                     s.title,
-                    s.dihedral_label(),
+                    c.label(),
                     s.frames.len(),
-                    s.range().0,
-                    s.range().1
+                    c.value_text(s.range().0),
+                    c.value_text(s.range().1)
                 ));
                 if !app.status.is_empty() {
                     ui.separator();

@@ -141,14 +141,15 @@ impl ScanView {
         let views = contexts.into_iter().map(Viewport::new).collect();
         // Open where the picture says most: the key frame nearest the middle of the range.
         let (lo, hi) = scene.scan.range();
-        let theta = scene.scan.frames[scene.scan.nearest_frame(0.5 * (lo + hi))].angle;
+        let theta = scene.scan.frames[scene.scan.nearest_frame(0.5 * (lo + hi))].at;
         Self {
             scene: Arc::new(scene),
             theta,
             mode: Interpolation::Exact,
             playing: false,
             looping: true,
-            speed: 30.0,
+            // A sweep of the whole range in six seconds (30°/s for a half-turn scan).
+            speed: ((hi - lo) / 6.0).max(1e-3),
             drag_twists: true,
             direction: 1.0,
             views,
@@ -200,9 +201,9 @@ impl ScanView {
         self.theta = t;
     }
 
-    /// The key angle before (`-1`) or after (`+1`) θ.
+    /// The key frame's value before (`-1`) or after (`+1`) θ.
     fn step_key(&mut self, dir: i32) {
-        let angles = self.scene.scan.angles();
+        let angles = self.scene.scan.values();
         let next = if dir > 0 {
             angles.iter().copied().find(|&a| a > self.theta + 1e-6)
         } else {
@@ -213,11 +214,17 @@ impl ScanView {
         }
     }
 
-    /// The rotatable bond j–k at θ, for grabbing it with the mouse.
-    fn bond(&self) -> [glam::Vec3; 2] {
+    /// The bond the coordinate moves about at θ (a dihedral's rotatable bond, an angle's
+    /// moving arm, a distance's bond), for grabbing it with the mouse; none for a path.
+    fn bond(&self) -> Option<[glam::Vec3; 2]> {
+        use crate::model::scan::Coordinate;
+        let (j, k) = match self.scene.scan.coordinate {
+            Coordinate::Distance([i, j]) => (i, j),
+            Coordinate::Angle([_, j, k]) | Coordinate::Dihedral([_, j, k, _]) => (j, k),
+            Coordinate::Path => return None,
+        };
         let m = self.scene.scan.geometry_at(self.theta);
-        let [_, j, k, _] = self.scene.scan.dihedral;
-        [m.atoms[j].position.as_vec3(), m.atoms[k].position.as_vec3()]
+        Some([m.atoms[j].position.as_vec3(), m.atoms[k].position.as_vec3()])
     }
 }
 
@@ -234,7 +241,9 @@ pub fn controls(ui: &mut egui::Ui, scan: &mut ScanView) -> Option<Follow> {
                 scan.playing = !scan.playing;
             }
             ui.checkbox(&mut scan.looping, "loop");
-            ui.add(egui::DragValue::new(&mut scan.speed).range(1.0..=360.0).suffix(" °/s"))
+            let unit = scan.scene.scan.coordinate.unit().trim();
+            let span = (hi - lo).max(1e-6);
+            ui.add(egui::DragValue::new(&mut scan.speed).range(span / 60.0..=span * 2.0).suffix(format!(" {unit}/s")))
                 .on_hover_text("animation speed");
             ui.separator();
             ui.label("θ");
@@ -242,7 +251,10 @@ pub fn controls(ui: &mut egui::Ui, scan: &mut ScanView) -> Option<Follow> {
             let width = (ui.available_width() - 150.0).max(160.0);
             ui.spacing_mut().slider_width = width;
             let mut theta = scan.theta;
-            let slider = ui.add(egui::Slider::new(&mut theta, lo..=hi).suffix("°").fixed_decimals(1).text("dihedral"));
+            let c = scan.scene.scan.coordinate;
+            let decimals = if matches!(c, crate::model::scan::Coordinate::Distance(_)) { 3 } else { 1 };
+            let slider =
+                ui.add(egui::Slider::new(&mut theta, lo..=hi).suffix(c.unit()).fixed_decimals(decimals).text(c.kind()));
             if slider.changed() {
                 scan.set_theta(theta);
             }
@@ -284,7 +296,7 @@ fn key_ticks(ui: &egui::Ui, rect: egui::Rect, scan: &ScanView, width: f32) {
     let x0 = rect.left() + inset;
     let x1 = rect.left() + width - inset;
     let stroke = egui::Stroke::new(1.5, ui.visuals().widgets.inactive.fg_stroke.color);
-    for a in scan.scene.scan.angles() {
+    for a in scan.scene.scan.values() {
         let x = x0 + ((a - lo) / (hi - lo).max(1e-9)) as f32 * (x1 - x0);
         painter.line_segment([egui::pos2(x, rect.bottom() - 4.0), egui::pos2(x, rect.bottom() + 1.0)], stroke);
     }
@@ -300,7 +312,7 @@ fn energy_plot(ui: &mut egui::Ui, scan: &ScanView) {
                 .frames
                 .iter()
                 .enumerate()
-                .map(|(f, fr)| s.tracks.points[slot][f].energy.map(|e| [fr.angle, e * EV_PER_HARTREE]))
+                .map(|(f, fr)| s.tracks.points[slot][f].energy.map(|e| [fr.at, e * EV_PER_HARTREE]))
                 .collect();
             points.map(|p| (format!("E({})", s.scan.orbitals[slot].to_uppercase()), p))
         })
@@ -359,7 +371,7 @@ pub fn views(
     }
     // The bond's position matters only where a press may start a drag that grabs it.
     let grab = !scan.drag_twists && ui.input(|i| i.pointer.primary_down());
-    let twist = TwistInput { drag_twists: scan.drag_twists, bond: grab.then(|| scan.bond()) };
+    let twist = TwistInput { drag_twists: scan.drag_twists, bond: grab.then(|| scan.bond()).flatten() };
     let (lo, hi) = scan.scene.scan.range();
     let n = scan.views.len().max(1);
     let mut dragged = 0.0;
@@ -380,7 +392,7 @@ pub fn views(
             }
             ui.horizontal(|ui| {
                 ui.strong(scan.scene.label(slot, scan.theta));
-                ui.label(RichText::new(format!("θ = {:.1}°", scan.theta)).weak());
+                ui.label(RichText::new(scan.scene.coordinate_label(scan.theta)).weak());
             });
             // Isosurfaces of the orbital at θ, cut in the background from the two key volumes.
             let wanted = scan.settings.iso.visible.then_some((scan.theta, scan.settings.iso));
@@ -393,9 +405,9 @@ pub fn views(
             match vp.poll_meshes(0) {
                 Some(Ok((n, note))) if n > 0 => {
                     said = Some(format!(
-                        "{}isosurfaces at θ = {:.1}°: {n} triangles",
+                        "{}isosurfaces at {}: {n} triangles",
                         note.map_or(String::new(), |n| n + "; "),
-                        scan.theta
+                        scan.scene.coordinate_label(scan.theta)
                     ))
                 }
                 Some(Err(e)) => said = Some(e),

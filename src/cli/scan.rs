@@ -11,7 +11,7 @@ use orbcloud::gpu::volume::{VolumeTexture, residency_budget, texel_bytes};
 use orbcloud::gpu::{GpuContext, OffscreenTarget, Renderer};
 use orbcloud::key_volumes::{DEFAULT_SCAN_POINTS, KeyOptions, ScanScene};
 use orbcloud::model::VolumeGrid;
-use orbcloud::model::scan::Scan;
+use orbcloud::model::scan::{Coordinate, Scan};
 use orbcloud::scene::Interpolation;
 use orbcloud::shots::ScanShots;
 
@@ -19,12 +19,23 @@ use super::{FigureArgs, ViewArgs, gpu};
 
 #[derive(Subcommand)]
 pub enum ScanCommand {
-    /// Write DIR/<name>.scan.toml from a directory of Molden/fchk files, one per angle.
+    /// Write DIR/<name>.scan.toml from a directory of Molden/fchk files, one per point of a
+    /// scan: a bond length, a bond angle, a dihedral, or a path (an IRC, a relaxed scan).
     Init {
         dir: PathBuf,
-        /// The dihedral's atoms, 1-based (default: the bonded dihedral that changes most).
-        #[arg(long, value_parser = parse_dihedral)]
+        /// The bond length between these atoms, 1-based (default: the bonded distance, angle or
+        /// dihedral that explains the change across the frames best, or a path).
+        #[arg(long, value_parser = parse_atoms::<2>, group = "coordinate")]
+        distance: Option<[usize; 2]>,
+        /// The angle i-j-k at j, 1-based.
+        #[arg(long, value_parser = parse_atoms::<3>, group = "coordinate")]
+        angle: Option<[usize; 3]>,
+        /// The dihedral i-j-k-l about the j-k bond, 1-based.
+        #[arg(long, value_parser = parse_atoms::<4>, group = "coordinate")]
         dihedral: Option<[usize; 4]>,
+        /// The frames as a path, in the order of their file names.
+        #[arg(long, group = "coordinate")]
+        path: bool,
         /// Print the manifest instead of writing it.
         #[arg(long)]
         dry_run: bool,
@@ -114,13 +125,14 @@ pub struct ScanRenderArgs {
     output: PathBuf,
 }
 
-fn parse_dihedral(s: &str) -> Result<[usize; 4], String> {
+/// N 1-based atom numbers `i,j,…`, returned 0-based.
+fn parse_atoms<const N: usize>(s: &str) -> Result<[usize; N], String> {
     let v: Vec<usize> =
         s.split(',').map(|t| t.trim().parse::<usize>()).collect::<Result<_, _>>().map_err(|e| e.to_string())?;
-    match v[..] {
-        [a, b, c, d] if v.iter().all(|&x| x >= 1) => Ok([a - 1, b - 1, c - 1, d - 1]),
-        _ => Err(format!("expected four 1-based atom numbers i,j,k,l, got {s:?}")),
+    if v.len() != N || v.contains(&0) {
+        return Err(format!("expected {N} atom numbers counted from 1, separated by commas, got {s:?}"));
     }
+    Ok(std::array::from_fn(|i| v[i] - 1))
 }
 
 fn follow_of(arg: Option<FollowArg>, file: &ScanFile) -> Follow {
@@ -152,8 +164,8 @@ pub fn build(ctx: &GpuContext, file: ScanFile, keys: &KeyArgs) -> Result<ScanSce
     );
     for s in &scene.tracks.swaps {
         eprintln!(
-            "note: at {}° {} overlaps the previous frame's orbital {:.3}, orbital {} overlaps it {:.3} (character swap{})",
-            scene.scan.frames[s.frame].angle,
+            "note: at {} {} overlaps the previous frame's orbital {:.3}, orbital {} overlaps it {:.3} (character swap{})",
+            scene.scan.coordinate.value_text(scene.scan.frames[s.frame].at),
             scene.scan.orbitals[s.slot],
             s.by_name_overlap,
             s.by_overlap + 1,
@@ -170,29 +182,33 @@ fn slot_of(scan: &Scan, name: &str) -> Result<usize> {
     })
 }
 
-/// Refuses an angle outside the scan's range (it would be drawn at the nearest end).
-fn check_angle(scan: &Scan, angle: f64) -> Result<()> {
+/// Refuses a value outside the scan's range (it would be drawn at the nearest end).
+fn check_angle(scan: &Scan, at: f64) -> Result<()> {
     let (lo, hi) = scan.range();
-    if !(lo..=hi).contains(&angle) {
-        bail!("--at {angle} is outside the scan's {lo}°..{hi}°");
+    if !(lo..=hi).contains(&at) {
+        let unit = scan.coordinate.unit();
+        bail!("--at {at} is outside the scan's {lo}{unit}..{hi}{unit}");
     }
     Ok(())
 }
 
 pub fn run(command: ScanCommand) -> Result<()> {
     match command {
-        ScanCommand::Init { dir, dihedral, dry_run } => {
-            let made = init(&dir, dihedral)?;
-            let d = made.dihedral.map(|i| i + 1);
+        ScanCommand::Init { dir, distance, angle, dihedral, path, dry_run } => {
+            let chosen = (distance.map(Coordinate::Distance))
+                .or(angle.map(Coordinate::Angle))
+                .or(dihedral.map(Coordinate::Dihedral))
+                .or(path.then_some(Coordinate::Path));
+            let made = init(&dir, chosen)?;
+            let c = made.coordinate;
+            let (lo, hi) = (made.frames[0].1, made.frames[made.frames.len() - 1].1);
+            let how = if made.found { " (the coordinate that explains the change best)" } else { "" };
             eprintln!(
-                "dihedral {}-{}-{}-{}; {} frames from {:.2}° to {:.2}°",
-                d[0],
-                d[1],
-                d[2],
-                d[3],
+                "{}{how}; {} frames from {} to {}",
+                c.label(),
                 made.frames.len(),
-                made.frames[0].1,
-                made.frames[made.frames.len() - 1].1
+                c.value_text(lo),
+                c.value_text(hi)
             );
             if dry_run {
                 print!("{}", made.text);
@@ -206,20 +222,14 @@ pub fn run(command: ScanCommand) -> Result<()> {
             let file = load_scan(&scan)?;
             let tracks = file.scan.track(follow_of(follow, &file))?;
             let s = &file.scan;
-            println!(
-                "{}\ndihedral {}, {} frames, {} atoms turn",
-                s.title,
-                s.dihedral_label(),
-                s.frames.len(),
-                s.moving.len()
-            );
-            print!("{:>9}  {:<28}", "angle", "file");
+            println!("{}\n{}, {} frames, {} atoms move", s.title, s.coordinate.label(), s.frames.len(), s.moving.len());
+            print!("{:>9}  {:<28}", s.coordinate.kind(), "file");
             for o in &s.orbitals {
                 print!("  {:>12} {:>5}", format!("E({o})"), "sign");
             }
             println!();
             for (f, frame) in s.frames.iter().enumerate() {
-                print!("{:>9.2}  {:<28}", frame.angle, frame.source);
+                print!("{:>9.3}  {:<28}", frame.at, frame.source);
                 for slot in 0..s.orbitals.len() {
                     let p = tracks.points[slot][f];
                     let e = p.energy.map_or("-".into(), |e| format!("{e:.5}"));
@@ -232,8 +242,8 @@ pub fn run(command: ScanCommand) -> Result<()> {
             }
             for w in &tracks.swaps {
                 println!(
-                    "swap at {}°: {} (|overlap| {:.3}) vs orbital {} (|overlap| {:.3})",
-                    s.frames[w.frame].angle,
+                    "swap at {}: {} (|overlap| {:.3}) vs orbital {} (|overlap| {:.3})",
+                    s.coordinate.value_text(s.frames[w.frame].at),
                     s.orbitals[w.slot],
                     w.by_name_overlap,
                     w.by_overlap + 1,
@@ -276,7 +286,7 @@ pub fn run(command: ScanCommand) -> Result<()> {
             check_angle(s, angle)?;
             let tracks = s.track(follow)?;
             let grid = s.key_grid(&tracks, orbcloud::scene::framing::ORBITAL_MARGIN, keys.points.clamp(8, 512));
-            let label = format!("{orbital} at {angle} deg (interpolated)");
+            let label = format!("{orbital} at {} (interpolated)", s.coordinate.value_text(angle));
             let volume = s.interpolated_grid(&tracks, slot, angle, &grid, &label);
             let molecule = s.geometry_at(angle);
             let title = format!("{}: {label}", s.title);
@@ -344,7 +354,7 @@ pub fn bench_keyvolumes(args: KeyVolumeBench) -> Result<()> {
     settings.volume.slices = args.slices.clamp(1, 4096);
     let (lo, hi) = grid.bounds();
     let camera = orbcloud::scene::Camera::framing(lo.as_vec3(), hi.as_vec3());
-    let molecule = s.geometry_at(s.frames[0].angle);
+    let molecule = s.geometry_at(s.frames[0].at);
     let target = OffscreenTarget::new(&ctx.device, args.size);
     println!("K,resident_MiB,exact_ms_median,three_pass_ms_median,upload_s");
     for &k in &args.counts {

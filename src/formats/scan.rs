@@ -1,22 +1,26 @@
-//! Scan manifests (`*.scan.toml`): a dihedral scan as key frames, each an angle and the file(s)
-//! holding that frame's orbitals. Paths are relative to the manifest.
+//! Scan manifests (`*.scan.toml`): key frames, each a value of the scan's coordinate and the
+//! file(s) holding that frame's orbitals. Paths are relative to the manifest.
 //!
 //! ```toml
-//! title = "PSB3 cation: twist about C3=C4"
-//! dihedral = [2, 3, 4, 5]          # atom numbers, 1-based
+//! title = "water bending"
+//! coordinate = "angle"             # distance (Å) | angle (°) | dihedral (°) | path
+//! atoms = [2, 1, 3]                # atom numbers, 1-based; none for a path
 //! orbitals = ["homo", "lumo"]      # default; also "homo-1", "lumo+2", an index
 //! follow = "index"                 # or "overlap": follow each orbital's character
 //! captions = ["RHF", "B3LYP"]      # optional, one per view
 //!
 //! [[frame]]
-//! angle = -180.0
-//! file = "psb3_m180.molden.gz"     # Molden or fchk, for every view; or one per view:
-//! # files = ["rhf/m180.molden", "b3lyp/m180.molden"]
+//! at = 95.0
+//! file = "h2o_a095.molden"         # Molden or fchk, for every view; or one per view:
+//! # files = ["rhf/a095.molden", "b3lyp/a095.molden"]
 //!
 //! [[frame]]
-//! angle = -150.0
-//! cubes = ["homo_m150.cube", "lumo_m150.cube"]   # or one cube per orbital
+//! at = 105.0
+//! cubes = ["homo_a105.cube", "lumo_a105.cube"]   # or one cube per orbital
 //! ```
+//!
+//! Older manifests name a dihedral scan `dihedral = [i, j, k, l]` with frames at `angle = θ`;
+//! they read as before.
 
 use std::path::{Path, PathBuf};
 
@@ -24,14 +28,21 @@ use serde::Deserialize;
 
 use super::{LoadError, ParseError};
 pub use crate::model::scan::Follow;
-use crate::model::scan::{ANGLE_TOLERANCE, FrameContent, KeyFrame, Scan, measure, most_changing_dihedral};
+use crate::model::scan::{ANGLE_TOLERANCE, Coordinate, FrameContent, KeyFrame, Scan, best_coordinate};
 use crate::model::{Document, Molecule};
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct Manifest {
     title: Option<String>,
-    dihedral: toml::Spanned<[usize; 4]>,
+    /// distance | angle | dihedral | path.
+    coordinate: Option<toml::Spanned<String>>,
+    /// The coordinate's atoms, 1-based.
+    atoms: Option<toml::Spanned<Vec<usize>>>,
+    /// A path's frames rotated onto each other.
+    align: Option<toml::Spanned<bool>>,
+    /// The older way to name a dihedral scan.
+    dihedral: Option<toml::Spanned<Vec<usize>>>,
     #[serde(default = "default_orbitals")]
     orbitals: Vec<String>,
     #[serde(default)]
@@ -46,7 +57,9 @@ struct Manifest {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct FrameEntry {
-    angle: f64,
+    /// The coordinate's value (`angle` in older manifests).
+    #[serde(alias = "angle")]
+    at: f64,
     file: Option<String>,
     /// One Molden/fchk file per orbital slot: the same orbital from two methods side by side.
     files: Option<Vec<String>>,
@@ -101,11 +114,7 @@ pub fn parse_scan(
         error(&name, line, "a scan manifest (title, dihedral, orbitals, [[frame]] angle + file or cubes)", e.message())
     })?;
     let dir = path.parent().unwrap_or(Path::new("."));
-    let dihedral_line = line_of(text, manifest.dihedral.span().start);
-    let dihedral = *manifest.dihedral.get_ref();
-    if dihedral.contains(&0) {
-        return Err(error(&name, dihedral_line, "four atom numbers counted from 1", format!("{dihedral:?}")).into());
-    }
+    let (coordinate, coordinate_line) = coordinate_of(&name, text, &manifest)?;
     if manifest.frames.len() < 2 {
         return Err(error(
             &name,
@@ -121,8 +130,8 @@ pub fn parse_scan(
         let line = line_of(text, spanned.span().start);
         let entry = spanned.get_ref();
         let named = |e| LoadError::Named { manifest: name.clone(), line, inner: Box::new(e) };
-        if !entry.angle.is_finite() {
-            return Err(error(&name, line, "a finite angle in degrees", entry.angle.to_string()).into());
+        if !entry.at.is_finite() {
+            return Err(error(&name, line, "a finite value of the coordinate (at = …)", entry.at.to_string()).into());
         }
         let single = entry.file.as_ref().map(std::slice::from_ref);
         let files =
@@ -185,19 +194,19 @@ pub fn parse_scan(
             )
             .into());
         }
-        frames.push((line, KeyFrame { angle: entry.angle, source, molecule, content }));
+        frames.push((line, KeyFrame { at: entry.at, source, molecule, content }));
     }
     check_frames(&name, &frames)?;
-    frames.sort_by(|a, b| a.1.angle.total_cmp(&b.1.angle));
+    frames.sort_by(|a, b| a.1.at.total_cmp(&b.1.at));
     for pair in frames.windows(2) {
         let ((l0, f0), (l1, f1)) = (&pair[0], &pair[1]);
-        if (f1.angle - f0.angle).abs() < ANGLE_TOLERANCE {
+        if (f1.at - f0.at).abs() < ANGLE_TOLERANCE {
             let (first, second) = if l0 < l1 { (l0, l1) } else { (l1, l0) };
             return Err(error(
                 &name,
                 *second,
-                format!("an angle different from the frame on line {first}"),
-                format!("angle = {}", f1.angle),
+                format!("a value different from the frame on line {first}"),
+                format!("at = {}", f1.at),
             )
             .into());
         }
@@ -205,13 +214,81 @@ pub fn parse_scan(
     let title = manifest
         .title
         .unwrap_or_else(|| path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default());
-    let dihedral = dihedral.map(|i| i - 1);
-    let mut scan = Scan::new(title, dihedral, manifest.orbitals, frames.into_iter().map(|(_, f)| f).collect())
-        .map_err(|e| error(&name, dihedral_line, "a dihedral about a bond that can turn", e.to_string()))?;
+    let mut scan = Scan::new(title, coordinate, manifest.orbitals, frames.into_iter().map(|(_, f)| f).collect())
+        .map_err(|e| {
+            let expected = format!("a {} whose atoms can move on one side of a bond", coordinate.kind());
+            error(&name, coordinate_line, expected, e.to_string())
+        })?;
     scan.captions = manifest.captions;
     // Resolving the orbitals of every frame reports a missing one before anything is evaluated.
     scan.check_orbitals().map_err(|e| error(&name, 1, "the orbitals the manifest names", e.to_string()))?;
     Ok(ScanFile { scan, follow: manifest.follow })
+}
+
+/// The manifest's coordinate (0-based atoms) and the line that names it: `coordinate` and
+/// `atoms`, or an older manifest's `dihedral`.
+fn coordinate_of(name: &str, text: &str, m: &Manifest) -> Result<(Coordinate, usize), ParseError> {
+    let line_at = |span: std::ops::Range<usize>| line_of(text, span.start);
+    let (kind, kind_line) = match (&m.coordinate, &m.dihedral) {
+        (Some(c), None) => (c.get_ref().as_str(), line_at(c.span())),
+        (None, Some(d)) => ("dihedral", line_at(d.span())),
+        (Some(c), Some(_)) => {
+            return Err(error(name, line_at(c.span()), "coordinate = … with atoms = […], or dihedral = […]", "both"));
+        }
+        (None, None) => {
+            return Err(error(
+                name,
+                1,
+                "coordinate = \"distance\" | \"angle\" | \"dihedral\" | \"path\" (with atoms = […])",
+                "no coordinate",
+            ));
+        }
+    };
+    let atoms = match (&m.atoms, &m.dihedral) {
+        (Some(a), _) => Some((a.get_ref().clone(), line_at(a.span()))),
+        (None, Some(d)) => Some((d.get_ref().clone(), line_at(d.span()))),
+        (None, None) => None,
+    };
+    let wanted = match kind {
+        "distance" => 2,
+        "angle" => 3,
+        "dihedral" => 4,
+        "path" => 0,
+        other => {
+            return Err(error(name, kind_line, "distance, angle, dihedral or path", format!("{other:?}")));
+        }
+    };
+    if let Some(align) = &m.align
+        && *align.get_ref()
+    {
+        let line = line_at(align.span());
+        if kind != "path" {
+            return Err(error(name, line, "align only for a path", format!("align with a {kind}")));
+        }
+        return Err(error(
+            name,
+            line,
+            "align = false: a path's frames are used in the files' own orientation (write them in one \
+             orientation, e.g. Gaussian's nosymm or ORCA's default)",
+            "align = true",
+        ));
+    }
+    let (list, line) = atoms.unwrap_or((Vec::new(), kind_line));
+    if list.len() != wanted || list.contains(&0) {
+        let expected = match wanted {
+            0 => "no atoms for a path".to_string(),
+            n => format!("{n} atom numbers counted from 1 for a {kind}"),
+        };
+        return Err(error(name, line, expected, format!("{list:?}")));
+    }
+    let a: Vec<usize> = list.iter().map(|i| i - 1).collect();
+    let coordinate = match wanted {
+        2 => Coordinate::Distance([a[0], a[1]]),
+        3 => Coordinate::Angle([a[0], a[1], a[2]]),
+        4 => Coordinate::Dihedral([a[0], a[1], a[2], a[3]]),
+        _ => Coordinate::Path,
+    };
+    Ok((coordinate, line))
 }
 
 /// Every frame must hold the first frame's atoms; cube series must share one grid.
@@ -263,9 +340,11 @@ fn check_frames(name: &str, frames: &[(usize, KeyFrame)]) -> Result<(), ParseErr
 pub struct ScanInit {
     pub path: PathBuf,
     pub text: String,
-    /// 0-based atoms of the dihedral.
-    pub dihedral: [usize; 4],
-    /// (file name, angle) in scan order.
+    /// The coordinate chosen (0-based atoms).
+    pub coordinate: Coordinate,
+    /// Whether it was found (not given).
+    pub found: bool,
+    /// (file name, value) in scan order.
     pub frames: Vec<(String, f64)>,
 }
 
@@ -276,10 +355,12 @@ fn is_wavefunction_file(name: &str) -> bool {
     [".molden", ".molden.input", ".mold", ".fchk", ".fch"].iter().any(|e| n.ends_with(e))
 }
 
-/// Builds `DIR/<dir name>.scan.toml` from the Molden/fchk files in `dir`: each frame's angle is
-/// the dihedral measured in its geometry (the given atoms, 0-based, or the bonded dihedral that
-/// changes most), frames sorted by angle. The text is returned, not written.
-pub fn init(dir: &Path, dihedral: Option<[usize; 4]>) -> Result<ScanInit, LoadError> {
+/// Builds `DIR/<dir name>.scan.toml` from the Molden/fchk files in `dir`: each frame's value is
+/// the coordinate measured in its geometry — the one given (0-based atoms), or the bonded
+/// distance, angle or dihedral that explains the change across the frames best, or a path
+/// (frames in file-name order) when none does ([`best_coordinate`]) — frames sorted by value.
+/// The text is returned, not written.
+pub fn init(dir: &Path, coordinate: Option<Coordinate>) -> Result<ScanInit, LoadError> {
     let io = |source| LoadError::Io { path: dir.display().to_string(), source };
     let mut names: Vec<String> = std::fs::read_dir(dir)
         .map_err(io)?
@@ -342,46 +423,56 @@ pub fn init(dir: &Path, dihedral: Option<[usize; 4]>) -> Result<ScanInit, LoadEr
         molecules.push(doc.molecule);
     }
     let n_atoms = molecules[0].atoms.len();
-    let d = match dihedral {
-        Some(d) => {
-            if let Some(&bad) = d.iter().find(|&&i| i >= n_atoms) {
-                return Err(
-                    error(&name, 0, format!("dihedral atoms between 1 and {n_atoms}"), (bad + 1).to_string()).into()
-                );
+    let found = coordinate.is_none();
+    let coordinate = match coordinate {
+        Some(c) => {
+            if let Some(&bad) = c.atoms().iter().find(|&&i| i >= n_atoms) {
+                let expected = format!("{} atoms between 1 and {n_atoms}", c.kind());
+                return Err(error(&name, 0, expected, (bad + 1).to_string()).into());
             }
-            d
+            c
         }
-        None => most_changing_dihedral(&molecules)
-            .ok_or_else(|| error(&name, 0, "a bond with neighbours on both sides (give --dihedral i,j,k,l)", "none"))?,
+        None => best_coordinate(&molecules)
+            .ok_or_else(|| error(&name, 0, "frames whose geometries differ", "the same geometry in every file"))?,
     };
-    let angles = unwrap_angles(&molecules.iter().map(|m| measure(m, d)).collect::<Vec<_>>());
-    let mut frames: Vec<(String, f64)> = names.into_iter().zip(angles).collect();
+    let values: Vec<f64> = match coordinate {
+        // A path's frames in the order of their names, one unit apart.
+        Coordinate::Path => (0..molecules.len()).map(|i| i as f64).collect(),
+        Coordinate::Dihedral(_) => {
+            unwrap_angles(&molecules.iter().filter_map(|m| coordinate.measure(m)).collect::<Vec<_>>())
+        }
+        _ => molecules.iter().filter_map(|m| coordinate.measure(m)).collect(),
+    };
+    let mut frames: Vec<(String, f64)> = names.into_iter().zip(values).collect();
     frames.sort_by(|a, b| a.1.total_cmp(&b.1));
     for w in frames.windows(2) {
         if (w[1].1 - w[0].1).abs() < ANGLE_TOLERANCE {
             return Err(error(
                 &dir.join(&w[1].0).display().to_string(),
                 0,
-                format!("a dihedral different from {}'s", w[0].0),
-                format!("{:.3}° in both", w[1].1),
+                format!("a {} different from {}'s", coordinate.kind(), w[0].0),
+                format!("{} in both", coordinate.value_text(w[1].1)),
             )
             .into());
         }
     }
+    let how = if found { "the coordinate that explains the change best" } else { "the coordinate given" };
     let mut text = format!(
-        "# Written by `orbcloud scan init`: angles measured from each file's geometry.\ntitle = \"{dir_name}\"\ndihedral = [{}, {}, {}, {}]\norbitals = [\"homo\", \"lumo\"]\n",
-        d[0] + 1,
-        d[1] + 1,
-        d[2] + 1,
-        d[3] + 1
+        "# Written by `orbcloud scan init`: {how}, measured in each file's geometry.\ntitle = \"{dir_name}\"\ncoordinate = \"{}\"\n",
+        coordinate.kind()
     );
-    for (file, angle) in &frames {
+    if !coordinate.atoms().is_empty() {
+        let atoms: Vec<String> = coordinate.atoms().iter().map(|i| (i + 1).to_string()).collect();
+        text.push_str(&format!("atoms = [{}]\n", atoms.join(", ")));
+    }
+    text.push_str("orbitals = [\"homo\", \"lumo\"]\n");
+    for (file, value) in &frames {
         text.push_str(&format!(
-            "\n[[frame]]\nangle = {angle:.3}\nfile = \"{}\"\n",
+            "\n[[frame]]\nat = {value:.4}\nfile = \"{}\"\n",
             file.replace('\\', "\\\\").replace('"', "\\\"")
         ));
     }
-    Ok(ScanInit { path: manifest_path, text, dihedral: d, frames })
+    Ok(ScanInit { path: manifest_path, text, coordinate, found, frames })
 }
 
 /// Dihedrals measured in (−180, 180] made continuous: the sequence starts after the largest gap

@@ -25,6 +25,7 @@ pub mod scan;
 pub mod simplify;
 pub mod solid_harmonics;
 pub mod structure;
+pub mod superpose;
 pub mod surface;
 pub mod synthetic;
 pub mod units;

@@ -1,5 +1,7 @@
-//! Dihedral scans (seed 000): key frames computed at known torsion angles θ, the skeleton at any
-//! θ between them, and which orbital of each frame continues which orbital of the previous one.
+//! Scans (seed 000): key frames computed at known values of a coordinate — a bond length, a
+//! bond angle, a dihedral, or a position along a path (an IRC, a relaxed scan) — the skeleton
+//! at any value between them, and which orbital of each frame continues which orbital of the
+//! previous one.
 //!
 //! Solvers return every orbital with an arbitrary sign and may reorder orbitals of similar
 //! energy between frames, so a frame's "HOMO" is matched to the previous frame's by overlap:
@@ -13,25 +15,98 @@ use super::gto::{GridSpec, PreparedBasis};
 use super::molecule::Molecule;
 use super::orbitals::{OrbitalSpec, Spin, Wavefunction};
 use super::overlap::cross_overlap;
+use super::superpose::superpose;
 use super::{Atom, VolumeGrid};
 
-/// Two key angles closer than this (degrees) are the same angle.
+/// Two key frames whose coordinates are closer than this (degrees, Å, path units) are at the
+/// same place.
 pub const ANGLE_TOLERANCE: f64 = 1e-3;
+
+/// What a scan's key frames vary. Atoms are 0-based.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Coordinate {
+    /// The distance between two atoms (Å): the side of the second moves along the bond.
+    Distance([usize; 2]),
+    /// The angle i–j–k at j (degrees): the side of k turns in the angle's plane.
+    Angle([usize; 3]),
+    /// The torsion i–j–k–l about the j–k bond (degrees): the side of k turns about the bond.
+    Dihedral([usize; 4]),
+    /// Frames in order with no single internal coordinate (an IRC, a relaxed scan, a morph):
+    /// every atom moves, blended between frames.
+    Path,
+}
+
+impl Coordinate {
+    /// The atoms that define it (none for a path).
+    pub fn atoms(&self) -> &[usize] {
+        match self {
+            Coordinate::Distance(a) => a,
+            Coordinate::Angle(a) => a,
+            Coordinate::Dihedral(a) => a,
+            Coordinate::Path => &[],
+        }
+    }
+
+    /// "distance", "angle", "dihedral" or "path", as manifests name it.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Coordinate::Distance(_) => "distance",
+            Coordinate::Angle(_) => "angle",
+            Coordinate::Dihedral(_) => "dihedral",
+            Coordinate::Path => "path",
+        }
+    }
+
+    /// The unit values are given in: "Å", "°", or none for a path.
+    pub fn unit(&self) -> &'static str {
+        match self {
+            Coordinate::Distance(_) => " Å",
+            Coordinate::Angle(_) | Coordinate::Dihedral(_) => "°",
+            Coordinate::Path => "",
+        }
+    }
+
+    /// As chemists write it: "angle 2-1-3" (1-based), "path".
+    pub fn label(&self) -> String {
+        let atoms: Vec<String> = self.atoms().iter().map(|i| (i + 1).to_string()).collect();
+        if atoms.is_empty() { self.kind().into() } else { format!("{} {}", self.kind(), atoms.join("-")) }
+    }
+
+    /// `value` with its unit: "104.5°", "1.20 Å", "3.00".
+    pub fn value_text(&self, value: f64) -> String {
+        match self {
+            Coordinate::Distance(_) => format!("{value:.3} Å"),
+            Coordinate::Path => format!("{value:.2}"),
+            _ => format!("{value:.1}°"),
+        }
+    }
+
+    /// The coordinate measured in `molecule` (Å or degrees); None for a path.
+    pub fn measure(&self, molecule: &Molecule) -> Option<f64> {
+        let p = |i: usize| molecule.atoms[i].position;
+        match *self {
+            Coordinate::Distance([i, j]) => Some(p(i).distance(p(j)) * super::units::ANGSTROM_PER_BOHR),
+            Coordinate::Angle([i, j, k]) => Some(super::measure::angle(p(i), p(j), p(k))),
+            Coordinate::Dihedral(d) => Some(measure(molecule, d)),
+            Coordinate::Path => None,
+        }
+    }
+}
 
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum ScanError {
     #[error("a scan needs at least two frames, found {0}")]
     TooFewFrames(usize),
-    #[error("atom {0} of the dihedral is beyond the {1} atoms of the molecule")]
+    #[error("atom {0} of the coordinate is beyond the {1} atoms of the molecule")]
     AtomOutOfRange(usize, usize),
-    #[error("the dihedral's atoms must be four different atoms")]
+    #[error("the coordinate's atoms must be different atoms")]
     RepeatedAtom,
-    #[error("atoms {0} and {1} of the dihedral lie in one ring: no fragment turns about their bond")]
+    #[error("atoms {0} and {1} lie in one ring: no fragment moves on one side of their bond alone")]
     Ring(usize, usize),
-    #[error("frame at {angle}°: no orbital {spec} (the frame's file has {available} orbitals of that spin)")]
-    MissingOrbital { angle: f64, spec: String, available: usize },
-    #[error("frame at {angle}°: {found} volumes for {wanted} orbitals")]
-    MissingVolume { angle: f64, wanted: usize, found: usize },
+    #[error("frame at {at}: no orbital {spec} (the frame's file has {available} orbitals of that spin)")]
+    MissingOrbital { at: f64, spec: String, available: usize },
+    #[error("frame at {at}: {found} volumes for {wanted} orbitals")]
+    MissingVolume { at: f64, wanted: usize, found: usize },
 }
 
 /// What a key frame holds for its orbitals.
@@ -46,8 +121,9 @@ pub enum FrameContent {
 
 #[derive(Debug, Clone)]
 pub struct KeyFrame {
-    /// θ of this frame (degrees), as the manifest labels it.
-    pub angle: f64,
+    /// The coordinate's value at this frame (degrees, Å, or the path position), as the manifest
+    /// labels it.
+    pub at: f64,
     /// Where the frame came from (for messages).
     pub source: String,
     pub molecule: Molecule,
@@ -68,16 +144,19 @@ pub enum Follow {
 #[derive(Debug, Clone)]
 pub struct Scan {
     pub title: String,
-    /// The torsion's atoms, 0-based.
-    pub dihedral: [usize; 4],
+    /// What the frames vary.
+    pub coordinate: Coordinate,
     /// What each view shows: the manifest's names ("homo", "lumo", "homo-1", …).
     pub orbitals: Vec<String>,
     /// Optional caption per view (say the method, when each view reads its own files).
     pub captions: Vec<String>,
-    /// Key frames, sorted by strictly increasing angle.
+    /// Key frames, sorted by strictly increasing value.
     pub frames: Vec<KeyFrame>,
-    /// Atoms that turn with θ: the side of the j–k bond that holds k.
+    /// Atoms that move with the coordinate: the side of the bond that holds its second (a
+    /// distance) or third (an angle, a dihedral) atom; every atom for a path.
     pub moving: Vec<usize>,
+    /// +1, or −1 when a distance's first atom's side moves (see [`moving_atoms`]).
+    pub direction: f64,
 }
 
 /// Where θ falls between the key frames: frames `a` ≤ θ ≤ `b` and the mixing ratio
@@ -196,6 +275,55 @@ pub fn twist(positions: &mut [DVec3], moving: &[usize], j: usize, k: usize, degr
     }
 }
 
+/// Turns `moving` atoms rigidly about the axis through `positions[j]` perpendicular to the
+/// plane of i–j–k, so that the angle i–j–k grows by `degrees`. A linear angle has no plane: any
+/// axis perpendicular to the i–j bond serves.
+pub fn bend(positions: &mut [DVec3], moving: &[usize], [i, j, k]: [usize; 3], degrees: f64) {
+    let origin = positions[j];
+    let (u, v) = (positions[i] - origin, positions[k] - origin);
+    let axis = u.cross(v).try_normalize().or_else(|| u.any_orthonormal_vector().try_normalize());
+    let Some(axis) = axis else { return };
+    let rotation = DQuat::from_axis_angle(axis, degrees.to_radians());
+    for &a in moving {
+        positions[a] = origin + rotation * (positions[a] - origin);
+    }
+}
+
+/// Moves `moving` atoms along the direction from `positions[i]` to `positions[j]` so that the
+/// distance i–j grows by `angstrom`.
+pub fn stretch(positions: &mut [DVec3], moving: &[usize], [i, j]: [usize; 2], angstrom: f64) {
+    let Some(direction) = (positions[j] - positions[i]).try_normalize() else { return };
+    let shift = direction * angstrom * super::units::BOHR_PER_ANGSTROM;
+    for &a in moving {
+        positions[a] += shift;
+    }
+}
+
+/// The atoms that move with `coordinate` in `molecule`: the side of the bond that holds the
+/// coordinate's second atom (a distance; the smaller side, with the sign of motion reversed,
+/// when the two atoms are not bonded and the first's side is smaller) or third atom (an angle,
+/// a dihedral); every atom for a path. Returns the atoms and ±1, the direction they move in.
+pub fn moving_atoms(molecule: &Molecule, coordinate: &Coordinate) -> Result<(Vec<usize>, f64), ScanError> {
+    match *coordinate {
+        Coordinate::Distance([i, j]) => {
+            let bonded = molecule
+                .bonds
+                .iter()
+                .any(|b| (b.a as usize, b.b as usize) == (i, j) || (b.a as usize, b.b as usize) == (j, i));
+            let of_j = moving_fragment(molecule, i, j)?;
+            if bonded {
+                return Ok((of_j, 1.0));
+            }
+            let of_i = moving_fragment(molecule, j, i)?;
+            Ok(if of_i.len() < of_j.len() { (of_i, -1.0) } else { (of_j, 1.0) })
+        }
+        Coordinate::Angle([_, j, k]) | Coordinate::Dihedral([_, j, k, _]) => {
+            Ok((moving_fragment(molecule, j, k)?, 1.0))
+        }
+        Coordinate::Path => Ok(((0..molecule.atoms.len()).collect(), 1.0)),
+    }
+}
+
 /// The bonded torsion i–j–k–l whose angle changes most across `molecules` (all with the same
 /// atoms; bonds from the first), or None when no bond has neighbours on both sides. Ring bonds
 /// are skipped; the outer atoms are each side's heaviest neighbour, lowest number on ties.
@@ -235,12 +363,113 @@ pub fn most_changing_dihedral(molecules: &[Molecule]) -> Option<[usize; 4]> {
     best.map(|(d, _)| d)
 }
 
+/// Root-mean-square change of the interatomic distances (Å) from `a` to `b`: how far two
+/// geometries differ whatever their orientation.
+fn distance_change(a: &[DVec3], b: &[DVec3]) -> f64 {
+    let n = a.len();
+    let (mut sum, mut pairs) = (0.0, 0usize);
+    for i in 0..n {
+        for j in i + 1..n {
+            let d = a[i].distance(a[j]) - b[i].distance(b[j]);
+            sum += d * d;
+            pairs += 1;
+        }
+    }
+    (sum / pairs.max(1) as f64).sqrt() * super::units::ANGSTROM_PER_BOHR
+}
+
+/// How much of the change across `molecules` a coordinate leaves unexplained: each frame's
+/// geometry predicted by moving the first frame's atoms to that frame's value of the coordinate
+/// (as the scan moves them between key frames), compared with the frame by its interatomic
+/// distances (Å, root mean square over the frames). None when its atoms cannot move alone.
+pub fn unexplained(molecules: &[Molecule], coordinate: &Coordinate) -> Option<f64> {
+    let first = molecules.first()?;
+    let (moving, direction) = moving_atoms(first, coordinate).ok()?;
+    let start = coordinate.measure(first)?;
+    let p0: Vec<DVec3> = first.atoms.iter().map(|a| a.position).collect();
+    let mut sum = 0.0;
+    for m in &molecules[1..] {
+        let mut delta = coordinate.measure(m)? - start;
+        if let Coordinate::Dihedral(_) = coordinate {
+            delta = wrap_degrees(delta);
+        }
+        let mut predicted = p0.clone();
+        match *coordinate {
+            Coordinate::Distance(d) => stretch(&mut predicted, &moving, d, direction * delta),
+            Coordinate::Angle(a) => bend(&mut predicted, &moving, a, delta),
+            Coordinate::Dihedral([_, j, k, _]) => twist(&mut predicted, &moving, j, k, delta),
+            Coordinate::Path => return None,
+        }
+        let actual: Vec<DVec3> = m.atoms.iter().map(|a| a.position).collect();
+        sum += distance_change(&predicted, &actual).powi(2);
+    }
+    Some((sum / (molecules.len() - 1).max(1) as f64).sqrt())
+}
+
+/// A path explains frames that no single coordinate does: what the best one leaves
+/// unexplained must stay under this (Å of interatomic distance, RMS).
+pub const PATH_THRESHOLD: f64 = 0.02;
+
+/// The bonded coordinate that explains the change across `molecules` best (bonds from the
+/// first): every bond length, every angle between two bonds, each bond's dihedral (its sides'
+/// heaviest neighbours); a path when even the best leaves more than [`PATH_THRESHOLD`]
+/// unexplained. Ties go to the coordinate whose moving side is smaller. None when the frames
+/// do not differ.
+pub fn best_coordinate(molecules: &[Molecule]) -> Option<Coordinate> {
+    let first = molecules.first()?;
+    let p0: Vec<DVec3> = first.atoms.iter().map(|a| a.position).collect();
+    let change = molecules[1..]
+        .iter()
+        .map(|m| distance_change(&p0, &m.atoms.iter().map(|a| a.position).collect::<Vec<_>>()))
+        .fold(0.0, f64::max);
+    if change < 1e-6 {
+        return None;
+    }
+    let n = first.atoms.len();
+    let mut neighbours = vec![Vec::new(); n];
+    for b in &first.bonds {
+        neighbours[b.a as usize].push(b.b as usize);
+        neighbours[b.b as usize].push(b.a as usize);
+    }
+    let mut candidates = Vec::new();
+    for b in &first.bonds {
+        let (i, j) = (b.a as usize, b.b as usize);
+        candidates.push(Coordinate::Distance([i, j]));
+        candidates.push(Coordinate::Distance([j, i]));
+    }
+    for (j, around) in neighbours.iter().enumerate() {
+        for &i in around {
+            for &k in around.iter().filter(|&&k| k != i) {
+                candidates.push(Coordinate::Angle([i, j, k]));
+            }
+        }
+    }
+    candidates.extend(most_changing_dihedral(molecules).map(Coordinate::Dihedral));
+    let mut best: Option<(Coordinate, f64, usize)> = None;
+    for c in candidates {
+        let Some(left) = unexplained(molecules, &c) else { continue };
+        let moving = moving_atoms(first, &c).map_or(usize::MAX, |(m, _)| m.len());
+        let better = match best {
+            None => true,
+            Some((_, l, m)) => left < l - 1e-6 || (left <= l + 1e-6 && moving < m),
+        };
+        if better {
+            best = Some((c, left, moving));
+        }
+    }
+    match best {
+        Some((c, left, _)) if left <= PATH_THRESHOLD => Some(c),
+        _ => Some(Coordinate::Path),
+    }
+}
+
 impl Scan {
-    /// Checks the dihedral against the molecule and finds the moving fragment. `frames` must be
-    /// sorted by angle without duplicates (the manifest reader reports those with their lines).
+    /// Checks the coordinate against the molecule and finds the atoms that move with it.
+    /// `frames` must be sorted by value without duplicates (the manifest reader reports those
+    /// with their lines).
     pub fn new(
         title: String,
-        dihedral: [usize; 4],
+        coordinate: Coordinate,
         orbitals: Vec<String>,
         frames: Vec<KeyFrame>,
     ) -> Result<Self, ScanError> {
@@ -248,64 +477,88 @@ impl Scan {
             return Err(ScanError::TooFewFrames(frames.len()));
         }
         let n = frames[0].molecule.atoms.len();
-        if let Some(&bad) = dihedral.iter().find(|&&i| i >= n) {
+        if let Some(&bad) = coordinate.atoms().iter().find(|&&i| i >= n) {
             return Err(ScanError::AtomOutOfRange(bad + 1, n));
         }
-        let mut sorted = dihedral;
+        let mut sorted = coordinate.atoms().to_vec();
         sorted.sort_unstable();
         if sorted.windows(2).any(|w| w[0] == w[1]) {
             return Err(ScanError::RepeatedAtom);
         }
-        let moving = moving_fragment(&frames[0].molecule, dihedral[1], dihedral[2])?;
-        Ok(Self { title, dihedral, orbitals, captions: Vec::new(), frames, moving })
+        let (moving, direction) = moving_atoms(&frames[0].molecule, &coordinate)?;
+        Ok(Self { title, coordinate, orbitals, captions: Vec::new(), frames, moving, direction })
     }
 
-    /// The dihedral as chemists write it: "2-3-4-5" (1-based).
-    pub fn dihedral_label(&self) -> String {
-        self.dihedral.map(|i| (i + 1).to_string()).join("-")
-    }
-
-    /// The angle range covered by the key frames.
+    /// The value range covered by the key frames.
     pub fn range(&self) -> (f64, f64) {
-        (self.frames[0].angle, self.frames[self.frames.len() - 1].angle)
+        (self.frames[0].at, self.frames[self.frames.len() - 1].at)
     }
 
-    pub fn angles(&self) -> Vec<f64> {
-        self.frames.iter().map(|f| f.angle).collect()
+    /// Each key frame's value.
+    pub fn values(&self) -> Vec<f64> {
+        self.frames.iter().map(|f| f.at).collect()
     }
 
     /// The two key frames around θ (clamped to the scan's range).
     pub fn bracket(&self, theta: f64) -> Bracket {
         let (lo, hi) = self.range();
         let t = theta.clamp(lo, hi);
-        let b = self.frames.iter().position(|f| f.angle >= t).unwrap_or(self.frames.len() - 1).max(1);
+        let b = self.frames.iter().position(|f| f.at >= t).unwrap_or(self.frames.len() - 1).max(1);
         let a = b - 1;
-        let (ta, tb) = (self.frames[a].angle, self.frames[b].angle);
+        let (ta, tb) = (self.frames[a].at, self.frames[b].at);
         Bracket { a, b, k: ((t - ta) / (tb - ta)).clamp(0.0, 1.0) }
     }
 
-    /// The skeleton at θ: each bracketing frame's moving fragment turned towards θ by its share
-    /// of the measured twist between them, then the two blended (1−k):k, so the result is each
-    /// key frame's own geometry at its angle and a rigid rotation for rigid scans.
+    /// Moves the coordinate's moving atoms in `positions` so the coordinate changes by `delta`
+    /// (Å or degrees; nothing for a path).
+    fn shift(&self, positions: &mut [DVec3], delta: f64) {
+        match self.coordinate {
+            Coordinate::Distance(d) => stretch(positions, &self.moving, d, self.direction * delta),
+            Coordinate::Angle(a) => bend(positions, &self.moving, a, delta),
+            Coordinate::Dihedral([_, j, k, _]) => twist(positions, &self.moving, j, k, delta),
+            Coordinate::Path => {}
+        }
+    }
+
+    /// The skeleton at θ: each bracketing frame's moving fragment moved towards θ by its share
+    /// of the measured change between them (slid along the bond, bent in the angle's plane,
+    /// twisted about the bond), then the two blended (1−k):k, so the result is each key frame's
+    /// own geometry at its value, and a rigid motion for rigid scans. A path blends the frames.
     pub fn geometry_at(&self, theta: f64) -> Molecule {
         let Bracket { a, b, k } = self.bracket(theta);
         let (fa, fb) = (&self.frames[a].molecule, &self.frames[b].molecule);
-        let [_, j, kk, _] = self.dihedral;
-        let delta = wrap_degrees(measure(fb, self.dihedral) - measure(fa, self.dihedral));
         let mut pa: Vec<DVec3> = fa.atoms.iter().map(|x| x.position).collect();
         let mut pb: Vec<DVec3> = fb.atoms.iter().map(|x| x.position).collect();
-        twist(&mut pa, &self.moving, j, kk, k * delta);
-        twist(&mut pb, &self.moving, j, kk, -(1.0 - k) * delta);
+        if let (Some(va), Some(vb)) = (self.coordinate.measure(fa), self.coordinate.measure(fb)) {
+            let delta = match self.coordinate {
+                Coordinate::Dihedral(_) => wrap_degrees(vb - va),
+                _ => vb - va,
+            };
+            self.shift(&mut pa, k * delta);
+            self.shift(&mut pb, -(1.0 - k) * delta);
+        }
+        // Both shapes are now at θ; a program may have written the frames in different
+        // orientations (a symmetric bend moves both arms in the standard orientation). Blend
+        // them laid on each other, then carry the blend the fraction k of the way from frame a's
+        // orientation to frame b's: each key frame comes back exactly as written.
+        let (rotation, shift) = superpose(&pb, &pa);
+        let centre = pa.iter().copied().sum::<DVec3>() / pa.len().max(1) as f64;
+        let back = rotation.inverse();
+        let turn = DQuat::IDENTITY.slerp(back, k);
+        let travel = back * (centre - shift) - centre;
         let atoms: Vec<Atom> = fa
             .atoms
             .iter()
             .zip(pa.iter().zip(&pb))
-            .map(|(atom, (&p, &q))| Atom { position: p.lerp(q, k), ..atom.clone() })
+            .map(|(atom, (&p, &q))| {
+                let blended = p.lerp(rotation * q + shift, k);
+                Atom { position: turn * (blended - centre) + centre + k * travel, ..atom.clone() }
+            })
             .collect();
         Molecule { atoms, bonds: self.frames[0].molecule.bonds.clone() }
     }
 
-    /// The angle of the key frame nearest to θ.
+    /// The key frame nearest to θ.
     pub fn nearest_frame(&self, theta: f64) -> usize {
         let Bracket { a, b, k } = self.bracket(theta);
         if k <= 0.5 { a } else { b }
@@ -404,16 +657,16 @@ impl Scan {
     fn named_orbital(&self, frame: &KeyFrame, slot: usize, spec: Option<OrbitalSpec>) -> Result<usize, ScanError> {
         match (&frame.content, frame.wavefunction(slot)) {
             (_, Some(wf)) => spec.and_then(|s| wf.resolve(s, Spin::Alpha)).ok_or_else(|| ScanError::MissingOrbital {
-                angle: frame.angle,
+                at: frame.at,
                 spec: self.orbitals[slot].clone(),
                 available: wf.of_spin(Spin::Alpha).count(),
             }),
             (FrameContent::Volumes(v), _) if slot < v.len() => Ok(slot),
             (FrameContent::Volumes(v), _) => {
-                Err(ScanError::MissingVolume { angle: frame.angle, wanted: self.orbitals.len(), found: v.len() })
+                Err(ScanError::MissingVolume { at: frame.at, wanted: self.orbitals.len(), found: v.len() })
             }
             (FrameContent::Wavefunctions(_), None) => {
-                Err(ScanError::MissingVolume { angle: frame.angle, wanted: self.orbitals.len(), found: 0 })
+                Err(ScanError::MissingVolume { at: frame.at, wanted: self.orbitals.len(), found: 0 })
             }
         }
     }
@@ -619,14 +872,15 @@ mod tests {
                 for (a, q) in m.atoms.iter_mut().zip(p) {
                     a.position = q;
                 }
-                KeyFrame { angle, source: format!("{angle}"), molecule: m, content: FrameContent::Volumes(vec![]) }
+                KeyFrame { at: angle, source: format!("{angle}"), molecule: m, content: FrameContent::Volumes(vec![]) }
             })
             .collect()
     }
 
     #[test]
     fn geometry_follows_theta() {
-        let scan = Scan::new("t".into(), [0, 1, 2, 3], vec![], frames(&[-180.0, -90.0, 0.0])).unwrap();
+        let scan =
+            Scan::new("t".into(), Coordinate::Dihedral([0, 1, 2, 3]), vec![], frames(&[-180.0, -90.0, 0.0])).unwrap();
         for theta in [-180.0, -150.0, -90.0, -45.0, -10.0, 0.0] {
             let m = scan.geometry_at(theta);
             assert!((wrap_degrees(measure(&m, [0, 1, 2, 3]) - theta)).abs() < 1e-9, "{theta}");
@@ -639,5 +893,94 @@ mod tests {
         assert_eq!(scan.bracket(-90.0).b, 1);
         let picked = most_changing_dihedral(&scan.frames.iter().map(|f| f.molecule.clone()).collect::<Vec<_>>());
         assert_eq!(picked, Some([0, 1, 2, 3]));
+    }
+
+    /// Water, O first, bent to `angle` degrees with O–H of `oh` Å, in the xy plane.
+    fn water(angle: f64, oh: f64) -> Molecule {
+        let r = oh * crate::model::units::BOHR_PER_ANGSTROM;
+        let half = (angle / 2.0).to_radians();
+        Molecule::new(vec![
+            atom(8, [0.0, 0.0, 0.0]),
+            atom(1, [r * half.sin(), r * half.cos(), 0.0]),
+            atom(1, [-r * half.sin(), r * half.cos(), 0.0]),
+        ])
+    }
+
+    fn key(at: f64, molecule: Molecule) -> KeyFrame {
+        KeyFrame { at, source: format!("{at}"), molecule, content: FrameContent::Volumes(vec![]) }
+    }
+
+    #[test]
+    fn bending_and_stretching_reproduce_key_frames_and_move_one_side() {
+        // An angle scan: H2 turns in the plane about O; key frames reproduced exactly.
+        let frames: Vec<KeyFrame> = [90.0, 105.0, 120.0].iter().map(|&a| key(a, water(a, 0.96))).collect();
+        let scan = Scan::new("bend".into(), Coordinate::Angle([1, 0, 2]), vec![], frames.clone()).unwrap();
+        assert_eq!(scan.moving, vec![2], "the side of the third atom moves");
+        for theta in [90.0, 97.0, 105.0, 111.5, 120.0] {
+            let m = scan.geometry_at(theta);
+            let measured = scan.coordinate.measure(&m).unwrap();
+            assert!((measured - theta).abs() < 1e-9, "{theta}: {measured}");
+            let oh = m.atoms[0].position.distance(m.atoms[2].position) * crate::model::units::ANGSTROM_PER_BOHR;
+            assert!((oh - 0.96).abs() < 1e-12, "the arm keeps its length");
+        }
+        for f in &frames {
+            let m = scan.geometry_at(f.at);
+            let apart = distance_change(&positions(&m), &positions(&f.molecule));
+            assert!(apart < 1e-12, "key frame at {} reproduced ({apart})", f.at);
+        }
+        // A bond-length scan: H2 slides along O–H2.
+        let frames: Vec<KeyFrame> = [0.9, 1.2, 1.6].iter().map(|&r| key(r, stretched(r))).collect();
+        let scan = Scan::new("stretch".into(), Coordinate::Distance([0, 2]), vec![], frames).unwrap();
+        assert_eq!(scan.moving, vec![2]);
+        for r in [0.9, 1.05, 1.37, 1.6] {
+            let measured = scan.coordinate.measure(&scan.geometry_at(r)).unwrap();
+            assert!((measured - r).abs() < 1e-9, "{r}: {measured}");
+        }
+        // A linear angle has no plane, and still bends.
+        let mut p = vec![DVec3::new(-1.0, 0.0, 0.0), DVec3::ZERO, DVec3::new(1.0, 0.0, 0.0)];
+        bend(&mut p, &[2], [0, 1, 2], -30.0);
+        assert!((crate::model::measure::angle(p[0], p[1], p[2]) - 150.0).abs() < 1e-9);
+    }
+
+    fn positions(m: &Molecule) -> Vec<DVec3> {
+        m.atoms.iter().map(|a| a.position).collect()
+    }
+
+    /// Water at 104.5° with its second O–H at `r` Å.
+    fn stretched(r: f64) -> Molecule {
+        let mut m = water(104.5, 0.96);
+        let o = m.atoms[0].position;
+        let dir = (m.atoms[2].position - o).normalize();
+        m.atoms[2].position = o + dir * r * crate::model::units::BOHR_PER_ANGSTROM;
+        m
+    }
+
+    #[test]
+    fn the_coordinate_that_explains_the_frames_is_found() {
+        let bends: Vec<Molecule> = [95.0, 105.0, 115.0, 125.0].iter().map(|&a| water(a, 0.96)).collect();
+        let c = best_coordinate(&bends).unwrap();
+        assert!(matches!(c, Coordinate::Angle([_, 0, _])), "{c:?}");
+        assert!(unexplained(&bends, &c).unwrap() < 1e-9);
+        let stretches: Vec<Molecule> = [0.9, 1.1, 1.3].iter().map(|&r| stretched(r)).collect();
+        assert_eq!(best_coordinate(&stretches), Some(Coordinate::Distance([0, 2])));
+        let twists: Vec<Molecule> = frames(&[-180.0, -120.0, -60.0]).into_iter().map(|f| f.molecule).collect();
+        assert_eq!(best_coordinate(&twists), Some(Coordinate::Dihedral([0, 1, 2, 3])));
+        // Bending and stretching at once: no single coordinate explains it, a path does.
+        let both: Vec<Molecule> = [(95.0, 0.9), (110.0, 1.1), (125.0, 1.3)].iter().map(|&(a, r)| water(a, r)).collect();
+        assert_eq!(best_coordinate(&both), Some(Coordinate::Path));
+        assert_eq!(best_coordinate(&[water(100.0, 1.0), water(100.0, 1.0)]), None, "nothing changes");
+    }
+
+    #[test]
+    fn a_path_blends_every_atom() {
+        let (a, b) = (water(95.0, 0.9), water(125.0, 1.3));
+        let scan =
+            Scan::new("path".into(), Coordinate::Path, vec![], vec![key(0.0, a.clone()), key(1.0, b.clone())]).unwrap();
+        assert_eq!(scan.moving, vec![0, 1, 2]);
+        let mid = scan.geometry_at(0.5);
+        for i in 0..3 {
+            let want = a.atoms[i].position.lerp(b.atoms[i].position, 0.5);
+            assert!(mid.atoms[i].position.distance(want) < 1e-12);
+        }
     }
 }
