@@ -1,0 +1,196 @@
+//! Scans of a bond angle, a bond length and a path (fixtures from
+//! scripts/make_coordinate_scans.py, PySCF): `scan init` finds the coordinate, key frames come
+//! back exactly, a withheld frame is interpolated from its neighbours, and the command line
+//! draws and exports at any value.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use orbcloud::formats::scan::{ScanFile, init, load_scan, parse_scan};
+use orbcloud::model::scan::{Coordinate, Follow, Scan};
+
+fn fixture(dir: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/scans").join(dir)
+}
+
+fn orbcloud(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_orbcloud")).args(args).env("NODEVICE_SELECT", "1").output().expect("run")
+}
+
+/// The manifest `scan init` makes for `dir`, read as a scan.
+fn initialised(dir: &str, coordinate: Option<Coordinate>) -> ScanFile {
+    let dir = fixture(dir);
+    let made = init(&dir, coordinate).unwrap();
+    parse_scan(&made.path, &made.text, &mut |p| orbcloud::formats::load(p)).unwrap()
+}
+
+fn norm(v: &[f32]) -> f64 {
+    v.iter().map(|&x| (x as f64).powi(2)).sum::<f64>().sqrt()
+}
+
+/// Relative L2 errors of frame `held` interpolated from its neighbours and of its nearer
+/// neighbour shown instead, on a common grid.
+fn held_out(scan: &Scan, held: usize, slot: usize) -> (f64, f64) {
+    let grid = scan.common_grid(orbcloud::scene::framing::ORBITAL_MARGIN, 40);
+    let full = scan.track(Follow::Index).unwrap();
+    let mut frames = scan.frames.clone();
+    let truth_frame = frames.remove(held);
+    let without = Scan::new(scan.title.clone(), scan.coordinate, scan.orbitals.clone(), frames).unwrap();
+    let tracks = without.track(Follow::Index).unwrap();
+    let interpolated = without.interpolated_values(&tracks, slot, truth_frame.at, &grid);
+    let aligned = |mut v: Vec<f32>, to: &[f32]| {
+        let dot: f64 = v.iter().zip(to).map(|(&a, &b)| a as f64 * b as f64).sum();
+        if dot < 0.0 {
+            v.iter_mut().for_each(|x| *x = -*x);
+        }
+        v
+    };
+    let truth = aligned(scan.key_values(&full, slot, held, &grid), &interpolated);
+    let nearest = aligned(without.key_values(&tracks, slot, without.nearest_frame(truth_frame.at), &grid), &truth);
+    let diff = |v: &[f32]| truth.iter().zip(v).map(|(a, b)| a - b).collect::<Vec<f32>>();
+    (norm(&diff(&interpolated)) / norm(&truth), norm(&diff(&nearest)) / norm(&truth))
+}
+
+/// Every key frame's own geometry at its value.
+fn assert_key_frames_reproduced(scan: &Scan) {
+    for f in &scan.frames {
+        let m = scan.geometry_at(f.at);
+        for (a, b) in m.atoms.iter().zip(&f.molecule.atoms) {
+            assert!(a.position.distance(b.position) < 1e-9, "{} at {}", scan.coordinate.label(), f.at);
+        }
+    }
+}
+
+#[test]
+fn a_bending_scan_opens_from_scan_init_alone() {
+    let file = initialised("water_bend", None);
+    let scan = &file.scan;
+    assert_eq!(scan.coordinate, Coordinate::Angle([1, 0, 2]), "the H-O-H angle, H2's side moving");
+    assert_eq!(scan.coordinate.label(), "angle 2-1-3");
+    assert_eq!(scan.values(), [80.0, 90.0, 100.0, 110.0, 120.0, 130.0, 140.0, 150.0, 160.0].map(|v: f64| v));
+    assert_key_frames_reproduced(scan);
+    // Between key frames the molecule keeps its O-H lengths and has the angle asked for.
+    for theta in [84.0, 117.5, 151.0] {
+        let m = scan.geometry_at(theta);
+        let measured = scan.coordinate.measure(&m).unwrap();
+        assert!((measured - theta).abs() < 1e-6, "{theta}: {measured}");
+        let oh = m.atoms[0].position.distance(m.atoms[2].position) * orbcloud::model::units::ANGSTROM_PER_BOHR;
+        assert!((oh - 0.96).abs() < 1e-6, "O-H {oh}");
+    }
+    // The frame at 120° withheld: its neighbours' mix comes close, far closer than either.
+    let held = scan.frames.iter().position(|f| f.at == 120.0).unwrap();
+    for slot in 0..2 {
+        let (err, nearest) = held_out(scan, held, slot);
+        eprintln!(
+            "{} at 120° from 110°/130°: {:.2}% (nearest {:.2}%)",
+            scan.orbitals[slot],
+            err * 100.0,
+            nearest * 100.0
+        );
+        assert!(err < 0.05 && err < 0.5 * nearest, "{}: {err} vs nearest {nearest}", scan.orbitals[slot]);
+    }
+}
+
+#[test]
+fn a_bond_length_scan_and_a_path() {
+    let file = initialised("water_stretch", None);
+    let scan = &file.scan;
+    assert_eq!(scan.coordinate, Coordinate::Distance([0, 2]), "O-H2, found");
+    let values = scan.values();
+    assert!(values.iter().zip([0.8, 1.0, 1.2, 1.4, 1.6]).all(|(a, b)| (a - b).abs() < 1e-4), "{values:?}");
+    assert_key_frames_reproduced(scan);
+    let m = scan.geometry_at(1.1);
+    assert!((scan.coordinate.measure(&m).unwrap() - 1.1).abs() < 1e-6);
+    // The LUMO (σ* of the stretched bond) changes most; the HOMO (the O lone pair) hardly.
+    let held = 2; // 1.2 Å
+    let (err, nearest) = held_out(scan, held, 1);
+    eprintln!("LUMO at 1.2 Å from 1.0/1.4 Å: {:.2}% (nearest {:.2}%)", err * 100.0, nearest * 100.0);
+    assert!(err < 0.5 * nearest, "{err} vs {nearest}");
+    // Given by hand, the same.
+    assert_eq!(initialised("water_stretch", Some(Coordinate::Distance([0, 2]))).scan.coordinate, scan.coordinate);
+
+    // The angle and a bond together: no single coordinate explains it, so a path.
+    let made = init(&fixture("water_path"), None).unwrap();
+    assert_eq!(made.coordinate, Coordinate::Path);
+    let path = load_scan(&fixture("water_path").join("water_path.scan.toml")).unwrap();
+    assert_eq!(path.scan.coordinate, Coordinate::Path);
+    assert_eq!(path.scan.moving.len(), 3, "every atom moves");
+    assert_key_frames_reproduced(&path.scan);
+}
+
+#[test]
+fn manifests_name_their_coordinate_and_errors_their_line() {
+    let dir = fixture("water_bend");
+    let parse = |text: &str| {
+        parse_scan(&dir.join("t.scan.toml"), text, &mut |p| orbcloud::formats::load(p)).map(|f| f.scan.coordinate)
+    };
+    let frames = "\n[[frame]]\nat = 90.0\nfile = \"h2o_a090.molden.gz\"\n\n[[frame]]\nat = 100.0\nfile = \"h2o_a100.molden.gz\"\n";
+    assert_eq!(
+        parse(&format!("coordinate = \"angle\"\natoms = [2, 1, 3]\n{frames}")).unwrap(),
+        Coordinate::Angle([1, 0, 2])
+    );
+    // The older keys: dihedral = [...] and angle = per frame.
+    let older = format!("dihedral = [1, 2, 3, 4]\n{}", frames.replace("at =", "angle ="));
+    let e = parse(&older).unwrap_err().to_string();
+    assert!(e.contains("t.scan.toml:1:") && e.contains("beyond the 3 atoms"), "{e}");
+    for (text, line, says) in [
+        (format!("coordinate = \"angle\"\natoms = [2, 1]\n{frames}"), 2, "3 atom numbers"),
+        (format!("coordinate = \"bend\"\natoms = [2, 1, 3]\n{frames}"), 1, "distance, angle, dihedral or path"),
+        (format!("coordinate = \"path\"\natoms = [1, 2]\n{frames}"), 2, "no atoms for a path"),
+        (format!("coordinate = \"path\"\nalign = true\n{frames}"), 2, "align = false"),
+        (format!("atoms = [1, 2]\n{frames}"), 1, "no coordinate"),
+    ] {
+        let e = parse(&text).unwrap_err().to_string();
+        assert!(e.contains(&format!("t.scan.toml:{line}:")) && e.contains(says), "{text}\n→ {e}");
+    }
+}
+
+#[test]
+fn the_command_line_takes_any_coordinate() {
+    let dir = fixture("water_bend");
+    let out = orbcloud(&["scan", "init", dir.to_str().unwrap(), "--dry-run"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("angle 2-1-3 (the coordinate that explains the change best)"), "{err}");
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("coordinate = \"angle\"") && text.contains("atoms = [2, 1, 3]") && text.contains("at = 80.0000")
+    );
+    let stretch = fixture("water_stretch");
+    let out = orbcloud(&["scan", "init", stretch.to_str().unwrap(), "--distance", "1,3", "--dry-run"]);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("distance 1-3; 5 frames from 0.800 Å to 1.600 Å"));
+    // A coordinate that does not change cannot order the frames.
+    let out = orbcloud(&["scan", "init", dir.to_str().unwrap(), "--distance", "1,2", "--dry-run"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("a distance different from"), "{err}");
+
+    // A manifest on disk, rendered and exported at a value between key frames.
+    let tmp = tempfile::tempdir().unwrap();
+    let manifest = tmp.path().join("bend.scan.toml");
+    let made = init(&dir, None).unwrap();
+    let text = made.text.replace("file = \"", &format!("file = \"{}/", dir.display()));
+    std::fs::write(&manifest, text).unwrap();
+    let png = tmp.path().join("bend.png");
+    let m = manifest.to_str().unwrap();
+    let out = orbcloud(&[
+        "scan",
+        "render",
+        m,
+        "--at",
+        "117",
+        "--points",
+        "24",
+        "--size",
+        "96x72",
+        "--lavapipe",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(image::open(&png).unwrap().width(), 192);
+    let out = orbcloud(&["scan", "render", m, "--at", "170", "-o", "x.png"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("--at 170 is outside the scan's 80°..160°"), "{err}");
+    let out = orbcloud(&["scan", "info", m]);
+    assert!(String::from_utf8_lossy(&out.stdout).contains("angle 2-1-3, 9 frames, 1 atoms move"));
+}
