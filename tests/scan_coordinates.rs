@@ -194,3 +194,56 @@ fn the_command_line_takes_any_coordinate() {
     let out = orbcloud(&["scan", "info", m]);
     assert!(String::from_utf8_lossy(&out.stdout).contains("angle 2-1-3, 9 frames, 1 atoms move"));
 }
+
+#[test]
+fn the_correlation_diagram_follows_each_orbital_by_character() {
+    use orbcloud::model::correlation::correlation;
+    let file = initialised("water_bend", None);
+    let scan = &file.scan;
+    let diagram = correlation(scan, 2, 2).unwrap();
+    let labels: Vec<&str> = diagram.lines.iter().map(|l| l.label.as_str()).collect();
+    assert_eq!(labels, ["HOMO−2", "HOMO−1", "HOMO", "LUMO", "LUMO+1", "LUMO+2"]);
+    for l in &diagram.lines {
+        eprintln!(
+            "{:8} {:?} crossings at {:?}",
+            l.label,
+            l.points.iter().map(|p| (p.2 + 1, (p.1 * 1e3).round() / 1e3)).collect::<Vec<_>>(),
+            l.crossings
+        );
+        // Each point is that frame's orbital's own energy.
+        for (f, &(at, e, i)) in l.points.iter().enumerate() {
+            assert_eq!(at, scan.frames[f].at);
+            assert_eq!(e, scan.frames[f].wavefunction(0).unwrap().orbitals[i].energy);
+        }
+    }
+    assert!(diagram.lines[..3].iter().all(|l| l.occupied) && diagram.lines[3..].iter().all(|l| !l.occupied));
+
+    // An independent witness of character: an orbital's parity under the molecule's two
+    // mirror planes (x → −x swaps the hydrogens; z → −z is the molecular plane). Every line
+    // keeps its symmetry from frame to frame, and across the crossing the orbital of the same
+    // number does not.
+    let symmetry = |f: usize, i: usize| {
+        let wf = scan.frames[f].wavefunction(0).unwrap();
+        let basis = orbcloud::model::PreparedBasis::new(&wf.basis);
+        let c = &wf.orbitals[i].coefficients;
+        let p = glam::DVec3::new(0.7, 0.9, 0.4);
+        let v = basis.orbital_value(c, p);
+        let parity = |q: glam::DVec3| (basis.orbital_value(c, q) / v).signum() as i32;
+        (parity(p * glam::DVec3::new(-1.0, 1.0, 1.0)), parity(p * glam::DVec3::new(1.0, 1.0, -1.0)))
+    };
+    for l in &diagram.lines {
+        let first = symmetry(0, l.points[0].2);
+        for (f, p) in l.points.iter().enumerate() {
+            assert_eq!(symmetry(f, p.2), first, "{} at frame {f} (orbital {})", l.label, p.2 + 1);
+        }
+    }
+    let crossing = diagram.lines.iter().find(|l| !l.crossings.is_empty()).expect("a crossing among the virtuals");
+    let f = crossing.crossings[0];
+    let (before, after) = (crossing.points[f - 1].2, crossing.points[f].2);
+    assert_ne!(before, after, "{} continues into another orbital number", crossing.label);
+    assert_ne!(symmetry(f, before), symmetry(f - 1, before), "by number, the character would change");
+    // The table, as `scan info --csv` writes it.
+    let csv = diagram.csv("angle / deg");
+    assert_eq!(csv.lines().count(), 10);
+    assert!(csv.starts_with("angle / deg,E(HOMO−2) / Eh,HOMO−2 orbital"));
+}

@@ -1,5 +1,6 @@
 //! The eframe viewer: the only module that uses egui and rfd.
 
+mod correlation;
 pub mod detail;
 pub mod files;
 pub mod jobs;
@@ -542,6 +543,18 @@ impl OrbApp {
         follow: Option<crate::model::scan::Follow>,
         ctx: &egui::Context,
     ) {
+        self.open_scan_with(source, follow, None, ctx);
+    }
+
+    /// [`Self::open_scan_following`], its views showing `orbitals` (as manifests name them)
+    /// when given.
+    pub fn open_scan_with(
+        &mut self,
+        source: ScanSource,
+        follow: Option<crate::model::scan::Follow>,
+        orbitals: Option<Vec<String>>,
+        ctx: &egui::Context,
+    ) {
         let Some(gpu) = self.gpu_context() else { return };
         if let Some(job) = self.scan_job.take() {
             job.cancel();
@@ -549,7 +562,7 @@ impl OrbApp {
         let ctx = ctx.clone();
         let options =
             crate::key_volumes::KeyOptions { points: self.scan_points, budget: self.scan_budget, ..Default::default() };
-        self.scan_job = Some(ScanJob::start(gpu, source, options, follow, move || ctx.request_repaint()));
+        self.scan_job = Some(ScanJob::start(gpu, source, options, follow, orbitals, move || ctx.request_repaint()));
     }
 
     /// Whether a file, a scan or a job of the scene is still being worked on.
@@ -1074,9 +1087,21 @@ impl eframe::App for OrbApp {
         }
         panels::error_window(ui, self);
         self.file_browser(&ctx);
-        let refollow = self.scan.as_mut().and_then(|scan| scan::controls(ui, scan).map(|f| (scan.source.clone(), f)));
-        if let Some((source, follow)) = refollow {
-            self.open_scan_following(source, Some(follow), &ctx);
+        let request = self.scan.as_mut().and_then(|scan| scan::controls(ui, scan).map(|r| (scan.source.clone(), r)));
+        match request {
+            Some((source, scan::ScanRequest::Follow(follow))) => self.open_scan_following(source, Some(follow), &ctx),
+            Some((source, scan::ScanRequest::Show(name))) => {
+                // The clicked orbital in the first view, the others as they were; by character,
+                // as the diagram's line follows it.
+                let mut orbitals = self.scan.as_ref().map(|s| s.scene.scan.orbitals.clone()).unwrap_or_default();
+                if orbitals.is_empty() {
+                    orbitals.push(name);
+                } else {
+                    orbitals[0] = name;
+                }
+                self.open_scan_with(source, Some(crate::model::scan::Follow::Overlap), Some(orbitals), &ctx);
+            }
+            None => {}
         }
         egui::CentralPanel::no_frame().show(ui, |ui| {
             let Some(rs) = frame.wgpu_render_state() else { return };

@@ -7,7 +7,6 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use egui::{Key, RichText};
-use egui_plot::{Legend, Line, Plot, VLine};
 
 use super::World;
 use super::detail::{Detail, interacting};
@@ -19,7 +18,6 @@ use crate::gpu::GpuContext;
 use crate::key_volumes::{KeyOptions, ScanScene, ScanSceneError, mix};
 use crate::meshes::isosurfaces_within;
 use crate::model::scan::Follow;
-use crate::model::units::EV_PER_HARTREE;
 use crate::scene::{AtomStyle, Interpolation, RenderSettings};
 
 /// Where a scan comes from.
@@ -60,6 +58,7 @@ impl ScanJob {
         source: ScanSource,
         options: KeyOptions,
         follow: Option<Follow>,
+        orbitals: Option<Vec<String>>,
         repaint: impl Fn() + Send + Sync + 'static,
     ) -> Self {
         let name = match &source {
@@ -74,11 +73,15 @@ impl ScanJob {
         let progress = repaint.clone();
         let work = move || {
             let run = || -> Result<ScanScene, ScanFailure> {
-                let file: ScanFile = match &source {
+                let mut file: ScanFile = match &source {
                     ScanSource::File(p) => load_scan(p),
                     ScanSource::Demo => crate::demo::scan(),
                 }
                 .map_err(|e| ScanFailure::Other(e.to_string()))?;
+                if let Some(names) = orbitals {
+                    file.scan.orbitals = names;
+                    file.scan.check_orbitals().map_err(|e| ScanFailure::Other(e.to_string()))?;
+                }
                 let options = KeyOptions { follow: follow.unwrap_or(file.follow), ..options };
                 ScanScene::build(&ctx, file.scan, &options, &mut |n, of| {
                     d.store(n, Ordering::Relaxed);
@@ -133,6 +136,17 @@ pub struct ScanView {
     pub settings: RenderSettings,
     /// The atom style the views were last shown with.
     styled: AtomStyle,
+    /// The correlation diagram under the views.
+    pub diagram: super::correlation::DiagramView,
+}
+
+/// What the scan's controls ask for that needs the key volumes made anew.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ScanRequest {
+    /// Follow the orbitals this way.
+    Follow(Follow),
+    /// Show this orbital (as manifests name it) in the first view, followed by character.
+    Show(String),
 }
 
 impl ScanView {
@@ -156,6 +170,7 @@ impl ScanView {
             source,
             settings: RenderSettings::default(),
             styled: AtomStyle::default(),
+            diagram: Default::default(),
         }
     }
 
@@ -168,6 +183,7 @@ impl ScanView {
         self.speed = old.speed;
         self.drag_twists = old.drag_twists;
         self.settings = old.settings;
+        self.diagram.window = old.diagram.window;
     }
 
     /// Where atom `atom` of the skeleton at θ is drawn in view `view` (for tests and overlays).
@@ -230,9 +246,9 @@ impl ScanView {
 
 /// The bottom panel: θ slider with key ticks, play/loop, interpolation mode, how orbitals are
 /// followed, energy plot. Returns a change of the following, which needs the key volumes anew.
-pub fn controls(ui: &mut egui::Ui, scan: &mut ScanView) -> Option<Follow> {
+pub fn controls(ui: &mut egui::Ui, scan: &mut ScanView) -> Option<ScanRequest> {
     let mut follow = None;
-    egui::Panel::bottom("scan controls").resizable(true).default_size(215.0).show(ui, |ui| {
+    egui::Panel::bottom("scan controls").resizable(true).default_size(300.0).show(ui, |ui| {
         let (lo, hi) = scan.scene.scan.range();
         ui.horizontal(|ui| {
             let play = if scan.playing { "Pause" } else { "Play" };
@@ -276,12 +292,18 @@ pub fn controls(ui: &mut egui::Ui, scan: &mut ScanView) -> Option<Follow> {
                 ))
                 .changed()
             {
-                follow = Some(if by_overlap { Follow::Overlap } else { Follow::Index });
+                follow = Some(ScanRequest::Follow(if by_overlap { Follow::Overlap } else { Follow::Index }));
             }
-            ui.checkbox(&mut scan.drag_twists, "drag twists")
-                .on_hover_text("a horizontal drag changes θ (right-drag pans); off: drag the bond");
+            ui.checkbox(&mut scan.drag_twists, "drag scans")
+                .on_hover_text("a horizontal drag changes the coordinate (right-drag pans); off: drag the bond");
+            ui.separator();
+            ui.label("diagram: HOMO−k … LUMO+k, k");
+            ui.add(egui::DragValue::new(&mut scan.diagram.window).range(0..=8))
+                .on_hover_text("the orbitals the correlation diagram shows; a click on a line shows it in the first view");
         });
-        energy_plot(ui, scan);
+        if let Some(name) = super::correlation::plot(ui, scan) {
+            follow = Some(ScanRequest::Show(name));
+        }
     });
     follow
 }
@@ -300,43 +322,6 @@ fn key_ticks(ui: &egui::Ui, rect: egui::Rect, scan: &ScanView, width: f32) {
         let x = x0 + ((a - lo) / (hi - lo).max(1e-9)) as f32 * (x1 - x0);
         painter.line_segment([egui::pos2(x, rect.bottom() - 4.0), egui::pos2(x, rect.bottom() + 1.0)], stroke);
     }
-}
-
-/// E(orbital) for every slot and the gap between the first two, in eV, against θ.
-fn energy_plot(ui: &mut egui::Ui, scan: &ScanView) {
-    let s = &scan.scene;
-    let series: Vec<(String, Vec<[f64; 2]>)> = (0..s.slots())
-        .filter_map(|slot| {
-            let points: Option<Vec<[f64; 2]>> = s
-                .scan
-                .frames
-                .iter()
-                .enumerate()
-                .map(|(f, fr)| s.tracks.points[slot][f].energy.map(|e| [fr.at, e * EV_PER_HARTREE]))
-                .collect();
-            points.map(|p| (format!("E({})", s.scan.orbitals[slot].to_uppercase()), p))
-        })
-        .collect();
-    if series.is_empty() {
-        ui.label(RichText::new("no orbital energies in these files").weak());
-        return;
-    }
-    let gap: Option<Vec<[f64; 2]>> = (series.len() >= 2)
-        .then(|| series[0].1.iter().zip(&series[1].1).map(|(a, b)| [a[0], (b[1] - a[1]).abs()]).collect());
-    Plot::new("scan energies")
-        .legend(Legend::default())
-        .x_axis_label("θ (degrees)")
-        .y_axis_label("eV")
-        .allow_scroll(false)
-        .show(ui, |plot| {
-            for (name, points) in series {
-                plot.line(Line::new(name, points));
-            }
-            if let Some(gap) = gap {
-                plot.line(Line::new("gap", gap));
-            }
-            plot.vline(VLine::new("θ", scan.theta));
-        });
 }
 
 /// The orbital views side by side, each labelled with its orbital and energy at θ; drags and

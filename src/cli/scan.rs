@@ -45,6 +45,13 @@ pub enum ScanCommand {
         scan: PathBuf,
         #[arg(long, value_enum)]
         follow: Option<FollowArg>,
+        /// The correlation diagram as CSV instead: HOMO−K … LUMO+K each followed by its
+        /// character, energy (Eh) and orbital number per frame.
+        #[arg(long)]
+        csv: bool,
+        /// K of --csv.
+        #[arg(long, default_value_t = 2)]
+        window: usize,
     },
     /// Render the scan's orbitals at an angle, side by side, to a PNG.
     Render(Box<ScanRenderArgs>),
@@ -218,8 +225,20 @@ pub fn run(command: ScanCommand) -> Result<()> {
             }
             Ok(())
         }
-        ScanCommand::Info { scan, follow } => {
+        ScanCommand::Info { scan, follow, csv, window } => {
             let file = load_scan(&scan)?;
+            if csv {
+                let s = &file.scan;
+                let diagram = orbcloud::model::correlation::correlation(s, window, window)
+                    .context("a correlation diagram needs Molden/fchk frames with orbital energies")?;
+                let unit = match s.coordinate.unit().trim() {
+                    "" => String::new(),
+                    "°" => " / deg".into(),
+                    u => format!(" / {u}"),
+                };
+                print!("{}", diagram.csv(&format!("{}{unit}", s.coordinate.label())));
+                return Ok(());
+            }
             let tracks = file.scan.track(follow_of(follow, &file))?;
             let s = &file.scan;
             println!("{}\n{}, {} frames, {} atoms move", s.title, s.coordinate.label(), s.frames.len(), s.moving.len());

@@ -8,6 +8,7 @@ pub mod atom;
 pub mod basis;
 pub mod bonds;
 pub mod cartesian;
+pub mod correlation;
 pub mod document;
 mod element_table;
 pub mod elements;

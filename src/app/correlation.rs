@@ -1,0 +1,125 @@
+//! The scan's correlation diagram under its views: HOMO−k … LUMO+k against the coordinate, each
+//! line one orbital followed by its character ([`crate::model::correlation`]), occupied ones
+//! solid and empty ones dashed, crossings marked, each line named at its right end (no legend
+//! to cover the curves). Dragging on the plot scrubs the coordinate; a click on a line shows
+//! that orbital in the first view.
+
+use egui::{Color32, RichText};
+use egui_plot::{Line, LineStyle, MarkerShape, Plot, PlotPoint, Points, Text, VLine};
+
+use super::scan::ScanView;
+use crate::model::correlation::{Diagram, correlation};
+use crate::model::units::EV_PER_HARTREE;
+
+/// How many orbitals below the HOMO and above the LUMO the diagram shows, and the diagram
+/// made for that many (made again when it changes).
+pub struct DiagramView {
+    pub window: usize,
+    made: Option<(usize, Option<Diagram>)>,
+}
+
+impl Default for DiagramView {
+    fn default() -> Self {
+        Self { window: 2, made: None }
+    }
+}
+
+impl DiagramView {
+    /// The diagram for the current window (None for cube series or files without energies).
+    pub fn diagram(&mut self, scan: &crate::model::scan::Scan) -> Option<&Diagram> {
+        if self.made.as_ref().is_none_or(|(w, _)| *w != self.window) {
+            self.made = Some((self.window, correlation(scan, self.window, self.window)));
+        }
+        self.made.as_ref().and_then(|(_, d)| d.as_ref())
+    }
+}
+
+/// A line's name as a scan manifest names orbitals: "HOMO−1" → "homo-1".
+fn manifest_name(label: &str) -> Option<String> {
+    let name = label.replace('−', "-").to_lowercase();
+    (!name.contains('β') && !name.contains(' ')).then_some(name)
+}
+
+/// The energy of `line` at `x` (eV), linearly between its frames.
+fn energy_at(points: &[(f64, f64, usize)], x: f64) -> Option<f64> {
+    let w = points.windows(2).find(|w| (w[0].0..=w[1].0).contains(&x))?;
+    let k = (x - w[0].0) / (w[1].0 - w[0].0).max(1e-12);
+    Some((w[0].1 + k * (w[1].1 - w[0].1)) * EV_PER_HARTREE)
+}
+
+/// Draws the diagram; a drag on it moves θ. Returns the orbital (as manifests name it) whose
+/// line was clicked.
+pub fn plot(ui: &mut egui::Ui, scan: &mut ScanView) -> Option<String> {
+    let shown: Vec<String> = scan.scene.scan.orbitals.clone();
+    let c = scan.scene.scan.coordinate;
+    let x_label = match c.unit().trim() {
+        "" => c.label(),
+        u => format!("{} ({u})", c.label()),
+    };
+    let theta = scan.theta;
+    let Some(diagram) = scan.diagram.diagram(&scan.scene.scan).cloned() else {
+        ui.label(RichText::new("no orbital energies in these files").weak());
+        return None;
+    };
+    let (lo, hi) = scan.scene.scan.range();
+    let mut clicked = None;
+    let mut scrub = None;
+    Plot::new("correlation diagram")
+        .x_axis_label(x_label)
+        .y_axis_label("orbital energy (eV)")
+        .allow_scroll(false)
+        .allow_drag(false)
+        .allow_zoom(false)
+        // Room after the last frame for the lines' names.
+        .include_x(hi + 0.15 * (hi - lo))
+        .show(ui, |plot| {
+            for line in &diagram.lines {
+                let points: Vec<[f64; 2]> = line.points.iter().map(|&(x, e, _)| [x, e * EV_PER_HARTREE]).collect();
+                let in_view = manifest_name(&line.label).is_some_and(|n| shown.contains(&n));
+                let style = if line.occupied { LineStyle::Solid } else { LineStyle::dashed_loose() };
+                let color =
+                    if line.occupied { Color32::from_rgb(90, 150, 255) } else { Color32::from_rgb(255, 120, 90) };
+                plot.line(Line::new(line.label.clone(), points.clone()).style(style).color(color).width(if in_view {
+                    3.0
+                } else {
+                    1.5
+                }));
+                let crossings: Vec<[f64; 2]> = line.crossings.iter().map(|&f| points[f]).collect();
+                if !crossings.is_empty() {
+                    plot.points(
+                        Points::new(format!("{} crossings", line.label), crossings)
+                            .shape(MarkerShape::Diamond)
+                            .radius(4.0)
+                            .color(Color32::from_rgb(250, 210, 80)),
+                    );
+                }
+                if let Some(&[x, y]) = points.last() {
+                    plot.text(
+                        Text::new(line.label.clone(), PlotPoint::new(x, y), format!(" {}", line.label))
+                            .anchor(egui::Align2::LEFT_CENTER)
+                            .color(color),
+                    );
+                }
+            }
+            plot.vline(VLine::new("θ", theta));
+            let response = plot.response();
+            let pointer = plot.pointer_coordinate();
+            if let Some(p) = pointer.filter(|_| response.dragged()) {
+                scrub = Some(p.x);
+            }
+            if let Some(p) = pointer.filter(|_| response.clicked()) {
+                // The line nearest the click at its x, within half an eV.
+                let nearest = (diagram.lines.iter())
+                    .filter_map(|l| Some((energy_at(&l.points, p.x)? - p.y).abs()).map(|d| (d, l)))
+                    .min_by(|a, b| a.0.total_cmp(&b.0));
+                match nearest {
+                    Some((d, l)) if d < 0.5 => clicked = manifest_name(&l.label),
+                    _ => scrub = Some(p.x),
+                }
+            }
+        });
+    if let Some(x) = scrub {
+        scan.set_theta(x.clamp(lo, hi));
+    }
+    clicked
+}
