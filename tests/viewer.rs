@@ -390,13 +390,13 @@ fn a_scan_shows_isosurfaces_at_theta_and_its_measured_dihedral_follows_theta() {
     let mut h = scan_demo();
     h.get_by_label("show ψ = ±value").click();
     let start = std::time::Instant::now();
-    while !h.state().status.starts_with("isosurfaces at θ") {
+    while !h.state().status.starts_with("isosurfaces at dihedral") {
         assert!(start.elapsed().as_secs() < 60, "no isosurfaces: {}", h.state().status);
         std::thread::sleep(std::time::Duration::from_millis(20));
         h.run_steps(1);
     }
     let status = h.state().status.clone();
-    assert!(status.contains("θ = -90.0°") || status.contains("θ = −90.0°"), "{status}");
+    assert!(status.contains("dihedral 2-3-4-5 = -90.0°"), "{status}");
     h.get_by_label("show ψ = ±value").click();
     h.get_by_label("show cloud").click();
     h.run_steps(3);
