@@ -11,10 +11,12 @@ pub mod mmcif;
 pub mod modes;
 pub mod molden;
 pub mod pdb;
+mod primitives;
 pub mod scan;
 mod structure;
 mod text;
 pub mod wavefunction;
+pub mod wfn;
 pub mod xyz;
 
 pub use error::{LoadError, ParseError};
@@ -49,8 +51,8 @@ pub const MAX_LINE_BYTES: usize = 1 << 20;
 pub const MAX_TRAILING_BYTES: usize = 64 << 10;
 
 /// Reads a file from disk, picking the reader by extension: `.cube`, `.cub`, `.molden`,
-/// `.molden.input`, `.mold`, `.fchk`, `.fch`, `.pdb`, `.ent`, `.cif`, `.mmcif`, `.xyz`, each
-/// also gzipped (`.gz`).
+/// `.molden.input`, `.mold`, `.fchk`, `.fch`, `.wfn`, `.pdb`, `.ent`, `.cif`, `.mmcif`, `.xyz`,
+/// each also gzipped (`.gz`).
 pub fn load(path: &Path) -> Result<Document, LoadError> {
     load_with(path, DEFAULT_OVERLAP)
 }
@@ -82,6 +84,7 @@ fn parse_text(name: &str, reader: Reader, text: Bounded, overlap: Option<Overlap
         Reader::Cube => cube::parse(name, &text.text),
         Reader::Molden => molden::parse(name, &text.text, overlap),
         Reader::Fchk => fchk::parse(name, &text.text, overlap),
+        Reader::Wfn => wfn::parse(name, &text.text, overlap),
         Reader::Pdb => pdb::parse(name, &text.text),
         Reader::Mmcif => mmcif::parse(name, &text.text),
         Reader::Xyz => xyz::parse(name, &text.text),
@@ -101,13 +104,14 @@ enum Reader {
     Cube,
     Molden,
     Fchk,
+    Wfn,
     Pdb,
     Mmcif,
     Xyz,
 }
 
 /// Every file name ending a reader takes (each also with `.gz`), and the reader.
-const READERS: [(&str, Reader); 12] = [
+const READERS: [(&str, Reader); 13] = [
     (".cube", Reader::Cube),
     (".cub", Reader::Cube),
     (".molden", Reader::Molden),
@@ -115,6 +119,7 @@ const READERS: [(&str, Reader); 12] = [
     (".mold", Reader::Molden),
     (".fchk", Reader::Fchk),
     (".fch", Reader::Fchk),
+    (".wfn", Reader::Wfn),
     (".pdb", Reader::Pdb),
     (".ent", Reader::Pdb),
     (".cif", Reader::Mmcif),
