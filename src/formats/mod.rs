@@ -17,6 +17,7 @@ mod structure;
 mod text;
 pub mod wavefunction;
 pub mod wfn;
+pub mod wfx;
 pub mod xyz;
 
 pub use error::{LoadError, ParseError};
@@ -51,8 +52,8 @@ pub const MAX_LINE_BYTES: usize = 1 << 20;
 pub const MAX_TRAILING_BYTES: usize = 64 << 10;
 
 /// Reads a file from disk, picking the reader by extension: `.cube`, `.cub`, `.molden`,
-/// `.molden.input`, `.mold`, `.fchk`, `.fch`, `.wfn`, `.pdb`, `.ent`, `.cif`, `.mmcif`, `.xyz`,
-/// each also gzipped (`.gz`).
+/// `.molden.input`, `.mold`, `.fchk`, `.fch`, `.wfn`, `.wfx`, `.pdb`, `.ent`, `.cif`, `.mmcif`,
+/// `.xyz`, each also gzipped (`.gz`).
 pub fn load(path: &Path) -> Result<Document, LoadError> {
     load_with(path, DEFAULT_OVERLAP)
 }
@@ -85,6 +86,7 @@ fn parse_text(name: &str, reader: Reader, text: Bounded, overlap: Option<Overlap
         Reader::Molden => molden::parse(name, &text.text, overlap),
         Reader::Fchk => fchk::parse(name, &text.text, overlap),
         Reader::Wfn => wfn::parse(name, &text.text, overlap),
+        Reader::Wfx => wfx::parse(name, &text.text, overlap),
         Reader::Pdb => pdb::parse(name, &text.text),
         Reader::Mmcif => mmcif::parse(name, &text.text),
         Reader::Xyz => xyz::parse(name, &text.text),
@@ -105,13 +107,14 @@ enum Reader {
     Molden,
     Fchk,
     Wfn,
+    Wfx,
     Pdb,
     Mmcif,
     Xyz,
 }
 
 /// Every file name ending a reader takes (each also with `.gz`), and the reader.
-const READERS: [(&str, Reader); 13] = [
+const READERS: [(&str, Reader); 14] = [
     (".cube", Reader::Cube),
     (".cub", Reader::Cube),
     (".molden", Reader::Molden),
@@ -120,6 +123,7 @@ const READERS: [(&str, Reader); 13] = [
     (".fchk", Reader::Fchk),
     (".fch", Reader::Fchk),
     (".wfn", Reader::Wfn),
+    (".wfx", Reader::Wfx),
     (".pdb", Reader::Pdb),
     (".ent", Reader::Pdb),
     (".cif", Reader::Mmcif),
