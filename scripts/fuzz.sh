@@ -10,7 +10,7 @@ cd "$(dirname "$0")/.."
 execs="${1:-10000000}"
 shift || true
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(cube cube_gz molden fchk scan_manifest pdb mmcif xyz)
+[ ${#targets[@]} -gt 0 ] || targets=(cube cube_gz molden fchk wfn wfx mkl scan_manifest pdb mmcif xyz)
 
 command -v cargo-afl >/dev/null || cargo install cargo-afl --locked
 # Seeds: the fixtures each reader is tested with, kept small (AFL slows on big inputs).
@@ -55,6 +55,9 @@ h2
 CUBE
 seed molden tests/fixtures/wavefunctions/h2o_cart_631gs.molden tests/fixtures/wavefunctions/h2o_cation_uhf_631gs.molden tests/fixtures/wavefunctions/h2_spdfgh.molden
 seed fchk tests/fixtures/wavefunctions/h2o_cart_631gs.fchk tests/fixtures/wavefunctions/h2o_cation_uhf_631gs.fchk
+seed wfn tests/fixtures/wfn_wfx_mkl/*.wfn
+seed wfx tests/fixtures/wfn_wfx_mkl/*.wfx
+seed mkl tests/fixtures/wfn_wfx_mkl/*.mkl
 seed scan_manifest assets/psb3/*.scan.toml tests/fixtures/*/*.scan.toml
 # Structures: every record kind of the fixtures but only their first 30 atoms, since AFL's
 # speed falls with the input's size (the 18 kB excerpts ran at a fifth of the speed).

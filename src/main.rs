@@ -44,9 +44,9 @@ struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
     /// Files to open in the viewer: Gaussian cube (.cube, .cub), Molden (.molden, .molden.input,
-    /// .mold), Gaussian formatted checkpoint (.fchk, .fch), PDB (.pdb, .ent), mmCIF (.cif,
-    /// .mmcif), XYZ (.xyz), each also gzipped (.gz), or a scan manifest (.scan.toml); the bundled
-    /// demo when none.
+    /// .mold), Gaussian formatted checkpoint (.fchk, .fch), AIM wavefunction (.wfn, .wfx), ORCA
+    /// Molekel (.mkl), PDB (.pdb, .ent), mmCIF (.cif, .mmcif), XYZ (.xyz), each also gzipped
+    /// (.gz), or a scan manifest (.scan.toml); the bundled demo when none.
     files: Vec<PathBuf>,
     /// Open a bundled demo instead of files.
     #[arg(long, value_enum)]
@@ -78,9 +78,9 @@ enum Command {
     /// Open the interactive viewer (the default).
     Viewer {
         /// Files to open: Gaussian cube (.cube, .cub), Molden (.molden, .molden.input, .mold),
-        /// Gaussian formatted checkpoint (.fchk, .fch), PDB (.pdb, .ent), mmCIF (.cif, .mmcif), XYZ
-        /// (.xyz), each also gzipped (.gz), or a scan manifest (.scan.toml); the bundled demo when
-        /// none.
+        /// Gaussian formatted checkpoint (.fchk, .fch), AIM wavefunction (.wfn, .wfx), ORCA Molekel
+        /// (.mkl), PDB (.pdb, .ent), mmCIF (.cif, .mmcif), XYZ (.xyz), each also gzipped (.gz), or a
+        /// scan manifest (.scan.toml); the bundled demo when none.
         files: Vec<PathBuf>,
         /// Open a bundled demo instead of files.
         #[arg(long, value_enum)]
@@ -91,8 +91,8 @@ enum Command {
     /// Print atoms and grids of a file.
     Info {
         /// Gaussian cube (.cube, .cub), Molden (.molden, .molden.input, .mold), Gaussian formatted
-        /// checkpoint (.fchk, .fch), PDB (.pdb, .ent), mmCIF (.cif, .mmcif) or XYZ (.xyz), each
-        /// also gzipped (.gz).
+        /// checkpoint (.fchk, .fch), AIM wavefunction (.wfn, .wfx), ORCA Molekel (.mkl), PDB (.pdb,
+        /// .ent), mmCIF (.cif, .mmcif) or XYZ (.xyz), each also gzipped (.gz).
         file: PathBuf,
         /// Machine-readable JSON instead of text.
         #[arg(long)]
@@ -257,7 +257,10 @@ impl WhatArgs {
 
 fn wavefunction_of(doc: &Document) -> Result<&Wavefunction> {
     doc.wavefunction.as_ref().ok_or_else(|| {
-        anyhow::anyhow!("{} holds no basis set or orbitals (a Molden or fchk file is needed)", doc.source)
+        anyhow::anyhow!(
+            "{} holds no basis set or orbitals (a Molden, fchk, wfn, wfx or MKL file is needed)",
+            doc.source
+        )
     })
 }
 
@@ -297,8 +300,9 @@ enum BenchCommand {
 #[derive(Args)]
 struct RenderArgs {
     /// Gaussian cube (.cube, .cub), Molden (.molden, .molden.input, .mold), Gaussian formatted
-    /// checkpoint (.fchk, .fch), PDB (.pdb, .ent), mmCIF (.cif, .mmcif) or XYZ (.xyz), each also
-    /// gzipped (.gz); the bundled demo when omitted.
+    /// checkpoint (.fchk, .fch), AIM wavefunction (.wfn, .wfx), ORCA Molekel (.mkl), PDB (.pdb,
+    /// .ent), mmCIF (.cif, .mmcif) or XYZ (.xyz), each also gzipped (.gz); the bundled demo when
+    /// omitted.
     file: Option<PathBuf>,
     /// Output PNG.
     #[arg(short, long)]

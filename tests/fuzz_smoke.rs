@@ -155,6 +155,14 @@ fn readers_survive_mutated_fixtures() {
 }
 
 #[test]
+fn aim_and_mkl_readers_survive_mutated_fixtures() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/wfn_wfx_mkl");
+    fuzz("wfn", &files_in(dir, "wfn"), read("fuzz.wfn"));
+    fuzz("wfx", &files_in(dir, "wfx"), read("fuzz.wfx"));
+    fuzz("mkl", &files_in(dir, "mkl"), read("fuzz.mkl"));
+}
+
+#[test]
 fn scan_manifests_survive_mutations() {
     let atom = |z, x, y, w| Atom { z, charge: z as f64, position: DVec3::new(x, y, w), ghost: false };
     let frame = Document {

@@ -9,6 +9,8 @@ use std::time::{Duration, Instant};
 use orbcloud::formats::{self, LoadError, MAX_LINE_BYTES, MAX_TRAILING_BYTES, ParseError};
 
 const FIXTURES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/wavefunctions");
+/// AIM `.wfn`/`.wfx` and ORCA `.mkl` fixtures.
+const AIM: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/wfn_wfx_mkl");
 
 /// A 2×2×3 bohr grid with one oxygen atom (line 7) and its 12 values (lines 8–9).
 fn cube(atom: &str, axes: [&str; 3], origin: &str) -> String {
@@ -174,7 +176,16 @@ fn gzip_bombs_are_refused_once_the_declared_values_are_read() {
 fn wavefunction_gzip_bombs_are_refused() {
     let molden = std::fs::read_to_string(format!("{FIXTURES}/h2o_cart_631gs.molden")).unwrap();
     let fchk = std::fs::read_to_string(format!("{FIXTURES}/h2o_cart_631gs.fchk")).unwrap();
-    for (name, head) in [("bomb.molden.gz", &molden), ("bomb.fchk.gz", &fchk)] {
+    let wfn = std::fs::read_to_string(format!("{AIM}/oh_rohf.wfn")).unwrap();
+    let wfx = std::fs::read_to_string(format!("{AIM}/oh_rohf.wfx")).unwrap();
+    let mkl = std::fs::read_to_string(format!("{AIM}/oh_rohf.mkl")).unwrap();
+    for (name, head) in [
+        ("bomb.molden.gz", &molden),
+        ("bomb.fchk.gz", &fchk),
+        ("bomb.wfn.gz", &wfn),
+        ("bomb.wfx.gz", &wfx),
+        ("bomb.mkl.gz", &mkl),
+    ] {
         let e = refused(name, &bomb(head, b"\n", 4));
         assert!(e.found.contains("decompression bomb"), "{name}: {e}");
     }
@@ -204,6 +215,74 @@ fn absurd_counts_are_refused() {
     assert!(e.expected.contains("array length"), "{e}");
 }
 
+/// AIM `.wfn`/`.wfx` and ORCA `.mkl` files: counts that would allocate, type codes past AIMAll's
+/// table, truncated blocks and fields that are not numbers are refused at their line, fast.
+#[test]
+fn aim_and_mkl_files_refuse_hostile_contents() {
+    let line_of = |text: &str, needle: &str| 1 + text[..text.find(needle).unwrap()].matches('\n').count();
+    let wfn = std::fs::read_to_string(format!("{AIM}/oh_rohf.wfn")).unwrap();
+    let header = wfn.lines().nth(1).unwrap().to_string();
+    // Header counts of 10^12 primitives or orbitals, or of nuclei: refused on the header line
+    // before anything is sized by them.
+    for (what, count) in [("MOL ORBITALS", "999999999999"), ("PRIMITIVES", "999999999999"), ("NUCLEI", "99999999")] {
+        let at = header.find(what).unwrap();
+        let start = header[..at].trim_end().rfind(' ').unwrap() + 1;
+        let bad_header = format!("{}{count} {}", &header[..start], &header[at..]);
+        let e = refused("count.wfn", wfn.replacen(&header, &bad_header, 1).as_bytes());
+        assert_eq!(e.line, 2, "{what}: {e}");
+        assert!(e.expected.contains("can hold"), "{what}: {e}");
+    }
+    let types = line_of(&wfn, "TYPE ASSIGNMENTS");
+    let e = refused("type.wfn", wfn.replacen("TYPE ASSIGNMENTS      1", "TYPE ASSIGNMENTS     57", 1).as_bytes());
+    assert_eq!((e.line, e.found.as_str()), (types, "57"), "{e}");
+    assert!(e.expected.contains("1..=56"), "{e}");
+    let exponents = line_of(&wfn, "EXPONENTS");
+    let e = refused("exp.wfn", wfn.replacen("EXPONENTS  0.", "EXPONENTS  x.", 1).as_bytes());
+    assert_eq!(e.line, exponents, "{e}");
+    // Cut inside the second orbital's coefficients.
+    let mo2 = wfn.find("MO    2").unwrap();
+    let cut = &wfn[..mo2 + wfn[mo2..].find('\n').unwrap() + 200];
+    let cut = &cut[..cut.rfind('\n').unwrap() + 1];
+    let e = refused("cut.wfn", cut.as_bytes());
+    assert!(e.expected.contains("coefficients of orbital 2"), "{e}");
+    assert_eq!(e.line, cut.lines().count(), "{e}");
+
+    let wfx = std::fs::read_to_string(format!("{AIM}/oh_rohf.wfx")).unwrap();
+    let e = refused(
+        "count.wfx",
+        wfx.replacen("<Number of Primitives>\n ", "<Number of Primitives>\n 99999999999", 1).as_bytes(),
+    );
+    assert!(e.expected.contains("99999999999") && e.expected.contains("values in <Primitive Centers>"), "{e}");
+    let types = line_of(&wfx, "<Primitive Types>") + 1;
+    let e = refused(
+        "type.wfx",
+        wfx.replacen("<Primitive Types>\n                   1", "<Primitive Types>\n                  99", 1)
+            .as_bytes(),
+    );
+    assert_eq!((e.line, e.found.as_str()), (types, "\"99\""), "{e}");
+    let cut = &wfx[..wfx.find("</Molecular Orbital Primitive Coefficients>").unwrap()];
+    let e = refused("cut.wfx", cut.as_bytes());
+    assert!(e.expected.contains("closing tag </Molecular Orbital Primitive Coefficients>"), "{e}");
+    let energies = line_of(&wfx, "<Molecular Orbital Energies>") + 1;
+    let e = refused(
+        "nan.wfx",
+        wfx.replacen("<Molecular Orbital Energies>\n ", "<Molecular Orbital Energies>\n NaN", 1).as_bytes(),
+    );
+    assert_eq!(e.line, energies, "{e}");
+
+    let mkl = std::fs::read_to_string(format!("{AIM}/oh_rohf.mkl")).unwrap();
+    let e = refused("shell.mkl", mkl.replacen(" 5 D 1.0", " 5000 D 1.0", 1).as_bytes());
+    assert_eq!(e.line, line_of(&mkl, " 5 D 1.0"), "{e}");
+    let e = refused("g.mkl", mkl.replacen(" 9 G 1.0", " 9 K 1.0", 1).as_bytes());
+    assert_eq!(e.line, line_of(&mkl, " 9 G 1.0"), "{e}");
+    let end = mkl.find(" $END\n\n$OCC_ALPHA").unwrap();
+    let short = format!("{}{}", &mkl[..mkl[..end - 1].rfind('\n').unwrap() + 1], &mkl[end..]);
+    let e = refused("short.mkl", short.as_bytes());
+    assert!(e.expected.contains("coefficient rows"), "{e}");
+    let e = refused("text.mkl", mkl.replacen(" a1g", " a1g\n  low", 1).as_bytes());
+    assert!(e.expected.contains("energies"), "{e}");
+}
+
 /// Replaces the first `key…` field on the line of `label` by `with` (the rest of the line goes).
 fn regex_free_replace(text: &str, label: &str, key: &str, with: &str) -> String {
     let at = text.find(label).unwrap();
@@ -223,7 +302,9 @@ fn empty_binary_and_endless_files_are_refused_in_every_format() {
         })
         .collect();
     let long_line = vec![b'7'; 3 * MAX_LINE_BYTES];
-    for ext in ["cube", "molden", "fchk", "cube.gz", "molden.gz", "fchk.gz"] {
+    for ext in
+        ["cube", "molden", "fchk", "wfn", "wfx", "mkl", "cube.gz", "molden.gz", "fchk.gz", "wfn.gz", "wfx.gz", "mkl.gz"]
+    {
         let name = format!("hostile.{ext}");
         let e = refused(&name, b"");
         assert!(e.found.contains("empty file"), "{name}: {e}");
@@ -249,7 +330,11 @@ fn truncated_files_never_panic() {
     let cube = cube(OXYGEN, AXES, ORIGIN);
     let molden = std::fs::read_to_string(format!("{FIXTURES}/h2o_cart_631gs.molden")).unwrap();
     let fchk = std::fs::read_to_string(format!("{FIXTURES}/h2o_cart_631gs.fchk")).unwrap();
-    for (name, text) in [("t.cube", &cube), ("t.molden", &molden), ("t.fchk", &fchk)] {
+    let aim = |name: &str| std::fs::read_to_string(format!("{AIM}/{name}")).unwrap();
+    let (wfn, wfx, mkl) = (aim("oh_rohf.wfn"), aim("oh_rohf.wfx"), aim("oh_rohf.mkl"));
+    for (name, text) in
+        [("t.cube", &cube), ("t.molden", &molden), ("t.fchk", &fchk), ("t.wfn", &wfn), ("t.wfx", &wfx), ("t.mkl", &mkl)]
+    {
         let step = (text.len() / 97).max(1);
         for cut in (0..text.len()).step_by(step) {
             if let Ok(cut_text) = std::str::from_utf8(&text.as_bytes()[..cut]) {

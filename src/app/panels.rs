@@ -32,7 +32,11 @@ pub fn top_bar(ui: &mut egui::Ui, app: &mut OrbApp) -> Action {
         ui.horizontal(|ui| {
             ui.strong("orbcloud");
             ui.separator();
-            if ui.button("Open…").on_hover_text("cube, Molden, fchk, a scan or a saved session").clicked() {
+            if ui
+                .button("Open…")
+                .on_hover_text("cube, Molden, fchk, wfn, wfx, MKL, a scan or a saved session")
+                .clicked()
+            {
                 action = Action::Open;
             }
             ui.checkbox(&mut app.open_replaces, "replace")

@@ -18,7 +18,7 @@ pub enum LoadError {
     #[error("{path}: not a text file (invalid UTF-8 at byte {offset})")]
     NotText { path: String, offset: usize },
     #[error(
-        "{path}: unknown file type (expected .cube, .cub, .molden, .molden.input, .mold, .fchk, .fch, .pdb, .ent, .cif, .mmcif or .xyz, optionally .gz)"
+        "{path}: unknown file type (expected .cube, .cub, .molden, .molden.input, .mold, .fchk, .fch, .wfn, .wfx, .mkl, .pdb, .ent, .cif, .mmcif or .xyz, optionally .gz)"
     )]
     UnknownFormat { path: String },
     #[error(transparent)]

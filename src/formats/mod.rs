@@ -7,14 +7,18 @@ pub mod cube_write;
 mod error;
 pub mod fchk;
 pub mod mesh_write;
+pub mod mkl;
 pub mod mmcif;
 pub mod modes;
 pub mod molden;
 pub mod pdb;
+mod primitives;
 pub mod scan;
 mod structure;
 mod text;
 pub mod wavefunction;
+pub mod wfn;
+pub mod wfx;
 pub mod xyz;
 
 pub use error::{LoadError, ParseError};
@@ -49,8 +53,8 @@ pub const MAX_LINE_BYTES: usize = 1 << 20;
 pub const MAX_TRAILING_BYTES: usize = 64 << 10;
 
 /// Reads a file from disk, picking the reader by extension: `.cube`, `.cub`, `.molden`,
-/// `.molden.input`, `.mold`, `.fchk`, `.fch`, `.pdb`, `.ent`, `.cif`, `.mmcif`, `.xyz`, each
-/// also gzipped (`.gz`).
+/// `.molden.input`, `.mold`, `.fchk`, `.fch`, `.wfn`, `.wfx`, `.mkl`, `.pdb`, `.ent`, `.cif`,
+/// `.mmcif`, `.xyz`, each also gzipped (`.gz`).
 pub fn load(path: &Path) -> Result<Document, LoadError> {
     load_with(path, DEFAULT_OVERLAP)
 }
@@ -82,6 +86,9 @@ fn parse_text(name: &str, reader: Reader, text: Bounded, overlap: Option<Overlap
         Reader::Cube => cube::parse(name, &text.text),
         Reader::Molden => molden::parse(name, &text.text, overlap),
         Reader::Fchk => fchk::parse(name, &text.text, overlap),
+        Reader::Wfn => wfn::parse(name, &text.text, overlap),
+        Reader::Wfx => wfx::parse(name, &text.text, overlap),
+        Reader::Mkl => mkl::parse(name, &text.text, overlap),
         Reader::Pdb => pdb::parse(name, &text.text),
         Reader::Mmcif => mmcif::parse(name, &text.text),
         Reader::Xyz => xyz::parse(name, &text.text),
@@ -101,13 +108,16 @@ enum Reader {
     Cube,
     Molden,
     Fchk,
+    Wfn,
+    Wfx,
+    Mkl,
     Pdb,
     Mmcif,
     Xyz,
 }
 
 /// Every file name ending a reader takes (each also with `.gz`), and the reader.
-const READERS: [(&str, Reader); 12] = [
+const READERS: [(&str, Reader); 15] = [
     (".cube", Reader::Cube),
     (".cub", Reader::Cube),
     (".molden", Reader::Molden),
@@ -115,6 +125,9 @@ const READERS: [(&str, Reader); 12] = [
     (".mold", Reader::Molden),
     (".fchk", Reader::Fchk),
     (".fch", Reader::Fchk),
+    (".wfn", Reader::Wfn),
+    (".wfx", Reader::Wfx),
+    (".mkl", Reader::Mkl),
     (".pdb", Reader::Pdb),
     (".ent", Reader::Pdb),
     (".cif", Reader::Mmcif),
