@@ -279,8 +279,10 @@ pub fn controls(ui: &mut egui::Ui, scan: &mut ScanView) -> Option<ScanRequest> {
         ui.horizontal(|ui| {
             ui.radio_value(&mut scan.mode, Interpolation::Exact, "exact")
                 .on_hover_text("mix the two key volumes per sample");
-            ui.radio_value(&mut scan.mode, Interpolation::ThreePass, "three-pass").on_hover_text(
-                "the real-time approximation: three blending passes per slice (attenuate, add (1−k)A, add kB)",
+            ui.radio_value(&mut scan.mode, Interpolation::ThreePass, "three-pass")
+                .on_hover_text("the real-time approximation: per slice attenuate by one key volume, add (1−k)A and kB");
+            ui.radio_value(&mut scan.mode, Interpolation::AlphaMix, "α-mix").on_hover_text(
+                "per slice the two key volumes' colours and opacities mixed (what three-pass approximates)",
             );
             let mut by_overlap = scan.scene.tracks.follow == Follow::Overlap;
             let swaps = scan.scene.tracks.swaps.len();
@@ -298,8 +300,9 @@ pub fn controls(ui: &mut egui::Ui, scan: &mut ScanView) -> Option<ScanRequest> {
                 .on_hover_text("a horizontal drag changes the coordinate (right-drag pans); off: drag the bond");
             ui.separator();
             ui.label("diagram: HOMO−k … LUMO+k, k");
-            ui.add(egui::DragValue::new(&mut scan.diagram.window).range(0..=8))
-                .on_hover_text("the orbitals the correlation diagram shows; a click on a line shows it in the first view");
+            ui.add(egui::DragValue::new(&mut scan.diagram.window).range(0..=8)).on_hover_text(
+                "the orbitals the correlation diagram shows; a click on a line shows it in the first view",
+            );
         });
         if let Some(name) = super::correlation::plot(ui, scan) {
             follow = Some(ScanRequest::Show(name));

@@ -91,9 +91,12 @@ pub enum FollowArg {
 pub enum InterpolationArg {
     /// Both key volumes mixed per sample (the interpolated orbital).
     Exact,
-    /// The real-time approximation: three blending passes per slice (attenuate, add (1−k)A,
-    /// add kB).
+    /// The real-time approximation: per slice, attenuate by one key volume's opacity, add
+    /// (1−k)A and kB (seed 000's three blends, drawn as one).
     ThreePass,
+    /// The reference the three passes approximate: per slice the two samples' colours and
+    /// opacities mixed.
+    AlphaMix,
 }
 
 impl From<InterpolationArg> for Interpolation {
@@ -101,6 +104,7 @@ impl From<InterpolationArg> for Interpolation {
         match m {
             InterpolationArg::Exact => Interpolation::Exact,
             InterpolationArg::ThreePass => Interpolation::ThreePass,
+            InterpolationArg::AlphaMix => Interpolation::AlphaMix,
         }
     }
 }
@@ -375,7 +379,10 @@ pub fn bench_keyvolumes(args: KeyVolumeBench) -> Result<()> {
     let camera = orbcloud::scene::Camera::framing(lo.as_vec3(), hi.as_vec3());
     let molecule = s.geometry_at(s.frames[0].at);
     let target = OffscreenTarget::new(&ctx.device, args.size);
-    println!("K,resident_MiB,exact_ms_median,three_pass_ms_median,upload_s");
+    println!(
+        "K,resident_MiB,exact_ms_median,three_pass_ms_median,alpha_mix_ms_median,three_pass_vs_alpha_mix_mean_255,\
+         three_pass_vs_alpha_mix_max_255,upload_s"
+    );
     for &k in &args.counts {
         if k < 2 || k as u64 > budget / per_volume {
             println!("{k},skipped (needs 2..={} to fit)", budget / per_volume);
@@ -393,7 +400,8 @@ pub fn bench_keyvolumes(args: KeyVolumeBench) -> Result<()> {
         let mut renderer = Renderer::new(&ctx);
         renderer.main().set_molecule(&ctx, &molecule, settings.atoms);
         let mut medians = Vec::new();
-        for mode in [Interpolation::Exact, Interpolation::ThreePass] {
+        let mut last_frames = Vec::new();
+        for mode in [Interpolation::Exact, Interpolation::ThreePass, Interpolation::AlphaMix] {
             let mut times = Vec::new();
             for f in 0..args.frames.max(1) + 1 {
                 // Spread the frames over all K volumes, as a drag across the whole range would.
@@ -413,12 +421,24 @@ pub fn bench_keyvolumes(args: KeyVolumeBench) -> Result<()> {
             }
             times.sort_by(f64::total_cmp);
             medians.push(times[times.len() / 2]);
+            last_frames.push(target.read_rgba(&ctx.device, &ctx.queue)?);
         }
+        // The three-pass approximation against the α-mix it approximates, on the last frame.
+        let (mut sum, mut worst) = (0u64, 0u8);
+        for (p, q) in last_frames[1].pixels().zip(last_frames[2].pixels()) {
+            for c in 0..3 {
+                let d = p[c].abs_diff(q[c]);
+                sum += d as u64;
+                worst = worst.max(d);
+            }
+        }
+        let mean = sum as f64 / (3 * last_frames[1].pixels().len()) as f64;
         println!(
-            "{k},{:.1},{:.1},{:.1},{upload:.2}",
+            "{k},{:.1},{:.1},{:.1},{:.1},{mean:.2},{worst},{upload:.2}",
             (k as u64 * per_volume) as f64 / 1048576.0,
             medians[0],
-            medians[1]
+            medians[1],
+            medians[2]
         );
     }
     Ok(())

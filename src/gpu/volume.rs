@@ -190,10 +190,10 @@ enum Program {
     Direct,
     /// Two key volumes mixed per sample.
     Exact,
-    /// Seed 000's three passes per slice: attenuate, add (1−k)A, add kB.
-    Attenuate,
-    AddA,
-    AddB,
+    /// Seed 000's three-pass compositing, in one pass.
+    ThreePass,
+    /// Seed 000's α-mix (the reference the three passes approximate).
+    AlphaMix,
     /// A full-screen pass of the resolve: translucent surfaces' fragments and the cloud's
     /// samples composited in one walk per pixel (volume_interleave.wgsl).
     Interleave,
@@ -205,34 +205,17 @@ impl Program {
             Program::Slices => "fs_main",
             Program::Direct => "fs_direct",
             Program::Exact => "fs_exact",
-            Program::Attenuate => "fs_attenuate",
-            Program::AddA => "fs_add_a",
-            Program::AddB => "fs_add_b",
+            Program::ThreePass => "fs_three_pass",
+            Program::AlphaMix => "fs_alpha_mix",
             Program::Interleave => "fs_interleave",
         }
     }
 
-    /// Premultiplied "over" for one pass per frame; the three-pass programs blend as seed 000:
-    /// dst·(1 − α) for the attenuation, dst + src for the two additions.
+    /// Premultiplied "over" for every program: a slice of each is one "over" blend.
     fn blend(self) -> wgpu::BlendState {
-        let component =
-            |src, dst| wgpu::BlendComponent { src_factor: src, dst_factor: dst, operation: wgpu::BlendOperation::Add };
-        match self {
-            Program::Attenuate => {
-                let c = component(wgpu::BlendFactor::Zero, wgpu::BlendFactor::OneMinusSrcAlpha);
-                wgpu::BlendState { color: c, alpha: c }
-            }
-            Program::AddA | Program::AddB => {
-                let c = component(wgpu::BlendFactor::One, wgpu::BlendFactor::One);
-                wgpu::BlendState { color: c, alpha: c }
-            }
-            _ => wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING,
-        }
+        wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING
     }
 }
-
-/// The programs of one frame, in the order each slice is drawn with them.
-const THREE_PASS: [Program; 3] = [Program::Attenuate, Program::AddA, Program::AddB];
 
 /// Which variant of the slice shader a frame needs: each is its own pipeline, specialised by
 /// WGSL override constants.
@@ -307,9 +290,7 @@ pub struct VolumePass {
     /// with the three programs in turn.
     variant: Variant,
     /// This frame's pipelines, one per program, in the order each slice is drawn with them.
-    frame_pipelines: Vec<wgpu::RenderPipeline>,
-    /// This frame's slices (vertex ranges, back to front).
-    ranges: Vec<std::ops::Range<u32>>,
+    frame_pipeline: Option<wgpu::RenderPipeline>,
     morph: Option<Morph>,
     uniforms: wgpu::Buffer,
     vertices: wgpu::Buffer,
@@ -484,8 +465,7 @@ impl VolumePass {
         Self {
             shared,
             variant: Variant { program: Program::Slices, gradient: false, shaped: false, clip: false },
-            frame_pipelines: Vec::new(),
-            ranges: Vec::new(),
+            frame_pipeline: None,
             morph: None,
             uniforms: super::uniform_buffer(device, "volume uniforms", std::mem::size_of::<VolumeUniforms>()),
             vertices: Self::vertex_buffer(device, 1024),
@@ -593,7 +573,6 @@ impl VolumePass {
             return;
         }
         let slices = vol.grid_box.slices(settings.mode, settings.slices, eye, view_dir);
-        self.ranges = slices.ranges().collect();
         let planes = slices.starts.len() as f32;
         let Slices { vertices, normal, spacing, nearest, .. } = slices;
         if vertices.is_empty() {
@@ -609,8 +588,11 @@ impl VolumePass {
         let t = &settings.transfer;
         let program = match (&self.direct, &self.morph) {
             (Some(_), _) => Program::Direct,
-            (None, Some(m)) if m.mode == Interpolation::ThreePass => Program::Attenuate,
-            (None, Some(_)) => Program::Exact,
+            (None, Some(m)) => match m.mode {
+                Interpolation::Exact => Program::Exact,
+                Interpolation::ThreePass => Program::ThreePass,
+                Interpolation::AlphaMix => Program::AlphaMix,
+            },
             (None, None) => Program::Slices,
         };
         self.variant = Variant {
@@ -619,8 +601,7 @@ impl VolumePass {
             shaped: t.kind == TransferKind::Shaped,
             clip: settings.clip.enabled,
         };
-        self.frame_pipelines =
-            self.programs().map(|program| self.shared.pipeline(device, Variant { program, ..self.variant })).collect();
+        self.frame_pipeline = Some(self.shared.pipeline(device, self.variant));
         let lobe = |l: &crate::scene::transfer::Lobe| [l.center, l.width, l.opacity, 0.0];
         let bits = u32::from(t.shading);
         let clip_normal = Vec3::from(settings.clip.normal).normalize_or(Vec3::Z);
@@ -681,17 +662,6 @@ impl VolumePass {
             (self.shared.pipeline(device, Variant { program: Program::Interleave, ..self.variant }), bind_group)
         })
     }
-
-    /// The programs each slice is drawn with this frame, in order.
-    fn programs(&self) -> impl Iterator<Item = Program> + use<> {
-        let programs: &'static [Program] = match self.variant.program {
-            Program::Attenuate => &THREE_PASS,
-            Program::Slices => &[Program::Slices],
-            Program::Direct => &[Program::Direct],
-            _ => &[Program::Exact],
-        };
-        programs.iter().copied()
-    }
 }
 
 impl super::frame::Draw for VolumePass {
@@ -710,7 +680,7 @@ impl super::frame::Draw for VolumePass {
         if self.vertex_count == 0 {
             return;
         }
-        let pipelines = &self.frame_pipelines;
+        let Some(pipeline) = &self.frame_pipeline else { return };
         pass.set_bind_group(0, bind_group, &[]);
         if let Some(gto) = &self.direct {
             pass.set_bind_group(1, &gto.bind_group, &[]);
@@ -719,18 +689,8 @@ impl super::frame::Draw for VolumePass {
             pass.set_bind_group(1, &morph.bind_group, &[]);
         }
         pass.set_vertex_buffer(0, self.vertices.slice(..self.vertex_count as u64 * 12));
-        if let [pipeline] = pipelines.as_slice() {
-            pass.set_pipeline(pipeline);
-            pass.draw(0..self.vertex_count, 0..1);
-            return;
-        }
-        // Seed 000's three passes: each slice is finished before the next one starts.
-        for range in &self.ranges {
-            for pipeline in pipelines {
-                pass.set_pipeline(pipeline);
-                pass.draw(range.clone(), 0..1);
-            }
-        }
+        pass.set_pipeline(pipeline);
+        pass.draw(0..self.vertex_count, 0..1);
     }
 }
 

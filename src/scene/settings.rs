@@ -21,9 +21,12 @@ pub enum Interpolation {
     /// Both volumes sampled and mixed per sample, ψ = (1−k)ψA + kψB: the interpolated orbital.
     #[default]
     Exact,
-    /// Seed 000's real-time approximation: per slice, three blending passes (attenuate by A_i,
-    /// add (1−k)A_i, add kB_i).
+    /// Seed 000's real-time approximation: per slice, three blends (attenuate by A_i's
+    /// opacity, B_i's past the middle; add (1−k)A_i; add kB_i), drawn as one.
     ThreePass,
+    /// Seed 000's reference for it: per slice the two samples' colours and opacities mixed,
+    /// α = (1−k)α_A + kα_B.
+    AlphaMix,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
