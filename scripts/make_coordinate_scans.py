@@ -14,6 +14,9 @@ water_stretch/ the second O-H from 0.80 to 1.60 A every 0.2 (5 frames) at 104.5 
 water_path/    four frames in which the angle and the second O-H change together (95 -> 125
                degrees, 0.90 -> 1.20 A), RHF/STO-3G, with a manifest `water_path.scan.toml` of
                coordinate = "path" and align = false.
+water_turned/  the same four frames, each after the first turned and moved rigidly (as a program
+               that writes every geometry in its own standard orientation would), with a
+               manifest of coordinate = "path" and align = true.
 
 Every frame: symmetry off, cartesian=False, conv_tol 1e-10, the default initial guess, one
 thread; Molden files from pyscf.tools.molden (all orbitals), gzip level 9 with mtime 0.
@@ -99,6 +102,34 @@ def main() -> None:
         print(f"path {s}: {angle:.1f} deg, {r:.2f} A: E = {e:.8f}")
     (path / "water_path.scan.toml").write_text("\n".join(lines) + "\n")
     assert np.isfinite(e)
+
+    turned = out / "water_turned"
+    turned.mkdir(parents=True, exist_ok=True)
+    lines = [
+        "# The morph of water_path/, each frame in its own orientation: aligned on reading.",
+        'title = "water morph, turned"',
+        'coordinate = "path"',
+        "align = true",
+        'orbitals = ["homo", "lumo"]',
+    ]
+    for s in range(steps):
+        t = s / (steps - 1)
+        atoms = water(95 + 30 * t, 0.96, 0.90 + 0.30 * t)
+        if s > 0:
+            atoms = moved(atoms, axis=[1.0, 2.0, 0.5 + s], degrees=40.0 * s, shift=[0.3 * s, -0.5, 1.0])
+        name = f"h2o_t{s}.molden.gz"
+        write_molden(turned / name, atoms, "sto-3g")
+        lines += ["", "[[frame]]", f"at = {s}", f'file = "{name}"']
+    (turned / "water_turned.scan.toml").write_text("\n".join(lines) + "\n")
+
+
+def moved(atoms, axis, degrees, shift):
+    """`atoms` turned by `degrees` about `axis` (through the origin), then shifted (A)."""
+    a = np.asarray(axis, float) / np.linalg.norm(axis)
+    th = math.radians(degrees)
+    k = np.array([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
+    r = np.eye(3) + math.sin(th) * k + (1 - math.cos(th)) * k @ k
+    return [(sym, tuple(r @ np.asarray(p) + np.asarray(shift))) for sym, p in atoms]
 
 
 if __name__ == "__main__":

@@ -247,3 +247,50 @@ fn the_correlation_diagram_follows_each_orbital_by_character() {
     assert_eq!(csv.lines().count(), 10);
     assert!(csv.starts_with("angle / deg,E(HOMO−2) / Eh,HOMO−2 orbital"));
 }
+
+#[test]
+fn a_path_written_in_many_orientations_is_aligned_with_its_orbitals() {
+    // The same morph twice: each frame in the natural orientation, and each turned and moved
+    // as its own file (water_turned/, align = true). Aligned, both give the same scan.
+    let natural_dir = fixture("water_path");
+    let text = std::fs::read_to_string(natural_dir.join("water_path.scan.toml")).unwrap();
+    let aligned_text = text.replace("align = false", "align = true");
+    let parse = |text: &str, dir: &Path| {
+        parse_scan(&dir.join("m.scan.toml"), text, &mut |p| orbcloud::formats::load(p)).unwrap().scan
+    };
+    let natural = parse(&aligned_text, &natural_dir);
+    let turned = load_scan(&fixture("water_turned").join("water_turned.scan.toml")).unwrap().scan;
+    for at in [0.0, 0.5, 1.5, 2.25, 3.0] {
+        let (a, b) = (natural.geometry_at(at), turned.geometry_at(at));
+        for (p, q) in a.atoms.iter().zip(&b.atoms) {
+            assert!(p.position.distance(q.position) < 1e-6, "atoms at {at}");
+        }
+    }
+    let grid = natural.common_grid(orbcloud::scene::framing::ORBITAL_MARGIN, 24);
+    let values = |scan: &Scan| {
+        let tracks = scan.track(Follow::Index).unwrap();
+        scan.interpolated_values(&tracks, 1, 1.5, &grid)
+    };
+    let (a, b) = (values(&natural), values(&turned));
+    let diff: Vec<f32> = a.iter().zip(&b).map(|(x, y)| x - y).collect();
+    let rel = norm(&diff) / norm(&a);
+    eprintln!("LUMO halfway along the path, turned files aligned vs natural: relative difference {rel:.2e} (norm {:.3}, {} points)", norm(&a), a.len());
+    assert!(rel < 1e-4, "{rel}");
+    // Without alignment the turned files' orbitals mix in different orientations.
+    let unaligned_text = std::fs::read_to_string(fixture("water_turned").join("water_turned.scan.toml"))
+        .unwrap()
+        .replace("align = true", "align = false");
+    let unaligned = parse(&unaligned_text, &fixture("water_turned"));
+    let c = values(&unaligned);
+    let off: Vec<f32> = a.iter().zip(&c).map(|(x, y)| x - y).collect();
+    assert!(norm(&off) / norm(&a) > 0.3, "unaligned frames blend into something else");
+    // Cube series cannot turn their orbitals.
+    let e = parse_scan(
+        &fixture("water_bend").join("c.scan.toml"),
+        "coordinate = \"angle\"\natoms = [2, 1, 3]\nalign = true\n[[frame]]\nat = 1\nfile = \"h2o_a080.molden.gz\"\n[[frame]]\nat = 2\nfile = \"h2o_a090.molden.gz\"\n",
+        &mut |p| orbcloud::formats::load(p),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("c.scan.toml:3:") && e.contains("align only for a path"), "{e}");
+}

@@ -198,6 +198,12 @@ pub fn parse_scan(
     }
     check_frames(&name, &frames)?;
     frames.sort_by(|a, b| a.1.at.total_cmp(&b.1.at));
+    if manifest.align.as_ref().is_some_and(|a| *a.get_ref()) {
+        let line = manifest.align.as_ref().map_or(1, |a| line_of(text, a.span().start));
+        let mut keys: Vec<&mut KeyFrame> = frames.iter_mut().map(|(_, f)| f).collect();
+        crate::model::scan::align_frames(&mut keys)
+            .map_err(|e| error(&name, line, "Molden or fchk frames to align", e.to_string()))?;
+    }
     for pair in frames.windows(2) {
         let ((l0, f0), (l1, f1)) = (&pair[0], &pair[1]);
         if (f1.at - f0.at).abs() < ANGLE_TOLERANCE {
@@ -260,18 +266,9 @@ fn coordinate_of(name: &str, text: &str, m: &Manifest) -> Result<(Coordinate, us
     };
     if let Some(align) = &m.align
         && *align.get_ref()
+        && kind != "path"
     {
-        let line = line_at(align.span());
-        if kind != "path" {
-            return Err(error(name, line, "align only for a path", format!("align with a {kind}")));
-        }
-        return Err(error(
-            name,
-            line,
-            "align = false: a path's frames are used in the files' own orientation (write them in one \
-             orientation, e.g. Gaussian's nosymm or ORCA's default)",
-            "align = true",
-        ));
+        return Err(error(name, line_at(align.span()), "align only for a path", format!("align with a {kind}")));
     }
     let (list, line) = atoms.unwrap_or((Vec::new(), kind_line));
     if list.len() != wanted || list.contains(&0) {

@@ -22,6 +22,7 @@ pub mod neighbours;
 pub mod octree;
 pub mod orbitals;
 pub mod overlap;
+pub mod rigid;
 pub mod scan;
 pub mod simplify;
 pub mod solid_harmonics;

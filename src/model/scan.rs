@@ -107,6 +107,8 @@ pub enum ScanError {
     MissingOrbital { at: f64, spec: String, available: usize },
     #[error("frame at {at}: {found} volumes for {wanted} orbitals")]
     MissingVolume { at: f64, wanted: usize, found: usize },
+    #[error("a path's frames are aligned with their orbitals: cube files cannot turn with them (align = false)")]
+    AlignCubes,
 }
 
 /// What a key frame holds for its orbitals.
@@ -461,6 +463,31 @@ pub fn best_coordinate(molecules: &[Molecule]) -> Option<Coordinate> {
         Some((c, left, _)) if left <= PATH_THRESHOLD => Some(c),
         _ => Some(Coordinate::Path),
     }
+}
+
+/// Lays each frame on the one before it (frames in path order): the rigid motion that fits its
+/// atoms to the previous frame's best ([`superpose`]), applied to the atoms and to every
+/// wavefunction of the frame, so its orbitals turn with it ([`super::rigid::moved`]). The
+/// first frame stays where its file put it.
+pub fn align_frames(frames: &mut [&mut KeyFrame]) -> Result<(), ScanError> {
+    for f in 1..frames.len() {
+        let target: Vec<DVec3> = frames[f - 1].molecule.atoms.iter().map(|a| a.position).collect();
+        let frame = &mut frames[f];
+        let here: Vec<DVec3> = frame.molecule.atoms.iter().map(|a| a.position).collect();
+        let (rotation, shift) = superpose(&here, &target);
+        for atom in &mut frame.molecule.atoms {
+            atom.position = rotation * atom.position + shift;
+        }
+        match &mut frame.content {
+            FrameContent::Wavefunctions(waves) => {
+                for wf in waves.iter_mut() {
+                    *wf = super::rigid::moved(wf, rotation, shift);
+                }
+            }
+            FrameContent::Volumes(_) => return Err(ScanError::AlignCubes),
+        }
+    }
+    Ok(())
 }
 
 impl Scan {
