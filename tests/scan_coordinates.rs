@@ -137,7 +137,7 @@ fn manifests_name_their_coordinate_and_errors_their_line() {
         (format!("coordinate = \"angle\"\natoms = [2, 1]\n{frames}"), 2, "3 atom numbers"),
         (format!("coordinate = \"bend\"\natoms = [2, 1, 3]\n{frames}"), 1, "distance, angle, dihedral or path"),
         (format!("coordinate = \"path\"\natoms = [1, 2]\n{frames}"), 2, "no atoms for a path"),
-        (format!("coordinate = \"path\"\nalign = true\n{frames}"), 2, "align = false"),
+        (format!("coordinate = \"angle\"\natoms = [2, 1, 3]\nalign = true\n{frames}"), 3, "align only for a path"),
         (format!("atoms = [1, 2]\n{frames}"), 1, "no coordinate"),
     ] {
         let e = parse(&text).unwrap_err().to_string();
@@ -274,7 +274,11 @@ fn a_path_written_in_many_orientations_is_aligned_with_its_orbitals() {
     let (a, b) = (values(&natural), values(&turned));
     let diff: Vec<f32> = a.iter().zip(&b).map(|(x, y)| x - y).collect();
     let rel = norm(&diff) / norm(&a);
-    eprintln!("LUMO halfway along the path, turned files aligned vs natural: relative difference {rel:.2e} (norm {:.3}, {} points)", norm(&a), a.len());
+    eprintln!(
+        "LUMO halfway along the path, turned files aligned vs natural: relative difference {rel:.2e} (norm {:.3}, {} points)",
+        norm(&a),
+        a.len()
+    );
     assert!(rel < 1e-4, "{rel}");
     // Without alignment the turned files' orbitals mix in different orientations.
     let unaligned_text = std::fs::read_to_string(fixture("water_turned").join("water_turned.scan.toml"))
@@ -293,4 +297,31 @@ fn a_path_written_in_many_orientations_is_aligned_with_its_orbitals() {
     .unwrap_err()
     .to_string();
     assert!(e.contains("c.scan.toml:3:") && e.contains("align only for a path"), "{e}");
+}
+
+#[test]
+fn a_multi_frame_xyz_beside_the_files_orders_a_path() {
+    // The morph's files under names whose order is not the path's, and the path as XYZ frames.
+    let tmp = tempfile::tempdir().unwrap();
+    let names = ["d.molden.gz", "b.molden.gz", "a.molden.gz", "c.molden.gz"]; // path order
+    let mut xyz = String::new();
+    for (s, name) in names.iter().enumerate() {
+        let from = fixture("water_path").join(format!("h2o_p{s}.molden.gz"));
+        std::fs::copy(&from, tmp.path().join(name)).unwrap();
+        let doc = orbcloud::formats::load(&from).unwrap();
+        xyz.push_str(&format!("3\nframe {s}\n"));
+        for a in &doc.molecule.atoms {
+            let p = a.position * orbcloud::model::units::ANGSTROM_PER_BOHR;
+            xyz.push_str(&format!("{} {:.8} {:.8} {:.8}\n", a.element().symbol, p.x, p.y, p.z));
+        }
+    }
+    std::fs::write(tmp.path().join("irc.xyz"), &xyz).unwrap();
+    let made = init(tmp.path(), Some(Coordinate::Path)).unwrap();
+    let order: Vec<&str> = made.frames.iter().map(|(f, _)| f.as_str()).collect();
+    assert_eq!(order, names, "the XYZ file's order, not the names'");
+    // Without it, the names' order.
+    std::fs::remove_file(tmp.path().join("irc.xyz")).unwrap();
+    let made = init(tmp.path(), Some(Coordinate::Path)).unwrap();
+    let order: Vec<&str> = made.frames.iter().map(|(f, _)| f.as_str()).collect();
+    assert_eq!(order, ["a.molden.gz", "b.molden.gz", "c.molden.gz", "d.molden.gz"]);
 }

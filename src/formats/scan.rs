@@ -433,8 +433,12 @@ pub fn init(dir: &Path, coordinate: Option<Coordinate>) -> Result<ScanInit, Load
             .ok_or_else(|| error(&name, 0, "frames whose geometries differ", "the same geometry in every file"))?,
     };
     let values: Vec<f64> = match coordinate {
-        // A path's frames in the order of their names, one unit apart.
-        Coordinate::Path => (0..molecules.len()).map(|i| i as f64).collect(),
+        // A path's frames in the order a multi-frame XYZ file beside them gives (each file at
+        // the frame of the path it matches), or of their names; one unit apart.
+        Coordinate::Path => match path_order(dir, &molecules)? {
+            Some(order) => order,
+            None => (0..molecules.len()).map(|i| i as f64).collect(),
+        },
         Coordinate::Dihedral(_) => {
             unwrap_angles(&molecules.iter().filter_map(|m| coordinate.measure(m)).collect::<Vec<_>>())
         }
@@ -470,6 +474,53 @@ pub fn init(dir: &Path, coordinate: Option<Coordinate>) -> Result<ScanInit, Load
         ));
     }
     Ok(ScanInit { path: manifest_path, text, coordinate, found, frames })
+}
+
+/// Where each of `molecules` lies along the path a multi-frame XYZ file in `dir` traces (the
+/// frame whose geometry it matches, by interatomic distances, whatever the orientation); None
+/// when `dir` holds no such file. Two files matching one frame, or a file matching none (within
+/// 0.05 Å RMS), are errors.
+fn path_order(dir: &Path, molecules: &[Molecule]) -> Result<Option<Vec<f64>>, LoadError> {
+    let xyz = std::fs::read_dir(dir)
+        .map_err(|source| LoadError::Io { path: dir.display().to_string(), source })?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.is_file() && p.to_string_lossy().to_ascii_lowercase().trim_end_matches(".gz").ends_with(".xyz"));
+    let n = molecules.first().map_or(0, |m| m.atoms.len());
+    for path in xyz {
+        let doc = super::load(&path)?;
+        let Some(s) = doc.structure.as_ref().map(|v| &v.structure).filter(|s| s.models.len() > 1) else { continue };
+        let frames: Vec<Vec<glam::DVec3>> = (s.models.iter())
+            .map(|m| s.position[m.atoms.start as usize..m.atoms.end as usize].to_vec())
+            .filter(|p| p.len() == n)
+            .collect();
+        if frames.len() < 2 {
+            continue;
+        }
+        let name = path.display().to_string();
+        let mut order = Vec::with_capacity(molecules.len());
+        for (i, m) in molecules.iter().enumerate() {
+            let here: Vec<glam::DVec3> = m.atoms.iter().map(|a| a.position).collect();
+            let (frame, off) = (frames.iter().enumerate())
+                .map(|(f, p)| (f, crate::model::scan::distance_change(&here, p)))
+                .min_by(|a, b| a.1.total_cmp(&b.1))
+                .unwrap_or((0, f64::INFINITY));
+            if off > 0.05 {
+                return Err(error(
+                    &name,
+                    0,
+                    format!("a frame matching file {} of the path", i + 1),
+                    format!("{off:.3} Å RMS from the nearest"),
+                )
+                .into());
+            }
+            if order.contains(&(frame as f64)) {
+                return Err(error(&name, 0, "one frame per file", format!("two files at frame {}", frame + 1)).into());
+            }
+            order.push(frame as f64);
+        }
+        return Ok(Some(order));
+    }
+    Ok(None)
 }
 
 /// Dihedrals measured in (−180, 180] made continuous: the sequence starts after the largest gap

@@ -367,7 +367,7 @@ pub fn most_changing_dihedral(molecules: &[Molecule]) -> Option<[usize; 4]> {
 
 /// Root-mean-square change of the interatomic distances (Å) from `a` to `b`: how far two
 /// geometries differ whatever their orientation.
-fn distance_change(a: &[DVec3], b: &[DVec3]) -> f64 {
+pub fn distance_change(a: &[DVec3], b: &[DVec3]) -> f64 {
     let n = a.len();
     let (mut sum, mut pairs) = (0.0, 0usize);
     for i in 0..n {
