@@ -61,19 +61,6 @@ fn reference(
     })
 }
 
-/// (mean, worst) per-channel difference over the picture, /255.
-fn difference(p: &image::RgbaImage, q: &image::RgbaImage) -> (f64, u8) {
-    let (mut sum, mut worst) = (0u64, 0u8);
-    for (a, b) in p.pixels().zip(q.pixels()) {
-        for c in 0..3 {
-            let d = a[c].abs_diff(b[c]);
-            sum += d as u64;
-            worst = worst.max(d);
-        }
-    }
-    (sum as f64 / (3 * p.pixels().len()) as f64, worst)
-}
-
 #[test]
 fn alpha_mix_and_three_pass_match_their_cpu_compositors() {
     let a = p_orbital(24, false);
@@ -112,7 +99,7 @@ fn alpha_mix_and_three_pass_match_their_cpu_compositors() {
             ctx.queue.submit([encoder.finish()]);
             let gpu = target.read_rgba(&ctx.device, &ctx.queue).unwrap();
             let cpu = reference(&a, &b, k as f64, mode, &cam, &s);
-            let (mean, worst) = difference(&gpu, &cpu);
+            let (mean, worst) = common::mean_max_difference(&gpu, &cpu);
             eprintln!("k = {k}, {mode:?}: mean |gpu − cpu| {mean:.3}/255, worst {worst}/255");
             // As for one volume (tests/volume_reference.rs): the f16 scene buffer rounds each of
             // ~40 blends; a ray grazing a slice polygon's edge may see one slice more or less.
@@ -121,10 +108,16 @@ fn alpha_mix_and_three_pass_match_their_cpu_compositors() {
         }
         // The two ways differ (their CPU pictures), and each GPU picture is nearer its own.
         let (alpha_mix, three_pass) = (&pictures[0], &pictures[1]);
-        let apart = difference(&alpha_mix.1, &three_pass.1).0;
+        let apart = common::mean_max_difference(&alpha_mix.1, &three_pass.1).0;
         eprintln!("k = {k}: three-pass against α-mix (CPU): mean {apart:.3}/255");
         assert!(apart > 0.3, "the approximation shows at k = {k}: {apart}");
-        assert!(difference(&three_pass.0, &three_pass.1).0 < difference(&three_pass.0, &alpha_mix.1).0);
-        assert!(difference(&alpha_mix.0, &alpha_mix.1).0 < difference(&alpha_mix.0, &three_pass.1).0);
+        assert!(
+            common::mean_max_difference(&three_pass.0, &three_pass.1).0
+                < common::mean_max_difference(&three_pass.0, &alpha_mix.1).0
+        );
+        assert!(
+            common::mean_max_difference(&alpha_mix.0, &alpha_mix.1).0
+                < common::mean_max_difference(&alpha_mix.0, &three_pass.1).0
+        );
     }
 }

@@ -176,18 +176,6 @@ fn interpolating_a_held_out_angle_comes_close_to_the_true_orbital() {
     }
 }
 
-fn mean_max_diff(a: &image::RgbaImage, b: &image::RgbaImage) -> (f64, u8) {
-    let (mut sum, mut max) = (0u64, 0u8);
-    for (p, q) in a.pixels().zip(b.pixels()) {
-        for c in 0..3 {
-            let d = p[c].abs_diff(q[c]);
-            sum += d as u64;
-            max = max.max(d);
-        }
-    }
-    (sum as f64 / (a.width() * a.height() * 3) as f64, max)
-}
-
 fn small_scene(ctx: &orbcloud::gpu::GpuContext) -> ScanScene {
     let options = KeyOptions { points: 40, ..KeyOptions::default() };
     ScanScene::build(ctx, psb3(), &options, &mut |_, _| true).unwrap()
@@ -209,7 +197,8 @@ fn three_pass_stays_close_to_exact_and_equals_it_at_key_angles() {
     let s = settings();
     let render = |theta: f64, mode| scene.render(&ctx, &[0, 1], theta, mode, &camera, &s, size).unwrap();
     // At a key angle k = 0: both reduce to that frame's volume.
-    let (mean, max) = mean_max_diff(&render(-90.0, Interpolation::Exact), &render(-90.0, Interpolation::ThreePass));
+    let (mean, max) =
+        common::mean_max_difference(&render(-90.0, Interpolation::Exact), &render(-90.0, Interpolation::ThreePass));
     // Only the rounding of two half-float blends instead of one separates them.
     assert!(mean < 1.0 && max <= 4, "at a key angle three-pass differs from exact: mean {mean}, max {max}");
     // Between: seed 000's approximation; report and bound its error.
@@ -217,12 +206,12 @@ fn three_pass_stays_close_to_exact_and_equals_it_at_key_angles() {
     for theta in [-97.5, -87.5, -45.0] {
         let exact = render(theta, Interpolation::Exact);
         let three = render(theta, Interpolation::ThreePass);
-        let (mean, max) = mean_max_diff(&exact, &three);
+        let (mean, max) = common::mean_max_difference(&exact, &three);
         eprintln!("θ = {theta}°: three-pass vs exact: mean {mean:.2}/255, max {max}/255");
         worst = worst.max(mean);
         // Both must differ from the nearer key frame's picture: they interpolate.
         let key = render(scene.scan.frames[scene.scan.nearest_frame(theta)].at, Interpolation::Exact);
-        assert!(mean_max_diff(&exact, &key).0 > 0.02, "θ = {theta}: exact shows only a key frame");
+        assert!(common::mean_max_difference(&exact, &key).0 > 0.02, "θ = {theta}: exact shows only a key frame");
     }
     assert!(worst < 2.0, "three-pass strays from exact by {worst}/255 on average");
 }
@@ -253,7 +242,7 @@ fn the_gpu_mix_matches_the_cpu_interpolated_grid() {
         renderer.render(&ctx, &mut encoder, &target.color_view, &FrameInput::single(&camera, &s, size));
         ctx.queue.submit([encoder.finish()]);
         let reference = target.read_rgba(&ctx.device, &ctx.queue).unwrap();
-        let (mean, max) = mean_max_diff(&mixed, &reference);
+        let (mean, max) = common::mean_max_difference(&mixed, &reference);
         eprintln!("slot {slot}: GPU mix vs CPU interpolation: mean {mean:.3}/255, max {max}/255");
         assert!(mean < 0.3 && max <= 6, "slot {slot}: mean {mean}, max {max}");
     }

@@ -9,16 +9,7 @@ use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use orbcloud::app::{OrbApp, wgpu_setup};
 use orbcloud::scene::{SliceMode, TransferKind};
-use viewer_support::{click_at, wait_loaded};
-
-fn harness() -> Harness<'static, OrbApp> {
-    let h = Harness::builder()
-        .with_size([1000.0, 700.0])
-        .wgpu_setup(wgpu_setup(true))
-        .build_eframe(|cc| OrbApp::cube_demo(cc));
-    assert!(h.state().error.is_none(), "viewer failed to start: {:?}", h.state().error);
-    h
-}
+use viewer_support::{click_at, harness, wait_loaded};
 
 /// A primary-button drag `dx` points to the right from `from`, in five moves; returns the
 /// views' (size on screen, size drawn) in the middle of the drag.

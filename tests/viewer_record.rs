@@ -5,18 +5,11 @@ mod common;
 #[path = "common/viewer.rs"]
 mod viewer_support;
 
+use viewer_support::harness;
+
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
-use orbcloud::app::{OrbApp, wgpu_setup};
-
-fn harness() -> Harness<'static, OrbApp> {
-    let h = Harness::builder()
-        .with_size([1000.0, 700.0])
-        .wgpu_setup(wgpu_setup(true))
-        .build_eframe(|cc| OrbApp::cube_demo(cc));
-    assert!(h.state().error.is_none(), "viewer failed to start: {:?}", h.state().error);
-    h
-}
+use orbcloud::app::OrbApp;
 
 /// Steps the window until `done` holds (failing after `seconds`).
 fn step_until(h: &mut Harness<'static, OrbApp>, seconds: u64, what: &str, done: impl Fn(&OrbApp) -> bool) {

@@ -10,6 +10,7 @@ pub mod bonds;
 pub mod cartesian;
 pub mod correlation;
 pub mod document;
+pub mod eigen;
 mod element_table;
 pub mod elements;
 pub mod extent;

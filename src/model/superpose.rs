@@ -5,6 +5,8 @@
 
 use glam::{DQuat, DVec3};
 
+use super::eigen::symmetric_eigen;
+
 /// The rotation `r` and translation `t` minimising Σ|r·mobile + t − target|² (equal weights).
 /// Fewer than two points, or a degenerate set, give the identity rotation.
 pub fn superpose(mobile: &[DVec3], target: &[DVec3]) -> (DQuat, DVec3) {
@@ -31,49 +33,12 @@ pub fn superpose(mobile: &[DVec3], target: &[DVec3]) -> (DQuat, DVec3) {
         [szx - sxz, sxy + syx, -sxx + syy - szz, syz + szy],
         [sxy - syx, szx + sxz, syz + szy, -sxx - syy + szz],
     ];
-    let (values, vectors) = symmetric_eigen(k);
+    let (values, vectors) = symmetric_eigen(k, 200);
     let best = (0..4).max_by(|&a, &b| values[a].total_cmp(&values[b])).unwrap_or(0);
     let [w, x, y, z] = std::array::from_fn(|i| vectors[i][best]);
     let q = DQuat::from_xyzw(x, y, z, w);
     let rotation = if q.length() > 1e-12 { q.normalize() } else { DQuat::IDENTITY };
     (rotation, ct - rotation * cm)
-}
-
-/// Eigenvalues and eigenvectors (columns) of a symmetric 4×4 matrix, by cyclic Jacobi rotations.
-fn symmetric_eigen(mut a: [[f64; 4]; 4]) -> ([f64; 4], [[f64; 4]; 4]) {
-    let mut v = [[0.0; 4]; 4];
-    for (i, row) in v.iter_mut().enumerate() {
-        row[i] = 1.0;
-    }
-    for _ in 0..64 {
-        let off: f64 = (0..4).flat_map(|p| (p + 1..4).map(move |q| (p, q))).map(|(p, q)| a[p][q] * a[p][q]).sum();
-        if off < 1e-30 {
-            break;
-        }
-        for p in 0..4 {
-            for q in p + 1..4 {
-                if a[p][q].abs() < 1e-300 {
-                    continue;
-                }
-                let theta = 0.5 * (2.0 * a[p][q]).atan2(a[q][q] - a[p][p]);
-                let (s, c) = theta.sin_cos();
-                for row in a.iter_mut() {
-                    let (akp, akq) = (row[p], row[q]);
-                    row[p] = c * akp - s * akq;
-                    row[q] = s * akp + c * akq;
-                }
-                let (rp, rq) = (a[p], a[q]);
-                a[p] = std::array::from_fn(|k| c * rp[k] - s * rq[k]);
-                a[q] = std::array::from_fn(|k| s * rp[k] + c * rq[k]);
-                for row in &mut v {
-                    let (vp, vq) = (row[p], row[q]);
-                    row[p] = c * vp - s * vq;
-                    row[q] = s * vp + c * vq;
-                }
-            }
-        }
-    }
-    (std::array::from_fn(|i| a[i][i]), v)
 }
 
 #[cfg(test)]

@@ -157,33 +157,9 @@ pub fn principal_axes(points: &[DVec3]) -> [DVec3; 3] {
             }
         }
     }
-    let mut v = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-    for _ in 0..50 {
-        let (p, q) = [(0, 1), (0, 2), (1, 2)]
-            .into_iter()
-            .max_by(|x, y| a[x.0][x.1].abs().total_cmp(&a[y.0][y.1].abs()))
-            .unwrap_or((0, 1));
-        if a[p][q].abs() < 1e-14 {
-            break;
-        }
-        let theta = 0.5 * (2.0 * a[p][q]).atan2(a[q][q] - a[p][p]);
-        let (s, c) = theta.sin_cos();
-        for row in a.iter_mut() {
-            let (akp, akq) = (row[p], row[q]);
-            row[p] = c * akp - s * akq;
-            row[q] = s * akp + c * akq;
-        }
-        let (rp, rq) = (a[p], a[q]);
-        a[p] = std::array::from_fn(|k| c * rp[k] - s * rq[k]);
-        a[q] = std::array::from_fn(|k| s * rp[k] + c * rq[k]);
-        for row in &mut v {
-            let (vp, vq) = (row[p], row[q]);
-            row[p] = c * vp - s * vq;
-            row[q] = s * vp + c * vq;
-        }
-    }
+    let (values, v) = crate::model::eigen::symmetric_eigen(a, 50);
     let mut order = [0usize, 1, 2];
-    order.sort_by(|&i, &j| a[j][j].total_cmp(&a[i][i]));
+    order.sort_by(|&i, &j| values[j].total_cmp(&values[i]));
     let axis = |k: usize| DVec3::new(v[0][k], v[1][k], v[2][k]).normalize_or(DVec3::X);
     let e1 = axis(order[0]);
     let e2 = (axis(order[1]) - e1.dot(axis(order[1])) * e1).normalize_or(e1.any_orthonormal_vector());

@@ -156,6 +156,19 @@ pub fn coverage(img: &image::RgbaImage, background: [u8; 3]) -> f64 {
 }
 
 /// Mean absolute difference of two pictures per colour channel, 0..255.
+/// Mean and largest per-channel difference (RGB, /255) between two pictures of one size.
+pub fn mean_max_difference(a: &image::RgbaImage, b: &image::RgbaImage) -> (f64, u8) {
+    let (mut sum, mut max) = (0u64, 0u8);
+    for (p, q) in a.pixels().zip(b.pixels()) {
+        for c in 0..3 {
+            let d = p[c].abs_diff(q[c]);
+            sum += d as u64;
+            max = max.max(d);
+        }
+    }
+    (sum as f64 / (a.width() * a.height() * 3) as f64, max)
+}
+
 pub fn mean_difference(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
     assert_eq!(a.dimensions(), b.dimensions());
     let sum: u64 =

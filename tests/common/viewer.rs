@@ -3,7 +3,17 @@
 #![allow(dead_code)]
 
 use egui_kittest::Harness;
-use orbcloud::app::OrbApp;
+use orbcloud::app::{OrbApp, wgpu_setup};
+
+/// The viewer on its bundled cube demo at 1000×700, on lavapipe.
+pub fn harness() -> Harness<'static, OrbApp> {
+    let h = Harness::builder()
+        .with_size([1000.0, 700.0])
+        .wgpu_setup(wgpu_setup(true))
+        .build_eframe(|cc| OrbApp::cube_demo(cc));
+    assert!(h.state().error.is_none(), "viewer failed to start: {:?}", h.state().error);
+    h
+}
 
 /// Steps the app until nothing is loading (failing after a minute).
 pub fn wait_loaded(h: &mut Harness<'static, OrbApp>) {
