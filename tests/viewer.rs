@@ -646,3 +646,58 @@ fn a_structure_gets_a_molecular_surface_from_the_scene_panel_that_follows_its_se
     h.run_steps(2);
     assert!(!matches!(h.state().hovered(), Some(PickId::Surface { .. })), "{:?}", h.state().hovered());
 }
+
+/// The water bending scan of tests/fixtures/scans, as `scan init` writes its manifest, in a
+/// temporary folder (file names made absolute).
+fn bending_scan(dir: &std::path::Path) -> Harness<'static, OrbApp> {
+    let frames = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/scans/water_bend");
+    let made = orbcloud::formats::scan::init(&frames, None).unwrap();
+    let manifest = dir.join("bend.scan.toml");
+    std::fs::write(&manifest, made.text.replace("file = \"", &format!("file = \"{}/", frames.display()))).unwrap();
+    let mut h = Harness::builder()
+        .with_size([1100.0, 720.0])
+        .wgpu_setup(wgpu_setup(true))
+        .build_eframe(|cc| OrbApp::new(cc, vec![manifest]));
+    wait_for_scan(&mut h, |_| true);
+    h
+}
+
+#[test]
+fn grabbing_the_moving_hydrogen_bends_the_angle() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = bending_scan(dir.path());
+    let start = h.state().scan.as_ref().unwrap().theta;
+    let screen = |h: &Harness<'static, OrbApp>, atom: usize| {
+        let app = h.state();
+        app.scan.as_ref().unwrap().atom_on_screen(0, atom, &app.view.camera).expect("on screen")
+    };
+    let (vertex, fixed, moving) = (screen(&h, 0), screen(&h, 1), screen(&h, 2));
+    // Turn the moving hydrogen about the oxygen on screen, away from the fixed one, by 10°.
+    let (arm, away) = (moving - vertex, fixed - vertex);
+    let sign = if arm.x * away.y - arm.y * away.x > 0.0 { -1.0f32 } else { 1.0 };
+    let target = |deg: f32| {
+        let (s, c) = (sign * deg.to_radians()).sin_cos();
+        vertex + egui::vec2(c * arm.x - s * arm.y, s * arm.x + c * arm.y)
+    };
+    // The screen angle at the oxygen between the fixed hydrogen and a point.
+    let opening = |p: egui::Pos2| {
+        let (u, w) = (fixed - vertex, p - vertex);
+        (u.x * w.y - u.y * w.x).atan2(u.x * w.x + u.y * w.y).abs().to_degrees()
+    };
+    // Grab the arm near the hydrogen (on the bond), then move the pointer round the vertex.
+    let grip = vertex + 0.7 * arm;
+    h.hover_at(grip);
+    h.drag_at(grip);
+    h.run_steps(1);
+    for deg in [3.0, 6.0, 8.0, 10.0, 10.0, 10.0] {
+        h.hover_at(target(deg));
+        h.run_steps(1);
+    }
+    h.drop_at(target(10.0));
+    h.run_steps(2);
+    let theta = h.state().scan.as_ref().unwrap().theta;
+    let (held, wanted) = (opening(screen(&h, 2)), opening(target(10.0)));
+    eprintln!("angle {start:.1}° → {theta:.1}°; on screen the hydrogen at {held:.1}°, the pointer at {wanted:.1}°");
+    assert!((held - wanted).abs() < 1.5, "the hydrogen follows the pointer: {held} vs {wanted}");
+    assert!(theta > start + 5.0, "grabbing the hydrogen opens the angle: {start} → {theta}");
+}

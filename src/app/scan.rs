@@ -17,7 +17,7 @@ use crate::formats::scan::{ScanFile, load_scan};
 use crate::gpu::GpuContext;
 use crate::key_volumes::{KeyOptions, ScanScene, ScanSceneError, mix};
 use crate::meshes::isosurfaces_within;
-use crate::model::scan::Follow;
+use crate::model::scan::{Coordinate, Follow};
 use crate::scene::{AtomStyle, Interpolation, RenderSettings};
 
 /// Where a scan comes from.
@@ -230,10 +230,42 @@ impl ScanView {
         }
     }
 
+    /// The coordinate's value that puts the grabbed atom under `pointer` in view `view`: a bond
+    /// length scaled by how far along the bond's screen direction the pointer is, an angle
+    /// changed by the pointer's turn about the vertex on screen; none for a dihedral or a path.
+    fn held_value(&self, view: usize, pointer: egui::Pos2, camera: &crate::scene::Camera) -> Option<f64> {
+        let screen = |atom: usize| self.atom_on_screen(view, atom, camera);
+        match self.scene.scan.coordinate {
+            Coordinate::Distance([i, j]) => {
+                let (a, b) = (screen(i)?, screen(j)?);
+                let axis = b - a;
+                let length = axis.length();
+                (length > 2.0).then(|| self.theta * ((pointer - a).dot(axis) / (length * length)) as f64)
+            }
+            Coordinate::Angle([i, j, k]) => {
+                // The screen angle at the vertex from the fixed arm to the moving atom, at θ and
+                // a degree on: one Newton step on that (a plane seen at a slant turns more or
+                // less on screen than in space).
+                let opening = |theta: f64, p: Option<egui::Pos2>| {
+                    let m = self.scene.scan.geometry_at(theta);
+                    let at = |a: usize| self.views.get(view)?.to_screen(camera, m.atoms[a].position.as_vec3());
+                    let (fixed, vertex) = (at(i)?, at(j)?);
+                    let w = p.map_or_else(|| at(k), Some)? - vertex;
+                    let u = fixed - vertex;
+                    Some((u.x * w.y - u.y * w.x).atan2(u.x * w.x + u.y * w.y).abs().to_degrees() as f64)
+                };
+                let (now, on, wanted) =
+                    (opening(self.theta, None)?, opening(self.theta + 1.0, None)?, opening(self.theta, Some(pointer))?);
+                let slope = on - now;
+                (slope.abs() > 0.05).then(|| self.theta + (wanted - now) / slope)
+            }
+            Coordinate::Dihedral(_) | Coordinate::Path => None,
+        }
+    }
+
     /// The bond the coordinate moves about at θ (a dihedral's rotatable bond, an angle's
     /// moving arm, a distance's bond), for grabbing it with the mouse; none for a path.
     fn bond(&self) -> Option<[glam::Vec3; 2]> {
-        use crate::model::scan::Coordinate;
         let (j, k) = match self.scene.scan.coordinate {
             Coordinate::Distance([i, j]) => (i, j),
             Coordinate::Angle([_, j, k]) | Coordinate::Dihedral([_, j, k, _]) => (j, k),
@@ -359,10 +391,13 @@ pub fn views(
     }
     // The bond's position matters only where a press may start a drag that grabs it.
     let grab = !scan.drag_twists && ui.input(|i| i.pointer.primary_down());
-    let twist = TwistInput { drag_twists: scan.drag_twists, bond: grab.then(|| scan.bond()).flatten() };
+    let direct = !matches!(scan.scene.scan.coordinate, Coordinate::Dihedral(_) | Coordinate::Path);
+    let bond = (grab || (direct && ui.input(|i| i.pointer.primary_down()))).then(|| scan.bond()).flatten();
+    let twist = TwistInput { drag_twists: scan.drag_twists, bond, direct };
     let (lo, hi) = scan.scene.scan.range();
     let n = scan.views.len().max(1);
     let mut dragged = 0.0;
+    let mut held: Option<(usize, egui::Pos2)> = None;
     if scan.styled != scan.settings.atoms {
         restyle(scan);
         scan.styled = scan.settings.atoms;
@@ -403,7 +438,9 @@ pub fn views(
             }
             vp.detail = detail;
             vp.clouds = vec![scan.settings.volume];
-            dragged += vp.show_twistable(ui, render_state, view, Some(&mut scan.settings.volume.clip), Some(twist));
+            let twisted = vp.show_twistable(ui, render_state, view, Some(&mut scan.settings.volume.clip), Some(twist));
+            dragged += twisted.along;
+            held = held.or(twisted.pointer.map(|p| (slot, p)));
             let world = World::single(scan.scene.scan.geometry_at(scan.theta));
             if let Some(click) = vp.click.take() {
                 let text = measurements.click(click, &world);
@@ -416,6 +453,10 @@ pub fn views(
     });
     if dragged != 0.0 {
         scan.set_theta(scan.theta + dragged as f64 * (hi - lo));
+        ui.ctx().request_repaint();
+    }
+    if let Some(theta) = held.and_then(|(v, p)| scan.held_value(v, p, &view.camera)) {
+        scan.set_theta(theta);
         ui.ctx().request_repaint();
     }
     said

@@ -64,6 +64,18 @@ pub struct TwistInput {
     pub drag_twists: bool,
     /// The rotatable bond (world, bohr): a drag that starts on it twists.
     pub bond: Option<[glam::Vec3; 2]>,
+    /// A drag that starts on the bond moves its atom to the pointer (a bond length, an angle)
+    /// rather than the coordinate by the drag's horizontal length.
+    pub direct: bool,
+}
+
+/// What a drag in a scan's view asks of the coordinate.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Twist {
+    /// The drag's horizontal length as a fraction of the view's width.
+    pub along: f32,
+    /// Where the pointer holds the grabbed atom (points, in the window).
+    pub pointer: Option<egui::Pos2>,
 }
 
 /// How long one UI frame may spend drawing bands of a costly frame, and how long one band
@@ -181,6 +193,8 @@ pub struct Viewport {
     layout: Option<(egui::Rect, [u32; 2])>,
     /// Whether the current drag twists the dihedral.
     twisting: bool,
+    /// Whether that drag started on the coordinate's bond: the grabbed atom follows the pointer.
+    grabbed: bool,
     /// A costly frame being drawn band by band, and how many rows the last band drew.
     progress: Option<Progress>,
     band_rows: u32,
@@ -227,6 +241,7 @@ impl Viewport {
             hovered_at: None,
             layout: None,
             twisting: false,
+            grabbed: false,
             scan_shown: None,
             progress: None,
             band_rows: 8,
@@ -887,11 +902,11 @@ impl Viewport {
         view: &mut ViewState,
         clip: Option<&mut ClipPlane>,
     ) {
-        self.show_twistable(ui, render_state, view, clip, None);
+        let _ = self.show_twistable(ui, render_state, view, clip, None);
     }
 
-    /// [`Self::show`] for a scan view: returns the twist dragged this frame, as a fraction of
-    /// the view's width (positive to the right).
+    /// [`Self::show`] for a scan view: returns the drag of this frame on the coordinate (its
+    /// horizontal length as a fraction of the view's width, or where a grabbed atom is held).
     pub fn show_twistable(
         &mut self,
         ui: &mut egui::Ui,
@@ -899,12 +914,12 @@ impl Viewport {
         view: &mut ViewState,
         clip: Option<&mut ClipPlane>,
         twist: Option<TwistInput>,
-    ) -> f32 {
+    ) -> Twist {
         let rect = ui.available_rect_before_wrap();
         let response = ui.allocate_rect(rect, Sense::click_and_drag());
         let ppp = ui.ctx().pixels_per_point();
         let size = [(rect.width() * ppp).round().max(1.0) as u32, (rect.height() * ppp).round().max(1.0) as u32];
-        let mut twisted = 0.0;
+        let mut twisted = Twist::default();
         if let Some(t) = twist {
             if response.drag_started_by(PointerButton::Primary) {
                 self.layout = Some((rect, size));
@@ -913,12 +928,17 @@ impl Viewport {
                     matches!(ends, (Some(a), Some(b)) if distance_to_segment(p, a, b) < BOND_GRAB)
                 });
                 self.twisting = t.drag_twists || on_bond;
+                self.grabbed = on_bond && t.direct;
             }
             if !response.dragged() {
                 self.twisting = false;
+                self.grabbed = false;
             }
             if self.twisting && response.dragged_by(PointerButton::Primary) {
-                twisted = response.drag_delta().x / rect.width().max(1.0);
+                match response.interact_pointer_pos().filter(|_| self.grabbed) {
+                    Some(p) => twisted.pointer = Some(p),
+                    None => twisted.along = response.drag_delta().x / rect.width().max(1.0),
+                }
             }
         }
         if !self.twisting {
