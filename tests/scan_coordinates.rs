@@ -325,3 +325,24 @@ fn a_multi_frame_xyz_beside_the_files_orders_a_path() {
     let order: Vec<&str> = made.frames.iter().map(|(f, _)| f.as_str()).collect();
     assert_eq!(order, ["a.molden.gz", "b.molden.gz", "c.molden.gz", "d.molden.gz"]);
 }
+
+#[test]
+fn an_unrestricted_diagram_has_alpha_and_beta_lines() {
+    use orbcloud::model::correlation::correlation;
+    use orbcloud::model::scan::{FrameContent, KeyFrame};
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/wavefunctions/h2o_cation_uhf_631gs.molden");
+    let doc = orbcloud::formats::load(&path).unwrap();
+    let wf = doc.wavefunction.clone().unwrap();
+    let frame = |at: f64| KeyFrame {
+        at,
+        source: format!("{at}"),
+        molecule: doc.molecule.clone(),
+        content: FrameContent::Wavefunctions(vec![wf.clone()]),
+    };
+    let scan = Scan::new("uhf".into(), Coordinate::Path, vec!["homo".into()], vec![frame(0.0), frame(1.0)]).unwrap();
+    let diagram = correlation(&scan, 1, 1).unwrap();
+    let labels: Vec<&str> = diagram.lines.iter().map(|l| l.label.as_str()).collect();
+    assert_eq!(labels, ["HOMO−1 α", "HOMO α", "LUMO α", "LUMO+1 α", "HOMO−1 β", "HOMO β", "LUMO β", "LUMO+1 β"]);
+    // The same frame twice: every line stays on its own orbital, no crossing.
+    assert!(diagram.lines.iter().all(|l| l.crossings.is_empty() && l.points[0].2 == l.points[1].2));
+}
