@@ -386,7 +386,12 @@ pub fn views(
         }
     }
     if scan.playing {
-        scan.advance(dt.min(0.1));
+        // Each step of the animation is drawn whole before the next: a frame that takes longer
+        // than a UI frame (drawn in bands) would otherwise be restarted at every step and only
+        // its top ever shown.
+        if scan.views.iter().all(|v| v.progress().is_none()) {
+            scan.advance(dt.min(0.1));
+        }
         ui.ctx().request_repaint();
     }
     // The bond's position matters only where a press may start a drag that grabs it.
