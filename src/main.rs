@@ -440,7 +440,8 @@ struct ViewArgs {
     /// Hide the volume (atoms only).
     #[arg(long)]
     no_volume: bool,
-    /// Transfer function: the power law α = k1·ρ^k2, or a shape of value (both signs).
+    /// Transfer function: the power law α = k1·ρ^k2, a shape of the value (both signs), or
+    /// nested-cores (left half on ψ > 0, right half on ψ < 0, peaked at the extremes).
     #[arg(long, value_enum, default_value_t = TfArg::Power)]
     tf: TfArg,
     /// Shape centre (iso-value), a fraction of max|value|.
@@ -479,6 +480,7 @@ enum TfArg {
     LeftHalf,
     RightHalf,
     Sinusoidal,
+    NestedCores,
 }
 
 fn parse_preset(s: &str) -> Result<([f32; 3], [f32; 3]), String> {
@@ -528,8 +530,11 @@ impl ViewArgs {
             s.volume.k2 = k2;
         }
         let t = &mut s.volume.transfer;
+        if matches!(self.tf, TfArg::NestedCores) {
+            t.nested_cores();
+        }
         let shape = match self.tf {
-            TfArg::Power => None,
+            TfArg::Power | TfArg::NestedCores => None,
             TfArg::Uniform => Some(Shape::Uniform),
             TfArg::Gaussian => Some(Shape::Gaussian),
             TfArg::LeftHalf => Some(Shape::LeftHalfGaussian),
@@ -538,8 +543,11 @@ impl ViewArgs {
         };
         if let Some(shape) = shape {
             t.kind = TransferKind::Shaped;
+            t.positive.shape = shape;
+            t.negative.shape = shape;
+        }
+        if t.kind == TransferKind::Shaped {
             for lobe in [&mut t.positive, &mut t.negative] {
-                lobe.shape = shape;
                 lobe.center = self.tf_center.unwrap_or(lobe.center);
                 lobe.width = self.tf_width.unwrap_or(lobe.width);
                 lobe.opacity = self.tf_opacity.unwrap_or(lobe.opacity);
