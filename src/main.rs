@@ -155,6 +155,10 @@ struct WhatArgs {
     /// The spin density (α − β) instead of an orbital.
     #[arg(long)]
     spin_density: bool,
+    /// A bare basis function (atomic orbital) instead of an orbital, named as the viewer's
+    /// atomic-orbital selector names it: "C3 2pz", "O1 3dz2", "O1 3dxy", "H2 3dxx".
+    #[arg(long, conflicts_with_all = ["density", "spin_density"])]
+    basis_function: Option<String>,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -181,13 +185,15 @@ impl WavefunctionArgs {
     /// Puts the requested quantity into the headless renderer, when the document has a
     /// wavefunction; returns how long that took (GPU fill and read-back included) and the grid.
     fn apply(&self, ctx: &GpuContext, h: &mut Headless, doc: &Document) -> Result<Option<(f64, VolumeGrid)>> {
-        let Some(wf) = &doc.wavefunction else { return Ok(None) };
+        if doc.wavefunction.is_none() {
+            return Ok(None);
+        }
         let start = Instant::now();
         let view = WavefunctionView {
-            quantity: self.what.resolve(wf)?,
+            quantity: self.what.resolve(doc)?,
             direct: self.direct,
             points: self.grid_points.clamp(8, 512),
-            shells: None,
+            functions: None,
         };
         let mut fill = None;
         let grid = show_wavefunction(ctx, h.renderer.main(), &mut fill, doc, &view)?;
@@ -196,7 +202,15 @@ impl WavefunctionArgs {
 }
 
 impl WhatArgs {
-    fn resolve(&self, wf: &Wavefunction) -> Result<Quantity> {
+    fn resolve(&self, doc: &Document) -> Result<Quantity> {
+        let wf = wavefunction_of(doc)?;
+        if let Some(name) = &self.basis_function {
+            return orbcloud::model::basis_labels::find_function(&doc.molecule, &wf.basis, name)
+                .map(Quantity::BasisFunction)
+                .ok_or_else(|| {
+                    anyhow::anyhow!("no basis function {name:?} in this file (names look like \"C3 2pz\")")
+                });
+        }
         if self.density {
             return Ok(Quantity::Density);
         }
@@ -212,8 +226,12 @@ impl WhatArgs {
             .ok_or_else(|| anyhow::anyhow!("no orbital {:?} of spin {spin:?} in this file", self.orbital))
     }
 
-    /// A short name for what is asked for: `homo`, `lumo+1`, `mo12_beta`, `density`.
+    /// A short name for what is asked for: `homo`, `lumo+1`, `mo12_beta`, `density`, `ao_C3_2pz`.
     fn short_name(&self) -> String {
+        if let Some(name) = &self.basis_function {
+            let name: String = name.split_whitespace().collect::<Vec<_>>().join("_");
+            return format!("ao_{name}");
+        }
         if self.density {
             return "density".into();
         }
@@ -235,6 +253,9 @@ impl WhatArgs {
 
     /// The quantity option as given, for messages: `--orbital lumo+1`, `--density`.
     fn describe(&self) -> String {
+        if let Some(name) = &self.basis_function {
+            return format!("--basis-function {name:?}");
+        }
         match self.short_name().as_str() {
             "density" => "--density".into(),
             "spin_density" => "--spin-density".into(),
@@ -242,10 +263,15 @@ impl WhatArgs {
         }
     }
 
-    fn label(&self, q: &Quantity, wf: &Wavefunction) -> String {
+    fn label(&self, q: &Quantity, doc: &Document) -> String {
+        let Some(wf) = &doc.wavefunction else { return String::new() };
         match q {
             Quantity::Density => "total electron density".into(),
             Quantity::SpinDensity => "spin density".into(),
+            Quantity::BasisFunction(k) => {
+                let name = orbcloud::model::basis_labels::function_name(&doc.molecule, &wf.basis, *k);
+                format!("basis function {}", name.unwrap_or_default())
+            }
             Quantity::Orbital(i) => {
                 let o = &wf.orbitals[*i];
                 let n = wf.of_spin(o.spin).position(|(j, _)| j == *i).map_or(0, |p| p + 1);
