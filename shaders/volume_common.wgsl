@@ -79,16 +79,20 @@ fn gaussian(x: f32) -> f32 {
     return exp(-x * x);
 }
 
-// Seed 004's shapes of t = |value| / max|value|; see scene::transfer::Shape::factor.
-fn shape_factor(shape: u32, t: f32, c: f32, w_in: f32) -> f32 {
+// Seed 004's shapes on the signed value s = value / max|value|, placed at the signed centre c;
+// `outward` (±1) is the sign of the values the lobe colours. See scene::transfer::Shape::at.
+fn shape_factor(shape: u32, s: f32, c: f32, w_in: f32, outward: f32) -> f32 {
     let w = max(w_in, 1e-4);
+    let bell = gaussian((s - c) / w);
     switch shape {
-        case 0u: { return select(0.0, 1.0, abs(t - c) <= 0.5 * w); }
-        case 1u: { return gaussian((t - c) / w); }
-        case 2u: { return select(gaussian((t - c) / w), 1.0, t >= c); }
-        case 3u: { return select(gaussian((t - c) / w), 1.0, t <= c); }
+        case 0u: { return select(0.0, 1.0, abs(s - c) <= 0.5 * w); }
+        case 1u: { return bell; }
+        // The halves of the bell left and right of its peak; nothing on the other side.
+        case 2u: { return select(0.0, bell, s <= c); }
+        case 3u: { return select(0.0, bell, s >= c); }
         default: {
-            return select(pow(0.5 + 0.5 * cos(6.2831853 * (t - c) / w), 8.0), 0.0, t < c - 0.5 * w);
+            let contours = pow(0.5 + 0.5 * cos(6.2831853 * (s - c) / w), 8.0);
+            return select(contours, 0.0, (s - c) * outward < -0.5 * w);
         }
     }
 }
@@ -143,7 +147,8 @@ fn shade(value: f32, grad: vec3<f32>, from_eye: vec3<f32>) -> vec4<f32> {
         let positive = value >= 0.0 || u.signed_field != 1u;
         let lobe = select(u.tf_negative, u.tf_positive, positive);
         let shape = select(u.shape_negative, u.shape_positive, positive);
-        extinction = lobe.z * shape_factor(shape, abs(scaled), lobe.x, lobe.y);
+        let sign = select(-1.0, 1.0, positive);
+        extinction = lobe.z * shape_factor(shape, scaled, sign * lobe.x, lobe.y, sign);
         if (extinction < 1e-5) {
             return vec4<f32>(-1.0);
         }

@@ -28,8 +28,9 @@ pub struct WavefunctionView {
     pub direct: bool,
     /// Points per axis of the evaluation grid.
     pub points: usize,
-    /// Per shell, whether it contributes (the atomic-orbital selector); `None`: all.
-    pub shells: Option<Vec<bool>>,
+    /// Per basis function, whether it contributes to an orbital (the atomic-orbital
+    /// selector); `None`: all.
+    pub functions: Option<Vec<bool>>,
 }
 
 /// A wavefunction's quantity evaluated for display, ready for a layer. Made by
@@ -64,16 +65,15 @@ pub fn evaluate_wavefunction(
         return Ok(None);
     };
     let prepared = PreparedBasis::new(&wf.basis);
-    match view.quantity {
-        Quantity::Orbital(i) => {
-            let mut coefficients = wf.orbitals[i].coefficients.clone();
-            if let Some(mask) = &view.shells {
-                for ((shell, offset), &keep) in wf.basis.shells.iter().zip(wf.basis.shell_offsets()).zip(mask) {
-                    if !keep {
-                        coefficients[offset..offset + shell.n_functions()].fill(0.0);
-                    }
-                }
-            }
+    // An orbital (restricted to the chosen functions) or a bare basis function: a combination
+    // of basis functions, filled on the GPU.
+    let combination = match view.quantity {
+        Quantity::Orbital(i) => Some(restricted(&wf.orbitals[i].coefficients, view.functions.as_deref())),
+        Quantity::BasisFunction(k) => Some(prepared.unit_coefficients(k)),
+        Quantity::Density | Quantity::SpinDensity => None,
+    };
+    match combination {
+        Some(coefficients) => {
             let expansion = CartesianExpansion::from_coefficients(&prepared, &coefficients);
             let texture = fill.fill(ctx, &expansion, &geometry)?;
             // The filled values give the range that scales the opacity (and the gradient scale).
@@ -87,12 +87,25 @@ pub fn evaluate_wavefunction(
             };
             Ok(Some(Evaluated { grid, cloud }))
         }
-        Quantity::Density | Quantity::SpinDensity => {
+        None => {
             let label = if view.quantity == Quantity::Density { "total density" } else { "spin density" };
             let values = prepared.quantity_grid_f32(wf, view.quantity, &geometry);
             let grid = VolumeGrid::new(label, geometry.dims, geometry.world_from_grid, values);
             Ok(Some(Evaluated { grid, cloud: Cloud::Values }))
         }
+    }
+}
+
+/// An orbital's coefficients with those of the functions not in `keep` set to 0 (the orbital
+/// restricted to the chosen atomic orbitals); all of them without a selection.
+pub fn restricted(coefficients: &[f64], keep: Option<&[bool]>) -> Vec<f64> {
+    match keep {
+        Some(keep) => coefficients
+            .iter()
+            .zip(keep.iter().chain(std::iter::repeat(&true)))
+            .map(|(&c, &on)| if on { c } else { 0.0 })
+            .collect(),
+        None => coefficients.to_vec(),
     }
 }
 

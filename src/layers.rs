@@ -141,7 +141,8 @@ pub fn show_quantity(
         }
         Source::Wavefunction(quantity) => {
             let e = &state.evaluation;
-            let view = WavefunctionView { quantity, direct: e.direct, points: e.grid_points, shells: e.shells() };
+            let functions = doc.wavefunction.as_ref().and_then(|wf| e.restriction(&wf.basis));
+            let view = WavefunctionView { quantity, direct: e.direct, points: e.grid_points, functions };
             show_wavefunction(ctx, layer, fill, doc, &view)?
         }
     };

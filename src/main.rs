@@ -155,6 +155,10 @@ struct WhatArgs {
     /// The spin density (α − β) instead of an orbital.
     #[arg(long)]
     spin_density: bool,
+    /// A bare basis function (atomic orbital) instead of an orbital, named as the viewer's
+    /// atomic-orbital selector names it: "C3 2pz", "O1 3dz2", "O1 3dxy", "H2 3dxx".
+    #[arg(long, conflicts_with_all = ["density", "spin_density"])]
+    basis_function: Option<String>,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -181,13 +185,15 @@ impl WavefunctionArgs {
     /// Puts the requested quantity into the headless renderer, when the document has a
     /// wavefunction; returns how long that took (GPU fill and read-back included) and the grid.
     fn apply(&self, ctx: &GpuContext, h: &mut Headless, doc: &Document) -> Result<Option<(f64, VolumeGrid)>> {
-        let Some(wf) = &doc.wavefunction else { return Ok(None) };
+        if doc.wavefunction.is_none() {
+            return Ok(None);
+        }
         let start = Instant::now();
         let view = WavefunctionView {
-            quantity: self.what.resolve(wf)?,
+            quantity: self.what.resolve(doc)?,
             direct: self.direct,
             points: self.grid_points.clamp(8, 512),
-            shells: None,
+            functions: None,
         };
         let mut fill = None;
         let grid = show_wavefunction(ctx, h.renderer.main(), &mut fill, doc, &view)?;
@@ -196,7 +202,15 @@ impl WavefunctionArgs {
 }
 
 impl WhatArgs {
-    fn resolve(&self, wf: &Wavefunction) -> Result<Quantity> {
+    fn resolve(&self, doc: &Document) -> Result<Quantity> {
+        let wf = wavefunction_of(doc)?;
+        if let Some(name) = &self.basis_function {
+            return orbcloud::model::basis_labels::find_function(&doc.molecule, &wf.basis, name)
+                .map(Quantity::BasisFunction)
+                .ok_or_else(|| {
+                    anyhow::anyhow!("no basis function {name:?} in this file (names look like \"C3 2pz\")")
+                });
+        }
         if self.density {
             return Ok(Quantity::Density);
         }
@@ -212,8 +226,12 @@ impl WhatArgs {
             .ok_or_else(|| anyhow::anyhow!("no orbital {:?} of spin {spin:?} in this file", self.orbital))
     }
 
-    /// A short name for what is asked for: `homo`, `lumo+1`, `mo12_beta`, `density`.
+    /// A short name for what is asked for: `homo`, `lumo+1`, `mo12_beta`, `density`, `ao_C3_2pz`.
     fn short_name(&self) -> String {
+        if let Some(name) = &self.basis_function {
+            let name: String = name.split_whitespace().collect::<Vec<_>>().join("_");
+            return format!("ao_{name}");
+        }
         if self.density {
             return "density".into();
         }
@@ -235,6 +253,9 @@ impl WhatArgs {
 
     /// The quantity option as given, for messages: `--orbital lumo+1`, `--density`.
     fn describe(&self) -> String {
+        if let Some(name) = &self.basis_function {
+            return format!("--basis-function {name:?}");
+        }
         match self.short_name().as_str() {
             "density" => "--density".into(),
             "spin_density" => "--spin-density".into(),
@@ -242,10 +263,15 @@ impl WhatArgs {
         }
     }
 
-    fn label(&self, q: &Quantity, wf: &Wavefunction) -> String {
+    fn label(&self, q: &Quantity, doc: &Document) -> String {
+        let Some(wf) = &doc.wavefunction else { return String::new() };
         match q {
             Quantity::Density => "total electron density".into(),
             Quantity::SpinDensity => "spin density".into(),
+            Quantity::BasisFunction(k) => {
+                let name = orbcloud::model::basis_labels::function_name(&doc.molecule, &wf.basis, *k);
+                format!("basis function {}", name.unwrap_or_default())
+            }
             Quantity::Orbital(i) => {
                 let o = &wf.orbitals[*i];
                 let n = wf.of_spin(o.spin).position(|(j, _)| j == *i).map_or(0, |p| p + 1);
@@ -440,7 +466,8 @@ struct ViewArgs {
     /// Hide the volume (atoms only).
     #[arg(long)]
     no_volume: bool,
-    /// Transfer function: the power law α = k1·ρ^k2, or a shape of value (both signs).
+    /// Transfer function: the power law α = k1·ρ^k2, a shape of the value (both signs), or
+    /// nested-cores (left half on ψ > 0, right half on ψ < 0, peaked at the extremes).
     #[arg(long, value_enum, default_value_t = TfArg::Power)]
     tf: TfArg,
     /// Shape centre (iso-value), a fraction of max|value|.
@@ -479,6 +506,7 @@ enum TfArg {
     LeftHalf,
     RightHalf,
     Sinusoidal,
+    NestedCores,
 }
 
 fn parse_preset(s: &str) -> Result<([f32; 3], [f32; 3]), String> {
@@ -528,8 +556,11 @@ impl ViewArgs {
             s.volume.k2 = k2;
         }
         let t = &mut s.volume.transfer;
+        if matches!(self.tf, TfArg::NestedCores) {
+            t.nested_cores();
+        }
         let shape = match self.tf {
-            TfArg::Power => None,
+            TfArg::Power | TfArg::NestedCores => None,
             TfArg::Uniform => Some(Shape::Uniform),
             TfArg::Gaussian => Some(Shape::Gaussian),
             TfArg::LeftHalf => Some(Shape::LeftHalfGaussian),
@@ -538,8 +569,11 @@ impl ViewArgs {
         };
         if let Some(shape) = shape {
             t.kind = TransferKind::Shaped;
+            t.positive.shape = shape;
+            t.negative.shape = shape;
+        }
+        if t.kind == TransferKind::Shaped {
             for lobe in [&mut t.positive, &mut t.negative] {
-                lobe.shape = shape;
                 lobe.center = self.tf_center.unwrap_or(lobe.center);
                 lobe.width = self.tf_width.unwrap_or(lobe.width);
                 lobe.opacity = self.tf_opacity.unwrap_or(lobe.opacity);

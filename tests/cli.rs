@@ -56,6 +56,39 @@ fn eval_reproduces_expected_values() {
 }
 
 #[test]
+fn eval_shows_a_bare_basis_function_as_pyscf_evaluates_it() {
+    let fixtures = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/wavefunctions");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(fixtures.join("h2o_ccpvtz.ao.json")).unwrap()).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let points = dir.path().join("points.txt");
+    let text: String = json["points"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| format!("{} {} {}\n", p[0].as_f64().unwrap(), p[1].as_f64().unwrap(), p[2].as_f64().unwrap()))
+        .collect();
+    std::fs::write(&points, text).unwrap();
+    let molden = fixtures.join("h2o_ccpvtz.molden").display().to_string();
+    let args = ["eval", &molden, "--basis-function", "O1 3dz2", "--points", &points.display().to_string()];
+    let out = orbcloud(&args);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let got: Vec<f64> = String::from_utf8(out.stdout)
+        .unwrap()
+        .lines()
+        .map(|l| l.split_whitespace().nth(3).unwrap().parse().unwrap())
+        .collect();
+    let want = json["functions"]["O1 3dz^2"].as_array().unwrap();
+    assert_eq!(got.len(), want.len());
+    for (g, w) in got.iter().zip(want) {
+        assert!((g - w.as_f64().unwrap()).abs() < 1e-9, "{g} vs PySCF {w}");
+    }
+    let out = orbcloud(&["eval", &molden, "--basis-function", "O1 9dz2", "--points", &points.display().to_string()]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no basis function \"O1 9dz2\""));
+}
+
+#[test]
 fn cube_output_reads_back() {
     if common::refdata("cli::cube_output_reads_back").is_none() {
         return;

@@ -37,7 +37,7 @@ fn render(
         quantity: quantity(doc.wavefunction.as_ref().unwrap()),
         direct: false,
         points: 48,
-        shells: None,
+        functions: None,
     };
     let evaluated = evaluate_wavefunction(&ctx, &GtoFillPass::new(&ctx), &doc, &view).unwrap().unwrap();
     let mut h = Headless::new(&ctx, &doc, None, &s, SIZE).unwrap();

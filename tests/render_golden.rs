@@ -140,3 +140,71 @@ fn clipped_cloud() {
     assert!(red(&clipped) * 4 < red(&whole), "clipping left {} of {} red pixels", red(&clipped), red(&whole));
     assert_golden("clipped_cloud", &clipped);
 }
+
+/// Seed 004's pairing for nested cores: opacity grows from the empty space to each lobe's
+/// extreme value, lit so the nested shells show.
+#[test]
+fn nested_cores() {
+    let mut s = settings(SliceMode::ViewAligned, AtomStyle::BallAndStick);
+    s.volume.transfer.nested_cores();
+    s.volume.transfer.shading = true;
+    let img = render(&scene(Some(p_orbital(40, false))), &s, 65.0, 20.0);
+    assert_two_coloured_lobes(&img);
+    assert_golden("nested_cores", &img);
+}
+
+/// A p orbital ψ = z·exp(−r²/2) in a box of ±4.5 bohr: beyond r ≈ 3 bohr |ψ| is under 5 % of
+/// its maximum, so the box holds plenty of empty space.
+fn compact_p_orbital(n: usize) -> orbcloud::model::VolumeGrid {
+    let h = 9.0 / (n - 1) as f64;
+    let world = orbcloud::model::VolumeGrid::affine(
+        glam::DVec3::splat(-4.5),
+        [glam::DVec3::X * h, glam::DVec3::Y * h, glam::DVec3::Z * h],
+    );
+    let values = (0..n * n * n)
+        .map(|m| {
+            let p =
+                world.transform_point3(glam::DVec3::new((m / (n * n)) as f64, ((m / n) % n) as f64, (m % n) as f64));
+            (p.z * (-p.length_squared() / 2.0).exp()) as f32
+        })
+        .collect();
+    orbcloud::model::VolumeGrid::new("compact p", [n, n, n], world, values)
+}
+
+/// Seed 004's half Gaussians are drawn on the signed value, so far from the molecule (ψ ≈ 0)
+/// they are clear: with the box filling the frame, the border of the picture is exactly what it
+/// is with the cloud hidden, while the lobes show.
+#[test]
+fn half_gaussians_leave_empty_space_clear() {
+    use orbcloud::scene::Shape;
+    let doc = scene(Some(compact_p_orbital(40)));
+    let ctx = lavapipe();
+    let mut cam = default_camera(&doc);
+    cam.orbit(65f32.to_radians(), 20f32.to_radians());
+    // Close enough that every pixel's ray crosses the grid's box.
+    cam.distance *= 0.45;
+    let hidden = {
+        let mut s = settings(SliceMode::ViewAligned, AtomStyle::Hidden);
+        s.volume.visible = false;
+        render_document(&ctx, &doc, Some(0), &cam, &s, SIZE).expect("render")
+    };
+    let (w, h) = hidden.dimensions();
+    let border = |x: u32, y: u32| x < w / 10 || x >= w - w / 10 || y < h / 10 || y >= h - h / 10;
+    for shape in [Shape::RightHalfGaussian, Shape::LeftHalfGaussian] {
+        let mut s = shaped(shape, false);
+        s.atoms = AtomStyle::Hidden;
+        for lobe in [&mut s.volume.transfer.positive, &mut s.volume.transfer.negative] {
+            lobe.center = 0.5;
+            lobe.width = 0.1;
+        }
+        let img = render_document(&ctx, &doc, Some(0), &cam, &s, SIZE).expect("render");
+        let (mut fogged, mut n) = (0, 0);
+        for (x, y, p) in img.enumerate_pixels().filter(|(x, y, _)| border(*x, *y)) {
+            n += 1;
+            fogged += usize::from(p != hidden.get_pixel(x, y));
+        }
+        assert_eq!(fogged, 0, "{shape:?}: {fogged} of {n} border pixels are not the background");
+        let shown = img.pixels().zip(hidden.pixels()).filter(|(a, b)| (0..3).any(|c| a[c].abs_diff(b[c]) > 20)).count();
+        assert!(shown * 20 > (w * h) as usize, "{shape:?}: the lobes show ({shown} pixels)");
+    }
+}

@@ -269,7 +269,7 @@ fn grids_over_the_gpus_limits_are_shown_coarser_with_a_note() {
         quantity: orbcloud::model::orbitals::Quantity::Orbital(homo),
         direct: false,
         points: 64,
-        shells: None,
+        functions: None,
     };
     let fill = orbcloud::gpu::gto::GtoFillPass::new(&ctx);
     let (evaluated, note) = evaluate_within(&ctx, &fill, &doc, &view, &small).unwrap();

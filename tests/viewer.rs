@@ -8,7 +8,7 @@ mod viewer_support;
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use orbcloud::app::{OrbApp, wgpu_setup};
-use orbcloud::scene::{SliceMode, TransferKind};
+use orbcloud::scene::{Shape, SliceMode, TransferKind};
 use viewer_support::{click_at, harness, wait_loaded};
 
 /// A primary-button drag `dx` points to the right from `from`, in five moves; returns the
@@ -65,6 +65,11 @@ fn starts_on_the_demo_and_changes_controls() {
     h.get_by_label("shapes").click();
     h.run_steps(2);
     assert_eq!(h.state().selected_quantity().unwrap().cloud.transfer.kind, TransferKind::Shaped);
+    // Seed 004's pairing: the left half on ψ > 0, the right half on ψ < 0.
+    h.get_by_label("nested cores").click();
+    h.run_steps(2);
+    let t = h.state().selected_quantity().unwrap().cloud.transfer;
+    assert_eq!((t.positive.shape, t.negative.shape), (Shape::LeftHalfGaussian, Shape::RightHalfGaussian));
 
     h.get_by_label("show cloud").click();
     h.run_steps(2);

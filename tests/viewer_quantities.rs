@@ -172,6 +172,71 @@ fn homo_and_lumo_of_one_file_side_by_side_in_linked_panes_and_a_session_keeps_th
 }
 
 /// A primary-button drag `dx` points to the right from `from`.
+/// The largest |shown − want| over the shown grid, and the largest |want|.
+fn worst_difference(app: &OrbApp, want: impl Fn(glam::DVec3) -> f64) -> (f64, f64) {
+    let grid = app.shown_values().expect("values shown");
+    let [nx, ny, nz] = grid.dims;
+    let (mut worst, mut max) = (0f64, 0f64);
+    for i in (0..nx).step_by(3) {
+        for j in (0..ny).step_by(3) {
+            for k in (0..nz).step_by(3) {
+                let w = want(grid.point(i, j, k));
+                worst = worst.max((grid.values[(i * ny + j) * nz + k] as f64 - w).abs());
+                max = max.max(w.abs());
+            }
+        }
+    }
+    (worst, max)
+}
+
+/// Seed 004's atomic-orbital selector picks single basis functions: ticking O 2px alone
+/// restricts the HOMO (water's lone pair) to c·χ(2px); right-clicking O 3dxy shows that bare
+/// d function as a quantity of its own.
+#[test]
+fn the_atomic_orbital_selector_picks_single_basis_functions() {
+    use orbcloud::model::basis_labels::find_function;
+    let mut h = open(vec![fixture("wavefunctions/h2o_ccpvtz.molden")]);
+    // Kept for a look: target/tmp/ao_*.png.
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"));
+    let doc = h.state().doc().clone();
+    let wf = doc.wavefunction.as_ref().expect("a wavefunction");
+    let prepared = orbcloud::model::PreparedBasis::new(&wf.basis);
+    let homo = wf.homo(Spin::Alpha).unwrap();
+    let homo_picture = picture(&mut h, dir, "ao_homo");
+
+    h.get_by_label("Atomic orbitals").click();
+    h.run_steps(2);
+    h.get_by_label("none").click();
+    h.run_steps(1);
+    // Water's first "2px" is the oxygen's.
+    h.get_all_by_label("2px").next().expect("the O 2px box").click();
+    wait_loaded(&mut h);
+    let px = find_function(&doc.molecule, &wf.basis, "O1 2px").unwrap();
+    let e = &h.state().objects[0].state.evaluation;
+    assert!(e.ao_filter, "ticking applies the selection");
+    let ticked: Vec<usize> = e.functions.iter().enumerate().filter(|(_, on)| **on).map(|(k, _)| k).collect();
+    assert_eq!(ticked, [px], "only O 2px is ticked");
+    let c = wf.orbitals[homo].coefficients[px];
+    let (worst, max) = worst_difference(h.state(), |p| c * prepared.basis_values(p)[px]);
+    assert!(max > 0.05 && worst < 1e-5, "the HOMO's O 2px part: worst {worst:.2e} of {max:.3}");
+    let restricted = picture(&mut h, dir, "ao_homo_on_o_2px");
+    let d = common::mean_difference(&homo_picture, &restricted);
+    assert!(d > 0.5, "the picture changes ({d})");
+
+    // Right-click O 3dxy: shown alone, normalised as the basis defines it.
+    h.get_all_by_label("3dxy").next().expect("the O 3dxy box").click_secondary();
+    h.run_steps(2);
+    h.get_by_label("show O1 3dxy alone").click();
+    wait_loaded(&mut h);
+    let dxy = find_function(&doc.molecule, &wf.basis, "O1 3dxy").unwrap();
+    assert_eq!(sources(h.state()), [Wavefunction(Quantity::BasisFunction(dxy))]);
+    assert!(h.query_by_label("O1 3dxy · cloud").is_some(), "the scene panel names it");
+    let (worst, max) = worst_difference(h.state(), |p| prepared.basis_values(p)[dxy]);
+    assert!(max > 0.1 && worst < 1e-5, "the bare O 3dxy: worst {worst:.2e} of {max:.3}");
+    picture(&mut h, dir, "ao_bare_3dxy");
+    assert!(h.state().error.is_none(), "{:?}", h.state().error);
+}
+
 fn drag(h: &mut Harness<'static, OrbApp>, from: egui::Pos2, dx: f32) {
     h.hover_at(from);
     h.drag_at(from);

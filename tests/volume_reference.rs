@@ -11,6 +11,7 @@ use orbcloud::headless::render_document;
 use orbcloud::model::VolumeGrid;
 use orbcloud::model::grid::ValueKind;
 use orbcloud::scene::framing::default_camera;
+use orbcloud::scene::transfer::Lobe;
 use orbcloud::scene::{AtomStyle, Camera, RenderSettings, Shape, SliceMode, TransferKind};
 
 const SIZE: [u32; 2] = [96, 72];
@@ -91,6 +92,19 @@ fn shaped_transfer_functions_match_the_cpu_compositor() {
         t.positive.width = 0.25;
         t.negative.shape = Shape::RightHalfGaussian;
         t.negative.center = 0.2;
+    });
+    // The paper's pairing: both halves rise from ψ = 0 towards the extreme values.
+    compare(SliceMode::ViewAligned, |s| {
+        let t = &mut s.volume.transfer;
+        t.kind = TransferKind::Shaped;
+        t.positive = Lobe { shape: Shape::LeftHalfGaussian, center: 0.6, width: 0.35, opacity: 1.5 };
+        t.negative = Lobe { shape: Shape::RightHalfGaussian, ..t.positive };
+    });
+    compare(SliceMode::ViewAligned, |s| {
+        let t = &mut s.volume.transfer;
+        t.kind = TransferKind::Shaped;
+        t.positive = Lobe { shape: Shape::RightHalfGaussian, center: 0.1, width: 0.5, opacity: 1.5 };
+        t.negative = Lobe { shape: Shape::Uniform, center: 0.25, width: 0.3, opacity: 1.0 };
     });
 }
 

@@ -439,7 +439,9 @@ impl OrbApp {
     /// in σ refer to) and whether its values are signed (an orbital: two surfaces).
     pub fn shown_grid(&self) -> (Option<f64>, bool) {
         let signed = |q: &crate::scene::QuantityState| match q.source {
-            crate::scene::Source::Wavefunction(crate::model::orbitals::Quantity::Orbital(_)) => true,
+            crate::scene::Source::Wavefunction(
+                crate::model::orbitals::Quantity::Orbital(_) | crate::model::orbitals::Quantity::BasisFunction(_),
+            ) => true,
             crate::scene::Source::Wavefunction(_) => false,
             crate::scene::Source::Volume(_) => true,
         };

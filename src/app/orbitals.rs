@@ -1,12 +1,14 @@
 //! The orbital browser (seed 004's orbital UI): every orbital with its spin, symmetry, energy
-//! and occupation, HOMO/LUMO labels, the density, and the atomic-orbital selector.
+//! and occupation, HOMO/LUMO labels, the density, and the atomic-orbital selector (single basis
+//! functions: an orbital restricted to them, or one alone).
 
 use egui::{RichText, ScrollArea};
 
+use crate::model::Document;
+use crate::model::basis_labels::{atom_name, function_labels};
 use crate::model::orbitals::Quantity;
 use crate::model::orbitals::{Spin, Wavefunction};
 use crate::model::units::EV_PER_HARTREE;
-use crate::model::{Document, basis::ShellKind};
 use crate::scene::{Camera, ObjectState, Panes, QuantityState, RenderSettings, Source};
 
 /// Residual of CᵀSC − I above which the orbitals are flagged as not orthonormal.
@@ -14,8 +16,6 @@ pub const ORTHONORMAL_TOLERANCE: f64 = 1e-5;
 
 /// The orbital browser's width, points: a row (its + and the 41 monospace columns) fits.
 const ORBITALS_PANEL_WIDTH: f32 = 400.0;
-
-const SHELL_LETTERS: [&str; 6] = ["s", "p", "d", "f", "g", "h"];
 
 /// What a click in the browser does with a wavefunction quantity.
 enum Pick {
@@ -123,7 +123,9 @@ pub fn panel(
         if let Some(p) = orbital_table(ui, wf, state.evaluation.spin, shown, scroll_to_frontier) {
             pick = Some(p);
         }
-        ao_selector(ui, doc, wf, state);
+        if let Some(p) = ao_selector(ui, doc, wf, state) {
+            pick = Some(p);
+        }
     });
     match pick {
         Some(Pick::Switch(q)) => {
@@ -272,33 +274,75 @@ fn row_text(name: &str, label: &str, sym: &str, eh: &str, ev: &str, occ: &str) -
     format!("{name:<6}{label:<7}{sym:<4}{eh:>10}{ev:>9}{occ:>5}")
 }
 
-/// Seed 004's atomic-orbital selector: restrict the shown orbital to chosen shells.
-fn ao_selector(ui: &mut egui::Ui, doc: &Document, wf: &Wavefunction, state: &mut ObjectState) {
+/// Seed 004's atomic-orbital selector (its Fig. 9): tick single basis functions — 2px apart
+/// from 2py, one d component — to restrict the shown orbitals to them, or show one alone as a
+/// quantity of its own (right-click).
+fn ao_selector(ui: &mut egui::Ui, doc: &Document, wf: &Wavefunction, state: &mut ObjectState) -> Option<Pick> {
+    let mut pick = None;
     let view = &mut state.evaluation;
+    let n = wf.basis.n_functions();
+    if view.functions.len() != n {
+        view.functions = view.ticked(&wf.basis);
+    }
     ui.collapsing("Atomic orbitals", |ui| {
-        ui.checkbox(&mut view.ao_filter, "show only the selected shells' part of the orbital");
-        if view.shell_mask.len() != wf.basis.shells.len() {
-            view.shell_mask = vec![true; wf.basis.shells.len()];
-        }
-        ScrollArea::vertical().id_salt("ao").max_height(200.0).show(ui, |ui| {
-            for (atom_index, atom) in doc.molecule.atoms.iter().enumerate() {
-                let shells: Vec<usize> =
-                    wf.basis.shells.iter().enumerate().filter(|(_, s)| s.atom == atom_index).map(|(k, _)| k).collect();
-                if shells.is_empty() {
+        ui.checkbox(&mut view.ao_filter, "show only the ticked functions' part of the orbitals");
+        let before = view.functions.clone();
+        ui.horizontal(|ui| {
+            let ticked = view.functions.iter().filter(|&&on| on).count();
+            ui.label(format!("{ticked} of {n} ticked"));
+            if ui.small_button("all").clicked() {
+                view.functions.fill(true);
+            }
+            if ui.small_button("none").clicked() {
+                view.functions.fill(false);
+            }
+        });
+        ui.label(
+            RichText::new("an atom's button ticks or unticks its functions; right-click a function to show it alone")
+                .small()
+                .weak(),
+        );
+        let labels = function_labels(&wf.basis);
+        ScrollArea::vertical().id_salt("ao").max_height(220.0).show(ui, |ui| {
+            for atom in 0..doc.molecule.atoms.len() {
+                let functions: Vec<usize> = (0..labels.len()).filter(|&k| labels[k].atom == atom).collect();
+                if functions.is_empty() {
                     continue;
                 }
+                let atom_label = atom_name(&doc.molecule, atom);
                 ui.horizontal_wrapped(|ui| {
-                    ui.label(format!("{}{}", atom.element().symbol, atom_index + 1));
-                    for k in shells {
-                        let s = &wf.basis.shells[k];
-                        let letter = SHELL_LETTERS.get(s.l as usize).copied().unwrap_or("?");
-                        let kind = if s.kind == ShellKind::Pure || s.l < 2 { "" } else { "c" };
-                        ui.checkbox(&mut view.shell_mask[k], format!("{letter}{kind}"));
+                    if ui.button(&atom_label).clicked() {
+                        let all = functions.iter().all(|&k| view.functions[k]);
+                        functions.iter().for_each(|&k| view.functions[k] = !all);
+                    }
+                    for &k in &functions {
+                        let orbital = labels[k].orbital();
+                        let full = format!("{atom_label} {orbital}");
+                        ui.checkbox(&mut view.functions[k], orbital).context_menu(|ui| {
+                            let bare = Quantity::BasisFunction(k);
+                            if ui.button(format!("show {full} alone")).clicked() {
+                                pick = Some(Pick::Switch(bare));
+                                ui.close();
+                            }
+                            if ui.button(format!("add {full} to this view")).clicked() {
+                                pick = Some(Pick::Add(bare));
+                                ui.close();
+                            }
+                            if ui.button(format!("show {full} beside (a pane of its own)")).clicked() {
+                                pick = Some(Pick::Beside(bare));
+                                ui.close();
+                            }
+                        });
                     }
                 });
             }
         });
+        // Ticking is choosing: a changed selection applies at once.
+        if view.functions != before {
+            view.ao_filter = true;
+        }
     });
+    pick
 }
 
 #[cfg(test)]

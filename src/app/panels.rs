@@ -476,7 +476,9 @@ pub fn error_window(ui: &mut egui::Ui, app: &mut OrbApp) {
     }
 }
 
-fn lobe_editor(ui: &mut egui::Ui, label: &str, lobe: &mut Lobe) {
+/// One lobe's shape, centre, width and opacity, and its curve over the signed value: 0 … 1 for
+/// ψ > 0 (and densities), −1 … 0 for ψ < 0 (`sign` −1), as seed 004 draws its shapes.
+fn lobe_editor(ui: &mut egui::Ui, label: &str, lobe: &mut Lobe, sign: f32) {
     ui.horizontal(|ui| {
         ui.label(label);
         ComboBox::from_id_salt(label).selected_text(lobe.shape.name()).show_ui(ui, |ui| {
@@ -489,15 +491,16 @@ fn lobe_editor(ui: &mut egui::Ui, label: &str, lobe: &mut Lobe) {
     ui.add(Slider::new(&mut lobe.center, 0.0..=1.0).text("centre (× max)"));
     ui.add(Slider::new(&mut lobe.width, 0.005..=0.5).logarithmic(true).text(width_label));
     ui.add(Slider::new(&mut lobe.opacity, 0.0..=2.0).text("opacity"));
-    // The shape over t = |value| / max|value|.
     let (rect, _) = ui.allocate_exact_size(egui::vec2(ui.available_width().min(220.0), 36.0), egui::Sense::hover());
     let painter = ui.painter_at(rect);
     painter.rect_filled(rect, 2.0, ui.visuals().extreme_bg_color);
     let points: Vec<egui::Pos2> = (0..=100)
         .map(|i| {
-            let t = i as f32 / 100.0;
-            let f = lobe.shape.factor(t, lobe.center, lobe.width);
-            egui::pos2(rect.left() + t * rect.width(), rect.bottom() - f * (rect.height() - 2.0))
+            let x = i as f32 / 100.0;
+            // Left to right: 0 … 1 for the positive lobe, −1 … 0 for the negative one.
+            let s = if sign > 0.0 { x } else { x - 1.0 };
+            let f = lobe.factor(s, sign);
+            egui::pos2(rect.left() + x * rect.width(), rect.bottom() - f * (rect.height() - 2.0))
         })
         .collect();
     painter.add(egui::Shape::line(points, egui::Stroke::new(1.5, ui.visuals().strong_text_color())));
@@ -531,11 +534,19 @@ fn transfer_editor(ui: &mut egui::Ui, t: &mut Transfer, signed: bool) {
             ui.selectable_value(&mut t.kind, TransferKind::Shaped, "shapes");
         });
         if t.kind == TransferKind::Shaped {
+            if signed
+                && ui
+                    .button("nested cores")
+                    .on_hover_text("left half on ψ > 0, right half on ψ < 0, peaked at the extremes (Jang & Varetto)")
+                    .clicked()
+            {
+                t.nested_cores();
+            }
             if signed {
-                lobe_editor(ui, "ψ > 0", &mut t.positive);
-                lobe_editor(ui, "ψ < 0", &mut t.negative);
+                lobe_editor(ui, "ψ > 0", &mut t.positive, 1.0);
+                lobe_editor(ui, "ψ < 0", &mut t.negative, -1.0);
             } else {
-                lobe_editor(ui, "density", &mut t.positive);
+                lobe_editor(ui, "density", &mut t.positive, 1.0);
             }
         }
         ui.checkbox(&mut t.shading, "shading from the gradient");

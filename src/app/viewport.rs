@@ -379,7 +379,8 @@ impl Viewport {
             }
             Source::Wavefunction(quantity) => {
                 let e = &state.evaluation;
-                let view = WavefunctionView { quantity, direct: e.direct, points: e.grid_points, shells: e.shells() };
+                let functions = doc.wavefunction.as_ref().and_then(|wf| e.restriction(&wf.basis));
+                let view = WavefunctionView { quantity, direct: e.direct, points: e.grid_points, functions };
                 let ctx = self.ctx.clone();
                 let fill = self.fill.get_or_insert_with(|| Arc::new(GtoFillPass::new(&ctx))).clone();
                 let doc = doc.clone();

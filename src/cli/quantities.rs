@@ -1,8 +1,8 @@
 //! Several quantities of one file on the `render` command line: each quantity option
-//! (`--orbital X`, `--density`, `--spin-density`, `--volume N`) after the first starts another
-//! quantity, and the representation options after it (`--iso`, `--translucent`, `--no-volume`,
-//! transfer function, colours) are its own; `--beside` puts the next quantity in a pane of its
-//! own, side by side with the same camera.
+//! (`--orbital X`, `--density`, `--spin-density`, `--basis-function F`, `--volume N`) after the
+//! first starts another quantity, and the representation options after it (`--iso`,
+//! `--translucent`, `--no-volume`, transfer function, colours) are its own; `--beside` puts the
+//! next quantity in a pane of its own, side by side with the same camera.
 
 use std::ffi::OsString;
 
@@ -17,7 +17,7 @@ use super::surface_cli::IsoArgs;
 use super::{Cli, Command, RenderArgs, ViewArgs, WavefunctionArgs};
 
 /// The options that start a quantity.
-const STARTS: [&str; 4] = ["--orbital", "--density", "--spin-density", "--volume"];
+const STARTS: [&str; 5] = ["--orbital", "--density", "--spin-density", "--basis-function", "--volume"];
 /// The option that puts the next quantity beside the ones before, in a pane of its own.
 const BESIDE: &str = "--beside";
 /// Options that belong to the whole picture or file, not to a quantity: wherever they are
@@ -131,7 +131,7 @@ pub fn quantity_of(
 ) -> Result<Option<QuantityState>> {
     let settings = view.settings();
     let source = match &doc.wavefunction {
-        Some(wf) => Source::Wavefunction(what.what.resolve(wf)?),
+        Some(_) => Source::Wavefunction(what.what.resolve(doc)?),
         None => match view.volume_index(doc)? {
             Some(i) => Source::Volume(i),
             None => return Ok(None),

@@ -252,12 +252,12 @@ impl GridArgs {
             });
         }
         let wf = wavefunction_of(doc)?;
-        let q = self.what.resolve(wf)?;
+        let q = self.what.resolve(doc)?;
         let g = orbital_geometry(doc, q, self.grid_points.clamp(8, 512)).context("the file has no atoms")?;
         let spec = g;
         let prepared = PreparedBasis::new(&wf.basis);
         let values = prepared.quantity_grid_f32(wf, q, &spec);
-        Ok(VolumeGrid::new(self.what.label(&q, wf), g.dims, g.world_from_grid, values))
+        Ok(VolumeGrid::new(self.what.label(&q, doc), g.dims, g.world_from_grid, values))
     }
 }
 

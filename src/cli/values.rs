@@ -30,13 +30,14 @@ pub fn info(file: &Path, json: bool) -> Result<()> {
 pub fn eval(file: &Path, what: &WhatArgs, points: &Path) -> Result<()> {
     let doc = formats::load(file)?;
     let wf = wavefunction_of(&doc)?;
-    let q = what.resolve(wf)?;
+    let q = what.resolve(&doc)?;
     let prepared = PreparedBasis::new(&wf.basis);
     let points = read_points(points)?;
     let values: Vec<f64> = points
         .par_iter()
         .map(|&p| match q {
             Quantity::Orbital(i) => prepared.orbital_value(&wf.orbitals[i].coefficients, p),
+            Quantity::BasisFunction(k) => prepared.basis_values(p).get(k).copied().unwrap_or(0.0),
             Quantity::Density => prepared.density(wf, p),
             Quantity::SpinDensity => prepared.spin_density(wf, p),
         })
@@ -59,7 +60,7 @@ pub fn cube(
 ) -> Result<()> {
     let doc = formats::load(file)?;
     let wf = wavefunction_of(&doc)?;
-    let q = what.resolve(wf)?;
+    let q = what.resolve(&doc)?;
     let (lo, hi) = match margin {
         Some(m) => doc.molecule.bounds().map(|(lo, hi)| (lo - DVec3::splat(m), hi + DVec3::splat(m))),
         None => orbcloud::model::extent::quantity_box(wf, &doc.molecule, q),
@@ -79,7 +80,7 @@ pub fn cube(
     let t = Instant::now();
     let values = prepared.quantity_grid_f32(wf, q, &spec);
     let seconds = t.elapsed().as_secs_f64();
-    let label = what.label(&q, wf);
+    let label = what.label(&q, &doc);
     let grid = VolumeGrid::new(&label, dims, spec.world_from_grid, values);
     let id = match q {
         Quantity::Orbital(i) => wf.of_spin(wf.orbitals[i].spin).position(|(j, _)| j == i).map_or(0, |p| p + 1),

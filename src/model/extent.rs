@@ -96,7 +96,7 @@ pub fn quantity_box(wf: &Wavefunction, molecule: &Molecule, quantity: Quantity) 
     let (lo, hi) = molecule.bounds()?;
     let prepared = PreparedBasis::new(&wf.basis);
     let decay = match quantity {
-        Quantity::Orbital(_) => Decay::Relative(FACE_FRACTION),
+        Quantity::Orbital(_) | Quantity::BasisFunction(_) => Decay::Relative(FACE_FRACTION),
         Quantity::Density | Quantity::SpinDensity => Decay::Absolute(DENSITY_FACE),
     };
     Some(decay_box(lo, hi, START_REACH, decay, |spec| prepared.quantity_grid(wf, quantity, spec)))

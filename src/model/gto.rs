@@ -385,6 +385,15 @@ impl PreparedBasis {
         out
     }
 
+    /// The coefficients of basis function `k` alone: 1 on it, 0 elsewhere (none past the last).
+    pub fn unit_coefficients(&self, k: usize) -> Vec<f64> {
+        let mut out = vec![0.0; self.n_functions];
+        if let Some(c) = out.get_mut(k) {
+            *c = 1.0;
+        }
+        out
+    }
+
     /// Per shell, the orbital's coefficients on the shell's cartesian monomials x^a y^b z^c
     /// (component factors and pure transformation folded in); flat, indexed by
     /// `first_cartesian`. Also returns which shells have any non-zero coefficient.
@@ -450,6 +459,7 @@ impl PreparedBasis {
     pub fn quantity_grid(&self, wf: &Wavefunction, quantity: Quantity, grid: &GridSpec) -> Vec<f64> {
         match quantity {
             Quantity::Orbital(i) => self.eval_grid(&wf.orbitals[i].coefficients, grid),
+            Quantity::BasisFunction(k) => self.eval_grid(&self.unit_coefficients(k), grid),
             Quantity::Density => self.density_grid(wf, grid),
             Quantity::SpinDensity => self.spin_density_grid(wf, grid),
         }
@@ -459,6 +469,7 @@ impl PreparedBasis {
     pub fn quantity_grid_f32(&self, wf: &Wavefunction, quantity: Quantity, grid: &GridSpec) -> Vec<f32> {
         match quantity {
             Quantity::Orbital(i) => self.eval_grid_f32(&wf.orbitals[i].coefficients, grid),
+            Quantity::BasisFunction(k) => self.eval_grid_f32(&self.unit_coefficients(k), grid),
             _ => self.quantity_grid(wf, quantity, grid).iter().map(|&v| v as f32).collect(),
         }
     }

@@ -6,6 +6,7 @@
 pub mod arrow;
 pub mod atom;
 pub mod basis;
+pub mod basis_labels;
 pub mod bonds;
 pub mod cartesian;
 pub mod correlation;

@@ -125,6 +125,9 @@ pub enum Quantity {
     Density,
     /// α − β density.
     SpinDensity,
+    /// A bare basis function (an atomic orbital, normalised as the basis defines it), by index
+    /// into the basis's functions: coefficient 1 on it, 0 elsewhere.
+    BasisFunction(usize),
 }
 
 /// Which orbital a user means: `homo`, `lumo`, `homo-2`, `lumo+1`, or a 1-based index into the

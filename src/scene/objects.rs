@@ -112,7 +112,8 @@ impl ObjectState {
     /// Makes the state fit `doc` (a session saved for a file that has changed since, or one
     /// written before quantities existed): quantities `doc` does not hold are dropped (a
     /// data set that is not there becomes the file's first quantity), the selection points at
-    /// one that is, and the shell mask has one entry per shell.
+    /// one that is, and the atomic-orbital selector has one entry per basis function (a
+    /// per-shell one spread over each shell's functions).
     pub fn fit_to(&mut self, doc: &Document, defaults: &RenderSettings) {
         for q in &mut self.quantities {
             if let (Source::Volume(_), false) = (q.source, q.source.exists_in(doc)) {
@@ -126,10 +127,8 @@ impl ObjectState {
             self.quantities.push(QuantityState::new(source, defaults));
         }
         self.selected = self.selected.min(self.quantities.len().saturating_sub(1));
-        if let Some(wf) = &doc.wavefunction
-            && self.evaluation.shell_mask.len() != wf.basis.shells.len()
-        {
-            self.evaluation.shell_mask = vec![true; wf.basis.shells.len()];
+        if let Some(wf) = &doc.wavefunction {
+            self.evaluation.functions = self.evaluation.ticked(&wf.basis);
         }
     }
 
@@ -218,7 +217,7 @@ pub fn changes(before: &ObjectState, after: &ObjectState) -> Changes {
     let layers = before.quantities.len() != after.quantities.len();
     let evaluation = before.evaluation.direct != after.evaluation.direct
         || before.evaluation.grid_points != after.evaluation.grid_points
-        || before.evaluation.shells() != after.evaluation.shells();
+        || before.evaluation.selection() != after.evaluation.selection();
     let quantities = if layers {
         Vec::new()
     } else {

@@ -4,6 +4,8 @@
 use serde::{Deserialize, Serialize};
 
 use crate::model::Document;
+use crate::model::basis::Basis;
+use crate::model::basis_labels::function_name;
 use crate::model::orbitals::{Quantity, Spin, Wavefunction};
 
 use super::{AtomColoring, AtomStyle, IsosurfaceSettings, RenderSettings, VolumeSettings};
@@ -24,6 +26,7 @@ impl Source {
             Source::Volume(i) => i < doc.volumes.len(),
             Source::Wavefunction(q) => doc.wavefunction.as_ref().is_some_and(|wf| match q {
                 Quantity::Orbital(i) => i < wf.orbitals.len(),
+                Quantity::BasisFunction(k) => k < wf.basis.n_functions(),
                 Quantity::Density => true,
                 Quantity::SpinDensity => !wf.restricted,
             }),
@@ -38,7 +41,8 @@ impl Source {
         }
     }
 
-    /// A short name: "HOMO", "LUMO+1 β", "MO 12", "total density", a data set's label.
+    /// A short name: "HOMO", "LUMO+1 β", "MO 12", "total density", "C3 2pz" (a bare basis
+    /// function), a data set's label.
     pub fn name(self, doc: &Document) -> String {
         match self {
             Source::Volume(i) => doc.volumes.get(i).map_or_else(|| format!("data set {}", i + 1), |v| v.label.clone()),
@@ -48,6 +52,11 @@ impl Source {
                 Some(wf) => orbital_name(wf, i),
                 None => format!("MO {}", i + 1),
             },
+            Source::Wavefunction(Quantity::BasisFunction(k)) => doc
+                .wavefunction
+                .as_ref()
+                .and_then(|wf| function_name(&doc.molecule, &wf.basis, k))
+                .unwrap_or_else(|| format!("basis function {}", k + 1)),
         }
     }
 }
@@ -168,23 +177,45 @@ pub struct Evaluation {
     pub spin: Spin,
     /// Evaluate orbitals per slice sample instead of on a GPU-filled grid.
     pub direct: bool,
-    /// Restrict orbitals to the shells ticked in `shell_mask` (the atomic-orbital selector).
+    /// Restrict orbitals to the basis functions ticked in `functions` (seed 004's
+    /// atomic-orbital selector).
     pub ao_filter: bool,
-    pub shell_mask: Vec<bool>,
+    /// Per basis function (the model's order), whether it contributes when the filter is on.
+    /// Sessions from when the selector picked shells stored one entry per shell here.
+    #[serde(alias = "shell_mask")]
+    pub functions: Vec<bool>,
     /// Points per axis of the evaluation grid.
     pub grid_points: usize,
 }
 
 impl Default for Evaluation {
     fn default() -> Self {
-        Self { spin: Spin::Alpha, direct: false, ao_filter: false, shell_mask: Vec::new(), grid_points: 72 }
+        Self { spin: Spin::Alpha, direct: false, ao_filter: false, functions: Vec::new(), grid_points: 72 }
     }
 }
 
 impl Evaluation {
-    /// The shells an orbital is restricted to, when the filter is on.
-    pub fn shells(&self) -> Option<Vec<bool>> {
-        self.ao_filter.then(|| self.shell_mask.clone())
+    /// The functions ticked, one entry per basis function of `basis`: as stored, or a stored
+    /// per-shell selection spread over each shell's functions; all of them when neither fits.
+    pub fn ticked(&self, basis: &Basis) -> Vec<bool> {
+        let n = basis.n_functions();
+        if self.functions.len() == n {
+            return self.functions.clone();
+        }
+        if self.functions.len() == basis.shells.len() {
+            return basis.shells.iter().zip(&self.functions).flat_map(|(s, &on)| vec![on; s.n_functions()]).collect();
+        }
+        vec![true; n]
+    }
+
+    /// The functions an orbital of `basis` is restricted to, when the filter is on.
+    pub fn restriction(&self, basis: &Basis) -> Option<Vec<bool>> {
+        self.ao_filter.then(|| self.ticked(basis))
+    }
+
+    /// What decides the restriction, to tell whether it changed.
+    pub fn selection(&self) -> (bool, &[bool]) {
+        (self.ao_filter, if self.ao_filter { &self.functions } else { &[] })
     }
 }
 

@@ -6,19 +6,28 @@
 
 use serde::{Deserialize, Serialize};
 
-/// Seed 004's five shapes, as functions of t = |value| / max|value| ∈ [0, 1].
+/// Seed 004's five shapes, drawn as the paper draws them: on the signed value
+/// s = value / max|value| ∈ [−1, 1], each lobe's shape placed at s = ±centre (its sign).
+///
+/// The halves are not mirror images of each other: a right half falls off towards larger s, a
+/// left half towards smaller s. The paper pairs them so that both fall off towards ψ = 0: the
+/// right half on ψ < 0 and the left half on ψ > 0 rise from the empty space towards the
+/// extreme value and reveal the nested shells around the cores (all of them with the centre at
+/// 1, the extreme itself); swapped, they are shells with a sharp outside. Every shape is clear
+/// where ψ ≈ 0 unless its centre is near 0.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 pub enum Shape {
-    /// A band of constant opacity |t − c| ≤ w/2: a thick isosurface.
+    /// A band of constant opacity |s − c| ≤ w/2: a thick isosurface.
     Uniform,
-    /// exp(−((t − c)/w)²): a soft shell around the iso-value c.
+    /// exp(−((s − c)/w)²): a soft shell around the iso-value c.
     #[default]
     Gaussian,
-    /// Full opacity for t ≥ c, a Gaussian tail below: a solid core inside the iso-value.
+    /// The bell's half left of its peak: exp(−((s − c)/w)²) for s ≤ c, nothing above.
     LeftHalfGaussian,
-    /// Full opacity for t ≤ c, a Gaussian tail above: everything outside the iso-value.
+    /// The bell's half right of its peak: exp(−((s − c)/w)²) for s ≥ c, nothing below.
     RightHalfGaussian,
-    /// (½ + ½·cos 2π(t − c)/w)^8 for t ≥ c − w/2: contour shells at c, c + w, c + 2w, …
+    /// (½ + ½·cos 2π(s − c)/w)^8 from half a period before c on, away from zero: contour shells
+    /// at c, c ± w, c ± 2w, … towards the lobe's extreme value.
     Sinusoidal,
 }
 
@@ -36,33 +45,22 @@ impl Shape {
         }
     }
 
-    /// Opacity factor in [0, 1] at normalised value `t` for centre `c` and width `w` — the CPU
-    /// reference of `shape_factor` in volume_common.wgsl.
-    pub fn factor(self, t: f32, c: f32, w: f32) -> f32 {
+    /// Opacity factor in [0, 1] at the signed value `s` of a shape placed at the signed centre
+    /// `c` with width `w`; `outward` (±1) is the sign of the values its lobe colours (the way
+    /// the contours run) — the CPU reference of `shape_factor` in volume_common.wgsl.
+    pub fn at(self, s: f32, c: f32, w: f32, outward: f32) -> f32 {
         let w = w.max(1e-4);
-        let g = |x: f32| (-(x * x)).exp();
+        let bell = (-((s - c) / w).powi(2)).exp();
         match self {
-            Shape::Uniform => f32::from((t - c).abs() <= 0.5 * w),
-            Shape::Gaussian => g((t - c) / w),
-            Shape::LeftHalfGaussian => {
-                if t >= c {
-                    1.0
-                } else {
-                    g((t - c) / w)
-                }
-            }
-            Shape::RightHalfGaussian => {
-                if t <= c {
-                    1.0
-                } else {
-                    g((t - c) / w)
-                }
-            }
+            Shape::Uniform => f32::from((s - c).abs() <= 0.5 * w),
+            Shape::Gaussian => bell,
+            Shape::LeftHalfGaussian => f32::from(s <= c) * bell,
+            Shape::RightHalfGaussian => f32::from(s >= c) * bell,
             Shape::Sinusoidal => {
-                if t < c - 0.5 * w {
+                if (s - c) * outward < -0.5 * w {
                     0.0
                 } else {
-                    (0.5 + 0.5 * (std::f32::consts::TAU * (t - c) / w).cos()).powi(8)
+                    (0.5 + 0.5 * (std::f32::consts::TAU * (s - c) / w).cos()).powi(8)
                 }
             }
         }
@@ -77,7 +75,7 @@ impl Shape {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Lobe {
     pub shape: Shape,
-    /// Centre c, as a fraction of max|value|.
+    /// Centre, as a fraction of max|value|: the shape sits at ±centre on the signed value.
     pub center: f32,
     /// Width w, as a fraction of max|value|.
     pub width: f32,
@@ -88,6 +86,14 @@ pub struct Lobe {
 impl Default for Lobe {
     fn default() -> Self {
         Self { shape: Shape::Gaussian, center: 0.25, width: 0.08, opacity: 0.9 }
+    }
+}
+
+impl Lobe {
+    /// Its shape's factor at the signed value `s`, for the lobe of values of sign `sign` (±1):
+    /// the shape sits at s = sign·centre.
+    pub fn factor(&self, s: f32, sign: f32) -> f32 {
+        self.shape.at(s, sign * self.center, self.width, sign)
     }
 }
 
@@ -130,6 +136,16 @@ impl Default for Transfer {
 }
 
 impl Transfer {
+    /// Seed 004's pairing for nested cores: the left half on ψ > 0 and the right half on ψ < 0,
+    /// each peaked at its extreme value, so opacity grows from the empty space to the cores.
+    /// The width keeps ψ = 0 under the shaders' visibility floor of 10⁻⁵ (2·e^−(1/0.28)² ≈ 6·10⁻⁶):
+    /// empty space stays exactly clear.
+    pub fn nested_cores(&mut self) {
+        self.kind = TransferKind::Shaped;
+        self.positive = Lobe { shape: Shape::LeftHalfGaussian, center: 1.0, width: 0.28, opacity: 2.0 };
+        self.negative = Lobe { shape: Shape::RightHalfGaussian, ..self.positive };
+    }
+
     /// Whether the shaders need the gradient at each sample.
     pub fn needs_gradient(&self) -> bool {
         self.shading || self.gradient_power > 0.0 || self.boundary > 0.0
@@ -165,19 +181,49 @@ impl Default for ClipPlane {
 mod tests {
     use super::*;
 
+    /// The paper's formulas written out with numbers: g(x) = e^(−x²), s the signed value.
     #[test]
-    fn shapes_peak_where_they_should() {
-        assert_eq!(Shape::Uniform.factor(0.30, 0.3, 0.1), 1.0);
-        assert_eq!(Shape::Uniform.factor(0.40, 0.3, 0.1), 0.0);
-        assert!((Shape::Gaussian.factor(0.3, 0.3, 0.1) - 1.0).abs() < 1e-6);
-        assert!(Shape::Gaussian.factor(0.5, 0.3, 0.1) < 0.02);
-        assert_eq!(Shape::LeftHalfGaussian.factor(0.9, 0.3, 0.1), 1.0);
-        assert!(Shape::LeftHalfGaussian.factor(0.1, 0.3, 0.1) < 0.02);
-        assert_eq!(Shape::RightHalfGaussian.factor(0.1, 0.3, 0.1), 1.0);
-        assert!(Shape::RightHalfGaussian.factor(0.9, 0.3, 0.1) < 0.02);
-        // Contours every w from c on: peaks at c + k·w, zero half-way and below the first.
-        assert!((Shape::Sinusoidal.factor(0.5, 0.1, 0.2) - 1.0).abs() < 1e-5);
-        assert!(Shape::Sinusoidal.factor(0.6, 0.1, 0.2) < 1e-6);
-        assert_eq!(Shape::Sinusoidal.factor(0.0, 0.1, 0.1), 0.0);
+    fn shapes_are_drawn_on_the_signed_value() {
+        let close = |a: f32, b: f32| (a - b).abs() < 1e-6;
+        let lobe = |shape, center, width| Lobe { shape, center, width, opacity: 1.0 };
+        // Right half on ψ < 0 at −0.5: g((s + 0.5)/0.1) from the peak towards zero, none beyond.
+        let right = lobe(Shape::RightHalfGaussian, 0.5, 0.1);
+        assert!(close(right.factor(-0.5, -1.0), 1.0));
+        assert!(close(right.factor(-0.45, -1.0), 0.778_800_8)); // e^(−0.25)
+        assert!(close(right.factor(-0.4, -1.0), 0.367_879_4)); // e^(−1)
+        assert_eq!(right.factor(-0.55, -1.0), 0.0);
+        assert_eq!(right.factor(-0.9, -1.0), 0.0);
+        assert!(right.factor(0.0, -1.0) < 1.4e-11); // e^(−25): empty space stays clear
+        // Left half on ψ > 0 at +0.5: its mirror image.
+        let left = lobe(Shape::LeftHalfGaussian, 0.5, 0.1);
+        assert!(close(left.factor(0.45, 1.0), 0.778_800_8));
+        assert_eq!(left.factor(0.55, 1.0), 0.0);
+        assert!(left.factor(0.0, 1.0) < 1.4e-11);
+        // Swapped, each falls off towards the extreme value instead, and is clear near zero too.
+        assert!(close(right.factor(0.6, 1.0), 0.367_879_4));
+        assert_eq!(right.factor(0.45, 1.0), 0.0);
+        assert!(close(left.factor(-0.6, -1.0), 0.367_879_4));
+        assert_eq!(left.factor(-0.45, -1.0), 0.0);
+        // Centred on the extreme, the paper's pairing rises all the way to the cores.
+        let core = lobe(Shape::LeftHalfGaussian, 1.0, 0.4);
+        assert!(core.factor(0.2, 1.0) < core.factor(0.6, 1.0) && core.factor(0.6, 1.0) < core.factor(1.0, 1.0));
+        // The preset: exactly clear at ψ = 0 (under the shaders' floor of 10⁻⁵), full at the extremes.
+        let mut t = Transfer::default();
+        t.nested_cores();
+        for (lobe, sign) in [(t.positive, 1.0), (t.negative, -1.0)] {
+            assert!(lobe.opacity * lobe.factor(0.0, sign) < 1e-5);
+            assert!(close(lobe.factor(sign, sign), 1.0));
+        }
+        // Symmetric shapes: the same for either sign.
+        let uniform = lobe(Shape::Uniform, 0.3, 0.1);
+        assert_eq!((uniform.factor(-0.3, -1.0), uniform.factor(-0.36, -1.0)), (1.0, 0.0));
+        assert!(close(lobe(Shape::Gaussian, 0.3, 0.1).factor(-0.2, -1.0), 0.367_879_4));
+        // Contours every w from c away from zero: peaks at ±(c + k·w), zero half-way and inside c.
+        let contours = lobe(Shape::Sinusoidal, 0.1, 0.2);
+        for sign in [1.0, -1.0] {
+            assert!(close(contours.factor(sign * 0.5, sign), 1.0));
+            assert!(contours.factor(sign * 0.6, sign) < 1e-6);
+            assert_eq!(contours.factor(sign * -0.05, sign), 0.0);
+        }
     }
 }

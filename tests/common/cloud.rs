@@ -5,7 +5,7 @@ use glam::{DVec3, Vec3};
 use orbcloud::model::VolumeGrid;
 use orbcloud::model::grid::ValueKind;
 use orbcloud::scene::slicing::GridBox;
-use orbcloud::scene::{Camera, RenderSettings, TransferKind, VolumeSettings};
+use orbcloud::scene::{Camera, RenderSettings, Shape, TransferKind, VolumeSettings};
 
 pub fn srgb_encode(c: f64) -> u8 {
     let c = c.clamp(0.0, 1.0);
@@ -25,6 +25,26 @@ fn ray_triangle(o: DVec3, d: DVec3, t: [DVec3; 3]) -> Option<f64> {
     let q = s.cross(e1);
     let v = d.dot(q) / det;
     (u >= 0.0 && v >= 0.0 && u + v <= 1.0).then(|| e2.dot(q) / det)
+}
+
+/// Jang & Varetto's transfer function shapes on the signed value `s` (a fraction of max|ψ|),
+/// placed at the signed centre `c` with width `w`, written out from the paper (not the
+/// renderer's code): a box, the bell e^(−((s − c)/w)²), the bell's half left of its peak (s ≤ c)
+/// and right of it (s ≥ c), and contours (½ + ½ cos 2π(s − c)/w)^8 from half a period inside c
+/// outwards, towards the lobe's sign `outward`.
+pub fn paper_shape(shape: Shape, s: f64, c: f64, w: f64, outward: f64) -> f64 {
+    let w = w.max(1e-4);
+    let bell = (-((s - c) / w).powi(2)).exp();
+    match shape {
+        Shape::Uniform if (s - c).abs() <= w / 2.0 => 1.0,
+        Shape::Uniform => 0.0,
+        Shape::Gaussian => bell,
+        Shape::LeftHalfGaussian if s <= c => bell,
+        Shape::RightHalfGaussian if s >= c => bell,
+        Shape::LeftHalfGaussian | Shape::RightHalfGaussian => 0.0,
+        Shape::Sinusoidal if (s - c) * outward < -w / 2.0 => 0.0,
+        Shape::Sinusoidal => (0.5 + 0.5 * (std::f64::consts::TAU * (s - c) / w).cos()).powi(8),
+    }
 }
 
 /// One sample of a ray: its distance from the eye, colour and opacity.
@@ -92,8 +112,10 @@ impl<'a> CloudReference<'a> {
             TransferKind::PowerLaw if signed => k1 * (t * t).powf(k2),
             TransferKind::PowerLaw => k1 * t.powf(k2),
             TransferKind::Shaped => {
-                let lobe = if v >= 0.0 { vs.transfer.positive } else { vs.transfer.negative };
-                lobe.opacity as f64 * lobe.shape.factor(t as f32, lobe.center, lobe.width) as f64
+                let (lobe, sign) =
+                    if v >= 0.0 || !signed { (vs.transfer.positive, 1.0) } else { (vs.transfer.negative, -1.0) };
+                lobe.opacity as f64
+                    * paper_shape(lobe.shape, sign * t, sign * lobe.center as f64, lobe.width as f64, sign)
             }
         }
     }
