@@ -83,12 +83,18 @@ impl ScanShots {
         })?;
         settings.background = background;
         if self.captions {
-            for (n, &slot) in slots.iter().enumerate() {
-                let lines = [scene.label(slot, theta), scene.coordinate_label(theta)];
-                caption(&mut image, n as u32 * self.size[0], self.size[0], &lines);
-            }
+            caption_views(&mut image, scene, slots, theta, self.size[0]);
         }
         Ok(image)
+    }
+}
+
+/// Captions each view of a scan picture (`slots` side by side, each `width` wide) with its
+/// orbital and energy and the coordinate's value at θ, as the window labels them.
+pub fn caption_views(image: &mut image::RgbaImage, scene: &ScanScene, slots: &[usize], theta: f64, width: u32) {
+    for (n, &slot) in slots.iter().enumerate() {
+        let lines = [scene.label(slot, theta), scene.coordinate_label(theta)];
+        caption(image, n as u32 * width, width, &lines);
     }
 }
 

@@ -50,18 +50,19 @@ fn energy_at(points: &[(f64, f64, usize)], x: f64) -> Option<f64> {
 /// Draws the diagram; a drag on it moves θ. Returns the orbital (as manifests name it) whose
 /// line was clicked.
 pub fn plot(ui: &mut egui::Ui, scan: &mut ScanView) -> Option<String> {
-    let shown: Vec<String> = scan.scene.scan.orbitals.clone();
+    let shown = &scan.scene.scan.orbitals;
     let c = scan.scene.scan.coordinate;
     let x_label = match c.unit().trim() {
         "" => c.label(),
         u => format!("{} ({u})", c.label()),
     };
     let theta = scan.theta;
-    let Some(diagram) = scan.diagram.diagram(&scan.scene.scan).cloned() else {
+    let (lo, hi) = scan.scene.scan.range();
+    // Borrowed, not copied: the diagram is drawn every frame.
+    let Some(diagram) = scan.diagram.diagram(&scan.scene.scan) else {
         ui.label(RichText::new("no orbital energies in these files").weak());
         return None;
     };
-    let (lo, hi) = scan.scene.scan.range();
     let mut clicked = None;
     let mut scrub = None;
     Plot::new("correlation diagram")

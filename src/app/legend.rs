@@ -21,16 +21,12 @@ pub fn value_bar(ui: &mut egui::Ui, rect: Rect, map: &ValueMap, name: &str) {
         let cell = Rect::from_min_size(Pos2::new(top.x, y), vec2(bar_w, bar_h / steps as f32 + 0.5));
         painter.rect_filled(cell, 0.0, Color32::from_rgb(r, g, b));
     }
-    let text = |v: f64| if v.abs() >= 0.01 { format!("{v:.3}") } else { format!("{v:.2e}") };
     let font = egui::FontId::proportional(12.0);
     let color = Color32::from_gray(235);
-    for (y, label) in [
-        (top.y, format!("+{}", text(map.range))),
-        (top.y + bar_h * 0.5, "0".into()),
-        (top.y + bar_h, format!("−{}", text(map.range))),
-    ] {
+    let [lo, mid, hi] = map.ticks();
+    for (y, label) in [(top.y, hi), (top.y + bar_h * 0.5, mid), (top.y + bar_h, lo)] {
         painter.text(Pos2::new(top.x - 6.0, y), egui::Align2::RIGHT_CENTER, label, font.clone(), color);
     }
-    let title = if name.is_empty() { "value (a.u.)".to_string() } else { format!("{name} (a.u.)") };
+    let title = ValueMap::title(name);
     painter.text(Pos2::new(top.x + bar_w, top.y - 8.0), egui::Align2::RIGHT_BOTTOM, title, font, color);
 }

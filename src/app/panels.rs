@@ -537,7 +537,7 @@ fn transfer_editor(ui: &mut egui::Ui, t: &mut Transfer, signed: bool) {
             if signed
                 && ui
                     .button("nested cores")
-                    .on_hover_text("left half on ψ > 0, right half on ψ < 0, peaked at the extremes (Jang & Varetto)")
+                    .on_hover_text("left half on ψ > 0, right half on ψ < 0, peaked at the extremes: the nested cores")
                     .clicked()
             {
                 t.nested_cores();

@@ -5,8 +5,9 @@
 use std::path::Path;
 
 use super::{OrbApp, files};
-use crate::figure::{Figure, MAX_SCALE, caption};
+use crate::figure::{Figure, MAX_SCALE};
 use crate::gpu::GpuError;
+use crate::shots::caption_views;
 
 /// The choices of the *Save PNG* window.
 pub struct PictureDialog {
@@ -109,10 +110,8 @@ impl OrbApp {
                         Err(e) => result = Err(e),
                     }
                 }
-                for n in 0..scan.views.len() {
-                    let lines = [scan.scene.label(n, scan.theta), scan.scene.coordinate_label(scan.theta)];
-                    caption(&mut out, n as u32 * size[0], size[0], &lines);
-                }
+                let slots: Vec<usize> = (0..scan.views.len()).collect();
+                caption_views(&mut out, &scan.scene, &slots, scan.theta, size[0]);
                 result.map(|()| out)
             }
             // A split view: its panes side by side, as drawn.

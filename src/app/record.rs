@@ -145,9 +145,6 @@ impl OrbApp {
                 return;
             }
             (what, _) => {
-                let scene: Vec<_> = (self.objects.iter().filter(|o| o.state.visible))
-                    .map(|o| (o.doc.clone(), o.state.clone()))
-                    .collect();
                 let motion = match what {
                     RecordWhat::Vibration => {
                         let Some(object) = self.objects.get(self.active) else { return };
@@ -155,22 +152,16 @@ impl OrbApp {
                             self.error = Some("choose a normal mode in the Vibrations panel first".into());
                             return;
                         };
-                        // The active object moves: it goes first.
                         Motion::Vibration { mode, amplitude: object.state.vibration.amplitude as f64 }
                     }
                     _ => Motion::Turntable,
                 };
-                let scene = match motion {
-                    Motion::Vibration { .. } => {
-                        let active = self.objects[self.active].doc.clone();
-                        let mut s = scene;
-                        if let Some(k) = s.iter().position(|(d, _)| Arc::ptr_eq(d, &active)) {
-                            s.swap(0, k);
-                        }
-                        s
-                    }
-                    Motion::Turntable => scene,
-                };
+                // A vibration moves the scene's first object: the active one goes first.
+                let first = matches!(motion, Motion::Vibration { .. }).then_some(self.active);
+                let order = first.into_iter().chain((0..self.objects.len()).filter(|&i| Some(i) != first));
+                let scene: Vec<_> = (order.map(|i| &self.objects[i]).filter(|o| o.state.visible))
+                    .map(|o| (o.doc.clone(), o.state.clone()))
+                    .collect();
                 let (camera, background) = (self.view.camera, self.view.background);
                 let arrows = self.objects.get(self.active).is_some_and(|o| o.state.vibration.arrows);
                 let points = self.objects.get(self.active).map_or(64, |o| o.state.evaluation.grid_points);

@@ -246,16 +246,17 @@ impl ScanView {
                 // The screen angle at the vertex from the fixed arm to the moving atom, at θ and
                 // a degree on: one Newton step on that (a plane seen at a slant turns more or
                 // less on screen than in space).
-                let opening = |theta: f64, p: Option<egui::Pos2>| {
-                    let m = self.scene.scan.geometry_at(theta);
+                let opening = |m: &crate::model::Molecule, p: Option<egui::Pos2>| {
                     let at = |a: usize| self.views.get(view)?.to_screen(camera, m.atoms[a].position.as_vec3());
                     let (fixed, vertex) = (at(i)?, at(j)?);
                     let w = p.map_or_else(|| at(k), Some)? - vertex;
                     let u = fixed - vertex;
                     Some((u.x * w.y - u.y * w.x).atan2(u.x * w.x + u.y * w.y).abs().to_degrees() as f64)
                 };
+                let (here, further) =
+                    (self.scene.scan.geometry_at(self.theta), self.scene.scan.geometry_at(self.theta + 1.0));
                 let (now, on, wanted) =
-                    (opening(self.theta, None)?, opening(self.theta + 1.0, None)?, opening(self.theta, Some(pointer))?);
+                    (opening(&here, None)?, opening(&further, None)?, opening(&here, Some(pointer))?);
                 let slope = on - now;
                 (slope.abs() > 0.05).then(|| self.theta + (wanted - now) / slope)
             }

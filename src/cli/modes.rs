@@ -46,19 +46,11 @@ impl ModeArgs {
     /// Moves `doc`'s atoms to mode `--normal-mode` at `--phase`, when one is asked for; the bonds stay
     /// those of the file's geometry.
     pub fn apply(&self, doc: &mut Document) -> Result<()> {
-        if let Some(note) = self.apply_quietly(doc)? {
-            eprintln!("{note}");
-        }
-        Ok(())
-    }
-
-    /// [`ModeArgs::apply`] without a word: what was done, for the caller to say or not.
-    pub fn apply_quietly(&self, doc: &mut Document) -> Result<Option<String>> {
-        let Some(mode) = self.normal_mode else { return Ok(None) };
+        let Some(mode) = self.normal_mode else { return Ok(()) };
         let (v, k) = chosen(doc, mode)?;
         let moved = v.displaced(k, self.phase.to_radians(), self.amplitude).context("the mode is there")?;
         let m = &v.modes[k];
-        let note = format!(
+        eprintln!(
             "mode {mode}: {:.2}{} cm⁻¹ at {:.0}°, largest displacement {:.3} bohr",
             m.frequency_cm1.abs(),
             if m.is_imaginary() { "i" } else { "" },
@@ -68,7 +60,7 @@ impl ModeArgs {
         for (atom, p) in doc.molecule.atoms.iter_mut().zip(moved) {
             atom.position = p;
         }
-        Ok(Some(note))
+        Ok(())
     }
 }
 

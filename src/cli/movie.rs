@@ -15,7 +15,7 @@ use orbcloud::scene::{Camera, ObjectState};
 use orbcloud::shots::{Motion, Progress, ScanShots, SceneShots, ShotError, record};
 
 use super::scan_cli::{InterpolationArg, KeyArgs, build};
-use super::{FigureArgs, ViewArgs, WavefunctionArgs, gpu, render_cli, surface_cli};
+use super::{FigureArgs, ViewArgs, WavefunctionArgs, gpu, quantities_cli, surface_cli};
 
 #[derive(Args)]
 pub struct MovieArgs {
@@ -163,7 +163,7 @@ fn file_movie(args: &MovieArgs, scan_input: bool) -> Result<(usize, f64)> {
     } else {
         let doc = orbcloud::formats::load(input)?;
         let camera = args.view.camera(&doc)?;
-        let object = render_cli::object_of(&doc, &args.view, &args.wavefunction, &args.iso)?;
+        let object = quantities_cli::object_of(&doc, &args.view, &args.wavefunction, &args.iso)?;
         (vec![(doc, object)], camera, args.view.settings().background)
     };
     let motion = match args.normal_mode {

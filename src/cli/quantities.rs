@@ -146,6 +146,28 @@ pub fn quantity_of(
     Ok(Some(q))
 }
 
+/// An object showing the atoms as `view` asks and evaluating orbitals as `what` asks, without
+/// quantities yet.
+fn bare_object(view: &ViewArgs, what: &WavefunctionArgs) -> ObjectState {
+    ObjectState {
+        atoms: orbcloud::scene::AtomLook::of(&view.settings()),
+        evaluation: Evaluation {
+            direct: what.direct,
+            grid_points: what.grid_points.clamp(8, 512),
+            ..Evaluation::default()
+        },
+        ..ObjectState::default()
+    }
+}
+
+/// The object a movie of one file shows: its atoms as `view` asks, and the quantity `what` names
+/// (or the file's data set) with `iso`'s isosurfaces.
+pub fn object_of(doc: &Document, view: &ViewArgs, what: &WavefunctionArgs, iso: &IsoArgs) -> Result<ObjectState> {
+    let mut object = bare_object(view, what);
+    object.quantities.extend(quantity_of(doc, view, what, iso)?);
+    Ok(object)
+}
+
 /// The later quantities' own options, parsed as `render` parses them.
 pub fn parse_later(later: &[Later]) -> Result<Vec<(bool, RenderArgs)>> {
     later
@@ -188,16 +210,7 @@ pub fn render(
     size: [u32; 2],
     background: [f32; 3],
 ) -> Result<image::RgbaImage> {
-    let base = first.view.settings();
-    let mut object = ObjectState {
-        atoms: orbcloud::scene::AtomLook::of(&base),
-        evaluation: Evaluation {
-            direct: first.wavefunction.direct,
-            grid_points: first.wavefunction.grid_points.clamp(8, 512),
-            ..Evaluation::default()
-        },
-        ..ObjectState::default()
-    };
+    let mut object = bare_object(&first.view, &first.wavefunction);
     // Which pane each quantity is drawn in.
     let mut panes = Vec::new();
     let mut pane = 0;

@@ -9,12 +9,10 @@ use orbcloud::demo;
 use orbcloud::figure::Figure;
 use orbcloud::gpu::GpuContext;
 use orbcloud::headless::Headless;
-use orbcloud::model::Document;
 use orbcloud::scene::coloring::ValueMap;
-use orbcloud::scene::{Camera, Evaluation, ObjectState, RenderSettings};
+use orbcloud::scene::{Camera, RenderSettings};
 
 use super::quantities_cli::{self, Later};
-use super::surface_cli::IsoArgs;
 use super::{DemoArg, RenderArgs, ViewArgs, WavefunctionArgs, gpu, load, surface_cli};
 
 /// `render`: `args`'s file (or the bundled demo) to a PNG; `later` are further quantities of the
@@ -82,32 +80,12 @@ pub fn render(args: RenderArgs, later: &[Later]) -> Result<()> {
     Ok(())
 }
 
-/// The object a movie of one file shows: its atoms as `view` asks, and the quantity `what` names
-/// (or the file's data set) with `iso`'s isosurfaces.
-pub fn object_of(doc: &Document, view: &ViewArgs, what: &WavefunctionArgs, iso: &IsoArgs) -> Result<ObjectState> {
-    let settings = view.settings();
-    let mut object = ObjectState {
-        atoms: orbcloud::scene::AtomLook::of(&settings),
-        evaluation: Evaluation {
-            direct: what.direct,
-            grid_points: what.grid_points.clamp(8, 512),
-            ..Evaluation::default()
-        },
-        ..ObjectState::default()
-    };
-    object.quantities.extend(quantities_cli::quantity_of(doc, view, what, iso)?);
-    Ok(object)
-}
-
 /// The colour bar of a surface coloured by a volume's values: the map's range, in atomic
 /// units, titled with the volume's name.
 pub fn value_bar(img: &mut image::RgbaImage, map: &ValueMap, name: &str) {
     let color = |t: f32| map.at(t).map(orbcloud::figure::encoded);
-    let r = map.range;
-    let text = |v: f64| if v.abs() >= 0.01 { format!("{v:.3}") } else { format!("{v:.2e}") };
-    let (lo, hi) = (format!("−{}", text(r)), format!("+{}", text(r)));
-    let title = if name.is_empty() { "value (a.u.)".to_string() } else { format!("{name} (a.u.)") };
-    orbcloud::figure::color_bar(img, color, [&lo, "0", &hi], &title);
+    let [lo, mid, hi] = map.ticks();
+    orbcloud::figure::color_bar(img, color, [&lo, &mid, &hi], &ValueMap::title(name));
 }
 
 /// Writes `img` to `path` and says so, with the adapter that drew it.

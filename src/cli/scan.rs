@@ -92,7 +92,7 @@ pub enum InterpolationArg {
     /// Both key volumes mixed per sample (the interpolated orbital).
     Exact,
     /// The real-time approximation: per slice, attenuate by one key volume's opacity, add
-    /// (1−k)A and kB (seed 000's three blends, drawn as one).
+    /// (1−k)A and kB (three blends per slice, drawn as one).
     ThreePass,
     /// The reference the three passes approximate: per slice the two samples' colours and
     /// opacities mixed.

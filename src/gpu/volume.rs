@@ -210,11 +210,6 @@ impl Program {
             Program::Interleave => "fs_interleave",
         }
     }
-
-    /// Premultiplied "over" for every program: a slice of each is one "over" blend.
-    fn blend(self) -> wgpu::BlendState {
-        wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING
-    }
 }
 
 /// Which variant of the slice shader a frame needs: each is its own pipeline, specialised by
@@ -381,7 +376,8 @@ fn make_pipeline(
             compilation_options: options,
             targets: &[Some(wgpu::ColorTargetState {
                 format: SCENE_FORMAT,
-                blend: Some(variant.program.blend()),
+                // Every program draws a slice as one premultiplied "over".
+                blend: Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING),
                 write_mask: wgpu::ColorWrites::ALL,
             })],
         }),

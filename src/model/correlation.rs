@@ -48,7 +48,6 @@ pub fn correlation(scan: &Scan, below: usize, above: usize) -> Option<Diagram> {
             let hi = (homo + 1 + above).min(order.len().saturating_sub(1));
             order[homo.saturating_sub(below)..=hi].to_vec()
         };
-        let rank = |w: &Wavefunction, i: usize| w.by_energy(spin).iter().position(|&j| j == i);
         let mut current: Vec<usize> = start.clone();
         let mut lines: Vec<Line> = start
             .iter()
@@ -102,9 +101,12 @@ pub fn correlation(scan: &Scan, below: usize, above: usize) -> Option<Diagram> {
                 taken.push(j);
                 next_current[l] = j;
             }
+            // Each orbital's place in its frame's energy order, once per frame.
+            let (before, after) = (prev.by_energy(spin), next.by_energy(spin));
+            let rank = |order: &[usize], i: usize| order.iter().position(|&j| j == i);
             for (l, line) in lines.iter_mut().enumerate() {
                 let j = next_current[l];
-                if rank(prev, current[l]) != rank(next, j) {
+                if rank(&before, current[l]) != rank(&after, j) {
                     line.crossings.push(f);
                 }
                 line.points.push((scan.frames[f].at, next.orbitals[j].energy, j));

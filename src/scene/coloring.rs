@@ -35,6 +35,19 @@ impl ValueMap {
         self.at((value / self.range.max(1e-30)).clamp(-1.0, 1.0) as f32)
     }
 
+    /// A colour bar's labels, bottom to top: "−0.022", "0", "+0.022" (three figures in
+    /// scientific notation under 0.01).
+    pub fn ticks(&self) -> [String; 3] {
+        let r = self.range;
+        let text = if r.abs() >= 0.01 { format!("{r:.3}") } else { format!("{r:.2e}") };
+        [format!("−{text}"), "0".into(), format!("+{text}")]
+    }
+
+    /// A colour bar's title: the quantity's name, in atomic units.
+    pub fn title(name: &str) -> String {
+        if name.is_empty() { "value (a.u.)".to_string() } else { format!("{name} (a.u.)") }
+    }
+
     /// Linear RGB at `t` in −1..1 of the range.
     pub fn at(&self, t: f32) -> [f32; 3] {
         let end = if t < 0.0 { Self::NEGATIVE } else { Self::POSITIVE };

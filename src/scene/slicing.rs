@@ -30,18 +30,6 @@ pub struct Slices {
     pub nearest: f32,
 }
 
-impl Slices {
-    /// The vertex range of each slice, back to front (empty slices skipped).
-    pub fn ranges(&self) -> impl Iterator<Item = std::ops::Range<u32>> + '_ {
-        let end = self.vertices.len() as u32;
-        self.starts
-            .iter()
-            .enumerate()
-            .map(move |(i, &s)| s..self.starts.get(i + 1).copied().unwrap_or(end))
-            .filter(|r| !r.is_empty())
-    }
-}
-
 impl GridBox {
     pub fn corners(&self) -> [Vec3; 8] {
         let e = self.edges;
