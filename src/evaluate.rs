@@ -70,7 +70,7 @@ pub fn evaluate_wavefunction(
     let combination = match view.quantity {
         Quantity::Orbital(i) => Some(restricted(&wf.orbitals[i].coefficients, view.functions.as_deref())),
         Quantity::BasisFunction(k) => Some(prepared.unit_coefficients(k)),
-        Quantity::Density | Quantity::SpinDensity => None,
+        Quantity::Density | Quantity::SpinDensity | Quantity::Potential => None,
     };
     match combination {
         Some(coefficients) => {
@@ -88,8 +88,12 @@ pub fn evaluate_wavefunction(
             Ok(Some(Evaluated { grid, cloud }))
         }
         None => {
-            let label = if view.quantity == Quantity::Density { "total density" } else { "spin density" };
-            let values = prepared.quantity_grid_f32(wf, view.quantity, &geometry);
+            let label = match view.quantity {
+                Quantity::Density => "total density",
+                Quantity::Potential => "electrostatic potential",
+                _ => "spin density",
+            };
+            let values = prepared.quantity_grid_f32(wf, &doc.molecule, view.quantity, &geometry);
             let grid = VolumeGrid::new(label, geometry.dims, geometry.world_from_grid, values);
             Ok(Some(Evaluated { grid, cloud: Cloud::Values }))
         }

@@ -155,6 +155,9 @@ struct WhatArgs {
     /// The spin density (α − β) instead of an orbital.
     #[arg(long)]
     spin_density: bool,
+    /// The electrostatic potential of the nuclei and electrons (a.u.) instead of an orbital.
+    #[arg(long, conflicts_with_all = ["density", "spin_density", "basis_function"])]
+    esp: bool,
     /// A bare basis function (atomic orbital) instead of an orbital, named as the viewer's
     /// atomic-orbital selector names it: "C3 2pz", "O1 3dz2", "O1 3dxy", "H2 3dxx".
     #[arg(long, conflicts_with_all = ["density", "spin_density"])]
@@ -214,6 +217,9 @@ impl WhatArgs {
         if self.density {
             return Ok(Quantity::Density);
         }
+        if self.esp {
+            return Ok(Quantity::Potential);
+        }
         if self.spin_density {
             return Ok(Quantity::SpinDensity);
         }
@@ -234,6 +240,9 @@ impl WhatArgs {
         }
         if self.density {
             return "density".into();
+        }
+        if self.esp {
+            return "esp".into();
         }
         if self.spin_density {
             return "spin_density".into();
@@ -258,6 +267,7 @@ impl WhatArgs {
         }
         match self.short_name().as_str() {
             "density" => "--density".into(),
+            "esp" => "--esp".into(),
             "spin_density" => "--spin-density".into(),
             name => format!("--orbital {name}"),
         }
@@ -268,6 +278,7 @@ impl WhatArgs {
         match q {
             Quantity::Density => "total electron density".into(),
             Quantity::SpinDensity => "spin density".into(),
+            Quantity::Potential => "electrostatic potential (a.u.)".into(),
             Quantity::BasisFunction(k) => {
                 let name = orbcloud::model::basis_labels::function_name(&doc.molecule, &wf.basis, *k);
                 format!("basis function {}", name.unwrap_or_default())

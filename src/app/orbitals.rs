@@ -91,6 +91,7 @@ pub fn panel(
         if !wf.restricted {
             densities.push((Quantity::SpinDensity, "spin density"));
         }
+        densities.push((Quantity::Potential, "electrostatic potential"));
         ui.horizontal(|ui| {
             ui.label("show");
             for &(q, name) in &densities {

@@ -134,6 +134,7 @@ pub fn quantity_choices(doc: &Document) -> Vec<(Source, String)> {
         if !wf.restricted {
             choices.push((Source::Wavefunction(Quantity::SpinDensity), "spin density".into()));
         }
+        choices.push((Source::Wavefunction(Quantity::Potential), "electrostatic potential".into()));
     }
     choices
 }

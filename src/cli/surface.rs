@@ -256,7 +256,7 @@ impl GridArgs {
         let g = orbital_geometry(doc, q, self.grid_points.clamp(8, 512)).context("the file has no atoms")?;
         let spec = g;
         let prepared = PreparedBasis::new(&wf.basis);
-        let values = prepared.quantity_grid_f32(wf, q, &spec);
+        let values = prepared.quantity_grid_f32(wf, &doc.molecule, q, &spec);
         Ok(VolumeGrid::new(self.what.label(&q, doc), g.dims, g.world_from_grid, values))
     }
 }

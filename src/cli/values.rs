@@ -8,6 +8,7 @@ use anyhow::{Context, Result, bail};
 use glam::DVec3;
 use orbcloud::formats::{self, cube_write};
 use orbcloud::info;
+use orbcloud::model::esp::{Potential, Scratch};
 use orbcloud::model::gto::PreparedBasis;
 use orbcloud::model::orbitals::Quantity;
 use orbcloud::model::{GridSpec, VolumeGrid};
@@ -33,9 +34,11 @@ pub fn eval(file: &Path, what: &WhatArgs, points: &Path) -> Result<()> {
     let q = what.resolve(&doc)?;
     let prepared = PreparedBasis::new(&wf.basis);
     let points = read_points(points)?;
+    let potential = (q == Quantity::Potential).then(|| Potential::new(&doc.molecule, wf));
     let values: Vec<f64> = points
         .par_iter()
-        .map(|&p| match q {
+        .map_init(Scratch::default, |scratch, &p| match q {
+            Quantity::Potential => potential.as_ref().map_or(0.0, |v| v.at(p, scratch)),
             Quantity::Orbital(i) => prepared.orbital_value(&wf.orbitals[i].coefficients, p),
             Quantity::BasisFunction(k) => prepared.basis_values(p).get(k).copied().unwrap_or(0.0),
             Quantity::Density => prepared.density(wf, p),
@@ -78,7 +81,7 @@ pub fn cube(
     }
     let prepared = PreparedBasis::new(&wf.basis);
     let t = Instant::now();
-    let values = prepared.quantity_grid_f32(wf, q, &spec);
+    let values = prepared.quantity_grid_f32(wf, &doc.molecule, q, &spec);
     let seconds = t.elapsed().as_secs_f64();
     let label = what.label(&q, &doc);
     let grid = VolumeGrid::new(&label, dims, spec.world_from_grid, values);

@@ -98,8 +98,11 @@ pub fn quantity_box(wf: &Wavefunction, molecule: &Molecule, quantity: Quantity) 
     let decay = match quantity {
         Quantity::Orbital(_) | Quantity::BasisFunction(_) => Decay::Relative(FACE_FRACTION),
         Quantity::Density | Quantity::SpinDensity => Decay::Absolute(DENSITY_FACE),
+        // The potential never decays (a charged molecule's goes as 1/r): it is shown in the
+        // density's box, where the surfaces it colours lie.
+        Quantity::Potential => return quantity_box(wf, molecule, Quantity::Density),
     };
-    Some(decay_box(lo, hi, START_REACH, decay, |spec| prepared.quantity_grid(wf, quantity, spec)))
+    Some(decay_box(lo, hi, START_REACH, decay, |spec| prepared.quantity_grid(wf, molecule, quantity, spec)))
 }
 
 #[cfg(test)]

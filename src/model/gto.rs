@@ -27,6 +27,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::basis::{Basis, ShellKind, cartesian_powers, n_cartesian};
+use super::molecule::Molecule;
 use super::orbitals::{Quantity, Spin, Wavefunction};
 use super::solid_harmonics::{cart_to_pure, component_factor, double_factorial_m1};
 
@@ -455,9 +456,11 @@ impl PreparedBasis {
         self.grid_sum(&sets, true, grid)
     }
 
-    /// An orbital, the total density or the spin density of `wf` on a grid.
-    pub fn quantity_grid(&self, wf: &Wavefunction, quantity: Quantity, grid: &GridSpec) -> Vec<f64> {
+    /// An orbital, the total density, the spin density or the electrostatic potential (of
+    /// `molecule`'s nuclei and `wf`'s electrons) on a grid.
+    pub fn quantity_grid(&self, wf: &Wavefunction, molecule: &Molecule, quantity: Quantity, grid: &GridSpec) -> Vec<f64> {
         match quantity {
+            Quantity::Potential => super::esp::Potential::new(molecule, wf).on_grid(grid),
             Quantity::Orbital(i) => self.eval_grid(&wf.orbitals[i].coefficients, grid),
             Quantity::BasisFunction(k) => self.eval_grid(&self.unit_coefficients(k), grid),
             Quantity::Density => self.density_grid(wf, grid),
@@ -466,11 +469,17 @@ impl PreparedBasis {
     }
 
     /// [`Self::quantity_grid`] in single precision (an orbital evaluated straight to f32).
-    pub fn quantity_grid_f32(&self, wf: &Wavefunction, quantity: Quantity, grid: &GridSpec) -> Vec<f32> {
+    pub fn quantity_grid_f32(
+        &self,
+        wf: &Wavefunction,
+        molecule: &Molecule,
+        quantity: Quantity,
+        grid: &GridSpec,
+    ) -> Vec<f32> {
         match quantity {
             Quantity::Orbital(i) => self.eval_grid_f32(&wf.orbitals[i].coefficients, grid),
             Quantity::BasisFunction(k) => self.eval_grid_f32(&self.unit_coefficients(k), grid),
-            _ => self.quantity_grid(wf, quantity, grid).iter().map(|&v| v as f32).collect(),
+            _ => self.quantity_grid(wf, molecule, quantity, grid).iter().map(|&v| v as f32).collect(),
         }
     }
 

@@ -128,6 +128,8 @@ pub enum Quantity {
     /// A bare basis function (an atomic orbital, normalised as the basis defines it), by index
     /// into the basis's functions: coefficient 1 on it, 0 elsewhere.
     BasisFunction(usize),
+    /// The electrostatic potential of the nuclei and the electrons (a.u.).
+    Potential,
 }
 
 /// Which orbital a user means: `homo`, `lumo`, `homo-2`, `lumo+1`, or a 1-based index into the

@@ -27,7 +27,7 @@ impl Source {
             Source::Wavefunction(q) => doc.wavefunction.as_ref().is_some_and(|wf| match q {
                 Quantity::Orbital(i) => i < wf.orbitals.len(),
                 Quantity::BasisFunction(k) => k < wf.basis.n_functions(),
-                Quantity::Density => true,
+                Quantity::Density | Quantity::Potential => true,
                 Quantity::SpinDensity => !wf.restricted,
             }),
         }
@@ -48,6 +48,7 @@ impl Source {
             Source::Volume(i) => doc.volumes.get(i).map_or_else(|| format!("data set {}", i + 1), |v| v.label.clone()),
             Source::Wavefunction(Quantity::Density) => "total density".into(),
             Source::Wavefunction(Quantity::SpinDensity) => "spin density".into(),
+            Source::Wavefunction(Quantity::Potential) => "electrostatic potential".into(),
             Source::Wavefunction(Quantity::Orbital(i)) => match &doc.wavefunction {
                 Some(wf) => orbital_name(wf, i),
                 None => format!("MO {}", i + 1),
