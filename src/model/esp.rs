@@ -110,58 +110,92 @@ fn hermite_e(la: usize, lb: usize, xpa: f64, xpb: f64, p: f64) -> HermiteE {
     e
 }
 
-/// Per-thread scratch of the R recursion and the Boys functions.
+/// Per-thread scratch of the R recursion.
 #[derive(Default)]
 pub struct Scratch {
     r: Vec<f64>,
 }
 
-/// R^0_tuv(p, X) for every t + u + v ≤ l, written into `scratch.r` at (t·s + u)·s + v (s = l + 1).
+/// One step of the R recursion: r[dst] = X_axis · r[from] + weight · r[back].
+#[derive(Clone, Copy)]
+struct Step {
+    dst: u16,
+    from: u16,
+    back: u16,
+    axis: u8,
+    weight: f64,
+}
+
+/// The R recursion of order l as a straight list of steps over a compact layout: level n holds
+/// the (t, u, v) of [`triples`]`(l − n)`, levels one after the other, so R^0 comes first and in
+/// the coefficients' order.
+struct Recipe {
+    /// Start of each level n.
+    levels: Vec<usize>,
+    steps: Vec<Step>,
+    len: usize,
+}
+
+fn recipe(l: usize) -> &'static Recipe {
+    static TABLE: std::sync::OnceLock<Vec<Recipe>> = std::sync::OnceLock::new();
+    let table = TABLE.get_or_init(|| {
+        (0..=MAX_PAIR_L.max(MULTIPOLE_ORDER))
+            .map(|l| {
+                let mut levels = Vec::with_capacity(l + 1);
+                let mut index = std::collections::HashMap::new();
+                let mut len = 0;
+                for n in 0..=l {
+                    levels.push(len);
+                    for &tuv in &triples(l - n).tuv {
+                        index.insert((n, tuv), len);
+                        len += 1;
+                    }
+                }
+                let at = |n: usize, tuv: [usize; 3]| index[&(n, tuv)] as u16;
+                let mut steps = Vec::new();
+                for k in 1..=l {
+                    for n in 0..=l - k {
+                        for &[t, u, v] in triples(k).tuv.iter().filter(|x| x.iter().sum::<usize>() == k) {
+                            // Lower the first non-zero index: R^n_{..i..} = X R^{n+1}_{..i−1..} +
+                            // (i − 1) R^{n+1}_{..i−2..}.
+                            let (axis, i) = if t > 0 { (0, t) } else if u > 0 { (1, u) } else { (2, v) };
+                            let lowered = |by: usize| {
+                                let mut x = [t, u, v];
+                                x[axis] -= by;
+                                x
+                            };
+                            let from = at(n + 1, lowered(1));
+                            let (back, weight) = if i > 1 { (at(n + 1, lowered(2)), (i - 1) as f64) } else { (from, 0.0) };
+                            steps.push(Step { dst: at(n, [t, u, v]), from, back, axis: axis as u8, weight });
+                        }
+                    }
+                }
+                Recipe { levels, steps, len }
+            })
+            .collect()
+    });
+    &table[l]
+}
+
+/// R^0_tuv(p, X) for every t + u + v ≤ l, written to `scratch.r[..]` in [`triples`]`(l)` order.
 /// `far` takes the asymptotic Boys functions: the derivatives of √π/(2√p |X|), a point's.
 fn hermite_r(l: usize, p: f64, x: DVec3, far: bool, scratch: &mut Scratch) {
-    let s = l + 1;
-    let level = s * s * s;
+    let recipe = recipe(l);
     let r = &mut scratch.r;
-    if r.len() < level * s {
-        r.resize(level * s, 0.0);
+    if r.len() < recipe.len {
+        r.resize(recipe.len, 0.0);
     }
     let mut f = [0.0; boys::MAX_N + 1];
     let t2 = p * x.length_squared();
     if far { boys::asymptotic(l, t2, &mut f) } else { boys(l, t2, &mut f) }
     let mut factor = 1.0;
-    for (n, fn_) in f.iter().enumerate().take(s) {
-        r[n * level] = factor * fn_;
+    for (n, &start) in recipe.levels.iter().enumerate() {
+        r[start] = factor * f[n];
         factor *= -2.0 * p;
     }
-    let at = |n: usize, t: usize, u: usize, v: usize| n * level + (t * s + u) * s + v;
-    for k in 1..=l {
-        for n in 0..=l - k {
-            for t in 0..=k {
-                for u in 0..=k - t {
-                    let v = k - t - u;
-                    let value = if t > 0 {
-                        let mut a = x.x * r[at(n + 1, t - 1, u, v)];
-                        if t > 1 {
-                            a += (t - 1) as f64 * r[at(n + 1, t - 2, u, v)];
-                        }
-                        a
-                    } else if u > 0 {
-                        let mut a = x.y * r[at(n + 1, 0, u - 1, v)];
-                        if u > 1 {
-                            a += (u - 1) as f64 * r[at(n + 1, 0, u - 2, v)];
-                        }
-                        a
-                    } else {
-                        let mut a = x.z * r[at(n + 1, 0, 0, v - 1)];
-                        if v > 1 {
-                            a += (v - 1) as f64 * r[at(n + 1, 0, 0, v - 2)];
-                        }
-                        a
-                    };
-                    r[at(n, t, u, v)] = value;
-                }
-            }
-        }
+    let x = x.to_array();
+    for s in &recipe.steps {
+        r[s.dst as usize] = x[s.axis as usize] * r[s.from as usize] + s.weight * r[s.back as usize];
     }
 }
 
@@ -384,14 +418,13 @@ impl Potential {
     /// hold, every pair exactly elsewhere.
     pub fn at(&self, point: DVec3, scratch: &mut Scratch) -> f64 {
         let mut v = self.nuclear(point);
-        let order = triples(MULTIPOLE_ORDER);
         for anchor in &self.anchors {
             let d = anchor.center.distance(point);
             let active = anchor.levels.partition_point(|l| l.radius <= d);
             let start = if active > 0 {
                 let level = &anchor.levels[active - 1];
                 hermite_r(MULTIPOLE_ORDER, 1.0, anchor.center - point, true, scratch);
-                v += order.cube.iter().zip(&level.moments).map(|(&k, m)| m * scratch.r[k]).sum::<f64>();
+                v += scratch.r.iter().zip(&level.moments).map(|(r, m)| m * r).sum::<f64>();
                 level.count
             } else {
                 0
@@ -448,8 +481,8 @@ impl Potential {
             }
             l => {
                 hermite_r(l, pair.p, x, false, scratch);
-                let cube = &triples(l).cube;
-                cube.iter().zip(c).map(|(&k, ck)| ck * scratch.r[k]).sum()
+                let n = triples(l).tuv.len();
+                scratch.r[..n].iter().zip(c).map(|(r, ck)| ck * r).sum()
             }
         }
     }
@@ -638,7 +671,7 @@ mod tests {
         let f = |x: DVec3| 0.5 * (std::f64::consts::PI / p).sqrt() / x.length();
         let mut s = Scratch::default();
         hermite_r(2, p, x, true, &mut s);
-        let at = |t: usize, u: usize, v: usize| s.r[(t * 3 + u) * 3 + v];
+        let at = |t: usize, u: usize, v: usize| s.r[triples(2).tuv.iter().position(|x| *x == [t, u, v]).unwrap()];
         let h = 1e-4;
         let dx = (f(x + DVec3::X * h) - f(x - DVec3::X * h)) / (2.0 * h);
         let dxy = (f(x + DVec3::new(h, h, 0.0)) - f(x + DVec3::new(h, -h, 0.0)) - f(x + DVec3::new(-h, h, 0.0))
