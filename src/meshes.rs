@@ -13,6 +13,7 @@ use crate::scene::coloring::ValueMap;
 use crate::scene::coloring::atom_colors;
 use crate::scene::selection::shown_atoms;
 use crate::scene::translucency::SurfaceLook;
+use crate::scene::quantity::Source;
 use crate::scene::{IsosurfaceSettings, SurfaceSettings};
 
 /// The isosurfaces `iso` asks for on `grid`, each with its colour: ψ = +v and ψ = −v for a
@@ -120,22 +121,49 @@ pub fn color_surface(
     None
 }
 
-/// Linear RGB for `grid`'s value at each point on a diverging map ([`ValueMap`]) whose range is
-/// the 98th percentile of |value| over the points (robust to a few points near a nucleus); grey
-/// where a point lies outside the grid. Returns the map too.
-pub fn color_by_values(points: &[glam::Vec3], grid: &VolumeGrid) -> (Vec<[f32; 3]>, ValueMap) {
+/// `grid`'s value at each point (bohr), trilinear; `None` where a point lies outside the grid.
+pub fn sample_grid(points: &[glam::Vec3], grid: &VolumeGrid) -> Vec<Option<f64>> {
     let grid_from_world = grid.world_from_grid.inverse();
-    let values: Vec<Option<f64>> = points
+    points
         .iter()
         .map(|p| {
             let g = grid_from_world.transform_point3(p.as_dvec3());
             let inside = (0..3).all(|a| g[a] >= -1e-9 && g[a] <= (grid.dims[a].max(1) - 1) as f64 + 1e-9);
             inside.then(|| grid.sample(g))
         })
-        .collect();
-    let mut magnitudes: Vec<f64> = values.iter().flatten().map(|v| v.abs()).collect();
-    magnitudes.sort_by(f64::total_cmp);
-    let map = ValueMap { range: magnitudes.get(magnitudes.len() * 98 / 100).copied().unwrap_or(0.0).max(1e-30) };
+        .collect()
+}
+
+/// The values of `source`, a quantity of `doc`, at each point (bohr): a wavefunction's quantity
+/// evaluated exactly there, a data set sampled trilinearly (`None` outside its grid).
+pub fn values_at(doc: &Document, source: Source, points: &[glam::Vec3]) -> Vec<Option<f64>> {
+    match (source, &doc.wavefunction) {
+        (Source::Wavefunction(q), Some(wf)) => {
+            let points: Vec<glam::DVec3> = points.iter().map(|p| p.as_dvec3()).collect();
+            let prepared = crate::model::gto::PreparedBasis::new(&wf.basis);
+            prepared.quantity_at_points(wf, &doc.molecule, q, &points).into_iter().map(Some).collect()
+        }
+        (Source::Volume(i), _) if i < doc.volumes.len() => sample_grid(points, &doc.volumes[i]),
+        _ => vec![None; points.len()],
+    }
+}
+
+/// Linear RGB for each value on a diverging map ([`ValueMap`]) of range `range`, or when that
+/// is `None` the 98th percentile of |value| (robust to a few points near a nucleus); grey where
+/// there is no value. Returns the map too.
+pub fn color_values(values: &[Option<f64>], range: Option<f64>) -> (Vec<[f32; 3]>, ValueMap) {
+    let range = range.filter(|r| *r > 0.0).unwrap_or_else(|| {
+        let mut magnitudes: Vec<f64> = values.iter().flatten().map(|v| v.abs()).collect();
+        magnitudes.sort_by(f64::total_cmp);
+        magnitudes.get(magnitudes.len() * 98 / 100).copied().unwrap_or(0.0)
+    });
+    let map = ValueMap { range: range.max(1e-30) };
     let colors = values.iter().map(|v| v.map_or([0.5; 3], |v| map.color(v))).collect();
     (colors, map)
+}
+
+/// Linear RGB for `grid`'s value at each point on a diverging map ([`color_values`], range
+/// automatic). Returns the map too.
+pub fn color_by_values(points: &[glam::Vec3], grid: &VolumeGrid) -> (Vec<[f32; 3]>, ValueMap) {
+    color_values(&sample_grid(points, grid), None)
 }

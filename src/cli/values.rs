@@ -8,11 +8,9 @@ use anyhow::{Context, Result, bail};
 use glam::DVec3;
 use orbcloud::formats::{self, cube_write};
 use orbcloud::info;
-use orbcloud::model::esp::{Potential, Scratch};
 use orbcloud::model::gto::PreparedBasis;
 use orbcloud::model::orbitals::Quantity;
 use orbcloud::model::{GridSpec, VolumeGrid};
-use rayon::prelude::*;
 
 use super::{WhatArgs, wavefunction_of};
 
@@ -34,17 +32,7 @@ pub fn eval(file: &Path, what: &WhatArgs, points: &Path) -> Result<()> {
     let q = what.resolve(&doc)?;
     let prepared = PreparedBasis::new(&wf.basis);
     let points = read_points(points)?;
-    let potential = (q == Quantity::Potential).then(|| Potential::new(&doc.molecule, wf));
-    let values: Vec<f64> = points
-        .par_iter()
-        .map_init(Scratch::default, |scratch, &p| match q {
-            Quantity::Potential => potential.as_ref().map_or(0.0, |v| v.at(p, scratch)),
-            Quantity::Orbital(i) => prepared.orbital_value(&wf.orbitals[i].coefficients, p),
-            Quantity::BasisFunction(k) => prepared.basis_values(p).get(k).copied().unwrap_or(0.0),
-            Quantity::Density => prepared.density(wf, p),
-            Quantity::SpinDensity => prepared.spin_density(wf, p),
-        })
-        .collect();
+    let values = prepared.quantity_at_points(wf, &doc.molecule, q, &points);
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());
     use std::io::Write;
     for (p, v) in points.iter().zip(values) {

@@ -39,7 +39,7 @@ const NUCLEUS_CORE: f64 = 1e-6;
 /// Order of the far-field multipole expansions.
 pub const MULTIPOLE_ORDER: usize = 6;
 /// Bound (a.u.) on the error of a group's far field where it replaces the exact sum.
-pub const FAR_FIELD_ERROR: f64 = 1e-8;
+pub const FAR_FIELD_ERROR: f64 = 1e-7;
 
 /// One primitive pair as a sum of Hermite Gaussians.
 #[derive(Debug, Clone, Copy)]

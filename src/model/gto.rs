@@ -456,6 +456,28 @@ impl PreparedBasis {
         self.grid_sum(&sets, true, grid)
     }
 
+    /// `quantity` at each of `points` (bohr), in parallel: what `eval` prints and what colours a
+    /// surface by a wavefunction's quantity.
+    pub fn quantity_at_points(
+        &self,
+        wf: &Wavefunction,
+        molecule: &Molecule,
+        quantity: Quantity,
+        points: &[DVec3],
+    ) -> Vec<f64> {
+        let potential = (quantity == Quantity::Potential).then(|| super::esp::Potential::new(molecule, wf));
+        points
+            .par_iter()
+            .map_init(super::esp::Scratch::default, |scratch, &p| match quantity {
+                Quantity::Orbital(i) => self.orbital_value(&wf.orbitals[i].coefficients, p),
+                Quantity::BasisFunction(k) => self.basis_values(p).get(k).copied().unwrap_or(0.0),
+                Quantity::Density => self.density(wf, p),
+                Quantity::SpinDensity => self.spin_density(wf, p),
+                Quantity::Potential => potential.as_ref().map_or(f64::NAN, |v| v.at(p, scratch)),
+            })
+            .collect()
+    }
+
     /// An orbital, the total density, the spin density or the electrostatic potential (of
     /// `molecule`'s nuclei and `wf`'s electrons) on a grid.
     pub fn quantity_grid(&self, wf: &Wavefunction, molecule: &Molecule, quantity: Quantity, grid: &GridSpec) -> Vec<f64> {

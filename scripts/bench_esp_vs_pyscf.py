@@ -1,0 +1,64 @@
+#!/usr/bin/env python3
+"""Times PySCF's cubegen.mep (the electrostatic potential on a cube grid), one thread.
+
+Molecules as scripts/bench_cube_vs_pyscf.py: PSB3 (RHF/6-31G*, 14 atoms, default) or benzene
+(B3LYP/6-31G*). With --molden PATH the same SCF is also written as a Molden file, so
+`orbcloud cube --esp` computes the same potential on the same grid (scripts/bench_esp_vs_pyscf.sh
+runs both and compares the cube files). Prints `pyscf_s=<seconds>` (best of --repeat runs,
+SCF excluded).
+"""
+import os
+
+os.environ["OMP_NUM_THREADS"] = "1"
+os.environ["OPENBLAS_NUM_THREADS"] = "1"
+os.environ["MKL_NUM_THREADS"] = "1"
+
+import argparse  # noqa: E402
+import shutil  # noqa: E402
+import sys  # noqa: E402
+import tempfile  # noqa: E402
+import time  # noqa: E402
+
+from pyscf import dft, gto, lib, scf  # noqa: E402
+from pyscf.tools import cubegen, molden  # noqa: E402
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from bench_cube_vs_pyscf import BENZENE, PSB3  # noqa: E402
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--n", type=int, default=40)
+    ap.add_argument("--repeat", type=int, default=1)
+    ap.add_argument("--molecule", choices=["benzene", "psb3"], default="psb3")
+    ap.add_argument("--molden", default=None, help="also write the SCF as a Molden file here")
+    ap.add_argument("--cube", default=None, help="keep PySCF's cube file here")
+    args = ap.parse_args()
+    lib.num_threads(1)
+    if args.molecule == "benzene":
+        mol = gto.M(atom=BENZENE, basis="6-31g*", symmetry=False, verbose=0)
+        mf = dft.RKS(mol)
+        mf.xc = "b3lyp"
+    else:
+        mol = gto.M(atom=PSB3, basis="6-31g*", charge=1, symmetry=False, verbose=0)
+        mf = scf.RHF(mol)
+    mf.kernel()
+    if args.molden:
+        molden.from_scf(mf, args.molden)
+    dm = mf.make_rdm1()
+    n = args.n
+    best = float("inf")
+    with tempfile.TemporaryDirectory() as tmp:
+        path = os.path.join(tmp, "mep.cube")
+        for _ in range(args.repeat):
+            t = time.perf_counter()
+            cubegen.mep(mol, path, dm, nx=n, ny=n, nz=n)
+            best = min(best, time.perf_counter() - t)
+        if args.cube:
+            shutil.copy(path, args.cube)
+    print(f"atoms={mol.natm} nao={mol.nao} grid={n}^3 threads={lib.num_threads()}")
+    print(f"pyscf_s={best:.4f}")
+
+
+if __name__ == "__main__":
+    main()
