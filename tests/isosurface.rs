@@ -128,8 +128,8 @@ fn mesh_files_read_back() {
     let meshes: Vec<Mesh> =
         isosurface::extract(&grid, &Level::pair(0.2, true)).into_iter().map(|m| m.welded()).collect();
     let named = [
-        NamedMesh { name: "psi_plus", mesh: &meshes[0], color: [1.0, 0.0, 0.0] },
-        NamedMesh { name: "psi_minus", mesh: &meshes[1], color: [0.0, 0.0, 1.0] },
+        NamedMesh { name: "psi_plus", mesh: &meshes[0], color: [1.0, 0.0, 0.0], values: None },
+        NamedMesh { name: "psi_minus", mesh: &meshes[1], color: [0.0, 0.0, 1.0], values: None },
     ];
     let (v, f) = (
         meshes[0].positions.len() + meshes[1].positions.len(),

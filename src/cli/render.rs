@@ -51,6 +51,19 @@ pub fn render(args: RenderArgs, later: &[Later]) -> Result<()> {
     if args.pick.is_some() && figure != Figure::default() {
         bail!("--pick reads the picture as drawn: leave out --scale and --transparent");
     }
+    // A cube file to colour by joins a copy of the document: the shown volume's index stays.
+    let colouring = match args.iso.color_by {
+        Some(_) => {
+            let mut with = doc.clone();
+            let source = args.iso.color_source(&mut with)?;
+            Some((with, source))
+        }
+        None => None,
+    };
+    let (color_doc, color) = match colouring {
+        Some((with, source)) => (Some(with), source),
+        None => (None, None),
+    };
     let ctx = gpu(args.lavapipe)?;
     let mut settings = args.view.settings();
     let mut h = Headless::new(&ctx, &doc, volume, &settings, size)?;
@@ -62,7 +75,7 @@ pub fn render(args: RenderArgs, later: &[Later]) -> Result<()> {
     let molsurface = args.molsurface.mesh(&doc, args.iso.translucent, grid)?;
     let map = molsurface.as_ref().and_then(|(_, _, map)| *map);
     let meshes = molsurface.into_iter().map(|(mesh, look, _)| (mesh, look)).collect();
-    surface_cli::show(&ctx, &mut h.renderer, grid, &args.iso, meshes);
+    let colored = surface_cli::show(&ctx, &mut h.renderer, (grid, color_doc.as_ref().unwrap_or(&doc)), &args.iso, color, meshes);
     let arrows = args.vibration.arrows(&doc)?;
     h.renderer.main().arrows.set_arrows(&ctx, &arrows, orbcloud::scene::vibration::ARROW_COLOR);
     let img = figure.draw(settings.background, |bg| {
@@ -70,7 +83,9 @@ pub fn render(args: RenderArgs, later: &[Later]) -> Result<()> {
         h.render(&ctx, &camera, &settings)
     })?;
     let mut img = img;
-    if let (Some(map), Some(grid)) = (map, grid) {
+    if let Some(c) = &colored {
+        value_bar(&mut img, &c.map, &c.name);
+    } else if let (Some(map), Some(grid)) = (map, grid) {
         value_bar(&mut img, &map, &grid.label);
     }
     save(&img, &args.output, &ctx)?;

@@ -11,7 +11,10 @@ use orbcloud::formats::mesh_write::{self, MeshFormat, NamedMesh};
 use orbcloud::gpu::frame::PickId;
 use orbcloud::gpu::{GpuContext, Renderer};
 use orbcloud::layers::show_meshes;
-use orbcloud::meshes::isosurfaces;
+use orbcloud::meshes::{color_values, isosurfaces, values_at};
+use orbcloud::model::orbitals::{OrbitalSpec, Quantity, Spin};
+use orbcloud::scene::Source;
+use orbcloud::scene::coloring::ValueMap;
 use orbcloud::model::gto::PreparedBasis;
 use orbcloud::model::isosurface::{self, Level, Mesh};
 use orbcloud::model::units::BOHR_PER_ANGSTROM;
@@ -42,6 +45,69 @@ pub struct IsoArgs {
     /// R,G,B factors or one factor, e.g. `g=0.5` or `d=1,0.5,0.5`; repeatable.
     #[arg(long = "optics-scale", value_parser = parse_tuning)]
     pub tuning: Vec<(String, Vec<f32>)>,
+    /// Colour the isosurfaces by another quantity's value at each vertex, on a map from red
+    /// (negative) through white to blue (positive): `esp` (the electrostatic potential),
+    /// `density`, `spin-density`, an orbital (`homo`, `lumo+1`, a number) or a cube file
+    /// (sampled trilinearly, grey outside its grid).
+    #[arg(long, value_name = "QUANTITY|FILE.cube", allow_hyphen_values = true)]
+    pub color_by: Option<String>,
+    /// The |value| at which `--color-by` colours saturate (a.u.); by default the 98th
+    /// percentile of |value| over the vertices.
+    #[arg(long, requires = "color_by")]
+    pub color_range: Option<f64>,
+}
+
+/// Surfaces coloured by a quantity's values: the map, the quantity's name, and each mesh's
+/// values at its vertices (`None` outside a cube file's grid).
+pub struct Colored {
+    pub map: ValueMap,
+    pub name: String,
+    pub values: Vec<Vec<Option<f64>>>,
+}
+
+impl IsoArgs {
+    /// What `--color-by` names: a quantity of `doc`'s wavefunction, or a cube file's first data
+    /// set added to `doc` as one of its volumes. With its name.
+    pub fn color_source(&self, doc: &mut Document) -> Result<Option<(Source, String)>> {
+        let Some(what) = &self.color_by else { return Ok(None) };
+        let word = what.trim().to_ascii_lowercase();
+        let quantity = match word.as_str() {
+            "esp" | "potential" => Some(Quantity::Potential),
+            "density" => Some(Quantity::Density),
+            "spin-density" | "spin_density" => Some(Quantity::SpinDensity),
+            _ => word.parse::<OrbitalSpec>().ok().and_then(|spec| {
+                doc.wavefunction.as_ref().and_then(|wf| wf.resolve(spec, Spin::Alpha)).map(Quantity::Orbital)
+            }),
+        };
+        if let Some(q) = quantity {
+            if doc.wavefunction.is_none() {
+                bail!("--color-by {what}: {} holds no wavefunction (a Molden, fchk, wfn, wfx or MKL file)", doc.source);
+            }
+            let source = Source::Wavefunction(q);
+            let name = if q == Quantity::Potential { "ESP".to_string() } else { source.name(doc) };
+            return Ok(Some((source, name)));
+        }
+        let path = std::path::Path::new(what);
+        if !path.exists() {
+            bail!("--color-by {what:?}: expected esp, density, spin-density, an orbital (homo, lumo+1, a number) or a cube file");
+        }
+        let other = load(Some(path))?;
+        let grid = other.volumes.into_iter().next().with_context(|| format!("--color-by {what}: the file holds no volume"))?;
+        let name = grid.label.clone();
+        doc.volumes.push(grid);
+        Ok(Some((Source::Volume(doc.volumes.len() - 1), name)))
+    }
+
+    /// Colours `meshes` by `source` of `doc` ([`Self::color_source`]), one map for all of them.
+    pub fn color(&self, doc: &Document, (source, name): (Source, String), meshes: &mut [(Mesh, SurfaceLook)]) -> Colored {
+        let values: Vec<Vec<Option<f64>>> = meshes.iter().map(|(m, _)| values_at(doc, source, &m.positions)).collect();
+        let all: Vec<Option<f64>> = values.iter().flatten().copied().collect();
+        let (_, map) = color_values(&all, self.color_range);
+        for ((mesh, _), v) in meshes.iter_mut().zip(&values) {
+            mesh.colors = color_values(v, Some(map.range)).0;
+        }
+        Colored { map, name, values }
+    }
 }
 
 /// `NAME=X` or `NAME=R,G,B`, NAME a coefficient of [`OpticsTuning::NAMES`].
@@ -169,27 +235,31 @@ impl IsoArgs {
     }
 }
 
-/// Puts `--iso` surfaces of `grid` and `more` (a molecular surface, a mode's arrows) into the
-/// renderer (nothing when none was asked for).
+/// Puts `--iso` surfaces of `grid` (coloured by `color` when given: [`IsoArgs::color_source`])
+/// and `more` (a molecular surface, a mode's arrows) into the renderer (nothing when none was
+/// asked for). Returns how the isosurfaces were coloured.
 pub fn show(
     ctx: &GpuContext,
     renderer: &mut Renderer,
-    grid: Option<&VolumeGrid>,
+    (grid, doc): (Option<&VolumeGrid>, &Document),
     iso: &IsoArgs,
+    color: Option<(Source, String)>,
     more: Vec<(Mesh, SurfaceLook)>,
-) {
+) -> Option<Colored> {
     let mut meshes = match grid {
         Some(grid) if !iso.levels().is_empty() => iso.meshes(grid, &iso.base()),
         _ => Vec::new(),
     };
+    let colored = color.filter(|_| !meshes.is_empty()).map(|c| iso.color(doc, c, &mut meshes));
     let what = if more.is_empty() { "isosurfaces" } else { "surfaces" };
     meshes.extend(more);
     if meshes.is_empty() {
-        return;
+        return colored;
     }
     let triangles = show_meshes(ctx, renderer.main(), &meshes);
     let how = if iso.translucent { ", translucent" } else { "" };
     eprintln!("{what}: {} surface(s), {triangles} triangles{how}", meshes.len());
+    colored
 }
 
 /// Prints what the rendered frame shows at `pixel`, and how long the pick took.
@@ -286,7 +356,8 @@ pub fn mesh(args: &MeshArgs, later: &[MeshArgs]) -> Result<()> {
     if let Some(q) = later.iter().find(|q| q.iso.levels().is_empty()) {
         bail!("{}: each quantity needs its own --iso VALUE or --iso-sigma S", q.grid.what.describe());
     }
-    let doc = load(Some(&args.file))?;
+    let mut doc = load(Some(&args.file))?;
+    let color = args.iso.color_source(&mut doc)?;
     let (meshes, names) = if args.molsurface.surface.is_some() {
         let by_volume = matches!(args.molsurface.surface_color, super::molsurface_cli::SurfaceColorArg::Volume);
         let grid = by_volume.then(|| args.grid.grid(&doc)).transpose()?;
@@ -310,9 +381,17 @@ pub fn mesh(args: &MeshArgs, later: &[MeshArgs]) -> Result<()> {
         }
         (meshes, names)
     };
-    let meshes: Vec<(Mesh, SurfaceLook)> = meshes.into_iter().map(|(m, c)| (m.welded(), c)).collect();
-    let named: Vec<NamedMesh> =
-        meshes.iter().zip(&names).map(|((mesh, color), name)| NamedMesh { name, mesh, color: color.color }).collect();
+    let mut meshes: Vec<(Mesh, SurfaceLook)> = meshes.into_iter().map(|(m, c)| (m.welded(), c)).collect();
+    let colored = color.map(|c| args.iso.color(&doc, c, &mut meshes));
+    let values: Vec<Option<Vec<f32>>> = (0..meshes.len())
+        .map(|i| colored.as_ref().map(|c| c.values[i].iter().map(|v| v.map_or(f32::NAN, |v| v as f32)).collect()))
+        .collect();
+    let named: Vec<NamedMesh> = meshes
+        .iter()
+        .zip(&names)
+        .zip(&values)
+        .map(|(((mesh, color), name), values)| NamedMesh { name, mesh, color: color.color, values: values.as_deref() })
+        .collect();
     let file = std::fs::File::create(&args.output).with_context(|| format!("creating {}", args.output.display()))?;
     let mut w = std::io::BufWriter::new(file);
     mesh_write::write(&mut w, format, &named).with_context(|| format!("writing {}", args.output.display()))?;
@@ -324,6 +403,9 @@ pub fn mesh(args: &MeshArgs, later: &[MeshArgs]) -> Result<()> {
             m.mesh.triangle_count(),
             m.mesh.area() / BOHR_PER_ANGSTROM.powi(2)
         );
+    }
+    if let Some(c) = &colored {
+        eprintln!("coloured by {}: ±{:.4} a.u. (red negative, blue positive)", c.name, c.map.range);
     }
     eprintln!("wrote {}", args.output.display());
     Ok(())

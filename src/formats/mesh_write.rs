@@ -11,8 +11,17 @@ use crate::model::units::BOHR_PER_ANGSTROM;
 pub struct NamedMesh<'a> {
     pub name: &'a str,
     pub mesh: &'a Mesh,
-    /// Linear RGB, written where the format has a place for it.
+    /// Linear RGB, written where the format has a place for it (the mesh's per-vertex colours
+    /// instead, when it has them).
     pub color: [f32; 3],
+    /// A value per vertex (a surface coloured by a quantity: NaN where there is none), written
+    /// beside the colour: PLY `property float value`, glTF attribute `_VALUE`.
+    pub values: Option<&'a [f32]>,
+}
+
+/// sRGB bytes of a linear colour.
+fn srgb(c: [f32; 3]) -> [u8; 3] {
+    c.map(|c| (c.clamp(0.0, 1.0).powf(1.0 / 2.2) * 255.0).round() as u8)
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -72,22 +81,28 @@ pub fn write_ply(w: &mut impl Write, meshes: &[NamedMesh]) -> io::Result<()> {
     let vertices: usize = meshes.iter().map(|m| m.mesh.positions.len()).sum();
     let faces: usize = meshes.iter().map(|m| m.mesh.triangle_count()).sum();
     let names: Vec<&str> = meshes.iter().map(|m| m.name).collect();
+    let with_values = meshes.iter().any(|m| m.values.is_some());
     write!(
         w,
         "ply\nformat binary_little_endian 1.0\ncomment orbcloud isosurfaces ({}); positions in angstrom\n\
          element vertex {vertices}\nproperty float x\nproperty float y\nproperty float z\n\
          property float nx\nproperty float ny\nproperty float nz\n\
-         property uchar red\nproperty uchar green\nproperty uchar blue\n\
+         property uchar red\nproperty uchar green\nproperty uchar blue\n{}\
          element face {faces}\nproperty list uchar int vertex_indices\nend_header\n",
-        names.join(", ")
+        names.join(", "),
+        if with_values { "property float value\n" } else { "" }
     )?;
     for m in meshes {
-        let rgb = m.color.map(|c| (c.clamp(0.0, 1.0).powf(1.0 / 2.2) * 255.0).round() as u8);
-        for (p, n) in m.mesh.positions.iter().zip(&m.mesh.normals) {
+        let own = srgb(m.color);
+        for (i, (p, n)) in m.mesh.positions.iter().zip(&m.mesh.normals).enumerate() {
             for v in angstrom(*p).into_iter().chain(n.to_array()) {
                 w.write_all(&v.to_le_bytes())?;
             }
-            w.write_all(&rgb)?;
+            w.write_all(&m.mesh.colors.get(i).map_or(own, |c| srgb(*c)))?;
+            if with_values {
+                let value = m.values.and_then(|v| v.get(i)).copied().unwrap_or(f32::NAN);
+                w.write_all(&value.to_le_bytes())?;
+            }
         }
     }
     let mut base = 0i32;
@@ -136,13 +151,26 @@ pub fn write_glb(w: &mut impl Write, meshes: &[NamedMesh]) -> io::Result<()> {
             r#"{{"bufferView":{iv},"componentType":5125,"count":{},"type":"SCALAR"}}"#,
             m.mesh.indices.len()
         ));
-        let [r, g, b] = m.color;
+        // Per-vertex colours (linear RGB, as glTF's COLOR_0 is) and values, when the surface has
+        // them.
+        let mut extra = String::new();
+        if m.mesh.colors.len() == count {
+            let cv = view(bytemuck::cast_slice(&m.mesh.colors), 34962);
+            extra += &format!(r#","COLOR_0":{}"#, accessors.len());
+            accessors.push(format!(r#"{{"bufferView":{cv},"componentType":5126,"count":{count},"type":"VEC3"}}"#));
+        }
+        if let Some(values) = m.values.filter(|v| v.len() == count) {
+            let vv = view(bytemuck::cast_slice(values), 34962);
+            extra += &format!(r#","_VALUE":{}"#, accessors.len());
+            accessors.push(format!(r#"{{"bufferView":{vv},"componentType":5126,"count":{count},"type":"SCALAR"}}"#));
+        }
+        let [r, g, b] = if m.mesh.colors.len() == count { [1.0; 3] } else { m.color };
         materials.push(format!(
             r#"{{"name":"{}","pbrMetallicRoughness":{{"baseColorFactor":[{r},{g},{b},1.0],"metallicFactor":0.0,"roughnessFactor":0.5}},"doubleSided":true}}"#,
             m.name
         ));
         gltf_meshes.push(format!(
-            r#"{{"name":"{}","primitives":[{{"attributes":{{"POSITION":{a},"NORMAL":{}}},"indices":{},"material":{n}}}]}}"#,
+            r#"{{"name":"{}","primitives":[{{"attributes":{{"POSITION":{a},"NORMAL":{}{extra}}},"indices":{},"material":{n}}}]}}"#,
             m.name,
             a + 1,
             a + 2
