@@ -109,3 +109,91 @@ fn far_fields_agree_with_the_exact_sum_on_a_grid() {
         eprintln!("{file}: far fields within {worst:.1e} of the exact sum");
     }
 }
+
+fn orbcloud(args: &[&str]) -> std::process::Output {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_orbcloud")).args(args).output().expect("run orbcloud");
+    assert!(out.status.success(), "orbcloud {args:?}: {}", String::from_utf8_lossy(&out.stderr));
+    out
+}
+
+/// Vertices (bohr) and `value` of a binary PLY written by `mesh` with `--color-by`.
+fn ply_values(path: &Path) -> Vec<(DVec3, f32, [u8; 3])> {
+    let bytes = std::fs::read(path).unwrap();
+    let end = bytes.windows(11).position(|w| w == b"end_header\n").unwrap() + 11;
+    let header = std::str::from_utf8(&bytes[..end]).unwrap();
+    assert!(header.contains("property float value\n"), "{header}");
+    let n: usize = header.lines().find_map(|l| l.strip_prefix("element vertex ")).unwrap().parse().unwrap();
+    let f = |o: usize| f32::from_le_bytes(bytes[o..o + 4].try_into().unwrap());
+    (0..n)
+        .map(|i| {
+            let o = end + i * (6 * 4 + 3 + 4);
+            let angstrom = DVec3::new(f(o) as f64, f(o + 4) as f64, f(o + 8) as f64);
+            let rgb = [bytes[o + 24], bytes[o + 25], bytes[o + 26]];
+            (angstrom * orbcloud::model::units::BOHR_PER_ANGSTROM, f(o + 27), rgb)
+        })
+        .collect()
+}
+
+#[test]
+fn a_density_surface_coloured_by_the_potential_carries_it_per_vertex() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("esp.ply");
+    let file = format!("{FIXTURES}/wavefunctions/h2o_ccpvtz.molden");
+    orbcloud(&["mesh", &file, "--density", "--iso", "0.002", "--color-by", "esp", "-o", out.to_str().unwrap()]);
+    let vertices = ply_values(&out);
+    assert!(vertices.len() > 1000, "{} vertices", vertices.len());
+    let doc = formats::load(Path::new(&file)).unwrap();
+    let wf = doc.wavefunction.as_ref().unwrap();
+    let v = Potential::new(&doc.molecule, wf);
+    let basis = orbcloud::model::gto::PreparedBasis::new(&wf.basis);
+    let mut s = Scratch::default();
+    let (mut negative, mut positive) = (0, 0);
+    for (p, value, rgb) in vertices.iter().step_by(37) {
+        // On the surface: the density is 0.002 to within the grid's linear interpolation.
+        let rho = basis.density(wf, *p);
+        assert!((rho - 0.002).abs() < 4e-4, "ρ = {rho} at a vertex");
+        // The value written is the potential there (f32).
+        let exact = v.exact_at(*p, &mut s);
+        assert!((*value as f64 - exact).abs() < 1e-6 + 1e-6 * exact.abs(), "{value} vs {exact}");
+        // Red where negative (the lone pairs), blue where positive (the hydrogens).
+        if exact < -0.01 {
+            negative += 1;
+            assert!(rgb[0] > rgb[2], "{rgb:?} for {exact}");
+        } else if exact > 0.01 {
+            positive += 1;
+            assert!(rgb[2] > rgb[0], "{rgb:?} for {exact}");
+        }
+    }
+    assert!(negative > 0 && positive > 0, "{negative} negative, {positive} positive vertices");
+}
+
+#[test]
+fn eval_and_cube_print_the_potential() {
+    let r = reference("h2o_cart_631gs");
+    let dir = tempfile::tempdir().unwrap();
+    let points = dir.path().join("points.txt");
+    let text: String = r.points.iter().map(|p| format!("{} {} {}\n", p[0], p[1], p[2])).collect();
+    std::fs::write(&points, text).unwrap();
+    let file = format!("{FIXTURES}/{}", r.source);
+    let out = orbcloud(&["eval", &file, "--esp", "--points", points.to_str().unwrap()]);
+    let printed: Vec<f64> = String::from_utf8(out.stdout)
+        .unwrap()
+        .lines()
+        .map(|l| l.split_whitespace().nth(3).unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(printed.len(), r.esp.len());
+    for (a, b) in printed.iter().zip(&r.esp) {
+        assert!((a - b).abs() < TOL, "eval --esp {a} vs PySCF {b}");
+    }
+    // The cube holds the same potential at its grid points.
+    let cube = dir.path().join("esp.cube");
+    orbcloud(&["cube", &file, "--esp", "--grid", "12", "--margin", "3", "-o", cube.to_str().unwrap()]);
+    let grid = formats::load(&cube).unwrap().volumes.remove(0);
+    let v = potential(Path::new(&file));
+    let mut s = Scratch::default();
+    for (i, j, k) in [(0, 0, 0), (5, 6, 7), (11, 11, 11), (3, 9, 1)] {
+        let want = v.exact_at(grid.point(i, j, k), &mut s);
+        let got = grid.value(i, j, k) as f64;
+        assert!((got - want).abs() < 1e-5 * want.abs().max(1.0), "cube {got} vs {want}");
+    }
+}
