@@ -28,6 +28,39 @@ pub fn isosurfaces(grid: &VolumeGrid, iso: &IsosurfaceSettings) -> Vec<(Mesh, Su
     isosurface::extract(grid, &levels).into_iter().zip(colors.into_iter().map(|c| iso.look(c))).collect()
 }
 
+/// Colours the meshes [`isosurfaces_within`] cut at `levels` (one per sign of a `signed` grid
+/// for each visible level, in order) by the quantity each level's `color_by` names, one map for
+/// all of them; returns that map and the quantity's name, when any level asks for it.
+pub fn color_isosurfaces(
+    doc: &Document,
+    levels: &[IsosurfaceSettings],
+    signed: bool,
+    meshes: &mut [(Mesh, SurfaceLook)],
+) -> Option<(ValueMap, String)> {
+    let per_level = if signed { 2 } else { 1 };
+    let mut owners = levels.iter().filter(|l| l.visible).flat_map(|l| std::iter::repeat_n(l, per_level));
+    let mut colored: Vec<(usize, Vec<Option<f64>>)> = Vec::new();
+    let mut asked = None;
+    for (k, (mesh, _)) in meshes.iter().enumerate() {
+        let Some(level) = owners.next() else { break };
+        if let Some(source) = level.color_by {
+            colored.push((k, values_at(doc, source, &mesh.positions)));
+            asked = Some((source, level.color_range));
+        }
+    }
+    let (source, range) = asked?;
+    let all: Vec<Option<f64>> = colored.iter().flat_map(|(_, v)| v.iter().copied()).collect();
+    let (_, map) = color_values(&all, range.map(f64::from));
+    for (k, values) in colored {
+        meshes[k].0.colors = color_values(&values, Some(map.range)).0;
+    }
+    let name = match source {
+        Source::Wavefunction(crate::model::orbitals::Quantity::Potential) => "ESP".to_string(),
+        s => s.name(doc),
+    };
+    Some((map, name))
+}
+
 /// Isosurfaces of `grid` at every level of `levels` (each as [`isosurfaces`] cuts it), every
 /// mesh's vertex and index data within `max_bytes` (a GPU buffer's limit): when the whole
 /// grid's meshes would not fit, they are cut from every 2nd, 4th, … point, with a note.

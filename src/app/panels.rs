@@ -230,7 +230,8 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
                             data_set_choice(ui, &doc, &mut q.source);
                         }
                         // Isosurfaces first: for orbitals the most used, and never below the fold.
-                        isosurfaces_editor(ui, &mut q.isosurfaces, grid_signed, grid_sigma);
+                        let colors = super::scene_panel::quantity_choices(&doc);
+                        isosurfaces_editor(ui, &mut q.isosurfaces, (grid_signed, grid_sigma), &colors);
                         ui.separator();
                         ui.heading("Cloud");
                         cloud_editor(ui, &mut q.cloud, grid_signed);
@@ -369,13 +370,19 @@ fn cloud_editor(ui: &mut egui::Ui, vs: &mut crate::scene::VolumeSettings, signed
 }
 
 /// Every isosurface of a quantity, each with its own controls, and *+ isosurface*.
-fn isosurfaces_editor(ui: &mut egui::Ui, list: &mut Vec<IsosurfaceSettings>, signed: bool, sigma: Option<f64>) {
+fn isosurfaces_editor(
+    ui: &mut egui::Ui,
+    list: &mut Vec<IsosurfaceSettings>,
+    (signed, sigma): (bool, Option<f64>),
+    colors: &[(Source, String)],
+) {
     ui.heading("Isosurfaces");
     let mut remove = None;
     for (k, iso) in list.iter_mut().enumerate() {
         ui.push_id(k, |ui| {
             egui::Frame::group(ui.style()).show(ui, |ui| {
                 isosurface_editor(ui, iso, signed, sigma);
+                color_by_editor(ui, iso, colors);
                 if ui.small_button("remove").on_hover_text("remove this isosurface").clicked() {
                     remove = Some(k);
                 }
@@ -611,6 +618,32 @@ fn isosurface_editor(ui: &mut egui::Ui, iso: &mut IsosurfaceSettings, signed: bo
         }
     });
     translucency_editor(ui, iso);
+}
+
+/// Colouring an isosurface by another quantity of its object (the electrostatic potential on a
+/// density surface), and the range of the map.
+fn color_by_editor(ui: &mut egui::Ui, iso: &mut IsosurfaceSettings, choices: &[(Source, String)]) {
+    let name = |s: Option<Source>| match s {
+        None => "its own colour".to_string(),
+        Some(s) => choices.iter().find(|(c, _)| *c == s).map_or("another quantity".into(), |(_, n)| n.clone()),
+    };
+    ComboBox::from_label("colour by").selected_text(name(iso.color_by)).show_ui(ui, |ui| {
+        ui.selectable_value(&mut iso.color_by, None, name(None));
+        for (source, label) in choices {
+            ui.selectable_value(&mut iso.color_by, Some(*source), label);
+        }
+    });
+    if iso.color_by.is_some() {
+        ui.horizontal(|ui| {
+            let mut automatic = iso.color_range.is_none();
+            if ui.checkbox(&mut automatic, "automatic range").on_hover_text("±98th percentile of |value| on the surface").changed() {
+                iso.color_range = if automatic { None } else { Some(0.05) };
+            }
+            if let Some(r) = &mut iso.color_range {
+                ui.add(Slider::new(r, 1e-4..=1.0).logarithmic(true).text("± (a.u.)"));
+            }
+        });
+    }
 }
 
 /// Translucent or opaque, and the look of a translucent surface (seed 003's optics).

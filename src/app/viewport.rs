@@ -13,7 +13,7 @@ use crate::gpu::gto::GtoFillPass;
 use crate::gpu::oit::FragmentStats;
 use crate::gpu::{FrameInput, GpuContext, GpuError, OffscreenTarget, Renderer, Tile};
 use crate::key_volumes::ScanScene;
-use crate::meshes::{isosurfaces_within, molecular_surface};
+use crate::meshes::{color_isosurfaces, isosurfaces_within, molecular_surface};
 use crate::model::isosurface::Mesh;
 use crate::model::{Document, VolumeGrid};
 use crate::scene::objects::Part;
@@ -130,6 +130,9 @@ struct LayerJobs {
     surface: Arc<Mutex<Option<BuiltSurface>>>,
     /// Thousandths of the molecular surface being built (the status line's bar); 0 when none is.
     surface_progress: Arc<AtomicU32>,
+    /// The map a quantity's isosurfaces are coloured with by another quantity, and that
+    /// quantity's name (for the colour bar).
+    iso_map: Arc<Mutex<Option<(crate::scene::coloring::ValueMap, String)>>>,
     /// An atoms layer's atoms displaced along a mode: (mode, phase bits, amplitude bits).
     displaced: Option<(usize, u64, u32)>,
 }
@@ -405,10 +408,23 @@ impl Viewport {
         };
         let levels = q.isosurfaces.clone();
         let max_bytes = self.ctx.device.limits().max_buffer_size;
+        let iso_map = self.slots[l].iso_map.clone();
         self.slots[l].extraction.request(move |_| {
             let grid = computed.as_deref().or(volume.and_then(|i| doc.volumes.get(i)));
-            prepared(grid.map(|g| isosurfaces_within(g, &levels, max_bytes)).unwrap_or_default())
+            let Some(grid) = grid else { return prepared(Default::default()) };
+            let (mut meshes, note) = isosurfaces_within(grid, &levels, max_bytes);
+            let signed = grid.kind == crate::model::grid::ValueKind::Signed;
+            let map = color_isosurfaces(&doc, &levels, signed, &mut meshes);
+            *iso_map.lock().unwrap_or_else(std::sync::PoisonError::into_inner) = map;
+            prepared((meshes, note))
         });
+    }
+
+    /// The map object `n`'s quantity `k` has its isosurfaces coloured with by another quantity,
+    /// and that quantity's name.
+    pub fn isosurface_map(&self, n: usize, k: usize) -> Option<(crate::scene::coloring::ValueMap, String)> {
+        let l = self.layer_of(n, Part::Quantity(k))?;
+        self.slots[l].iso_map.lock().unwrap_or_else(std::sync::PoisonError::into_inner).clone()
     }
 
     /// The map object `n`'s molecular surface is coloured with, when it is coloured by a
@@ -574,6 +590,7 @@ impl Viewport {
             extraction: Latest::new("cutting isosurfaces", move || again()),
             surface: Arc::default(),
             surface_progress: Arc::default(),
+            iso_map: Arc::default(),
             displaced: None,
         }
     }

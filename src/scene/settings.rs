@@ -188,6 +188,14 @@ pub struct IsosurfaceSettings {
     /// Per-channel factors on the preset's coefficients.
     #[serde(default)]
     pub tuning: super::translucency::OpticsTuning,
+    /// Coloured by another quantity of the object at each vertex (the electrostatic potential
+    /// on a density surface), on a diverging map, instead of its own colour.
+    #[serde(default)]
+    pub color_by: Option<super::Source>,
+    /// The |value| at which those colours saturate (a.u.); automatic (the 98th percentile of
+    /// |value| over the vertices) when `None`.
+    #[serde(default)]
+    pub color_range: Option<f32>,
 }
 
 impl Default for IsosurfaceSettings {
@@ -202,6 +210,8 @@ impl Default for IsosurfaceSettings {
             translucent: false,
             optics: super::OpticsPreset::default(),
             tuning: Default::default(),
+            color_by: None,
+            color_range: None,
         }
     }
 }
