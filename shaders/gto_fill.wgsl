@@ -4,7 +4,8 @@
 struct FillParams {
     // Grid index (i, j, k) to bohr.
     world_from_grid: mat4x4<f32>,
-    // x: nx, y: ny, z: nz (texture width = nz: cube order, z fastest)
+    // x: nx, y: ny, z: nz (texture width = nz: cube order, z fastest); w: what is written,
+    // 0 ψ, 1–3 the x, y or z component of its analytic gradient (direct mode's, for checks).
     dims: vec4<u32>,
 };
 
@@ -18,5 +19,11 @@ fn cs_fill(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let p = (fill.world_from_grid * vec4<f32>(f32(id.z), f32(id.y), f32(id.x), 1.0)).xyz;
-    textureStore(out_volume, vec3<i32>(id), vec4<f32>(gto_value(p), 0.0, 0.0, 1.0));
+    var v: f32;
+    if (fill.dims.w == 0u) {
+        v = gto_value(p);
+    } else {
+        v = gto_value_and_gradient(p)[min(fill.dims.w, 3u)];
+    }
+    textureStore(out_volume, vec3<i32>(id), vec4<f32>(v, 0.0, 0.0, 1.0));
 }

@@ -1,6 +1,7 @@
 //! Evaluating a wavefunction's quantities for display: orbitals filled on the GPU (a 3D texture,
-//! read back once for isosurfaces), densities on the CPU, seed 004's direct mode, on grids the
-//! device holds; and the opacity a cloud of the values starts with.
+//! read back once for isosurfaces), densities on the CPU, seed 004's direct mode (no grid: the
+//! orbital's range measured from CPU samples, a grid filled only when isosurfaces want one), on
+//! grids the device holds; and the opacity a cloud of the values starts with.
 
 use crate::gpu::gto::{GtoFillPass, read_volume, volume_from_texture};
 use crate::gpu::renderer::Layer;
@@ -9,7 +10,7 @@ use crate::gpu::{GpuContext, GpuError};
 use crate::model::cartesian::CartesianExpansion;
 use crate::model::extent::quantity_box;
 use crate::model::grid::ValueKind;
-use crate::model::gto::{GridSpec, PreparedBasis};
+use crate::model::gto::{GridSpec, PreparedBasis, SampledRange};
 use crate::model::orbitals::Quantity;
 use crate::model::{Document, VolumeGrid};
 
@@ -31,30 +32,71 @@ pub struct WavefunctionView {
     /// Per basis function, whether it contributes to an orbital (the atomic-orbital
     /// selector); `None`: all.
     pub functions: Option<Vec<bool>>,
+    /// In direct mode, whether the values on a grid are wanted as well (isosurfaces are shown);
+    /// without, none is filled. Grid mode always fills one.
+    pub grid: bool,
 }
+
+/// Lattice points per axis direct mode measures an orbital on (4096 CPU samples).
+pub const SAMPLES_PER_AXIS: usize = 16;
 
 /// A wavefunction's quantity evaluated for display, ready for a layer. Made by
 /// [`evaluate_wavefunction`], which may run on any thread (the viewer's jobs); shown with
 /// [`Evaluated::show`] on the thread that owns the renderer.
 pub struct Evaluated {
-    /// The values on the evaluation grid: what isosurfaces are cut from and what scales the
-    /// opacity.
-    pub grid: VolumeGrid,
+    pub values: Values,
     cloud: Cloud,
+}
+
+/// The values behind an evaluated quantity's picture.
+#[derive(Debug, Clone, Default)]
+pub struct Values {
+    /// The values on the evaluation grid: what isosurfaces are cut from. `None` in direct mode
+    /// unless the view asked for a grid.
+    pub grid: Option<VolumeGrid>,
+    /// Direct mode: the orbital measured at samples (its range, gradient scale and a coarse
+    /// lattice of values).
+    pub sampled: Option<Sampled>,
+}
+
+/// An orbital measured at CPU samples instead of on a grid (direct mode).
+#[derive(Debug, Clone)]
+pub struct Sampled {
+    pub range: SampledRange,
+    /// Points per axis of the evaluation grid over the same box (the step k1 refers to).
+    pub points: usize,
+}
+
+impl Values {
+    /// What stands for the quantity's values (its σ, its opacity): the grid, else the samples.
+    pub fn shown(&self) -> Option<&VolumeGrid> {
+        self.grid.as_ref().or(self.sampled.as_ref().map(|s| &s.range.samples))
+    }
+
+    /// Sets `volume.k1` from the grid ([`auto_opacity`]), else from the samples
+    /// ([`auto_opacity_sampled`]).
+    pub fn auto_opacity(&self, volume: &mut crate::scene::VolumeSettings) {
+        match (&self.grid, &self.sampled) {
+            (Some(grid), _) => auto_opacity(volume, grid),
+            (None, Some(sampled)) => auto_opacity_sampled(volume, sampled),
+            (None, None) => {}
+        }
+    }
 }
 
 enum Cloud {
     /// An orbital filled on the GPU, already a texture.
     Texture(VolumeTexture),
-    /// Seed 004's direct mode: the orbital evaluated per slice sample.
-    Direct(CartesianExpansion, GridSpec),
+    /// Seed 004's direct mode: the orbital evaluated per slice sample, scaled to its measured
+    /// (max |ψ|, max |∇ψ|).
+    Direct(CartesianExpansion, GridSpec, (f64, f64)),
     /// Values computed on the CPU (densities), uploaded when shown.
     Values,
 }
 
 /// Evaluates what `view` asks for of `doc`'s wavefunction: orbitals on the GPU (a filled
-/// texture, read back once for the grid's values), densities on the CPU. `None` when the
-/// document has no wavefunction.
+/// texture, read back once for the grid's values; in direct mode only when `view.grid` asks),
+/// densities on the CPU. `None` when the document has no wavefunction.
 pub fn evaluate_wavefunction(
     ctx: &GpuContext,
     fill: &GtoFillPass,
@@ -75,17 +117,32 @@ pub fn evaluate_wavefunction(
     match combination {
         Some(coefficients) => {
             let expansion = CartesianExpansion::from_coefficients(&prepared, &coefficients);
+            if view.direct {
+                // The shader evaluates ψ and its analytic gradient per sample; what scales them
+                // is measured on the CPU, so no grid is filled unless its values are wanted.
+                let range = prepared.sampled_range(&coefficients, &geometry, SAMPLES_PER_AXIS);
+                let grid = if view.grid {
+                    let texture = fill.fill(ctx, &expansion, &geometry)?;
+                    Some(VolumeGrid::new(
+                        "orbital",
+                        geometry.dims,
+                        geometry.world_from_grid,
+                        read_volume(ctx, &texture)?,
+                    ))
+                } else {
+                    None
+                };
+                let cloud = Cloud::Direct(expansion, geometry, (range.max_abs, range.max_grad));
+                let sampled = Some(Sampled { range, points: geometry.dims[0] });
+                return Ok(Some(Evaluated { values: Values { grid, sampled }, cloud }));
+            }
             let texture = fill.fill(ctx, &expansion, &geometry)?;
             // The filled values give the range that scales the opacity (and the gradient scale).
             let grid = VolumeGrid::new("orbital", geometry.dims, geometry.world_from_grid, read_volume(ctx, &texture)?);
-            let cloud = if view.direct {
-                Cloud::Direct(expansion, geometry)
-            } else {
-                let mut volume = volume_from_texture(texture, &geometry, grid.stats.max_abs);
-                volume.max_grad = grid.max_gradient().max(1e-30) as f32;
-                Cloud::Texture(volume)
-            };
-            Ok(Some(Evaluated { grid, cloud }))
+            let mut volume = volume_from_texture(texture, &geometry, grid.stats.max_abs);
+            volume.max_grad = grid.max_gradient().max(1e-30) as f32;
+            let values = Values { grid: Some(grid), sampled: None };
+            Ok(Some(Evaluated { values, cloud: Cloud::Texture(volume) }))
         }
         None => {
             let label = match view.quantity {
@@ -95,7 +152,8 @@ pub fn evaluate_wavefunction(
             };
             let values = prepared.quantity_grid_f32(wf, &doc.molecule, view.quantity, &geometry);
             let grid = VolumeGrid::new(label, geometry.dims, geometry.world_from_grid, values);
-            Ok(Some(Evaluated { grid, cloud: Cloud::Values }))
+            let values = Values { grid: Some(grid), sampled: None };
+            Ok(Some(Evaluated { values, cloud: Cloud::Values }))
         }
     }
 }
@@ -147,16 +205,16 @@ pub fn evaluate_within(
 }
 
 impl Evaluated {
-    /// Shows the cloud in `layer`; returns the values on the grid.
-    pub fn show(self, ctx: &GpuContext, layer: &mut Layer) -> Result<VolumeGrid, GpuError> {
+    /// Shows the cloud in `layer`; returns the values behind it.
+    pub fn show(self, ctx: &GpuContext, layer: &mut Layer) -> Result<Values, GpuError> {
         match self.cloud {
             Cloud::Texture(volume) => layer.set_volume_texture(ctx, volume),
-            Cloud::Direct(expansion, geometry) => layer.set_direct(ctx, &expansion, &geometry, self.grid.stats.max_abs),
+            Cloud::Direct(expansion, geometry, scale) => layer.set_direct(ctx, &expansion, &geometry, scale),
             Cloud::Values => {
-                layer.set_volume(ctx, Some(&self.grid))?;
+                layer.set_volume(ctx, self.values.grid.as_ref())?;
             }
         }
-        Ok(self.grid)
+        Ok(self.values)
     }
 }
 
@@ -168,5 +226,20 @@ pub fn auto_opacity(volume: &mut crate::scene::VolumeSettings, grid: &VolumeGrid
         let max = grid.stats.max_abs as f32;
         volume.k1 =
             crate::scene::opacity::auto_k1(&grid.values, grid.dims, signed, max, volume.density_scale, volume.k2);
+    }
+}
+
+/// [`auto_opacity`] from direct mode's samples: the law summed along the sample lattice's lines,
+/// scaled to the evaluation grid's step (lines through it hold (points − 1)/(n − 1) times as
+/// many points), the law normalised to the measured max |ψ| as the shader does.
+pub fn auto_opacity_sampled(volume: &mut crate::scene::VolumeSettings, sampled: &Sampled) {
+    if volume.auto_k1 {
+        let samples = &sampled.range.samples;
+        let signed = samples.kind == ValueKind::Signed;
+        let max = sampled.range.max_abs as f32;
+        let k1 =
+            crate::scene::opacity::auto_k1(&samples.values, samples.dims, signed, max, volume.density_scale, volume.k2);
+        let finer = (sampled.points.max(2) - 1) as f32 / (samples.dims[0].max(2) - 1) as f32;
+        volume.k1 = (k1 / finer).clamp(0.005, 2.0);
     }
 }

@@ -2,7 +2,7 @@
 //! colours, the atoms a selection shows), each quantity in a layer of its own (a data set, or an
 //! orbital or density evaluated), their isosurfaces, placement and visibility.
 
-use crate::evaluate::{WavefunctionView, auto_opacity, evaluate_wavefunction};
+use crate::evaluate::{Values, WavefunctionView, evaluate_wavefunction};
 use crate::gpu::atoms::AtomSizes;
 use crate::gpu::gto::GtoFillPass;
 use crate::gpu::renderer::Layer;
@@ -17,15 +17,16 @@ use crate::scene::translucency::SurfaceLook;
 use crate::scene::{AtomLook, Evaluation, IsosurfaceSettings, ObjectState, Source};
 
 /// Puts a wavefunction's orbital or density into `layer` ([`evaluate_wavefunction`], then
-/// [`Evaluated::show`]). `fill` caches the compute pipeline between calls. Returns the values on
-/// the grid (what isosurfaces are cut from), or `None` when the document has no wavefunction.
+/// [`Evaluated::show`]). `fill` caches the compute pipeline between calls. Returns the values
+/// behind the picture (the grid isosurfaces are cut from, when one was filled), or `None` when
+/// the document has no wavefunction.
 pub fn show_wavefunction(
     ctx: &GpuContext,
     layer: &mut Layer,
     fill: &mut Option<GtoFillPass>,
     doc: &Document,
     view: &WavefunctionView,
-) -> Result<Option<VolumeGrid>, GpuError> {
+) -> Result<Option<Values>, GpuError> {
     let fill = fill.get_or_insert_with(|| GtoFillPass::new(ctx));
     evaluate_wavefunction(ctx, fill, doc, view)?.map(|e| e.show(ctx, layer)).transpose()
 }
@@ -120,8 +121,9 @@ pub fn show_object(
 
 /// Puts quantity `k` of the object `state` describes into `layer`: a data set of `doc` as it
 /// is, or its wavefunction's orbital or density evaluated on a grid of `points` per side
-/// (`fill` caches the compute pipeline), then its isosurfaces. Returns the values shown (what
-/// the cloud's opacity is scaled to), `None` when `doc` does not hold the quantity.
+/// (`fill` caches the compute pipeline; in direct mode a grid is filled only for visible
+/// isosurfaces), then its isosurfaces. Returns the values shown (what the cloud's opacity is
+/// scaled to), `None` when `doc` does not hold the quantity.
 pub fn show_quantity(
     ctx: &GpuContext,
     layer: &mut Layer,
@@ -129,28 +131,29 @@ pub fn show_quantity(
     doc: &Document,
     state: &ObjectState,
     k: usize,
-) -> Result<Option<VolumeGrid>, GpuError> {
+) -> Result<Option<Values>, GpuError> {
     layer.clear(ctx);
     place_layer(layer, state, Part::Quantity(k));
     let Some(q) = state.quantities.get(k) else { return Ok(None) };
-    let grid = match q.source {
+    let values = match q.source {
         Source::Volume(i) => {
             let grid = doc.volumes.get(i).cloned();
             layer.set_volume(ctx, grid.as_ref())?;
-            grid
+            grid.map(|grid| Values { grid: Some(grid), sampled: None })
         }
         Source::Wavefunction(quantity) => {
             let e = &state.evaluation;
             let functions = doc.wavefunction.as_ref().and_then(|wf| e.restriction(&wf.basis));
-            let view = WavefunctionView { quantity, direct: e.direct, points: e.grid_points, functions };
+            let grid = q.wants_grid();
+            let view = WavefunctionView { quantity, direct: e.direct, points: e.grid_points, functions, grid };
             show_wavefunction(ctx, layer, fill, doc, &view)?
         }
     };
-    if let Some(grid) = &grid {
+    if let Some(grid) = values.as_ref().and_then(|v| v.grid.as_ref()) {
         let meshes: Vec<_> = q.isosurfaces.iter().flat_map(|iso| isosurfaces(grid, iso)).collect();
         show_meshes(ctx, layer, &meshes);
     }
-    Ok(grid)
+    Ok(values)
 }
 
 /// Each layer's cloud settings, and the scene's bounds (bohr).
@@ -185,10 +188,10 @@ pub fn show_scene<D: std::borrow::Borrow<Document>>(
             Part::Quantity(k) => {
                 let evaluation = Evaluation { grid_points: points, ..state.evaluation.clone() };
                 let state = ObjectState { evaluation, ..state.clone() };
-                let grid = show_quantity(ctx, layer, &mut fill, doc, &state, k)?;
+                let values = show_quantity(ctx, layer, &mut fill, doc, &state, k)?;
                 let mut cloud = state.quantities[k].cloud;
-                if let Some(grid) = &grid {
-                    auto_opacity(&mut cloud, grid);
+                if let Some(values) = &values {
+                    values.auto_opacity(&mut cloud);
                 }
                 clouds.push(cloud);
             }

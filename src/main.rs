@@ -5,12 +5,11 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use orbcloud::evaluate::WavefunctionView;
+use orbcloud::evaluate::{Values, WavefunctionView};
 use orbcloud::gpu::{AdapterPreference, GpuContext};
 use orbcloud::headless::Headless;
 use orbcloud::layers::show_wavefunction;
 use orbcloud::model::Document;
-use orbcloud::model::VolumeGrid;
 use orbcloud::model::orbitals::{OrbitalSpec, Quantity, Spin, Wavefunction};
 use orbcloud::scene::framing::camera_for;
 use orbcloud::scene::transfer::PRESETS;
@@ -186,8 +185,9 @@ struct WavefunctionArgs {
 
 impl WavefunctionArgs {
     /// Puts the requested quantity into the headless renderer, when the document has a
-    /// wavefunction; returns how long that took (GPU fill and read-back included) and the grid.
-    fn apply(&self, ctx: &GpuContext, h: &mut Headless, doc: &Document) -> Result<Option<(f64, VolumeGrid)>> {
+    /// wavefunction; returns how long that took (GPU fill and read-back included) and the values
+    /// behind it. In direct mode a grid is filled only when `grid` says its values are wanted.
+    fn apply(&self, ctx: &GpuContext, h: &mut Headless, doc: &Document, grid: bool) -> Result<Option<(f64, Values)>> {
         if doc.wavefunction.is_none() {
             return Ok(None);
         }
@@ -197,10 +197,11 @@ impl WavefunctionArgs {
             direct: self.direct,
             points: self.grid_points.clamp(8, 512),
             functions: None,
+            grid,
         };
         let mut fill = None;
-        let grid = show_wavefunction(ctx, h.renderer.main(), &mut fill, doc, &view)?;
-        Ok(grid.map(|g| (start.elapsed().as_secs_f64(), g)))
+        let values = show_wavefunction(ctx, h.renderer.main(), &mut fill, doc, &view)?;
+        Ok(values.map(|v| (start.elapsed().as_secs_f64(), v)))
     }
 }
 

@@ -144,8 +144,8 @@ fn the_gpu_shows_the_restricted_orbital_and_the_bare_function() {
         (Quantity::BasisFunction(index("O1 3dxy")), None, vec![(index("O1 3dxy"), 1.0)]),
     ];
     for (quantity, functions, terms) in cases {
-        let view = WavefunctionView { quantity, direct: false, points: 24, functions };
-        let grid = evaluate_wavefunction(&ctx, &fill, &doc, &view).unwrap().unwrap().grid;
+        let view = WavefunctionView { quantity, direct: false, points: 24, functions, grid: true };
+        let grid = evaluate_wavefunction(&ctx, &fill, &doc, &view).unwrap().unwrap().values.grid.unwrap();
         let [nx, ny, nz] = grid.dims;
         let (mut worst, mut max) = (0f64, 0f64);
         for i in 0..nx {

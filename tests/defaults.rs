@@ -38,11 +38,12 @@ fn render(
         direct: false,
         points: 48,
         functions: None,
+        grid: true,
     };
     let evaluated = evaluate_wavefunction(&ctx, &GtoFillPass::new(&ctx), &doc, &view).unwrap().unwrap();
     let mut h = Headless::new(&ctx, &doc, None, &s, SIZE).unwrap();
-    let grid = evaluated.show(&ctx, h.renderer.main()).unwrap();
-    auto_opacity(&mut s.volume, &grid);
+    let values = evaluated.show(&ctx, h.renderer.main()).unwrap();
+    auto_opacity(&mut s.volume, values.grid.as_ref().unwrap());
     let camera = camera_for(&doc, ViewPreset::Auto).unwrap();
     luma_std(&h.render(&ctx, &camera, &s).unwrap())
 }

@@ -90,7 +90,8 @@ fn direct_mode_matches_slicing_the_filled_grid() {
 
     h.renderer.main().set_volume_texture(&ctx, volume_from_texture(texture, &grid, max_abs));
     let sliced = h.render(&ctx, &camera, &settings).unwrap();
-    h.renderer.main().set_direct(&ctx, &e, &grid, max_abs);
+    // The gradient scale the slice path's texture gets without one measured (unused here).
+    h.renderer.main().set_direct(&ctx, &e, &grid, (max_abs, 2.0 * max_abs));
     let direct = h.render(&ctx, &camera, &settings).unwrap();
 
     let covered = direct.pixels().filter(|p| p[0].abs_diff(p[2]) > 20).count();
@@ -134,5 +135,146 @@ fn gpu_fill_of_real_orbitals_matches_the_cpu_evaluator() {
             eprintln!("{name} MO {i}: worst |gpu − cpu| {:.2e} of max|ψ| {max:.3}", worst / max);
             assert!(worst <= 1e-4 * max, "{name} MO {i}: GPU differs by {worst:e} (max {max})");
         }
+    }
+}
+
+fn fixture(name: &str) -> orbcloud::model::Document {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/wavefunctions").join(name);
+    orbcloud::formats::load(&path).unwrap_or_else(|e| panic!("{e}"))
+}
+
+#[test]
+fn the_analytic_gpu_gradient_matches_the_cpu_gradient() {
+    use orbcloud::gpu::gto::Component;
+    use orbcloud::model::gto::PreparedBasis;
+    let ctx = common::lavapipe();
+    let fill = GtoFillPass::new(&ctx);
+    // Cartesian d (6-31G*) and pure d, f (cc-pVTZ): every branch of the angular derivative.
+    for name in ["h2o_cart_631gs.molden", "h2o_ccpvtz.molden"] {
+        let doc = fixture(name);
+        let wf = doc.wavefunction.as_ref().unwrap();
+        let prepared = PreparedBasis::new(&wf.basis);
+        let homo = wf.homo(orbcloud::model::Spin::Alpha).unwrap();
+        let c = &wf.orbitals[homo].coefficients;
+        let quantity = orbcloud::model::orbitals::Quantity::Orbital(homo);
+        let geometry = orbcloud::evaluate::orbital_geometry(&doc, quantity, 19).unwrap();
+        let e = CartesianExpansion::from_coefficients(&prepared, c);
+        let components = [Component::GradientX, Component::GradientY, Component::GradientZ];
+        let gpu: Vec<Vec<f32>> = components
+            .iter()
+            .map(|&a| read_volume(&ctx, &fill.fill_component(&ctx, &e, &geometry, a).unwrap()).unwrap())
+            .collect();
+        let [nx, ny, nz] = geometry.dims;
+        let (mut worst, mut max) = (0f64, 0f64);
+        for i in 0..nx {
+            for j in 0..ny {
+                for k in 0..nz {
+                    let p = geometry.world_from_grid.transform_point3(DVec3::new(i as f64, j as f64, k as f64));
+                    let (_, cpu) = prepared.orbital_value_and_gradient(c, p);
+                    let m = (i * ny + j) * nz + k;
+                    let got = DVec3::new(gpu[0][m] as f64, gpu[1][m] as f64, gpu[2][m] as f64);
+                    worst = worst.max((got - cpu).length());
+                    max = max.max(cpu.length());
+                }
+            }
+        }
+        eprintln!("{name}: max |∇ψ| {max:.4}, worst |gpu − cpu| {worst:.2e} ({:.1e} of max)", worst / max);
+        assert!(max > 0.05, "{name}: the gradient is not trivial");
+        assert!(worst <= 2e-4 * max, "{name}: GPU gradient differs by {worst:e} (max {max})");
+    }
+    assert_eq!(fill.fills(), 6, "every fill is counted");
+}
+
+/// An object showing `doc`'s HOMO per sample (direct mode) on 24 points per side.
+fn direct_homo(doc: &orbcloud::model::Document, iso: bool) -> orbcloud::scene::ObjectState {
+    use orbcloud::scene::{Evaluation, IsoLevel, ObjectState, QuantityState, RenderSettings, Source};
+    let homo = doc.wavefunction.as_ref().unwrap().homo(orbcloud::model::Spin::Alpha).unwrap();
+    let source = Source::Wavefunction(orbcloud::model::orbitals::Quantity::Orbital(homo));
+    let mut q = QuantityState::new(source, &RenderSettings::default());
+    q.isosurfaces[0].visible = iso;
+    q.isosurfaces[0].level = IsoLevel::Absolute(0.05);
+    let evaluation = Evaluation { direct: true, grid_points: 24, ..Default::default() };
+    ObjectState { quantities: vec![q], evaluation, ..Default::default() }
+}
+
+#[test]
+fn direct_mode_fills_no_grid_unless_isosurfaces_are_shown() {
+    use orbcloud::gpu::Renderer;
+    use orbcloud::layers::show_quantity;
+    let ctx = common::lavapipe();
+    let doc = fixture("h2o_cart_631gs.molden");
+    let mut renderer = Renderer::new(&ctx);
+    let mut fill = None;
+    let fills = |f: &Option<GtoFillPass>| f.as_ref().map_or(0, GtoFillPass::fills);
+
+    let state = direct_homo(&doc, false);
+    let values = show_quantity(&ctx, renderer.main(), &mut fill, &doc, &state, 0).unwrap().unwrap();
+    assert_eq!(fills(&fill), 0, "no grid filled for a direct-mode cloud alone");
+    assert!(values.grid.is_none() && values.sampled.is_some());
+    assert!(renderer.main().volume.is_direct());
+    assert!(renderer.main().surfaces.is_empty());
+
+    // An isosurface shown: one grid, read back and cut; the cloud stays direct.
+    let state = direct_homo(&doc, true);
+    let values = show_quantity(&ctx, renderer.main(), &mut fill, &doc, &state, 0).unwrap().unwrap();
+    assert_eq!(fills(&fill), 1);
+    assert_eq!(values.grid.as_ref().map(|g| g.dims), Some([24; 3]));
+    assert!(renderer.main().volume.is_direct());
+    assert!(!renderer.main().surfaces.is_empty(), "the isosurfaces are shown");
+
+    // Grid mode fills one whatever is shown.
+    let mut state = direct_homo(&doc, false);
+    state.evaluation.direct = false;
+    show_quantity(&ctx, renderer.main(), &mut fill, &doc, &state, 0).unwrap();
+    assert_eq!(fills(&fill), 2);
+    assert!(!renderer.main().volume.is_direct());
+}
+
+#[test]
+fn direct_mode_measures_the_range_and_gradient_scale() {
+    use orbcloud::evaluate::{WavefunctionView, evaluate_wavefunction};
+    use orbcloud::model::gto::PreparedBasis;
+    let ctx = common::lavapipe();
+    let fill = GtoFillPass::new(&ctx);
+    for name in ["h2o_cart_631gs.molden", "benzene_631gs.molden"] {
+        let doc = fixture(name);
+        let wf = doc.wavefunction.as_ref().unwrap();
+        let homo = wf.homo(orbcloud::model::Spin::Alpha).unwrap();
+        let quantity = orbcloud::model::orbitals::Quantity::Orbital(homo);
+        let view = WavefunctionView { quantity, direct: true, points: 48, functions: None, grid: false };
+        let before = fill.fills();
+        let values = evaluate_wavefunction(&ctx, &fill, &doc, &view).unwrap().unwrap().values;
+        assert_eq!(fill.fills(), before, "{name}: measured without a grid");
+        let range = values.sampled.unwrap().range;
+        // Reference: a dense CPU lattice over the same box plus the nuclei inside it (where
+        // p-type gradients peak), ψ and ∇ψ from the CPU evaluator.
+        let prepared = PreparedBasis::new(&wf.basis);
+        let c = &wf.orbitals[homo].coefficients;
+        let geometry = orbcloud::evaluate::orbital_geometry(&doc, quantity, 41).unwrap();
+        let grid_from_world = geometry.world_from_grid.inverse();
+        let inside = |p: DVec3| {
+            let g = grid_from_world.transform_point3(p);
+            (0..3).all(|a| g[a] >= 0.0 && g[a] <= 40.0)
+        };
+        let lattice = (0..41 * 41 * 41).map(|m| {
+            let u = DVec3::new((m / 1681) as f64, (m / 41 % 41) as f64, (m % 41) as f64);
+            geometry.world_from_grid.transform_point3(u)
+        });
+        let nuclei = doc.molecule.atoms.iter().map(|a| a.position).filter(|&p| inside(p));
+        let (mut max_abs, mut max_grad) = (0f64, 0f64);
+        for p in lattice.chain(nuclei) {
+            let (v, g) = prepared.orbital_value_and_gradient(c, p);
+            max_abs = max_abs.max(v.abs());
+            max_grad = max_grad.max(g.length());
+        }
+        eprintln!(
+            "{name}: measured max |ψ| {:.4} |∇ψ| {:.4}; dense lattice {max_abs:.4} {max_grad:.4}",
+            range.max_abs, range.max_grad
+        );
+        // Measured values are values of ψ, never above the truth; they must not fall short of
+        // what a search 17 times denser finds.
+        assert!(range.max_abs >= 0.99 * max_abs, "{name}: max |ψ| {} vs {max_abs}", range.max_abs);
+        assert!(range.max_grad >= 0.97 * max_grad, "{name}: max |∇ψ| {} vs {max_grad}", range.max_grad);
+        assert!(range.samples.values.len() >= 1000, "a few thousand samples");
     }
 }

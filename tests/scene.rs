@@ -270,10 +270,11 @@ fn grids_over_the_gpus_limits_are_shown_coarser_with_a_note() {
         direct: false,
         points: 64,
         functions: None,
+        grid: true,
     };
     let fill = orbcloud::gpu::gto::GtoFillPass::new(&ctx);
     let (evaluated, note) = evaluate_within(&ctx, &fill, &doc, &view, &small).unwrap();
-    let grid = evaluated.unwrap().grid;
+    let grid = evaluated.unwrap().values.grid.unwrap();
     assert!(grid.dims.iter().all(|&d| d <= 24), "{:?}", grid.dims);
     assert!(note.unwrap().contains("64 points per side are more than this GPU holds"));
 

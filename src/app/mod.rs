@@ -445,7 +445,12 @@ impl OrbApp {
             crate::scene::Source::Wavefunction(_) => false,
             crate::scene::Source::Volume(_) => true,
         };
-        match self.shown_values() {
+        // Direct mode without a grid: the σ of its samples over the same box.
+        let sampled = || {
+            let (vp, o) = (self.viewport.as_ref()?, self.objects.get(self.active)?);
+            vp.sampled(self.active, o.state.selected).map(|s| &s.range.samples)
+        };
+        match self.shown_values().or_else(sampled) {
             Some(g) => (Some(g.stats.sigma), g.kind == crate::model::grid::ValueKind::Signed),
             None => (None, self.objects.get(self.active).and_then(|o| o.state.selected_quantity()).is_none_or(signed)),
         }
@@ -907,8 +912,12 @@ impl OrbApp {
     fn auto_opacity(&mut self, n: usize, k: usize) {
         let (Some(vp), Some(o)) = (&self.viewport, self.objects.get_mut(n)) else { return };
         let grid = vp.shown_grid(n, k, &o.doc, &o.state);
-        if let (Some(grid), Some(q)) = (grid, o.state.quantities.get_mut(k)) {
-            crate::evaluate::auto_opacity(&mut q.cloud, grid);
+        let sampled = vp.sampled(n, k);
+        let Some(q) = o.state.quantities.get_mut(k) else { return };
+        match (grid, sampled) {
+            (Some(grid), _) => crate::evaluate::auto_opacity(&mut q.cloud, grid),
+            (None, Some(sampled)) => crate::evaluate::auto_opacity_sampled(&mut q.cloud, sampled),
+            (None, None) => {}
         }
     }
 

@@ -119,6 +119,8 @@ struct LayerJobs {
     /// A quantity's values on its grid when computed from a basis (cube files' grids stay in the
     /// document): isosurfaces are cut from it.
     computed: Option<Arc<VolumeGrid>>,
+    /// Direct mode's orbital measured at samples (its opacity and σ without a grid).
+    sampled: Option<Arc<crate::evaluate::Sampled>>,
     /// Orbitals filled on the GPU and densities evaluated on the CPU, with a note when the grid
     /// had to be coarser than asked.
     evaluation: Latest<Evaluation>,
@@ -377,13 +379,16 @@ impl Viewport {
                 let slot = &mut self.slots[l];
                 slot.evaluation.cancel();
                 slot.computed = None;
+                slot.sampled = None;
                 self.update_isosurfaces(n, k, doc, state);
                 Ok(coarser(doc, i, step))
             }
             Source::Wavefunction(quantity) => {
                 let e = &state.evaluation;
                 let functions = doc.wavefunction.as_ref().and_then(|wf| e.restriction(&wf.basis));
-                let view = WavefunctionView { quantity, direct: e.direct, points: e.grid_points, functions };
+                // Direct mode fills a grid only for what cuts or colours from one.
+                let grid = q.wants_grid() || (k == state.selected && state.surface.color_by_volume);
+                let view = WavefunctionView { quantity, direct: e.direct, points: e.grid_points, functions, grid };
                 let ctx = self.ctx.clone();
                 let fill = self.fill.get_or_insert_with(|| Arc::new(GtoFillPass::new(&ctx))).clone();
                 let doc = doc.clone();
@@ -505,11 +510,13 @@ impl Viewport {
                 guarded(&ctx.device, || evaluated.show(ctx, layer)).map(Some).map_err(|e| e.to_string())
             });
             match shown {
-                Ok(grid) => {
-                    if grid.is_some() {
+                Ok(values) => {
+                    if values.is_some() {
                         evaluated.push(k);
                     }
+                    let (grid, sampled) = values.map_or((None, None), |v| (v.grid, v.sampled));
                     self.slots[l].computed = grid.map(Arc::new);
+                    self.slots[l].sampled = sampled.map(Arc::new);
                     self.generation += 1;
                     self.update_isosurfaces(n, k, doc, state);
                     if k == state.selected && state.surface.color_by_volume {
@@ -567,6 +574,11 @@ impl Viewport {
         self.slots.get(self.layer_of(n, Part::Quantity(k))?)?.computed.as_deref()
     }
 
+    /// Object `n`'s quantity `k` measured at samples (direct mode).
+    pub fn sampled(&self, n: usize, k: usize) -> Option<&crate::evaluate::Sampled> {
+        self.slots.get(self.layer_of(n, Part::Quantity(k))?)?.sampled.as_deref()
+    }
+
     /// The values object `n`'s quantity `k` shows: computed, or the document's data set.
     pub fn shown_grid<'a>(
         &'a self,
@@ -586,6 +598,7 @@ impl Viewport {
         let again = self.repaint.clone();
         LayerJobs {
             computed: None,
+            sampled: None,
             evaluation: Latest::new("evaluating the orbital", move || repaint()),
             extraction: Latest::new("cutting isosurfaces", move || again()),
             surface: Arc::default(),

@@ -67,10 +67,14 @@ pub fn render(args: RenderArgs, later: &[Later]) -> Result<()> {
     let ctx = gpu(args.lavapipe)?;
     let mut settings = args.view.settings();
     let mut h = Headless::new(&ctx, &doc, volume, &settings, size)?;
-    let computed = args.wavefunction.apply(&ctx, &mut h, &doc)?.map(|(_, g)| g);
-    let grid = computed.as_ref().or(volume.and_then(|i| doc.volumes.get(i)));
-    if let Some(grid) = grid {
-        orbcloud::evaluate::auto_opacity(&mut settings.volume, grid);
+    // Direct mode fills a grid only for isosurfaces or a surface coloured by its values.
+    let wants_grid = !args.iso.levels().is_empty() || args.molsurface.settings(false).color_by_volume;
+    let computed = args.wavefunction.apply(&ctx, &mut h, &doc, wants_grid)?.map(|(_, v)| v);
+    let grid = computed.as_ref().and_then(|v| v.grid.as_ref()).or(volume.and_then(|i| doc.volumes.get(i)));
+    match (&computed, grid) {
+        (Some(values), _) => values.auto_opacity(&mut settings.volume),
+        (None, Some(grid)) => orbcloud::evaluate::auto_opacity(&mut settings.volume, grid),
+        (None, None) => {}
     }
     let molsurface = args.molsurface.mesh(&doc, args.iso.translucent, grid)?;
     let map = molsurface.as_ref().and_then(|(_, _, map)| *map);
@@ -123,9 +127,13 @@ pub fn bench(
     let ctx = gpu(lavapipe)?;
     let settings = view.settings();
     let mut h = Headless::new(&ctx, &doc, view.volume_index(&doc)?, &settings, view.size)?;
-    if let Some((seconds, _)) = wavefunction.apply(&ctx, &mut h, &doc)? {
+    if let Some((seconds, values)) = wavefunction.apply(&ctx, &mut h, &doc, false)? {
         let n = wavefunction.grid_points;
-        println!("wavefunction_setup_ms={:.1} (grid {n}^3: GPU fill and read-back for the value range)", seconds * 1e3);
+        let how = match values.grid {
+            Some(_) => format!("grid {n}^3: GPU fill and read-back for the value range"),
+            None => "direct: range measured at CPU samples, no grid".to_string(),
+        };
+        println!("wavefunction_setup_ms={:.1} ({how})", seconds * 1e3);
     }
     let wait = |ctx: &GpuContext| ctx.device.poll(wgpu::PollType::wait_indefinitely()).map(|_| ());
     for _ in 0..2 {

@@ -1,6 +1,8 @@
 //! Orbitals evaluated from their basis functions on the GPU: a compute pass that fills a 3D
 //! texture for the slice renderer (exact orbitals, switched without resampling files).
 
+use std::sync::atomic::{AtomicUsize, Ordering};
+
 use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 
@@ -15,14 +17,27 @@ use crate::model::grid::{GridSpec, ValueKind};
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
 pub struct FillParams {
     pub world_from_grid: [[f32; 4]; 4],
+    /// nx, ny, nz, and the [`Component`] filled.
     pub dims: [u32; 4],
 }
 const _: () = assert!(std::mem::size_of::<FillParams>() == 80);
+
+/// What a fill writes per grid point: ψ, or one component of its analytic gradient (what direct
+/// mode shades with; filled to check it against the CPU).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Component {
+    Value = 0,
+    GradientX = 1,
+    GradientY = 2,
+    GradientZ = 3,
+}
 
 pub struct GtoFillPass {
     pipeline: wgpu::ComputePipeline,
     fill_layout: wgpu::BindGroupLayout,
     gto_layout: wgpu::BindGroupLayout,
+    /// Grids filled so far (what shows that direct mode fills none).
+    fills: AtomicUsize,
 }
 
 impl GtoFillPass {
@@ -59,7 +74,12 @@ impl GtoFillPass {
             compilation_options: Default::default(),
             cache: None,
         });
-        Self { pipeline, fill_layout, gto_layout }
+        Self { pipeline, fill_layout, gto_layout, fills: AtomicUsize::new(0) }
+    }
+
+    /// How many grids this pass has filled.
+    pub fn fills(&self) -> usize {
+        self.fills.load(Ordering::Relaxed)
     }
 
     /// Evaluates `expansion` on `grid` into a new R32Float 3D texture (texel x = grid k).
@@ -68,6 +88,17 @@ impl GtoFillPass {
         ctx: &GpuContext,
         expansion: &CartesianExpansion,
         grid: &GridSpec,
+    ) -> Result<wgpu::Texture, GpuError> {
+        self.fill_component(ctx, expansion, grid, Component::Value)
+    }
+
+    /// As [`Self::fill`], writing `component` of the orbital.
+    pub fn fill_component(
+        &self,
+        ctx: &GpuContext,
+        expansion: &CartesianExpansion,
+        grid: &GridSpec,
+        component: Component,
     ) -> Result<wgpu::Texture, GpuError> {
         let device = &ctx.device;
         let [nx, ny, nz] = grid.dims;
@@ -89,7 +120,7 @@ impl GtoFillPass {
         });
         let params = FillParams {
             world_from_grid: grid.world_from_grid.as_mat4().to_cols_array_2d(),
-            dims: [nx as u32, ny as u32, nz as u32, 0],
+            dims: [nx as u32, ny as u32, nz as u32, component as u32],
         };
         let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("gto fill params"),
@@ -116,6 +147,7 @@ impl GtoFillPass {
             pass.dispatch_workgroups((nz as u32).div_ceil(4), (ny as u32).div_ceil(4), (nx as u32).div_ceil(4));
         }
         ctx.queue.submit([encoder.finish()]);
+        self.fills.fetch_add(1, Ordering::Relaxed);
         Ok(texture)
     }
 }

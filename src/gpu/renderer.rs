@@ -115,9 +115,16 @@ impl Layer {
         self.volume.set_morph(ctx, a, b, k, mode);
     }
 
-    /// Shows an orbital evaluated per fragment from its basis functions (seed 004's direct mode).
-    pub fn set_direct(&mut self, ctx: &GpuContext, expansion: &CartesianExpansion, geometry: &GridSpec, max_abs: f64) {
-        self.volume.set_direct(ctx, expansion, geometry, max_abs);
+    /// Shows an orbital evaluated per fragment from its basis functions (seed 004's direct mode),
+    /// its opacity and gradient scaled to `(max |ψ|, max |∇ψ|)`.
+    pub fn set_direct(
+        &mut self,
+        ctx: &GpuContext,
+        expansion: &CartesianExpansion,
+        geometry: &GridSpec,
+        scale: (f64, f64),
+    ) {
+        self.volume.set_direct(ctx, expansion, geometry, scale);
     }
 
     /// Empties the layer (no atoms, surfaces or cloud), keeping its pipelines.

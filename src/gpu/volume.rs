@@ -489,9 +489,16 @@ impl VolumePass {
     }
 
     /// Seed 004's direct mode: the slices through `geometry`'s box evaluate `expansion` per
-    /// fragment. `max_abs` scales the opacity like a grid's maximum; the grid spacing of
-    /// `geometry` is the reference step of k1.
-    pub fn set_direct(&mut self, ctx: &GpuContext, expansion: &CartesianExpansion, geometry: &GridSpec, max_abs: f64) {
+    /// fragment. `max_abs` scales the opacity like a grid's maximum and `max_grad` the analytic
+    /// gradient (both measured: [`crate::model::gto::PreparedBasis::sampled_range`]); the grid
+    /// spacing of `geometry` is the reference step of k1.
+    pub fn set_direct(
+        &mut self,
+        ctx: &GpuContext,
+        expansion: &CartesianExpansion,
+        geometry: &GridSpec,
+        (max_abs, max_grad): (f64, f64),
+    ) {
         // The texture binding is unused by the direct shader but part of the shared layout.
         let placeholder = ctx.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("direct-mode placeholder volume"),
@@ -503,13 +510,14 @@ impl VolumePass {
             usage: wgpu::TextureUsages::TEXTURE_BINDING,
             view_formats: &[],
         });
-        let shape = VolumeTexture::from_texture(
+        let mut shape = VolumeTexture::from_texture(
             placeholder,
             geometry.dims,
             geometry.world_from_grid,
             ValueKind::Signed,
             max_abs,
         );
+        shape.max_grad = max_grad.max(1e-30) as f32;
         self.set_texture(ctx, Some(shape));
         self.direct = Some(GtoBuffers::new(&ctx.device, &self.shared.gto_layout, &GtoArrays::new(expansion)));
     }

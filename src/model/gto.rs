@@ -790,6 +790,86 @@ fn interval(a: f64, b: f64, c0: f64, r2max: f64, n: usize) -> Option<(usize, usi
     (lo < hi).then_some((lo, hi))
 }
 
+/// An orbital's scale measured from samples, without a grid: its largest |ψ| and |∇ψ| over a
+/// box, and its values on a coarse lattice of the box.
+#[derive(Debug, Clone)]
+pub struct SampledRange {
+    pub max_abs: f64,
+    /// Largest analytic gradient magnitude (per bohr).
+    pub max_grad: f64,
+    /// ψ on the lattice (`n`³ points spanning the box, cube order).
+    pub samples: super::VolumeGrid,
+}
+
+/// Starting points kept for the climbs to the peaks of |ψ| and of |∇ψ|.
+const CLIMBS: usize = 6;
+
+impl PreparedBasis {
+    /// Measures the combination `coefficients` of basis functions over the box `grid` spans: ψ
+    /// and ∇ψ (analytic) at a lattice of `n`³ points, then, since lattice points miss the peaks
+    /// between them, a climb from the largest lattice maxima of |ψ| and of |∇ψ| to the peaks
+    /// themselves (staying inside the box).
+    pub fn sampled_range(&self, coefficients: &[f64], grid: &GridSpec, n: usize) -> SampledRange {
+        let n = n.max(2);
+        let scale = DVec3::from_array(std::array::from_fn(|a| (grid.dims[a].max(2) - 1) as f64 / (n - 1) as f64));
+        let world_from_lattice = grid.world_from_grid * glam::DMat4::from_scale(scale);
+        let at = |u: DVec3| self.orbital_value_and_gradient(coefficients, world_from_lattice.transform_point3(u));
+        let index = |m: usize| DVec3::new((m / (n * n)) as f64, (m / n % n) as f64, (m % n) as f64);
+        let sampled: Vec<(f64, DVec3)> = (0..n * n * n).into_par_iter().map(|m| at(index(m))).collect();
+        let abs: Vec<f64> = sampled.iter().map(|s| s.0.abs()).collect();
+        let grad: Vec<f64> = sampled.iter().map(|s| s.1.length()).collect();
+        let mut max_abs = abs.iter().fold(0.0f64, |m, &v| m.max(v));
+        let mut max_grad = grad.iter().fold(0.0f64, |m, &v| m.max(v));
+        let top = |f: &[f64]| {
+            let mut peaks: Vec<usize> = (0..f.len()).filter(|&m| f[m] > 0.0 && lattice_peak(f, n, m)).collect();
+            peaks.sort_by(|&a, &b| f[b].total_cmp(&f[a]));
+            peaks.truncate(CLIMBS);
+            peaks
+        };
+        let hi = DVec3::splat((n - 1) as f64);
+        for m in top(&abs) {
+            max_abs = max_abs.max(climb(|u| at(u).0.abs(), index(m), hi));
+        }
+        for m in top(&grad) {
+            max_grad = max_grad.max(climb(|u| at(u).1.length(), index(m), hi));
+        }
+        let values = sampled.iter().map(|s| s.0 as f32).collect();
+        SampledRange {
+            max_abs,
+            max_grad,
+            samples: super::VolumeGrid::new("orbital samples", [n; 3], world_from_lattice, values),
+        }
+    }
+}
+
+/// Whether lattice point `m` of `f` (`n`³ values, cube order) is at least its six neighbours.
+fn lattice_peak(f: &[f64], n: usize, m: usize) -> bool {
+    let (i, j, k) = (m / (n * n), m / n % n, m % n);
+    let strides = [n * n, n, 1];
+    [i, j, k].iter().zip(strides).all(|(&c, s)| (c == 0 || f[m - s] <= f[m]) && (c + 1 == n || f[m + s] <= f[m]))
+}
+
+/// The largest value of `f` a compass search reaches from `start` within the box 0..`hi` (steps
+/// from half a lattice spacing down to 1/256 of one); at least `f(start)`.
+fn climb(f: impl Fn(DVec3) -> f64, start: DVec3, hi: DVec3) -> f64 {
+    let (mut u, mut best, mut h) = (start, f(start), 0.5);
+    for _ in 0..200 {
+        if h < 1.0 / 256.0 {
+            break;
+        }
+        let moves = (0..6).map(|d| {
+            let mut v = u;
+            v[d / 2] = (v[d / 2] + if d % 2 == 0 { h } else { -h }).clamp(0.0, hi[d / 2]);
+            v
+        });
+        match moves.map(|v| (f(v), v)).max_by(|a, b| a.0.total_cmp(&b.0)) {
+            Some((value, v)) if value > best => (best, u) = (value, v),
+            _ => h *= 0.5,
+        }
+    }
+    best
+}
+
 /// Weight of an orbital in the spin density: +n for alpha and −n for beta orbitals of an
 /// unrestricted wavefunction; for a restricted one, the unpaired part min(n, 2 − n) (an
 /// open-shell orbital with occupation 1 counts as alpha).
@@ -1074,5 +1154,34 @@ mod tests {
                 assert!(b[f].abs() <= DEFAULT_THRESHOLD);
             }
         }
+    }
+
+    #[test]
+    fn sampled_range_finds_the_peaks_between_lattice_points() {
+        // One normalised s Gaussian N·exp(−α r²): |ψ| peaks at the centre at N, |∇ψ| = 2αrψ
+        // peaks at r = 1/√(2α) at N·√(2α)·e^(−½). The lattice (9 points over an off-centre box)
+        // passes 0.36 bohr from the centre.
+        let alpha = 1.3;
+        let shell = Shell {
+            atom: 0,
+            center: DVec3::ZERO,
+            l: 0,
+            kind: ShellKind::Cartesian,
+            exponents: vec![alpha],
+            coefficients: vec![1.0],
+        };
+        let prepared = PreparedBasis::new(&Basis { shells: vec![shell] });
+        let grid = GridSpec::cube(DVec3::new(-3.3, -2.8, -3.05), DVec3::new(2.9, 3.4, 3.15), 40);
+        let range = prepared.sampled_range(&[1.0], &grid, 9);
+        let n = (2.0 * alpha / std::f64::consts::PI).powf(0.75);
+        let lattice_max = range.samples.stats.max_abs;
+        assert!(lattice_max < 0.9 * n, "the lattice alone misses the peak ({lattice_max} vs {n})");
+        assert!((range.max_abs / n - 1.0).abs() < 1e-4, "max |ψ| {} vs {n}", range.max_abs);
+        let max_grad = n * (2.0 * alpha).sqrt() * (-0.5f64).exp();
+        assert!((range.max_grad / max_grad - 1.0).abs() < 1e-4, "max |∇ψ| {} vs {max_grad}", range.max_grad);
+        assert_eq!(range.samples.dims, [9; 3]);
+        // The lattice spans the grid's box.
+        let corner = range.samples.world_from_grid.transform_point3(DVec3::splat(8.0));
+        assert!((corner - DVec3::new(2.9, 3.4, 3.15)).length() < 1e-9);
     }
 }

@@ -10,7 +10,7 @@
 
 use std::sync::LazyLock;
 
-use glam::{DMat3, DVec3, Vec3};
+use glam::{DMat3, DVec3, Mat3, Vec3};
 use rayon::prelude::*;
 
 use super::VolumeGrid;
@@ -132,6 +132,29 @@ fn edge_between(a: usize, b: usize) -> usize {
 /// Per case (bit c set: corner c inside), triangles as triples of edge numbers.
 static CASES: LazyLock<Vec<Vec<[u8; 3]>>> = LazyLock::new(|| (0..256).map(triangulate_case).collect());
 
+/// The case table flattened for the extraction loop: per case, its triangles' edges (at most
+/// 5 triangles) and how many, and the mask of the edges it crosses.
+struct FlatCase {
+    edges: [u8; 15],
+    count: u8,
+    crossed: u16,
+}
+
+static FLAT_CASES: LazyLock<Vec<FlatCase>> = LazyLock::new(|| {
+    CASES
+        .iter()
+        .map(|tris| {
+            let mut edges = [0; 15];
+            let mut crossed = 0u16;
+            for (n, &e) in tris.iter().flatten().enumerate() {
+                edges[n] = e;
+                crossed |= 1 << e;
+            }
+            FlatCase { edges, count: (3 * tris.len()) as u8, crossed }
+        })
+        .collect()
+});
+
 /// The six faces, each as its four corners counter-clockwise seen from outside the cube.
 fn faces() -> Vec<[usize; 4]> {
     let mut faces = Vec::new();
@@ -191,26 +214,34 @@ fn triangulate_case(case: usize) -> Vec<[u8; 3]> {
     triangles
 }
 
-/// The field's gradient (world units) at grid points by central differences, one-sided at the
-/// borders.
+/// The field's gradient at grid points by central differences (one-sided at the borders), in
+/// index space: ∇_world = J⁻ᵀ ∇_index (J the step vectors as columns), applied once per vertex
+/// after interpolating along the edge.
 struct Gradient<'a> {
     grid: &'a VolumeGrid,
-    /// ∇_world = J⁻ᵀ ∇_index, J the step vectors as columns.
-    inv_t: DMat3,
+    inv_t: Mat3,
 }
 
 impl Gradient<'_> {
-    fn at(&self, p: [usize; 3]) -> DVec3 {
+    fn index_space(&self, p: [usize; 3]) -> Vec3 {
         let g = self.grid;
-        let mut d = DVec3::ZERO;
+        let [nx, ny, nz] = g.dims;
+        let v = &g.values;
+        let at = (p[0] * ny + p[1]) * nz + p[2];
+        if p[0] > 0 && p[0] + 1 < nx && p[1] > 0 && p[1] + 1 < ny && p[2] > 0 && p[2] + 1 < nz {
+            // Interior (nearly every vertex): by index strides.
+            let (sx, sy) = (ny * nz, nz);
+            return 0.5 * Vec3::new(v[at + sx] - v[at - sx], v[at + sy] - v[at - sy], v[at + 1] - v[at - 1]);
+        }
+        let mut d = Vec3::ZERO;
         for a in 0..3 {
             let (mut lo, mut hi) = (p, p);
             lo[a] = p[a].saturating_sub(1);
             hi[a] = (p[a] + 1).min(g.dims[a] - 1);
-            let span = (hi[a] - lo[a]).max(1) as f64;
-            d[a] = (g.value(hi[0], hi[1], hi[2]) - g.value(lo[0], lo[1], lo[2])) as f64 / span;
+            let span = (hi[a] - lo[a]).max(1) as f32;
+            d[a] = (g.value(hi[0], hi[1], hi[2]) - g.value(lo[0], lo[1], lo[2])) / span;
         }
-        self.inv_t * d
+        d
     }
 }
 
@@ -226,7 +257,7 @@ pub fn extract(grid: &VolumeGrid, levels: &[Level]) -> Vec<Mesh> {
         return vec![Mesh::default(); levels.len()];
     }
     let jac = DMat3::from_cols(grid.step(0), grid.step(1), grid.step(2));
-    let gradient = Gradient { grid, inv_t: jac.inverse().transpose() };
+    let gradient = Gradient { grid, inv_t: jac.inverse().transpose().as_mat3() };
     // A few runs per thread balance the load; within a run, consecutive slabs share a plane's
     // flags and the vertices on it.
     let slabs = nx - 1;
@@ -242,6 +273,11 @@ pub fn extract(grid: &VolumeGrid, levels: &[Level]) -> Vec<Mesh> {
         })
         .collect();
     let mut meshes = vec![Mesh::default(); levels.len()];
+    for (l, mesh) in meshes.iter_mut().enumerate() {
+        mesh.positions.reserve(parts.iter().map(|p| p[l].positions.len()).sum());
+        mesh.normals.reserve(parts.iter().map(|p| p[l].normals.len()).sum());
+        mesh.indices.reserve(parts.iter().map(|p| p[l].indices.len()).sum());
+    }
     for part in parts {
         for (mesh, piece) in meshes.iter_mut().zip(part) {
             mesh.append(piece);
@@ -251,11 +287,15 @@ pub fn extract(grid: &VolumeGrid, levels: &[Level]) -> Vec<Mesh> {
 }
 
 /// One plane's flags: per grid point, bit L set when the point is inside level L; per row of
-/// points, `Some(flags)` when every point of the row has the same flags.
+/// points, how many leading cells and from which cell on its flags stay the same (the row's
+/// first and last change), so that rows of cells are walked only where a surface can cross.
 #[derive(Default)]
 struct PlaneFlags {
     points: Vec<u8>,
-    rows: Vec<Option<u8>>,
+    /// Per row: the first k with flags[k] ≠ flags[k + 1] (nz − 1 when none).
+    left: Vec<u32>,
+    /// Per row: one past the last such k (0 when none).
+    right: Vec<u32>,
 }
 
 impl PlaneFlags {
@@ -270,13 +310,28 @@ impl PlaneFlags {
                 *bits |= u8::from(level.sign * v > level.value) << l;
             }
         }
-        self.rows.clear();
-        self.rows.extend(self.points.chunks_exact(nz).map(|row| {
+        self.left.clear();
+        self.right.clear();
+        for row in self.points.chunks_exact(nz) {
+            // Most rows are uniform: a fold that vectorises tells them before any scan.
             let (and, or) = row.iter().fold((u8::MAX, 0u8), |(a, o), &b| (a & b, o | b));
-            (and == or).then_some(and)
-        }));
+            let (left, right) = match and == or {
+                true => (nz - 1, 0),
+                false => {
+                    let left = row.windows(2).position(|w| w[0] != w[1]).unwrap_or(nz - 1);
+                    (left, row.windows(2).rposition(|w| w[0] != w[1]).map_or(0, |k| k + 1))
+                }
+            };
+            self.left.push(left as u32);
+            self.right.push(right as u32);
+        }
     }
 }
+
+/// 1 in every byte of a u64.
+const BYTES: u64 = 0x0101_0101_0101_0101;
+/// Multiplying bytes of 0 or 1 by this gathers byte c into bit c of the top byte.
+const GATHER: u64 = 0x0102_0408_1020_4080;
 
 /// A vertex made on an edge, valid while its stamp (which row of which plane) matches: the
 /// cache is never cleared, only overwritten.
@@ -305,6 +360,9 @@ struct Run<'a> {
     /// Flags of the slab's two planes, and which plane the second one is.
     flags: [PlaneFlags; 2],
     flagged: Option<usize>,
+    /// The static tables, dereferenced once.
+    cases: &'static [FlatCase],
+    edges: [(usize, usize, usize); 12],
 }
 
 impl<'a> Run<'a> {
@@ -320,6 +378,8 @@ impl<'a> Run<'a> {
             caches: (0..levels.len()).map(|_| cache()).collect(),
             flags: Default::default(),
             flagged: None,
+            cases: &FLAT_CASES,
+            edges: *EDGES,
         }
     }
 
@@ -335,32 +395,46 @@ impl<'a> Run<'a> {
         self.flagged = Some(i + 1);
         let flags = std::mem::take(&mut self.flags);
         for j in 0..ny - 1 {
-            // Most rows of cells lie wholly inside or outside every surface.
-            let uniform = [flags[0].rows[j], flags[0].rows[j + 1], flags[1].rows[j], flags[1].rows[j + 1]];
-            if uniform[0].is_some() && uniform.iter().all(|&u| u == uniform[0]) {
-                continue;
-            }
             let points = [&flags[0].points, &flags[1].points];
             let rows = [
                 [&points[0][j * nz..(j + 1) * nz], &points[0][(j + 1) * nz..(j + 2) * nz]],
                 [&points[1][j * nz..(j + 1) * nz], &points[1][(j + 1) * nz..(j + 2) * nz]],
             ];
-            for k in 0..nz - 1 {
-                let corners: [u8; 8] = std::array::from_fn(|c| {
-                    let [dx, dy, dz] = corner(c);
-                    rows[dx][dy][k + dz]
-                });
-                if corners.iter().all(|&b| b == corners[0]) {
+            // Before every row's first change (after every row's last) the four rows are
+            // constant: those cells are crossed only when the rows' flags differ there.
+            let ends = |f: &dyn Fn(&PlaneFlags, usize) -> u32| {
+                [f(&flags[0], j), f(&flags[0], j + 1), f(&flags[1], j), f(&flags[1], j + 1)]
+            };
+            let same_at = |k: usize| rows.iter().flatten().all(|r| r[k] == rows[0][0][k]);
+            let start = if same_at(0) { *ends(&|p, r| p.left[r]).iter().min().unwrap_or(&0) as usize } else { 0 };
+            let end =
+                if same_at(nz - 1) { *ends(&|p, r| p.right[r]).iter().max().unwrap_or(&0) as usize } else { nz - 1 };
+            if start >= end {
+                continue;
+            }
+            // Corner c of cell k is rows[c & 1][c >> 1 & 1][k + (c >> 2)]: pairs of each row.
+            let pairs = |dx: usize, dy: usize| rows[dx][dy][start..=end].windows(2);
+            let cells = pairs(0, 0).zip(pairs(1, 0)).zip(pairs(0, 1)).zip(pairs(1, 1));
+            for (n, (((a, b), c), d)) in cells.enumerate() {
+                let k = start + n;
+                let word = u64::from_le_bytes([a[0], b[0], c[0], d[0], a[1], b[1], c[1], d[1]]);
+                if word == u64::from(a[0]) * BYTES {
                     continue;
                 }
                 for l in 0..self.levels.len() {
-                    let case = corners.iter().enumerate().fold(0, |case, (c, &b)| case | ((b >> l & 1) as usize) << c);
-                    for tri in &CASES[case] {
-                        for &e in tri {
-                            let v = self.vertex(l, [i, j, k], e as usize);
-                            self.meshes[l].indices.push(v);
-                        }
+                    // Bit l of each corner's flags gathered into the case's bit c.
+                    let case = (((word >> l) & BYTES).wrapping_mul(GATHER) >> 56) as usize;
+                    let flat = &self.cases[case];
+                    // Each crossed edge's vertex once, then the triangles by edge.
+                    let mut ids = [0u32; 12];
+                    let mut crossed = flat.crossed;
+                    while crossed != 0 {
+                        let e = crossed.trailing_zeros() as usize;
+                        ids[e] = self.vertex(l, [i, j, k], e);
+                        crossed &= crossed - 1;
                     }
+                    let indices = &mut self.meshes[l].indices;
+                    indices.extend(flat.edges[..flat.count as usize].iter().map(|&e| ids[e as usize]));
                 }
             }
         }
@@ -370,7 +444,7 @@ impl<'a> Run<'a> {
     /// The vertex of level `l` on edge `e` of cell `cell`, made once.
     fn vertex(&mut self, l: usize, cell: [usize; 3], e: usize) -> u32 {
         let [_, ny, nz] = self.grid.dims;
-        let (c0, c1, axis) = EDGES[e];
+        let (c0, c1, axis) = self.edges[e];
         let [dx, dy, dz] = corner(c0);
         let [i, j, k] = cell;
         let row = j + dy;
@@ -389,14 +463,14 @@ impl<'a> Run<'a> {
         let p0: [usize; 3] = std::array::from_fn(|a| cell[a] + corner(c0)[a]);
         let p1: [usize; 3] = std::array::from_fn(|a| cell[a] + corner(c1)[a]);
         let (v0, v1) = (level.sign * grid.value(p0[0], p0[1], p0[2]), level.sign * grid.value(p1[0], p1[1], p1[2]));
-        let t = ((level.value - v0) / (v1 - v0)).clamp(0.0, 1.0) as f64;
+        let t = ((level.value - v0) / (v1 - v0)).clamp(0.0, 1.0);
         let mut g = DVec3::new(p0[0] as f64, p0[1] as f64, p0[2] as f64);
-        g[axis] += t;
+        g[axis] += t as f64;
         // Outside is where the signed field falls: the normal is −∇(sign·value).
-        let grad = self.gradient.at(p0).lerp(self.gradient.at(p1), t) * level.sign as f64;
+        let grad = self.gradient.index_space(p0).lerp(self.gradient.index_space(p1), t);
         let mesh = &mut self.meshes[l];
         mesh.positions.push(grid.world_from_grid.transform_point3(g).as_vec3());
-        mesh.normals.push((-grad).normalize_or_zero().as_vec3());
+        mesh.normals.push((self.gradient.inv_t * grad * -level.sign).normalize_or_zero());
         let vertex = (mesh.positions.len() - 1) as u32;
         *slot = Cached { stamp, vertex };
         vertex

@@ -228,8 +228,10 @@ pub fn changes(before: &ObjectState, after: &ObjectState) -> Changes {
             .map(|(a, b)| {
                 let wavefunction = matches!(b.source, Source::Wavefunction(_));
                 let (was, now) = (&a.cloud, &b.cloud);
+                // Direct mode fills a grid only for isosurfaces: showing the first asks for one.
+                let grid = wavefunction && after.evaluation.direct && b.wants_grid() && !a.wants_grid();
                 QuantityChanges {
-                    values: a.source != b.source || (wavefunction && evaluation),
+                    values: a.source != b.source || (wavefunction && (evaluation || grid)),
                     isosurfaces: a.isosurfaces != b.isosurfaces,
                     opacity: was.k2 != now.k2
                         || was.density_scale != now.density_scale
@@ -429,6 +431,14 @@ mod tests {
         let mut direct = before.clone();
         direct.evaluation.direct = true;
         assert!(changes(&before, &direct).quantities.iter().all(|q| q.values));
+        // Direct mode holds no grid until an isosurface wants one: showing it evaluates anew
+        // (with the grid), hiding it does not.
+        let mut iso = direct.clone();
+        iso.quantities[1].isosurfaces[0].visible = true;
+        let c = changes(&direct, &iso);
+        assert!(c.quantities[1].values && c.quantities[1].isosurfaces && !c.quantities[0].values);
+        assert!(!changes(&iso, &direct).quantities[1].values);
+        assert!(!changes(&before, &after_iso(&before)).quantities[1].values, "grid mode has its grid");
         // A quantity added: the layers are laid out again.
         let mut more = before.clone();
         more.quantities.push(more.quantities[0].clone());
@@ -445,6 +455,12 @@ mod tests {
         narrower.selection = "chain A".into();
         let c = changes(&selected, &narrower);
         assert!(c.atoms && c.surface);
+    }
+
+    fn after_iso(s: &ObjectState) -> ObjectState {
+        let mut s = s.clone();
+        s.quantities[1].isosurfaces[0].visible = true;
+        s
     }
 
     #[test]

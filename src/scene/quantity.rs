@@ -104,6 +104,12 @@ impl QuantityState {
         Self { source, visible: true, cloud: defaults.volume, isosurfaces: vec![defaults.iso], pane: None }
     }
 
+    /// Whether its values on a grid are wanted: an isosurface of it is shown (direct mode fills
+    /// no grid otherwise).
+    pub fn wants_grid(&self) -> bool {
+        self.isosurfaces.iter().any(|i| i.visible)
+    }
+
     /// Whether it is drawn in pane `pane` of a view split into `count`.
     pub fn in_pane(&self, pane: usize, count: usize) -> bool {
         self.pane.is_none_or(|p| p.min(count.max(1) - 1) == pane)
