@@ -332,6 +332,6 @@ def widget(doc_or_docs, **options):
     zoomed with the wheel, with controls for the orbital, the isovalue and cloud or isosurfaces; a
     list of documents (a scan's frames) adds a slider along them. Needs ``jupyter_rfb`` and
     ``ipywidgets``."""
-    from .widget import Viewer
+    from .notebook import Viewer
 
     return Viewer(doc_or_docs, **options)

@@ -112,16 +112,7 @@ fn points_of(points: &PyReadonlyArray2<'_, f64>) -> PyResult<Vec<DVec3>> {
 
 /// `quantity` at every point, on all cores.
 fn values_at(wf: &Wavefunction, prepared: &PreparedBasis, q: Quantity, points: &[DVec3]) -> Vec<f64> {
-    points
-        .par_iter()
-        .with_min_len(256)
-        .map(|&p| match q {
-            Quantity::Orbital(i) => prepared.orbital_value(&wf.orbitals[i].coefficients, p),
-            Quantity::BasisFunction(k) => prepared.basis_values(p)[k],
-            Quantity::Density => prepared.density(wf, p),
-            Quantity::SpinDensity => prepared.spin_density(wf, p),
-        })
-        .collect()
+    points.par_chunks(1024).flat_map_iter(|chunk| prepared.quantity_at(wf, q, chunk)).collect()
 }
 
 /// The grid `quantity` is shown on: `points` per side over the box where it decays.
