@@ -104,8 +104,13 @@ class Viewer(widgets.VBox):
         self.docs = docs
         doc = docs[0]
         choices = _orbital_choices(doc)
-        start = doc.orbital_index(orbital) + 1 if choices and not isinstance(orbital, int) else (orbital + 1 if isinstance(orbital, int) else None)
-        self.orbital = widgets.Dropdown(options=choices, value=str(start) if choices else None, description="orbital", disabled=not choices)
+        start = None
+        if choices:
+            index = orbital if isinstance(orbital, int) else doc.orbital_index(orbital)
+            start = str(index + 1)
+            if start not in [word for _, word in choices]:
+                choices.insert(0, (f"MO {index}", start))
+        self.orbital = widgets.Dropdown(options=choices, value=start, description="orbital", disabled=not choices)
         self.iso = widgets.FloatLogSlider(value=iso, base=10, min=-3, max=0, step=0.05, description="isovalue", readout_format=".3f")
         self.style = widgets.ToggleButtons(options=list(STYLES), value=style, description="show")
         self.frame = None

@@ -2,7 +2,7 @@
 //! (`python/orbcloud/`) wraps it; nothing here computes what the library does not.
 
 use std::path::PathBuf;
-use std::sync::OnceLock;
+use std::sync::{Mutex, OnceLock};
 
 use glam::DVec3;
 use numpy::ndarray::{Array2, Array3};
@@ -393,11 +393,23 @@ fn render<'py>(
 }
 
 /// One quantity's scene as `render` draws it, kept on the GPU and drawn again from a camera the
-/// caller turns (the notebook viewer).
-#[pyclass(module = "orbcloud._native", unsendable)]
+/// caller turns (the notebook viewer, whose events may arrive on another thread than the one
+/// that made it).
+#[pyclass(module = "orbcloud._native", frozen)]
 struct Scene {
+    state: Mutex<SceneState>,
+}
+
+struct SceneState {
     picture: Box<cli::Picture>,
     camera: Camera,
+}
+
+impl Scene {
+    fn state(&self) -> std::sync::MutexGuard<'_, SceneState> {
+        // A panic while drawing leaves the scene as it was: keep using it.
+        self.state.lock().unwrap_or_else(|e| e.into_inner())
+    }
 }
 
 #[pymethods]
@@ -408,7 +420,9 @@ impl Scene {
         let doc = doc.map(|d| d.get().doc.clone());
         let drawing = py.detach(|| cli::render_drawing(doc, &words).map_err(|e| format!("{e:#}")));
         match drawing.map_err(PyValueError::new_err)? {
-            cli::Drawing::Scene(picture) => Ok(Self { camera: picture.camera, picture }),
+            cli::Drawing::Scene(picture) => {
+                Ok(Self { state: Mutex::new(SceneState { camera: picture.camera, picture }) })
+            }
             cli::Drawing::Drawn(..) => {
                 Err(PyValueError::new_err("the interactive view shows one quantity (no --beside, no second quantity)"))
             }
@@ -416,36 +430,41 @@ impl Scene {
     }
 
     /// Turns the camera about its target (radians).
-    fn orbit(&mut self, d_yaw: f32, d_pitch: f32) {
-        self.camera.orbit(d_yaw, d_pitch);
+    fn orbit(&self, d_yaw: f32, d_pitch: f32) {
+        self.state().camera.orbit(d_yaw, d_pitch);
     }
 
     /// Moves the camera closer (factor < 1) or away.
-    fn zoom(&mut self, factor: f32) {
-        self.camera.zoom(factor);
+    fn zoom(&self, factor: f32) {
+        self.state().camera.zoom(factor);
     }
 
     /// Back to the camera the options ask for.
-    fn reset(&mut self) {
-        self.camera = self.picture.camera;
+    fn reset(&self) {
+        let mut state = self.state();
+        state.camera = state.picture.camera;
     }
 
     /// The camera as JSON (target, yaw, pitch, distance, fov_y, orientation).
     #[getter]
     fn get_camera(&self) -> PyResult<String> {
-        serde_json::to_string(&self.camera).map_err(runtime)
+        serde_json::to_string(&self.state().camera).map_err(runtime)
     }
 
     #[setter]
-    fn set_camera(&mut self, json: &str) -> PyResult<()> {
-        self.camera = serde_json::from_str(json).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    fn set_camera(&self, json: &str) -> PyResult<()> {
+        self.state().camera = serde_json::from_str(json).map_err(|e| PyValueError::new_err(e.to_string()))?;
         Ok(())
     }
 
-    /// The picture from the current camera (height × width × 4, RGBA).
-    fn draw<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyArray3<u8>>> {
-        let img = self.picture.draw(&self.camera).map_err(|e| PyRuntimeError::new_err(format!("{e:#}")))?;
-        rgba(py, img)
+    /// The picture from the current camera (height × width × 4, RGBA), drawn without the GIL.
+    fn draw<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray3<u8>>> {
+        let img = py.detach(|| {
+            let mut state = self.state();
+            let camera = state.camera;
+            state.picture.draw(&camera).map_err(|e| format!("{e:#}"))
+        });
+        rgba(py, img.map_err(PyRuntimeError::new_err)?)
     }
 }
 

@@ -61,3 +61,26 @@ def test_scan_slider_moves_along_the_frames():
     viewer.frame.value = 2
     last = np.asarray(viewer.canvas.get_frame()).copy()
     assert np.abs(last.astype(int) - first).sum() > 0
+
+
+def test_events_from_another_thread():
+    """ipykernel may deliver a widget's messages on a thread of its own."""
+    import threading
+
+    viewer = orbcloud.widget(orbcloud.load(WATER), size=(64, 48), lavapipe=True)
+    before = camera(viewer)
+    errors = []
+
+    def drag():
+        try:
+            viewer.canvas.handle_event({"event_type": "pointer_down", "x": 10, "y": 10, "button": 1, "buttons": [1], "modifiers": []})
+            viewer.canvas.handle_event({"event_type": "pointer_move", "x": 30, "y": 12, "button": 0, "buttons": [1], "modifiers": []})
+            viewer.canvas.get_frame()
+        except Exception as e:  # reported below, on the test's thread
+            errors.append(e)
+
+    thread = threading.Thread(target=drag)
+    thread.start()
+    thread.join()
+    assert not errors, errors
+    assert camera(viewer)["yaw"] != before["yaw"]
