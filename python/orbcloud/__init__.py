@@ -24,7 +24,7 @@ import numpy as np
 from . import _native
 from ._image import Image
 
-__all__ = ["Document", "Image", "LoadError", "Orbital", "from_pyscf", "load", "render", "view", "widget"]
+__all__ = ["Document", "Image", "LoadError", "Orbital", "Scan", "from_pyscf", "load", "load_scan", "render", "view", "widget"]
 
 PathLike = Union[str, "os.PathLike[str]"]
 
@@ -251,6 +251,29 @@ def load(path: PathLike) -> Document:
     return Document(native, path=path)
 
 
+class Scan(NamedTuple):
+    """A scan manifest's key frames (``*.scan.toml``), each a :class:`Document`."""
+
+    title: str
+    coordinate: str
+    """What the frames vary, as chemists write it: "dihedral 1-2-3-4", "angle 2-1-3", "path"."""
+    values: list[float]
+    """The coordinate's value at each frame (degrees, Å, or the path position)."""
+    labels: list[str]
+    """Each value with its unit: "104.5°"."""
+    frames: list[Document]
+
+
+def load_scan(path: PathLike) -> Scan:
+    """Reads a scan manifest and every frame it names, as the viewer does (geometries aligned,
+    frames checked against each other). :func:`widget` of a scan has a slider along it."""
+    try:
+        title, coordinate, frames = _native.load_scan(os.fspath(path))
+    except _native.NativeLoadError as e:
+        raise LoadError(*e.args) from None
+    return Scan(title, coordinate, [f[0] for f in frames], [f[1] for f in frames], [Document(f[2]) for f in frames])
+
+
 def from_pyscf(mf_or_mol, mo_coeff=None, mo_occ=None, mo_energy=None) -> Document:
     """A document straight from PySCF: a mean-field object (``from_pyscf(mf)``) or a molecule with
     its orbitals (``from_pyscf(mol, mo_coeff, mo_occ, mo_energy)``). Restricted, restricted
@@ -330,8 +353,8 @@ def view(doc_or_path: Document | PathLike | Sequence[Document | PathLike]) -> su
 def widget(doc_or_docs, **options):
     """An interactive view for Jupyter: frames drawn by orbcloud's renderer, turned with the mouse,
     zoomed with the wheel, with controls for the orbital, the isovalue and cloud or isosurfaces; a
-    list of documents (a scan's frames) adds a slider along them. Needs ``jupyter_rfb`` and
-    ``ipywidgets``."""
+    :class:`Scan` (or a list of documents) adds a slider along its frames. Needs ``jupyter_rfb``
+    and ``ipywidgets``."""
     from .notebook import Viewer
 
     return Viewer(doc_or_docs, **options)

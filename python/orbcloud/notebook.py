@@ -11,7 +11,7 @@ from typing import Sequence
 import ipywidgets as widgets
 from jupyter_rfb import RemoteFrameBuffer
 
-from . import Document, _native, _words, load
+from . import Document, Scan, _native, _words, load
 
 # Radians per pixel dragged, and the wheel's zoom per unit of scroll: the desktop viewer's.
 DRAG_ROTATE = 0.008
@@ -93,8 +93,12 @@ class Viewer(widgets.VBox):
     """:class:`Canvas` with its controls; a list of documents (a scan's frames) adds a slider."""
 
     def __init__(self, doc_or_docs, size=(600, 450), orbital: str | int = "homo", iso: float = 0.05, style: str = "isosurfaces", **options):
-        if isinstance(doc_or_docs, (list, tuple)):
-            docs: Sequence[Document] = [d if isinstance(d, Document) else load(d) for d in doc_or_docs]
+        self.labels = None
+        if isinstance(doc_or_docs, Scan):
+            docs: Sequence[Document] = doc_or_docs.frames
+            self.labels = [f"{doc_or_docs.coordinate} = {label}" for label in doc_or_docs.labels]
+        elif isinstance(doc_or_docs, (list, tuple)):
+            docs = [d if isinstance(d, Document) else load(d) for d in doc_or_docs]
         else:
             docs = [doc_or_docs if isinstance(doc_or_docs, Document) else load(doc_or_docs)]
         if not docs:
@@ -117,7 +121,7 @@ class Viewer(widgets.VBox):
         controls = [self.orbital, self.iso, self.style]
         if len(docs) > 1:
             self.frame = widgets.IntSlider(value=0, min=0, max=len(docs) - 1, description="frame", continuous_update=False)
-            self.frame_label = widgets.Label(docs[0].source)
+            self.frame_label = widgets.Label(self._frame_name(0))
             controls.append(widgets.HBox([self.frame, self.frame_label]))
         self.canvas = Canvas(doc, size=size, **self._options(), **options)
         for control in (self.orbital, self.iso, self.style):
@@ -125,6 +129,9 @@ class Viewer(widgets.VBox):
         if self.frame is not None:
             self.frame.observe(self._frame_changed, names="value")
         super().__init__(children=[widgets.HBox(controls[:2]), widgets.HBox(controls[2:]), self.canvas])
+
+    def _frame_name(self, i: int) -> str:
+        return self.labels[i] if self.labels else self.docs[i].source
 
     def _options(self) -> dict:
         quantity = self.orbital.value
@@ -141,5 +148,5 @@ class Viewer(widgets.VBox):
 
     def _frame_changed(self, change) -> None:
         doc = self.docs[change["new"]]
-        self.frame_label.value = doc.source
+        self.frame_label.value = self._frame_name(change["new"])
         self.canvas.show(doc, **self._options())

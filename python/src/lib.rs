@@ -11,6 +11,7 @@ use orbcloud::formats::{self, LoadError, cube_write};
 use orbcloud::model::basis::{Basis, Shell, ShellKind};
 use orbcloud::model::gto::PreparedBasis;
 use orbcloud::model::orbitals::{MolecularOrbital, OrbitalSpec, Quantity, Spin, Wavefunction};
+use orbcloud::model::scan::FrameContent;
 use orbcloud::model::{Atom, Document, GridSpec, VolumeGrid};
 use orbcloud::scene::Camera;
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
@@ -91,6 +92,8 @@ impl PyDocument {
 type AtomArrays<'py> = (Bound<'py, PyArray1<u32>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>, Vec<bool>);
 /// A grid's values and its world-from-grid matrix.
 type GridArrays<'py> = (Bound<'py, PyArray3<f64>>, Bound<'py, PyArray2<f64>>);
+/// A scan's frame: the coordinate's value, the value as text, the frame.
+type ScanFrame = (f64, String, PyDocument);
 /// A shell: atom index, l, pure, exponents, coefficients of normalised primitives.
 type ShellParts = (usize, u32, bool, Vec<f64>, Vec<f64>);
 
@@ -367,6 +370,33 @@ fn from_parts(
     Ok(PyDocument::new(doc))
 }
 
+/// A scan manifest's frames as documents (each frame's first file, its geometry as the scan
+/// aligns it): the title, the coordinate ("angle 2-1-3") and each frame's value as text.
+#[pyfunction]
+fn load_scan(py: Python<'_>, path: PathBuf) -> PyResult<(String, String, Vec<ScanFrame>)> {
+    let scan = py.detach(|| formats::scan::load_scan(&path)).map_err(|e| load_error(&e))?.scan;
+    let frames = scan
+        .frames
+        .iter()
+        .map(|f| {
+            let (wavefunction, volumes) = match &f.content {
+                FrameContent::Wavefunctions(w) => (w.first().cloned(), Vec::new()),
+                FrameContent::Volumes(v) => (None, v.clone()),
+            };
+            let doc = Document {
+                source: f.source.clone(),
+                title: f.source.clone(),
+                molecule: f.molecule.clone(),
+                wavefunction,
+                volumes,
+                ..Default::default()
+            };
+            (f.at, scan.coordinate.value_text(f.at), PyDocument::new(doc))
+        })
+        .collect();
+    Ok((scan.title.clone(), scan.coordinate.label(), frames))
+}
+
 fn rgba<'py>(py: Python<'py>, img: image::RgbaImage) -> PyResult<Bound<'py, PyArray3<u8>>> {
     let (w, h) = img.dimensions();
     let a = Array3::from_shape_vec((h as usize, w as usize, 4), img.into_raw()).map_err(runtime)?;
@@ -480,6 +510,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Scene>()?;
     m.add_function(wrap_pyfunction!(load, m)?)?;
     m.add_function(wrap_pyfunction!(from_parts, m)?)?;
+    m.add_function(wrap_pyfunction!(load_scan, m)?)?;
     m.add_function(wrap_pyfunction!(render, m)?)?;
     m.add_function(wrap_pyfunction!(run_viewer, m)?)?;
     m.add("NativeLoadError", m.py().get_type::<NativeLoadError>())?;

@@ -84,3 +84,12 @@ def test_events_from_another_thread():
     thread.join()
     assert not errors, errors
     assert camera(viewer)["yaw"] != before["yaw"]
+
+
+def test_scan_manifest_gives_the_slider():
+    scan = orbcloud.load_scan(FIXTURES / "scans" / "water_path" / "water_path.scan.toml")
+    assert scan.coordinate == "path" and scan.values == [0, 1, 2, 3] and len(scan.frames) == 4
+    viewer = orbcloud.widget(scan, size=(64, 48), lavapipe=True)
+    assert viewer.frame.max == 3 and viewer.frame_label.value == "path = 0.00"
+    viewer.frame.value = 3
+    assert viewer.frame_label.value == "path = 3.00"
