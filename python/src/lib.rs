@@ -20,7 +20,7 @@ use rayon::prelude::*;
 
 /// The command line, compiled here so that `render` parses and draws exactly as
 /// `orbcloud render` does.
-#[allow(dead_code, unused_imports)]
+#[allow(dead_code, unused_imports, reason = "of the command line only `render` is called from here")]
 #[path = "../../src/main.rs"]
 mod cli;
 
