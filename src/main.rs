@@ -645,6 +645,24 @@ fn load(file: Option<&Path>) -> Result<Document> {
     }
 }
 
+/// What `render` makes of its options, given as words after `orbcloud render` (a file or not,
+/// `--orbital lumo --iso 0.05`, …), without a file written; `doc` replaces the file they name.
+/// The Python package compiles this file as a module and takes `render`'s options this way.
+#[allow(dead_code, reason = "the Python package's entry; the binary writes files")]
+pub fn render_drawing(doc: Option<Document>, words: &[String]) -> Result<render_cli::Drawing> {
+    let head = ["orbcloud", "render", "--output", "unused.png"].map(String::from);
+    let line = head.into_iter().chain(words.iter().cloned()).map(std::ffi::OsString::from).collect();
+    let (line, later) = quantities_cli::split(line)?;
+    match Cli::try_parse_from(line) {
+        Ok(Cli { command: Some(Command::Render(args)), .. }) => render_cli::drawing(&args, doc, &later),
+        Ok(_) => bail!("expected the options of `render`"),
+        Err(e) => bail!("{}", e.to_string().trim()),
+    }
+}
+
+#[allow(unused_imports, reason = "named by the Python package")]
+pub use render_cli::{Drawing, Picture};
+
 /// Image size, frame count and adapter of a frame-time benchmark.
 #[derive(Args)]
 struct BenchFrames {

@@ -9,6 +9,7 @@ use orbcloud::demo;
 use orbcloud::figure::Figure;
 use orbcloud::gpu::GpuContext;
 use orbcloud::headless::Headless;
+use orbcloud::model::Document;
 use orbcloud::scene::coloring::ValueMap;
 use orbcloud::scene::{Camera, RenderSettings};
 
@@ -18,26 +19,51 @@ use super::{DemoArg, RenderArgs, ViewArgs, WavefunctionArgs, gpu, load, surface_
 /// `render`: `args`'s file (or the bundled demo) to a PNG; `later` are further quantities of the
 /// file, each with its options ([`quantities_cli`]).
 pub fn render(args: RenderArgs, later: &[Later]) -> Result<()> {
+    match drawing(&args, None, later)? {
+        Drawing::Drawn(img, ctx) => save(&img, &args.output, &ctx),
+        Drawing::Scene(mut picture) => {
+            let img = picture.draw(&picture.camera.clone())?;
+            save(&img, &args.output, &picture.ctx)?;
+            if let Some(pixel) = args.pick {
+                surface_cli::print_pick(&picture.ctx, &picture.headless.renderer, &picture.doc, pixel)?;
+            }
+            Ok(())
+        }
+    }
+}
+
+/// What `render` makes of its options: one quantity's scene, ready to be drawn from any camera,
+/// or a picture already drawn (several quantities, a demo scene).
+pub enum Drawing {
+    Scene(Box<Picture>),
+    Drawn(image::RgbaImage, Box<GpuContext>),
+}
+
+/// The scene `args` and `later` ask for, of `doc`, or else of the file (or demo) `args` names.
+pub fn drawing(args: &RenderArgs, doc: Option<Document>, later: &[Later]) -> Result<Drawing> {
     let figure = args.figure.figure();
     let size = figure.drawn_size(args.view.size);
-    match args.demo {
-        Some(DemoArg::Cycloaddition) => {
+    match (args.demo, &doc) {
+        (Some(DemoArg::Cycloaddition), None) => {
             let ctx = gpu(args.lavapipe)?;
             let scene = demo::cycloaddition().context("the bundled demo did not load")?;
             let background = RenderSettings::default().background;
             let mut shown = surface_cli::SceneShown::new(&ctx, scene, &args.iso, size)?;
             let img = figure.draw(background, |bg| shown.draw(&ctx, bg))?;
-            return save(&img, &args.output, &ctx);
+            return Ok(Drawing::Drawn(img, Box::new(ctx)));
         }
-        Some(DemoArg::Scan) => bail!("the scan demo renders with `orbcloud scan render`"),
+        (Some(DemoArg::Scan), None) => bail!("the scan demo renders with `orbcloud scan render`"),
         _ => {}
     }
-    let mut doc = load(args.file.as_deref())?;
+    let mut doc = match doc {
+        Some(doc) => doc,
+        None => load(args.file.as_deref())?,
+    };
     // Arguments that depend on the file are checked before any GPU work. The camera frames the
     // file's geometry, so pictures of a vibration's phases line up.
     let camera = args.view.camera(&doc)?;
     args.vibration.apply(&mut doc)?;
-    let volume = args.view.volume_index(&doc)?;
+    args.view.volume_index(&doc)?;
     if !later.is_empty() {
         let later = quantities_cli::parse_later(later)?;
         if args.pick.is_some() {
@@ -45,58 +71,84 @@ pub fn render(args: RenderArgs, later: &[Later]) -> Result<()> {
         }
         let ctx = gpu(args.lavapipe)?;
         let background = RenderSettings::default().background;
-        let img = figure.draw(background, |bg| quantities_cli::render(&ctx, &doc, &args, &later, &camera, size, bg))?;
-        return save(&img, &args.output, &ctx);
+        let img = figure.draw(background, |bg| quantities_cli::render(&ctx, &doc, args, &later, &camera, size, bg))?;
+        return Ok(Drawing::Drawn(img, Box::new(ctx)));
     }
     if args.pick.is_some() && figure != Figure::default() {
         bail!("--pick reads the picture as drawn: leave out --scale and --transparent");
     }
-    // A cube file to colour by joins a copy of the document: the shown volume's index stays.
-    let colouring = match args.iso.color_by {
-        Some(_) => {
-            let mut with = doc.clone();
-            let source = args.iso.color_source(&mut with)?;
-            Some((with, source))
+    Ok(Drawing::Scene(Box::new(Picture::new(args, doc, camera)?)))
+}
+
+/// One file's scene as `render` draws it (one quantity), kept so that it can be drawn again from
+/// other cameras: `render` draws it once, the Python package's notebook viewer as the mouse turns
+/// it.
+pub struct Picture {
+    pub ctx: GpuContext,
+    pub doc: Document,
+    /// The camera the options ask for.
+    pub camera: Camera,
+    headless: Headless,
+    settings: RenderSettings,
+    figure: Figure,
+    /// A surface coloured by a quantity's values: the map and the quantity's name, for the colour
+    /// bar.
+    bar: Option<(ValueMap, String)>,
+}
+
+impl Picture {
+    /// `doc` shown as `args` asks (`doc` already displaced by `--normal-mode`), seen by `camera`.
+    pub(super) fn new(args: &RenderArgs, doc: Document, camera: Camera) -> Result<Self> {
+        let figure = args.figure.figure();
+        let size = figure.drawn_size(args.view.size);
+        let volume = args.view.volume_index(&doc)?;
+        // A cube file to colour by joins a copy of the document: the shown volume's index stays.
+        let (color_doc, color) = match args.iso.color_by {
+            Some(_) => {
+                let mut with = doc.clone();
+                let source = args.iso.color_source(&mut with)?;
+                (Some(with), source)
+            }
+            None => (None, None),
+        };
+        let ctx = gpu(args.lavapipe)?;
+        let mut settings = args.view.settings();
+        let mut h = Headless::new(&ctx, &doc, volume, &settings, size)?;
+        // Direct mode fills a grid only for isosurfaces or a surface coloured by its values.
+        let wants_grid = !args.iso.levels().is_empty() || args.molsurface.settings(false).color_by_volume;
+        let computed = args.wavefunction.apply(&ctx, &mut h, &doc, wants_grid)?.map(|(_, v)| v);
+        let grid = computed.as_ref().and_then(|v| v.grid.as_ref()).or(volume.and_then(|i| doc.volumes.get(i)));
+        match (&computed, grid) {
+            (Some(values), _) => values.auto_opacity(&mut settings.volume),
+            (None, Some(grid)) => orbcloud::evaluate::auto_opacity(&mut settings.volume, grid),
+            (None, None) => {}
         }
-        None => None,
-    };
-    let (color_doc, color) = match colouring {
-        Some((with, source)) => (Some(with), source),
-        None => (None, None),
-    };
-    let ctx = gpu(args.lavapipe)?;
-    let mut settings = args.view.settings();
-    let mut h = Headless::new(&ctx, &doc, volume, &settings, size)?;
-    // Direct mode fills a grid only for isosurfaces or a surface coloured by its values.
-    let wants_grid = !args.iso.levels().is_empty() || args.molsurface.settings(false).color_by_volume;
-    let computed = args.wavefunction.apply(&ctx, &mut h, &doc, wants_grid)?.map(|(_, v)| v);
-    let grid = computed.as_ref().and_then(|v| v.grid.as_ref()).or(volume.and_then(|i| doc.volumes.get(i)));
-    match (&computed, grid) {
-        (Some(values), _) => values.auto_opacity(&mut settings.volume),
-        (None, Some(grid)) => orbcloud::evaluate::auto_opacity(&mut settings.volume, grid),
-        (None, None) => {}
+        let molsurface = args.molsurface.mesh(&doc, args.iso.translucent, grid)?;
+        let map = molsurface.as_ref().and_then(|(_, _, map)| *map);
+        let meshes = molsurface.into_iter().map(|(mesh, look, _)| (mesh, look)).collect();
+        let shown = (grid, color_doc.as_ref().unwrap_or(&doc));
+        let colored = surface_cli::show(&ctx, &mut h.renderer, shown, &args.iso, color, meshes);
+        let arrows = args.vibration.arrows(&doc)?;
+        h.renderer.main().arrows.set_arrows(&ctx, &arrows, orbcloud::scene::vibration::ARROW_COLOR);
+        let bar = match colored {
+            Some(c) => Some((c.map, c.name)),
+            None => map.zip(grid.map(|g| g.label.clone())),
+        };
+        Ok(Self { ctx, doc, camera, headless: h, settings, figure, bar })
     }
-    let molsurface = args.molsurface.mesh(&doc, args.iso.translucent, grid)?;
-    let map = molsurface.as_ref().and_then(|(_, _, map)| *map);
-    let meshes = molsurface.into_iter().map(|(mesh, look, _)| (mesh, look)).collect();
-    let colored = surface_cli::show(&ctx, &mut h.renderer, (grid, color_doc.as_ref().unwrap_or(&doc)), &args.iso, color, meshes);
-    let arrows = args.vibration.arrows(&doc)?;
-    h.renderer.main().arrows.set_arrows(&ctx, &arrows, orbcloud::scene::vibration::ARROW_COLOR);
-    let img = figure.draw(settings.background, |bg| {
-        let settings = RenderSettings { background: bg, ..settings };
-        h.render(&ctx, &camera, &settings)
-    })?;
-    let mut img = img;
-    if let Some(c) = &colored {
-        value_bar(&mut img, &c.map, &c.name);
-    } else if let (Some(map), Some(grid)) = (map, grid) {
-        value_bar(&mut img, &map, &grid.label);
+
+    /// The scene seen by `camera`, as `render` writes it.
+    pub fn draw(&mut self, camera: &Camera) -> Result<image::RgbaImage> {
+        let Self { ctx, headless, settings, .. } = self;
+        let mut img = self.figure.draw(settings.background, |bg| {
+            let settings = RenderSettings { background: bg, ..*settings };
+            headless.render(ctx, camera, &settings)
+        })?;
+        if let Some((map, name)) = &self.bar {
+            value_bar(&mut img, map, name);
+        }
+        Ok(img)
     }
-    save(&img, &args.output, &ctx)?;
-    if let Some(pixel) = args.pick {
-        surface_cli::print_pick(&ctx, &h.renderer, &doc, pixel)?;
-    }
-    Ok(())
 }
 
 /// The colour bar of a surface coloured by a volume's values: the map's range, in atomic

@@ -348,29 +348,35 @@ impl PreparedBasis {
     /// Electron density Σ n_i |ψ_i|² over all orbitals (alpha and beta; a restricted orbital
     /// carries its occupation up to 2).
     pub fn density(&self, wf: &Wavefunction, point: DVec3) -> f64 {
-        let v = self.basis_values(point);
-        wf.orbitals
-            .iter()
-            .filter(|o| o.occupation != 0.0)
-            .map(|o| {
-                let psi = dot(&o.coefficients, &v);
-                o.occupation * psi * psi
-            })
-            .sum()
+        density_of(wf, &self.basis_values(point))
     }
 
     /// Spin density ρα − ρβ (see [`spin_weight`]).
     pub fn spin_density(&self, wf: &Wavefunction, point: DVec3) -> f64 {
-        let v = self.basis_values(point);
-        wf.orbitals
+        spin_density_of(wf, &self.basis_values(point))
+    }
+
+    /// An orbital, a bare basis function, the total density or the spin density of `wf` at each
+    /// of `points` (what [`Self::orbital_value`], [`Self::density`]… give), one scratch for all;
+    /// NaN for the potential, which needs the nuclei ([`Self::quantity_at_points`]).
+    fn quantity_at(&self, wf: &Wavefunction, quantity: Quantity, points: &[DVec3]) -> Vec<f64> {
+        let mut values = vec![0.0; self.n_functions];
+        let (mut c, mut cg) = (Vec::new(), Vec::new());
+        points
             .iter()
-            .map(|o| (spin_weight(wf, o.occupation, o.spin), o))
-            .filter(|(w, _)| *w != 0.0)
-            .map(|(w, o)| {
-                let psi = dot(&o.coefficients, &v);
-                w * psi * psi
+            .map(|&p| {
+                for s in &self.shells {
+                    self.shell_values(s, p - s.center(), &mut values[s.functions()], None, &mut c, &mut cg);
+                }
+                match quantity {
+                    Quantity::Orbital(i) => dot(&wf.orbitals[i].coefficients, &values),
+                    Quantity::BasisFunction(k) => values[k],
+                    Quantity::Density => density_of(wf, &values),
+                    Quantity::SpinDensity => spin_density_of(wf, &values),
+                    Quantity::Potential => f64::NAN,
+                }
             })
-            .sum()
+            .collect()
     }
 
     /// Coefficients restricted to the basis functions in `subset` (others set to 0): the
@@ -465,17 +471,10 @@ impl PreparedBasis {
         quantity: Quantity,
         points: &[DVec3],
     ) -> Vec<f64> {
-        let potential = (quantity == Quantity::Potential).then(|| super::esp::Potential::new(molecule, wf));
-        points
-            .par_iter()
-            .map_init(super::esp::Scratch::default, |scratch, &p| match quantity {
-                Quantity::Orbital(i) => self.orbital_value(&wf.orbitals[i].coefficients, p),
-                Quantity::BasisFunction(k) => self.basis_values(p).get(k).copied().unwrap_or(0.0),
-                Quantity::Density => self.density(wf, p),
-                Quantity::SpinDensity => self.spin_density(wf, p),
-                Quantity::Potential => potential.as_ref().map_or(f64::NAN, |v| v.at(p, scratch)),
-            })
-            .collect()
+        if quantity == Quantity::Potential {
+            return super::esp::Potential::new(molecule, wf).at_points(points);
+        }
+        points.par_chunks(1024).flat_map_iter(|chunk| self.quantity_at(wf, quantity, chunk)).collect()
     }
 
     /// An orbital, the total density, the spin density or the electrostatic potential (of
@@ -884,6 +883,31 @@ pub fn spin_weight(wf: &Wavefunction, occupation: f64, spin: Spin) -> f64 {
     }
 }
 
+/// Σ n_i ψ_i² from the basis-function values at a point.
+fn density_of(wf: &Wavefunction, values: &[f64]) -> f64 {
+    wf.orbitals
+        .iter()
+        .filter(|o| o.occupation != 0.0)
+        .map(|o| {
+            let psi = dot(&o.coefficients, values);
+            o.occupation * psi * psi
+        })
+        .sum()
+}
+
+/// ρα − ρβ from the basis-function values at a point.
+fn spin_density_of(wf: &Wavefunction, values: &[f64]) -> f64 {
+    wf.orbitals
+        .iter()
+        .map(|o| (spin_weight(wf, o.occupation, o.spin), o))
+        .filter(|(w, _)| *w != 0.0)
+        .map(|(w, o)| {
+            let psi = dot(&o.coefficients, values);
+            w * psi * psi
+        })
+        .sum()
+}
+
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
@@ -1123,6 +1147,19 @@ mod tests {
                     assert!((part[idx] - want).abs() < 1e-11);
                     assert!((single[idx] - v[5]).abs() < 1e-11);
                 }
+            }
+        }
+        // The same quantities at scattered points, one scratch for all of them.
+        let scattered = points(50, 9, 3.0);
+        for q in [Quantity::Orbital(1), Quantity::BasisFunction(7), Quantity::Density, Quantity::SpinDensity] {
+            let at = |p| match q {
+                Quantity::Orbital(i) => pb.orbital_value(&wf.orbitals[i].coefficients, p),
+                Quantity::BasisFunction(k) => pb.basis_values(p)[k],
+                Quantity::Density => pb.density(&wf, p),
+                Quantity::SpinDensity => pb.spin_density(&wf, p),
+            };
+            for (v, &p) in pb.quantity_at(&wf, q, &scattered).iter().zip(&scattered) {
+                assert_eq!(*v, at(p), "{q:?} at {p}");
             }
         }
     }

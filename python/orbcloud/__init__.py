@@ -1,0 +1,361 @@
+"""orbcloud from Python: molecular orbitals and densities read, evaluated and rendered by
+orbcloud's Rust library (the same readers, evaluator and renderer as the ``orbcloud`` command).
+
+>>> import orbcloud
+>>> doc = orbcloud.load("water.molden")          # or orbcloud.from_pyscf(mf)
+>>> doc.evaluate(points, orbital="homo")          # numpy, all cores, the GIL released
+>>> orbcloud.render(doc, orbital="lumo", iso=0.05)  # an RGBA image, shown inline by IPython
+
+Positions are in bohr, energies in hartree. An ``orbital`` is ``"homo"``, ``"lumo"``,
+``"homo-N"``, ``"lumo+N"`` or an ``int``: a 0-based index among the orbitals of that spin, as
+PySCF numbers the columns of ``mo_coeff``.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import tempfile
+from typing import NamedTuple, Sequence, Union
+
+import numpy as np
+
+from . import _native
+from ._image import Image
+
+__all__ = ["Document", "Image", "LoadError", "Orbital", "Scan", "from_pyscf", "load", "load_scan", "render", "view", "widget"]
+
+PathLike = Union[str, "os.PathLike[str]"]
+
+
+class LoadError(ValueError):
+    """A file orbcloud could not read: the reader's message, with the file and (when the reader
+    names one) the 1-based line."""
+
+    def __init__(self, message: str, file: str | None = None, line: int | None = None):
+        super().__init__(message)
+        self.file = file
+        self.line = line
+
+
+class Atoms(NamedTuple):
+    numbers: np.ndarray
+    """Atomic numbers (0 for a dummy centre)."""
+    charges: np.ndarray
+    """Nuclear charges as the file gives them."""
+    positions: np.ndarray
+    """Positions, bohr, n × 3."""
+    ghost: np.ndarray
+    """Whether each atom is a ghost (basis functions, no nucleus)."""
+
+
+class Orbital(NamedTuple):
+    index: int
+    """0-based among the orbitals of its spin."""
+    spin: str
+    """``"alpha"`` or ``"beta"`` (every orbital of a restricted wavefunction is alpha)."""
+    energy: float
+    """Hartree (NaN when the file gives none)."""
+    occupation: float
+    label: str
+    """Symmetry label as written ("" when none)."""
+
+
+class Grid(NamedTuple):
+    values: np.ndarray
+    """nx × ny × nz values, x slowest (cube order)."""
+    world_from_grid: np.ndarray
+    """4 × 4 affine map from grid indices (i, j, k, 1) to bohr."""
+
+    @property
+    def origin(self) -> np.ndarray:
+        return self.world_from_grid[:3, 3]
+
+    @property
+    def axes(self) -> np.ndarray:
+        """The three step vectors (rows), bohr."""
+        return self.world_from_grid[:3, :3].T
+
+    def points(self) -> np.ndarray:
+        """Every grid point's position (nx·ny·nz × 3, bohr) in the values' order."""
+        idx = np.indices(self.values.shape).reshape(3, -1).T.astype(float)
+        return idx @ self.axes + self.origin
+
+
+class Document:
+    """What orbcloud read from a file (or was given by :func:`from_pyscf`): atoms, data sets and
+    the wavefunction, with its orbitals evaluated and rendered by the Rust library."""
+
+    def __init__(self, native: _native.Document, path: str | None = None, pyscf=None):
+        self._native = native
+        self.path = path
+        """The file it was read from (``None`` for :func:`from_pyscf`)."""
+        self._pyscf = pyscf
+
+    def __repr__(self) -> str:
+        n = len(self.atoms.numbers)
+        what = f"{len(self.orbitals)} orbitals over {self._native.n_basis} basis functions" if self.has_wavefunction else "no wavefunction"
+        return f"<orbcloud.Document {self.source!r}: {n} atoms, {what}>"
+
+    @property
+    def source(self) -> str:
+        return self._native.source
+
+    @property
+    def title(self) -> str:
+        return self._native.title
+
+    @property
+    def atoms(self) -> Atoms:
+        z, charges, positions, ghost = self._native.atoms()
+        return Atoms(z, charges, positions, np.array(ghost, dtype=bool))
+
+    @property
+    def bonds(self) -> list[tuple[int, int]]:
+        return self._native.bonds()
+
+    @property
+    def has_wavefunction(self) -> bool:
+        return self._native.has_wavefunction
+
+    @property
+    def restricted(self) -> bool | None:
+        return self._native.restricted
+
+    @property
+    def orbitals(self) -> list[Orbital]:
+        """Every orbital, alpha first, in file order."""
+        out, count = [], {"alpha": 0, "beta": 0}
+        for energy, occupation, spin, label in self._native.orbitals():
+            out.append(Orbital(count[spin], spin, energy, occupation, label))
+            count[spin] += 1
+        return out
+
+    def energies(self, spin: str = "alpha") -> np.ndarray:
+        return np.array([o.energy for o in self.orbitals if o.spin == spin])
+
+    def occupations(self, spin: str = "alpha") -> np.ndarray:
+        return np.array([o.occupation for o in self.orbitals if o.spin == spin])
+
+    @property
+    def writer(self) -> str | None:
+        """The program that wrote the file, as the reader recognised it ("ORCA", "PySCF", …)."""
+        n = self._native.normalization()
+        return n and n[0]
+
+    @property
+    def repair(self) -> str | None:
+        """The writer repair applied to make the orbitals orthonormal ("none" when none was needed)."""
+        n = self._native.normalization()
+        return n and n[1]
+
+    @property
+    def residual(self) -> float | None:
+        """max |CᵀSC − I| of the orbitals, after any repair."""
+        n = self._native.normalization()
+        return n and n[2]
+
+    @property
+    def basis_functions(self) -> list[str]:
+        """Names of the basis functions ("O1 2px"), in orbcloud's order."""
+        return self._native.basis_function_names()
+
+    @property
+    def volumes(self) -> list[str]:
+        """Names of the file's data sets (cube volumes)."""
+        return self._native.volume_names()
+
+    @property
+    def problems(self) -> list[str]:
+        """Parts of the file that could not be read while the rest opened."""
+        return self._native.problems()
+
+    def orbital_index(self, orbital: str | int = "homo", spin: str = "alpha") -> int:
+        """The 0-based index, among the orbitals of ``spin``, of ``orbital``."""
+        flat = self._flat_index(orbital, spin)
+        return sum(1 for o in self._native.orbitals()[:flat] if o[2] == spin)
+
+    def _flat_index(self, orbital: str | int, spin: str) -> int:
+        if isinstance(orbital, (int, np.integer)) and not isinstance(orbital, bool):
+            if orbital < 0:
+                raise ValueError(f"orbital {orbital}: indices count from 0")
+            return self._native.resolve(str(int(orbital) + 1), spin)
+        return self._native.resolve(str(orbital), spin)
+
+    @staticmethod
+    def _points(points) -> np.ndarray:
+        p = np.ascontiguousarray(points, dtype=np.float64)
+        if p.ndim == 1 and p.shape[0] == 3:
+            p = p[None, :]
+        if p.ndim != 2 or p.shape[1] != 3:
+            raise ValueError(f"points must have shape (n, 3), got {p.shape}")
+        return p
+
+    def evaluate(self, points, orbital: str | int = "homo", spin: str = "alpha") -> np.ndarray:
+        """ψ at ``points`` (n × 3, bohr): one value per point."""
+        return self._native.values(self._points(points), "orbital", self._flat_index(orbital, spin))
+
+    def density(self, points, spin_density: bool = False) -> np.ndarray:
+        """The total electron density (or the spin density ρα − ρβ) at ``points`` (n × 3, bohr)."""
+        return self._native.values(self._points(points), "spin_density" if spin_density else "density", 0)
+
+    def basis_function(self, points, function: int | str) -> np.ndarray:
+        """One basis function (an index, or a name as :attr:`basis_functions` gives it) at ``points``."""
+        if isinstance(function, str):
+            function = self.basis_functions.index(function)
+        return self._native.values(self._points(points), "basis_function", int(function))
+
+    def esp(self, points) -> np.ndarray:
+        """The electrostatic potential of the nuclei and electrons at ``points`` (n × 3, bohr), in
+        atomic units (hartree per elementary charge), as ``orbcloud eval --esp`` gives it."""
+        return self._native.values(self._points(points), "esp", 0)
+
+    def _quantity(self, orbital, spin, density) -> tuple[str, int]:
+        if density in (True, "total"):
+            return "density", 0
+        if density == "spin":
+            return "spin_density", 0
+        return "orbital", self._flat_index(orbital, spin)
+
+    def grid(self, orbital: str | int = "homo", spin: str = "alpha", points: int = 80, density: bool | str = False) -> Grid:
+        """An orbital (or ``density=True`` / ``"spin"``) on a grid of ``points`` per side over the
+        box where it decays, as ``orbcloud cube`` makes it."""
+        values, matrix = self._native.grid(*self._quantity(orbital, spin, density), int(points))
+        return Grid(values, matrix)
+
+    def write_cube(self, path: PathLike, orbital: str | int = "homo", spin: str = "alpha", points: int = 80, density: bool | str = False) -> None:
+        """Writes :meth:`grid`'s values as a Gaussian cube file."""
+        self._native.write_cube(os.fspath(path), *self._quantity(orbital, spin, density), int(points))
+
+    def render(self, **options) -> Image:
+        """:func:`orbcloud.render` of this document."""
+        return render(self, **options)
+
+    def view(self) -> subprocess.Popen:
+        """:func:`orbcloud.view` of this document."""
+        return view(self)
+
+    def widget(self, **options):
+        """:func:`orbcloud.widget` of this document."""
+        return widget(self, **options)
+
+
+def load(path: PathLike) -> Document:
+    """Reads a file as the viewer opens it: Gaussian cube, Molden, fchk, AIM wfn/wfx, ORCA MKL,
+    PDB, mmCIF or XYZ (each also gzipped). Raises :class:`LoadError` with the reader's message."""
+    path = os.fspath(path)
+    try:
+        native = _native.load(path)
+    except _native.NativeLoadError as e:
+        raise LoadError(*e.args) from None
+    return Document(native, path=path)
+
+
+class Scan(NamedTuple):
+    """A scan manifest's key frames (``*.scan.toml``), each a :class:`Document`."""
+
+    title: str
+    coordinate: str
+    """What the frames vary, as chemists write it: "dihedral 1-2-3-4", "angle 2-1-3", "path"."""
+    values: list[float]
+    """The coordinate's value at each frame (degrees, Å, or the path position)."""
+    labels: list[str]
+    """Each value with its unit: "104.5°"."""
+    frames: list[Document]
+
+
+def load_scan(path: PathLike) -> Scan:
+    """Reads a scan manifest and every frame it names, as the viewer does (geometries aligned,
+    frames checked against each other). :func:`widget` of a scan has a slider along it."""
+    try:
+        title, coordinate, frames = _native.load_scan(os.fspath(path))
+    except _native.NativeLoadError as e:
+        raise LoadError(*e.args) from None
+    return Scan(title, coordinate, [f[0] for f in frames], [f[1] for f in frames], [Document(f[2]) for f in frames])
+
+
+def from_pyscf(mf_or_mol, mo_coeff=None, mo_occ=None, mo_energy=None) -> Document:
+    """A document straight from PySCF: a mean-field object (``from_pyscf(mf)``) or a molecule with
+    its orbitals (``from_pyscf(mol, mo_coeff, mo_occ, mo_energy)``). Restricted, restricted
+    open-shell and unrestricted orbitals; cartesian or pure basis sets up to h functions."""
+    from ._pyscf import document_parts
+
+    parts, keep = document_parts(mf_or_mol, mo_coeff, mo_occ, mo_energy)
+    return Document(_native.from_parts(**parts), pyscf=keep)
+
+
+def _words(options: dict) -> list[str]:
+    """``render``'s keyword arguments as the command's options: ``iso=0.05`` → ``--iso 0.05``,
+    ``size=(800, 600)`` → ``--size 800x600``, ``no_volume=True`` → ``--no-volume``, a list
+    repeats an option that may be given several times (``iso=[0.02, 0.05]``), other sequences
+    join with commas (``clip=(0, 0, 1)``); ``args=[...]`` adds words as they are."""
+    repeated = {"iso", "iso_sigma", "optics_scale"}
+    words: list[str] = []
+    extra = list(options.pop("args", []) or [])
+    for key, value in options.items():
+        flag = "--" + key.replace("_", "-")
+        if value is None or value is False:
+            continue
+        if value is True:
+            words.append(flag)
+            continue
+        if key == "size":
+            width, height = value
+            value = f"{int(width)}x{int(height)}"
+        elif key == "orbital" and isinstance(value, (int, np.integer)):
+            value = int(value) + 1  # the command counts from 1
+        elif isinstance(value, (list, tuple, np.ndarray)):
+            if key in repeated:
+                for v in value:
+                    words += [flag, str(v)]
+                continue
+            value = ",".join(str(v) for v in value)
+        words += [flag, str(value)]
+    return words + [str(w) for w in extra]
+
+
+def render(doc_or_path: Document | PathLike | None = None, size: tuple[int, int] = (800, 600), **options) -> Image:
+    """The picture ``orbcloud render`` draws of a document or file with the same options, as an
+    RGBA image (height × width × 4, uint8) that IPython shows inline. Options are the command's,
+    with underscores: ``orbital="lumo"``, ``iso=0.05``, ``view="z"``, ``yaw=30``,
+    ``no_volume=True``, ``colors="red-white"``, ``lavapipe=True``; see :func:`_words`."""
+    words = _words({"size": size, **options})
+    native = None
+    if isinstance(doc_or_path, Document):
+        native = doc_or_path._native
+    elif doc_or_path is not None:
+        words.insert(0, os.fspath(doc_or_path))
+    return Image.of(_native.render(native, words))
+
+
+def _viewable_path(doc: Document) -> str:
+    """A file the desktop viewer can open holding ``doc``: its own, or a Molden file PySCF writes."""
+    if doc.path is not None:
+        return os.path.abspath(doc.path)
+    if doc._pyscf is None:
+        raise ValueError("this document has no file to show")
+    from ._pyscf import write_molden
+
+    fd, path = tempfile.mkstemp(prefix="orbcloud-", suffix=".molden")
+    os.close(fd)
+    write_molden(doc._pyscf, path)
+    return path
+
+
+def view(doc_or_path: Document | PathLike | Sequence[Document | PathLike]) -> subprocess.Popen:
+    """Opens the desktop viewer on a document or file (or several) in a process of its own and
+    returns at once; a document made by :func:`from_pyscf` goes through a temporary Molden file."""
+    items = doc_or_path if isinstance(doc_or_path, (list, tuple)) else [doc_or_path]
+    files = [_viewable_path(d) if isinstance(d, Document) else os.path.abspath(os.fspath(d)) for d in items]
+    return subprocess.Popen([sys.executable, "-m", "orbcloud", "view", *files], start_new_session=True)
+
+
+def widget(doc_or_docs, **options):
+    """An interactive view for Jupyter: frames drawn by orbcloud's renderer, turned with the mouse,
+    zoomed with the wheel, with controls for the orbital, the isovalue and cloud or isosurfaces; a
+    :class:`Scan` (or a list of documents) adds a slider along its frames. Needs ``jupyter_rfb``
+    and ``ipywidgets``."""
+    from .notebook import Viewer
+
+    return Viewer(doc_or_docs, **options)
