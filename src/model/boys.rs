@@ -87,6 +87,23 @@ pub fn boys(m: usize, t: f64, out: &mut [f64]) {
     }
 }
 
+/// F_0(t) alone: the one order a pair of s functions needs.
+#[inline]
+pub fn f0(t: f64) -> f64 {
+    if t >= T_TABLE {
+        return 0.5 * (std::f64::consts::PI / t).sqrt();
+    }
+    let i = (t / STEP).round() as usize;
+    let row = &table()[i];
+    let dt = -(t - i as f64 * STEP);
+    // Σ_k F_k(T_i) (−dt)^k / k!, by Horner.
+    let mut sum = row[TAYLOR - 1];
+    for k in (0..TAYLOR - 1).rev() {
+        sum = row[k] + sum * dt / (k + 1) as f64;
+    }
+    sum
+}
+
 /// The large-T form: what a Gaussian charge looks like from far away (a point multipole).
 #[inline]
 pub fn asymptotic(m: usize, t: f64, out: &mut [f64]) {
@@ -126,6 +143,14 @@ mod tests {
                     "F_{n}({t}) = {value}, quadrature {want}"
                 );
             }
+        }
+    }
+
+    #[test]
+    fn f0_alone_agrees_with_quadrature() {
+        for &t in &[0.0, 0.02, 0.5, 3.3, 17.0, 39.99, 41.0] {
+            let want = quadrature(0, t);
+            assert!((f0(t) - want).abs() <= 1e-13 * want, "F_0({t}) = {}, quadrature {want}", f0(t));
         }
     }
 

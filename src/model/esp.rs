@@ -219,8 +219,8 @@ pub struct Potential {
 /// multipole per anchor and the exact sum over the pairs not yet active.
 struct Anchor {
     center: DVec3,
-    /// Indices into `Potential::pairs`, by activation distance.
-    pairs: Vec<usize>,
+    /// Its pairs, by activation distance (copies: the exact sums walk them in order).
+    pairs: Vec<HermitePair>,
     levels: Vec<Level>,
 }
 
@@ -326,7 +326,7 @@ impl Potential {
                     }
                     j += 1;
                 }
-                Anchor { center, pairs: list.into_iter().map(|(_, i)| i).collect(), levels }
+                Anchor { center, pairs: list.into_iter().map(|(_, i)| self.pairs[i]).collect(), levels }
             })
             .collect()
     }
@@ -429,8 +429,8 @@ impl Potential {
             } else {
                 0
             };
-            for &i in &anchor.pairs[start..] {
-                v += self.pair_at(&self.pairs[i], point, scratch);
+            for pair in &anchor.pairs[start..] {
+                v += self.pair_at(pair, point, scratch);
             }
         }
         v
@@ -451,11 +451,7 @@ impl Potential {
         let c = &self.coefficients[pair.first..];
         let t = pair.p * x.length_squared();
         match pair.l {
-            0 => {
-                let mut f = [0.0; 1];
-                boys(0, t, &mut f);
-                c[0] * f[0]
-            }
+            0 => c[0] * boys::f0(t),
             // R^0_000 = F0, R^0_i = X_i a1 (a_n = (−2p)^n F_n).
             1 => {
                 let mut f = [0.0; 2];

@@ -1157,6 +1157,7 @@ mod tests {
                 Quantity::BasisFunction(k) => pb.basis_values(p)[k],
                 Quantity::Density => pb.density(&wf, p),
                 Quantity::SpinDensity => pb.spin_density(&wf, p),
+                Quantity::Potential => f64::NAN,
             };
             for (v, &p) in pb.quantity_at(&wf, q, &scattered).iter().zip(&scattered) {
                 assert_eq!(*v, at(p), "{q:?} at {p}");
