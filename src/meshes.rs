@@ -11,9 +11,9 @@ use crate::model::units::ANGSTROM_PER_BOHR;
 use crate::model::{Document, VolumeGrid};
 use crate::scene::coloring::ValueMap;
 use crate::scene::coloring::atom_colors;
+use crate::scene::quantity::Source;
 use crate::scene::selection::shown_atoms;
 use crate::scene::translucency::SurfaceLook;
-use crate::scene::quantity::Source;
 use crate::scene::{IsosurfaceSettings, SurfaceSettings};
 
 /// The isosurfaces `iso` asks for on `grid`, each with its colour: ψ = +v and ψ = −v for a

@@ -1153,9 +1153,10 @@ impl eframe::App for OrbApp {
                         let name = o.state.selected_quantity().map(|q| q.source.name(&o.doc)).unwrap_or_default();
                         legend::value_bar(ui, ui.min_rect(), &map, &name);
                     } else if let Some(o) = self.objects.get(self.active)
-                        && let Some(k) = o.state.quantities.iter().position(|q| {
-                            q.visible && q.isosurfaces.iter().any(|i| i.visible && i.color_by.is_some())
-                        })
+                        && let Some(k) =
+                            o.state.quantities.iter().position(|q| {
+                                q.visible && q.isosurfaces.iter().any(|i| i.visible && i.color_by.is_some())
+                            })
                         && let Some((map, name)) = vp.isosurface_map(self.active, k)
                     {
                         legend::value_bar(ui, ui.min_rect(), &map, &name);

@@ -636,7 +636,11 @@ fn color_by_editor(ui: &mut egui::Ui, iso: &mut IsosurfaceSettings, choices: &[(
     if iso.color_by.is_some() {
         ui.horizontal(|ui| {
             let mut automatic = iso.color_range.is_none();
-            if ui.checkbox(&mut automatic, "automatic range").on_hover_text("±98th percentile of |value| on the surface").changed() {
+            if ui
+                .checkbox(&mut automatic, "automatic range")
+                .on_hover_text("±98th percentile of |value| on the surface")
+                .changed()
+            {
                 iso.color_range = if automatic { None } else { Some(0.05) };
             }
             if let Some(r) = &mut iso.color_range {

@@ -12,13 +12,13 @@ use orbcloud::gpu::frame::PickId;
 use orbcloud::gpu::{GpuContext, Renderer};
 use orbcloud::layers::show_meshes;
 use orbcloud::meshes::{color_values, isosurfaces, values_at};
-use orbcloud::model::orbitals::{OrbitalSpec, Quantity, Spin};
-use orbcloud::scene::Source;
-use orbcloud::scene::coloring::ValueMap;
 use orbcloud::model::gto::PreparedBasis;
 use orbcloud::model::isosurface::{self, Level, Mesh};
+use orbcloud::model::orbitals::{OrbitalSpec, Quantity, Spin};
 use orbcloud::model::units::BOHR_PER_ANGSTROM;
 use orbcloud::model::{Document, VolumeGrid};
+use orbcloud::scene::Source;
+use orbcloud::scene::coloring::ValueMap;
 use orbcloud::scene::translucency::{OpticsTuning, SurfaceLook};
 use orbcloud::scene::{IsoLevel, IsosurfaceSettings, OpticsPreset};
 
@@ -89,17 +89,25 @@ impl IsoArgs {
         }
         let path = std::path::Path::new(what);
         if !path.exists() {
-            bail!("--color-by {what:?}: expected esp, density, spin-density, an orbital (homo, lumo+1, a number) or a cube file");
+            bail!(
+                "--color-by {what:?}: expected esp, density, spin-density, an orbital (homo, lumo+1, a number) or a cube file"
+            );
         }
         let other = load(Some(path))?;
-        let grid = other.volumes.into_iter().next().with_context(|| format!("--color-by {what}: the file holds no volume"))?;
+        let grid =
+            other.volumes.into_iter().next().with_context(|| format!("--color-by {what}: the file holds no volume"))?;
         let name = grid.label.clone();
         doc.volumes.push(grid);
         Ok(Some((Source::Volume(doc.volumes.len() - 1), name)))
     }
 
     /// Colours `meshes` by `source` of `doc` ([`Self::color_source`]), one map for all of them.
-    pub fn color(&self, doc: &Document, (source, name): (Source, String), meshes: &mut [(Mesh, SurfaceLook)]) -> Colored {
+    pub fn color(
+        &self,
+        doc: &Document,
+        (source, name): (Source, String),
+        meshes: &mut [(Mesh, SurfaceLook)],
+    ) -> Colored {
         let values: Vec<Vec<Option<f64>>> = meshes.iter().map(|(m, _)| values_at(doc, source, &m.positions)).collect();
         let all: Vec<Option<f64>> = values.iter().flatten().copied().collect();
         let (_, map) = color_values(&all, self.color_range);

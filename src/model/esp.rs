@@ -21,12 +21,12 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
+use super::GridSpec;
 use super::basis::MAX_L;
 use super::boys::{self, boys};
 use super::gto::{PreparedBasis, PreparedShell};
 use super::molecule::Molecule;
 use super::orbitals::Wavefunction;
-use super::GridSpec;
 
 /// Primitive pairs whose charge is below this (a.u.) are left out.
 const PAIR_SCREEN: f64 = 1e-15;
@@ -158,14 +158,21 @@ fn recipe(l: usize) -> &'static Recipe {
                         for &[t, u, v] in triples(k).tuv.iter().filter(|x| x.iter().sum::<usize>() == k) {
                             // Lower the first non-zero index: R^n_{..i..} = X R^{n+1}_{..i−1..} +
                             // (i − 1) R^{n+1}_{..i−2..}.
-                            let (axis, i) = if t > 0 { (0, t) } else if u > 0 { (1, u) } else { (2, v) };
+                            let (axis, i) = if t > 0 {
+                                (0, t)
+                            } else if u > 0 {
+                                (1, u)
+                            } else {
+                                (2, v)
+                            };
                             let lowered = |by: usize| {
                                 let mut x = [t, u, v];
                                 x[axis] -= by;
                                 x
                             };
                             let from = at(n + 1, lowered(1));
-                            let (back, weight) = if i > 1 { (at(n + 1, lowered(2)), (i - 1) as f64) } else { (from, 0.0) };
+                            let (back, weight) =
+                                if i > 1 { (at(n + 1, lowered(2)), (i - 1) as f64) } else { (from, 0.0) };
                             steps.push(Step { dst: at(n, [t, u, v]), from, back, axis: axis as u8, weight });
                         }
                     }
@@ -187,7 +194,11 @@ fn hermite_r(l: usize, p: f64, x: DVec3, far: bool, scratch: &mut Scratch) {
     }
     let mut f = [0.0; boys::MAX_N + 1];
     let t2 = p * x.length_squared();
-    if far { boys::asymptotic(l, t2, &mut f) } else { boys(l, t2, &mut f) }
+    if far {
+        boys::asymptotic(l, t2, &mut f)
+    } else {
+        boys(l, t2, &mut f)
+    }
     let mut factor = 1.0;
     for (n, &start) in recipe.levels.iter().enumerate() {
         r[start] = factor * f[n];
@@ -242,12 +253,8 @@ impl Potential {
     /// The potential of `molecule`'s nuclei (their charges as the file gives them: core charges
     /// where the file has pseudopotentials) and `wf`'s electrons.
     pub fn new(molecule: &Molecule, wf: &Wavefunction) -> Self {
-        let nuclei = molecule
-            .atoms
-            .iter()
-            .filter(|a| !a.ghost && a.charge != 0.0)
-            .map(|a| (a.position, a.charge))
-            .collect();
+        let nuclei =
+            molecule.atoms.iter().filter(|a| !a.ghost && a.charge != 0.0).map(|a| (a.position, a.charge)).collect();
         let basis = PreparedBasis::with_threshold(&wf.basis, 0.0);
         let density = density_matrix(wf);
         let n = basis.n_functions();

@@ -479,7 +479,13 @@ impl PreparedBasis {
 
     /// An orbital, the total density, the spin density or the electrostatic potential (of
     /// `molecule`'s nuclei and `wf`'s electrons) on a grid.
-    pub fn quantity_grid(&self, wf: &Wavefunction, molecule: &Molecule, quantity: Quantity, grid: &GridSpec) -> Vec<f64> {
+    pub fn quantity_grid(
+        &self,
+        wf: &Wavefunction,
+        molecule: &Molecule,
+        quantity: Quantity,
+        grid: &GridSpec,
+    ) -> Vec<f64> {
         match quantity {
             Quantity::Potential => super::esp::Potential::new(molecule, wf).on_grid(grid),
             Quantity::Orbital(i) => self.eval_grid(&wf.orbitals[i].coefficients, grid),
