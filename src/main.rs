@@ -72,6 +72,8 @@ impl DemoArg {
     }
 }
 
+// Parsed once per process: boxing the larger variants would save nothing worth the noise.
+#[allow(clippy::large_enum_variant)]
 #[derive(Subcommand)]
 enum Command {
     /// Open the interactive viewer (the default).

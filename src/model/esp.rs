@@ -652,15 +652,15 @@ mod tests {
         let p = alpha + beta;
         let centre = (alpha * a + beta * b) / p;
         let e = hermite_e(5, 5, centre - a, centre - b, p);
-        for i in 0..=5 {
-            for j in 0..=5 {
+        for (i, row) in e.iter().enumerate() {
+            for (j, cell) in row.iter().enumerate() {
                 let steps = 40_000;
                 let (lo, hi) = (centre - 12.0, centre + 12.0);
                 let h = (hi - lo) / steps as f64;
                 let f = |x: f64| (x - a).powi(i as i32) * (x - b).powi(j as i32) * (-p * (x - centre).powi(2)).exp();
                 let sum: f64 = (0..steps).map(|k| f(lo + (k as f64 + 0.5) * h)).sum::<f64>() * h;
                 let want = sum / (std::f64::consts::PI / p).sqrt();
-                assert!((e[i][j][0] - want).abs() < 1e-9 * want.abs().max(1.0), "E^{i}{j}_0 {} vs {want}", e[i][j][0]);
+                assert!((cell[0] - want).abs() < 1e-9 * want.abs().max(1.0), "E^{i}{j}_0 {} vs {want}", cell[0]);
             }
         }
     }
