@@ -41,16 +41,21 @@ C 1.8300 0.0950 0.0; H 1.9310 1.1770 0.0;
 N 2.9520 -0.5860 0.0; H 3.8580 -0.1350 0.0; H 2.9290 -1.5950 0.0"""
 
 
-def main():
+def arguments(n, molecule):
+    """The options both benchmarks take; PySCF limited to one thread."""
     ap = argparse.ArgumentParser()
-    ap.add_argument("--n", type=int, default=80)
+    ap.add_argument("--n", type=int, default=n)
     ap.add_argument("--repeat", type=int, default=3)
-    ap.add_argument("--molecule", choices=["benzene", "psb3"], default="benzene")
+    ap.add_argument("--molecule", choices=["benzene", "psb3"], default=molecule)
     ap.add_argument("--molden", default=None, help="also write the SCF as a Molden file here")
     ap.add_argument("--cube", default=None, help="keep PySCF's cube file here")
-    args = ap.parse_args()
     lib.num_threads(1)
-    if args.molecule == "benzene":
+    return ap.parse_args()
+
+
+def converged(molecule, molden_path=None):
+    """The benchmark molecule's SCF (written as Molden when a path is given)."""
+    if molecule == "benzene":
         mol = gto.M(atom=BENZENE, basis="6-31g*", symmetry=False, verbose=0)
         mf = dft.RKS(mol)
         mf.xc = "b3lyp"
@@ -58,8 +63,14 @@ def main():
         mol = gto.M(atom=PSB3, basis="6-31g*", charge=1, symmetry=False, verbose=0)
         mf = scf.RHF(mol)
     mf.kernel()
-    if args.molden:
-        molden.from_scf(mf, args.molden)
+    if molden_path:
+        molden.from_scf(mf, molden_path)
+    return mol, mf
+
+
+def main():
+    args = arguments(80, "benzene")
+    mol, mf = converged(args.molecule, args.molden)
     homo = int(np.max(np.nonzero(mf.mo_occ > 0)))
     c = mf.mo_coeff[:, homo]
     n = args.n

@@ -14,33 +14,5 @@ mkdir -p "$out"
 "$python" scripts/bench_cube_vs_pyscf.py --molecule "$molecule" --molden "$out/$molecule.molden" \
     --cube "$out/${molecule}_pyscf.cube" | tee "$out/${molecule}_pyscf.txt"
 pyscf=$(sed -n 's/^pyscf_s=//p' "$out/${molecule}_pyscf.txt")
-"$python" - "$out/${molecule}_pyscf.cube" "$out/${molecule}_orbcloud.cube" "$pyscf" "$out/$molecule.molden" <<'PY'
-import os
-import subprocess
-import sys
-import time
-
-import numpy as np
-
-ours = float("inf")
-for _ in range(3):
-    t = time.perf_counter()
-    subprocess.run(
-        ["target/release/orbcloud", "cube", sys.argv[4], "--orbital", "homo", "--grid", "80", "--margin", "3",
-         "-o", sys.argv[2]],
-        check=True, stderr=subprocess.DEVNULL, env={**os.environ, "RAYON_NUM_THREADS": "1"},
-    )
-    ours = min(ours, time.perf_counter() - t)
-
-def values(path):
-    lines = open(path).read().split("\n")
-    natoms = abs(int(lines[2].split()[0]))
-    n = [abs(int(lines[3 + i].split()[0])) for i in range(3)]
-    return np.array(" ".join(lines[6 + natoms:]).split(), dtype=float).reshape(n)
-
-a, b = values(sys.argv[1]), values(sys.argv[2])
-pyscf = float(sys.argv[3])
-# Both files hold 5-6 significant digits: compare relative to the largest value.
-print(f"max |orbcloud - pyscf| / max|psi| = {np.abs(a - b).max() / np.abs(a).max():.1e} (file precision)")
-print(f"pyscf_cubegen_s={pyscf:.3f} orbcloud_cube_s={ours:.3f} ratio={pyscf / ours:.1f}")
-PY
+"$python" scripts/time_orbcloud_cube.py "$out/${molecule}_pyscf.cube" "$pyscf" "$out/${molecule}_orbcloud.cube" \
+    "$out/$molecule.molden" --orbital homo --grid 80 --margin 3

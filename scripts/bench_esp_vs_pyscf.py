@@ -13,38 +13,21 @@ os.environ["OMP_NUM_THREADS"] = "1"
 os.environ["OPENBLAS_NUM_THREADS"] = "1"
 os.environ["MKL_NUM_THREADS"] = "1"
 
-import argparse  # noqa: E402
 import shutil  # noqa: E402
 import sys  # noqa: E402
 import tempfile  # noqa: E402
 import time  # noqa: E402
 
-from pyscf import dft, gto, lib, scf  # noqa: E402
-from pyscf.tools import cubegen, molden  # noqa: E402
+from pyscf import lib  # noqa: E402
+from pyscf.tools import cubegen  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from bench_cube_vs_pyscf import BENZENE, PSB3  # noqa: E402
+from bench_cube_vs_pyscf import arguments, converged  # noqa: E402
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--n", type=int, default=40)
-    ap.add_argument("--repeat", type=int, default=1)
-    ap.add_argument("--molecule", choices=["benzene", "psb3"], default="psb3")
-    ap.add_argument("--molden", default=None, help="also write the SCF as a Molden file here")
-    ap.add_argument("--cube", default=None, help="keep PySCF's cube file here")
-    args = ap.parse_args()
-    lib.num_threads(1)
-    if args.molecule == "benzene":
-        mol = gto.M(atom=BENZENE, basis="6-31g*", symmetry=False, verbose=0)
-        mf = dft.RKS(mol)
-        mf.xc = "b3lyp"
-    else:
-        mol = gto.M(atom=PSB3, basis="6-31g*", charge=1, symmetry=False, verbose=0)
-        mf = scf.RHF(mol)
-    mf.kernel()
-    if args.molden:
-        molden.from_scf(mf, args.molden)
+    args = arguments(40, "psb3")
+    mol, mf = converged(args.molecule, args.molden)
     dm = mf.make_rdm1()
     n = args.n
     best = float("inf")
