@@ -22,6 +22,9 @@ pub fn render(args: RenderArgs, later: &[Later]) -> Result<()> {
     match drawing(&args, None, later)? {
         Drawing::Drawn(img, ctx) => save(&img, &args.output, &ctx),
         Drawing::Scene(mut picture) => {
+            if let Some(said) = &picture.said {
+                eprintln!("{said}");
+            }
             let img = picture.draw(&picture.camera.clone())?;
             save(&img, &args.output, &picture.ctx)?;
             if let Some(pixel) = args.pick {
@@ -94,6 +97,8 @@ pub struct Picture {
     /// A surface coloured by a quantity's values: the map and the quantity's name, for the colour
     /// bar.
     bar: Option<(ValueMap, String)>,
+    /// What was put into the scene, in words, for the command to print (a notebook does not).
+    pub said: Option<String>,
 }
 
 impl Picture {
@@ -127,14 +132,14 @@ impl Picture {
         let map = molsurface.as_ref().and_then(|(_, _, map)| *map);
         let meshes = molsurface.into_iter().map(|(mesh, look, _)| (mesh, look)).collect();
         let shown = (grid, color_doc.as_ref().unwrap_or(&doc));
-        let colored = surface_cli::show(&ctx, &mut h.renderer, shown, &args.iso, color, meshes);
+        let (colored, said) = surface_cli::show(&ctx, &mut h.renderer, shown, &args.iso, color, meshes);
         let arrows = args.vibration.arrows(&doc)?;
         h.renderer.main().arrows.set_arrows(&ctx, &arrows, orbcloud::scene::vibration::ARROW_COLOR);
         let bar = match colored {
             Some(c) => Some((c.map, c.name)),
             None => map.zip(grid.map(|g| g.label.clone())),
         };
-        Ok(Self { ctx, doc, camera, headless: h, settings, figure, bar })
+        Ok(Self { ctx, doc, camera, headless: h, settings, figure, bar, said })
     }
 
     /// The scene seen by `camera`, as `render` writes it.

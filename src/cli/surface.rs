@@ -245,7 +245,8 @@ impl IsoArgs {
 
 /// Puts `--iso` surfaces of `grid` (coloured by `color` when given: [`IsoArgs::color_source`])
 /// and `more` (a molecular surface, a mode's arrows) into the renderer (nothing when none was
-/// asked for). Returns how the isosurfaces were coloured.
+/// asked for). Returns how the isosurfaces were coloured, and what was shown in words
+/// ("isosurfaces: 2 surface(s), 11800 triangles") for the command to print.
 pub fn show(
     ctx: &GpuContext,
     renderer: &mut Renderer,
@@ -253,7 +254,7 @@ pub fn show(
     iso: &IsoArgs,
     color: Option<(Source, String)>,
     more: Vec<(Mesh, SurfaceLook)>,
-) -> Option<Colored> {
+) -> (Option<Colored>, Option<String>) {
     let mut meshes = match grid {
         Some(grid) if !iso.levels().is_empty() => iso.meshes(grid, &iso.base()),
         _ => Vec::new(),
@@ -262,12 +263,11 @@ pub fn show(
     let what = if more.is_empty() { "isosurfaces" } else { "surfaces" };
     meshes.extend(more);
     if meshes.is_empty() {
-        return colored;
+        return (colored, None);
     }
     let triangles = show_meshes(ctx, renderer.main(), &meshes);
     let how = if iso.translucent { ", translucent" } else { "" };
-    eprintln!("{what}: {} surface(s), {triangles} triangles{how}", meshes.len());
-    colored
+    (colored, Some(format!("{what}: {} surface(s), {triangles} triangles{how}", meshes.len())))
 }
 
 /// Prints what the rendered frame shows at `pixel`, and how long the pick took.
