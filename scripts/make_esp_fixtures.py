@@ -88,6 +88,20 @@ def main():
     mf = scf.RHF(mol).run(conv_tol=1e-12)
     write("h2_spdfgh", "wavefunctions/h2_spdfgh.molden", mol, mf.make_rdm1(), rng)
 
+    # Volume arithmetic: water's density in cc-pVTZ minus the same in cartesian 6-31G*, both
+    # from PySCF's reading of the Molden files.
+    def density(name, points):
+        mol, _, mo_coeff, mo_occ, _, _ = molden.load(os.path.join(WAVEFUNCTIONS, name + ".molden"))
+        ao = mol.eval_gto("GTOval_cart" if mol.cart else "GTOval_sph", points)
+        return np.einsum("pi,ij,pj->p", ao, density_matrix(mo_coeff, mo_occ), ao)
+
+    points = points_around(gto.M(atom=make_wavefunction_fixtures.H2O, unit="Angstrom", verbose=0), rng)
+    diff = density("h2o_ccpvtz", points) - density("h2o_cart_631gs", points)
+    with open(os.path.join(OUT, "density_difference.json"), "w") as f:
+        json.dump({"a": "wavefunctions/h2o_ccpvtz.molden", "b": "wavefunctions/h2o_cart_631gs.molden",
+                   "points": points.tolist(), "difference": diff.tolist()}, f, indent=1)
+    print(f"density_difference: {len(diff)} points, |Δρ| up to {np.abs(diff).max():.4f}")
+
     # A pseudopotential: the nuclear term uses the core charge the fchk file gives.
     mol = gto.M(atom="H 0 0 0; I 0 0 1.61", basis="def2-svp", ecp="def2-svp", unit="Angstrom",
                 symmetry=False, verbose=0)

@@ -107,6 +107,10 @@ enum Command {
         /// File of points, one `x y z` (bohr) per line; `-` reads standard input.
         #[arg(long)]
         points: PathBuf,
+        /// Subtract the same quantity of another file (two states, two methods, a complex
+        /// minus a part): its wavefunction's, or its first data set's, resampled trilinearly.
+        #[arg(long, value_name = "FILE")]
+        minus: Option<PathBuf>,
     },
     /// Write an orbital or the density on a grid as a Gaussian cube file (like cubegen).
     Cube {
@@ -123,6 +127,10 @@ enum Command {
         /// its largest value, a density to 1e-4 a.u.).
         #[arg(long)]
         margin: Option<f64>,
+        /// Subtract the same quantity of another file on this grid: its wavefunction's, or its
+        /// first data set's, resampled trilinearly (refused when the grids do not overlap).
+        #[arg(long, value_name = "FILE")]
+        minus: Option<PathBuf>,
         #[arg(short, long)]
         output: PathBuf,
     },
@@ -701,9 +709,9 @@ fn main() -> Result<()> {
         Some(Command::Viewer { files, demo }) => Ok(orbcloud::app::run(files, demo.map(DemoArg::demo))?),
         Some(Command::Render(args)) => render_cli::render(args, &later),
         Some(Command::Info { file, json }) => values_cli::info(&file, json),
-        Some(Command::Eval { file, what, points }) => values_cli::eval(&file, &what, &points),
-        Some(Command::Cube { file, what, grid, spacing, margin, output }) => {
-            values_cli::cube(&file, &what, (grid, spacing, margin), &output)
+        Some(Command::Eval { file, what, points, minus }) => values_cli::eval(&file, &what, &points, minus.as_deref()),
+        Some(Command::Cube { file, what, grid, spacing, margin, minus, output }) => {
+            values_cli::cube(&file, &what, (grid, spacing, margin), minus.as_deref(), &output)
         }
         Some(Command::Scan(command)) => scan_cli::run(command),
         Some(Command::Modes(args)) => modes_cli::write_xyz(&args),

@@ -26,13 +26,19 @@ pub fn info(file: &Path, json: bool) -> Result<()> {
 }
 
 /// `eval`: the quantity `what` asks for at each point of `points` (`x y z` in bohr per line).
-pub fn eval(file: &Path, what: &WhatArgs, points: &Path) -> Result<()> {
+/// With `minus`, that file's same quantity is subtracted ([`other_values`]).
+pub fn eval(file: &Path, what: &WhatArgs, points: &Path, minus: Option<&Path>) -> Result<()> {
     let doc = formats::load(file)?;
     let wf = wavefunction_of(&doc)?;
     let q = what.resolve(&doc)?;
     let prepared = PreparedBasis::new(&wf.basis);
     let points = read_points(points)?;
-    let values = prepared.quantity_at_points(wf, &doc.molecule, q, &points);
+    let mut values = prepared.quantity_at_points(wf, &doc.molecule, q, &points);
+    if let Some(other) = minus {
+        for (v, o) in values.iter_mut().zip(other_values(other, what, &points)?) {
+            *v -= o;
+        }
+    }
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());
     use std::io::Write;
     for (p, v) in points.iter().zip(values) {
@@ -47,6 +53,7 @@ pub fn cube(
     file: &Path,
     what: &WhatArgs,
     (grid, spacing, margin): (usize, Option<f64>, Option<f64>),
+    minus: Option<&Path>,
     output: &Path,
 ) -> Result<()> {
     let doc = formats::load(file)?;
@@ -69,9 +76,18 @@ pub fn cube(
     }
     let prepared = PreparedBasis::new(&wf.basis);
     let t = Instant::now();
-    let values = prepared.quantity_grid_f32(wf, &doc.molecule, q, &spec);
+    let mut values = prepared.quantity_grid_f32(wf, &doc.molecule, q, &spec);
+    let mut label = what.label(&q, &doc);
+    if let Some(other) = minus {
+        let points: Vec<DVec3> = (0..dims[0])
+            .flat_map(|i| (0..dims[1]).flat_map(move |j| (0..dims[2]).map(move |k| spec.point(i, j, k))))
+            .collect();
+        for (v, o) in values.iter_mut().zip(other_values(other, what, &points)?) {
+            *v -= o as f32;
+        }
+        label = format!("{label} minus {}", other.display());
+    }
     let seconds = t.elapsed().as_secs_f64();
-    let label = what.label(&q, &doc);
     let grid = VolumeGrid::new(&label, dims, spec.world_from_grid, values);
     let id = match q {
         Quantity::Orbital(i) => wf.of_spin(wf.orbitals[i].spin).position(|(j, _)| j == i).map_or(0, |p| p + 1),
@@ -84,6 +100,33 @@ pub fn cube(
         .with_context(|| format!("writing {}", output.display()))?;
     eprintln!("wrote {} ({}×{}×{}, {label}; evaluated in {seconds:.3} s)", output.display(), dims[0], dims[1], dims[2]);
     Ok(())
+}
+
+/// The quantity `what` asks for, of the file `other`, at `points` (bohr): evaluated from its
+/// wavefunction, or its first data set sampled trilinearly (0 outside its grid, with a warning;
+/// refused when no point lies inside).
+fn other_values(other: &Path, what: &WhatArgs, points: &[DVec3]) -> Result<Vec<f64>> {
+    let doc = formats::load(other)?;
+    if let Some(wf) = &doc.wavefunction {
+        let q = what.resolve(&doc)?;
+        return Ok(PreparedBasis::new(&wf.basis).quantity_at_points(wf, &doc.molecule, q, points));
+    }
+    let grid =
+        doc.volumes.first().with_context(|| format!("{}: no wavefunction and no data set to subtract", doc.source))?;
+    let at: Vec<glam::Vec3> = points.iter().map(|p| p.as_vec3()).collect();
+    let values = orbcloud::meshes::sample_grid(&at, grid);
+    let outside = values.iter().filter(|v| v.is_none()).count();
+    if outside == values.len() {
+        bail!("{}: its grid does not overlap the points asked for (no point lies inside it)", doc.source);
+    }
+    if outside > 0 {
+        eprintln!(
+            "{}: {outside} of {} points lie outside its grid; its value there is taken as 0",
+            doc.source,
+            values.len()
+        );
+    }
+    Ok(values.into_iter().map(|v| v.unwrap_or(0.0)).collect())
 }
 
 fn read_points(path: &Path) -> Result<Vec<DVec3>> {
