@@ -145,11 +145,7 @@ pub fn evaluate_wavefunction(
             Ok(Some(Evaluated { values, cloud: Cloud::Texture(volume) }))
         }
         None => {
-            let label = match view.quantity {
-                Quantity::Density => "total density",
-                Quantity::Potential => "electrostatic potential",
-                _ => "spin density",
-            };
+            let label = crate::scene::Source::Wavefunction(view.quantity).name(doc);
             let values = prepared.quantity_grid_f32(wf, &doc.molecule, view.quantity, &geometry);
             let grid = VolumeGrid::new(label, geometry.dims, geometry.world_from_grid, values);
             let values = Values { grid: Some(grid), sampled: None };

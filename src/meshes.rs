@@ -38,27 +38,52 @@ pub fn color_isosurfaces(
     meshes: &mut [(Mesh, SurfaceLook)],
 ) -> Option<(ValueMap, String)> {
     let per_level = if signed { 2 } else { 1 };
-    let mut owners = levels.iter().filter(|l| l.visible).flat_map(|l| std::iter::repeat_n(l, per_level));
-    let mut colored: Vec<(usize, Vec<Option<f64>>)> = Vec::new();
-    let mut asked = None;
-    for (k, (mesh, _)) in meshes.iter().enumerate() {
-        let Some(level) = owners.next() else { break };
-        if let Some(source) = level.color_by {
-            colored.push((k, values_at(doc, source, &mesh.positions)));
-            asked = Some((source, level.color_range));
+    let owners = levels.iter().filter(|l| l.visible).flat_map(|l| std::iter::repeat_n(l, per_level));
+    let asking: Vec<(usize, Source)> =
+        owners.zip(0..meshes.len()).filter_map(|(level, k)| level.color_by.map(|s| (k, s))).collect();
+    let last = levels.iter().rev().filter(|l| l.visible).find_map(|l| l.color_by.map(|s| (s, l.color_range)))?;
+    // Each quantity evaluated once, over the vertices of every mesh it colours.
+    let mut per_mesh: Vec<Option<Vec<Option<f64>>>> = vec![None; meshes.len()];
+    let mut sources: Vec<Source> = asking.iter().map(|&(_, s)| s).collect();
+    sources.dedup();
+    for source in sources {
+        let ks: Vec<usize> = asking.iter().filter(|(_, s)| *s == source).map(|&(k, _)| k).collect();
+        let of: Vec<&Mesh> = ks.iter().map(|&k| &meshes[k].0).collect();
+        for (k, v) in ks.iter().zip(values_on(doc, source, &of)) {
+            per_mesh[*k] = Some(v);
         }
     }
-    let (source, range) = asked?;
-    let all: Vec<Option<f64>> = colored.iter().flat_map(|(_, v)| v.iter().copied()).collect();
-    let (_, map) = color_values(&all, range.map(f64::from));
-    for (k, values) in colored {
-        meshes[k].0.colors = color_values(&values, Some(map.range)).0;
-    }
-    let name = match source {
+    let (mut colored, values): (Vec<&mut Mesh>, Vec<Vec<Option<f64>>>) =
+        meshes.iter_mut().zip(per_mesh).filter_map(|((m, _), v)| Some((m, v?))).unzip();
+    let map = color_meshes(&mut colored, &values, last.1.map(f64::from));
+    Some((map, color_name(doc, last.0)))
+}
+
+/// How a colour bar names `source`: "ESP" for the electrostatic potential, else its name.
+pub fn color_name(doc: &Document, source: Source) -> String {
+    match source {
         Source::Wavefunction(crate::model::orbitals::Quantity::Potential) => "ESP".to_string(),
         s => s.name(doc),
-    };
-    Some((map, name))
+    }
+}
+
+/// `source`'s values at the vertices of each of `meshes` ([`values_at`]), evaluated in one pass
+/// over all of them (one potential built, one basis prepared).
+pub fn values_on(doc: &Document, source: Source, meshes: &[&Mesh]) -> Vec<Vec<Option<f64>>> {
+    let points: Vec<glam::Vec3> = meshes.iter().flat_map(|m| m.positions.iter().copied()).collect();
+    let mut all = values_at(doc, source, &points).into_iter();
+    meshes.iter().map(|m| all.by_ref().take(m.positions.len()).collect()).collect()
+}
+
+/// Colours each mesh by its `values` on one diverging map ([`color_values`]: `range`, or robust
+/// over all of them); returns the map.
+pub fn color_meshes(meshes: &mut [&mut Mesh], values: &[Vec<Option<f64>>], range: Option<f64>) -> ValueMap {
+    let all: Vec<Option<f64>> = values.iter().flatten().copied().collect();
+    let (_, map) = color_values(&all, range);
+    for (mesh, v) in meshes.iter_mut().zip(values) {
+        mesh.colors = color_values(v, Some(map.range)).0;
+    }
+    map
 }
 
 /// Isosurfaces of `grid` at every level of `levels` (each as [`isosurfaces`] cuts it), every

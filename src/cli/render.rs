@@ -103,19 +103,12 @@ pub struct Picture {
 
 impl Picture {
     /// `doc` shown as `args` asks (`doc` already displaced by `--normal-mode`), seen by `camera`.
-    pub(super) fn new(args: &RenderArgs, doc: Document, camera: Camera) -> Result<Self> {
+    pub(super) fn new(args: &RenderArgs, mut doc: Document, camera: Camera) -> Result<Self> {
         let figure = args.figure.figure();
         let size = figure.drawn_size(args.view.size);
         let volume = args.view.volume_index(&doc)?;
-        // A cube file to colour by joins a copy of the document: the shown volume's index stays.
-        let (color_doc, color) = match args.iso.color_by {
-            Some(_) => {
-                let mut with = doc.clone();
-                let source = args.iso.color_source(&mut with)?;
-                (Some(with), source)
-            }
-            None => (None, None),
-        };
+        // A cube file to colour by joins the document's volumes last: the shown one's index stays.
+        let color = args.iso.color_source(&mut doc)?;
         let ctx = gpu(args.lavapipe)?;
         let mut settings = args.view.settings();
         let mut h = Headless::new(&ctx, &doc, volume, &settings, size)?;
@@ -131,8 +124,7 @@ impl Picture {
         let molsurface = args.molsurface.mesh(&doc, args.iso.translucent, grid)?;
         let map = molsurface.as_ref().and_then(|(_, _, map)| *map);
         let meshes = molsurface.into_iter().map(|(mesh, look, _)| (mesh, look)).collect();
-        let shown = (grid, color_doc.as_ref().unwrap_or(&doc));
-        let (colored, said) = surface_cli::show(&ctx, &mut h.renderer, shown, &args.iso, color, meshes);
+        let (colored, said) = surface_cli::show(&ctx, &mut h.renderer, (grid, &doc), &args.iso, color, meshes);
         let arrows = args.vibration.arrows(&doc)?;
         h.renderer.main().arrows.set_arrows(&ctx, &arrows, orbcloud::scene::vibration::ARROW_COLOR);
         let bar = match colored {

@@ -11,7 +11,7 @@ use orbcloud::formats::mesh_write::{self, MeshFormat, NamedMesh};
 use orbcloud::gpu::frame::PickId;
 use orbcloud::gpu::{GpuContext, Renderer};
 use orbcloud::layers::show_meshes;
-use orbcloud::meshes::{color_values, isosurfaces, values_at};
+use orbcloud::meshes::{color_meshes, color_name, isosurfaces, values_on};
 use orbcloud::model::gto::PreparedBasis;
 use orbcloud::model::isosurface::{self, Level, Mesh};
 use orbcloud::model::orbitals::{OrbitalSpec, Quantity, Spin};
@@ -67,8 +67,8 @@ pub struct Colored {
 
 impl IsoArgs {
     /// What `--color-by` names: a quantity of `doc`'s wavefunction, or a cube file's first data
-    /// set added to `doc` as one of its volumes. With its name.
-    pub fn color_source(&self, doc: &mut Document) -> Result<Option<(Source, String)>> {
+    /// set added to `doc` as one of its volumes.
+    pub fn color_source(&self, doc: &mut Document) -> Result<Option<Source>> {
         let Some(what) = &self.color_by else { return Ok(None) };
         let word = what.trim().to_ascii_lowercase();
         let quantity = match word.as_str() {
@@ -83,9 +83,7 @@ impl IsoArgs {
             if doc.wavefunction.is_none() {
                 bail!("--color-by {what}: {} holds no wavefunction (a Molden, fchk, wfn, wfx or MKL file)", doc.source);
             }
-            let source = Source::Wavefunction(q);
-            let name = if q == Quantity::Potential { "ESP".to_string() } else { source.name(doc) };
-            return Ok(Some((source, name)));
+            return Ok(Some(Source::Wavefunction(q)));
         }
         let path = std::path::Path::new(what);
         if !path.exists() {
@@ -96,24 +94,15 @@ impl IsoArgs {
         let other = load(Some(path))?;
         let grid =
             other.volumes.into_iter().next().with_context(|| format!("--color-by {what}: the file holds no volume"))?;
-        let name = grid.label.clone();
         doc.volumes.push(grid);
-        Ok(Some((Source::Volume(doc.volumes.len() - 1), name)))
+        Ok(Some(Source::Volume(doc.volumes.len() - 1)))
     }
 
     /// Colours `meshes` by `source` of `doc` ([`Self::color_source`]), one map for all of them.
-    pub fn color(
-        &self,
-        doc: &Document,
-        (source, name): (Source, String),
-        meshes: &mut [(Mesh, SurfaceLook)],
-    ) -> Colored {
-        let values: Vec<Vec<Option<f64>>> = meshes.iter().map(|(m, _)| values_at(doc, source, &m.positions)).collect();
-        let all: Vec<Option<f64>> = values.iter().flatten().copied().collect();
-        let (_, map) = color_values(&all, self.color_range);
-        for ((mesh, _), v) in meshes.iter_mut().zip(&values) {
-            mesh.colors = color_values(v, Some(map.range)).0;
-        }
+    pub fn color(&self, doc: &Document, source: Source, meshes: &mut [(Mesh, SurfaceLook)]) -> Colored {
+        let values = values_on(doc, source, &meshes.iter().map(|(m, _)| m).collect::<Vec<_>>());
+        let map = color_meshes(&mut meshes.iter_mut().map(|(m, _)| m).collect::<Vec<_>>(), &values, self.color_range);
+        let name = color_name(doc, source);
         Colored { map, name, values }
     }
 }
@@ -252,7 +241,7 @@ pub fn show(
     renderer: &mut Renderer,
     (grid, doc): (Option<&VolumeGrid>, &Document),
     iso: &IsoArgs,
-    color: Option<(Source, String)>,
+    color: Option<Source>,
     more: Vec<(Mesh, SurfaceLook)>,
 ) -> (Option<Colored>, Option<String>) {
     let mut meshes = match grid {

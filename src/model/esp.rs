@@ -213,7 +213,6 @@ fn hermite_r(l: usize, p: f64, x: DVec3, far: bool, scratch: &mut Scratch) {
 /// The charges of a molecule, ready to give the potential anywhere.
 pub struct Potential {
     nuclei: Vec<(DVec3, f64)>,
-    pairs: Vec<HermitePair>,
     /// Per pair, per (t, u, v) of [`triples`]: −(2π/p) Σ_μν P_μν E_t E_u E_v (the electrons'
     /// share of the potential of Λ_tuv).
     coefficients: Vec<f64>,
@@ -223,14 +222,14 @@ pub struct Potential {
 /// The primitive pairs whose centre lies nearest one shell centre, and their far field about it.
 ///
 /// Each pair has an activation distance: from there on (distance of the point from the
-/// anchor) the pair is a point multipole to within [`FAR_FIELD_ERROR`] / (pairs) — its Boys
+/// anchor) the pair is a point multipole to within a tenth of [`FAR_FIELD_ERROR`] — its Boys
 /// functions are their asymptotic form — and that multipole moved to the anchor and cut at
 /// order [`MULTIPOLE_ORDER`] is within the same bound. Pairs are sorted by that distance; each
 /// level holds the summed moments of the pairs active from its radius on, so a point takes one
 /// multipole per anchor and the exact sum over the pairs not yet active.
 struct Anchor {
     center: DVec3,
-    /// Its pairs, by activation distance (copies: the exact sums walk them in order).
+    /// Its pairs, by activation distance (the exact sums walk them in order).
     pairs: Vec<HermitePair>,
     levels: Vec<Level>,
 }
@@ -271,10 +270,11 @@ impl Potential {
                 (pairs, coefficients)
             })
             .collect();
-        let mut out = Self { nuclei, pairs: Vec::new(), coefficients: Vec::new(), anchors: Vec::new() };
-        for (pairs, coefficients) in blocks {
+        let mut out = Self { nuclei, coefficients: Vec::new(), anchors: Vec::new() };
+        let mut pairs = Vec::new();
+        for (block, coefficients) in blocks {
             let base = out.coefficients.len();
-            out.pairs.extend(pairs.into_iter().map(|p| HermitePair { first: p.first + base, ..p }));
+            pairs.extend(block.into_iter().map(|p| HermitePair { first: p.first + base, ..p }));
             out.coefficients.extend(coefficients);
         }
         let centres: Vec<DVec3> = {
@@ -283,17 +283,17 @@ impl Potential {
             c.dedup();
             c
         };
-        out.anchors = out.anchors(&centres);
+        out.anchors = out.anchors(&pairs, &centres);
         out
     }
 
-    /// Groups the pairs by nearest centre and sums their far fields level by level.
-    fn anchors(&self, centres: &[DVec3]) -> Vec<Anchor> {
-        let mut members: Vec<Vec<(f64, usize)>> = vec![Vec::new(); centres.len()];
+    /// Groups `pairs` by nearest centre and sums their far fields level by level.
+    fn anchors(&self, pairs: &[HermitePair], centres: &[DVec3]) -> Vec<Anchor> {
+        let mut members: Vec<Vec<(f64, &HermitePair)>> = vec![Vec::new(); centres.len()];
         // Errors of different pairs differ in sign and size: a tenth of the bound each keeps the
         // sum well inside it (measured: tests/esp.rs).
         let budget = FAR_FIELD_ERROR / 10.0;
-        for (i, pair) in self.pairs.iter().enumerate() {
+        for pair in pairs {
             let Some((a, centre)) = centres
                 .iter()
                 .enumerate()
@@ -301,15 +301,9 @@ impl Potential {
             else {
                 continue;
             };
-            let radius = self.activation(pair, pair.center.distance(*centre), budget);
-            if radius.is_finite() {
-                members[a].push((radius, i));
-            }
-            // A pair never far enough (none in practice) stays out of every level and is summed
+            // A pair never far enough (infinite radius) stays out of every level and is summed
             // exactly at every point, as the last of its anchor's list.
-            else {
-                members[a].push((f64::INFINITY, i));
-            }
+            members[a].push((self.activation(pair, pair.center.distance(*centre), budget), pair));
         }
         centres
             .par_iter()
@@ -333,7 +327,7 @@ impl Potential {
                     }
                     j += 1;
                 }
-                Anchor { center, pairs: list.into_iter().map(|(_, i)| self.pairs[i]).collect(), levels }
+                Anchor { center, pairs: list.into_iter().map(|(_, pair)| *pair).collect(), levels }
             })
             .collect()
     }
@@ -374,9 +368,8 @@ impl Potential {
         d
     }
 
-    /// Adds pair `i`'s moments about `anchor` (order ≤ [`MULTIPOLE_ORDER`]) to `moments`.
-    fn add_moments(&self, i: usize, anchor: DVec3, moments: &mut [f64]) {
-        let pair = &self.pairs[i];
+    /// Adds `pair`'s moments about `anchor` (order ≤ [`MULTIPOLE_ORDER`]) to `moments`.
+    fn add_moments(&self, pair: &HermitePair, anchor: DVec3, moments: &mut [f64]) {
         let own = triples(pair.l);
         let order = triples(MULTIPOLE_ORDER);
         let delta = pair.center - anchor;
@@ -404,20 +397,12 @@ impl Potential {
         }
     }
 
-    /// Number of primitive pairs kept after screening.
-    pub fn n_pairs(&self) -> usize {
-        self.pairs.len()
-    }
-
     /// The total charge the potential describes (nuclei minus electrons), from the Hermite
     /// coefficients: only Λ_000 carries charge, (π/p)^{3/2} each.
     pub fn total_charge(&self) -> f64 {
         let nuclear: f64 = self.nuclei.iter().map(|n| n.1).sum();
-        let electronic: f64 = self
-            .pairs
-            .iter()
-            .map(|pair| self.coefficients[pair.first] * (std::f64::consts::PI / pair.p).sqrt() / 2.0)
-            .sum();
+        let electronic: f64 =
+            self.pairs().map(|pair| self.coefficients[pair.first] * (std::f64::consts::PI / pair.p).sqrt() / 2.0).sum();
         nuclear + electronic
     }
 
@@ -446,7 +431,12 @@ impl Potential {
     /// The potential at `point` with every pair summed exactly (no far fields): the reference
     /// the far fields are tested against.
     pub fn exact_at(&self, point: DVec3, scratch: &mut Scratch) -> f64 {
-        self.nuclear(point) + self.pairs.iter().map(|pair| self.pair_at(pair, point, scratch)).sum::<f64>()
+        self.nuclear(point) + self.pairs().map(|pair| self.pair_at(pair, point, scratch)).sum::<f64>()
+    }
+
+    /// Every primitive pair kept, anchor by anchor.
+    fn pairs(&self) -> impl Iterator<Item = &HermitePair> {
+        self.anchors.iter().flat_map(|a| &a.pairs)
     }
 
     fn nuclear(&self, point: DVec3) -> f64 {
