@@ -9,6 +9,10 @@ converged RHF the fixture was written from: the density matrix of a converged RH
 on the orbitals' phases), V(C) = Σ_A Z_A/|C − R_A| − Σ_μν P_μν (μ|1/r_C|ν) with `int1e_rinv` per
 point and the charges of `mol.atom_charges()` (core charges with pseudopotentials).
 
+It also writes a density cube and a potential cube of water (cc-pVTZ) with PySCF's cubegen on
+two different grids (`h2o_density.cube`, `h2o_potential.cube`): the pair a viewer opens together.
+`--pair-only DIR N` writes just that pair on N³ and (N·3/4)³ points into DIR (for screenshots).
+
 Run: python scripts/make_esp_fixtures.py   (PySCF 2.x; output is deterministic)
 """
 import json
@@ -17,7 +21,7 @@ import sys
 
 import numpy as np
 from pyscf import gto, scf
-from pyscf.tools import molden
+from pyscf.tools import cubegen, molden
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.join(HERE, "..")
@@ -74,8 +78,32 @@ def write(name, source, mol, dm, rng):
     print(f"{name}: {len(values)} points, nao {mol.nao}, ESP range {min(values):.4f} .. {max(values):.4f}")
 
 
+def cube_pair(out, n):
+    """cubegen's density on n³ points and its potential on (3n/4)³ points with a wider margin:
+    two files of the same atoms on grids that differ, as two runs of cubegen write them."""
+    mol, _, mo_coeff, mo_occ, _, _ = molden.load(os.path.join(WAVEFUNCTIONS, "h2o_ccpvtz.molden"))
+    dm = density_matrix(mo_coeff, mo_occ)
+    m = n * 3 // 4
+    for name, write, points, margin in [("h2o_density.cube", cubegen.density, n, 4.5),
+                                        ("h2o_potential.cube", cubegen.mep, m, 5.0)]:
+        path = os.path.join(out, name)
+        write(mol, path, dm, nx=points, ny=points, nz=points, margin=margin)
+        # The date PySCF stamps on line 2 would make every run's file differ.
+        with open(path) as f:
+            lines = f.read().split("\n")
+        lines[1] = lines[1].split("Date:")[0].rstrip()
+        with open(path, "w") as f:
+            f.write("\n".join(lines))
+    print(f"h2o_density.cube ({n}³), h2o_potential.cube ({m}³) in {out}")
+
+
 def main():
+    if len(sys.argv) == 4 and sys.argv[1] == "--pair-only":
+        os.makedirs(sys.argv[2], exist_ok=True)
+        cube_pair(sys.argv[2], int(sys.argv[3]))
+        return
     os.makedirs(OUT, exist_ok=True)
+    cube_pair(OUT, 16)
     rng = np.random.default_rng(SEED)
     for name in ["h2o_cart_631gs", "h2o_ccpvtz", "h2o_cation_uhf_631gs", "h3o_cation_631gss", "benzene_631gs"]:
         mol, _, mo_coeff, mo_occ, _, _ = molden.load(os.path.join(WAVEFUNCTIONS, name + ".molden"))

@@ -59,11 +59,17 @@ pub fn color_isosurfaces(
     Some((map, color_name(doc, last.0)))
 }
 
-/// How a colour bar names `source`: "ESP" for the electrostatic potential, else its name.
+/// How a colour bar names `source`: "ESP" for an electrostatic potential (the wavefunction's or a
+/// data set that says it is one), else its name, cut to fit the bar.
 pub fn color_name(doc: &Document, source: Source) -> String {
-    match source {
-        Source::Wavefunction(crate::model::orbitals::Quantity::Potential) => "ESP".to_string(),
-        s => s.name(doc),
+    const LONGEST: usize = 28;
+    if source.is_potential(doc) {
+        return "ESP".to_string();
+    }
+    let name = source.name(doc);
+    match name.char_indices().nth(LONGEST) {
+        Some((end, _)) => format!("{}…", name[..end].trim_end()),
+        None => name,
     }
 }
 

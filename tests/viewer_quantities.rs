@@ -437,3 +437,59 @@ fn a_normal_mode_animates_with_arrows_and_a_click_on_its_band_picks_it() {
     wait_loaded(&mut h);
     assert_eq!(common::mean_difference(&still, &picture(&mut h, dir.path(), "rest")), 0.0, "back at rest");
 }
+
+/// Pixels of `img` clearly red and clearly blue (the ends of the diverging map).
+fn red_and_blue(img: &image::RgbaImage) -> (usize, usize) {
+    let (mut red, mut blue) = (0, 0);
+    for p in img.pixels() {
+        let [r, _, b, _] = p.0.map(i32::from);
+        red += usize::from(r > b + 25);
+        blue += usize::from(b > r + 25);
+    }
+    (red, blue)
+}
+
+#[test]
+fn a_density_cube_and_its_potential_cube_open_as_one_object_shown_as_an_esp_map() {
+    let (density, potential) = (fixture("esp/h2o_density.cube"), fixture("esp/h2o_potential.cube"));
+    let mut h = open(vec![density.clone(), potential.clone()]);
+    let dir = tempfile::tempdir().unwrap();
+    let app = h.state();
+    assert_eq!(app.objects.len(), 1, "the potential joined the density's object: {}", app.status);
+    assert_eq!(app.doc().volumes.len(), 2);
+    assert_eq!(sources(app), [Source::Volume(0), Source::Volume(1), Source::Volume(0)]);
+    let state = &app.objects[0].state;
+    assert_eq!(state.joined, [potential.clone()]);
+    assert!(!state.quantities[0].visible && !state.quantities[1].visible, "the map takes the view");
+    let map = &state.quantities[2];
+    assert_eq!(map.isosurfaces[0].color_by, Some(Source::Volume(1)), "the density's surface coloured by the potential");
+    assert!(!map.cloud.visible);
+    let notice = app.notice.clone().unwrap_or_default();
+    assert!(notice.contains("h2o_potential.cube joined") && notice.contains("ESP map"), "{notice}");
+
+    // Oxygen's lone pairs attract a positive charge (red), the hydrogens repel it (blue).
+    let shown = picture(&mut h, dir.path(), "esp_map");
+    let (red, blue) = red_and_blue(&shown);
+    assert!(red > 100 && blue > 100, "both ends of the map show: {red} red, {blue} blue pixels");
+
+    // A session keeps the joined file; reopened after the scene was replaced, all is as it was.
+    let session = dir.path().join("pair.orbcloud.toml");
+    h.state_mut().save_session(&session);
+    let saved = h.state().objects[0].state.clone();
+    let ctx = h.ctx.clone();
+    h.state_mut().open_as(fixture("wavefunctions/h2o_cart_631gs.molden"), orbcloud::app::Opening::Replace, &ctx);
+    wait_loaded(&mut h);
+    h.state_mut().open(session, &ctx);
+    wait_loaded(&mut h);
+    assert_eq!(h.state().objects.len(), 1);
+    assert_eq!(h.state().objects[0].state, saved);
+    assert_eq!(h.state().doc().volumes.len(), 2, "the potential cube was read again");
+    let reopened = picture(&mut h, dir.path(), "reopened");
+    assert!(common::mean_difference(&shown, &reopened) < 0.5, "{}", common::mean_difference(&shown, &reopened));
+
+    // A cube of other atoms opens beside it, as its own object.
+    let demo = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/demo.cube.gz");
+    h.state_mut().open_as(demo, orbcloud::app::Opening::Add, &ctx);
+    wait_loaded(&mut h);
+    assert_eq!(h.state().objects.len(), 2, "other atoms do not join");
+}

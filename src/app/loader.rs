@@ -19,7 +19,10 @@ pub struct LoadJob {
 }
 
 impl LoadJob {
-    pub fn start(path: PathBuf, repaint: impl Fn() + Send + Sync + 'static) -> Self {
+    /// Loads `path`, then each of `joined` onto it ([`Document::join`]: a session's object
+    /// that a potential cube had joined); a joined file that fails is noted in the document's
+    /// problems, the rest still opens.
+    pub fn start(path: PathBuf, joined: Vec<PathBuf>, repaint: impl Fn() + Send + Sync + 'static) -> Self {
         let total = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
         let read = Arc::new(AtomicU64::new(0));
         let (p, counter) = (path.clone(), read.clone());
@@ -27,7 +30,16 @@ impl LoadJob {
         let progress = repaint.clone();
         let result = spawn(
             &format!("loading {}", path.display()),
-            move || load_with_progress(&p, &counter, &*progress),
+            move || {
+                let mut doc = load_with_progress(&p, &counter, &*progress)?;
+                for other in &joined {
+                    let joined = formats::load(other).map_err(|e| e.to_string()).and_then(|o| doc.join(o));
+                    if let Err(e) = joined {
+                        doc.problems.push(e);
+                    }
+                }
+                Ok(doc)
+            },
             move || repaint(),
         );
         Self { path, read, total, result }

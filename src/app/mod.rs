@@ -4,6 +4,7 @@ mod correlation;
 pub mod detail;
 pub mod files;
 pub mod jobs;
+mod joining;
 mod legend;
 mod loader;
 pub mod measure;
@@ -534,7 +535,11 @@ impl OrbApp {
             return;
         }
         let repaint = ctx.clone();
-        self.job = Some((LoadJob::start(path, move || repaint.request_repaint()), how));
+        let joined = match &how {
+            Opening::Restore(state) => state.joined.clone(),
+            _ => Vec::new(),
+        };
+        self.job = Some((LoadJob::start(path, joined, move || repaint.request_repaint()), how));
     }
 
     /// Loads a scan and makes its key volumes in the background, following orbitals as its
@@ -959,7 +964,7 @@ impl OrbApp {
         {
             let Some((_, how)) = self.job.take() else { return };
             match result {
-                Ok(doc) => self.add_object(doc, how),
+                Ok(doc) => self.add_or_join(doc, how),
                 Err(e) => {
                     self.error = Some(e.to_string());
                     self.show_demo_if_empty(ctx);

@@ -9,7 +9,7 @@ use crate::model::basis_labels::{atom_name, function_labels};
 use crate::model::orbitals::Quantity;
 use crate::model::orbitals::{Spin, Wavefunction};
 use crate::model::units::EV_PER_HARTREE;
-use crate::scene::{Camera, IsoLevel, IsosurfaceSettings, ObjectState, Panes, QuantityState, RenderSettings, Source};
+use crate::scene::{Camera, ObjectState, Panes, QuantityState, RenderSettings, Source};
 
 /// Residual of CᵀSC − I above which the orbitals are flagged as not orthonormal.
 pub const ORTHONORMAL_TOLERANCE: f64 = 1e-5;
@@ -29,9 +29,6 @@ enum Pick {
     /// and is what it shows.
     EspMap,
 }
-
-/// The density an ESP map is drawn on (a.u.): the molecule's van der Waals-like surface.
-pub const ESP_MAP_DENSITY: f32 = 0.002;
 
 /// The orbital browser of the object `state` describes: it edits `state` in place (the
 /// selected quantity's orbital or density, the spin listed, how orbitals are evaluated).
@@ -150,15 +147,11 @@ pub fn panel(
         }
         Some(Pick::Add(q)) => add(state, q, defaults),
         Some(Pick::EspMap) => {
-            let mut map = QuantityState::new(Source::Wavefunction(Quantity::Density), defaults);
-            map.cloud.visible = false;
-            map.isosurfaces = vec![IsosurfaceSettings {
-                visible: true,
-                level: IsoLevel::Absolute(ESP_MAP_DENSITY),
-                translucent: false,
-                color_by: Some(Source::Wavefunction(Quantity::Potential)),
-                ..Default::default()
-            }];
+            let map = QuantityState::esp_map(
+                Source::Wavefunction(Quantity::Density),
+                Source::Wavefunction(Quantity::Potential),
+                defaults,
+            );
             // It takes the view; what was shown stays listed, hidden, a tick away.
             state.quantities.iter_mut().for_each(|q| q.visible = false);
             state.quantities.push(map);

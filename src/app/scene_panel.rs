@@ -87,7 +87,7 @@ fn quantities(ui: &mut egui::Ui, doc: &Document, state: &mut ObjectState, defaul
     if choices.is_empty() {
         return;
     }
-    ComboBox::from_id_salt("add quantity").selected_text("+ quantity").show_ui(ui, |ui| {
+    let added = ComboBox::from_id_salt("add quantity").selected_text("+ quantity").show_ui(ui, |ui| {
         for (source, name) in choices {
             if ui.selectable_label(false, name).clicked() {
                 let joining = QuantityState::joining(source, defaults, &state.quantities);
@@ -96,6 +96,7 @@ fn quantities(ui: &mut egui::Ui, doc: &Document, state: &mut ObjectState, defaul
             }
         }
     });
+    added.response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::ComboBox, true, "add a quantity"));
 }
 
 /// What a quantity draws, in words: "cloud", "cloud + 2 isosurfaces", "hidden".

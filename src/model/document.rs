@@ -38,3 +38,85 @@ impl Document {
         })
     }
 }
+
+/// How far apart two files' atoms may be and still be one molecule (bohr): cube writers print
+/// six decimals, some of them in ångström.
+const SAME_PLACE: f64 = 1e-4;
+
+impl Document {
+    /// Whether `other` holds the same atoms at the same places (the same molecule written by
+    /// another run or tool).
+    pub fn same_atoms(&self, other: &Document) -> bool {
+        let (a, b) = (&self.molecule.atoms, &other.molecule.atoms);
+        a.len() == b.len()
+            && a.iter().zip(b).all(|(a, b)| a.z == b.z && a.position.distance(b.position) <= SAME_PLACE)
+    }
+
+    /// Whether it is values on grids and nothing else (a cube file): another such file of the
+    /// same molecule can [`Self::join`] it.
+    pub fn is_grid_only(&self) -> bool {
+        !self.volumes.is_empty() && self.wavefunction.is_none() && self.structure.is_none()
+    }
+
+    /// Appends `other`'s data sets to this document's (a potential cube joining the density
+    /// cube made beside it); returns the index of the first one appended. Refused, with the
+    /// reason, unless both are grid-only files of the same atoms.
+    pub fn join(&mut self, other: Document) -> Result<usize, String> {
+        if !self.is_grid_only() || !other.is_grid_only() {
+            return Err(format!("{}: only data sets on grids join another file's", other.source));
+        }
+        if !self.same_atoms(&other) {
+            return Err(format!("{}: its atoms are not those of {}", other.source, self.source));
+        }
+        let first = self.volumes.len();
+        self.volumes.extend(other.volumes);
+        self.problems.extend(other.problems);
+        Ok(first)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::atom::Atom;
+    use crate::model::grid::VolumeGrid;
+
+    fn cube(atoms: &[(u32, [f64; 3])], label: &str) -> Document {
+        let atoms = atoms
+            .iter()
+            .map(|&(z, p)| Atom { z, charge: z as f64, position: glam::DVec3::from_array(p), ghost: false })
+            .collect();
+        let grid = VolumeGrid::new(label.into(), [2, 2, 2], glam::DMat4::IDENTITY, vec![0.0; 8]);
+        Document {
+            source: format!("{label}.cube"),
+            molecule: Molecule::new(atoms),
+            volumes: vec![grid],
+            ..Default::default()
+        }
+    }
+
+    #[test]
+    fn a_cube_of_the_same_atoms_joins_and_others_are_refused() {
+        let water = [(8, [0.0, 0.0, 0.0]), (1, [1.4, 1.1, 0.0]), (1, [-1.4, 1.1, 0.0])];
+        let mut density = cube(&water, "density");
+        let mut moved = water;
+        moved[1].1[0] += 1e-5;
+        assert_eq!(density.join(cube(&moved, "potential")), Ok(1));
+        assert_eq!(density.volumes.len(), 2);
+        assert_eq!(density.volumes[1].label, "potential");
+
+        moved[1].1[0] += 1e-2;
+        let e = density.join(cube(&moved, "far")).unwrap_err();
+        assert!(e.contains("far.cube") && e.contains("not those of density.cube"), "{e}");
+        let e = density.join(cube(&water[..2], "fewer")).unwrap_err();
+        assert!(e.contains("not those"), "{e}");
+        let mut swapped = water;
+        swapped[0].0 = 7;
+        assert!(density.join(cube(&swapped, "nitrogen")).is_err());
+        let mut orbitals = cube(&water, "molden");
+        orbitals.wavefunction = None;
+        orbitals.volumes.clear();
+        assert!(density.join(orbitals).unwrap_err().contains("only data sets"));
+        assert_eq!(density.volumes.len(), 2, "a refused file leaves the document as it was");
+    }
+}

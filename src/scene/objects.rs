@@ -46,6 +46,9 @@ impl Placement {
 pub struct ObjectState {
     /// The file it was read from; `None` for the bundled demo.
     pub path: Option<std::path::PathBuf>,
+    /// Files of the same atoms whose data sets joined the object's after its own (a potential
+    /// cube beside a density cube), in order: `Source::Volume` numbers them after `path`'s.
+    pub joined: Vec<std::path::PathBuf>,
     /// Whether the object is drawn at all.
     pub visible: bool,
     pub placement: Placement,
@@ -68,6 +71,7 @@ impl Default for ObjectState {
     fn default() -> Self {
         Self {
             path: None,
+            joined: Vec::new(),
             visible: true,
             placement: Placement::default(),
             atoms: AtomLook::default(),
@@ -121,6 +125,9 @@ impl ObjectState {
             }
         }
         self.quantities.retain(|q| q.source.exists_in(doc));
+        for iso in self.quantities.iter_mut().flat_map(|q| &mut q.isosurfaces) {
+            iso.color_by = iso.color_by.filter(|s| s.exists_in(doc));
+        }
         if self.quantities.is_empty()
             && let Some(source) = first_source(doc)
         {
@@ -262,6 +269,7 @@ pub fn changes(before: &ObjectState, after: &ObjectState) -> Changes {
 #[serde(default)]
 struct StoredObject {
     path: Option<std::path::PathBuf>,
+    joined: Vec<std::path::PathBuf>,
     visible: Option<bool>,
     placement: Placement,
     atoms: Option<AtomLook>,
@@ -290,6 +298,7 @@ impl From<StoredObject> for ObjectState {
         }
         Self {
             path: s.path,
+            joined: s.joined,
             visible: s.visible.unwrap_or(true),
             placement: s.placement,
             atoms: s.atoms.or(s.settings.as_ref().map(AtomLook::of)).unwrap_or_default(),

@@ -33,6 +33,20 @@ impl Source {
         }
     }
 
+    /// Whether it is an electrostatic potential: the wavefunction's, or a data set whose
+    /// label says so (cubegen's "Electrostatic potential from Total SCF Density", PySCF's
+    /// "Molecular electrostatic potential", an "ESP" or "MEP" grid).
+    pub fn is_potential(self, doc: &Document) -> bool {
+        match self {
+            Source::Wavefunction(q) => q == Quantity::Potential,
+            Source::Volume(i) => doc.volumes.get(i).is_some_and(|v| {
+                let label = v.label.to_ascii_lowercase();
+                label.contains("potential")
+                    || label.split(|c: char| !c.is_ascii_alphanumeric()).any(|w| w == "esp" || w == "mep")
+            }),
+        }
+    }
+
     /// The orbital it shows, if it is one.
     pub fn orbital(self) -> Option<usize> {
         match self {
@@ -129,6 +143,27 @@ impl QuantityState {
             }
         }
         q
+    }
+}
+
+/// The density (a.u.) whose surface an ESP map colours: ρ = 0.002 a.u. encloses about 97% of
+/// the electrons and is where the potential is conventionally read.
+pub const ESP_MAP_DENSITY: f32 = 0.002;
+
+impl QuantityState {
+    /// An *ESP map*: the surface ρ = [`ESP_MAP_DENSITY`] of `density` coloured by `potential`
+    /// on the diverging map, opaque, without a cloud.
+    pub fn esp_map(density: Source, potential: Source, defaults: &RenderSettings) -> Self {
+        let mut map = Self::new(density, defaults);
+        map.cloud.visible = false;
+        map.isosurfaces = vec![IsosurfaceSettings {
+            visible: true,
+            level: super::IsoLevel::Absolute(ESP_MAP_DENSITY),
+            translucent: false,
+            color_by: Some(potential),
+            ..Default::default()
+        }];
+        map
     }
 }
 
