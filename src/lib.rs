@@ -4,6 +4,7 @@
 //! `layers` ← `headless`, `key_volumes` ← `app` ← `main`.
 
 pub mod app;
+pub mod arithmetic;
 pub mod demo;
 pub mod evaluate;
 pub mod figure;

@@ -14,6 +14,7 @@ use egui_kittest::kittest::Queryable;
 use orbcloud::app::{OrbApp, wgpu_setup};
 use orbcloud::model::orbitals::{Quantity, Spin};
 use orbcloud::scene::Source::{self, Wavefunction};
+use orbcloud::scene::objects::AddedVolume;
 use viewer_support::{click_at, wait_loaded};
 
 fn fixture(name: &str) -> PathBuf {
@@ -459,7 +460,7 @@ fn a_density_cube_and_its_potential_cube_open_as_one_object_shown_as_an_esp_map(
     assert_eq!(app.doc().volumes.len(), 2);
     assert_eq!(sources(app), [Source::Volume(0), Source::Volume(1), Source::Volume(0)]);
     let state = &app.objects[0].state;
-    assert_eq!(state.joined, [potential.clone()]);
+    assert_eq!(state.added, [AddedVolume::Joined { path: potential.clone() }]);
     assert!(!state.quantities[0].visible && !state.quantities[1].visible, "the map takes the view");
     let map = &state.quantities[2];
     assert_eq!(map.isosurfaces[0].color_by, Some(Source::Volume(1)), "the density's surface coloured by the potential");
@@ -492,4 +493,52 @@ fn a_density_cube_and_its_potential_cube_open_as_one_object_shown_as_an_esp_map(
     h.state_mut().open_as(demo, orbcloud::app::Opening::Add, &ctx);
     wait_loaded(&mut h);
     assert_eq!(h.state().objects.len(), 2, "other atoms do not join");
+}
+
+#[test]
+fn a_density_minus_another_files_density_joins_as_a_data_set_and_a_session_makes_it_again() {
+    let (a, b) = (fixture("wavefunctions/h2o_ccpvtz.molden"), fixture("wavefunctions/h2o_cart_631gs.molden"));
+    let mut h = open(vec![a.clone(), b.clone()]);
+    assert_eq!(h.state().objects.len(), 2, "files with wavefunctions open as objects of their own");
+    h.state_mut().select(0);
+    h.state_mut().objects[0].state.quantities[0].source = Wavefunction(Quantity::Density);
+    wait_loaded(&mut h);
+    assert_eq!(h.state().subtractable(), [(1, "h2o_cart_631gs.molden".to_string())]);
+
+    h.get_by_label("minus").click();
+    h.run_steps(2);
+    h.get_by_label("h2o_cart_631gs.molden").click();
+    wait_loaded(&mut h);
+    let app = h.state();
+    assert_eq!(sources(app), [Wavefunction(Quantity::Density), Source::Volume(0)]);
+    let grid = &app.objects[0].doc.volumes[0];
+    assert_eq!(grid.label, "total density − h2o_cart_631gs.molden");
+    assert!(grid.stats.min < 0.0 && grid.stats.max > 0.0, "a difference has both signs");
+
+    // Each point is ρ_A − ρ_B there, by the evaluator tested against PySCF.
+    let density = |doc: &orbcloud::model::Document, p: glam::DVec3| {
+        let wf = doc.wavefunction.as_ref().unwrap();
+        let prepared = orbcloud::model::gto::PreparedBasis::new(&wf.basis);
+        prepared.quantity_at_points(wf, &doc.molecule, Quantity::Density, &[p])[0]
+    };
+    let (da, db) = (&app.objects[0].doc, &app.objects[1].doc);
+    for (i, j, k) in [(10, 20, 30), (36, 36, 36), (50, 40, 20), (36, 30, 40)] {
+        let p = grid.point(i, j, k);
+        let want = density(da, p) - density(db, p);
+        let got = grid.value(i, j, k) as f64;
+        assert!((got - want).abs() < 1e-5 * want.abs().max(1.0), "at {p}: {got} against {want}");
+    }
+
+    // A session makes it again from the two files.
+    let dir = tempfile::tempdir().unwrap();
+    let session = dir.path().join("difference.orbcloud.toml");
+    h.state_mut().save_session(&session);
+    let saved = h.state().objects[0].state.clone();
+    let values = h.state().objects[0].doc.volumes[0].values.clone();
+    let ctx = h.ctx.clone();
+    h.state_mut().open(session, &ctx);
+    wait_loaded(&mut h);
+    let app = h.state();
+    assert_eq!(app.objects[0].state, saved);
+    assert_eq!(app.objects[0].doc.volumes[0].values, values, "the same difference, made again");
 }

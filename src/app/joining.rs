@@ -7,6 +7,7 @@ use std::sync::Arc;
 
 use super::{Opening, OrbApp};
 use crate::model::Document;
+use crate::scene::objects::AddedVolume;
 use crate::scene::{QuantityState, Source};
 
 impl OrbApp {
@@ -48,7 +49,9 @@ impl OrbApp {
             }
         };
         let state = &mut object.state;
-        state.joined.extend(path.exists().then_some(path));
+        if path.exists() {
+            state.added.push(AddedVolume::Joined { path });
+        }
         let defaults = self.defaults;
         let density = state.quantities.iter().map(|q| q.source).find(|s| !s.is_potential(&merged));
         for i in first..merged.volumes.len() {

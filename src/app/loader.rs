@@ -9,6 +9,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use super::jobs::{Pending, spawn};
 use crate::formats::{self, LoadError};
 use crate::model::Document;
+use crate::scene::objects::AddedVolume;
 
 pub struct LoadJob {
     pub path: PathBuf,
@@ -19,10 +20,8 @@ pub struct LoadJob {
 }
 
 impl LoadJob {
-    /// Loads `path`, then each of `joined` onto it ([`Document::join`]: a session's object
-    /// that a potential cube had joined); a joined file that fails is noted in the document's
-    /// problems, the rest still opens.
-    pub fn start(path: PathBuf, joined: Vec<PathBuf>, repaint: impl Fn() + Send + Sync + 'static) -> Self {
+    /// Loads `path`, then makes the data sets a session's object had added to it ([`add`]).
+    pub fn start(path: PathBuf, added: Vec<AddedVolume>, repaint: impl Fn() + Send + Sync + 'static) -> Self {
         let total = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
         let read = Arc::new(AtomicU64::new(0));
         let (p, counter) = (path.clone(), read.clone());
@@ -32,11 +31,9 @@ impl LoadJob {
             &format!("loading {}", path.display()),
             move || {
                 let mut doc = load_with_progress(&p, &counter, &*progress)?;
-                for other in &joined {
-                    let joined = formats::load(other).map_err(|e| e.to_string()).and_then(|o| doc.join(o));
-                    if let Err(e) = joined {
-                        doc.problems.push(e);
-                    }
+                // Those after one that fails would be numbered wrongly: they are left out.
+                if let Some(e) = added.iter().find_map(|a| add(&mut doc, a).err()) {
+                    doc.problems.push(e);
                 }
                 Ok(doc)
             },
@@ -55,6 +52,23 @@ impl LoadJob {
     /// The document, or why it did not load (a reader's error, or a failure of the job).
     pub fn poll(&self) -> Option<Result<Document, String>> {
         self.result.poll().map(|r| r.and_then(|loaded| loaded.map_err(|e| e.to_string())))
+    }
+}
+
+/// Appends the data set(s) `added` names to `doc`: a joined file's, or a difference with
+/// another file made again.
+pub fn add(doc: &mut Document, added: &AddedVolume) -> Result<(), String> {
+    match added {
+        AddedVolume::Joined { path } => {
+            let other = formats::load(path).map_err(|e| e.to_string())?;
+            doc.join(other).map(|_| ())
+        }
+        AddedVolume::Difference { of, minus, points } => {
+            let other = formats::load(minus).map_err(|e| e.to_string())?;
+            let grid = crate::arithmetic::difference(doc, *of, *points, &other)?;
+            doc.volumes.push(grid);
+            Ok(())
+        }
     }
 }
 

@@ -2,6 +2,7 @@
 
 mod correlation;
 pub mod detail;
+mod difference;
 pub mod files;
 pub mod jobs;
 mod joining;
@@ -220,6 +221,8 @@ pub struct OrbApp {
     /// An open dihedral scan (shown instead of the scene), and one being prepared.
     pub scan: Option<ScanView>,
     scan_job: Option<ScanJob>,
+    /// A quantity minus another file's being made ([`difference`]).
+    difference: Option<difference::DifferenceJob>,
     /// Points along the longest side of a scan's common grid.
     pub scan_points: usize,
     /// Memory allowed for a scan's key volumes (bytes); `None`: derived from the device.
@@ -394,6 +397,7 @@ impl OrbApp {
             status: String::new(),
             scan: None,
             scan_job: None,
+            difference: None,
             scan_points: crate::key_volumes::DEFAULT_SCAN_POINTS,
             scan_retry: None,
             scan_budget: None,
@@ -535,11 +539,11 @@ impl OrbApp {
             return;
         }
         let repaint = ctx.clone();
-        let joined = match &how {
-            Opening::Restore(state) => state.joined.clone(),
+        let added = match &how {
+            Opening::Restore(state) => state.added.clone(),
             _ => Vec::new(),
         };
-        self.job = Some((LoadJob::start(path, joined, move || repaint.request_repaint()), how));
+        self.job = Some((LoadJob::start(path, added, move || repaint.request_repaint()), how));
     }
 
     /// Loads a scan and makes its key volumes in the background, following orbitals as its
@@ -579,7 +583,11 @@ impl OrbApp {
 
     /// Whether a file, a scan or a job of the scene is still being worked on.
     pub fn is_loading(&self) -> bool {
-        self.job.is_some() || !self.queue.is_empty() || self.scan_job.is_some() || self.busy().is_some()
+        self.job.is_some()
+            || !self.queue.is_empty()
+            || self.scan_job.is_some()
+            || self.difference.is_some()
+            || self.busy().is_some()
     }
 
     /// Adds a loaded document to the scene as `how` says: beside the others, instead of them,
@@ -942,6 +950,7 @@ impl OrbApp {
 
     fn poll_job(&mut self, ctx: &egui::Context) {
         self.poll_object_jobs();
+        self.poll_difference();
         let reported: Vec<String> = std::mem::take(&mut *self.gpu_errors.lock().unwrap_or_else(|p| p.into_inner()));
         if let Some(lost) = reported.iter().find(|e| e.starts_with(DEVICE_LOST)) {
             self.save_last_session();

@@ -200,6 +200,7 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
                 ui.separator();
             }
             let (grid_sigma, grid_signed) = app.shown_grid();
+            let subtractable = app.subtractable();
             if let Some(scan) = &mut app.scan {
                 let g = scan.scene.grid.dims;
                 ui.heading("Volume");
@@ -222,6 +223,7 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
                 atoms_editor(ui, &mut s.atoms, &mut s.atom_colors, &mut s.depth_cue);
             } else if let Some(o) = app.objects.get_mut(app.active) {
                 let doc = o.doc.clone();
+                let mut subtract = None;
                 let state = &mut o.state;
                 match state.selected_quantity_mut() {
                     Some(q) => {
@@ -229,6 +231,7 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
                         if doc.volumes.len() > 1 && matches!(q.source, Source::Volume(_)) {
                             data_set_choice(ui, &doc, &mut q.source);
                         }
+                        subtract = minus_choice(ui, &subtractable);
                         // Isosurfaces first: for orbitals the most used, and never below the fold.
                         let colors = super::scene_panel::quantity_choices(&doc);
                         isosurfaces_editor(ui, &mut q.isosurfaces, (grid_signed, grid_sigma), &colors);
@@ -247,6 +250,9 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
                 atoms_editor(ui, &mut a.style, &mut a.colors, &mut a.depth_cue);
                 ui.add(Slider::new(&mut a.ball_scale, 0.3..=3.0).text("ball size (×)"));
                 ui.add(Slider::new(&mut a.stick_scale, 0.3..=3.0).text("stick radius (×)"));
+                if let Some(m) = subtract {
+                    app.start_difference(m, ui.ctx());
+                }
             }
             if let Some(model) = super::models::controls(ui, app) {
                 app.show_model(model);
@@ -302,6 +308,31 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
             ui.label(RichText::new(help).small().weak());
         });
     });
+}
+
+/// *minus*: another open file whose same quantity is subtracted from this one, as a new data
+/// set of the object; the file picked.
+fn minus_choice(ui: &mut egui::Ui, files: &[(usize, String)]) -> Option<usize> {
+    if files.is_empty() {
+        return None;
+    }
+    let mut picked = None;
+    ui.horizontal(|ui| {
+        let label = ui.label("minus");
+        ComboBox::from_id_salt("minus")
+            .selected_text("another file's…")
+            .show_ui(ui, |ui| {
+                for (m, name) in files {
+                    if ui.selectable_label(false, name).clicked() {
+                        picked = Some(*m);
+                    }
+                }
+            })
+            .response
+            .labelled_by(label.id)
+            .on_hover_text("this quantity minus the same quantity of another open file, on this one's grid: a new data set (a density difference)");
+    });
+    picked
 }
 
 /// Which of a file's data sets a quantity shows (cube files with several).

@@ -11,6 +11,7 @@ use orbcloud::info;
 use orbcloud::model::gto::PreparedBasis;
 use orbcloud::model::orbitals::Quantity;
 use orbcloud::model::{GridSpec, VolumeGrid};
+use orbcloud::scene::Source;
 
 use super::{WhatArgs, wavefunction_of};
 
@@ -79,9 +80,7 @@ pub fn cube(
     let mut values = prepared.quantity_grid_f32(wf, &doc.molecule, q, &spec);
     let mut label = what.label(&q, &doc);
     if let Some(other) = minus {
-        let points: Vec<DVec3> = (0..dims[0])
-            .flat_map(|i| (0..dims[1]).flat_map(move |j| (0..dims[2]).map(move |k| spec.point(i, j, k))))
-            .collect();
+        let points = orbcloud::arithmetic::grid_points(dims, |i, j, k| spec.point(i, j, k));
         for (v, o) in values.iter_mut().zip(other_values(other, what, &points)?) {
             *v -= o as f32;
         }
@@ -107,18 +106,12 @@ pub fn cube(
 /// refused when no point lies inside).
 fn other_values(other: &Path, what: &WhatArgs, points: &[DVec3]) -> Result<Vec<f64>> {
     let doc = formats::load(other)?;
-    if let Some(wf) = &doc.wavefunction {
-        let q = what.resolve(&doc)?;
-        return Ok(PreparedBasis::new(&wf.basis).quantity_at_points(wf, &doc.molecule, q, points));
-    }
-    let grid =
-        doc.volumes.first().with_context(|| format!("{}: no wavefunction and no data set to subtract", doc.source))?;
-    let at: Vec<glam::Vec3> = points.iter().map(|p| p.as_vec3()).collect();
-    let values = orbcloud::meshes::sample_grid(&at, grid);
-    let outside = values.iter().filter(|v| v.is_none()).count();
-    if outside == values.len() {
-        bail!("{}: its grid does not overlap the points asked for (no point lies inside it)", doc.source);
-    }
+    let source = match &doc.wavefunction {
+        Some(_) => Source::Wavefunction(what.resolve(&doc)?),
+        None if doc.volumes.is_empty() => bail!("{}: no wavefunction and no data set to subtract", doc.source),
+        None => Source::Volume(0),
+    };
+    let (values, outside) = orbcloud::arithmetic::values_of(&doc, source, points).map_err(anyhow::Error::msg)?;
     if outside > 0 {
         eprintln!(
             "{}: {outside} of {} points lie outside its grid; its value there is taken as 0",
@@ -126,7 +119,7 @@ fn other_values(other: &Path, what: &WhatArgs, points: &[DVec3]) -> Result<Vec<f
             values.len()
         );
     }
-    Ok(values.into_iter().map(|v| v.unwrap_or(0.0)).collect())
+    Ok(values)
 }
 
 fn read_points(path: &Path) -> Result<Vec<DVec3>> {

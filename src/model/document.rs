@@ -48,8 +48,7 @@ impl Document {
     /// another run or tool).
     pub fn same_atoms(&self, other: &Document) -> bool {
         let (a, b) = (&self.molecule.atoms, &other.molecule.atoms);
-        a.len() == b.len()
-            && a.iter().zip(b).all(|(a, b)| a.z == b.z && a.position.distance(b.position) <= SAME_PLACE)
+        a.len() == b.len() && a.iter().zip(b).all(|(a, b)| a.z == b.z && a.position.distance(b.position) <= SAME_PLACE)
     }
 
     /// Whether it is values on grids and nothing else (a cube file): another such file of the

@@ -46,9 +46,9 @@ impl Placement {
 pub struct ObjectState {
     /// The file it was read from; `None` for the bundled demo.
     pub path: Option<std::path::PathBuf>,
-    /// Files of the same atoms whose data sets joined the object's after its own (a potential
-    /// cube beside a density cube), in order: `Source::Volume` numbers them after `path`'s.
-    pub joined: Vec<std::path::PathBuf>,
+    /// Data sets appended to the file's own, in order (`Source::Volume` numbers them after
+    /// `path`'s): files of the same atoms that joined it, differences with other files.
+    pub added: Vec<AddedVolume>,
     /// Whether the object is drawn at all.
     pub visible: bool,
     pub placement: Placement,
@@ -67,11 +67,22 @@ pub struct ObjectState {
     pub vibration: VibrationState,
 }
 
+/// A data set an object holds beyond its file's own, made again when a session reopens.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum AddedVolume {
+    /// A file of the same atoms whose data sets joined (a potential cube beside a density cube).
+    Joined { path: std::path::PathBuf },
+    /// Quantity `of` minus file `minus`'s same quantity, on `of`'s grid (`points` per axis for
+    /// a wavefunction's).
+    Difference { of: Source, minus: std::path::PathBuf, points: usize },
+}
+
 impl Default for ObjectState {
     fn default() -> Self {
         Self {
             path: None,
-            joined: Vec::new(),
+            added: Vec::new(),
             visible: true,
             placement: Placement::default(),
             atoms: AtomLook::default(),
@@ -269,7 +280,7 @@ pub fn changes(before: &ObjectState, after: &ObjectState) -> Changes {
 #[serde(default)]
 struct StoredObject {
     path: Option<std::path::PathBuf>,
-    joined: Vec<std::path::PathBuf>,
+    added: Vec<AddedVolume>,
     visible: Option<bool>,
     placement: Placement,
     atoms: Option<AtomLook>,
@@ -298,7 +309,7 @@ impl From<StoredObject> for ObjectState {
         }
         Self {
             path: s.path,
-            joined: s.joined,
+            added: s.added,
             visible: s.visible.unwrap_or(true),
             placement: s.placement,
             atoms: s.atoms.or(s.settings.as_ref().map(AtomLook::of)).unwrap_or_default(),
