@@ -77,14 +77,6 @@ impl Mesh {
         out.indices = self.indices.iter().map(|&i| remap[i as usize]).collect();
         out
     }
-
-    fn append(&mut self, other: Mesh) {
-        let base = self.positions.len() as u32;
-        self.positions.extend(other.positions);
-        self.normals.extend(other.normals);
-        self.colors.extend(other.colors);
-        self.indices.extend(other.indices.into_iter().map(|i| i + base));
-    }
 }
 
 /// One surface to extract: where `sign·value = level` (level > 0 for orbitals' ± pair), the
@@ -223,6 +215,7 @@ struct Gradient<'a> {
 }
 
 impl Gradient<'_> {
+    #[inline(always)]
     fn index_space(&self, p: [usize; 3]) -> Vec3 {
         let g = self.grid;
         let [nx, ny, nz] = g.dims;
@@ -258,11 +251,12 @@ pub fn extract(grid: &VolumeGrid, levels: &[Level]) -> Vec<Mesh> {
     }
     let jac = DMat3::from_cols(grid.step(0), grid.step(1), grid.step(2));
     let gradient = Gradient { grid, inv_t: jac.inverse().transpose().as_mat3() };
-    // A few runs per thread balance the load; within a run, consecutive slabs share a plane's
-    // flags and the vertices on it.
+    // A few runs per thread balance the load (one run when there is one thread: nothing to
+    // merge); within a run, consecutive slabs share a plane's flags and the vertices on it.
     let slabs = nx - 1;
-    let runs = (4 * rayon::current_num_threads()).clamp(1, slabs);
-    let parts: Vec<Vec<Mesh>> = (0..runs)
+    let threads = rayon::current_num_threads();
+    let runs = if threads == 1 { 1 } else { (4 * threads).clamp(1, slabs) };
+    let mut parts: Vec<Vec<Mesh>> = (0..runs)
         .into_par_iter()
         .map(|r| {
             let mut run = Run::new(grid, &gradient, levels);
@@ -272,18 +266,53 @@ pub fn extract(grid: &VolumeGrid, levels: &[Level]) -> Vec<Mesh> {
             run.meshes
         })
         .collect();
-    let mut meshes = vec![Mesh::default(); levels.len()];
-    for (l, mesh) in meshes.iter_mut().enumerate() {
-        mesh.positions.reserve(parts.iter().map(|p| p[l].positions.len()).sum());
-        mesh.normals.reserve(parts.iter().map(|p| p[l].normals.len()).sum());
-        mesh.indices.reserve(parts.iter().map(|p| p[l].indices.len()).sum());
+    if let [part] = parts.as_mut_slice() {
+        let mut meshes = std::mem::take(part);
+        meshes.iter_mut().for_each(|m| m.normals.iter_mut().for_each(|n| *n = n.normalize_or_zero()));
+        return meshes;
     }
-    for part in parts {
-        for (mesh, piece) in meshes.iter_mut().zip(part) {
-            mesh.append(piece);
+    (0..levels.len()).map(|l| merge(parts.iter().map(|p| &p[l]).collect())).collect()
+}
+
+/// The runs' pieces of one level's mesh joined in order, each copied in parallel into its place
+/// in the whole (no reallocation on the way), its normals made unit on the way.
+fn merge(pieces: Vec<&Mesh>) -> Mesh {
+    let mut mesh = Mesh {
+        positions: bytemuck::zeroed_vec(pieces.iter().map(|p| p.positions.len()).sum()),
+        normals: bytemuck::zeroed_vec(pieces.iter().map(|p| p.normals.len()).sum()),
+        indices: vec![0; pieces.iter().map(|p| p.indices.len()).sum()],
+        colors: Vec::new(),
+    };
+    let positions = split(&mut mesh.positions, pieces.iter().map(|p| p.positions.len()));
+    let normals = split(&mut mesh.normals, pieces.iter().map(|p| p.normals.len()));
+    let indices = split(&mut mesh.indices, pieces.iter().map(|p| p.indices.len()));
+    let bases = pieces.iter().scan(0u32, |base, p| {
+        let first = *base;
+        *base += p.positions.len() as u32;
+        Some(first)
+    });
+    let jobs: Vec<_> = pieces.iter().zip(bases).zip(positions.into_iter().zip(normals).zip(indices)).collect();
+    jobs.into_par_iter().for_each(|((piece, base), ((positions, normals), indices))| {
+        positions.copy_from_slice(&piece.positions);
+        for (n, g) in normals.iter_mut().zip(&piece.normals) {
+            *n = g.normalize_or_zero();
         }
-    }
-    meshes
+        for (i, &p) in indices.iter_mut().zip(&piece.indices) {
+            *i = p + base;
+        }
+    });
+    mesh
+}
+
+/// `all` cut into consecutive pieces of the given lengths.
+fn split<T>(mut all: &mut [T], lengths: impl Iterator<Item = usize>) -> Vec<&mut [T]> {
+    lengths
+        .map(|n| {
+            let (piece, rest) = std::mem::take(&mut all).split_at_mut(n);
+            all = rest;
+            piece
+        })
+        .collect()
 }
 
 /// One plane's flags: per grid point, bit L set when the point is inside level L; per row of
@@ -304,10 +333,17 @@ impl PlaneFlags {
         let values = &grid.values[i * ny * nz..(i + 1) * ny * nz];
         self.points.clear();
         self.points.resize(values.len(), 0);
-        // One simple loop per level vectorises; a loop over levels inside would not.
-        for (l, level) in levels.iter().enumerate() {
+        // One simple loop per level vectorises; a loop over levels inside would not. An
+        // orbital's ± pair, the usual case, gets one loop for both: one read of the plane.
+        if let [a, b] = levels {
             for (bits, &v) in self.points.iter_mut().zip(values) {
-                *bits |= u8::from(level.sign * v > level.value) << l;
+                *bits = u8::from(a.sign * v > a.value) | u8::from(b.sign * v > b.value) << 1;
+            }
+        } else {
+            for (l, level) in levels.iter().enumerate() {
+                for (bits, &v) in self.points.iter_mut().zip(values) {
+                    *bits |= u8::from(level.sign * v > level.value) << l;
+                }
             }
         }
         self.left.clear();
@@ -332,6 +368,23 @@ impl PlaneFlags {
 const BYTES: u64 = 0x0101_0101_0101_0101;
 /// Multiplying bytes of 0 or 1 by this gathers byte c into bit c of the top byte.
 const GATHER: u64 = 0x0102_0408_1020_4080;
+
+/// Per cell k in start..end of a row of cells (corner rows `rows[dx][dy]`), the levels whose
+/// flags differ among its eight corners (bit L: level L crosses it); byte-wide loops that
+/// vectorise, in place of a test per cell.
+fn mixed_cells(rows: [[&[u8]; 2]; 2], start: usize, end: usize, columns: &mut [Vec<u8>; 2], mixed: &mut Vec<u8>) {
+    let span = |dx: usize, dy: usize| &rows[dx][dy][start..=end];
+    let (a, b, c, d) = (span(0, 0), span(1, 0), span(0, 1), span(1, 1));
+    let [any, all] = columns;
+    any.clear();
+    any.extend(a.iter().zip(b).zip(c).zip(d).map(|(((a, b), c), d)| a | b | c | d));
+    all.clear();
+    all.extend(a.iter().zip(b).zip(c).zip(d).map(|(((a, b), c), d)| a & b & c & d));
+    mixed.clear();
+    mixed.extend(
+        any.iter().zip(&any[1..]).zip(all.iter().zip(&all[1..])).map(|((o0, o1), (a0, a1))| (o0 | o1) ^ (a0 & a1)),
+    );
+}
 
 /// A vertex made on an edge, valid while its stamp (which row of which plane) matches: the
 /// cache is never cleared, only overwritten.
@@ -360,6 +413,10 @@ struct Run<'a> {
     /// Flags of the slab's two planes, and which plane the second one is.
     flags: [PlaneFlags; 2],
     flagged: Option<usize>,
+    /// Scratch for a row of cells: per point the OR and AND of its column of four flags, and per
+    /// cell the levels crossing it.
+    columns: [Vec<u8>; 2],
+    mixed: Vec<u8>,
     /// The static tables, dereferenced once.
     cases: &'static [FlatCase],
     edges: [(usize, usize, usize); 12],
@@ -378,6 +435,8 @@ impl<'a> Run<'a> {
             caches: (0..levels.len()).map(|_| cache()).collect(),
             flags: Default::default(),
             flagged: None,
+            columns: Default::default(),
+            mixed: Vec::new(),
             cases: &FLAT_CASES,
             edges: *EDGES,
         }
@@ -412,33 +471,45 @@ impl<'a> Run<'a> {
             if start >= end {
                 continue;
             }
-            // Corner c of cell k is rows[c & 1][c >> 1 & 1][k + (c >> 2)]: pairs of each row.
-            let pairs = |dx: usize, dy: usize| rows[dx][dy][start..=end].windows(2);
-            let cells = pairs(0, 0).zip(pairs(1, 0)).zip(pairs(0, 1)).zip(pairs(1, 1));
-            for (n, (((a, b), c), d)) in cells.enumerate() {
-                let k = start + n;
-                let word = u64::from_le_bytes([a[0], b[0], c[0], d[0], a[1], b[1], c[1], d[1]]);
-                if word == u64::from(a[0]) * BYTES {
+            let mut mixed = std::mem::take(&mut self.mixed);
+            mixed_cells(rows, start, end, &mut self.columns, &mut mixed);
+            // Most cells in the span are inside or outside everything: skip them eight at a time.
+            for (q, chunk) in mixed.chunks(8).enumerate() {
+                if chunk.len() == 8 && u64::from_le_bytes(chunk.try_into().unwrap_or_default()) == 0 {
                     continue;
                 }
-                for l in 0..self.levels.len() {
-                    // Bit l of each corner's flags gathered into the case's bit c.
-                    let case = (((word >> l) & BYTES).wrapping_mul(GATHER) >> 56) as usize;
-                    let flat = &self.cases[case];
-                    // Each crossed edge's vertex once, then the triangles by edge.
-                    let mut ids = [0u32; 12];
-                    let mut crossed = flat.crossed;
-                    while crossed != 0 {
-                        let e = crossed.trailing_zeros() as usize;
-                        ids[e] = self.vertex(l, [i, j, k], e);
-                        crossed &= crossed - 1;
-                    }
-                    let indices = &mut self.meshes[l].indices;
-                    indices.extend(flat.edges[..flat.count as usize].iter().map(|&e| ids[e as usize]));
+                for (n, &levels) in chunk.iter().enumerate().filter(|(_, m)| **m != 0) {
+                    let k = start + 8 * q + n;
+                    // Corner c of cell k is rows[c & 1][c >> 1 & 1][k + (c >> 2)].
+                    let flag = |c: usize| rows[c & 1][(c >> 1) & 1][k + (c >> 2)];
+                    self.cell([i, j, k], u64::from_le_bytes(std::array::from_fn(flag)), levels);
                 }
             }
+            self.mixed = mixed;
         }
         self.flags = flags;
+    }
+
+    /// The triangles of a crossed cell, for the levels whose bits are set in `levels`, from its
+    /// corners' flags (byte c: corner c).
+    fn cell(&mut self, cell: [usize; 3], word: u64, mut levels: u8) {
+        while levels != 0 {
+            let l = levels.trailing_zeros() as usize;
+            levels &= levels - 1;
+            // Bit l of each corner's flags gathered into the case's bit c.
+            let case = (((word >> l) & BYTES).wrapping_mul(GATHER) >> 56) as usize;
+            let flat = &self.cases[case];
+            // Each crossed edge's vertex once, then the triangles by edge.
+            let mut ids = [0u32; 12];
+            let mut crossed = flat.crossed;
+            while crossed != 0 {
+                let e = crossed.trailing_zeros() as usize;
+                ids[e] = self.vertex(l, cell, e);
+                crossed &= crossed - 1;
+            }
+            let indices = &mut self.meshes[l].indices;
+            indices.extend(flat.edges[..flat.count as usize].iter().map(|&e| ids[e as usize]));
+        }
     }
 
     /// The vertex of level `l` on edge `e` of cell `cell`, made once.
@@ -466,11 +537,12 @@ impl<'a> Run<'a> {
         let t = ((level.value - v0) / (v1 - v0)).clamp(0.0, 1.0);
         let mut g = DVec3::new(p0[0] as f64, p0[1] as f64, p0[2] as f64);
         g[axis] += t as f64;
-        // Outside is where the signed field falls: the normal is −∇(sign·value).
+        // Outside is where the signed field falls: the normal is −∇(sign·value), made unit when
+        // the runs are joined (away from this loop's chain of dependent work).
         let grad = self.gradient.index_space(p0).lerp(self.gradient.index_space(p1), t);
         let mesh = &mut self.meshes[l];
         mesh.positions.push(grid.world_from_grid.transform_point3(g).as_vec3());
-        mesh.normals.push((self.gradient.inv_t * grad * -level.sign).normalize_or_zero());
+        mesh.normals.push(self.gradient.inv_t * grad * -level.sign);
         let vertex = (mesh.positions.len() - 1) as u32;
         *slot = Cached { stamp, vertex };
         vertex
