@@ -7,10 +7,10 @@ use crate::gpu::atoms::AtomSizes;
 use crate::gpu::gto::GtoFillPass;
 use crate::gpu::renderer::Layer;
 use crate::gpu::{GpuContext, GpuError, Renderer};
-use crate::meshes::isosurfaces;
+use crate::meshes::{color_isosurfaces, isosurfaces};
 use crate::model::isosurface::Mesh;
 use crate::model::{Document, VolumeGrid};
-use crate::scene::coloring::{AtomColors, atom_colors};
+use crate::scene::coloring::{AtomColors, ValueMap, atom_colors};
 use crate::scene::objects::{Part, layer_parts};
 use crate::scene::selection::shown_atoms;
 use crate::scene::translucency::SurfaceLook;
@@ -119,11 +119,20 @@ pub fn show_object(
     Ok(show_meshes(ctx, layer, &meshes))
 }
 
+/// What [`show_quantity`] put into a layer.
+#[derive(Default)]
+pub struct ShownQuantity {
+    /// The values shown (what the cloud's opacity is scaled to); `None` when the document does
+    /// not hold the quantity.
+    pub values: Option<Values>,
+    /// The map its isosurfaces are coloured with by another quantity, and that one's name.
+    pub color_map: Option<(ValueMap, String)>,
+}
+
 /// Puts quantity `k` of the object `state` describes into `layer`: a data set of `doc` as it
 /// is, or its wavefunction's orbital or density evaluated on a grid of `points` per side
 /// (`fill` caches the compute pipeline; in direct mode a grid is filled only for visible
-/// isosurfaces), then its isosurfaces. Returns the values shown (what the cloud's opacity is
-/// scaled to), `None` when `doc` does not hold the quantity.
+/// isosurfaces), then its isosurfaces, coloured by another quantity where they ask.
 pub fn show_quantity(
     ctx: &GpuContext,
     layer: &mut Layer,
@@ -131,10 +140,10 @@ pub fn show_quantity(
     doc: &Document,
     state: &ObjectState,
     k: usize,
-) -> Result<Option<Values>, GpuError> {
+) -> Result<ShownQuantity, GpuError> {
     layer.clear(ctx);
     place_layer(layer, state, Part::Quantity(k));
-    let Some(q) = state.quantities.get(k) else { return Ok(None) };
+    let Some(q) = state.quantities.get(k) else { return Ok(ShownQuantity::default()) };
     let values = match q.source {
         Source::Volume(i) => {
             let grid = doc.volumes.get(i).cloned();
@@ -149,20 +158,30 @@ pub fn show_quantity(
             show_wavefunction(ctx, layer, fill, doc, &view)?
         }
     };
+    let mut color_map = None;
     if let Some(grid) = values.as_ref().and_then(|v| v.grid.as_ref()) {
-        let meshes: Vec<_> = q.isosurfaces.iter().flat_map(|iso| isosurfaces(grid, iso)).collect();
+        let mut meshes: Vec<_> = q.isosurfaces.iter().flat_map(|iso| isosurfaces(grid, iso)).collect();
+        let signed = grid.kind == crate::model::grid::ValueKind::Signed;
+        color_map = color_isosurfaces(doc, &q.isosurfaces, signed, &mut meshes);
         show_meshes(ctx, layer, &meshes);
     }
-    Ok(values)
+    Ok(ShownQuantity { values, color_map })
 }
 
-/// Each layer's cloud settings, and the scene's bounds (bohr).
-pub type ShownScene = (Vec<crate::scene::VolumeSettings>, Option<(glam::DVec3, glam::DVec3)>);
+/// What [`show_scene`] put into a renderer.
+pub struct ShownScene {
+    /// Each layer's cloud settings, opacity scaled to its grid.
+    pub clouds: Vec<crate::scene::VolumeSettings>,
+    /// The scene's bounds (bohr).
+    pub bounds: Option<(glam::DVec3, glam::DVec3)>,
+    /// The last map a quantity's isosurfaces are coloured with, and what it shows (the colour
+    /// bar a picture of the scene carries).
+    pub color_map: Option<(ValueMap, String)>,
+}
 
 /// Puts each object of `scene` into `renderer`, its layers as [`layer_parts`] orders them (its
 /// atoms, then each quantity: a data set, or its wavefunction's orbital or density evaluated on
-/// a grid of `points` per side, with every isosurface of it). Returns each layer's cloud
-/// settings (opacity scaled to its grid) and the scene's bounds.
+/// a grid of `points` per side, with every isosurface of it).
 pub fn show_scene<D: std::borrow::Borrow<Document>>(
     ctx: &GpuContext,
     renderer: &mut Renderer,
@@ -172,6 +191,7 @@ pub fn show_scene<D: std::borrow::Borrow<Document>>(
     let mut fill = None;
     let mut clouds = Vec::new();
     let mut bounds: Option<(glam::DVec3, glam::DVec3)> = None;
+    let mut color_map = None;
     let parts = layer_parts(scene.iter().map(|(_, s)| s));
     renderer.truncate(parts.len());
     for (n, &(object, part)) in parts.iter().enumerate() {
@@ -188,14 +208,15 @@ pub fn show_scene<D: std::borrow::Borrow<Document>>(
             Part::Quantity(k) => {
                 let evaluation = Evaluation { grid_points: points, ..state.evaluation.clone() };
                 let state = ObjectState { evaluation, ..state.clone() };
-                let values = show_quantity(ctx, layer, &mut fill, doc, &state, k)?;
+                let shown = show_quantity(ctx, layer, &mut fill, doc, &state, k)?;
                 let mut cloud = state.quantities[k].cloud;
-                if let Some(values) = &values {
+                if let Some(values) = &shown.values {
                     values.auto_opacity(&mut cloud);
                 }
                 clouds.push(cloud);
+                color_map = shown.color_map.or(color_map);
             }
         }
     }
-    Ok((clouds, bounds))
+    Ok(ShownScene { clouds, bounds, color_map })
 }

@@ -14,6 +14,7 @@ use crate::layers::{show_atoms, show_scene};
 use crate::model::Document;
 use crate::model::arrow::mode_arrows;
 use crate::movie::{MovieError, MovieWriter, full_turn};
+use crate::scene::coloring::ValueMap;
 use crate::scene::vibration::ARROW_COLOR;
 use crate::scene::{Camera, Interpolation, ObjectState, RenderSettings, VolumeSettings};
 
@@ -105,6 +106,8 @@ pub struct SceneShots<D> {
     renderer: Renderer,
     target: OffscreenTarget,
     clouds: Vec<VolumeSettings>,
+    /// The colour bar each frame carries (a surface coloured by another quantity).
+    color_map: Option<(ValueMap, String)>,
     camera: Camera,
     background: [f32; 3],
     motion: Motion,
@@ -128,7 +131,7 @@ impl<D: std::borrow::Borrow<Document>> SceneShots<D> {
         points: usize,
     ) -> Result<Self, ShotError> {
         let mut renderer = Renderer::new(ctx);
-        let (clouds, _) = show_scene(ctx, &mut renderer, &scene, points)?;
+        let shown = show_scene(ctx, &mut renderer, &scene, points)?;
         // The first object's atoms move with a vibration: a copy of its document to move them in.
         let moving = match motion {
             Motion::Vibration { mode, .. } => {
@@ -154,7 +157,8 @@ impl<D: std::borrow::Borrow<Document>> SceneShots<D> {
             moving,
             renderer,
             target,
-            clouds,
+            clouds: shown.clouds,
+            color_map: shown.color_map,
             camera,
             background,
             motion,
@@ -198,8 +202,21 @@ impl<D: std::borrow::Borrow<Document>> SceneShots<D> {
             }
         }
         let (renderer, target, clouds) = (&mut self.renderer, &self.target, &self.clouds);
-        self.figure.draw(self.background, |bg| Ok(picture(ctx, renderer, target, &camera, bg, clouds)?.0))
+        let mut img =
+            self.figure.draw(self.background, |bg| Ok(picture(ctx, renderer, target, &camera, bg, clouds)?.0))?;
+        if let Some((map, name)) = &self.color_map {
+            value_bar(&mut img, map, name);
+        }
+        Ok(img)
     }
+}
+
+/// The colour bar of a surface coloured by a volume's values, at the right of `img`: the map's
+/// range, in atomic units, titled with the volume's name.
+pub fn value_bar(img: &mut image::RgbaImage, map: &ValueMap, name: &str) {
+    let color = |t: f32| map.at(t).map(crate::figure::encoded);
+    let [lo, mid, hi] = map.ticks();
+    crate::figure::color_bar(img, color, [&lo, &mid, &hi], &ValueMap::title(name));
 }
 
 /// How far a recording has got, shared with whoever shows it, and a flag that stops it.

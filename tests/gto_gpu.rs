@@ -208,7 +208,7 @@ fn direct_mode_fills_no_grid_unless_isosurfaces_are_shown() {
     let fills = |f: &Option<GtoFillPass>| f.as_ref().map_or(0, GtoFillPass::fills);
 
     let state = direct_homo(&doc, false);
-    let values = show_quantity(&ctx, renderer.main(), &mut fill, &doc, &state, 0).unwrap().unwrap();
+    let values = show_quantity(&ctx, renderer.main(), &mut fill, &doc, &state, 0).unwrap().values.unwrap();
     assert_eq!(fills(&fill), 0, "no grid filled for a direct-mode cloud alone");
     assert!(values.grid.is_none() && values.sampled.is_some());
     assert!(renderer.main().volume.is_direct());
@@ -216,7 +216,7 @@ fn direct_mode_fills_no_grid_unless_isosurfaces_are_shown() {
 
     // An isosurface shown: one grid, read back and cut; the cloud stays direct.
     let state = direct_homo(&doc, true);
-    let values = show_quantity(&ctx, renderer.main(), &mut fill, &doc, &state, 0).unwrap().unwrap();
+    let values = show_quantity(&ctx, renderer.main(), &mut fill, &doc, &state, 0).unwrap().values.unwrap();
     assert_eq!(fills(&fill), 1);
     assert_eq!(values.grid.as_ref().map(|g| g.dims), Some([24; 3]));
     assert!(renderer.main().volume.is_direct());

@@ -5,6 +5,9 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+use orbcloud::scene::objects::AddedVolume;
+use orbcloud::scene::{ObjectState, QuantityState, RenderSettings, Session, Source};
+
 mod common;
 
 fn orbcloud(args: &[&str]) -> std::process::Output {
@@ -220,6 +223,43 @@ fn a_surface_coloured_by_a_volume_carries_its_colour_bar() {
     let blue = column.iter().position(|p| p[2] > 150 && p[0] < 120).expect("the bar's blue end");
     let red = column.iter().rposition(|p| p[0] > 150 && p[2] < 120).expect("the bar's red end");
     assert!(blue < red, "blue at {blue}, red at {red}");
+}
+
+/// Down the column `x` of `img`: the map's positive end (blue) above its negative end (red).
+fn bar_in_column(img: &image::RgbaImage, x: u32) -> bool {
+    let column: Vec<[u8; 4]> = (0..img.height()).map(|y| img.get_pixel(x, y).0).collect();
+    let blue = column.iter().position(|p| p[2] > 150 && p[0] < 120);
+    let red = column.iter().rposition(|p| p[0] > 150 && p[2] < 120);
+    matches!((blue, red), (Some(b), Some(r)) if b < r)
+}
+
+#[test]
+fn every_frame_of_a_movie_of_an_esp_map_carries_its_colour_bar() {
+    let dir = tempfile::tempdir().unwrap();
+    let density = asset("tests/fixtures/esp/h2o_density.cube");
+    let potential = asset("tests/fixtures/esp/h2o_potential.cube");
+    let frames = dir.path().join("turn/");
+    let args = ["movie", &density, "--turntable", "--frames", "2", "--size", "240x180", "--lavapipe", "--no-volume"];
+    ok(&[&args[..], &["--iso", "0.002", "--color-by", &potential, "-o", s(&frames)]].concat());
+    for k in 1..=2 {
+        let img = png(&frames.join(format!("frame_000{k}.png")));
+        assert!(bar_in_column(&img, 240 - 16), "frame {k} carries the bar");
+    }
+    // A session of the pair opened in the viewer (the potential joined the density's object)
+    // turns with its bar too.
+    let session = dir.path().join("pair.orbcloud.toml");
+    let map = QuantityState::esp_map(Source::Volume(0), Source::Volume(1), &RenderSettings::default());
+    let object = ObjectState {
+        path: Some(density.clone().into()),
+        added: vec![AddedVolume::Joined { path: potential.clone().into() }],
+        quantities: vec![map],
+        ..Default::default()
+    };
+    let saved = Session { objects: vec![object], ..Default::default() };
+    orbcloud::app::session::write(&session, &saved).unwrap();
+    let frames = dir.path().join("session/");
+    ok(&["movie", s(&session), "--turntable", "--frames", "2", "--size", "240x180", "--lavapipe", "-o", s(&frames)]);
+    assert!(bar_in_column(&png(&frames.join("frame_0001.png")), 240 - 16), "the session's movie carries the bar");
 }
 
 #[test]

@@ -289,8 +289,8 @@ fn the_diene_so2_demo_and_nested_shells_match_their_golden_images() {
         [[Wavefunction(Density), Wavefunction(Orbital(14))], [Wavefunction(Density), Wavefunction(Orbital(16))]]
     );
     let mut renderer = Renderer::new(&ctx);
-    let (clouds, bounds) = show_scene(&ctx, &mut renderer, &scene, 48).expect("scene shown");
-    let (lo, hi) = bounds.expect("bounds");
+    let shown = show_scene(&ctx, &mut renderer, &scene, 48).expect("scene shown");
+    let (clouds, (lo, hi)) = (shown.clouds, shown.bounds.expect("bounds"));
     let mut cam = Camera::framing(lo.as_vec3(), hi.as_vec3());
     let (yaw, pitch) = orbcloud::demo::CYCLOADDITION_VIEW;
     cam.orbit(yaw, pitch);

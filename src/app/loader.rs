@@ -20,7 +20,8 @@ pub struct LoadJob {
 }
 
 impl LoadJob {
-    /// Loads `path`, then makes the data sets a session's object had added to it ([`add`]).
+    /// Loads `path`, then makes the data sets a session's object had added to it
+    /// ([`super::session::add_volume`]).
     pub fn start(path: PathBuf, added: Vec<AddedVolume>, repaint: impl Fn() + Send + Sync + 'static) -> Self {
         let total = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
         let read = Arc::new(AtomicU64::new(0));
@@ -32,7 +33,7 @@ impl LoadJob {
             move || {
                 let mut doc = load_with_progress(&p, &counter, &*progress)?;
                 // Those after one that fails would be numbered wrongly: they are left out.
-                if let Some(e) = added.iter().find_map(|a| add(&mut doc, a).err()) {
+                if let Some(e) = added.iter().find_map(|a| super::session::add_volume(&mut doc, a).err()) {
                     doc.problems.push(e);
                 }
                 Ok(doc)
@@ -52,23 +53,6 @@ impl LoadJob {
     /// The document, or why it did not load (a reader's error, or a failure of the job).
     pub fn poll(&self) -> Option<Result<Document, String>> {
         self.result.poll().map(|r| r.and_then(|loaded| loaded.map_err(|e| e.to_string())))
-    }
-}
-
-/// Appends the data set(s) `added` names to `doc`: a joined file's, or a difference with
-/// another file made again.
-pub fn add(doc: &mut Document, added: &AddedVolume) -> Result<(), String> {
-    match added {
-        AddedVolume::Joined { path } => {
-            let other = formats::load(path).map_err(|e| e.to_string())?;
-            doc.join(other).map(|_| ())
-        }
-        AddedVolume::Difference { of, minus, points } => {
-            let other = formats::load(minus).map_err(|e| e.to_string())?;
-            let grid = crate::arithmetic::difference(doc, *of, *points, &other)?;
-            doc.volumes.push(grid);
-            Ok(())
-        }
     }
 }
 

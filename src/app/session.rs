@@ -4,7 +4,9 @@
 use std::path::{Path, PathBuf};
 
 use super::{Opening, OrbApp};
+use crate::model::Document;
 use crate::scene::Session;
+use crate::scene::objects::AddedVolume;
 use crate::scene::objects::SESSION_SUFFIX;
 
 /// `path` ending in `.orbcloud.toml` (a dialog may have dropped the double suffix).
@@ -39,6 +41,23 @@ pub fn write(path: &Path, session: &Session) -> Result<(), String> {
         std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     }
     std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// Appends the data set(s) `added` names to `doc`: a joined file's, or a difference with
+/// another file made again.
+pub fn add_volume(doc: &mut Document, added: &AddedVolume) -> Result<(), String> {
+    match added {
+        AddedVolume::Joined { path } => {
+            let other = crate::formats::load(path).map_err(|e| e.to_string())?;
+            doc.join(other).map(|_| ())
+        }
+        AddedVolume::Difference { of, minus, points } => {
+            let other = crate::formats::load(minus).map_err(|e| e.to_string())?;
+            let grid = crate::arithmetic::difference(doc, *of, *points, &other)?;
+            doc.volumes.push(grid);
+            Ok(())
+        }
+    }
 }
 
 impl OrbApp {

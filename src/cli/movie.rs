@@ -161,9 +161,10 @@ fn file_movie(args: &MovieArgs, scan_input: bool) -> Result<(usize, f64)> {
         let (scene, camera, background) = session_scene(input)?;
         (scene, args.view.orbit(camera), background)
     } else {
-        let doc = orbcloud::formats::load(input)?;
+        let mut doc = orbcloud::formats::load(input)?;
         let camera = args.view.camera(&doc)?;
-        let object = quantities_cli::object_of(&doc, &args.view, &args.wavefunction, &args.iso)?;
+        let mut object = quantities_cli::object_of(&doc, &args.view, &args.wavefunction, &args.iso)?;
+        args.iso.color_object(&mut doc, &mut object)?;
         (vec![(doc, object)], camera, args.view.settings().background)
     };
     let motion = match args.normal_mode {
@@ -192,8 +193,12 @@ fn session_scene(path: &Path) -> Result<(Objects, Camera, [f32; 3])> {
     let mut scene = Vec::new();
     for mut state in session.objects {
         let Some(file) = state.path.clone() else { continue };
-        let doc = orbcloud::formats::load(&file)
+        let mut doc = orbcloud::formats::load(&file)
             .with_context(|| format!("{}: opening {}", path.display(), file.display()))?;
+        for added in &state.added {
+            orbcloud::app::session::add_volume(&mut doc, added)
+                .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        }
         state.fit_to(&doc, &orbcloud::scene::RenderSettings::default());
         scene.push((doc, state));
     }

@@ -237,9 +237,13 @@ pub fn render(
         let pane_scene = [(doc, state)];
         let mut renderer = Renderer::new(ctx);
         let points = first.wavefunction.grid_points.clamp(8, 512);
-        let (clouds, _) = show_scene(ctx, &mut renderer, &pane_scene, points)?;
+        let shown = show_scene(ctx, &mut renderer, &pane_scene, points)?;
         let target = OffscreenTarget::new(&ctx.device, [pane_width, height]);
-        let (picture, _) = orbcloud::headless::picture(ctx, &mut renderer, &target, camera, background, &clouds)?;
+        let (mut picture, _) =
+            orbcloud::headless::picture(ctx, &mut renderer, &target, camera, background, &shown.clouds)?;
+        if let Some((map, name)) = &shown.color_map {
+            orbcloud::shots::value_bar(&mut picture, map, name);
+        }
         image::imageops::replace(&mut image, &picture, (p as u32 * pane_width) as i64, 0);
     }
     Ok(image)

@@ -142,18 +142,10 @@ impl Picture {
             headless.render(ctx, camera, &settings)
         })?;
         if let Some((map, name)) = &self.bar {
-            value_bar(&mut img, map, name);
+            orbcloud::shots::value_bar(&mut img, map, name);
         }
         Ok(img)
     }
-}
-
-/// The colour bar of a surface coloured by a volume's values: the map's range, in atomic
-/// units, titled with the volume's name.
-pub fn value_bar(img: &mut image::RgbaImage, map: &ValueMap, name: &str) {
-    let color = |t: f32| map.at(t).map(orbcloud::figure::encoded);
-    let [lo, mid, hi] = map.ticks();
-    orbcloud::figure::color_bar(img, color, [&lo, &mid, &hi], &ValueMap::title(name));
 }
 
 /// Writes `img` to `path` and says so, with the adapter that drew it.

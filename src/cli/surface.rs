@@ -98,6 +98,16 @@ impl IsoArgs {
         Ok(Some(Source::Volume(doc.volumes.len() - 1)))
     }
 
+    /// Every isosurface of `object` coloured by what `--color-by` names (a cube file's data set
+    /// joins `doc`), saturating at `--color-range`.
+    pub fn color_object(&self, doc: &mut Document, object: &mut orbcloud::scene::ObjectState) -> Result<()> {
+        let Some(source) = self.color_source(doc)? else { return Ok(()) };
+        for iso in object.quantities.iter_mut().flat_map(|q| &mut q.isosurfaces) {
+            (iso.color_by, iso.color_range) = (Some(source), self.color_range.map(|r| r as f32));
+        }
+        Ok(())
+    }
+
     /// Colours `meshes` by `source` of `doc` ([`Self::color_source`]), one map for all of them.
     pub fn color(&self, doc: &Document, source: Source, meshes: &mut [(Mesh, SurfaceLook)]) -> Colored {
         let values = values_on(doc, source, &meshes.iter().map(|(m, _)| m).collect::<Vec<_>>());
@@ -588,6 +598,7 @@ pub fn image_error(a: &image::RgbaImage, b: &image::RgbaImage, background: &[f32
 pub struct SceneShown {
     renderer: Renderer,
     clouds: Vec<orbcloud::scene::VolumeSettings>,
+    color_map: Option<(orbcloud::scene::coloring::ValueMap, String)>,
     camera: orbcloud::scene::Camera,
     target: orbcloud::gpu::OffscreenTarget,
 }
@@ -603,19 +614,23 @@ impl SceneShown {
             state.quantities.iter_mut().for_each(|q| iso.apply_to(q));
         }
         let mut renderer = Renderer::new(ctx);
-        let (clouds, bounds) = orbcloud::layers::show_scene(ctx, &mut renderer, &scene, 64)?;
-        let (lo, hi) = bounds.context("the scene is empty")?;
+        let shown = orbcloud::layers::show_scene(ctx, &mut renderer, &scene, 64)?;
+        let (clouds, color_map) = (shown.clouds, shown.color_map);
+        let (lo, hi) = shown.bounds.context("the scene is empty")?;
         let mut camera = orbcloud::scene::Camera::framing(lo.as_vec3(), hi.as_vec3());
         let (yaw, pitch) = orbcloud::demo::CYCLOADDITION_VIEW;
         camera.orbit(yaw, pitch);
         let target = orbcloud::gpu::OffscreenTarget::new(&ctx.device, size);
-        Ok(Self { renderer, clouds, camera, target })
+        Ok(Self { renderer, clouds, color_map, camera, target })
     }
 
     /// The picture over `background`.
     pub fn draw(&mut self, ctx: &GpuContext, background: [f32; 3]) -> Result<image::RgbaImage> {
-        let (img, stats) =
+        let (mut img, stats) =
             orbcloud::headless::picture(ctx, &mut self.renderer, &self.target, &self.camera, background, &self.clouds)?;
+        if let Some((map, name)) = &self.color_map {
+            orbcloud::shots::value_bar(&mut img, map, name);
+        }
         if let Some(s) = stats {
             eprintln!("translucent surfaces: {} fragments in {} band(s), exact order", s.needed, s.bands);
         }
