@@ -14,6 +14,9 @@ export NODEVICE_SELECT=1
 for n in $slices; do
     out=$(target/release/orbcloud bench render "$cube" --size 800x600 --slices "$n" --frames 8 --lavapipe --atoms hidden)
     ours=$(sed -n 's/^ms_per_frame_median=\([0-9.]*\).*/\1/p' <<<"$out")
+    # The same frames with every slice whole (no empty space skipped), for comparison.
+    whole=$(target/release/orbcloud bench render "$cube" --size 800x600 --slices "$n" --frames 8 --lavapipe \
+        --atoms hidden --full-slices | sed -n 's/^ms_per_frame_median=\([0-9.]*\).*/\1/p')
     eye=$(sed -n 's/^camera: eye=\([^ ]*\) .*/\1/p' <<<"$out")
     target=$(sed -n 's/^camera: .* target=\([^ ]*\) .*/\1/p' <<<"$out")
     fov=$(sed -n 's/^camera: .* fov_deg=\([^ ]*\)$/\1/p' <<<"$out")
@@ -21,5 +24,5 @@ for n in $slices; do
     vtk=$("$python" scripts/peer_vtk.py "$cube" --size 800x600 --frames 8 --eye="$eye" --target="$target" \
         --fov "$fov" --sample-distance "$spacing" | sed -n 's/^vtk_ms_per_frame=//p')
     ratio=$("$python" -c "print(f'{$vtk / $ours:.2f}')")
-    echo "slices=$n spacing_bohr=$spacing orbcloud_ms=$ours vtk_ms=$vtk vtk/orbcloud=$ratio"
+    echo "slices=$n spacing_bohr=$spacing orbcloud_ms=$ours orbcloud_full_slices_ms=$whole vtk_ms=$vtk vtk/orbcloud=$ratio"
 done

@@ -7,6 +7,7 @@ use crate::gpu::gto::{GtoFillPass, read_volume, volume_from_texture};
 use crate::gpu::renderer::Layer;
 use crate::gpu::volume::VolumeTexture;
 use crate::gpu::{GpuContext, GpuError};
+use crate::model::bricks::{BRICK_CELLS, BrickRanges};
 use crate::model::cartesian::CartesianExpansion;
 use crate::model::extent::quantity_box;
 use crate::model::grid::ValueKind;
@@ -141,6 +142,7 @@ pub fn evaluate_wavefunction(
             let grid = VolumeGrid::new("orbital", geometry.dims, geometry.world_from_grid, read_volume(ctx, &texture)?);
             let mut volume = volume_from_texture(texture, &geometry, grid.stats.max_abs);
             volume.max_grad = grid.max_gradient().max(1e-30) as f32;
+            volume.bricks = Some(std::sync::Arc::new(BrickRanges::of(&grid, BRICK_CELLS)));
             let values = Values { grid: Some(grid), sampled: None };
             Ok(Some(Evaluated { values, cloud: Cloud::Texture(volume) }))
         }

@@ -488,6 +488,10 @@ struct ViewArgs {
     /// Hide the volume (atoms only).
     #[arg(long)]
     no_volume: bool,
+    /// Draw every slice whole, also through the bricks where the transfer function shows
+    /// nothing (the same picture, more fragments: to compare).
+    #[arg(long)]
+    full_slices: bool,
     /// Transfer function: the power law α = k1·ρ^k2, a shape of the value (both signs), or
     /// nested-cores (left half on ψ > 0, right half on ψ < 0, peaked at the extremes).
     #[arg(long, value_enum, default_value_t = TfArg::Power)]
@@ -567,6 +571,7 @@ impl ViewArgs {
             ModeArg::Axis => SliceMode::AxisAligned,
         };
         s.volume.visible = !self.no_volume;
+        s.volume.skip_empty = !self.full_slices;
         if let Some(n) = self.slices {
             s.volume.slices = n.clamp(1, 4096);
         }

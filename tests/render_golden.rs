@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{assert_golden, coverage, lavapipe, p_orbital, scene};
+use common::{assert_golden, compact_p_orbital, coverage, lavapipe, p_orbital, scene};
 use orbcloud::headless::render_document;
 use orbcloud::scene::framing::default_camera;
 use orbcloud::scene::{AtomStyle, RenderSettings, SliceMode};
@@ -153,31 +153,13 @@ fn nested_cores() {
     assert_golden("nested_cores", &img);
 }
 
-/// A p orbital ψ = z·exp(−r²/2) in a box of ±4.5 bohr: beyond r ≈ 3 bohr |ψ| is under 5 % of
-/// its maximum, so the box holds plenty of empty space.
-fn compact_p_orbital(n: usize) -> orbcloud::model::VolumeGrid {
-    let h = 9.0 / (n - 1) as f64;
-    let world = orbcloud::model::VolumeGrid::affine(
-        glam::DVec3::splat(-4.5),
-        [glam::DVec3::X * h, glam::DVec3::Y * h, glam::DVec3::Z * h],
-    );
-    let values = (0..n * n * n)
-        .map(|m| {
-            let p =
-                world.transform_point3(glam::DVec3::new((m / (n * n)) as f64, ((m / n) % n) as f64, (m % n) as f64));
-            (p.z * (-p.length_squared() / 2.0).exp()) as f32
-        })
-        .collect();
-    orbcloud::model::VolumeGrid::new("compact p", [n, n, n], world, values)
-}
-
 /// Seed 004's half Gaussians are drawn on the signed value, so far from the molecule (ψ ≈ 0)
 /// they are clear: with the box filling the frame, the border of the picture is exactly what it
 /// is with the cloud hidden, while the lobes show.
 #[test]
 fn half_gaussians_leave_empty_space_clear() {
     use orbcloud::scene::Shape;
-    let doc = scene(Some(compact_p_orbital(40)));
+    let doc = scene(Some(compact_p_orbital(40, 2)));
     let ctx = lavapipe();
     let mut cam = default_camera(&doc);
     cam.orbit(65f32.to_radians(), 20f32.to_radians());

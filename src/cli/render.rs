@@ -217,6 +217,14 @@ pub fn bench(
     if let Some(v) = h.renderer.main().volume.volume() {
         let s = v.grid_box.slices(settings.volume.mode, settings.volume.slices, eye, -camera.backward());
         println!("slice_spacing_bohr={:.5}", s.spacing);
+        // What the last frame drew against whole slices: the fragments empty space spared.
+        let drawn = h.renderer.main().volume.slice_vertices();
+        let area = |v: &[glam::Vec3]| v.chunks(3).map(|t| (t[1] - t[0]).cross(t[2] - t[0]).length() * 0.5).sum::<f32>();
+        println!(
+            "slice_triangles={} slice_area_fraction={:.3}",
+            drawn.len() / 3,
+            area(drawn) / area(&s.vertices).max(1e-30)
+        );
     }
     println!(
         "ms_per_frame_median={median:.1} min={:.1} max={:.1} frames={}",

@@ -10,8 +10,10 @@ use wgpu::util::DeviceExt;
 use super::basis_buffers::{GtoArrays, GtoBuffers, gto_layout};
 use super::{DEPTH_FORMAT, GpuContext, GpuError, SCENE_FORMAT};
 use crate::model::GridSpec;
+use crate::model::bricks::{BRICK_CELLS, BrickRanges};
 use crate::model::cartesian::CartesianExpansion;
 use crate::model::{VolumeGrid, grid::ValueKind};
+use crate::scene::occupancy::{Occupancy, visible_floor};
 use crate::scene::slicing::{GridBox, Slices};
 use crate::scene::{DensityScale, Interpolation, TransferKind, VolumeSettings};
 
@@ -51,18 +53,7 @@ pub struct VolumeUniforms {
 }
 const _: () = assert!(std::mem::size_of::<VolumeUniforms>() == 464);
 
-/// Extinction per reference step below which a sample cannot be seen.
-const INVISIBLE: f32 = 1e-4;
-
-/// The smallest scaled |value| whose opacity k1·ρ^k2 reaches [`INVISIBLE`]
-/// (ρ = value² for an orbital, value for a density).
-pub fn visibility_threshold(k1: f32, k2: f32, signed: bool) -> f32 {
-    if k1 <= 0.0 {
-        return f32::INFINITY;
-    }
-    let rho = (INVISIBLE / k1).powf(1.0 / k2.max(1e-3));
-    if signed { rho.sqrt() } else { rho }
-}
+pub use crate::scene::opacity::visibility_threshold;
 
 /// Values below this fraction of the grid's largest |value| are invisible at any opacity
 /// setting the viewer offers (ψ² of 10⁻⁸ of the maximum).
@@ -97,6 +88,9 @@ pub struct VolumeTexture {
     pub max_grad: f32,
     /// Mean grid spacing (bohr): the step k1 refers to.
     pub step: f32,
+    /// The values' range per brick, where they are known: slices skip the bricks the transfer
+    /// function cannot show.
+    pub bricks: Option<Arc<BrickRanges>>,
 }
 
 impl VolumeTexture {
@@ -138,6 +132,7 @@ impl VolumeTexture {
         );
         let mut volume = Self::from_texture(texture, grid.dims, grid.world_from_grid, grid.kind, grid.stats.max_abs);
         volume.grid_box = active_box(grid);
+        volume.bricks = Some(Arc::new(BrickRanges::of(grid, BRICK_CELLS)));
         volume.max_grad = grid.max_gradient().max(1e-30) as f32;
         Ok(volume)
     }
@@ -177,6 +172,7 @@ impl VolumeTexture {
             // Without the values at hand: an orbital changes by about its maximum over half a bohr.
             max_grad: (2.0 * max_abs).max(1e-30) as f32,
             step: voxel.cbrt().max(1e-6) as f32,
+            bricks: None,
         }
     }
 }
@@ -290,6 +286,11 @@ pub struct VolumePass {
     uniforms: wgpu::Buffer,
     vertices: wgpu::Buffer,
     vertex_count: u32,
+    /// This frame's slice triangles (world), as uploaded.
+    slice_vertices: Vec<Vec3>,
+    /// The occupied cells for the last visibility floor (None: nothing to skip), kept while
+    /// the volume and the floor stay.
+    occupancy: Option<(f32, Option<Occupancy>)>,
     bind_group: Option<wgpu::BindGroup>,
     volume: Option<VolumeTexture>,
     /// Basis functions of the orbital shown in direct mode (then `volume` holds only its box).
@@ -466,6 +467,8 @@ impl VolumePass {
             uniforms: super::uniform_buffer(device, "volume uniforms", std::mem::size_of::<VolumeUniforms>()),
             vertices: Self::vertex_buffer(device, 1024),
             vertex_count: 0,
+            slice_vertices: Vec::new(),
+            occupancy: None,
             bind_group: None,
             volume: None,
             direct: None,
@@ -525,6 +528,7 @@ impl VolumePass {
     /// Shows a volume already on the GPU (None shows none).
     pub fn set_texture(&mut self, ctx: &GpuContext, volume: Option<VolumeTexture>) {
         self.direct = None;
+        self.occupancy = None;
         self.morph = None;
         self.volume = volume;
         self.bind_group = self.volume.as_ref().map(|v| {
@@ -542,7 +546,12 @@ impl VolumePass {
 
     /// Seed 000's interpolated frame: key volumes `a` and `b` (one grid, one scale: `a`'s box
     /// and `max_abs` are used) mixed (1−k):k as `mode` says.
-    pub fn set_morph(&mut self, ctx: &GpuContext, a: VolumeTexture, b: VolumeTexture, k: f32, mode: Interpolation) {
+    pub fn set_morph(&mut self, ctx: &GpuContext, mut a: VolumeTexture, b: VolumeTexture, k: f32, mode: Interpolation) {
+        // A mix can show a brick where either volume can.
+        a.bricks = match (&a.bricks, &b.bricks) {
+            (Some(x), Some(y)) => x.union(y).map(Arc::new),
+            _ => None,
+        };
         self.set_texture(ctx, Some(a));
         let bind_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("key volume B"),
@@ -561,6 +570,26 @@ impl VolumePass {
         self.volume.as_ref()
     }
 
+    /// The triangles of this frame's slices (world), back to front.
+    pub fn slice_vertices(&self) -> &[Vec3] {
+        &self.slice_vertices
+    }
+
+    /// The cells of the volume's box that `settings` can show, where some can be skipped: not
+    /// in direct mode (no grid), nor where the values' bricks are unknown or the transfer
+    /// function shows values near zero.
+    fn occupancy(&mut self, settings: &VolumeSettings) -> Option<&Occupancy> {
+        let vol = self.volume.as_ref().filter(|_| settings.skip_empty && self.direct.is_none())?;
+        let bricks = vol.bricks.as_ref()?;
+        let signed = vol.kind == ValueKind::Signed;
+        let floor = visible_floor(settings, signed, vol.max_abs)?;
+        if self.occupancy.as_ref().is_none_or(|(f, _)| *f != floor) {
+            let cells = Occupancy::new(&vol.grid_box, bricks, &bricks.occupied(floor, signed)).filter(|o| !o.is_full());
+            self.occupancy = Some((floor, cells));
+        }
+        self.occupancy.as_ref()?.1.as_ref()
+    }
+
     /// Cuts this frame's slices and uploads them with the uniforms.
     pub fn set_view(
         &mut self,
@@ -572,11 +601,17 @@ impl VolumePass {
     ) {
         let (eye, view_dir) = (view.eye, view.view_dir);
         self.vertex_count = 0;
-        let Some(vol) = &self.volume else { return };
+        self.slice_vertices.clear();
         if !settings.visible {
             return;
         }
-        let slices = vol.grid_box.slices(settings.mode, settings.slices, eye, view_dir);
+        let (mode, count) = (settings.mode, settings.slices);
+        let cells = self.occupancy(settings).map(|o| (*o).clone());
+        let Some(vol) = &self.volume else { return };
+        let slices = match &cells {
+            Some(o) => o.slices(&vol.grid_box, mode, count, eye, view_dir),
+            None => vol.grid_box.slices(mode, count, eye, view_dir),
+        };
         let planes = slices.starts.len() as f32;
         let Slices { vertices, normal, spacing, nearest, .. } = slices;
         if vertices.is_empty() {
@@ -587,6 +622,7 @@ impl VolumePass {
         }
         queue.write_buffer(&self.vertices, 0, bytemuck::cast_slice(&vertices));
         self.vertex_count = vertices.len() as u32;
+        self.slice_vertices = vertices;
         let signed = vol.kind == ValueKind::Signed;
         let (log_lo, inv_log_span) = settings.density_scale.log_uniforms();
         let t = &settings.transfer;

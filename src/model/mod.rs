@@ -9,6 +9,7 @@ pub mod basis;
 pub mod basis_labels;
 pub mod bonds;
 pub mod boys;
+pub mod bricks;
 pub mod cartesian;
 pub mod correlation;
 pub mod document;

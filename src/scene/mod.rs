@@ -5,6 +5,7 @@ pub mod coloring;
 pub mod framing;
 pub mod molsurface;
 pub mod objects;
+pub mod occupancy;
 pub mod opacity;
 pub mod quantity;
 pub mod selection;

@@ -53,6 +53,19 @@ pub fn law(value: f32, signed: bool, max_abs: f32, scale: DensityScale, k2: f32)
     if signed { (value.abs() / max_abs.max(1e-30)).powf(2.0 * k2) } else { scale.t(value, max_abs).powf(k2) }
 }
 
+/// Extinction per reference step below which a sample cannot be seen.
+const INVISIBLE: f32 = 1e-4;
+
+/// The smallest scaled |value| whose opacity k1·ρ^k2 reaches [`INVISIBLE`]
+/// (ρ = value² for an orbital, value for a density): the shaders' `visible_min`.
+pub fn visibility_threshold(k1: f32, k2: f32, signed: bool) -> f32 {
+    if k1 <= 0.0 {
+        return f32::INFINITY;
+    }
+    let rho = (INVISIBLE / k1).powf(1.0 / k2.max(1e-3));
+    if signed { rho.sqrt() } else { rho }
+}
+
 /// Optical depth the densest lines of sight get with the automatic k1.
 const TARGET_DEPTH: f64 = 2.5;
 /// Which line of sight counts as "densest": this quantile of all grid lines' sums.

@@ -54,6 +54,10 @@ pub struct VolumeSettings {
     /// turns it off.
     #[serde(default = "yes")]
     pub auto_k1: bool,
+    /// Whether slices are cut only through the bricks of the grid the transfer function shows
+    /// (the same picture, fewer fragments); off draws every slice whole.
+    #[serde(default = "yes")]
+    pub skip_empty: bool,
 }
 
 fn yes() -> bool {
@@ -74,6 +78,7 @@ impl Default for VolumeSettings {
             clip: ClipPlane::default(),
             density_scale: DensityScale::default(),
             auto_k1: true,
+            skip_empty: true,
         }
     }
 }

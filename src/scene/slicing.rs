@@ -25,6 +25,8 @@ pub struct Slices {
     pub spacing: f32,
     /// Index of each slice's first vertex, back to front (a slice ends where the next starts).
     pub starts: Vec<u32>,
+    /// Each slice's plane n·p = depth, back to front.
+    pub depths: Vec<f32>,
     /// Signed distance along `normal` of the nearest plane: plane j (front to back) lies at
     /// `nearest + j·spacing`, j < `starts.len()`.
     pub nearest: f32,
@@ -57,7 +59,7 @@ impl GridBox {
     }
 
     /// The 12 edges as pairs of corner indices.
-    const EDGES: [(usize, usize); 12] =
+    pub(super) const EDGES: [(usize, usize); 12] =
         [(0, 1), (2, 3), (4, 5), (6, 7), (0, 2), (1, 3), (4, 6), (5, 7), (0, 4), (1, 5), (2, 6), (3, 7)];
 
     pub fn slices(&self, mode: SliceMode, count: u32, eye: Vec3, view_dir: Vec3) -> Slices {
@@ -78,20 +80,25 @@ impl GridBox {
         let mut vertices = Vec::with_capacity(count as usize * 12);
         let mut starts = Vec::with_capacity(count as usize);
         // Far to near: the first plane is deepest.
-        for s in 0..count {
+        let depths: Vec<f32> = (0..count).map(|s| hi - (s as f32 + 0.5) * spacing).collect();
+        for &d in &depths {
             starts.push(vertices.len() as u32);
-            let d = hi - (s as f32 + 0.5) * spacing;
-            let mut poly: Vec<Vec3> = Vec::with_capacity(6);
-            for &(a, b) in &Self::EDGES {
-                let (da, db) = (depths[a] - d, depths[b] - d);
-                if (da < 0.0) != (db < 0.0) {
-                    let t = da / (da - db);
-                    poly.push(corners[a].lerp(corners[b], t));
-                }
-            }
-            triangulate_convex(&mut poly, n, &mut vertices);
+            self.cut(n, d, &mut vertices);
         }
-        Slices { vertices, normal: n, spacing, starts, nearest: lo + 0.5 * spacing }
+        Slices { vertices, normal: n, spacing, starts, depths, nearest: lo + 0.5 * spacing }
+    }
+
+    /// The box's section by the plane n·p = d (n a unit vector), as triangles appended to `out`.
+    pub fn cut(&self, n: Vec3, d: f32, out: &mut Vec<Vec3>) {
+        let corners = self.corners();
+        let mut poly: Vec<Vec3> = Vec::with_capacity(6);
+        for &(a, b) in &Self::EDGES {
+            let (da, db) = (corners[a].dot(n) - d, corners[b].dot(n) - d);
+            if (da < 0.0) != (db < 0.0) {
+                poly.push(corners[a].lerp(corners[b], da / (da - db)));
+            }
+        }
+        triangulate_convex(&mut poly, n, out);
     }
 
     /// Seed 000's three stacks: planes of constant grid coordinate along the axis that faces the
@@ -114,11 +121,13 @@ impl GridBox {
         let far_first = e[axis].dot(normal) > 0.0;
         let mut vertices = Vec::with_capacity(count as usize * 6);
         let mut starts = Vec::with_capacity(count as usize);
+        let mut depths = Vec::with_capacity(count as usize);
         for s in 0..count {
             starts.push(vertices.len() as u32);
             let i = if far_first { count - 1 - s } else { s };
             let t = (i as f32 + 0.5) / count as f32;
             let p = self.origin + e[axis] * t;
+            depths.push(normal.dot(p));
             let quad = [p, p + e[u], p + e[u] + e[w], p + e[w]];
             vertices.extend_from_slice(&[quad[0], quad[1], quad[2], quad[0], quad[2], quad[3]]);
         }
@@ -127,7 +136,7 @@ impl GridBox {
         let along = e[axis].dot(normal);
         let nearest =
             normal.dot(self.origin) + (0.5 / count as f32 * along).min((count as f32 - 0.5) / count as f32 * along);
-        Slices { vertices, normal, spacing, starts, nearest }
+        Slices { vertices, normal, spacing, starts, depths, nearest }
     }
 }
 

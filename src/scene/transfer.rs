@@ -89,7 +89,26 @@ impl Default for Lobe {
     }
 }
 
+/// Opacity per reference step below which the shaders drop a shaped sample.
+pub const SHAPED_FLOOR: f32 = 1e-5;
+
 impl Lobe {
+    /// The smallest |s| at which this lobe can reach [`SHAPED_FLOOR`] (infinite when it never
+    /// does). Every shape is zero or below the floor from there towards s = 0, on either sign;
+    /// the half bells are bounded by the whole bell.
+    pub fn lowest_visible(&self) -> f32 {
+        if self.opacity < SHAPED_FLOOR {
+            return f32::INFINITY;
+        }
+        let w = self.width.max(1e-4);
+        let reach = match self.shape {
+            Shape::Uniform | Shape::Sinusoidal => 0.5 * w,
+            // exp(−x²)·opacity ≥ floor for |x| ≤ √ln(opacity / floor).
+            _ => w * (self.opacity / SHAPED_FLOOR).ln().sqrt(),
+        };
+        (self.center - reach).max(0.0)
+    }
+
     /// Its shape's factor at the signed value `s`, for the lobe of values of sign `sign` (±1):
     /// the shape sits at s = sign·centre.
     pub fn factor(&self, s: f32, sign: f32) -> f32 {
@@ -144,6 +163,14 @@ impl Transfer {
         self.kind = TransferKind::Shaped;
         self.positive = Lobe { shape: Shape::LeftHalfGaussian, center: 1.0, width: 0.28, opacity: 2.0 };
         self.negative = Lobe { shape: Shape::RightHalfGaussian, ..self.positive };
+    }
+
+    /// The smallest |s| (s = value / max|value|) a shaped sample needs to be seen: the lowest of
+    /// both lobes for a signed field, the positive lobe's otherwise. The gradient terms only
+    /// lower opacity, so they cannot lower this.
+    pub fn lowest_visible(&self, signed: bool) -> f32 {
+        let positive = self.positive.lowest_visible();
+        if signed { positive.min(self.negative.lowest_visible()) } else { positive }
     }
 
     /// Whether the shaders need the gradient at each sample.
@@ -225,5 +252,31 @@ mod tests {
             assert!(contours.factor(sign * 0.6, sign) < 1e-6);
             assert_eq!(contours.factor(sign * -0.05, sign), 0.0);
         }
+    }
+
+    /// Below the lowest visible |s| no shape reaches the shaders' floor, on either sign.
+    #[test]
+    fn nothing_is_visible_below_the_lowest_visible_value() {
+        for shape in Shape::ALL {
+            for (center, width, opacity) in [(0.25, 0.08, 0.9), (1.0, 0.28, 2.0), (0.1, 0.2, 1.0), (0.6, 0.05, 5.0)] {
+                let lobe = Lobe { shape, center, width, opacity };
+                let low = lobe.lowest_visible();
+                for sign in [1.0, -1.0] {
+                    let seen = (0..=2000)
+                        .map(|i| i as f32 / 2000.0)
+                        .filter(|&s| lobe.opacity * lobe.factor(sign * s, sign) >= SHAPED_FLOOR)
+                        .fold(f32::INFINITY, f32::min);
+                    assert!(seen >= low, "{shape:?} {center} {width}: seen at {seen}, lowest {low}");
+                    if matches!(shape, Shape::Uniform | Shape::Gaussian) {
+                        assert!(seen - low < 1e-3, "{shape:?} {center} {width}: {seen} is far above {low}");
+                    }
+                }
+            }
+        }
+        let mut t = Transfer::default();
+        t.nested_cores();
+        assert!(t.lowest_visible(true) > 0.0 && t.lowest_visible(true) < 0.05);
+        t.positive.opacity = 0.0;
+        assert_eq!(t.lowest_visible(false), f32::INFINITY);
     }
 }

@@ -175,3 +175,21 @@ pub fn mean_difference(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
         a.pixels().zip(b.pixels()).map(|(p, q)| (0..3).map(|k| p[k].abs_diff(q[k]) as u64).sum::<u64>()).sum();
     sum as f64 / (3 * a.width() * a.height()) as f64
 }
+
+/// A p orbital ψ = p[axis]·exp(−r²/2) (axis 2: p_z) in a box of ±4.5 bohr: beyond r ≈ 3 bohr
+/// |ψ| is under 5 % of its maximum, so the box holds plenty of empty space.
+pub fn compact_p_orbital(n: usize, axis: usize) -> orbcloud::model::VolumeGrid {
+    let h = 9.0 / (n - 1) as f64;
+    let world = orbcloud::model::VolumeGrid::affine(
+        glam::DVec3::splat(-4.5),
+        [glam::DVec3::X * h, glam::DVec3::Y * h, glam::DVec3::Z * h],
+    );
+    let values = (0..n * n * n)
+        .map(|m| {
+            let p =
+                world.transform_point3(glam::DVec3::new((m / (n * n)) as f64, ((m / n) % n) as f64, (m % n) as f64));
+            (p[axis] * (-p.length_squared() / 2.0).exp()) as f32
+        })
+        .collect();
+    orbcloud::model::VolumeGrid::new("compact p", [n, n, n], world, values)
+}
