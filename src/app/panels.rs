@@ -658,11 +658,21 @@ fn color_by_editor(ui: &mut egui::Ui, iso: &mut IsosurfaceSettings, choices: &[(
         None => "its own colour".to_string(),
         Some(s) => choices.iter().find(|(c, _)| *c == s).map_or("another quantity".into(), |(_, n)| n.clone()),
     };
-    ComboBox::from_label("colour by").selected_text(name(iso.color_by)).show_ui(ui, |ui| {
-        ui.selectable_value(&mut iso.color_by, None, name(None));
-        for (source, label) in choices {
-            ui.selectable_value(&mut iso.color_by, Some(*source), label);
-        }
+    ui.horizontal(|ui| {
+        let label = ui.label("colour by");
+        // A data set's long label (a cube's comment line) is cut to the box, not wrapped.
+        ComboBox::from_id_salt("colour by")
+            .width(150.0)
+            .wrap_mode(egui::TextWrapMode::Truncate)
+            .selected_text(name(iso.color_by))
+            .show_ui(ui, |ui| {
+                ui.selectable_value(&mut iso.color_by, None, name(None));
+                for (source, label) in choices {
+                    ui.selectable_value(&mut iso.color_by, Some(*source), label);
+                }
+            })
+            .response
+            .labelled_by(label.id);
     });
     if iso.color_by.is_some() {
         ui.horizontal(|ui| {
