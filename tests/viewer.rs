@@ -304,8 +304,12 @@ fn files_join_the_scene_are_measured_across_and_a_session_reopens_them() {
     let demo = orbcloud::demo::document().unwrap();
     let dir = tempfile::tempdir().unwrap();
     let files: Vec<_> = ["a.cube", "b.cube"].iter().map(|n| dir.path().join(n)).collect();
-    let text = orbcloud::formats::cube_write::write("demo", "copy", &demo.molecule, &[(&demo.volumes[0], 1)]);
-    for f in &files {
+    // The second a slightly different geometry (one hydrogen 0.01 bohr away): a cube of the
+    // same atoms would join the first object as a quantity.
+    let mut moved = demo.molecule.clone();
+    moved.atoms[3].position.x += 0.01;
+    for (f, molecule) in files.iter().zip([&demo.molecule, &moved]) {
+        let text = orbcloud::formats::cube_write::write("demo", "copy", molecule, &[(&demo.volumes[0], 1)]);
         std::fs::write(f, &text).unwrap();
     }
     let mut h = harness();

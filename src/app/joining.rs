@@ -20,12 +20,17 @@ impl OrbApp {
         }
     }
 
-    /// The object `doc` would join: the active one when it matches, else the last that does.
+    /// The object `doc` would join: the active one when it matches, else the last that does
+    /// (objects read from a file only).
     fn join_target(&self, doc: &Document, how: &Opening) -> Option<usize> {
         if *how != Opening::Add || !doc.is_grid_only() {
             return None;
         }
-        let fits = |n: &usize| self.objects[*n].doc.is_grid_only() && self.objects[*n].doc.same_atoms(doc);
+        // Not onto the bundled demo: sessions leave it out, and what joined it with it.
+        let fits = |n: &usize| {
+            let o = &self.objects[*n];
+            o.state.path.is_some() && o.doc.is_grid_only() && o.doc.same_atoms(doc)
+        };
         std::iter::once(self.active).chain((0..self.objects.len()).rev()).filter(|n| *n < self.objects.len()).find(fits)
     }
 
