@@ -48,6 +48,13 @@ fn series(t: f64) -> [f64; ORDERS] {
     f
 }
 
+/// Index of the table point nearest `t` (0 ≤ t < [`T_TABLE`]); adding ½ and truncating is
+/// `round` without the library call.
+#[inline]
+fn nearest(t: f64) -> usize {
+    (t * (1.0 / STEP) + 0.5) as usize
+}
+
 /// Writes F_0(t)..F_m(t) into `out[..=m]` (m ≤ [`MAX_N`], t ≥ 0).
 #[inline]
 pub fn boys(m: usize, t: f64, out: &mut [f64]) {
@@ -56,7 +63,7 @@ pub fn boys(m: usize, t: f64, out: &mut [f64]) {
         asymptotic(m, t, out);
         return;
     }
-    let i = (t / STEP).round() as usize;
+    let i = nearest(t);
     let row = &table()[i];
     let dt = t - i as f64 * STEP;
     if m <= DIRECT {
@@ -93,7 +100,7 @@ pub fn f0(t: f64) -> f64 {
     if t >= T_TABLE {
         return 0.5 * (std::f64::consts::PI / t).sqrt();
     }
-    let i = (t / STEP).round() as usize;
+    let i = nearest(t);
     let row = &table()[i];
     let dt = -(t - i as f64 * STEP);
     // Σ_k F_k(T_i) (−dt)^k / k!, by Horner.
