@@ -2,7 +2,7 @@
 //! density and potential cubes cubegen or orca_plot write for one molecule become two
 //! quantities of one object, and a potential joining a density is shown as an ESP map.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use super::{Opening, OrbApp};
@@ -26,10 +26,19 @@ impl OrbApp {
         if *how != Opening::Add || !doc.is_grid_only() {
             return None;
         }
-        // Not onto the bundled demo: sessions leave it out, and what joined it with it.
+        // Not onto the bundled demo (sessions leave it out, and what joined it with it), and
+        // not a file onto itself: opened again, a file is a second object.
+        let same_file = |a: &Path| same_path(a, Path::new(&doc.source));
         let fits = |n: &usize| {
             let o = &self.objects[*n];
-            o.state.path.is_some() && o.doc.is_grid_only() && o.doc.same_atoms(doc)
+            let files = o.state.path.iter().chain(o.state.added.iter().filter_map(|a| match a {
+                AddedVolume::Joined { path } => Some(path),
+                AddedVolume::Difference { .. } => None,
+            }));
+            o.state.path.is_some()
+                && !files.map(PathBuf::as_path).any(same_file)
+                && o.doc.is_grid_only()
+                && o.doc.same_atoms(doc)
         };
         std::iter::once(self.active).chain((0..self.objects.len()).rev()).filter(|n| *n < self.objects.len()).find(fits)
     }
@@ -85,4 +94,10 @@ impl OrbApp {
         object.doc = Arc::new(merged);
         self.active = n;
     }
+}
+
+/// Whether two paths name one file (compared resolved where they exist).
+fn same_path(a: &Path, b: &Path) -> bool {
+    let resolved = |p: &Path| std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf());
+    resolved(a) == resolved(b)
 }
