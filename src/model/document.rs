@@ -85,7 +85,7 @@ mod tests {
             .iter()
             .map(|&(z, p)| Atom { z, charge: z as f64, position: glam::DVec3::from_array(p), ghost: false })
             .collect();
-        let grid = VolumeGrid::new(label.into(), [2, 2, 2], glam::DMat4::IDENTITY, vec![0.0; 8]);
+        let grid = VolumeGrid::new(label, [2, 2, 2], glam::DMat4::IDENTITY, vec![0.0; 8]);
         Document {
             source: format!("{label}.cube"),
             molecule: Molecule::new(atoms),
