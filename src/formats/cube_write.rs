@@ -4,6 +4,8 @@
 use std::fmt::Write as _;
 use std::io::Write;
 
+use rayon::prelude::*;
+
 use crate::model::{Molecule, VolumeGrid};
 
 /// Cube text for one or more grids of identical geometry over `molecule` (all bohr); see
@@ -56,30 +58,49 @@ pub fn write_to(
     }
     w.write_all(out.as_bytes())?;
     let nz = first.dims[2].max(1);
-    let pow10 = pow10_table();
-    let mut bytes = Vec::with_capacity(nz * grids.len() * 14 + 16);
-    // Values are stored in cube order: an (x, y) row is `nz` consecutive values of each grid.
-    let mut rows: Vec<std::slice::Chunks<f32>> = grids.iter().map(|(g, _)| g.values.chunks(nz)).collect();
-    for _ in 0..first.values.len() / nz {
-        let row: Vec<&[f32]> = rows.iter_mut().filter_map(|r| r.next()).collect();
-        // Each (x, y) row starts a new line, six values per line.
-        bytes.clear();
-        let mut n = 0;
-        for k in 0..nz {
-            for values in &row {
-                push_scientific(&mut bytes, values[k], pow10);
-                n += 1;
-                if n % 6 == 0 {
-                    bytes.push(b'\n');
-                }
-            }
-        }
-        if n % 6 != 0 {
-            bytes.push(b'\n');
-        }
-        w.write_all(&bytes)?;
+    // Every row has the same layout, so rows are formatted straight into their place in a block
+    // of rows (in parallel when there are threads) and each block is written at once: blocks of
+    // at least a megabyte pass a `BufWriter` by.
+    let row_bytes = row_len(nz * grids.len());
+    let rows = first.values.len() / nz;
+    let block_rows = ((2 << 20) / row_bytes).clamp(1, rows.max(1));
+    let mut block = vec![0u8; block_rows * row_bytes];
+    for start in (0..rows).step_by(block_rows) {
+        let n = block_rows.min(rows - start);
+        let bytes = &mut block[..n * row_bytes];
+        bytes
+            .par_chunks_mut(row_bytes)
+            .enumerate()
+            .for_each_init(Vec::new, |scratch, (r, out)| format_row(out, grids, start + r, nz, scratch));
+        w.write_all(bytes)?;
     }
     w.flush()
+}
+
+/// Bytes of a row of `n` values: 13 per value, six values per line.
+fn row_len(n: usize) -> usize {
+    n * 13 + n.div_ceil(6)
+}
+
+/// Row `row` (`nz` values of each grid, interleaved per point) into `out`, six values a line;
+/// `scratch` holds the interleaved values of several grids.
+fn format_row(out: &mut [u8], grids: &[(&VolumeGrid, i64)], row: usize, nz: usize, scratch: &mut Vec<f32>) {
+    let pow10 = pow10_table();
+    let points = row * nz..(row + 1) * nz;
+    let values = match grids {
+        [(g, _)] => &g.values[points],
+        _ => {
+            scratch.clear();
+            scratch.extend(points.flat_map(|k| grids.iter().map(move |(g, _)| g.values[k])));
+            &scratch[..]
+        }
+    };
+    for (line, six) in out.chunks_mut(6 * 13 + 1).zip(values.chunks(6)) {
+        for (slot, &v) in line.chunks_exact_mut(13).zip(six) {
+            slot.copy_from_slice(&scientific(v, pow10));
+        }
+        line[six.len() * 13] = b'\n';
+    }
 }
 
 /// Powers of ten 10^k for k in [`POW10_LO`]..=60: an f32 with six digits never needs more.
@@ -91,12 +112,26 @@ fn pow10_table() -> &'static [f64] {
     TABLE.get_or_init(|| (POW10_LO..=60).map(|k| format!("1e{k}").parse().unwrap_or(0.0)).collect())
 }
 
-/// Appends ` ±d.dddddE±XX` (13 bytes), the Fortran layout cube files use, six significant
-/// digits — without `format!`, which dominates writing a large grid.
-fn push_scientific(out: &mut Vec<u8>, v: f32, pow10: &[f64]) {
+/// The two decimal digits of `n` < 100.
+fn digit_pair(n: u32) -> &'static [u8] {
+    const PAIRS: [u8; 200] = {
+        let mut t = [0u8; 200];
+        let mut i = 0;
+        while i < 100 {
+            t[2 * i] = b'0' + (i / 10) as u8;
+            t[2 * i + 1] = b'0' + (i % 10) as u8;
+            i += 1;
+        }
+        t
+    };
+    &PAIRS[2 * n as usize..2 * n as usize + 2]
+}
+
+/// ` ±d.dddddE±XX` (13 bytes), the Fortran layout cube files use, six significant digits —
+/// without `format!`, which dominates writing a large grid.
+fn scientific(v: f32, pow10: &[f64]) -> [u8; 13] {
     if v == 0.0 || !v.is_finite() {
-        out.extend_from_slice(b"  0.00000E+00");
-        return;
+        return *b"  0.00000E+00";
     }
     let a = v.abs() as f64;
     let p = |k: i32| pow10[(k - POW10_LO).clamp(0, pow10.len() as i32 - 1) as usize];
@@ -106,37 +141,30 @@ fn push_scientific(out: &mut Vec<u8>, v: f32, pow10: &[f64]) {
     // ⌊binary · log10 2⌋ with log10 2 ≈ 1233/4096; the arithmetic shift floors negatives too.
     // (Integer arithmetic: `floor` and `round` are library calls on baseline x86-64.)
     let mut e = (binary * 1233) >> 12;
-    if a >= p(e + 1) {
-        e += 1;
-    } else if a < p(e) {
-        e -= 1;
-    }
+    // Branch-free: which way the estimate is off depends on the value, unpredictably.
+    e += (a >= p(e + 1)) as i32 - (a < p(e)) as i32;
     // Round half up: within an ulp of a tie this may differ from exact decimal rounding in the
     // sixth digit, which a cube file's precision does not notice.
-    let mut m = (a * p(5 - e) + 0.5) as u64;
+    let mut m = (a * p(5 - e) + 0.5) as i64 as u32;
     // Rounding may carry into a seventh digit (9.999996 → 10.0000).
     if m >= 1_000_000 {
         m = (m + 5) / 10;
         e += 1;
     }
     let mut b = *b"  0.00000E+00";
-    if v < 0.0 {
-        b[1] = b'-';
-    }
-    b[2] = b'0' + (m / 100_000) as u8;
-    let mut rest = m % 100_000;
-    for d in b[4..9].iter_mut().rev() {
-        *d = b'0' + (rest % 10) as u8;
-        rest /= 10;
-    }
-    if e < 0 {
-        b[10] = b'-';
-    }
-    let e = e.unsigned_abs();
-    b[11] = b'0' + (e / 10 % 10) as u8;
-    b[12] = b'0' + (e % 10) as u8;
+    b[1] = if v < 0.0 { b'-' } else { b' ' };
+    let first = m / 100_000;
+    let rest = m - first * 100_000;
+    let (pair1, rest) = (rest / 1000, rest % 1000);
+    let (pair2, last) = (rest / 10, rest % 10);
+    b[2] = b'0' + first as u8;
+    b[4..6].copy_from_slice(digit_pair(pair1));
+    b[6..8].copy_from_slice(digit_pair(pair2));
+    b[8] = b'0' + last as u8;
+    b[10] = if e < 0 { b'-' } else { b'+' };
+    b[11..13].copy_from_slice(digit_pair(e.unsigned_abs().min(99)));
     // f32 exponents stay within ±45: two digits always suffice.
-    out.extend_from_slice(&b);
+    b
 }
 
 #[cfg(test)]
@@ -157,9 +185,7 @@ mod tests {
             let mantissa = (s >> 11) as f64 / (1u64 << 53) as f64 * 9.0 + 1.0;
             let sign = if i % 2 == 0 { 1.0 } else { -1.0 };
             let v = (sign * mantissa * 10f64.powi(exp)) as f32;
-            let mut out = Vec::new();
-            push_scientific(&mut out, v, pow10_table());
-            let text = String::from_utf8(out).unwrap();
+            let text = String::from_utf8(scientific(v, pow10_table()).to_vec()).unwrap();
             // Exact decimal rounding may differ in the last digit when the value sits within an
             // ulp of a tie; anything more is a bug.
             let expected: f64 = format!("{:.5E}", v as f64).parse().unwrap();
@@ -168,9 +194,7 @@ mod tests {
             assert_eq!(text.len(), 13, "{text}");
         }
         for (v, text) in [(1.0f32, "  1.00000E+00"), (-0.000123456, " -1.23456E-04"), (9.999996e-3, "  1.00000E-02")] {
-            let mut out = Vec::new();
-            push_scientific(&mut out, v, pow10_table());
-            assert_eq!(String::from_utf8(out).unwrap(), text);
+            assert_eq!(String::from_utf8(scientific(v, pow10_table()).to_vec()).unwrap(), text);
         }
     }
 

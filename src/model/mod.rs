@@ -29,6 +29,7 @@ pub mod orbitals;
 pub mod overlap;
 pub mod rigid;
 pub mod scan;
+mod separable;
 pub mod simplify;
 pub mod solid_harmonics;
 pub mod structure;
