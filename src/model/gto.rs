@@ -955,7 +955,7 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::model::basis::Shell;
     use crate::model::orbitals::MolecularOrbital;
@@ -984,7 +984,8 @@ mod tests {
         Basis { shells }
     }
 
-    fn pseudo_random(n: usize, seed: u64) -> Vec<f64> {
+    /// Reproducible values in −1..1 (a linear congruential sequence).
+    pub(crate) fn pseudo_random(n: usize, seed: u64) -> Vec<f64> {
         let mut x = seed;
         (0..n)
             .map(|_| {

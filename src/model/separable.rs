@@ -443,6 +443,7 @@ fn add_polynomial(row: &mut [f64], dz: &[f64], ez: &[f64], b: &[f64]) {
 mod tests {
     use super::*;
     use crate::model::basis::{Basis, Shell, ShellKind};
+    use crate::model::gto::tests::pseudo_random;
 
     /// Cartesian and pure shells up to h, contracted, on four centres: two at one height (they
     /// share z tables), and a tight p shell.
@@ -476,16 +477,6 @@ mod tests {
             coefficients: vec![0.2, 0.5, 0.6],
         });
         Basis { shells }
-    }
-
-    fn pseudo_random(n: usize, seed: u64) -> Vec<f64> {
-        let mut x = seed;
-        (0..n)
-            .map(|_| {
-                x = x.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-                ((x >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-            })
-            .collect()
     }
 
     /// Largest |a − b| relative to the largest |b|.
