@@ -24,7 +24,8 @@ struct VolumeUniforms {
     // pipeline overrides).
     shape_positive: u32,
     shape_negative: u32,
-    // Bit 0: shading from the gradient.
+    // TF_* bits: shading from the gradient, and (read where a walk takes several clouds, which
+    // one pipeline's overrides cannot tell apart) the gradient, a shaped function, clipping.
     tf_bits: u32,
     // The smallest scaled |value| that can be seen at these k1, k2.
     visible_min: f32,
@@ -52,6 +53,11 @@ struct VolumeUniforms {
     box_from_world: mat4x4<f32>,
     slab: vec4<f32>,
 };
+
+const TF_SHADING: u32 = 1u;
+const TF_GRADIENT: u32 = 2u;
+const TF_SHAPED: u32 = 4u;
+const TF_CLIP: u32 = 8u;
 
 @group(0) @binding(0) var<uniform> u: VolumeUniforms;
 @group(0) @binding(1) var volume: texture_3d<f32>;
@@ -111,60 +117,66 @@ fn needs_gradient() -> bool {
     return GRADIENT;
 }
 
-// Premultiplied colour of one sample with gradient `grad` (world units; ignored unless the
-// transfer function needs it); alpha < 0 means invisible (the caller discards, which skips the
-// frame buffer's read-modify-write).
 // The value as the transfer function sees it: ψ / max|ψ| (sign kept), ρ / max ρ, or log ρ
 // between the bounds (scene::opacity::DensityScale::t is the CPU reference).
-fn transfer_value(value: f32) -> f32 {
-    if (u.signed_field == 2u) {
+fn transfer_value(c: VolumeUniforms, value: f32) -> f32 {
+    if (c.signed_field == 2u) {
         if (value <= 0.0) {
             return 0.0;
         }
-        return clamp((log2(value) * 0.30103 - u.log_lo) * u.inv_log_span, 0.0, 1.0);
+        return clamp((log2(value) * 0.30103 - c.log_lo) * c.inv_log_span, 0.0, 1.0);
     }
-    return value * u.inv_max;
+    return value * c.inv_max;
 }
 
+// Premultiplied colour of one sample with gradient `grad` (world units; ignored unless the
+// transfer function needs it); alpha < 0 means invisible (the caller discards, which skips the
+// frame buffer's read-modify-write).
 fn shade(value: f32, grad: vec3<f32>, from_eye: vec3<f32>) -> vec4<f32> {
-    let scaled = transfer_value(value);
+    return shade_with(u, SHAPED, needs_gradient(), value, grad, from_eye);
+}
+
+// `shade` for the cloud `c` describes: `shaped` and `gradient` say which transfer function it
+// uses (constants where one pipeline draws one cloud, flags where a walk takes several).
+fn shade_with(c: VolumeUniforms, shaped: bool, gradient: bool, value: f32, grad: vec3<f32>, from_eye: vec3<f32>) -> vec4<f32> {
+    let scaled = transfer_value(c, value);
     var extinction: f32;
     var color: vec3<f32>;
-    if (!SHAPED) {
+    if (!shaped) {
         // Below this magnitude a sample is invisible (computed on the CPU from k1, k2).
-        if (abs(scaled) < u.visible_min) {
+        if (abs(scaled) < c.visible_min) {
             return vec4<f32>(-1.0);
         }
-        if (u.signed_field == 1u) {
+        if (c.signed_field == 1u) {
             // rho = psi^2, so rho^k2 = |psi|^(2 k2).
-            extinction = u.k1 * pow(abs(scaled), 2.0 * u.k2);
-            color = select(u.negative_color.rgb, u.positive_color.rgb, value >= 0.0);
+            extinction = c.k1 * pow(abs(scaled), 2.0 * c.k2);
+            color = select(c.negative_color.rgb, c.positive_color.rgb, value >= 0.0);
         } else {
-            extinction = u.k1 * pow(max(scaled, 0.0), u.k2);
-            color = mix(u.negative_color.rgb, u.positive_color.rgb, sqrt(min(scaled, 1.0)));
+            extinction = c.k1 * pow(max(scaled, 0.0), c.k2);
+            color = mix(c.negative_color.rgb, c.positive_color.rgb, sqrt(min(scaled, 1.0)));
         }
     } else {
-        let positive = value >= 0.0 || u.signed_field != 1u;
-        let lobe = select(u.tf_negative, u.tf_positive, positive);
-        let shape = select(u.shape_negative, u.shape_positive, positive);
+        let positive = value >= 0.0 || c.signed_field != 1u;
+        let lobe = select(c.tf_negative, c.tf_positive, positive);
+        let shape = select(c.shape_negative, c.shape_positive, positive);
         let sign = select(-1.0, 1.0, positive);
         extinction = lobe.z * shape_factor(shape, scaled, sign * lobe.x, lobe.y, sign);
         if (extinction < 1e-5) {
             return vec4<f32>(-1.0);
         }
-        color = select(u.negative_color.rgb, u.positive_color.rgb, positive);
+        color = select(c.negative_color.rgb, c.positive_color.rgb, positive);
     }
-    if (needs_gradient()) {
-        let g = min(length(grad) * u.inv_max_grad, 1.0);
-        if (u.gradient_power > 0.0) {
-            extinction *= pow(g, u.gradient_power);
+    if (gradient) {
+        let g = min(length(grad) * c.inv_max_grad, 1.0);
+        if (c.gradient_power > 0.0) {
+            extinction *= pow(g, c.gradient_power);
         }
-        extinction *= 1.0 - u.boundary + u.boundary * sqrt(g);
-        if ((u.tf_bits & 1u) != 0u && length(grad) > 0.0) {
+        extinction *= 1.0 - c.boundary + c.boundary * sqrt(g);
+        if ((c.tf_bits & TF_SHADING) != 0u && length(grad) > 0.0) {
             // Two-sided lighting: a translucent shell is seen from both sides.
             let n = normalize(grad);
             let v = -normalize(from_eye);
-            let l = u.light.xyz;
+            let l = c.light.xyz;
             let diffuse = abs(dot(n, l));
             let h = normalize(l + v);
             let specular = pow(abs(dot(n, h)), 32.0);
@@ -175,8 +187,8 @@ fn shade(value: f32, grad: vec3<f32>, from_eye: vec3<f32>) -> vec4<f32> {
     // composes exactly over the distance the ray travels between two slices:
     // alpha = 1 - exp(-extinction * path / step).
     let ray = normalize(from_eye);
-    let path = u.plane.w / max(abs(dot(ray, u.plane.xyz)), 0.05);
-    let x = extinction * path / u.ref_step;
+    let path = c.plane.w / max(abs(dot(ray, c.plane.xyz)), 0.05);
+    let x = extinction * path / c.ref_step;
     // 1 − e^−x loses its digits to cancellation for small x: use the series there.
     let alpha = select(1.0 - exp2(-1.442695 * x), x * (1.0 - x * (0.5 - x / 6.0)), x < 0.03);
     return vec4<f32>(color * alpha, alpha);

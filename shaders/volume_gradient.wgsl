@@ -12,6 +12,11 @@ fn field_gradient(uvw: vec3<f32>) -> vec3<f32> {
         (field(uvw + dy) - field(uvw - dy)) / (2.0 * h.y),
         (field(uvw + dz) - field(uvw - dz)) / (2.0 * h.z),
     );
-    let m = mat3x3<f32>(u.tex_from_world[0].xyz, u.tex_from_world[1].xyz, u.tex_from_world[2].xyz);
+    return world_gradient(u, g_tex);
+}
+
+// Mᵀ g: a texture-space gradient in world units.
+fn world_gradient(c: VolumeUniforms, g_tex: vec3<f32>) -> vec3<f32> {
+    let m = mat3x3<f32>(c.tex_from_world[0].xyz, c.tex_from_world[1].xyz, c.tex_from_world[2].xyz);
     return transpose(m) * g_tex;
 }

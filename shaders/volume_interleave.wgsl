@@ -1,81 +1,252 @@
-// Translucent surfaces inside a cloud (seed 003 with seed 000's clouds): per pixel, the
-// sorted fragments and the cloud's samples are composited front to back in one walk, the
-// samples taken where the slices would take them (the same planes, the same opacity law).
-// The slices already drew the cloud alone into the scene, over what lies behind it, so the
-// scene behind the cloud is what that drawing let through: every fragment's transmission
-// multiplies it too.
-// Prepended: volume_common.wgsl, volume_gradient.wgsl, volume_field.wgsl, fullscreen.wgsl,
-// oit_common.wgsl, oit_sort.wgsl.
+// Clouds and translucent surfaces in one depth order (seed 003 with seed 000's clouds): per
+// pixel, the sorted fragments and the samples of up to four clouds are composited front to
+// back in one walk. Each cloud is sampled where its slices would sample it (its own planes, its
+// own opacity law); the clouds' samples are merged by depth, and samples of several clouds at
+// one depth combine symmetrically, so the order the clouds are listed in changes nothing.
+//
+// A single cloud is drawn by its slices first (PREDRAWN): only pixels with fragments are
+// walked, and the scene behind the cloud is what the slices let through. Several clouds are
+// not drawn by slices at all: every pixel walks them over the scene.
+// Prepended: volume_common.wgsl (cloud 0 is its `u` and `volume`), volume_gradient.wgsl,
+// volume_field.wgsl, fullscreen.wgsl, oit_common.wgsl, oit_sort.wgsl.
+
+@group(0) @binding(3) var<uniform> u1: VolumeUniforms;
+@group(0) @binding(4) var volume1: texture_3d<f32>;
+@group(0) @binding(5) var<uniform> u2: VolumeUniforms;
+@group(0) @binding(6) var volume2: texture_3d<f32>;
+@group(0) @binding(7) var<uniform> u3: VolumeUniforms;
+@group(0) @binding(8) var volume3: texture_3d<f32>;
+// The opaque scene's depth: a cloud's samples stop there.
+@group(0) @binding(9) var scene_depth: texture_depth_2d;
+
+// How many clouds the walk takes (at most 4), and whether the one cloud is already drawn.
+override CLOUDS: u32 = 1u;
+override PREDRAWN: bool = true;
+
+fn cloud_uniforms(k: u32) -> VolumeUniforms {
+    switch k {
+        case 1u: { return u1; }
+        case 2u: { return u2; }
+        case 3u: { return u3; }
+        default: { return u; }
+    }
+}
+
+// Cloud k's value at texture coordinate uvw (each texture named where it is sampled: a texture
+// handed to a function as an argument is not something every driver compiles).
+fn cloud_value(k: u32, uvw: vec3<f32>) -> f32 {
+    switch k {
+        case 1u: { return textureSampleLevel(volume1, volume_sampler, uvw, 0.0).r; }
+        case 2u: { return textureSampleLevel(volume2, volume_sampler, uvw, 0.0).r; }
+        case 3u: { return textureSampleLevel(volume3, volume_sampler, uvw, 0.0).r; }
+        default: { return textureSampleLevel(volume, volume_sampler, uvw, 0.0).r; }
+    }
+}
+
+// Cloud k's gradient (world units) by central differences one texel apart.
+fn cloud_gradient(k: u32, c: VolumeUniforms, uvw: vec3<f32>) -> vec3<f32> {
+    var dims: vec3<u32>;
+    switch k {
+        case 1u: { dims = textureDimensions(volume1); }
+        case 2u: { dims = textureDimensions(volume2); }
+        case 3u: { dims = textureDimensions(volume3); }
+        default: { dims = textureDimensions(volume); }
+    }
+    let h = 1.0 / vec3<f32>(dims);
+    var g_tex: vec3<f32>;
+    for (var a = 0; a < 3; a += 1) {
+        var d = vec3<f32>(0.0);
+        d[a] = h[a];
+        g_tex[a] = (cloud_value(k, uvw + d) - cloud_value(k, uvw - d)) / (2.0 * h[a]);
+    }
+    return world_gradient(c, g_tex);
+}
+
+// One sample of cloud k at p (its object's frame): the premultiplied colour, alpha < 0 where it
+// is invisible or cut away.
+fn sample_cloud(k: u32, p: vec3<f32>, from_eye: vec3<f32>) -> vec4<f32> {
+    let c = cloud_uniforms(k);
+    if ((c.tf_bits & TF_CLIP) != 0u && dot(c.clip.xyz, p) > c.clip.w) {
+        return vec4<f32>(-1.0);
+    }
+    let uvw = (c.tex_from_world * vec4<f32>(p, 1.0)).xyz;
+    let gradient = GRADIENT && (c.tf_bits & TF_GRADIENT) != 0u;
+    var grad = vec3<f32>(0.0);
+    if (gradient) {
+        grad = cloud_gradient(k, c, uvw);
+    }
+    return shade_with(c, SHAPED && (c.tf_bits & TF_SHAPED) != 0u, gradient, cloud_value(k, uvw), grad, from_eye);
+}
+
+// Each cloud's ray (its object's frame), the planes it crosses, and the next one's depth.
+var<private> ray_eye: array<vec3<f32>, 4>;
+var<private> ray_dir: array<vec3<f32>, 4>;
+// x: the nearest plane's distance from the eye along the normal, y: the spacing, z: n·ray.
+var<private> ray_planes: array<vec3<f32>, 4>;
+// The next plane and the last.
+var<private> plane_next: array<f32, 4>;
+var<private> plane_last: array<f32, 4>;
+// Rows z and w of the cloud's clip_from_world: window depth = row_z·p / row_w·p.
+var<private> depth_z: array<vec4<f32>, 4>;
+var<private> depth_w: array<vec4<f32>, 4>;
+var<private> next_depth: array<f32, 4>;
+
+const NO_SAMPLE: f32 = 2.0;
+
+fn sample_point(k: u32) -> vec3<f32> {
+    let planes = ray_planes[k];
+    return ray_eye[k] + (planes.x + plane_next[k] * planes.y) / planes.z * ray_dir[k];
+}
+
+fn depth_of_next(k: u32) -> f32 {
+    if (plane_next[k] > plane_last[k]) {
+        return NO_SAMPLE;
+    }
+    let p = vec4<f32>(sample_point(k), 1.0);
+    return dot(depth_z[k], p) / dot(depth_w[k], p);
+}
+
+// The nearest sample of any cloud (NO_SAMPLE when all are done).
+fn nearest_depth() -> f32 {
+    var z = NO_SAMPLE;
+    for (var k = 0u; k < CLOUDS; k += 1u) {
+        z = min(z, next_depth[k]);
+    }
+    return z;
+}
+
+// Sets up every cloud's ray through the pixel at `xy`; returns the first sample's depth.
+fn begin_clouds(xy: vec2<f32>) -> f32 {
+    for (var k = 0u; k < CLOUDS; k += 1u) {
+        let c = cloud_uniforms(k);
+        let ndc = vec2<f32>(xy.x / c.slab.z * 2.0 - 1.0, 1.0 - xy.y / c.slab.w * 2.0);
+        let far = c.world_from_clip * vec4<f32>(ndc, 1.0, 1.0);
+        let eye = c.eye.xyz;
+        let dir = normalize(far.xyz / far.w - eye);
+        ray_eye[k] = eye;
+        ray_dir[k] = dir;
+        let m = c.clip_from_world;
+        depth_z[k] = vec4<f32>(m[0].z, m[1].z, m[2].z, m[3].z);
+        depth_w[k] = vec4<f32>(m[0].w, m[1].w, m[2].w, m[3].w);
+        plane_next[k] = 1.0;
+        plane_last[k] = 0.0;
+        let n = c.plane.xyz;
+        let spacing = c.plane.w;
+        let n_dot_r = dot(n, dir);
+        if (n_dot_r > 1e-4) {
+            // Where the ray is inside the slices' box, and the planes it crosses there.
+            let o = (c.box_from_world * vec4<f32>(eye, 1.0)).xyz;
+            let d = (c.box_from_world * vec4<f32>(dir, 0.0)).xyz;
+            let t0 = -o / d;
+            let t1 = (vec3<f32>(1.0) - o) / d;
+            let t_in = max(max(max(min(t0.x, t1.x), min(t0.y, t1.y)), min(t0.z, t1.z)), 0.0);
+            let t_out = min(min(max(t0.x, t1.x), max(t0.y, t1.y)), max(t0.z, t1.z));
+            let e = dot(n, eye);
+            ray_planes[k] = vec3<f32>(c.slab.x - e, spacing, n_dot_r);
+            plane_next[k] = max(ceil((e + t_in * n_dot_r - c.slab.x) / spacing), 0.0);
+            plane_last[k] = min(floor((e + t_out * n_dot_r - c.slab.x) / spacing), c.slab.y - 1.0);
+        }
+        next_depth[k] = depth_of_next(k);
+    }
+    return nearest_depth();
+}
+
+// The samples of every cloud at depth z, combined (α = 1 − Π(1 − αₖ), colours weighted by
+// their opacities: the same whichever cloud is listed first), and each of those clouds moved
+// to its next plane. Alpha 0 where none is visible.
+fn take_samples(z: f32) -> vec4<f32> {
+    var color = vec3<f32>(0.0);
+    var alpha_sum = 0.0;
+    var through = 1.0;
+    var visible = 0u;
+    var only = vec4<f32>(0.0);
+    for (var k = 0u; k < CLOUDS; k += 1u) {
+        if (next_depth[k] != z) {
+            continue;
+        }
+        let p = sample_point(k);
+        let s = sample_cloud(k, p, p - ray_eye[k]);
+        if (s.a > 0.0) {
+            color += s.rgb;
+            alpha_sum += s.a;
+            through *= 1.0 - s.a;
+            visible += 1u;
+            only = s;
+        }
+        plane_next[k] += 1.0;
+        next_depth[k] = depth_of_next(k);
+    }
+    if (visible <= 1u) {
+        return only;
+    }
+    let alpha = 1.0 - through;
+    return vec4<f32>(color * (alpha / alpha_sum), alpha);
+}
 
 @fragment
 fn fs_interleave(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
     let px = vec2<u32>(pos.xy);
     let shown = textureLoad(scene, vec2<i32>(px), 0).rgb;
     let count = gather(px);
-    if (count == 0u) {
+    if (PREDRAWN && count == 0u) {
         return vec4<f32>(shown, 1.0);
     }
     var walk = begin_walk(count);
-    // The ray through the pixel's centre, in the cloud's frame.
-    let ndc = vec2<f32>(pos.x / u.slab.z * 2.0 - 1.0, 1.0 - pos.y / u.slab.w * 2.0);
-    let far = u.world_from_clip * vec4<f32>(ndc, 1.0, 1.0);
-    let eye = u.eye.xyz;
-    let dir = normalize(far.xyz / far.w - eye);
-    let opaque = textureLoad(opaque_depth, px, 0);
-    // What the slices drew here: the cloud alone.
+    // What the clouds alone composite to here (what a predrawn cloud's slices drew).
     var cloud = vec3<f32>(0.0);
     var cloud_through = 1.0;
     // And what the fragments let through, of all behind the cloud.
     var fragments_through = vec3<f32>(1.0);
     var i = 0u;
-    let n = u.plane.xyz;
-    let spacing = u.plane.w;
-    let n_dot_r = dot(n, dir);
-    if (n_dot_r > 1e-4) {
-        // Where the ray is inside the slices' box, and the planes it crosses there.
-        let o = (u.box_from_world * vec4<f32>(eye, 1.0)).xyz;
-        let d = (u.box_from_world * vec4<f32>(dir, 0.0)).xyz;
-        let t0 = -o / d;
-        let t1 = (vec3<f32>(1.0) - o) / d;
-        let t_in = max(max(max(min(t0.x, t1.x), min(t0.y, t1.y)), min(t0.z, t1.z)), 0.0);
-        let t_out = min(min(max(t0.x, t1.x), max(t0.y, t1.y)), max(t0.z, t1.z));
-        let e = dot(n, eye);
-        let first = max(ceil((e + t_in * n_dot_r - u.slab.x) / spacing), 0.0);
-        let last = min(floor((e + t_out * n_dot_r - u.slab.x) / spacing), u.slab.y - 1.0);
-        for (var j = first; j <= last; j += 1.0) {
-            let t = (u.slab.x + j * spacing - e) / n_dot_r;
-            let p = eye + t * dir;
-            let clip = u.clip_from_world * vec4<f32>(p, 1.0);
-            let z = clip.z / clip.w;
-            if (z >= opaque) {
-                break;
-            }
-            while (i < count && sorted_depth[i] < z) {
-                walk = step_walk(walk, i);
-                fragments_through *= walk.last;
-                i += 1u;
-            }
-            if (clipped(p)) {
-                continue;
-            }
-            let uvw = (u.tex_from_world * vec4<f32>(p, 1.0)).xyz;
-            var grad = vec3<f32>(0.0);
-            if (needs_gradient()) {
-                grad = field_gradient(uvw);
-            }
-            let c = shade(field(uvw), grad, p - eye);
-            if (c.a < 0.0) {
-                continue;
-            }
+    let opaque = textureLoad(scene_depth, px, 0);
+    var z = begin_clouds(pos.xy);
+    loop {
+        if (z >= opaque) {
+            break;
+        }
+        while (i < count && sorted_depth[i] < z) {
+            walk = step_walk(walk, i);
+            fragments_through *= walk.last;
+            i += 1u;
+        }
+        let c = take_samples(z);
+        if (c.a > 0.0) {
             walk.color += walk.through * c.rgb;
             walk.through *= 1.0 - c.a;
             cloud += cloud_through * c.rgb;
             cloud_through *= 1.0 - c.a;
         }
+        z = nearest_depth();
     }
     for (; i < count; i += 1u) {
         walk = step_walk(walk, i);
         fragments_through *= walk.last;
     }
-    return vec4<f32>(walk.color + fragments_through * max(shown - cloud, vec3<f32>(0.0)), 1.0);
+    if (PREDRAWN) {
+        return vec4<f32>(walk.color + fragments_through * max(shown - cloud, vec3<f32>(0.0)), 1.0);
+    }
+    return vec4<f32>(walk.color + walk.through * shown, 1.0);
+}
+
+// Several clouds and no translucent surfaces: the clouds' samples alone, over the scene.
+@fragment
+fn fs_clouds(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
+    let px = vec2<u32>(pos.xy);
+    let shown = textureLoad(scene, vec2<i32>(px), 0).rgb;
+    let opaque = textureLoad(scene_depth, px, 0);
+    var color = vec3<f32>(0.0);
+    var through = 1.0;
+    var z = begin_clouds(pos.xy);
+    loop {
+        if (z >= opaque) {
+            break;
+        }
+        let c = take_samples(z);
+        if (c.a > 0.0) {
+            color += through * c.rgb;
+            through *= 1.0 - c.a;
+        }
+        z = nearest_depth();
+    }
+    return vec4<f32>(color + through * shown, 1.0);
 }

@@ -1,7 +1,8 @@
 //! Translucent isosurfaces (seed 003) on lavapipe: the GPU's sorted fragment lists against a
 //! CPU reference that sorts every fragment, independence of the order surfaces are given in,
 //! frames over the fragment budget drawn in bands, the glow where surfaces of two objects
-//! overlap, and surfaces inside a cloud against a CPU reference that walks both.
+//! overlap, surfaces inside a cloud against a CPU reference that walks both, and overlapping
+//! clouds composited in one depth order whichever is listed first.
 
 mod common;
 
@@ -272,6 +273,126 @@ fn surfaces_inside_a_cloud_match_a_cpu_reference_that_walks_both() {
     show_object(&ctx, bare.main(), &doc, &object(iso, AtomStyle::Hidden)).expect("orbital");
     let (alone, _) = draw(&ctx, &mut bare);
     assert!(common::mean_difference(&alone, &gpu) > 3.0, "the cloud changes the picture");
+}
+
+/// ψ = (z − c_z)·exp(−|r − c|²/12) (signed) or ρ = exp(−|r − c|²/6) on a 32³ grid of ±4 bohr
+/// around `centre`: no margin the slices would trim, so a reference slicing the whole box
+/// samples where the GPU does.
+fn wide_cloud(centre: DVec3, signed: bool) -> VolumeGrid {
+    let n = 32;
+    let h = 8.0 / (n - 1) as f64;
+    let world = VolumeGrid::affine(centre - 4.0, [DVec3::X * h, DVec3::Y * h, DVec3::Z * h]);
+    let values = (0..n * n * n)
+        .map(|m| {
+            let p = world.transform_point3(DVec3::new((m / (n * n)) as f64, ((m / n) % n) as f64, (m % n) as f64));
+            let d = p - centre;
+            let v = if signed { d.z * (-d.length_squared() / 12.0).exp() } else { (-d.length_squared() / 6.0).exp() };
+            v as f32
+        })
+        .collect();
+    VolumeGrid::new(if signed { "orbital" } else { "density" }, [n, n, n], world, values)
+}
+
+/// Two clouds that overlap on screen, an orbital's and a density's (with translucent
+/// isosurfaces when `surfaces`), drawn with the orbital in layer `orbital_layer`.
+fn two_clouds(
+    ctx: &GpuContext,
+    orbital_layer: usize,
+    surfaces: bool,
+) -> (image::RgbaImage, [(VolumeGrid, ObjectState); 2]) {
+    let look = |grid: VolumeGrid, color: [f32; 3], level: f32| {
+        let mut iso = translucent(level, color);
+        iso.visible = surfaces;
+        let mut state = object(iso, AtomStyle::Hidden);
+        let cloud = &mut state.quantities[0].cloud;
+        cloud.visible = true;
+        cloud.slices = 48;
+        cloud.k1 = 0.3;
+        // A blob that fades out, not a box filled to its edges.
+        cloud.density_scale = orbcloud::scene::DensityScale::Linear;
+        cloud.positive_color = color;
+        (grid, state)
+    };
+    let orbital = look(wide_cloud(DVec3::new(-0.8, 0.0, 0.0), true), [0.9, 0.3, 0.1], 0.3);
+    let density = look(wide_cloud(DVec3::new(1.0, 0.4, 0.3), false), [0.2, 0.5, 0.95], 0.5);
+    let mut layers = [orbital, density];
+    if orbital_layer == 1 {
+        layers.swap(0, 1);
+    }
+    let mut renderer = Renderer::new(&ctx);
+    for (n, (grid, state)) in layers.iter().enumerate() {
+        let doc = Document { volumes: vec![grid.clone()], ..Default::default() };
+        show_object(ctx, renderer.layer_mut(ctx, n), &doc, state).expect("cloud shown");
+    }
+    let cam = camera();
+    let target = OffscreenTarget::new(&ctx.device, SIZE);
+    let clouds = layers.each_ref().map(|(_, s)| s.quantities[0].cloud);
+    let frame = FrameInput { camera: &cam, background: BACKGROUND, clouds: &clouds, size: SIZE, tile: None };
+    // Counts come back only with translucent surfaces.
+    let _ = draw_exact(ctx, &mut renderer, &target.color_view, &frame);
+    (target.read_rgba(&ctx.device, &ctx.queue).expect("read back"), layers)
+}
+
+#[test]
+fn overlapping_clouds_are_composited_in_one_depth_order_whichever_is_listed_first() {
+    let ctx = lavapipe();
+    let (first, layers) = two_clouds(&ctx, 0, false);
+    let (second, _) = two_clouds(&ctx, 1, false);
+    let swapped = max_difference(&first, &second);
+    eprintln!("two clouds, listed either way: max difference {swapped}/255");
+    assert!(swapped <= 1, "swapping the clouds changed the picture by {swapped}/255");
+    // A CPU reference: every sample of both clouds, merged by distance along the ray.
+    let cam = camera();
+    let references: Vec<CloudReference> = layers
+        .iter()
+        .map(|(grid, state)| CloudReference::new(grid, &cam, &state.render_settings(0, BACKGROUND)))
+        .collect();
+    let reference = |merged: bool| {
+        image::RgbaImage::from_fn(SIZE[0], SIZE[1], |px, py| {
+            let d = references[0].ray(&cam, SIZE, px, py);
+            let mut samples: Vec<_> = references.iter().map(|r| r.samples(d)).collect();
+            if merged {
+                let mut all: Vec<_> = samples.drain(..).flatten().collect();
+                all.sort_by(|a, b| b.t.total_cmp(&a.t));
+                samples = vec![all];
+            }
+            // Back to front: each cloud over what is behind it (unmerged: the second over the first).
+            let mut c = BACKGROUND.map(f64::from);
+            for sample in samples.iter().flatten() {
+                c = [0, 1, 2].map(|k| sample.color[k] * sample.alpha + (1.0 - sample.alpha) * c[k]);
+            }
+            image::Rgba([srgb_encode(c[0]), srgb_encode(c[1]), srgb_encode(c[2]), 255])
+        })
+    };
+    let cpu = reference(true);
+    let mean = common::mean_difference(&first, &cpu);
+    let over = first.pixels().zip(cpu.pixels()).filter(|(p, q)| (0..3).any(|k| p[k].abs_diff(q[k]) > 3)).count();
+    let n = first.pixels().len();
+    let in_layer_order = common::mean_difference(&first, &reference(false));
+    eprintln!(
+        "against the CPU merge: mean {mean:.3}/255, {over} of {n} pixels > 3/255; one cloud over the other: {in_layer_order:.3}/255"
+    );
+    assert!(mean < 1.0 && over * 100 < n, "mean {mean:.3}/255, {over} pixels > 3/255");
+    // Drawing one cloud over the other would be far off.
+    assert!(in_layer_order > 5.0 * mean.max(0.2), "one over the other: {in_layer_order:.3}/255");
+}
+
+#[test]
+fn overlapping_clouds_with_translucent_surfaces_give_one_picture_whichever_is_listed_first() {
+    let ctx = lavapipe();
+    let (first, _) = two_clouds(&ctx, 0, true);
+    let (second, _) = two_clouds(&ctx, 1, true);
+    let (bare, _) = two_clouds(&ctx, 0, false);
+    let swapped = max_difference(&first, &second);
+    eprintln!("two clouds and their surfaces, listed either way: max difference {swapped}/255");
+    assert!(swapped <= 1, "swapping the quantities changed the picture by {swapped}/255");
+    let surfaces = common::mean_difference(&first, &bare);
+    eprintln!("the surfaces change the picture by {surfaces:.2}/255 on average");
+    if std::env::var_os("ORBCLOUD_SAVE").is_some() {
+        first.save("/tmp/two_clouds_surfaces.png").unwrap();
+        bare.save("/tmp/two_clouds.png").unwrap();
+    }
+    assert!(surfaces > 2.0, "the surfaces are in the picture");
 }
 
 #[test]

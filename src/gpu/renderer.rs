@@ -9,7 +9,7 @@ use super::isosurface::IsosurfacePass;
 use super::occlusion::DepthPyramid;
 use super::oit::{FragmentDump, FragmentLists, FragmentStats, MAX_BANDS, Transparency};
 use super::resolve::{Lists, ResolvePass, Rows};
-use super::volume::{VolumePass, VolumeTexture};
+use super::volume::{MAX_WALKED, VolumePass, VolumeTexture};
 use super::{GpuContext, GpuError};
 use crate::model::GridSpec;
 use crate::model::cartesian::CartesianExpansion;
@@ -34,7 +34,8 @@ pub struct FrameInput<'a> {
 
 /// One band of a frame drawn progressively: the first clears the targets and draws every opaque
 /// thing; each draws the clouds inside its rectangle only, over what the earlier ones left.
-/// Every tile resolves the whole frame, so the picture fills in band by band.
+/// Every tile resolves the whole frame (a walk over clouds: the first copies the whole frame
+/// without them, each walks its own rows), so the picture fills in band by band.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Tile {
     /// x, y, width, height in pixels.
@@ -384,21 +385,52 @@ impl Renderer {
         if collects && !weighted {
             self.lists.begin_frame(encoder);
         }
-        // The first cloud drawn from a texture takes the surfaces through it; any others stay
-        // behind them.
-        let through = match oit && !weighted {
-            true => self.layers.iter().filter(|l| l.visible).find_map(|l| l.volume.interleave(&ctx.device)),
+        // The clouds drawn from a texture are composited in one depth order with each other and
+        // the surfaces, by a walk per pixel (one cloud alone with no surfaces: by its slices).
+        let sorted = oit && !weighted;
+        let walked: Vec<usize> = (self.layers.iter().enumerate())
+            .filter(|(_, l)| l.visible && l.volume.walkable())
+            .map(|(n, _)| n)
+            .take(MAX_WALKED)
+            .collect();
+        let walks = !weighted && (walked.len() > 1 || (walked.len() == 1 && sorted));
+        for (n, layer) in self.layers.iter_mut().enumerate() {
+            layer.volume.set_walked(walks && walked.len() > 1 && walked.contains(&n));
+        }
+        let walk = match walks {
+            true => {
+                let clouds: Vec<&VolumePass> = walked.iter().map(|&n| &self.layers[n].volume).collect();
+                VolumePass::walk(&ctx.device, &clouds, &targets.depth_view, sorted)
+            }
             false => None,
         };
-        let composite = match (oit, self.lists.weighted().filter(|_| weighted), &through) {
-            (false, _, _) => None,
+        let lists_bind = if sorted { self.lists.composite_bind() } else { None };
+        let composite = match (oit, self.lists.weighted().filter(|_| weighted), &walk) {
             (true, Some(w), _) => Some(Lists::Weighted(&w.resolve_bind)),
-            (true, None, Some((pipeline, cloud))) => {
-                self.lists.composite_bind().map(|lists| Lists::ThroughCloud(lists, pipeline, cloud))
+            (_, _, Some((pipeline, clouds))) if lists_bind.is_some() || !sorted => {
+                Some(Lists::Walk(lists_bind, pipeline, clouds))
             }
-            (true, None, None) => self.lists.composite_bind().map(Lists::Sorted),
+            (false, _, _) => None,
+            (true, _, _) => lists_bind.map(Lists::Sorted),
+        };
+        // A tile of a walked frame walks its own rows; the first shows the rest without clouds.
+        let walk_rows = frame
+            .tile
+            .filter(|_| matches!(composite, Some(Lists::Walk(..))))
+            .map(|Tile { rect: [_, y, _, h], first }| (y, h, first));
+        let resolve_rows = |rows: Option<Rows>| match (walk_rows, rows) {
+            (None, rows) => rows,
+            (Some((y, h, _)), None) => Some(Rows { start: y, count: h, first: false }),
+            (Some((y, h, _)), Some(r)) => {
+                let start = r.start.max(y);
+                let end = (r.start + r.count).min(y + h);
+                (end > start).then_some(Rows { start, count: end - start, first: false })
+            }
         };
         for node in self.frame {
+            if node.phase == Phase::Resolve && walk_rows.is_some_and(|(_, _, first)| first) {
+                self.resolve.draw(encoder, resolve, output, None, None, width);
+            }
             match node.phase {
                 Phase::Resolve if bands > 1 => {
                     for band in 0..bands {
@@ -406,10 +438,15 @@ impl Renderer {
                         self.collect(encoder, targets, frame.background, Some((start, count)));
                         self.lists.end_band(encoder, band);
                         let rows = Rows { start, count, first: band == 0 };
-                        self.resolve.draw(encoder, resolve, output, composite, Some(rows), width);
+                        if let Some(rows) = resolve_rows(Some(rows)) {
+                            self.resolve.draw(encoder, resolve, output, composite, Some(rows), width);
+                        }
                     }
                 }
-                Phase::Resolve => self.resolve.draw(encoder, resolve, output, composite, None, width),
+                Phase::Resolve => {
+                    let rows = resolve_rows(None);
+                    self.resolve.draw(encoder, resolve, output, composite, rows, width);
+                }
                 Phase::Fragments if collects && weighted => self.collect_weighted(encoder),
                 Phase::Fragments => {
                     if collects && bands == 1 {

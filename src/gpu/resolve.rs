@@ -18,9 +18,9 @@ pub struct ResolvePass {
 pub enum Lists<'a> {
     Sorted(&'a wgpu::BindGroup),
     Weighted(&'a wgpu::BindGroup),
-    /// Sorted, through a cloud: the lists, the cloud's pipeline and its bind group
-    /// ([`super::volume::VolumePass::interleave`]).
-    ThroughCloud(&'a wgpu::BindGroup, &'a wgpu::RenderPipeline, &'a wgpu::BindGroup),
+    /// A walk over clouds in one depth order, with the sorted lists when there are any: the
+    /// lists, the walk's pipeline and its bind group ([`super::volume::VolumePass::walk`]).
+    Walk(Option<&'a wgpu::BindGroup>, &'a wgpu::RenderPipeline, &'a wgpu::BindGroup),
 }
 
 /// Which rows a resolve writes, and whether it is the frame's first.
@@ -82,7 +82,7 @@ impl ResolvePass {
                 cache: None,
             })
         };
-        // Group 0 is a cloud's (volume_interleave.wgsl); 1 the scene, 2 the lists, 3 weighted
+        // Group 0 is a walk's clouds (volume_interleave.wgsl); 1 the scene, 2 the lists, 3 weighted
         // blending's targets.
         let composite =
             pipeline("resolve with translucent surfaces", &[None, Some(&layout), Some(lists)], "fs_composite");
@@ -142,10 +142,12 @@ impl ResolvePass {
                 pass.set_pipeline(&self.weighted);
                 pass.set_bind_group(3, targets, &[]);
             }
-            Some(Lists::ThroughCloud(lists, pipeline, cloud)) => {
+            Some(Lists::Walk(lists, pipeline, clouds)) => {
                 pass.set_pipeline(pipeline);
-                pass.set_bind_group(0, cloud, &[]);
-                pass.set_bind_group(2, lists, &[]);
+                pass.set_bind_group(0, clouds, &[]);
+                if let Some(lists) = lists {
+                    pass.set_bind_group(2, lists, &[]);
+                }
             }
             None => pass.set_pipeline(&self.pipeline),
         }

@@ -190,9 +190,11 @@ enum Program {
     ThreePass,
     /// Seed 000's α-mix (the reference the three passes approximate).
     AlphaMix,
-    /// A full-screen pass of the resolve: translucent surfaces' fragments and the cloud's
-    /// samples composited in one walk per pixel (volume_interleave.wgsl).
+    /// A full-screen pass of the resolve: translucent surfaces' fragments and the samples of
+    /// up to [`MAX_WALKED`] clouds composited in one walk per pixel (volume_interleave.wgsl).
     Interleave,
+    /// The same walk over several clouds without translucent surfaces.
+    Clouds,
 }
 
 impl Program {
@@ -204,7 +206,12 @@ impl Program {
             Program::ThreePass => "fs_three_pass",
             Program::AlphaMix => "fs_alpha_mix",
             Program::Interleave => "fs_interleave",
+            Program::Clouds => "fs_clouds",
         }
+    }
+
+    fn walks(self) -> bool {
+        matches!(self, Program::Interleave | Program::Clouds)
     }
 }
 
@@ -216,7 +223,12 @@ struct Variant {
     gradient: bool,
     shaped: bool,
     clip: bool,
+    /// The clouds a walk takes (0 for the slice programs): with one, its slices drew it first.
+    clouds: u8,
 }
+
+/// The most clouds one walk composites; clouds beyond them are drawn by their slices, behind.
+pub const MAX_WALKED: usize = 4;
 
 /// A slice shader module and its pipeline layout.
 struct SliceShader {
@@ -252,7 +264,11 @@ struct VolumeShaders {
     direct: SliceShader,
     morph: SliceShader,
     interleave: SliceShader,
+    /// The walk over clouds without fragment lists: the interleave module, no group 2.
+    clouds: SliceShader,
     layout: wgpu::BindGroupLayout,
+    /// The walk's group 0: [`MAX_WALKED`] clouds' uniforms and textures and the scene's depth.
+    walk_layout: wgpu::BindGroupLayout,
     morph_layout: wgpu::BindGroupLayout,
     gto_layout: wgpu::BindGroupLayout,
     sampler: wgpu::Sampler,
@@ -267,6 +283,7 @@ impl VolumeShaders {
             .entry(variant)
             .or_insert_with(|| match variant.program {
                 Program::Interleave => make_interleave_pipeline(device, &self.interleave, variant),
+                Program::Clouds => make_interleave_pipeline(device, &self.clouds, variant),
                 _ => make_pipeline(device, (&self.slices, &self.direct, &self.morph), variant),
             })
             .clone()
@@ -295,16 +312,23 @@ pub struct VolumePass {
     volume: Option<VolumeTexture>,
     /// Basis functions of the orbital shown in direct mode (then `volume` holds only its box).
     direct: Option<GtoBuffers>,
+    /// This frame's cloud is composited by a walk over several clouds, not by its slices.
+    walked: bool,
 }
 
-/// The override constants of `variant`.
-fn constants(variant: Variant) -> [(&'static str, f64); 3] {
+/// The override constants of `variant` (a walk's: whether any of its clouds needs each).
+fn constants(variant: Variant) -> Vec<(&'static str, f64)> {
     let flag = |b: bool| f64::from(u8::from(b));
-    [("GRADIENT", flag(variant.gradient)), ("SHAPED", flag(variant.shaped)), ("CLIP", flag(variant.clip))]
+    let mut constants =
+        vec![("GRADIENT", flag(variant.gradient)), ("SHAPED", flag(variant.shaped)), ("CLIP", flag(variant.clip))];
+    if variant.program.walks() {
+        constants.extend([("CLOUDS", f64::from(variant.clouds)), ("PREDRAWN", flag(variant.clouds == 1))]);
+    }
+    constants
 }
 
-/// The full-screen pipeline that walks fragments and cloud samples together for `variant`'s
-/// transfer function.
+/// The full-screen pipeline that walks fragments and clouds' samples together for `variant`'s
+/// transfer functions.
 fn make_interleave_pipeline(device: &wgpu::Device, shader: &SliceShader, variant: Variant) -> wgpu::RenderPipeline {
     let constants = constants(variant);
     let options = wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() };
@@ -427,7 +451,13 @@ impl VolumePass {
         let slices = SliceShader::new(device, "volume_slices.wgsl", &[Some(&layout)]);
         let direct = SliceShader::new(device, "volume_direct.wgsl", &[Some(&layout), Some(&gto_layout)]);
         let morph = SliceShader::new(device, "volume_morph.wgsl", &[Some(&layout), Some(&morph_layout)]);
-        let interleave = SliceShader::new(device, "volume_interleave.wgsl", &[Some(&layout), Some(scene), Some(lists)]);
+        let walk_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("cloud walk bind group layout"),
+            entries: &walk_entries(),
+        });
+        let interleave =
+            SliceShader::new(device, "volume_interleave.wgsl", &[Some(&walk_layout), Some(scene), Some(lists)]);
+        let clouds = SliceShader::new(device, "volume_interleave.wgsl", &[Some(&walk_layout), Some(scene)]);
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("volume sampler"),
             address_mode_u: wgpu::AddressMode::ClampToEdge,
@@ -442,13 +472,15 @@ impl VolumePass {
             direct,
             morph,
             interleave,
+            clouds,
             layout,
+            walk_layout,
             morph_layout,
             gto_layout,
             sampler,
             pipelines: Mutex::new(HashMap::new()),
         };
-        let variant = Variant { program: Program::Slices, gradient: false, shaped: false, clip: false };
+        let variant = Variant { program: Program::Slices, gradient: false, shaped: false, clip: false, clouds: 0 };
         shared.pipeline(device, variant);
         Self::with_shared(device, Arc::new(shared))
     }
@@ -461,7 +493,7 @@ impl VolumePass {
     fn with_shared(device: &wgpu::Device, shared: Arc<VolumeShaders>) -> Self {
         Self {
             shared,
-            variant: Variant { program: Program::Slices, gradient: false, shaped: false, clip: false },
+            variant: Variant { program: Program::Slices, gradient: false, shaped: false, clip: false, clouds: 0 },
             frame_pipeline: None,
             morph: None,
             uniforms: super::uniform_buffer(device, "volume uniforms", std::mem::size_of::<VolumeUniforms>()),
@@ -472,6 +504,7 @@ impl VolumePass {
             bind_group: None,
             volume: None,
             direct: None,
+            walked: false,
         }
     }
 
@@ -640,10 +673,15 @@ impl VolumePass {
             gradient: t.needs_gradient(),
             shaped: t.kind == TransferKind::Shaped,
             clip: settings.clip.enabled,
+            clouds: 0,
         };
         self.frame_pipeline = Some(self.shared.pipeline(device, self.variant));
         let lobe = |l: &crate::scene::transfer::Lobe| [l.center, l.width, l.opacity, 0.0];
-        let bits = u32::from(t.shading);
+        let v = self.variant;
+        let bits = [(t.shading, TF_SHADING), (v.gradient, TF_GRADIENT), (v.shaped, TF_SHAPED), (v.clip, TF_CLIP)]
+            .iter()
+            .filter(|(on, _)| *on)
+            .fold(0, |bits, (_, bit)| bits | bit);
         let clip_normal = Vec3::from(settings.clip.normal).normalize_or(Vec3::Z);
         let box_centre =
             vol.grid_box.origin + 0.5 * (vol.grid_box.edges[0] + vol.grid_box.edges[1] + vol.grid_box.edges[2]);
@@ -693,16 +731,102 @@ impl VolumePass {
         queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
     }
 
-    /// The full-screen pipeline that takes translucent surfaces through this frame's cloud, and
-    /// the cloud's bind group; `None` unless the cloud is drawn from a 3D texture in one pass
-    /// (direct-mode and interpolated clouds stay behind the surfaces).
-    pub fn interleave(&self, device: &wgpu::Device) -> Option<(wgpu::RenderPipeline, &wgpu::BindGroup)> {
-        let bind_group = self.bind_group.as_ref()?;
-        (self.variant.program == Program::Slices && self.vertex_count > 0).then(|| {
-            (self.shared.pipeline(device, Variant { program: Program::Interleave, ..self.variant }), bind_group)
-        })
+    /// Whether a walk can take this frame's cloud: one drawn from a 3D texture in one pass
+    /// (direct-mode and interpolated clouds stay behind the surfaces and the walked clouds).
+    pub fn walkable(&self) -> bool {
+        self.bind_group.is_some() && self.variant.program == Program::Slices && self.vertex_count > 0
+    }
+
+    /// Leaves this frame's cloud to a walk over several clouds: its slices are not drawn.
+    pub fn set_walked(&mut self, walked: bool) {
+        self.walked = walked;
+    }
+
+    /// The full-screen pipeline that composites `clouds` (walkable, at most [`MAX_WALKED`]) in
+    /// one depth order, with the translucent surfaces' fragments when `lists`, and its bind
+    /// group; `depth` is the opaque scene's. One cloud is walked only where fragments are, over
+    /// what its slices drew.
+    pub fn walk(
+        device: &wgpu::Device,
+        clouds: &[&VolumePass],
+        depth: &wgpu::TextureView,
+        lists: bool,
+    ) -> Option<(wgpu::RenderPipeline, wgpu::BindGroup)> {
+        let first = clouds.first()?;
+        let clouds = &clouds[..clouds.len().min(MAX_WALKED)];
+        let shared = &first.shared;
+        let views: Vec<&wgpu::TextureView> =
+            clouds.iter().map(|c| c.volume.as_ref().map(|v| &v.view)).collect::<Option<_>>()?;
+        let slot = |k: usize| clouds.get(k).copied().unwrap_or(first);
+        let view = |k: usize| views.get(k).copied().unwrap_or(views[0]);
+        let mut entries =
+            vec![wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&shared.sampler) }];
+        for k in 0..MAX_WALKED {
+            let (uniforms, texture) = walk_bindings(k);
+            entries.push(wgpu::BindGroupEntry { binding: uniforms, resource: slot(k).uniforms.as_entire_binding() });
+            entries
+                .push(wgpu::BindGroupEntry { binding: texture, resource: wgpu::BindingResource::TextureView(view(k)) });
+        }
+        entries.push(wgpu::BindGroupEntry { binding: WALK_DEPTH, resource: wgpu::BindingResource::TextureView(depth) });
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("cloud walk bind group"),
+            layout: &shared.walk_layout,
+            entries: &entries,
+        });
+        let variant = Variant {
+            program: if lists { Program::Interleave } else { Program::Clouds },
+            gradient: clouds.iter().any(|c| c.variant.gradient),
+            shaped: clouds.iter().any(|c| c.variant.shaped),
+            clip: false,
+            clouds: clouds.len() as u8,
+        };
+        Some((shared.pipeline(device, variant), bind_group))
     }
 }
+
+/// The bindings of walked cloud `k`'s uniforms and texture (volume_interleave.wgsl): cloud 0's
+/// are the slices' own, 0 and 1 (2 is the sampler).
+fn walk_bindings(k: usize) -> (u32, u32) {
+    match k {
+        0 => (0, 1),
+        _ => (1 + 2 * k as u32, 2 + 2 * k as u32),
+    }
+}
+
+/// The opaque scene's depth in a walk's group 0.
+const WALK_DEPTH: u32 = 9;
+
+/// Group 0 of a walk over clouds.
+fn walk_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
+    let mut entries = vec![wgpu::BindGroupLayoutEntry {
+        binding: 2,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+        count: None,
+    }];
+    for k in 0..MAX_WALKED {
+        let (uniforms, texture) = walk_bindings(k);
+        entries.push(super::uniform_entry(uniforms, wgpu::ShaderStages::FRAGMENT));
+        entries.push(volume_entry(texture));
+    }
+    entries.push(wgpu::BindGroupLayoutEntry {
+        binding: WALK_DEPTH,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Depth,
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    });
+    entries
+}
+
+/// The bits of `VolumeUniforms::tf_bits` (volume_common.wgsl's TF_*).
+const TF_SHADING: u32 = 1;
+const TF_GRADIENT: u32 = 2;
+const TF_SHAPED: u32 = 4;
+const TF_CLIP: u32 = 8;
 
 impl super::frame::Draw for VolumePass {
     fn prepare(&mut self, f: &super::frame::Prepare<'_>) {
@@ -717,7 +841,7 @@ impl super::frame::Draw for VolumePass {
         let Some(bind_group) = &self.bind_group else {
             return;
         };
-        if self.vertex_count == 0 {
+        if self.vertex_count == 0 || self.walked {
             return;
         }
         let Some(pipeline) = &self.frame_pipeline else { return };
