@@ -62,8 +62,9 @@ fn cloud_gradient(k: u32, c: VolumeUniforms, uvw: vec3<f32>) -> vec3<f32> {
     return world_gradient(c, g_tex);
 }
 
-// One sample of cloud k at p (its object's frame): the premultiplied colour, alpha < 0 where it
-// is invisible or cut away.
+// One sample of cloud k at p (its object's frame): the premultiplied colour, alpha < 0 where
+// it is invisible or cut away. (One body for every cloud: with a copy per cloud inlined,
+// lavapipe's rasteriser threads crash.)
 fn sample_cloud(k: u32, p: vec3<f32>, from_eye: vec3<f32>) -> vec4<f32> {
     let c = cloud_uniforms(k);
     if ((c.tf_bits & TF_CLIP) != 0u && dot(c.clip.xyz, p) > c.clip.w) {
@@ -92,6 +93,10 @@ var<private> depth_w: array<vec4<f32>, 4>;
 var<private> next_depth: array<f32, 4>;
 
 const NO_SAMPLE: f32 = 2.0;
+
+// Where less than this gets through, what lies behind cannot change the pixel by half a level
+// of 255: the walk ends there.
+const OPAQUE_ENOUGH: f32 = 0.002;
 
 fn sample_point(k: u32) -> vec3<f32> {
     let planes = ray_planes[k];
@@ -215,6 +220,9 @@ fn fs_interleave(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
             walk.through *= 1.0 - c.a;
             cloud += cloud_through * c.rgb;
             cloud_through *= 1.0 - c.a;
+            if (!PREDRAWN && max(max(walk.through.r, walk.through.g), walk.through.b) < OPAQUE_ENOUGH) {
+                return vec4<f32>(walk.color, 1.0);
+            }
         }
         z = nearest_depth();
     }
@@ -245,6 +253,9 @@ fn fs_clouds(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
         if (c.a > 0.0) {
             color += through * c.rgb;
             through *= 1.0 - c.a;
+            if (through < OPAQUE_ENOUGH) {
+                break;
+            }
         }
         z = nearest_depth();
     }

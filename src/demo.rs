@@ -77,6 +77,22 @@ pub fn cycloaddition() -> Result<Vec<(Document, ObjectState)>, LoadError> {
         ("butadiene.molden.gz", BUTADIENE_MOLDEN_GZ, false, [0.9, 0.2, 0.12], [0.15, 0.35, 0.95]),
         ("so2.molden.gz", SO2_MOLDEN_GZ, true, [0.95, 0.7, 0.15], [0.2, 0.8, 0.4]),
     ];
+    parts
+        .into_iter()
+        .map(|(name, bytes, lumo, positive, negative)| {
+            let doc = formats::load_bytes(Path::new(name), bytes)?;
+            let wf = doc.wavefunction.as_ref();
+            let orbital = wf.and_then(|wf| if lumo { wf.lumo(Spin::Alpha) } else { wf.homo(Spin::Alpha) });
+            let state = density_and_orbital(orbital, positive, negative);
+            Ok((doc, state))
+        })
+        .collect()
+}
+
+/// An object showing its total density and orbital `orbital` (when given) as translucent
+/// surfaces that glow where they meet another molecule's, coloured `positive` and `negative`
+/// (the demo's look); their clouds hidden.
+pub fn density_and_orbital(orbital: Option<usize>, positive: [f32; 3], negative: [f32; 3]) -> ObjectState {
     let surface = |level, positive_color, negative_color, density_color| IsosurfaceSettings {
         visible: true,
         level: IsoLevel::Absolute(level),
@@ -87,32 +103,24 @@ pub fn cycloaddition() -> Result<Vec<(Document, ObjectState)>, LoadError> {
         optics: OpticsPreset::Koide,
         ..IsosurfaceSettings::default()
     };
-    parts
-        .into_iter()
-        .map(|(name, bytes, lumo, positive, negative)| {
-            let doc = formats::load_bytes(Path::new(name), bytes)?;
-            let wf = doc.wavefunction.as_ref();
-            let orbital = wf.and_then(|wf| if lumo { wf.lumo(Spin::Alpha) } else { wf.homo(Spin::Alpha) });
-            let quantity = |source, iso| QuantityState {
-                source,
-                visible: true,
-                cloud: VolumeSettings { visible: false, ..VolumeSettings::default() },
-                isosurfaces: vec![iso],
-                pane: None,
-            };
-            let density = quantity(
-                Source::Wavefunction(Quantity::Density),
-                surface(DEMO_DENSITY_LEVEL, positive, negative, [0.62, 0.66, 0.72]),
-            );
-            let mut state = ObjectState { quantities: vec![density], ..ObjectState::default() };
-            if let Some(i) = orbital {
-                let iso = surface(DEMO_ORBITAL_LEVEL, positive, negative, positive);
-                state.quantities.push(quantity(Source::Wavefunction(Quantity::Orbital(i)), iso));
-                state.selected = 1;
-            }
-            Ok((doc, state))
-        })
-        .collect()
+    let quantity = |source, iso| QuantityState {
+        source,
+        visible: true,
+        cloud: VolumeSettings { visible: false, ..VolumeSettings::default() },
+        isosurfaces: vec![iso],
+        pane: None,
+    };
+    let density = quantity(
+        Source::Wavefunction(Quantity::Density),
+        surface(DEMO_DENSITY_LEVEL, positive, negative, [0.62, 0.66, 0.72]),
+    );
+    let mut state = ObjectState { quantities: vec![density], ..ObjectState::default() };
+    if let Some(i) = orbital {
+        let iso = surface(DEMO_ORBITAL_LEVEL, positive, negative, positive);
+        state.quantities.push(quantity(Source::Wavefunction(Quantity::Orbital(i)), iso));
+        state.selected = 1;
+    }
+    state
 }
 
 /// The demo's density surface (a.u.): close around the nuclei, so the orbitals' lobes stand out

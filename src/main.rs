@@ -30,6 +30,8 @@ mod quantities_cli;
 mod render_cli;
 #[path = "cli/scan.rs"]
 mod scan_cli;
+#[path = "cli/scene.rs"]
+mod scene_cli;
 #[path = "cli/structure.rs"]
 mod structure_cli;
 #[path = "cli/surface.rs"]
@@ -343,6 +345,9 @@ enum BenchCommand {
     /// ms to build a molecular surface (Gaussian, solvent-excluded) of a file's atoms, and ms
     /// per frame drawing it.
     Surface(molsurface_cli::SurfaceBench),
+    /// ms from a change to the coarse preview and to the full picture of several molecules
+    /// with clouds and translucent surfaces.
+    Scene(scene_cli::SceneBench),
 }
 
 #[derive(Args)]
@@ -728,6 +733,7 @@ fn main() -> Result<()> {
         Some(Command::Bench(BenchCommand::Spheres(args))) => structure_cli::bench_spheres(&args),
         Some(Command::Bench(BenchCommand::Surfaces(args))) => surface_cli::bench_translucent(&args),
         Some(Command::Bench(BenchCommand::Surface(args))) => molsurface_cli::bench(&args),
+        Some(Command::Bench(BenchCommand::Scene(args))) => scene_cli::bench(&args),
         Some(Command::Bench(BenchCommand::Render { file, view, frames, lavapipe, wavefunction })) => {
             render_cli::bench(file.as_deref(), &view, frames, lavapipe, &wavefunction)
         }

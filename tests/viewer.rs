@@ -500,6 +500,8 @@ fn direct_mode_draws_in_bands_and_the_window_keeps_answering() {
     // 96 basis functions per sample: the frame is drawn band by band, each UI frame short.
     let (mut steps, mut slowest, mut seen) = (0, 0.0f64, Vec::new());
     h.run_steps(1);
+    // The coarse picture stands in at once while the full one fills in.
+    assert!(h.state().frame_progress().is_some() && h.state().previewing(), "a preview while the frame is drawn");
     while let Some(p) = h.state().frame_progress() {
         seen.push(p);
         let t = std::time::Instant::now();
@@ -521,6 +523,7 @@ fn direct_mode_draws_in_bands_and_the_window_keeps_answering() {
     let after = &seen[4.min(seen.len())..];
     assert!(after.len() >= 2 && after.windows(2).all(|w| w[1] >= w[0]), "the picture fills in: {seen:?}");
     assert!(slowest < 1.5, "a UI frame took {slowest:.2} s");
+    assert!(!h.state().previewing(), "the full picture replaced the preview");
 }
 
 #[test]

@@ -3,7 +3,7 @@
 //! a CPU rasteriser fewer pixels too, which the texture filter scales up. The full picture
 //! returns with the first frame after.
 
-use crate::scene::VolumeSettings;
+pub use crate::scene::detail::Detail;
 
 /// Slices per view at most while interacting.
 pub const INTERACTIVE_SLICES: u32 = 64;
@@ -65,19 +65,7 @@ pub fn adjust(scale: f32, frame_ms: f64) -> f32 {
     next.clamp(1.0, LodBudget::MAX)
 }
 
-/// What one view draws this frame.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Detail {
-    pub max_slices: u32,
-    /// At most this many pixels; the view's size is scaled down to fit, keeping its aspect.
-    pub max_pixels: u32,
-    /// The factor on surfaces' level-of-detail thresholds (seed 002).
-    pub lod_scale: f32,
-}
-
 impl Detail {
-    pub const FULL: Self = Self { max_slices: u32::MAX, max_pixels: u32::MAX, lod_scale: 1.0 };
-
     /// The detail for each of `views` views: full when `interacting` is false.
     pub fn for_frame(interacting: bool, adapter: wgpu::DeviceType, views: usize) -> Self {
         if !interacting {
@@ -88,22 +76,6 @@ impl Detail {
             _ => u32::MAX,
         };
         Self { max_slices: INTERACTIVE_SLICES, max_pixels, lod_scale: INTERACTIVE_LOD_SCALE }
-    }
-
-    /// The size to render a view shown at `size` pixels.
-    pub fn render_size(&self, size: [u32; 2]) -> [u32; 2] {
-        let pixels = size[0] as f64 * size[1] as f64;
-        if pixels <= self.max_pixels as f64 {
-            return size;
-        }
-        let scale = (self.max_pixels as f64 / pixels).sqrt();
-        size.map(|s| ((s as f64 * scale).floor() as u32).max(1))
-    }
-
-    /// `cloud` with the slice count capped.
-    pub fn cloud(&self, mut cloud: VolumeSettings) -> VolumeSettings {
-        cloud.slices = cloud.slices.min(self.max_slices);
-        cloud
     }
 }
 
@@ -116,6 +88,7 @@ pub fn interacting(ctx: &egui::Context, playing: bool) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::VolumeSettings;
 
     #[test]
     fn still_frames_are_full() {

@@ -494,6 +494,11 @@ impl OrbApp {
         self.viewport.as_ref()?.progress()
     }
 
+    /// Whether a coarse picture stands in while the single-file view's costly frame is drawn.
+    pub fn previewing(&self) -> bool {
+        self.viewport.as_ref().is_some_and(|vp| vp.is_previewing())
+    }
+
     /// What the single-file view's translucent surfaces took (fragments, bands).
     pub fn fragment_note(&self) -> Option<String> {
         self.viewport.as_ref()?.fragment_note()

@@ -83,6 +83,11 @@ pub struct Twist {
 const FRAME_BUDGET: Duration = Duration::from_millis(40);
 const BAND_TIME: Duration = Duration::from_millis(25);
 
+/// A full picture slower than this gets a coarse preview at once after the next change.
+const PREVIEW_AFTER_MS: f64 = 300.0;
+/// A picture still being drawn after this shows its progress.
+const PROGRESS_AFTER: Duration = Duration::from_millis(150);
+
 /// A costly frame being drawn in bands: the first row not drawn yet, and rows per band.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Progress {
@@ -94,6 +99,50 @@ struct Progress {
 fn coarser(doc: &Document, i: usize, step: usize) -> Option<String> {
     let grid = doc.volumes.get(i).filter(|_| step > 1)?;
     Some(crate::layers::coarser_note(&doc.source, grid.dims, step))
+}
+
+/// Makes `slot` an offscreen target of `size` shown through an egui texture (the texture id is
+/// kept across sizes); true when it was made anew.
+fn sized_target(
+    slot: &mut Option<(OffscreenTarget, egui::TextureId)>,
+    device: &wgpu::Device,
+    render_state: &egui_wgpu::RenderState,
+    size: [u32; 2],
+) -> bool {
+    if slot.as_ref().is_some_and(|(t, _)| t.size == size) {
+        return false;
+    }
+    let target = OffscreenTarget::new(device, size);
+    let mut egui_renderer = render_state.renderer.write();
+    let id = match slot.take() {
+        Some((_, id)) => {
+            egui_renderer.update_egui_texture_from_wgpu_texture(
+                device,
+                &target.encoded_view,
+                wgpu::FilterMode::Linear,
+                id,
+            );
+            id
+        }
+        None => egui_renderer.register_native_texture(device, &target.encoded_view, wgpu::FilterMode::Linear),
+    };
+    *slot = Some((target, id));
+    true
+}
+
+/// A thin bar along the bottom of the view, `done` (0..1) of it filled, and the words.
+fn progress_bar(painter: &egui::Painter, rect: egui::Rect, done: f32) {
+    let bar = egui::Rect::from_min_max(egui::pos2(rect.left(), rect.bottom() - 4.0), rect.right_bottom());
+    painter.rect_filled(bar, 0.0, egui::Color32::from_black_alpha(140));
+    let filled = egui::Rect::from_min_size(bar.min, egui::vec2(bar.width() * done.clamp(0.0, 1.0), bar.height()));
+    painter.rect_filled(filled, 0.0, egui::Color32::from_rgb(90, 160, 255));
+    painter.text(
+        bar.left_top() + egui::vec2(6.0, -4.0),
+        egui::Align2::LEFT_BOTTOM,
+        format!("refining {:.0} %", 100.0 * done),
+        egui::FontId::proportional(12.0),
+        egui::Color32::from_gray(220),
+    );
 }
 
 /// Screen distance (points) within which a press grabs the rotatable bond.
@@ -202,6 +251,11 @@ pub struct Viewport {
     grabbed: bool,
     /// A costly frame being drawn band by band, and how many rows the last band drew.
     progress: Option<Progress>,
+    /// The coarse picture shown while a costly frame is drawn ([`Detail::PREVIEW`]), whether
+    /// it stands in now, and whether the last full picture took long enough to want one.
+    preview: Option<(OffscreenTarget, egui::TextureId)>,
+    previewing: bool,
+    last_full_slow: bool,
     band_rows: u32,
     /// The scan frame shown: (θ, interpolation), for tests and redraws.
     pub scan_shown: Option<(f64, crate::scene::Interpolation)>,
@@ -249,6 +303,9 @@ impl Viewport {
             grabbed: false,
             scan_shown: None,
             progress: None,
+            preview: None,
+            previewing: false,
+            last_full_slow: true,
             band_rows: 8,
             scan_iso: None,
             awaiting_fragments: false,
@@ -977,43 +1034,33 @@ impl Viewport {
         }
         self.shown_size = Some(size);
         let drawn = *view;
+        let shown = size;
         let size = self.detail.render_size(size);
-        if self.target.as_ref().is_none_or(|(t, _)| t.size != size) {
-            let target = OffscreenTarget::new(&self.ctx.device, size);
-            let mut egui_renderer = render_state.renderer.write();
-            let id = match self.target.take() {
-                Some((_, id)) => {
-                    egui_renderer.update_egui_texture_from_wgpu_texture(
-                        &self.ctx.device,
-                        &target.encoded_view,
-                        wgpu::FilterMode::Linear,
-                        id,
-                    );
-                    id
-                }
-                None => egui_renderer.register_native_texture(
-                    &self.ctx.device,
-                    &target.encoded_view,
-                    wgpu::FilterMode::Linear,
-                ),
-            };
-            self.target = Some((target, id));
+        if sized_target(&mut self.target, &self.ctx.device, render_state, size) {
             self.drawn = None;
         }
         let clouds: Vec<VolumeSettings> = self.clouds.iter().map(|&c| self.detail.cloud(c)).collect();
         self.renderer.set_lod_scale(self.detail.lod_scale);
         let key = (drawn, clouds, size, self.generation, self.detail.lod_scale.to_bits());
-        if let Some((target, id)) = &self.target {
-            let changed = self.drawn.as_ref() != Some(&key);
-            if changed {
-                self.picture_started = Some(Instant::now());
-                // A costly frame (orbitals evaluated per sample, or any frame on a CPU rasteriser)
-                // is drawn in bands over several UI frames, so the window answers while the
-                // picture fills in; a cheap one still takes one band.
-                let cpu = self.ctx.info.device_type == wgpu::DeviceType::Cpu;
-                self.progress =
-                    (cpu || self.renderer.is_costly()).then_some(Progress { next_row: 0, rows: self.band_rows });
+        let changed = self.drawn.as_ref() != Some(&key);
+        if changed && self.target.is_some() {
+            self.picture_started = Some(Instant::now());
+            // A costly frame (orbitals evaluated per sample, or any frame on a CPU rasteriser)
+            // is drawn in bands over several UI frames, so the window answers while the
+            // picture fills in; a cheap one still takes one band.
+            let cpu = self.ctx.info.device_type == wgpu::DeviceType::Cpu;
+            self.progress =
+                (cpu || self.renderer.is_costly()).then_some(Progress { next_row: 0, rows: self.band_rows });
+            // Until then a coarse picture of the whole view stands in, drawn at once; a frame
+            // already drawn coarse (a drag) needs none.
+            self.previewing = self.progress.is_some()
+                && self.detail == Detail::FULL
+                && (self.last_full_slow || self.renderer.is_costly());
+            if self.previewing {
+                self.draw_preview(render_state, &key.0, shown);
             }
+        }
+        if let Some((target, id)) = &self.target {
             if changed || self.progress.is_some() {
                 let frame = FrameInput {
                     camera: &key.0.camera,
@@ -1053,6 +1100,9 @@ impl Viewport {
                         if p.next_row >= size[1] {
                             self.progress = None;
                             self.picture_ms = self.picture_started.take().map(|t| t.elapsed().as_secs_f64() * 1e3);
+                            if self.detail == Detail::FULL {
+                                self.last_full_slow = self.picture_ms.is_some_and(|ms| ms > PREVIEW_AFTER_MS);
+                            }
                         } else {
                             ui.ctx().request_repaint();
                         }
@@ -1065,7 +1115,28 @@ impl Viewport {
                 }
             }
             let uv = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
-            ui.painter().image(*id, rect, uv, egui::Color32::WHITE);
+            let painter = ui.painter();
+            match (&self.preview, self.progress) {
+                (Some((_, coarse)), Some(p)) if self.previewing => {
+                    // The coarse picture, with the rows of the full one drawn so far over it.
+                    painter.image(*coarse, rect, uv, egui::Color32::WHITE);
+                    let done = p.next_row as f32 / size[1].max(1) as f32;
+                    let top = egui::Rect::from_min_size(rect.min, egui::vec2(rect.width(), rect.height() * done));
+                    painter.image(
+                        *id,
+                        top,
+                        egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, done)),
+                        egui::Color32::WHITE,
+                    );
+                }
+                _ => {
+                    painter.image(*id, rect, uv, egui::Color32::WHITE);
+                }
+            }
+            let slow = self.picture_started.is_some_and(|t| t.elapsed() > PROGRESS_AFTER);
+            if let Some(p) = self.progress.filter(|_| self.previewing || slow) {
+                progress_bar(painter, rect, p.next_row as f32 / size[1].max(1) as f32);
+            }
         }
         self.check_fragments(ui.ctx());
         self.layout = Some((rect, size));
@@ -1104,6 +1175,28 @@ impl Viewport {
 
     /// Reads the last frame's fragment counts once they are back: a frame whose lists
     /// overflowed is drawn again, in as many bands as it needs.
+    /// Draws the coarse picture of `view` for a view shown at `shown` pixels into the preview
+    /// target, at once.
+    fn draw_preview(&mut self, render_state: &egui_wgpu::RenderState, view: &ViewState, shown: [u32; 2]) {
+        let detail = Detail::PREVIEW;
+        let size = detail.render_size(shown);
+        sized_target(&mut self.preview, &self.ctx.device, render_state, size);
+        let Some((target, _)) = &self.preview else { return };
+        let clouds: Vec<VolumeSettings> = self.clouds.iter().map(|&c| detail.cloud(c)).collect();
+        self.renderer.set_lod_scale(detail.lod_scale);
+        let frame = FrameInput { camera: &view.camera, background: view.background, clouds: &clouds, size, tile: None };
+        let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
+        self.renderer.render(&self.ctx, &mut encoder, &target.color_view, &frame);
+        self.ctx.queue.submit([encoder.finish()]);
+        let _ = self.ctx.device.poll(wgpu::PollType::wait_indefinitely());
+        self.renderer.set_lod_scale(self.detail.lod_scale);
+    }
+
+    /// Whether a coarse picture stands in while the full one is drawn.
+    pub fn is_previewing(&self) -> bool {
+        self.previewing && self.progress.is_some()
+    }
+
     fn check_fragments(&mut self, ctx: &egui::Context) {
         if !self.awaiting_fragments {
             return;

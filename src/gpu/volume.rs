@@ -718,14 +718,7 @@ impl VolumePass {
             clip: clip_normal.extend(clip_normal.dot(box_centre) + settings.clip.offset).to_array(),
             light: view.light.extend(0.0).to_array(),
             world_from_clip: view.clip_from_object.inverse().to_cols_array_2d(),
-            box_from_world: glam::Mat4::from_cols(
-                vol.grid_box.edges[0].extend(0.0),
-                vol.grid_box.edges[1].extend(0.0),
-                vol.grid_box.edges[2].extend(0.0),
-                vol.grid_box.origin.extend(1.0),
-            )
-            .inverse()
-            .to_cols_array_2d(),
+            box_from_world: walked_box(&vol.grid_box, cells.as_ref()).inverse().to_cols_array_2d(),
             slab: [nearest, planes, size[0] as f32, size[1] as f32],
         };
         queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
@@ -820,6 +813,20 @@ fn walk_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
         count: None,
     });
     entries
+}
+
+/// The box a walk samples the cloud in, as the map from the unit cube: the slices' box, cut to
+/// the occupied cells where some are empty.
+fn walked_box(grid_box: &GridBox, cells: Option<&Occupancy>) -> Mat4 {
+    let e = grid_box.edges;
+    let (lo, hi) = cells.and_then(Occupancy::occupied_bounds).unwrap_or(([0.0; 3], [1.0; 3]));
+    let origin = grid_box.origin + lo[0] * e[0] + lo[1] * e[1] + lo[2] * e[2];
+    Mat4::from_cols(
+        ((hi[0] - lo[0]) * e[0]).extend(0.0),
+        ((hi[1] - lo[1]) * e[1]).extend(0.0),
+        ((hi[2] - lo[2]) * e[2]).extend(0.0),
+        origin.extend(1.0),
+    )
 }
 
 /// The bits of `VolumeUniforms::tf_bits` (volume_common.wgsl's TF_*).

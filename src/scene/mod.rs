@@ -2,6 +2,7 @@
 
 pub mod camera;
 pub mod coloring;
+pub mod detail;
 pub mod framing;
 pub mod molsurface;
 pub mod objects;

@@ -119,6 +119,24 @@ impl Occupancy {
         Some(Self { cuts, occupied: flags, surface })
     }
 
+    /// The box around the occupied cells, as fractions of the edges (lo, hi); `None` when no
+    /// cell is.
+    pub fn occupied_bounds(&self) -> Option<([f32; 3], [f32; 3])> {
+        let [ni, nj, nk] = self.cuts.each_ref().map(|c| c.len() - 1);
+        let mut bounds: Option<([f32; 3], [f32; 3])> = None;
+        for (n, _) in self.occupied.iter().enumerate().filter(|(_, o)| **o) {
+            let cell = [n / (nj * nk), (n / nk) % nj, n % nk];
+            debug_assert!(cell[0] < ni);
+            let lo: [f32; 3] = std::array::from_fn(|a| self.cuts[a][cell[a]]);
+            let hi: [f32; 3] = std::array::from_fn(|a| self.cuts[a][cell[a] + 1]);
+            bounds = Some(match bounds {
+                None => (lo, hi),
+                Some((l, h)) => (std::array::from_fn(|a| l[a].min(lo[a])), std::array::from_fn(|a| h[a].max(hi[a]))),
+            });
+        }
+        bounds
+    }
+
     /// Whether every cell is occupied (skipping would only add triangles).
     pub fn is_full(&self) -> bool {
         self.occupied.iter().all(|&o| o)

@@ -1,0 +1,167 @@
+//! `orbcloud bench scene`: how long a scene of several molecules with clouds and translucent
+//! surfaces takes to show after a change, as the window shows it on a slow adapter: the coarse
+//! preview at once, then the full picture.
+
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use clap::Args;
+use orbcloud::gpu::{FrameInput, OffscreenTarget, Renderer};
+use orbcloud::headless::draw_exact;
+use orbcloud::layers::show_scene;
+use orbcloud::scene::detail::Detail;
+use orbcloud::scene::{Camera, ObjectState, Placement};
+
+#[derive(Args)]
+pub struct SceneBench {
+    /// Files of the molecules, each shown with its density and HOMO; the bundled diene + SO₂
+    /// demo's molecules when none are given.
+    files: Vec<std::path::PathBuf>,
+    /// Molecules in the scene: the files (or the demo's) in turn, copies placed beside.
+    #[arg(long, default_value_t = 3)]
+    molecules: usize,
+    /// Also write the scene as a session the viewer opens (its files given by path).
+    #[arg(long)]
+    session: Option<std::path::PathBuf>,
+    /// Grid points per side of each evaluated quantity.
+    #[arg(long, default_value_t = 64)]
+    points: usize,
+    #[command(flatten)]
+    bench: super::BenchFrames,
+    /// Write the last preview and full picture here (preview.png, full.png).
+    #[arg(long)]
+    images: Option<std::path::PathBuf>,
+}
+
+/// The molecules of `files` (each with its density and HOMO) or of the demo, each quantity with
+/// its cloud shown beside its translucent surface, repeated to `count` molecules in a row along
+/// x, 4 bohr apart.
+fn molecules(files: &[std::path::PathBuf], count: usize) -> Result<Vec<(orbcloud::model::Document, ObjectState)>> {
+    const COLOURS: [([f32; 3], [f32; 3]); 3] = [
+        ([0.9, 0.2, 0.12], [0.15, 0.35, 0.95]),
+        ([0.95, 0.7, 0.15], [0.2, 0.8, 0.4]),
+        ([0.85, 0.3, 0.8], [0.2, 0.75, 0.75]),
+    ];
+    let demo = match files {
+        [] => orbcloud::demo::cycloaddition()?,
+        _ => (files.iter().zip(COLOURS.iter().cycle()))
+            .map(|(path, &(positive, negative))| {
+                let doc = orbcloud::formats::load(path)?;
+                let homo = doc.wavefunction.as_ref().and_then(|wf| wf.homo(orbcloud::model::orbitals::Spin::Alpha));
+                let state = ObjectState {
+                    path: Some(std::fs::canonicalize(path)?),
+                    ..orbcloud::demo::density_and_orbital(homo, positive, negative)
+                };
+                Ok((doc, state))
+            })
+            .collect::<Result<_>>()?,
+    };
+    let mut scene = Vec::new();
+    let mut right = f32::NEG_INFINITY;
+    for n in 0..count {
+        let (doc, mut state) = demo[n % demo.len()].clone();
+        for q in &mut state.quantities {
+            q.cloud.visible = true;
+        }
+        let (lo, hi) = doc.bounds().context("the demo has atoms")?;
+        // The demo's two molecules stand as the demo places them; any other beside the last.
+        if n > 0 && (!files.is_empty() || n >= demo.len()) {
+            state.placement = Placement::beside(right, lo.as_vec3(), 4.0);
+        }
+        right = right.max(state.placement.world_from_object().transform_point3(hi.as_vec3()).x);
+        scene.push((doc, state));
+    }
+    Ok(scene)
+}
+
+/// The placed atoms' bounds over the scene.
+fn scene_bounds(scene: &[(orbcloud::model::Document, ObjectState)]) -> Option<(glam::Vec3, glam::Vec3)> {
+    scene
+        .iter()
+        .filter_map(|(doc, state)| {
+            let (lo, hi) = doc.bounds()?;
+            let m = state.placement.world_from_object();
+            let corners =
+                orbcloud::model::octree::box_corners(lo.as_vec3(), hi.as_vec3()).map(|c| m.transform_point3(c));
+            Some(corners.iter().fold((corners[0], corners[0]), |(l, h), &c| (l.min(c), h.max(c))))
+        })
+        .reduce(|(l, h), (a, b)| (l.min(a), h.max(b)))
+}
+
+pub fn bench(args: &SceneBench) -> Result<()> {
+    let ctx = super::gpu(args.bench.lavapipe)?;
+    let scene = molecules(&args.files, args.molecules.max(1))?;
+    if let Some(path) = &args.session {
+        let (lo, hi) = scene_bounds(&scene).context("the scene has no atoms")?;
+        let session = orbcloud::scene::Session {
+            camera: Camera::framing(lo, hi),
+            objects: scene.iter().map(|(_, s)| s.clone()).collect(),
+            ..Default::default()
+        };
+        let text = toml::to_string(&session).context("writing the session")?;
+        std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))?;
+    }
+    let mut renderer = Renderer::new(&ctx);
+    let shown = show_scene(&ctx, &mut renderer, &scene, args.points)?;
+    let (lo, hi) = scene_bounds(&scene).context("the scene has no atoms")?;
+    let camera = Camera::framing(lo, hi);
+    let size = args.bench.size;
+    let quantities: usize = scene.iter().map(|(_, s)| s.quantities.len()).sum();
+    println!("adapter: {}", ctx.describe());
+    println!(
+        "scene: {} molecules, {quantities} quantities (clouds with translucent surfaces), {}³ points each, {}x{}",
+        scene.len(),
+        args.points,
+        size[0],
+        size[1]
+    );
+    // One picture at `detail` after the camera moved by `f` steps: ms from the change to the
+    // picture done, and the picture.
+    let mut picture = |detail: Detail, f: u32| -> Result<(f64, image::RgbaImage)> {
+        let mut cam = camera;
+        cam.orbit(0.05 * f as f32, 0.02 * f as f32);
+        let size = detail.render_size(size);
+        let clouds: Vec<_> = shown.clouds.iter().map(|&c| detail.cloud(c)).collect();
+        let target = OffscreenTarget::new(&ctx.device, size);
+        renderer.set_lod_scale(detail.lod_scale);
+        let start = Instant::now();
+        let frame = FrameInput { camera: &cam, background: [0.02, 0.02, 0.03], clouds: &clouds, size, tile: None };
+        draw_exact(&ctx, &mut renderer, &target.color_view, &frame);
+        ctx.device.poll(wgpu::PollType::wait_indefinitely())?;
+        let ms = start.elapsed().as_secs_f64() * 1e3;
+        Ok((ms, target.read_rgba(&ctx.device, &ctx.queue)?))
+    };
+    // Warm up: every pipeline built once, at both sizes.
+    picture(Detail::PREVIEW, 0)?;
+    picture(Detail::FULL, 0)?;
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let (mut previews, mut fulls) = (Vec::new(), Vec::new());
+    let mut last = None;
+    for f in 1..=args.bench.frames.max(1) {
+        let (preview_ms, preview) = picture(Detail::PREVIEW, f)?;
+        let (full_ms, full) = picture(Detail::FULL, f)?;
+        previews.push(preview_ms);
+        fulls.push(preview_ms + full_ms);
+        last = Some((preview, full));
+    }
+    let preview_size = Detail::PREVIEW.render_size(size);
+    println!(
+        "preview ({}x{}, at most {} slices a cloud): {:.0} ms after a change",
+        preview_size[0],
+        preview_size[1],
+        Detail::PREVIEW.max_slices,
+        median(previews)
+    );
+    println!("full picture: {:.0} ms after a change (the preview's time included)", median(fulls));
+    if let (Some(dir), Some((preview, full))) = (&args.images, last) {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        for (name, img) in [("preview", preview), ("full", full)] {
+            let path = dir.join(format!("{name}.png"));
+            img.save(&path).with_context(|| format!("writing {}", path.display()))?;
+        }
+    }
+    Ok(())
+}
