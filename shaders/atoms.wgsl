@@ -85,11 +85,35 @@ fn vs_sphere(@builtin(vertex_index) vi: u32, @builtin(instance_index) k: u32) ->
 @fragment
 fn fs_sphere(in: SphereOut) -> FragOut {
     let d = in.world - g.eye.xyz;
-    let t = hit_sphere(d, positions[in.atom].xyz, radius_of(in.atom));
+    let centre = positions[in.atom].xyz;
+    let radius = radius_of(in.atom);
+    let t = hit_sphere(d, centre, radius);
     if (t < 0.0) {
         discard;
     }
+    if (beyond_cut(g.eye.xyz + d * t) > 0.0) {
+        // Cut away where the ray enters: the cut face, where the ray crosses the plane inside.
+        let p = g.eye.xyz + d * cut_crossing(d);
+        if (dot(g.cut.xyz, d) >= 0.0 || distance(p, centre) > radius) {
+            discard;
+        }
+        return cut_face(in.atom, d, p);
+    }
     return sphere_fragment(in.atom, d, t);
+}
+
+// The ray parameter where the ray eye + t·d crosses the clipping plane.
+fn cut_crossing(d: vec3<f32>) -> f32 {
+    return (g.cut.w - dot(g.cut.xyz, g.eye.xyz)) / dot(g.cut.xyz, d);
+}
+
+// The flat face the clipping plane leaves of atom i's sphere or half-bond, at `p`.
+fn cut_face(i: u32, d: vec3<f32>, p: vec3<f32>) -> FragOut {
+    var out: FragOut;
+    out.color = vec4<f32>(cued(shade(color_of(i), g.cut.xyz, -normalize(d)), p), 1.0);
+    out.id = g.pick.x | i;
+    out.depth = depth_of(p);
+    return out;
 }
 
 // ---- spheres the compute rasteriser drew ----
@@ -182,6 +206,16 @@ fn fs_cylinder(in: CylinderOut) -> FragOut {
     if (h < 0.0 || h > len) {
         discard;
     }
+    if (beyond_cut(hit) > 0.0) {
+        // Cut away where the ray enters: the cut face, where the ray crosses the plane inside.
+        let p = ro + rd * cut_crossing(rd);
+        let hp = dot(p - p0, a);
+        let off_axis = length(p - p0 - a * hp);
+        if (dot(g.cut.xyz, rd) >= 0.0 || off_axis > radius || hp < 0.0 || hp > len) {
+            discard;
+        }
+        return cut_face(select(in.atoms.y, in.atoms.x, hp < 0.5 * len), rd, p);
+    }
     // The half nearer an atom is that atom's: its colour, and picking it picks the atom.
     let atom = select(in.atoms.y, in.atoms.x, h < 0.5 * len);
     let n = normalize(hit - p0 - a * h);
@@ -225,6 +259,9 @@ fn vs_line(@builtin(vertex_index) vi: u32, @builtin(instance_index) b: u32) -> L
 
 @fragment
 fn fs_line(in: LineOut) -> LineFrag {
+    if (beyond_cut(in.world) > 0.0) {
+        discard;
+    }
     var out: LineFrag;
     out.color = vec4<f32>(cued(color_of(in.atom), in.world), 1.0);
     out.id = g.pick.x | in.atom;

@@ -41,6 +41,9 @@ struct Globals {
     // through ndc reaches clip zw = clip_zw.xy + t·(ray_zw.xy + ndc.x·ray_zw.zw + ndc.y·ray_zw_y.xy).
     ray_zw: vec4<f32>,
     ray_zw_y: vec4<f32>,
+    // The object's clipping plane when it cuts atoms (xyz: unit normal, w: distance): points p
+    // with dot(xyz, p) > w are cut away; (0, 0, 0, 1e30) cuts nothing.
+    cut: vec4<f32>,
 };
 
 // Words before the lists in `lists`: the spheres' and the bonds' indirect draws, then the cell
@@ -116,6 +119,11 @@ fn hit_sphere(d: vec3<f32>, center: vec3<f32>, radius: f32) -> f32 {
         return -1.0;
     }
     return (-b - sqrt(disc)) / a;
+}
+
+// How far beyond the clipping plane `p` lies (> 0: cut away).
+fn beyond_cut(p: vec3<f32>) -> f32 {
+    return dot(g.cut.xyz, p) - g.cut.w;
 }
 
 fn depth_of(world: vec3<f32>) -> f32 {

@@ -45,7 +45,7 @@ fn index_of(gid: vec3<u32>) -> u32 {
 
 struct Screen {
     // x, y: pixel position of the centre; z: projected radius (px); w: 0 culled, 1 splat,
-    // 2 quad, 3 quad through the eye's plane
+    // 2 quad, 3 quad through the eye's plane, 4 quad cut by the clipping plane
     p: vec4<f32>,
     // The centre (bohr) and the radius the rasteriser draws (never under half a pixel)
     centre: vec3<f32>,
@@ -63,6 +63,12 @@ fn screen_of(i: u32) -> Screen {
         return s;
     }
     s.centre = positions[i].xyz;
+    // Wholly beyond the clipping plane: culled; crossing it: a quad, which draws the cut face
+    // (and is no occluder).
+    let beyond = beyond_cut(s.centre);
+    if (beyond >= r) {
+        return s;
+    }
     let c = g.clip_from_world * vec4<f32>(s.centre, 1.0);
     s.zw = c.zw;
     s.radius = max(r, 0.5 * c.w / g.viewport.z);
@@ -80,6 +86,9 @@ fn screen_of(i: u32) -> Screen {
     }
     s.p = vec4<f32>((ndc.x + 1.0) * 0.5 * g.viewport.x, (1.0 - ndc.y) * 0.5 * g.viewport.y, r_px,
         select(2.0, 1.0, r_px <= g.viewport.w));
+    if (beyond > -r) {
+        s.p.w = 4.0;
+    }
     return s;
 }
 
@@ -431,6 +440,9 @@ fn cs_bonds(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let p0 = positions[bond.x].xyz;
     let p1 = positions[bond.y].xyz;
+    if (min(beyond_cut(p0), beyond_cut(p1)) >= g.sticks.x) {
+        return;
+    }
     // The bond's bounding sphere against the frustum; its nearer end for the thickness.
     let mid = 0.5 * (p0 + p1);
     let reach = 0.5 * length(p1 - p0) + g.sticks.x;

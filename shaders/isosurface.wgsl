@@ -11,6 +11,9 @@ struct SurfaceUniforms {
     color: vec4<f32>,
     // x: pick id
     pick: vec4<u32>,
+    // The object's clipping plane (xyz: unit normal, w: distance): points p with
+    // dot(xyz, p) > w are cut away; (0, 0, 0, 1e30) cuts nothing.
+    cut: vec4<f32>,
 };
 
 @group(0) @binding(0) var<uniform> u: SurfaceUniforms;
@@ -38,8 +41,16 @@ struct FragOut {
     @location(1) id: u32,
 };
 
+// Whether the clipping plane cuts `p` (object frame) away.
+fn cut_away(p: vec3<f32>) -> bool {
+    return dot(u.cut.xyz, p) > u.cut.w;
+}
+
 @fragment
 fn fs_main(in: VertexOut) -> FragOut {
+    if (cut_away(in.world)) {
+        discard;
+    }
     var out: FragOut;
     out.color = vec4<f32>(lit(in.world, in.normal, in.tint), 1.0);
     out.id = u.pick.x;
@@ -51,8 +62,8 @@ fn fs_main(in: VertexOut) -> FragOut {
 fn lit(world: vec3<f32>, normal: vec3<f32>, tint: vec3<f32>) -> vec3<f32> {
     let view = normalize(u.eye.xyz - world);
     var n = normalize(normal);
-    // A surface cut open by the grid's box shows its inside: light that side too, a little
-    // darker so the cut reads as one.
+    // A surface cut open by the grid's box or the clipping plane shows its inside: light that
+    // side too, a little darker so the cut reads as one.
     var inner = 1.0;
     if (dot(n, view) < 0.0) {
         n = -n;
@@ -87,6 +98,8 @@ struct SplatOut {
     @location(1) world: vec3<f32>,
     @location(2) normal: vec3<f32>,
     @location(3) tint: vec3<f32>,
+    // the point of the disc (the clipping plane cuts discs per pixel)
+    @location(4) point: vec3<f32>,
 };
 
 @vertex
@@ -118,12 +131,13 @@ fn vs_splat(
     out.world = centre;
     out.normal = normal;
     out.tint = tint;
+    out.point = world;
     return out;
 }
 
 @fragment
 fn fs_splat(in: SplatOut) -> FragOut {
-    if (dot(in.corner, in.corner) > 1.0) {
+    if (dot(in.corner, in.corner) > 1.0 || cut_away(in.point)) {
         discard;
     }
     var out: FragOut;
@@ -170,7 +184,7 @@ fn cosines(in: VertexOut) -> vec3<f32> {
 
 @fragment
 fn fs_collect(in: VertexOut) {
-    if (behind_opaque(in)) {
+    if (behind_opaque(in) || cut_away(in.world)) {
         return;
     }
     let px = vec2<u32>(in.clip.xy);
@@ -200,7 +214,7 @@ struct Weighted {
 
 @fragment
 fn fs_weighted(in: VertexOut) -> Weighted {
-    if (behind_opaque(in)) {
+    if (behind_opaque(in) || cut_away(in.world)) {
         discard;
     }
     let c = cosines(in);

@@ -3,7 +3,7 @@
 
 use crate::gpu::oit::FragmentStats;
 use crate::gpu::{FrameInput, GpuContext, GpuError, OffscreenTarget, Renderer};
-use crate::layers::{show_atoms, show_isosurfaces};
+use crate::layers::{object_centre, show_atoms, show_isosurfaces};
 use crate::model::Document;
 use crate::scene::{AtomLook, Camera, RenderSettings, VolumeSettings};
 
@@ -25,6 +25,7 @@ impl Headless {
         let mut renderer = Renderer::new(ctx);
         let layer = renderer.main();
         show_atoms(ctx, layer, doc, &AtomLook::of(settings), "");
+        layer.clip_centre = object_centre(doc);
         let grid = volume_index.and_then(|i| doc.volumes.get(i));
         layer.set_volume(ctx, grid)?;
         if let Some(grid) = grid {
@@ -35,6 +36,8 @@ impl Headless {
 
     /// Records and submits one frame (waits for it only when it has translucent surfaces).
     pub fn draw(&mut self, ctx: &GpuContext, camera: &Camera, settings: &RenderSettings) {
+        // The one layer holds the whole scene: the plane cuts all of it.
+        self.renderer.main().clip = settings.clip;
         let frame = FrameInput::single(camera, settings, self.target.size);
         draw_exact(ctx, &mut self.renderer, &self.target.color_view, &frame);
     }

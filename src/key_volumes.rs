@@ -180,6 +180,8 @@ impl ScanScene {
         let keys = &self.keys[slot];
         let layer = renderer.main();
         layer.set_morph(ctx, keys[a].clone(), keys[b].clone(), k as f32, mode);
+        // A clipping plane's offset is measured from the middle of what the sweep shows.
+        layer.clip_centre = (0.5 * (self.visible.0 + self.visible.1)).as_vec3();
         layer.set_molecule(ctx, &self.scan.geometry_at(theta), style);
     }
 
@@ -277,6 +279,7 @@ impl ScanPainter {
         let mut out = image::RgbaImage::new(size[0] * slots.len() as u32, size[1]);
         for (n, &slot) in slots.iter().enumerate() {
             scene.show(ctx, &mut self.renderer, slot, theta, mode, settings.atoms);
+            self.renderer.main().clip = settings.clip;
             let mut encoder =
                 ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("scan frame") });
             let frame = FrameInput::single(camera, settings, size);

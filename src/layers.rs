@@ -79,15 +79,23 @@ pub fn atom_look(doc: &Document, look: &AtomLook, selection: &str) -> AtomColors
 /// is added when built, its quantities have layers of their own).
 pub fn show_object_atoms(ctx: &GpuContext, layer: &mut Layer, doc: &Document, state: &ObjectState) {
     show_atoms(ctx, layer, doc, &state.atoms, &state.selection);
+    layer.clip_centre = object_centre(doc);
     layer.volume.set_texture(ctx, None);
     layer.surfaces.clear();
     place_layer(layer, state, Part::Atoms);
 }
 
-/// Gives `layer`, which draws `part` of the object `state` describes, the object's placement
-/// and whether it is drawn (the object's visibility, and the quantity's).
+/// The point an object's clipping plane is measured from: the centre of `doc`'s bounds (its
+/// atoms and grids), in the object's frame.
+pub fn object_centre(doc: &Document) -> glam::Vec3 {
+    doc.bounds().map_or(glam::Vec3::ZERO, |(lo, hi)| (0.5 * (lo + hi)).as_vec3())
+}
+
+/// Gives `layer`, which draws `part` of the object `state` describes, the object's placement,
+/// its clipping plane and whether it is drawn (the object's visibility, and the quantity's).
 pub fn place_layer(layer: &mut Layer, state: &ObjectState, part: Part) {
     layer.world_from_object = state.placement.world_from_object();
+    layer.clip = state.clip;
     layer.visible = state.visible
         && match part {
             Part::Atoms => true,
@@ -143,6 +151,7 @@ pub fn show_quantity(
 ) -> Result<ShownQuantity, GpuError> {
     layer.clear(ctx);
     place_layer(layer, state, Part::Quantity(k));
+    layer.clip_centre = object_centre(doc);
     let Some(q) = state.quantities.get(k) else { return Ok(ShownQuantity::default()) };
     let values = match q.source {
         Source::Volume(i) => {

@@ -519,10 +519,15 @@ struct ViewArgs {
     /// 2D transfer function: opacity × (|∇|/max|∇|)^P.
     #[arg(long)]
     gradient_power: Option<f32>,
-    /// Clipping plane NX,NY,NZ[,OFFSET]: cut away what lies beyond it (offset in bohr from the
-    /// grid's centre along the normal).
+    /// Clipping plane NX,NY,NZ[,OFFSET]: cut away what lies beyond it from the clouds,
+    /// isosurfaces and molecular surface (offset in bohr from the centre of the molecule's and
+    /// grids' bounds, along the normal).
     #[arg(long, value_parser = parse_clip, allow_hyphen_values = true)]
     clip: Option<[f32; 4]>,
+    /// Let the clipping plane cut the atoms and bonds too (a cut sphere or stick shows its flat
+    /// face).
+    #[arg(long, requires = "clip")]
+    clip_atoms: bool,
     /// Colours for ψ > 0 and ψ < 0: red-blue, red-white, orange-teal, gold-purple or
     /// green-magenta.
     #[arg(long, value_parser = parse_preset)]
@@ -615,7 +620,7 @@ impl ViewArgs {
         t.boundary = self.boundary.unwrap_or(0.0).clamp(0.0, 1.0);
         t.gradient_power = self.gradient_power.unwrap_or(0.0).max(0.0);
         if let Some([x, y, z, offset]) = self.clip {
-            s.volume.clip = ClipPlane { enabled: true, normal: [x, y, z], offset };
+            s.clip = ClipPlane { enabled: true, normal: [x, y, z], offset, atoms: self.clip_atoms };
         }
         if let Some((pos, neg)) = self.colors {
             s.volume.positive_color = pos;

@@ -665,3 +665,26 @@ fn ball_and_stick_sizes_change_the_picture() {
     assert!(lit(&sticks) > lit(&plain), "thicker sticks cover more: {} vs {}", lit(&sticks), lit(&plain));
     assert!(common::mean_difference(&sticks, &balls) > 0.5);
 }
+
+#[test]
+fn the_clipping_plane_cuts_what_render_draws_and_atoms_only_when_asked() {
+    let size = ["--size", "96x64", "--no-volume"];
+    let whole = render_png(&size).0;
+    // The bundled formaldehyde's atoms stay whole under a plane that cuts no atoms.
+    let spared = render_png(&[&size[..], &["--clip", "1,0,0"]].concat()).0;
+    assert_eq!(whole.as_raw(), spared.as_raw(), "--clip alone leaves atoms whole");
+    let cut = render_png(&[&size[..], &["--clip", "1,0,0", "--clip-atoms"]].concat()).0;
+    assert_ne!(whole.as_raw(), cut.as_raw(), "--clip-atoms cuts them");
+    let out = orbcloud(&["render", "--clip-atoms", "--lavapipe", "-o", "/dev/null"]);
+    assert!(!out.status.success() && String::from_utf8_lossy(&out.stderr).contains("--clip"));
+    // Several quantities of one file: the plane (the object's, wherever it is given) cuts
+    // every one of them.
+    let file = benzene();
+    let density = [file.as_str(), "--size", "96x64", "--atoms", "hidden", "--density", "--iso", "0.05", "--no-volume"];
+    let homo = ["--orbital", "homo", "--iso", "0.05", "--no-volume"];
+    let whole = render_png(&[&density[..], &homo].concat()).0;
+    let cut = render_png(&[&density[..], &homo, &["--clip", "0,0,1,-0.5"]].concat()).0;
+    let only_density = render_png(&[&density[..], &["--clip", "0,0,1,-0.5"], &homo].concat()).0;
+    assert_ne!(whole.as_raw(), cut.as_raw());
+    assert_eq!(cut.as_raw(), only_density.as_raw(), "--clip belongs to the picture, not a quantity");
+}

@@ -129,11 +129,11 @@ fn contour_shells() {
 #[test]
 fn clipped_cloud() {
     let mut s = settings(SliceMode::ViewAligned, AtomStyle::BallAndStick);
-    s.volume.clip.enabled = true;
-    s.volume.clip.normal = [0.0, 0.0, 1.0];
+    s.clip.enabled = true;
+    s.clip.normal = [0.0, 0.0, 1.0];
     let doc = scene(Some(p_orbital(40, false)));
     let clipped = render(&doc, &s, 65.0, 20.0);
-    s.volume.clip.enabled = false;
+    s.clip.enabled = false;
     let whole = render(&doc, &s, 65.0, 20.0);
     // The plane z = 0 removes the positive (red, z > 0) lobe and keeps the negative one.
     let red = |img: &image::RgbaImage| img.pixels().filter(|p| p[0] as i32 > p[2] as i32 + 30).count();

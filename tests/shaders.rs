@@ -132,10 +132,11 @@ fn rust_mirrors_match_the_wgsl_layouts() {
                 cue,
                 clip_zw,
                 ray_zw,
-                ray_zw_y
+                ray_zw_y,
+                cut
             ]
         ),
-        mirror!("isosurface.wgsl", "SurfaceUniforms", SurfaceUniforms, [clip_from_world, eye, light, color, pick]),
+        mirror!("isosurface.wgsl", "SurfaceUniforms", SurfaceUniforms, [clip_from_world, eye, light, color, pick, cut]),
         mirror!("surface_cull.wgsl", "CullUniforms", CullUniforms, [clip_from_object, counts]),
         mirror!("surface_cull.wgsl", "Batch", GpuBatch, [lo, first_index, hi, index_count, cluster]),
         mirror!("depth_pyramid.wgsl", "PyramidSize", PyramidSize, [frame]),

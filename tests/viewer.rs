@@ -713,3 +713,44 @@ fn grabbing_the_moving_hydrogen_bends_the_angle() {
     assert!((held - wanted).abs() < 1.5, "the hydrogen follows the pointer: {held} vs {wanted}");
     assert!(theta > start + 5.0, "grabbing the hydrogen opens the angle: {start} → {theta}");
 }
+
+/// The clipping plane is the object's, edited under its atoms: on, it leaves the atoms whole
+/// until asked to cut them too, and then an atom beyond it is no longer there to pick.
+#[test]
+fn the_object_s_clipping_plane_cuts_its_atoms_when_asked() {
+    use orbcloud::gpu::frame::PickId;
+    let mut h = harness();
+    h.run_steps(2);
+    let oxygen = h.state().atom_on_screen(1).expect("the oxygen on screen");
+    let picks = |h: &mut Harness<'static, OrbApp>| {
+        h.hover_at(oxygen);
+        h.run_steps(3);
+        h.state().hovered()
+    };
+    let oxygen_id = Some(PickId::Atom { object: 0, index: 1 });
+    assert_eq!(picks(&mut h), oxygen_id);
+    h.get_by_label("Clipping plane").scroll_to_me();
+    h.run_steps(20);
+    h.get_by_label("Clipping plane").click();
+    h.run_steps(2);
+    h.get_by_label("clip").click();
+    h.run_steps(2);
+    assert!(h.state().objects[0].state.clip.enabled);
+    // A plane one bohr before the oxygen's centre, facing away from the object's centre.
+    let doc = h.state().doc();
+    let (centre, o) = (orbcloud::layers::object_centre(doc), doc.molecule.atoms[1].position.as_vec3());
+    let n = (o - centre).normalize();
+    let clip = &mut h.state_mut().objects[0].state.clip;
+    clip.normal = n.to_array();
+    clip.offset = (o - centre).dot(n) - 1.0;
+    h.run_steps(3);
+    // Every layer of the object (its atoms, its cloud) cuts along the same plane.
+    let plane = h.state().objects[0].state.clip.plane(centre);
+    assert_eq!(h.state().clip_planes(0), [plane, plane], "the atoms' layer and the quantity's");
+    assert_eq!(picks(&mut h), oxygen_id, "atoms are cut only when asked");
+    h.get_by_label("cut atoms and bonds too").click();
+    h.run_steps(2);
+    assert!(h.state().objects[0].state.clip.atoms);
+    let hovered = picks(&mut h);
+    assert_ne!(hovered, oxygen_id, "the oxygen beyond the plane is cut away");
+}

@@ -127,9 +127,9 @@ fn a_density_on_its_log_scale_matches_the_cpu_compositor() {
 #[test]
 fn the_clipping_plane_matches_the_cpu_compositor() {
     compare(SliceMode::ViewAligned, |s| {
-        s.volume.clip.enabled = true;
-        s.volume.clip.normal = [0.3, 1.0, 0.2];
-        s.volume.clip.offset = -0.5;
+        s.clip.enabled = true;
+        s.clip.normal = [0.3, 1.0, 0.2];
+        s.clip.offset = -0.5;
     });
 }
 

@@ -80,8 +80,8 @@ fn skipping_empty_bricks_draws_fewer_fragments_and_the_same_picture() {
     cores.volume.transfer.nested_cores();
     cases.push(("nested cores", cores, None));
     let mut clipped = base;
-    clipped.volume.clip.enabled = true;
-    clipped.volume.clip.normal = [1.0, 0.3, 0.2];
+    clipped.clip.enabled = true;
+    clipped.clip.normal = [1.0, 0.3, 0.2];
     cases.push(("clipped", clipped, None));
     for mode in [Interpolation::Exact, Interpolation::ThreePass, Interpolation::AlphaMix] {
         cases.push(("key volumes mixed", base, Some(mode)));

@@ -504,6 +504,12 @@ impl OrbApp {
         self.viewport.as_ref()?.fragment_note()
     }
 
+    /// The clipping plane each layer of object `n` draws with in the single-file view
+    /// ([`Viewport::clip_planes`]).
+    pub fn clip_planes(&self, n: usize) -> Vec<Option<glam::Vec4>> {
+        self.viewport.as_ref().map(|vp| vp.clip_planes(n)).unwrap_or_default()
+    }
+
     /// Each view shown: (size on screen, size of its last frame), pixels. The frame is smaller
     /// while a drag or the animation runs on a CPU adapter ([`detail`]).
     pub fn view_sizes(&self) -> Vec<([u32; 2], [u32; 2])> {
@@ -792,7 +798,7 @@ impl OrbApp {
             if changes.arrows {
                 vp.set_arrows(n, &o.doc, &o.state);
             }
-            if changes.placement || changes.visibility {
+            if changes.placement || changes.visibility || changes.clip {
                 vp.set_visibility(n, &o.state);
             }
             moved |= changes.placement;
@@ -1161,9 +1167,7 @@ impl eframe::App for OrbApp {
                         vp.show_split(ui, rs, &mut self.view, &panes);
                     } else {
                         vp.unsplit();
-                        let clip = (self.objects.get_mut(self.active))
-                            .and_then(|o| o.state.selected_quantity_mut())
-                            .map(|q| &mut q.cloud.clip);
+                        let clip = self.objects.get_mut(self.active).map(|o| &mut o.state.clip);
                         vp.show(ui, rs, &mut self.view, clip);
                     }
                     if let Some(o) = self.objects.get(self.active).filter(|o| o.state.surface.color_by_volume)

@@ -221,6 +221,8 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
                 ui.heading("Atoms");
                 let s = &mut scan.settings;
                 atoms_editor(ui, &mut s.atoms, &mut s.atom_colors, &mut s.depth_cue);
+                ui.separator();
+                clip_editor(ui, &mut s.clip);
             } else if let Some(o) = app.objects.get_mut(app.active) {
                 let doc = o.doc.clone();
                 let mut subtract = None;
@@ -250,6 +252,8 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
                 atoms_editor(ui, &mut a.style, &mut a.colors, &mut a.depth_cue);
                 ui.add(Slider::new(&mut a.ball_scale, 0.3..=3.0).text("ball size (×)"));
                 ui.add(Slider::new(&mut a.stick_scale, 0.3..=3.0).text("stick radius (×)"));
+                ui.separator();
+                clip_editor(ui, &mut state.clip);
                 if let Some(m) = subtract {
                     app.start_difference(m, ui.ctx());
                 }
@@ -351,8 +355,8 @@ fn data_set_choice(ui: &mut egui::Ui, doc: &crate::model::Document, source: &mut
         .labelled_by(label.id);
 }
 
-/// A cloud's settings: shown or not, slicing, opacity law, colours, transfer function and
-/// clipping plane. `signed`: an orbital's two signs (else a density's scale).
+/// A cloud's settings: shown or not, slicing, opacity law, colours and transfer function.
+/// `signed`: an orbital's two signs (else a density's scale).
 fn cloud_editor(ui: &mut egui::Ui, vs: &mut crate::scene::VolumeSettings, signed: bool) {
     ui.checkbox(&mut vs.visible, "show cloud");
     ui.horizontal(|ui| {
@@ -397,7 +401,6 @@ fn cloud_editor(ui: &mut egui::Ui, vs: &mut crate::scene::VolumeSettings, signed
         }
     });
     transfer_editor(ui, &mut vs.transfer, signed);
-    clip_editor(ui, &mut vs.clip);
 }
 
 /// Every isosurface of a quantity, each with its own controls, and *+ isosurface*.
@@ -593,9 +596,12 @@ fn transfer_editor(ui: &mut egui::Ui, t: &mut Transfer, signed: bool) {
     });
 }
 
+/// The object's clipping plane: on or off, its normal and offset, and whether it cuts atoms.
 fn clip_editor(ui: &mut egui::Ui, clip: &mut ClipPlane) {
     ui.collapsing("Clipping plane", |ui| {
-        ui.checkbox(&mut clip.enabled, "clip the cloud");
+        ui.checkbox(&mut clip.enabled, "clip")
+            .on_hover_text("cut the clouds, isosurfaces and molecular surface on the far side of the plane");
+        ui.checkbox(&mut clip.atoms, "cut atoms and bonds too");
         ui.horizontal(|ui| {
             ui.label("normal");
             for (c, name) in clip.normal.iter_mut().zip(["x", "y", "z"]) {
@@ -609,7 +615,8 @@ fn clip_editor(ui: &mut egui::Ui, clip: &mut ClipPlane) {
                 }
             }
         });
-        ui.add(Slider::new(&mut clip.offset, -15.0..=15.0).text("offset (bohr)"));
+        ui.add(Slider::new(&mut clip.offset, -15.0..=15.0).text("offset (bohr)"))
+            .on_hover_text("from the centre of the object's bounds, along the normal");
         ui.label(RichText::new("Ctrl + drag in the view moves the plane").small().weak());
     });
 }

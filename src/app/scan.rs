@@ -444,7 +444,8 @@ pub fn views(
             }
             vp.detail = detail;
             vp.clouds = vec![scan.settings.volume];
-            let twisted = vp.show_twistable(ui, render_state, view, Some(&mut scan.settings.volume.clip), Some(twist));
+            vp.set_clip(scan.settings.clip);
+            let twisted = vp.show_twistable(ui, render_state, view, Some(&mut scan.settings.clip), Some(twist));
             dragged += twisted.along;
             held = held.or(twisted.pointer.map(|p| (slot, p)));
             let world = World::single(scan.scene.scan.geometry_at(scan.theta));

@@ -198,7 +198,7 @@ mod tests {
 
     /// An object as sessions wrote it before objects held several quantities: one cloud, the
     /// first isosurface in `settings.iso`, the rest in `isosurfaces`, the orbital in `quantity`.
-    #[derive(serde::Serialize)]
+    #[derive(serde::Serialize, Default)]
     struct OldObject {
         path: PathBuf,
         visible: bool,
@@ -254,5 +254,50 @@ mod tests {
         let text = toml::to_string_pretty(&old).unwrap();
         assert!(!text.contains("[settings") && text.contains("[[quantities]]"), "{text}");
         assert_eq!(toml::from_str::<ObjectState>(&text).unwrap(), old);
+    }
+
+    /// Sessions written while each cloud had its own clipping plane: the plane on becomes the
+    /// object's, and is written back as the object's.
+    #[test]
+    fn a_cloud_s_clipping_plane_becomes_its_object_s() {
+        let defaults = RenderSettings::default();
+        let quantity = |q| crate::scene::QuantityState::new(Source::Wavefunction(q), &defaults);
+        let state = ObjectState {
+            quantities: vec![quantity(Quantity::Orbital(3)), quantity(Quantity::Density)],
+            ..Default::default()
+        };
+        // The same object as such a session wrote it: a plane in each cloud, none of its own.
+        let mut old = toml::Value::try_from(&state).unwrap();
+        let table = old.as_table_mut().unwrap();
+        table.remove("clip");
+        let plane = |on: bool, normal: [f64; 3], offset: f64| {
+            let normal = toml::Value::Array(normal.iter().map(|&x| toml::Value::Float(x)).collect());
+            let mut t = toml::Table::new();
+            t.insert("enabled".into(), toml::Value::Boolean(on));
+            t.insert("normal".into(), normal);
+            t.insert("offset".into(), toml::Value::Float(offset));
+            toml::Value::Table(t)
+        };
+        let clouds = table["quantities"].as_array_mut().unwrap();
+        let planes = [plane(false, [1.0, 0.0, 0.0], 0.0), plane(true, [0.0, 1.0, 0.0], -1.5)];
+        for (q, p) in clouds.iter_mut().zip(planes) {
+            q["cloud"].as_table_mut().unwrap().insert("clip".into(), p);
+        }
+        let text = toml::to_string_pretty(&old).unwrap();
+        assert!(text.contains("[quantities.cloud.clip]"), "{text}");
+        let read: ObjectState = toml::from_str(&text).unwrap();
+        let on = crate::scene::ClipPlane { enabled: true, normal: [0.0, 1.0, 0.0], offset: -1.5, atoms: false };
+        assert_eq!(read.clip, on);
+        assert!(read.quantities.iter().all(|q| q.cloud.stored_clip.is_none()));
+        assert_eq!(read.quantities, state.quantities);
+        let again = toml::to_string_pretty(&read).unwrap();
+        assert!(again.contains("[clip]") && !again.contains("cloud.clip"), "{again}");
+        assert_eq!(toml::from_str::<ObjectState>(&again).unwrap(), read);
+        // Before quantities: the one cloud's plane in `settings.volume`.
+        let mut older = toml::Value::try_from(OldObject::default()).unwrap();
+        let volume = older["settings"]["volume"].as_table_mut().unwrap();
+        volume.insert("clip".into(), plane(true, [0.0, 0.0, 2.0], 0.5));
+        let read: ObjectState = toml::from_str(&toml::to_string_pretty(&older).unwrap()).unwrap();
+        assert_eq!(read.clip, crate::scene::ClipPlane { normal: [0.0, 0.0, 2.0], offset: 0.5, ..on });
     }
 }

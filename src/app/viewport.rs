@@ -429,6 +429,7 @@ impl Viewport {
         };
         let (ctx, layer) = (&self.ctx, self.renderer.layer_mut(&self.ctx, l));
         crate::layers::place_layer(layer, state, Part::Quantity(k));
+        layer.clip_centre = crate::layers::object_centre(doc);
         self.generation += 1;
         match q.source {
             Source::Volume(i) => {
@@ -757,6 +758,12 @@ impl Viewport {
             .collect();
     }
 
+    /// The clipping plane each layer of object `n` draws with ((unit n, d), `None` when off).
+    pub fn clip_planes(&self, n: usize) -> Vec<Option<glam::Vec4>> {
+        let layers = self.layers_of(n).filter_map(|l| self.renderer.layer(l));
+        layers.map(|l| l.clip.plane(l.clip_centre)).collect()
+    }
+
     /// Which of the renderer's layers pane `pane` of `count` draws: every object's atoms, and
     /// the quantities drawn in that pane ([`crate::scene::QuantityState::in_pane`]), while the
     /// object and the quantity are shown.
@@ -968,6 +975,15 @@ impl Viewport {
     }
 
     /// Shows slot `slot` of a scan at θ (both key volumes and the twisted skeleton).
+    /// Cuts a single-layer view (a scan's) with `clip`; draws again when it moved.
+    pub fn set_clip(&mut self, clip: ClipPlane) {
+        let layer = self.renderer.main();
+        if layer.clip != clip {
+            layer.clip = clip;
+            self.generation += 1;
+        }
+    }
+
     pub fn show_scan(
         &mut self,
         scene: &ScanScene,
@@ -982,7 +998,7 @@ impl Viewport {
     }
 
     /// Shows the view in the remaining space of `ui`, applying mouse and keyboard input to
-    /// `view.camera`; Ctrl + drag moves `clip` (the edited cloud's clipping plane) when it is on.
+    /// `view.camera`; Ctrl + drag moves `clip` (the edited object's clipping plane) when it is on.
     pub fn show(
         &mut self,
         ui: &mut egui::Ui,
@@ -1326,6 +1342,8 @@ fn handle_input(ui: &egui::Ui, response: &egui::Response, view: &mut ViewState, 
         // Ctrl + drag moves the clipping plane: a view height of drag is the camera distance.
         let h = response.rect.height().max(1.0);
         clip.offset -= response.drag_delta().y / h * view.camera.distance * 0.5;
+        // The layers take the moved plane next frame.
+        ui.ctx().request_repaint();
         return;
     }
     let cam = &mut view.camera;

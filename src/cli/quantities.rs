@@ -23,7 +23,7 @@ const BESIDE: &str = "--beside";
 /// Options that belong to the whole picture or file, not to a quantity: wherever they are
 /// given, they join the first part of the command line (`mesh FILE --density --iso 0.1
 /// --orbital homo --iso 0.05 -o out.glb`).
-const WHOLE_PICTURE: [&str; 29] = [
+const WHOLE_PICTURE: [&str; 31] = [
     "--output",
     "-o",
     "--size",
@@ -53,9 +53,11 @@ const WHOLE_PICTURE: [&str; 29] = [
     "--stick-scale",
     "--scale",
     "--transparent",
+    "--clip",
+    "--clip-atoms",
 ];
 /// Those of them that take no value.
-const WHOLE_PICTURE_FLAGS: [&str; 4] = ["--lavapipe", "--direct", "--arrows", "--transparent"];
+const WHOLE_PICTURE_FLAGS: [&str; 5] = ["--lavapipe", "--direct", "--arrows", "--transparent", "--clip-atoms"];
 
 /// A quantity given after the first, with the options that followed it.
 pub struct Later {
@@ -149,8 +151,10 @@ pub fn quantity_of(
 /// An object showing the atoms as `view` asks and evaluating orbitals as `what` asks, without
 /// quantities yet.
 fn bare_object(view: &ViewArgs, what: &WavefunctionArgs) -> ObjectState {
+    let settings = view.settings();
     ObjectState {
-        atoms: orbcloud::scene::AtomLook::of(&view.settings()),
+        atoms: orbcloud::scene::AtomLook::of(&settings),
+        clip: settings.clip,
         evaluation: Evaluation {
             direct: what.direct,
             grid_points: what.grid_points.clamp(8, 512),

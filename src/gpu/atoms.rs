@@ -13,6 +13,7 @@ use glam::{Mat4, Vec3, Vec4};
 use super::GpuContext;
 use super::frame::{Draw, ObjectView, Phase, PickId, opaque_depth, opaque_targets};
 use crate::model::{Molecule, units::BOHR_PER_ANGSTROM};
+use crate::scene::transfer::NO_CUT;
 use crate::scene::{AtomColors, AtomStyle};
 
 /// Mirror of `Globals` in atoms_common.wgsl.
@@ -49,8 +50,11 @@ pub struct AtomGlobals {
     /// Clip z and w of the pixel rays' parts: ray_f0 − eye and ray_fx, then ray_fy.
     pub ray_zw: [f32; 4],
     pub ray_zw_y: [f32; 4],
+    /// The object's clipping plane when it cuts atoms (unit n, d; points with n·p > d are cut
+    /// away), else [`NO_CUT`].
+    pub cut: [f32; 4],
 }
-const _: () = assert!(std::mem::size_of::<AtomGlobals>() == 320);
+const _: () = assert!(std::mem::size_of::<AtomGlobals>() == 336);
 
 /// Ball radius as a fraction of the van der Waals radius in ball-and-stick.
 const BALL_FRACTION: f32 = 0.24;
@@ -747,8 +751,9 @@ impl AtomsPass {
     }
 
     /// This frame's camera, in the frame of the object the atoms belong to; their pick ids name
-    /// `object`. `size` is the frame's in pixels.
-    pub fn set_view(&mut self, ctx: &GpuContext, view: &ObjectView, object: u32, size: [u32; 2]) {
+    /// `object`. `size` is the frame's in pixels; `cut`: the clipping plane when it cuts atoms
+    /// (a sphere or bond crossing it shows its cut face).
+    pub fn set_view(&mut self, ctx: &GpuContext, view: &ObjectView, object: u32, size: [u32; 2], cut: Option<Vec4>) {
         let clip = view.clip_from_object;
         let world_from_clip = clip.inverse();
         let far = |x: f32, y: f32| {
@@ -804,6 +809,7 @@ impl AtomsPass {
             clip_zw: [eye_zw.x, eye_zw.y, view_zw.x, view_zw.y],
             ray_zw: [ray0.x, ray0.y, ray_x.x, ray_x.y],
             ray_zw_y: [ray_y.x, ray_y.y, 0.0, 0.0],
+            cut: cut.unwrap_or(NO_CUT).to_array(),
         };
         ctx.queue.write_buffer(&self.globals, 0, bytemuck::bytes_of(&g));
         let Some(d) = &mut self.data else { return };
@@ -873,7 +879,7 @@ pub fn projected_radius_px(clip_from_world: Mat4, center: Vec3, radius: f32, hei
 impl Draw for AtomsPass {
     fn prepare(&mut self, f: &super::frame::Prepare<'_>) {
         if !f.later_tile {
-            self.set_view(f.ctx, f.view, f.layer, f.size);
+            self.set_view(f.ctx, f.view, f.layer, f.size, f.clip.filter(|_| f.clip_atoms));
         }
     }
 

@@ -157,6 +157,11 @@ pub struct Prepare<'a> {
     pub lists: Option<(&'a wgpu::BindGroup, super::oit::Transparency)>,
     /// The layer's cloud.
     pub cloud: &'a crate::scene::VolumeSettings,
+    /// The object's clipping plane in its own frame, (unit n, d): points with n·p > d are cut
+    /// away from the clouds and surfaces; `None` when off.
+    pub clip: Option<glam::Vec4>,
+    /// Whether the plane cuts the atoms and bonds too.
+    pub clip_atoms: bool,
 }
 
 /// The frame's camera as one object sees it: every vector in the object's own frame, so a

@@ -11,6 +11,7 @@ use super::occlusion::{BatchCuller, CulledBatches};
 use super::oit::Transparency;
 use crate::model::isosurface::Mesh;
 use crate::model::octree::{LodLevel, LodView, Selection};
+use crate::scene::transfer::NO_CUT;
 use crate::scene::translucency::{MAX_TRANSLUCENT_SURFACES, Optics, SurfaceLook};
 
 /// Mirror of `SurfaceUniforms` in isosurface.wgsl.
@@ -22,8 +23,11 @@ pub struct SurfaceUniforms {
     pub light: [f32; 4],
     pub color: [f32; 4],
     pub pick: [u32; 4],
+    /// The object's clipping plane (unit n, d; points with n·p > d are cut away), or
+    /// [`NO_CUT`].
+    pub cut: [f32; 4],
 }
-const _: () = assert!(std::mem::size_of::<SurfaceUniforms>() == 128);
+const _: () = assert!(std::mem::size_of::<SurfaceUniforms>() == 144);
 
 /// One splat as the instance buffer holds it (mirror of `vs_splat`'s inputs).
 #[repr(C)]
@@ -152,6 +156,8 @@ pub struct IsosurfacePass {
     surfaces: Vec<GpuSurface>,
     /// The frame's fragment lists (set in `prepare` when a surface is translucent).
     lists: Option<wgpu::BindGroup>,
+    /// Whether this frame's clipping plane cuts the surfaces.
+    cut: bool,
 }
 
 impl IsosurfacePass {
@@ -292,6 +298,7 @@ impl IsosurfacePass {
             occlusion: true,
             surfaces: Vec::new(),
             lists: None,
+            cut: false,
             transparency: Transparency::Exact,
         }
     }
@@ -414,6 +421,7 @@ impl IsosurfacePass {
             occlusion: self.occlusion,
             surfaces: Vec::new(),
             lists: None,
+            cut: false,
             transparency: Transparency::Exact,
         }
     }
@@ -459,7 +467,9 @@ impl IsosurfacePass {
     /// threshold (`None` keeps what the last call chose: a later tile of the same frame).
     /// Translucent surfaces are numbered from `first_translucent` among the
     /// frame's; past [`MAX_TRANSLUCENT_SURFACES`] they are drawn opaque. `lists`: the frame's
-    /// fragment lists, and how they are composited.
+    /// fragment lists, and how they are composited. `clip`: the object's clipping plane (a
+    /// closed surface cut open shows its inside).
+    #[allow(clippy::too_many_arguments)]
     pub fn set_view(
         &mut self,
         ctx: &GpuContext,
@@ -468,7 +478,9 @@ impl IsosurfacePass {
         lod: Option<([u32; 2], f32)>,
         first_translucent: usize,
         lists: Option<(&wgpu::BindGroup, Transparency)>,
+        clip: Option<glam::Vec4>,
     ) {
+        self.cut = clip.is_some();
         self.lists = lists.map(|(l, _)| l.clone());
         self.transparency = lists.map_or(Transparency::Exact, |(_, t)| t);
         let mut next = first_translucent;
@@ -484,6 +496,7 @@ impl IsosurfacePass {
                 light: view.light.extend(0.0).to_array(),
                 color: [s.color[0], s.color[1], s.color[2], 1.0],
                 pick: [PickId::Surface { object, index: s.pick }.encode(), s.translucent.unwrap_or(0), 0, 0],
+                cut: clip.unwrap_or(NO_CUT).to_array(),
             };
             ctx.queue.write_buffer(&s.uniforms, 0, bytemuck::bytes_of(&u));
             if let (Some(lod), Some((size, lod_scale))) = (&mut s.lod, lod) {
@@ -492,7 +505,7 @@ impl IsosurfacePass {
                     eye: view.eye,
                     height_px: size[1] as f32,
                     threshold_px: lod.threshold_px * lod_scale,
-                    back_faces: true,
+                    back_faces: clip.is_none(),
                 };
                 let root = &lod.levels[0].tree.cells[0];
                 let errors = lod.levels.iter().map(|l| l.error);
@@ -537,7 +550,8 @@ impl IsosurfacePass {
     /// those seen last frame (all of them without occlusion culling), in the late one those
     /// the occlusion test left.
     fn draw_lod_triangles(&self, pass: &mut wgpu::RenderPass<'_>, late: bool) {
-        pass.set_pipeline(&self.closed);
+        // Cut open, a closed surface shows its inside.
+        pass.set_pipeline(if self.cut { &self.pipeline } else { &self.closed });
         for (s, lod) in self.lods() {
             Self::bind_mesh(s, pass);
             if self.occlusion {
@@ -554,7 +568,7 @@ impl IsosurfacePass {
 impl Draw for IsosurfacePass {
     fn prepare(&mut self, f: &super::frame::Prepare<'_>) {
         let lod = (!f.later_tile).then_some((f.size, f.lod_scale));
-        self.set_view(f.ctx, f.view, f.layer, lod, f.first_translucent, f.lists);
+        self.set_view(f.ctx, f.view, f.layer, lod, f.first_translucent, f.lists, f.clip);
     }
 
     fn translucent_surfaces(&self) -> usize {

@@ -16,7 +16,7 @@ use crate::model::cartesian::CartesianExpansion;
 use crate::model::octree::box_corners;
 use crate::model::{Molecule, VolumeGrid};
 use crate::scene::translucency::TranslucentSurface;
-use crate::scene::{AtomColors, AtomStyle, Camera, RenderSettings, VolumeSettings};
+use crate::scene::{AtomColors, AtomStyle, Camera, ClipPlane, RenderSettings, VolumeSettings};
 
 /// What one frame needs besides the long-lived GPU state.
 #[derive(Debug, Clone, Copy)]
@@ -71,6 +71,9 @@ pub struct Layer {
     pub visible: bool,
     /// The molecule's bounds in the object's frame, padded by the largest atom.
     molecule_bounds: Option<(Vec3, Vec3)>,
+    /// The object's clipping plane, its offset measured from `clip_centre` (object frame).
+    pub clip: ClipPlane,
+    pub clip_centre: Vec3,
 }
 
 impl Layer {
@@ -198,6 +201,8 @@ impl Renderer {
             world_from_object: Mat4::IDENTITY,
             visible: true,
             molecule_bounds: None,
+            clip: ClipPlane::default(),
+            clip_centre: Vec3::ZERO,
         };
         Self {
             layers: vec![layer],
@@ -250,6 +255,8 @@ impl Renderer {
             world_from_object: Mat4::IDENTITY,
             visible: true,
             molecule_bounds: None,
+            clip: ClipPlane::default(),
+            clip_centre: Vec3::ZERO,
         }
     }
 
@@ -366,6 +373,8 @@ impl Renderer {
                 first_translucent,
                 lists: lists.filter(|_| layer.visible).map(|l| (l, self.transparency)),
                 cloud: frame.clouds.get(n).unwrap_or(&hidden),
+                clip: layer.clip.plane(layer.clip_centre),
+                clip_atoms: layer.clip.atoms,
             };
             for drawer in layer.drawers_mut() {
                 drawer.prepare(&prepare);

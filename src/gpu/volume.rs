@@ -623,13 +623,16 @@ impl VolumePass {
         self.occupancy.as_ref()?.1.as_ref()
     }
 
-    /// Cuts this frame's slices and uploads them with the uniforms.
+    /// Cuts this frame's slices and uploads them with the uniforms; `clip`: the object's
+    /// clipping plane ([`super::frame::Prepare::clip`]).
+    #[allow(clippy::too_many_arguments)]
     pub fn set_view(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         view: &super::frame::ObjectView,
         settings: &VolumeSettings,
+        clip: Option<Vec4>,
         size: [u32; 2],
     ) {
         let (eye, view_dir) = (view.eye, view.view_dir);
@@ -672,7 +675,7 @@ impl VolumePass {
             program,
             gradient: t.needs_gradient(),
             shaped: t.kind == TransferKind::Shaped,
-            clip: settings.clip.enabled,
+            clip: clip.is_some(),
             clouds: 0,
         };
         self.frame_pipeline = Some(self.shared.pipeline(device, self.variant));
@@ -682,9 +685,6 @@ impl VolumePass {
             .iter()
             .filter(|(on, _)| *on)
             .fold(0, |bits, (_, bit)| bits | bit);
-        let clip_normal = Vec3::from(settings.clip.normal).normalize_or(Vec3::Z);
-        let box_centre =
-            vol.grid_box.origin + 0.5 * (vol.grid_box.edges[0] + vol.grid_box.edges[1] + vol.grid_box.edges[2]);
         let rgb = |c: [f32; 3]| Vec4::new(c[0], c[1], c[2], 1.0).to_array();
         let u = VolumeUniforms {
             clip_from_world: view.clip_from_object.to_cols_array_2d(),
@@ -715,7 +715,7 @@ impl VolumePass {
             boundary: t.boundary.clamp(0.0, 1.0),
             inv_max_grad: 1.0 / vol.max_grad,
             _pad2: 0.0,
-            clip: clip_normal.extend(clip_normal.dot(box_centre) + settings.clip.offset).to_array(),
+            clip: clip.unwrap_or(crate::scene::transfer::NO_CUT).to_array(),
             light: view.light.extend(0.0).to_array(),
             world_from_clip: view.clip_from_object.inverse().to_cols_array_2d(),
             box_from_world: walked_box(&vol.grid_box, cells.as_ref()).inverse().to_cols_array_2d(),
@@ -837,7 +837,7 @@ const TF_CLIP: u32 = 8;
 
 impl super::frame::Draw for VolumePass {
     fn prepare(&mut self, f: &super::frame::Prepare<'_>) {
-        self.set_view(&f.ctx.device, &f.ctx.queue, f.view, f.cloud, f.size);
+        self.set_view(&f.ctx.device, &f.ctx.queue, f.view, f.cloud, f.clip, f.size);
     }
 
     fn phases(&self) -> &'static [super::frame::Phase] {

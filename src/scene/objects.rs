@@ -9,7 +9,7 @@ use crate::model::orbitals::Quantity;
 
 use super::quantity::{AtomLook, Evaluation, QuantityState, Source, first_source};
 use super::vibration::VibrationState;
-use super::{Camera, IsosurfaceSettings, RenderSettings, SurfaceChoice, SurfaceSettings};
+use super::{Camera, ClipPlane, IsosurfaceSettings, RenderSettings, SurfaceChoice, SurfaceSettings};
 
 /// Where an object sits in the scene: a rigid placement (rotation about the object's own
 /// origin, then a translation), so distances and the clouds' opacity per path are unchanged.
@@ -65,6 +65,10 @@ pub struct ObjectState {
     pub surface: SurfaceSettings,
     /// The normal mode shown, how it moves, its arrows and the IR spectrum's broadening.
     pub vibration: VibrationState,
+    /// The clipping plane that cuts all its representations (its atoms when asked), in the
+    /// object's frame, its offset from the centre of the object's bounds
+    /// ([`crate::model::Document::bounds`]).
+    pub clip: ClipPlane,
 }
 
 /// A data set an object holds beyond its file's own, made again when a session reopens.
@@ -92,6 +96,7 @@ impl Default for ObjectState {
             selection: String::new(),
             surface: SurfaceSettings::default(),
             vibration: VibrationState::default(),
+            clip: ClipPlane::default(),
         }
     }
 }
@@ -112,7 +117,7 @@ impl ObjectState {
     /// and their isosurface (the state of one renderer layer, as tests and single renders use).
     pub fn of_settings(source: Option<Source>, settings: &RenderSettings) -> Self {
         let quantities = source.map(|s| QuantityState::new(s, settings)).into_iter().collect();
-        Self { atoms: AtomLook::of(settings), quantities, ..Self::default() }
+        Self { atoms: AtomLook::of(settings), quantities, clip: settings.clip, ..Self::default() }
     }
 
     /// The quantity the panels edit, if the object has any.
@@ -155,6 +160,7 @@ impl ObjectState {
     pub fn render_settings(&self, k: usize, background: [f32; 3]) -> RenderSettings {
         let base = RenderSettings { background, ..RenderSettings::default() };
         let mut settings = self.atoms.onto(base);
+        settings.clip = self.clip;
         if let Some(q) = self.quantities.get(k) {
             settings.volume = q.cloud;
             settings.iso = q.isosurfaces.first().copied().unwrap_or_default();
@@ -179,6 +185,8 @@ pub struct Changes {
     pub arrows: bool,
     /// The atoms go back to the file's geometry (no mode is shown any more).
     pub rest: bool,
+    /// The clipping plane moved, or was turned on or off.
+    pub clip: bool,
     /// Per quantity (when `layers` is false): what to redo.
     pub quantities: Vec<QuantityChanges>,
 }
@@ -203,7 +211,14 @@ impl QuantityChanges {
 impl Changes {
     /// Whether nothing needs to be redone.
     pub fn is_empty(&self) -> bool {
-        !(self.layers || self.atoms || self.placement || self.visibility || self.surface || self.arrows || self.rest)
+        !(self.layers
+            || self.atoms
+            || self.placement
+            || self.visibility
+            || self.surface
+            || self.arrows
+            || self.rest
+            || self.clip)
             && self.quantities.iter().all(|q| !q.any())
     }
 }
@@ -268,6 +283,7 @@ pub fn changes(before: &ObjectState, after: &ObjectState) -> Changes {
             || (after.surface.choice != SurfaceChoice::Off && before.selection != after.selection),
         arrows: before.vibration.arrows_key() != after.vibration.arrows_key(),
         rest: before.vibration.mode.is_some() && after.vibration.mode.is_none(),
+        clip: before.clip != after.clip,
         quantities,
     }
 }
@@ -275,7 +291,8 @@ pub fn changes(before: &ObjectState, after: &ObjectState) -> Changes {
 /// An object state as sessions store it: today's fields, and those of sessions written before
 /// objects held several quantities (one cloud in `settings.volume`, the first isosurface in
 /// `settings.iso`, the rest in `isosurfaces`, the data set in `volume`, the orbital in
-/// `quantity`), turned into one quantity.
+/// `quantity`), turned into one quantity; and the clipping plane each cloud had before the
+/// plane belonged to the object (the first one on becomes the object's).
 #[derive(Deserialize, Default)]
 #[serde(default)]
 struct StoredObject {
@@ -290,6 +307,7 @@ struct StoredObject {
     selection: String,
     surface: SurfaceSettings,
     vibration: VibrationState,
+    clip: Option<ClipPlane>,
     settings: Option<RenderSettings>,
     isosurfaces: Vec<IsosurfaceSettings>,
     volume: usize,
@@ -307,6 +325,12 @@ impl From<StoredObject> for ObjectState {
             let isosurfaces = std::iter::once(settings.iso).chain(s.isosurfaces).collect();
             quantities.push(QuantityState { source, visible: true, cloud: settings.volume, isosurfaces, pane: None });
         }
+        let clouds = quantities.iter().map(|q| q.cloud.stored_clip).chain(s.settings.map(|s| s.volume.stored_clip));
+        let stored: Vec<ClipPlane> = clouds.flatten().collect();
+        let clip = s.clip.or_else(|| stored.iter().find(|c| c.enabled).or(stored.first()).copied());
+        for q in &mut quantities {
+            q.cloud.stored_clip = None;
+        }
         Self {
             path: s.path,
             added: s.added,
@@ -319,6 +343,7 @@ impl From<StoredObject> for ObjectState {
             selection: s.selection,
             surface: s.surface,
             vibration: s.vibration,
+            clip: clip.unwrap_or_default(),
         }
     }
 }
@@ -434,10 +459,11 @@ mod tests {
         let density = QuantityState::new(Source::Wavefunction(Quantity::Density), &defaults);
         let before = ObjectState { quantities: vec![density, homo], ..Default::default() };
         assert!(changes(&before, &before).is_empty());
-        // k1 moves with every frame's automatic opacity: nothing to redo.
+        // k1 moves with every frame's automatic opacity, a cloud's slices are the frame's:
+        // nothing to redo.
         let mut after = before.clone();
         after.quantities[1].cloud.k1 = 0.9;
-        after.quantities[1].cloud.clip.offset = 2.0;
+        after.quantities[1].cloud.slices = 64;
         assert!(changes(&before, &after).is_empty());
         after.quantities[1].isosurfaces[0].visible = true;
         let c = changes(&before, &after);
@@ -467,7 +493,12 @@ mod tests {
         moved.placement.offset[0] = 1.0;
         moved.quantities[0].visible = false;
         let c = changes(&before, &moved);
-        assert!(c.placement && c.visibility && !c.atoms && !c.surface);
+        assert!(c.placement && c.visibility && !c.atoms && !c.surface && !c.clip);
+        // The clipping plane is the frame's: nothing is rebuilt, every layer takes it anew.
+        let mut cut = before.clone();
+        cut.clip.enabled = true;
+        let c = changes(&before, &cut);
+        assert!(c.clip && !c.placement && !c.surface && !c.atoms && c.quantities.iter().all(|q| !q.any()));
         // Which atoms are shown restyles them, and wraps a molecular surface anew.
         let mut selected = before.clone();
         selected.surface.choice = SurfaceChoice::Gaussian;

@@ -46,7 +46,10 @@ pub struct VolumeSettings {
     /// Seed 004's shaped transfer functions, gradient shading and boundary enhancement (when
     /// `transfer.kind` is `Shaped`; k1 and k2 apply to the power law).
     pub transfer: Transfer,
-    pub clip: ClipPlane,
+    /// The clipping plane a cloud had before the plane belonged to its object (sessions
+    /// written then); read only, carried to the object when such a session opens.
+    #[serde(default, rename = "clip", skip_serializing)]
+    pub stored_clip: Option<ClipPlane>,
     /// How a density's values are scaled (orbitals: |ψ| / max |ψ| always).
     #[serde(default)]
     pub density_scale: DensityScale,
@@ -75,7 +78,7 @@ impl Default for VolumeSettings {
             positive_color: [0.90, 0.12, 0.10],
             negative_color: [0.10, 0.30, 0.95],
             transfer: Transfer::default(),
-            clip: ClipPlane::default(),
+            stored_clip: None,
             density_scale: DensityScale::default(),
             auto_k1: true,
             skip_empty: true,
@@ -270,6 +273,8 @@ pub struct RenderSettings {
     /// Factors on the atom style's ball and stick radii (1: as the style draws them).
     pub ball_scale: f32,
     pub stick_scale: f32,
+    /// The clipping plane, its offset from the centre of what is drawn.
+    pub clip: ClipPlane,
 }
 
 /// Above this many atoms a file opens space filling (ball and stick is sub-pixel noise at that
@@ -303,6 +308,7 @@ impl Default for RenderSettings {
             depth_cue: 0.0,
             ball_scale: 1.0,
             stick_scale: 1.0,
+            clip: ClipPlane::default(),
         }
     }
 }

@@ -188,25 +188,65 @@ pub const PRESETS: &[(&str, [f32; 3], [f32; 3])] = &[
     ("green / magenta", [0.15, 0.70, 0.20], [0.75, 0.10, 0.60]),
 ];
 
-/// A clipping plane: points with n·p > offset are cut away (n need not be unit length; it is
-/// normalised when used).
+/// An object's clipping plane: points p of the object's frame with n·(p − c) > offset are cut
+/// away, c the centre of the object's bounds (n need not be unit length; it is normalised when
+/// used). It cuts every representation of the object: its clouds, isosurfaces and molecular
+/// surface, and its atoms and bonds when `atoms` is set.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
 pub struct ClipPlane {
     pub enabled: bool,
     pub normal: [f32; 3],
-    /// Signed distance (bohr) of the plane from the scene centre along the normal.
+    /// Signed distance (bohr) of the plane from the object's centre along the normal.
     pub offset: f32,
+    /// Whether atoms and bonds are cut too (a sphere or stick crossing the plane shows its
+    /// cut face).
+    pub atoms: bool,
 }
 
 impl Default for ClipPlane {
     fn default() -> Self {
-        Self { enabled: false, normal: [0.0, 0.0, 1.0], offset: 0.0 }
+        Self { enabled: false, normal: [0.0, 0.0, 1.0], offset: 0.0, atoms: false }
     }
 }
+
+impl ClipPlane {
+    /// The plane as the shaders take it, in the object's frame: (unit n, d) with the points
+    /// n·p > d cut away, `centre` the point the offset is measured from; `None` when off.
+    pub fn plane(&self, centre: glam::Vec3) -> Option<glam::Vec4> {
+        let n = glam::Vec3::from(self.normal).normalize_or(glam::Vec3::Z);
+        self.enabled.then(|| n.extend(n.dot(centre) + self.offset))
+    }
+
+    /// Whether point `p` (object frame) is kept (the CPU reference of the shaders' test).
+    pub fn keeps(&self, centre: glam::Vec3, p: glam::Vec3) -> bool {
+        self.plane(centre).is_none_or(|q| q.truncate().dot(p) <= q.w)
+    }
+}
+
+/// What a plane that cuts nothing looks like to the shaders: every point lies 10³⁰ bohr
+/// before it (0·p > 10³⁰ never holds, and no sphere reaches it).
+pub const NO_CUT: glam::Vec4 = glam::Vec4::new(0.0, 0.0, 0.0, 1e30);
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The plane's offset runs along the unit normal from the centre it is given; off, it keeps
+    /// everything.
+    #[test]
+    fn a_clipping_plane_keeps_the_near_side_of_its_offset() {
+        let centre = glam::Vec3::new(1.0, 2.0, 3.0);
+        let mut clip = ClipPlane { enabled: true, normal: [0.0, 0.0, 2.0], offset: 0.5, atoms: false };
+        assert_eq!(clip.plane(centre), Some(glam::Vec4::new(0.0, 0.0, 1.0, 3.5)));
+        assert!(clip.keeps(centre, glam::Vec3::new(9.0, -9.0, 3.4)));
+        assert!(!clip.keeps(centre, glam::Vec3::new(1.0, 2.0, 3.6)));
+        clip.enabled = false;
+        assert_eq!(clip.plane(centre), None);
+        assert!(clip.keeps(centre, glam::Vec3::splat(100.0)));
+        // What the shaders take for "off" cuts nothing anywhere.
+        assert!(NO_CUT.truncate().dot(glam::Vec3::splat(1e6)) <= NO_CUT.w);
+    }
 
     /// The paper's formulas written out with numbers: g(x) = e^(−x²), s the signed value.
     #[test]

@@ -1,7 +1,7 @@
 //! An independent CPU compositor of the slice pass: the same slice polygons, ray–triangle
 //! intersection per pixel, trilinear sampling in f64 and the same opacity law.
 
-use glam::{DVec3, Vec3};
+use glam::DVec3;
 use orbcloud::model::VolumeGrid;
 use orbcloud::model::grid::ValueKind;
 use orbcloud::scene::slicing::GridBox;
@@ -62,7 +62,8 @@ pub struct CloudReference<'a> {
     spacing: f64,
     normal: DVec3,
     grid_from_world: glam::DMat4,
-    clip: (DVec3, f64),
+    /// The clipping plane (unit n, d): points with n·p > d are cut away.
+    clip: Option<glam::DVec4>,
     pub eye: DVec3,
 }
 
@@ -78,8 +79,9 @@ impl<'a> CloudReference<'a> {
         let slices = gbox.slices(s.volume.mode, s.volume.slices, eye, view_dir);
         let tris = slices.vertices.chunks(3).map(|t| [t[0].as_dvec3(), t[1].as_dvec3(), t[2].as_dvec3()]).collect();
         let vs = s.volume;
-        let clip_n = Vec3::from(vs.clip.normal).normalize().as_dvec3();
-        let centre = (gbox.origin + 0.5 * (gbox.edges[0] + gbox.edges[1] + gbox.edges[2])).as_dvec3();
+        // The test scenes' atoms lie inside their grid: the object's centre is the grid's.
+        let centre = gbox.origin + 0.5 * (gbox.edges[0] + gbox.edges[1] + gbox.edges[2]);
+        let plane = s.clip.plane(centre).map(|p| p.as_dvec4());
         Self {
             grid,
             vs,
@@ -87,7 +89,7 @@ impl<'a> CloudReference<'a> {
             spacing: slices.spacing as f64,
             normal: slices.normal.as_dvec3(),
             grid_from_world: grid.world_from_grid.inverse(),
-            clip: (clip_n, clip_n.dot(centre) + vs.clip.offset as f64),
+            clip: plane,
             eye: eye.as_dvec3(),
         }
     }
@@ -135,7 +137,7 @@ impl<'a> CloudReference<'a> {
         hits.into_iter()
             .filter_map(|t| {
                 let p = self.eye + d * t;
-                if self.vs.clip.enabled && self.clip.0.dot(p) > self.clip.1 {
+                if self.clip.is_some_and(|c| c.truncate().dot(p) > c.w) {
                     return None;
                 }
                 let v = self.grid.sample(self.grid_from_world.transform_point3(p));
