@@ -7,30 +7,21 @@
 // A single cloud is drawn by its slices first (PREDRAWN): only pixels with fragments are
 // walked, and the scene behind the cloud is what the slices let through. Several clouds are
 // not drawn by slices at all: every pixel walks them over the scene.
-// Prepended: volume_common.wgsl (cloud 0 is its `u` and `volume`), volume_gradient.wgsl,
+// Prepended: volume_common.wgsl (cloud 0's texture is its `volume`), volume_gradient.wgsl,
 // volume_field.wgsl, fullscreen.wgsl, oit_common.wgsl, oit_sort.wgsl.
 
-@group(0) @binding(3) var<uniform> u1: VolumeUniforms;
+// Each walked cloud's uniforms, indexed at run time (a copy of one chosen by a switch would cost
+// a CPU rasteriser the whole struct per sample), and its texture (cloud 0's is `volume`).
+@group(0) @binding(3) var<uniform> clouds: array<VolumeUniforms, 4>;
 @group(0) @binding(4) var volume1: texture_3d<f32>;
-@group(0) @binding(5) var<uniform> u2: VolumeUniforms;
-@group(0) @binding(6) var volume2: texture_3d<f32>;
-@group(0) @binding(7) var<uniform> u3: VolumeUniforms;
-@group(0) @binding(8) var volume3: texture_3d<f32>;
+@group(0) @binding(5) var volume2: texture_3d<f32>;
+@group(0) @binding(6) var volume3: texture_3d<f32>;
 // The opaque scene's depth: a cloud's samples stop there.
-@group(0) @binding(9) var scene_depth: texture_depth_2d;
+@group(0) @binding(7) var scene_depth: texture_depth_2d;
 
 // How many clouds the walk takes (at most 4), and whether the one cloud is already drawn.
 override CLOUDS: u32 = 1u;
 override PREDRAWN: bool = true;
-
-fn cloud_uniforms(k: u32) -> VolumeUniforms {
-    switch k {
-        case 1u: { return u1; }
-        case 2u: { return u2; }
-        case 3u: { return u3; }
-        default: { return u; }
-    }
-}
 
 // Cloud k's value at texture coordinate uvw (each texture named where it is sampled: a texture
 // handed to a function as an argument is not something every driver compiles).
@@ -63,10 +54,9 @@ fn cloud_gradient(k: u32, c: VolumeUniforms, uvw: vec3<f32>) -> vec3<f32> {
 }
 
 // One sample of cloud k at p (its object's frame): the premultiplied colour, alpha < 0 where
-// it is invisible or cut away. (One body for every cloud: with a copy per cloud inlined,
-// lavapipe's rasteriser threads crash.)
+// it is invisible or cut away.
 fn sample_cloud(k: u32, p: vec3<f32>, from_eye: vec3<f32>) -> vec4<f32> {
-    let c = cloud_uniforms(k);
+    let c = clouds[k];
     if ((c.tf_bits & TF_CLIP) != 0u && dot(c.clip.xyz, p) > c.clip.w) {
         return vec4<f32>(-1.0);
     }
@@ -79,18 +69,28 @@ fn sample_cloud(k: u32, p: vec3<f32>, from_eye: vec3<f32>) -> vec4<f32> {
     return shade_with(c, SHAPED && (c.tf_bits & TF_SHAPED) != 0u, gradient, cloud_value(k, uvw), grad, from_eye);
 }
 
-// Each cloud's ray (its object's frame), the planes it crosses, and the next one's depth.
-var<private> ray_eye: array<vec3<f32>, 4>;
-var<private> ray_dir: array<vec3<f32>, 4>;
-// x: the nearest plane's distance from the eye along the normal, y: the spacing, z: n·ray.
-var<private> ray_planes: array<vec3<f32>, 4>;
+// Each cloud's ray (its object's frame), the planes it crosses and the next one's depth, one
+// cloud per component (vectors, not arrays: an array indexed at run time costs memory traffic
+// per access on a CPU rasteriser, a vector's component a select).
+var<private> eye_x: vec4<f32>;
+var<private> eye_y: vec4<f32>;
+var<private> eye_z: vec4<f32>;
+var<private> dir_x: vec4<f32>;
+var<private> dir_y: vec4<f32>;
+var<private> dir_z: vec4<f32>;
+// Plane j lies at t = (first + j·spacing) / n_dot_r along the ray.
+var<private> first: vec4<f32>;
+var<private> spacing: vec4<f32>;
+var<private> n_dot_r: vec4<f32>;
 // The next plane and the last.
-var<private> plane_next: array<f32, 4>;
-var<private> plane_last: array<f32, 4>;
-// Rows z and w of the cloud's clip_from_world: window depth = row_z·p / row_w·p.
-var<private> depth_z: array<vec4<f32>, 4>;
-var<private> depth_w: array<vec4<f32>, 4>;
-var<private> next_depth: array<f32, 4>;
+var<private> plane_next: vec4<f32>;
+var<private> plane_last: vec4<f32>;
+// Window depth at t: (depth_a + t·depth_b) / (depth_c + t·depth_d).
+var<private> depth_a: vec4<f32>;
+var<private> depth_b: vec4<f32>;
+var<private> depth_c: vec4<f32>;
+var<private> depth_d: vec4<f32>;
+var<private> next_depth: vec4<f32>;
 
 const NO_SAMPLE: f32 = 2.0;
 
@@ -98,47 +98,54 @@ const NO_SAMPLE: f32 = 2.0;
 // of 255: the walk ends there.
 const OPAQUE_ENOUGH: f32 = 0.002;
 
-fn sample_point(k: u32) -> vec3<f32> {
-    let planes = ray_planes[k];
-    return ray_eye[k] + (planes.x + plane_next[k] * planes.y) / planes.z * ray_dir[k];
+fn next_t() -> vec4<f32> {
+    return (first + plane_next * spacing) / n_dot_r;
 }
 
-fn depth_of_next(k: u32) -> f32 {
-    if (plane_next[k] > plane_last[k]) {
-        return NO_SAMPLE;
-    }
-    let p = vec4<f32>(sample_point(k), 1.0);
-    return dot(depth_z[k], p) / dot(depth_w[k], p);
+// Every cloud's next sample's depth (NO_SAMPLE past its last plane).
+fn next_depths() -> vec4<f32> {
+    let t = next_t();
+    let z = (depth_a + t * depth_b) / (depth_c + t * depth_d);
+    return select(vec4<f32>(NO_SAMPLE), z, plane_next <= plane_last);
 }
 
 // The nearest sample of any cloud (NO_SAMPLE when all are done).
 fn nearest_depth() -> f32 {
-    var z = NO_SAMPLE;
-    for (var k = 0u; k < CLOUDS; k += 1u) {
-        z = min(z, next_depth[k]);
-    }
-    return z;
+    let d = next_depth;
+    return min(min(d.x, d.y), min(d.z, d.w));
 }
 
 // Sets up every cloud's ray through the pixel at `xy`; returns the first sample's depth.
 fn begin_clouds(xy: vec2<f32>) -> f32 {
+    plane_next = vec4<f32>(1.0);
+    plane_last = vec4<f32>(0.0);
+    first = vec4<f32>(0.0);
+    spacing = vec4<f32>(1.0);
+    n_dot_r = vec4<f32>(1.0);
+    depth_c = vec4<f32>(1.0);
     for (var k = 0u; k < CLOUDS; k += 1u) {
-        let c = cloud_uniforms(k);
+        let c = clouds[k];
         let ndc = vec2<f32>(xy.x / c.slab.z * 2.0 - 1.0, 1.0 - xy.y / c.slab.w * 2.0);
         let far = c.world_from_clip * vec4<f32>(ndc, 1.0, 1.0);
         let eye = c.eye.xyz;
         let dir = normalize(far.xyz / far.w - eye);
-        ray_eye[k] = eye;
-        ray_dir[k] = dir;
+        eye_x[k] = eye.x;
+        eye_y[k] = eye.y;
+        eye_z[k] = eye.z;
+        dir_x[k] = dir.x;
+        dir_y[k] = dir.y;
+        dir_z[k] = dir.z;
         let m = c.clip_from_world;
-        depth_z[k] = vec4<f32>(m[0].z, m[1].z, m[2].z, m[3].z);
-        depth_w[k] = vec4<f32>(m[0].w, m[1].w, m[2].w, m[3].w);
-        plane_next[k] = 1.0;
-        plane_last[k] = 0.0;
+        let row_z = vec4<f32>(m[0].z, m[1].z, m[2].z, m[3].z);
+        let row_w = vec4<f32>(m[0].w, m[1].w, m[2].w, m[3].w);
+        depth_a[k] = dot(row_z, vec4<f32>(eye, 1.0));
+        depth_b[k] = dot(row_z, vec4<f32>(dir, 0.0));
+        depth_c[k] = dot(row_w, vec4<f32>(eye, 1.0));
+        depth_d[k] = dot(row_w, vec4<f32>(dir, 0.0));
         let n = c.plane.xyz;
-        let spacing = c.plane.w;
-        let n_dot_r = dot(n, dir);
-        if (n_dot_r > 1e-4) {
+        let step = c.plane.w;
+        let along = dot(n, dir);
+        if (along > 1e-4) {
             // Where the ray is inside the slices' box, and the planes it crosses there.
             let o = (c.box_from_world * vec4<f32>(eye, 1.0)).xyz;
             let d = (c.box_from_world * vec4<f32>(dir, 0.0)).xyz;
@@ -147,12 +154,14 @@ fn begin_clouds(xy: vec2<f32>) -> f32 {
             let t_in = max(max(max(min(t0.x, t1.x), min(t0.y, t1.y)), min(t0.z, t1.z)), 0.0);
             let t_out = min(min(max(t0.x, t1.x), max(t0.y, t1.y)), max(t0.z, t1.z));
             let e = dot(n, eye);
-            ray_planes[k] = vec3<f32>(c.slab.x - e, spacing, n_dot_r);
-            plane_next[k] = max(ceil((e + t_in * n_dot_r - c.slab.x) / spacing), 0.0);
-            plane_last[k] = min(floor((e + t_out * n_dot_r - c.slab.x) / spacing), c.slab.y - 1.0);
+            first[k] = c.slab.x - e;
+            spacing[k] = step;
+            n_dot_r[k] = along;
+            plane_next[k] = max(ceil((e + t_in * along - c.slab.x) / step), 0.0);
+            plane_last[k] = min(floor((e + t_out * along - c.slab.x) / step), c.slab.y - 1.0);
         }
-        next_depth[k] = depth_of_next(k);
     }
+    next_depth = next_depths();
     return nearest_depth();
 }
 
@@ -160,17 +169,20 @@ fn begin_clouds(xy: vec2<f32>) -> f32 {
 // their opacities: the same whichever cloud is listed first), and each of those clouds moved
 // to its next plane. Alpha 0 where none is visible.
 fn take_samples(z: f32) -> vec4<f32> {
+    let here = next_depth == vec4<f32>(z);
+    let t = next_t();
     var color = vec3<f32>(0.0);
     var alpha_sum = 0.0;
     var through = 1.0;
     var visible = 0u;
     var only = vec4<f32>(0.0);
     for (var k = 0u; k < CLOUDS; k += 1u) {
-        if (next_depth[k] != z) {
+        if (!here[k]) {
             continue;
         }
-        let p = sample_point(k);
-        let s = sample_cloud(k, p, p - ray_eye[k]);
+        let eye = vec3<f32>(eye_x[k], eye_y[k], eye_z[k]);
+        let from_eye = t[k] * vec3<f32>(dir_x[k], dir_y[k], dir_z[k]);
+        let s = sample_cloud(k, eye + from_eye, from_eye);
         if (s.a > 0.0) {
             color += s.rgb;
             alpha_sum += s.a;
@@ -178,9 +190,9 @@ fn take_samples(z: f32) -> vec4<f32> {
             visible += 1u;
             only = s;
         }
-        plane_next[k] += 1.0;
-        next_depth[k] = depth_of_next(k);
     }
+    plane_next += select(vec4<f32>(0.0), vec4<f32>(1.0), here);
+    next_depth = next_depths();
     if (visible <= 1u) {
         return only;
     }

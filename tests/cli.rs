@@ -552,6 +552,26 @@ fn render_draws_several_quantities_of_one_file_and_panes_side_by_side() {
 }
 
 #[test]
+fn listing_two_quantities_of_one_file_the_other_way_round_changes_nothing() {
+    let file = benzene();
+    let size = ["--size", "160x120"];
+    let surfaces = ["--iso", "0.05", "--translucent", "--no-volume"];
+    let render = |first: &[&str], second: &[&str]| render_png(&[&[file.as_str()][..], &size, first, second].concat()).0;
+    let max_difference = |a: &image::RgbaImage, b: &image::RgbaImage| {
+        a.pixels().zip(b.pixels()).flat_map(|(p, q)| (0..3).map(move |k| p[k].abs_diff(q[k]))).max().unwrap_or(0)
+    };
+    let density: Vec<&str> = [&["--density"][..], &surfaces].concat();
+    let homo: Vec<&str> = [&["--orbital", "homo"][..], &surfaces].concat();
+    let (a, b) = (render(&density, &homo), render(&homo, &density));
+    assert!(max_difference(&a, &b) <= 1, "translucent surfaces: {}/255", max_difference(&a, &b));
+    // Overlapping clouds: one depth order, whichever is listed first.
+    let (a, b) = (render(&["--density"], &["--orbital", "homo"]), render(&["--orbital", "homo"], &["--density"]));
+    assert!(max_difference(&a, &b) <= 1, "clouds: {}/255", max_difference(&a, &b));
+    let homo_alone = render(&["--orbital", "homo"], &[]);
+    assert!(common::mean_difference(&a, &homo_alone) > 1.0, "both clouds are drawn");
+}
+
+#[test]
 fn mesh_writes_each_quantitys_surfaces_named_after_it() {
     let dir = tempfile::tempdir().unwrap();
     let obj = dir.path().join("both.obj");

@@ -409,7 +409,7 @@ impl Renderer {
         let walk = match walks {
             true => {
                 let clouds: Vec<&VolumePass> = walked.iter().map(|&n| &self.layers[n].volume).collect();
-                VolumePass::walk(&ctx.device, &clouds, &targets.depth_view, sorted)
+                VolumePass::walk(ctx, &clouds, &targets.depth_view, sorted)
             }
             false => None,
         };

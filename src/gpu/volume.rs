@@ -269,6 +269,8 @@ struct VolumeShaders {
     layout: wgpu::BindGroupLayout,
     /// The walk's group 0: [`MAX_WALKED`] clouds' uniforms and textures and the scene's depth.
     walk_layout: wgpu::BindGroupLayout,
+    /// The walked clouds' uniforms, one array.
+    walk_uniforms: wgpu::Buffer,
     morph_layout: wgpu::BindGroupLayout,
     gto_layout: wgpu::BindGroupLayout,
     sampler: wgpu::Sampler,
@@ -314,6 +316,8 @@ pub struct VolumePass {
     direct: Option<GtoBuffers>,
     /// This frame's cloud is composited by a walk over several clouds, not by its slices.
     walked: bool,
+    /// This frame's uniforms, as written to `uniforms` (a walk copies them into its array).
+    frame_uniforms: VolumeUniforms,
 }
 
 /// The override constants of `variant` (a walk's: whether any of its clouds needs each).
@@ -475,6 +479,11 @@ impl VolumePass {
             clouds,
             layout,
             walk_layout,
+            walk_uniforms: super::uniform_buffer(
+                device,
+                "cloud walk uniforms",
+                MAX_WALKED * std::mem::size_of::<VolumeUniforms>(),
+            ),
             morph_layout,
             gto_layout,
             sampler,
@@ -505,6 +514,7 @@ impl VolumePass {
             volume: None,
             direct: None,
             walked: false,
+            frame_uniforms: VolumeUniforms::zeroed(),
         }
     }
 
@@ -722,6 +732,7 @@ impl VolumePass {
             slab: [nearest, planes, size[0] as f32, size[1] as f32],
         };
         queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
+        self.frame_uniforms = u;
     }
 
     /// Whether a walk can take this frame's cloud: one drawn from a 3D texture in one pass
@@ -740,7 +751,7 @@ impl VolumePass {
     /// group; `depth` is the opaque scene's. One cloud is walked only where fragments are, over
     /// what its slices drew.
     pub fn walk(
-        device: &wgpu::Device,
+        ctx: &GpuContext,
         clouds: &[&VolumePass],
         depth: &wgpu::TextureView,
         lists: bool,
@@ -750,18 +761,19 @@ impl VolumePass {
         let shared = &first.shared;
         let views: Vec<&wgpu::TextureView> =
             clouds.iter().map(|c| c.volume.as_ref().map(|v| &v.view)).collect::<Option<_>>()?;
-        let slot = |k: usize| clouds.get(k).copied().unwrap_or(first);
-        let view = |k: usize| views.get(k).copied().unwrap_or(views[0]);
-        let mut entries =
-            vec![wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&shared.sampler) }];
-        for k in 0..MAX_WALKED {
-            let (uniforms, texture) = walk_bindings(k);
-            entries.push(wgpu::BindGroupEntry { binding: uniforms, resource: slot(k).uniforms.as_entire_binding() });
-            entries
-                .push(wgpu::BindGroupEntry { binding: texture, resource: wgpu::BindingResource::TextureView(view(k)) });
-        }
-        entries.push(wgpu::BindGroupEntry { binding: WALK_DEPTH, resource: wgpu::BindingResource::TextureView(depth) });
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        let uniforms: Vec<VolumeUniforms> =
+            (0..MAX_WALKED).map(|k| clouds.get(k).map_or(VolumeUniforms::zeroed(), |c| c.frame_uniforms)).collect();
+        ctx.queue.write_buffer(&shared.walk_uniforms, 0, bytemuck::cast_slice(&uniforms));
+        let view = |k: usize| wgpu::BindingResource::TextureView(views.get(k).copied().unwrap_or(views[0]));
+        let mut entries = vec![
+            wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&shared.sampler) },
+            wgpu::BindGroupEntry { binding: WALK_UNIFORMS, resource: shared.walk_uniforms.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: WALK_DEPTH, resource: wgpu::BindingResource::TextureView(depth) },
+        ];
+        entries.extend(
+            WALK_TEXTURES.iter().enumerate().map(|(k, &binding)| wgpu::BindGroupEntry { binding, resource: view(k) }),
+        );
+        let bind_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("cloud walk bind group"),
             layout: &shared.walk_layout,
             entries: &entries,
@@ -773,21 +785,17 @@ impl VolumePass {
             clip: false,
             clouds: clouds.len() as u8,
         };
-        Some((shared.pipeline(device, variant), bind_group))
+        Some((shared.pipeline(&ctx.device, variant), bind_group))
     }
 }
 
-/// The bindings of walked cloud `k`'s uniforms and texture (volume_interleave.wgsl): cloud 0's
-/// are the slices' own, 0 and 1 (2 is the sampler).
-fn walk_bindings(k: usize) -> (u32, u32) {
-    match k {
-        0 => (0, 1),
-        _ => (1 + 2 * k as u32, 2 + 2 * k as u32),
-    }
-}
-
+/// The bindings of the walked clouds' textures (volume_interleave.wgsl): cloud 0's is the
+/// slices' own; 2 is the sampler.
+const WALK_TEXTURES: [u32; MAX_WALKED] = [1, 4, 5, 6];
+/// The walked clouds' uniforms, one array.
+const WALK_UNIFORMS: u32 = 3;
 /// The opaque scene's depth in a walk's group 0.
-const WALK_DEPTH: u32 = 9;
+const WALK_DEPTH: u32 = 7;
 
 /// Group 0 of a walk over clouds.
 fn walk_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
@@ -797,11 +805,8 @@ fn walk_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
         ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
         count: None,
     }];
-    for k in 0..MAX_WALKED {
-        let (uniforms, texture) = walk_bindings(k);
-        entries.push(super::uniform_entry(uniforms, wgpu::ShaderStages::FRAGMENT));
-        entries.push(volume_entry(texture));
-    }
+    entries.push(super::uniform_entry(WALK_UNIFORMS, wgpu::ShaderStages::FRAGMENT));
+    entries.extend(WALK_TEXTURES.map(volume_entry));
     entries.push(wgpu::BindGroupLayoutEntry {
         binding: WALK_DEPTH,
         visibility: wgpu::ShaderStages::FRAGMENT,
