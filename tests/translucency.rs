@@ -319,7 +319,7 @@ fn two_clouds(
     if orbital_layer == 1 {
         layers.swap(0, 1);
     }
-    let mut renderer = Renderer::new(&ctx);
+    let mut renderer = Renderer::new(ctx);
     for (n, (grid, state)) in layers.iter().enumerate() {
         let doc = Document { volumes: vec![grid.clone()], ..Default::default() };
         show_object(ctx, renderer.layer_mut(ctx, n), &doc, state).expect("cloud shown");

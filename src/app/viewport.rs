@@ -80,8 +80,11 @@ pub struct Twist {
 
 /// How long one UI frame may spend drawing bands of a costly frame, and how long one band
 /// should take: inputs are answered within about 100 ms whatever the view shows.
-const FRAME_BUDGET: Duration = Duration::from_millis(40);
-const BAND_TIME: Duration = Duration::from_millis(25);
+const FRAME_BUDGET: Duration = Duration::from_millis(80);
+/// The same while a coarse picture stands in: each window frame on a CPU rasteriser costs about
+/// as much again as the bands it draws, so longer turns finish the picture sooner.
+const REFINE_BUDGET: Duration = Duration::from_millis(250);
+const BAND_TIME: Duration = Duration::from_millis(40);
 
 /// A full picture slower than this gets a coarse preview at once after the next change.
 const PREVIEW_AFTER_MS: f64 = 300.0;
@@ -1076,7 +1079,10 @@ impl Viewport {
                 self.draw_preview(render_state, &key.0, shown);
             }
         }
-        if let Some((target, id)) = &self.target {
+        // The band loop below may call for a preview: the target is borrowed through clones.
+        let shown_target = self.target.as_ref().map(|(t, id)| (t.color_view.clone(), *id));
+        let mut want_preview = false;
+        if let Some((color_view, id)) = &shown_target {
             if changed || self.progress.is_some() {
                 let frame = FrameInput {
                     camera: &key.0.camera,
@@ -1088,19 +1094,21 @@ impl Viewport {
                 match &mut self.progress {
                     None => {
                         let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
-                        self.renderer.render(&self.ctx, &mut encoder, &target.color_view, &frame);
+                        self.renderer.render(&self.ctx, &mut encoder, color_view, &frame);
                         self.ctx.queue.submit([encoder.finish()]);
                         self.picture_ms = self.picture_started.take().map(|t| t.elapsed().as_secs_f64() * 1e3);
                     }
                     Some(p) => {
                         let start = Instant::now();
-                        while p.next_row < size[1] && start.elapsed() < FRAME_BUDGET {
+                        // With a preview standing in the window loses nothing to longer turns.
+                        let budget = if self.previewing { REFINE_BUDGET } else { FRAME_BUDGET };
+                        while p.next_row < size[1] && start.elapsed() < budget {
                             let rows = p.rows.min(size[1] - p.next_row);
                             let tile = Tile { rect: [0, p.next_row, size[0], rows], first: p.next_row == 0 };
                             let band = Instant::now();
                             let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
                             let frame = FrameInput { tile: Some(tile), ..frame };
-                            self.renderer.render(&self.ctx, &mut encoder, &target.color_view, &frame);
+                            self.renderer.render(&self.ctx, &mut encoder, color_view, &frame);
                             self.ctx.queue.submit([encoder.finish()]);
                             // Waiting here keeps each frame's GPU work within the budget.
                             let _ = self.ctx.device.poll(wgpu::PollType::wait_indefinitely());
@@ -1111,6 +1119,12 @@ impl Viewport {
                             // into one band that holds the window for seconds.
                             let most = (2 * rows).min(size[1]);
                             p.rows = ((BAND_TIME.as_secs_f64() / per_row.max(1e-6)) as u32).clamp(1, most);
+                            // The rest will take long: a coarse picture stands in from now.
+                            let rest_ms = per_row * (size[1] - p.next_row) as f64 * 1e3;
+                            if !self.previewing && self.detail == Detail::FULL && rest_ms > PREVIEW_AFTER_MS {
+                                want_preview = true;
+                                break;
+                            }
                         }
                         self.band_rows = p.rows;
                         if p.next_row >= size[1] {
@@ -1122,6 +1136,15 @@ impl Viewport {
                         } else {
                             ui.ctx().request_repaint();
                         }
+                    }
+                }
+                if want_preview {
+                    self.previewing = true;
+                    self.draw_preview(render_state, &key.0, shown);
+                    // The preview drew through the renderer's own targets: the full picture
+                    // starts again from its first band.
+                    if let Some(p) = &mut self.progress {
+                        p.next_row = 0;
                     }
                 }
                 self.drawn = Some(key);
@@ -1189,8 +1212,6 @@ impl Viewport {
         twisted
     }
 
-    /// Reads the last frame's fragment counts once they are back: a frame whose lists
-    /// overflowed is drawn again, in as many bands as it needs.
     /// Draws the coarse picture of `view` for a view shown at `shown` pixels into the preview
     /// target, at once.
     fn draw_preview(&mut self, render_state: &egui_wgpu::RenderState, view: &ViewState, shown: [u32; 2]) {
@@ -1213,6 +1234,8 @@ impl Viewport {
         self.previewing && self.progress.is_some()
     }
 
+    /// Reads the last frame's fragment counts once they are back: a frame whose lists
+    /// overflowed is drawn again, in as many bands as it needs.
     fn check_fragments(&mut self, ctx: &egui::Context) {
         if !self.awaiting_fragments {
             return;

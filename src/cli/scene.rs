@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use clap::Args;
-use orbcloud::gpu::{FrameInput, OffscreenTarget, Renderer};
+use orbcloud::gpu::{FrameInput, OffscreenTarget, Renderer, Tile};
 use orbcloud::headless::draw_exact;
 use orbcloud::layers::show_scene;
 use orbcloud::scene::detail::Detail;
@@ -88,6 +88,9 @@ fn scene_bounds(scene: &[(orbcloud::model::Document, ObjectState)]) -> Option<(g
         .reduce(|(l, h), (a, b)| (l.min(a), h.max(b)))
 }
 
+/// Rows of one band of a picture drawn band by band.
+const BAND_ROWS: u32 = 32;
+
 pub fn bench(args: &SceneBench) -> Result<()> {
     let ctx = super::gpu(args.bench.lavapipe)?;
     let scene = molecules(&args.files, args.molecules.max(1))?;
@@ -117,7 +120,9 @@ pub fn bench(args: &SceneBench) -> Result<()> {
     );
     // One picture at `detail` after the camera moved by `f` steps: ms from the change to the
     // picture done, and the picture.
-    let mut picture = |detail: Detail, f: u32| -> Result<(f64, image::RgbaImage)> {
+    // `band`: drawn as the window draws a slow picture, in tiles of that many rows, each
+    // waited for.
+    let mut picture = |detail: Detail, f: u32, band: Option<u32>| -> Result<(f64, image::RgbaImage)> {
         let mut cam = camera;
         cam.orbit(0.05 * f as f32, 0.02 * f as f32);
         let size = detail.render_size(size);
@@ -126,23 +131,37 @@ pub fn bench(args: &SceneBench) -> Result<()> {
         renderer.set_lod_scale(detail.lod_scale);
         let start = Instant::now();
         let frame = FrameInput { camera: &cam, background: [0.02, 0.02, 0.03], clouds: &clouds, size, tile: None };
-        draw_exact(&ctx, &mut renderer, &target.color_view, &frame);
+        match band {
+            None => {
+                draw_exact(&ctx, &mut renderer, &target.color_view, &frame);
+            }
+            Some(rows) => {
+                for y in (0..size[1]).step_by(rows.max(1) as usize) {
+                    let tile = Tile { rect: [0, y, size[0], rows.min(size[1] - y)], first: y == 0 };
+                    let mut encoder = ctx.device.create_command_encoder(&Default::default());
+                    renderer.render(&ctx, &mut encoder, &target.color_view, &FrameInput { tile: Some(tile), ..frame });
+                    ctx.queue.submit([encoder.finish()]);
+                    ctx.device.poll(wgpu::PollType::wait_indefinitely())?;
+                }
+            }
+        }
         ctx.device.poll(wgpu::PollType::wait_indefinitely())?;
         let ms = start.elapsed().as_secs_f64() * 1e3;
         Ok((ms, target.read_rgba(&ctx.device, &ctx.queue)?))
     };
     // Warm up: every pipeline built once, at both sizes.
-    picture(Detail::PREVIEW, 0)?;
-    picture(Detail::FULL, 0)?;
+    picture(Detail::PREVIEW, 0, None)?;
+    picture(Detail::FULL, 0, None)?;
     let median = |mut v: Vec<f64>| {
         v.sort_by(f64::total_cmp);
         v[v.len() / 2]
     };
-    let (mut previews, mut fulls) = (Vec::new(), Vec::new());
+    let (mut previews, mut fulls, mut banded) = (Vec::new(), Vec::new(), Vec::new());
     let mut last = None;
     for f in 1..=args.bench.frames.max(1) {
-        let (preview_ms, preview) = picture(Detail::PREVIEW, f)?;
-        let (full_ms, full) = picture(Detail::FULL, f)?;
+        let (preview_ms, preview) = picture(Detail::PREVIEW, f, None)?;
+        let (full_ms, full) = picture(Detail::FULL, f, None)?;
+        banded.push(picture(Detail::FULL, f, Some(BAND_ROWS))?.0);
         previews.push(preview_ms);
         fulls.push(preview_ms + full_ms);
         last = Some((preview, full));
@@ -156,6 +175,7 @@ pub fn bench(args: &SceneBench) -> Result<()> {
         median(previews)
     );
     println!("full picture: {:.0} ms after a change (the preview's time included)", median(fulls));
+    println!("full picture in bands of {BAND_ROWS} rows, as the window draws it: {:.0} ms", median(banded));
     if let (Some(dir), Some((preview, full))) = (&args.images, last) {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
         for (name, img) in [("preview", preview), ("full", full)] {
