@@ -199,7 +199,7 @@ const CRATE_RULES: &[(&str, &[&str])] = &[
     ("demo.rs", &["flate2"]),
     ("app", &["glam", "serde", "toml", "wgpu", "image", "log", "egui", "eframe", "egui_wgpu", "egui_plot", "rfd"]),
     // The binary: main.rs and its subcommands.
-    ("cli", &["wgpu", "glam", "rayon", "clap", "anyhow", "image", "serde_json"]),
+    ("cli", &["wgpu", "glam", "rayon", "clap", "anyhow", "image", "serde_json", "toml"]),
     ("main.rs", &["clap", "anyhow", "env_logger", "libc"]),
 ];
 

@@ -44,4 +44,4 @@ impl Detail {
 /// Slices per cloud in a preview.
 pub const PREVIEW_SLICES: u32 = 48;
 /// Pixels of a preview at most.
-pub const PREVIEW_PIXELS: u32 = 240 * 180;
+pub const PREVIEW_PIXELS: u32 = 200 * 150;
