@@ -200,6 +200,41 @@ fn surfaces_of_two_objects_glow_where_they_overlap_and_only_there() {
     assert!(glowing > 200 && glowing <= overlap, "{glowing} glowing of {overlap}");
 }
 
+/// One object holding two quantities, a density and an orbital, each a translucent surface: the
+/// orbital's surface glows inside the density's (they are different quantities), while the same
+/// surfaces as shells of one quantity do not.
+#[test]
+fn an_orbitals_surface_glows_inside_its_own_molecules_density_surface() {
+    let ctx = lavapipe();
+    let density = blob(DVec3::ZERO);
+    let orbital = p_orbital(48, false);
+    let doc = Document { volumes: vec![density.clone(), orbital.clone()], ..Default::default() };
+    let (density_look, orbital_look) = (translucent(0.3, [0.62, 0.66, 0.72]), translucent(0.08, [0.9, 0.15, 0.1]));
+    let mut state = object(density_look, AtomStyle::Hidden);
+    let mut second = state.quantities[0].clone();
+    second.source = orbcloud::scene::Source::Volume(1);
+    second.isosurfaces = vec![orbital_look];
+    state.quantities.push(second);
+    let mut renderer = Renderer::new(&ctx);
+    show_scene(&ctx, &mut renderer, &[(&doc, state)], 48).expect("object shown");
+    let (own_object, _) = draw(&ctx, &mut renderer);
+    // The same surfaces as one quantity's shells: no glow.
+    let shells: Vec<_> =
+        isosurfaces(&density, &density_look).into_iter().chain(isosurfaces(&orbital, &orbital_look)).collect();
+    let mut one = Renderer::new(&ctx);
+    show_meshes(&ctx, one.layer_mut(&ctx, 1), &shells);
+    let (one_quantity, _) = draw(&ctx, &mut one);
+    let changed = own_object.pixels().zip(one_quantity.pixels()).filter(|(p, q)| p != q).count();
+    let brighter = own_object
+        .pixels()
+        .zip(one_quantity.pixels())
+        .filter(|(p, q)| (0..3).map(|k| p[k] as u32).sum::<u32>() > (0..3).map(|k| q[k] as u32).sum::<u32>() + 3)
+        .count();
+    eprintln!("{changed} pixels differ from one quantity's shells, {brighter} of them brighter");
+    assert!(brighter > 300, "the orbital glows inside the density: {brighter} brighter pixels");
+    assert!(brighter * 10 >= changed * 9, "the difference is the glow: {brighter} of {changed} brighter");
+}
+
 #[test]
 fn surfaces_inside_a_cloud_match_a_cpu_reference_that_walks_both() {
     let ctx = lavapipe();
