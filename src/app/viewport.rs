@@ -86,6 +86,9 @@ const FRAME_BUDGET: Duration = Duration::from_millis(80);
 const REFINE_BUDGET: Duration = Duration::from_millis(250);
 const BAND_TIME: Duration = Duration::from_millis(40);
 
+/// The most bands a picture is drawn in.
+const MAX_BANDS: u32 = 32;
+
 /// A full picture slower than this gets a coarse preview at once after the next change.
 const PREVIEW_AFTER_MS: f64 = 300.0;
 /// A picture still being drawn after this shows its progress.
@@ -1118,7 +1121,11 @@ impl Viewport {
                             // work overlapping the last) must not turn the rest of the frame
                             // into one band that holds the window for seconds.
                             let most = (2 * rows).min(size[1]);
-                            p.rows = ((BAND_TIME.as_secs_f64() / per_row.max(1e-6)) as u32).clamp(1, most);
+                            // A band also costs a fixed part (the frame's set-up, every slice's
+                            // triangles): at least 1/MAX_BANDS of the rows, or bands of one row
+                            // would spend their time on it.
+                            let least = (size[1] / MAX_BANDS).clamp(1, most);
+                            p.rows = ((BAND_TIME.as_secs_f64() / per_row.max(1e-6)) as u32).clamp(least, most);
                             // The rest will take long: a coarse picture stands in from now.
                             let rest_ms = per_row * (size[1] - p.next_row) as f64 * 1e3;
                             if !self.previewing && self.detail == Detail::FULL && rest_ms > PREVIEW_AFTER_MS {
