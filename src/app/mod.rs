@@ -718,15 +718,7 @@ impl OrbApp {
             objects => {
                 let boxes = objects.iter().filter_map(|o| {
                     let (lo, hi) = crate::scene::framing::framing_box_of(&o.doc, &o.state.selection)?;
-                    let m = o.state.placement.world_from_object();
-                    let corners = [lo, hi];
-                    let points: Vec<glam::Vec3> = (0..8)
-                        .map(|i| {
-                            let c = glam::Vec3::new(corners[i & 1].x, corners[(i >> 1) & 1].y, corners[i >> 2].z);
-                            m.transform_point3(c)
-                        })
-                        .collect();
-                    points.iter().copied().reduce(|a, b| a.min(b)).zip(points.iter().copied().reduce(|a, b| a.max(b)))
+                    Some(o.state.placement.placed_box(lo, hi))
                 });
                 match boxes.reduce(|a, b| (a.0.min(b.0), a.1.max(b.1))) {
                     Some((lo, hi)) => crate::scene::Camera::framing(lo, hi),

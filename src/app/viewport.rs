@@ -81,8 +81,8 @@ pub struct Twist {
 /// How long one UI frame may spend drawing bands of a costly frame, and how long one band
 /// should take: inputs are answered within about 100 ms whatever the view shows.
 const FRAME_BUDGET: Duration = Duration::from_millis(80);
-/// The same while a coarse picture stands in: each window frame on a CPU rasteriser costs about
-/// as much again as the bands it draws, so longer turns finish the picture sooner.
+/// The same while a coarse picture stands in: the window's own drawing between turns costs tens
+/// of ms on a CPU rasteriser, so longer turns finish the picture sooner.
 const REFINE_BUDGET: Duration = Duration::from_millis(250);
 const BAND_TIME: Duration = Duration::from_millis(40);
 
@@ -107,8 +107,28 @@ fn coarser(doc: &Document, i: usize, step: usize) -> Option<String> {
     Some(crate::layers::coarser_note(&doc.source, grid.dims, step))
 }
 
-/// Makes `slot` an offscreen target of `size` shown through an egui texture (the texture id is
-/// kept across sizes); true when it was made anew.
+/// An offscreen target of `size` shown through an egui texture: `old`'s texture id when given
+/// (it then shows the new target), else a new one.
+fn egui_target(
+    device: &wgpu::Device,
+    render_state: &egui_wgpu::RenderState,
+    size: [u32; 2],
+    old: Option<egui::TextureId>,
+) -> (OffscreenTarget, egui::TextureId) {
+    let target = OffscreenTarget::new(device, size);
+    let mut egui_renderer = render_state.renderer.write();
+    let filter = wgpu::FilterMode::Linear;
+    let id = match old {
+        Some(id) => {
+            egui_renderer.update_egui_texture_from_wgpu_texture(device, &target.encoded_view, filter, id);
+            id
+        }
+        None => egui_renderer.register_native_texture(device, &target.encoded_view, filter),
+    };
+    (target, id)
+}
+
+/// Makes `slot` an [`egui_target`] of `size`, keeping its texture id; true when it was made anew.
 fn sized_target(
     slot: &mut Option<(OffscreenTarget, egui::TextureId)>,
     device: &wgpu::Device,
@@ -118,21 +138,7 @@ fn sized_target(
     if slot.as_ref().is_some_and(|(t, _)| t.size == size) {
         return false;
     }
-    let target = OffscreenTarget::new(device, size);
-    let mut egui_renderer = render_state.renderer.write();
-    let id = match slot.take() {
-        Some((_, id)) => {
-            egui_renderer.update_egui_texture_from_wgpu_texture(
-                device,
-                &target.encoded_view,
-                wgpu::FilterMode::Linear,
-                id,
-            );
-            id
-        }
-        None => egui_renderer.register_native_texture(device, &target.encoded_view, wgpu::FilterMode::Linear),
-    };
-    *slot = Some((target, id));
+    *slot = Some(egui_target(device, render_state, size, slot.as_ref().map(|(_, id)| *id)));
     true
 }
 
@@ -832,21 +838,8 @@ impl Viewport {
             let pane = Pane { camera: fit_width(view.panes.camera(p, &view.camera), size), ..pane.clone() };
             let key = (pane, clouds.clone(), size, view.background, self.generation);
             if self.split.get(p).is_none_or(|t| t.target.size != size) {
-                let target = OffscreenTarget::new(&self.ctx.device, size);
-                let mut egui_renderer = render_state.renderer.write();
-                let filter = wgpu::FilterMode::Linear;
-                let id = match self.split.get(p) {
-                    Some(old) => {
-                        egui_renderer.update_egui_texture_from_wgpu_texture(
-                            &self.ctx.device,
-                            &target.encoded_view,
-                            filter,
-                            old.id,
-                        );
-                        old.id
-                    }
-                    None => egui_renderer.register_native_texture(&self.ctx.device, &target.encoded_view, filter),
-                };
+                let old = self.split.get(p).map(|t| t.id);
+                let (target, id) = egui_target(&self.ctx.device, render_state, size, old);
                 let slot = PaneTarget { target, id, drawn: None };
                 if p < self.split.len() {
                     self.split[p] = slot;

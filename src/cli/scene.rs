@@ -80,10 +80,7 @@ fn scene_bounds(scene: &[(orbcloud::model::Document, ObjectState)]) -> Option<(g
         .iter()
         .filter_map(|(doc, state)| {
             let (lo, hi) = doc.bounds()?;
-            let m = state.placement.world_from_object();
-            let corners =
-                orbcloud::model::octree::box_corners(lo.as_vec3(), hi.as_vec3()).map(|c| m.transform_point3(c));
-            Some(corners.iter().fold((corners[0], corners[0]), |(l, h), &c| (l.min(c), h.max(c))))
+            Some(state.placement.placed_box(lo.as_vec3(), hi.as_vec3()))
         })
         .reduce(|(l, h), (a, b)| (l.min(a), h.max(b)))
 }
@@ -94,8 +91,8 @@ const BAND_ROWS: u32 = 32;
 pub fn bench(args: &SceneBench) -> Result<()> {
     let ctx = super::gpu(args.bench.lavapipe)?;
     let scene = molecules(&args.files, args.molecules.max(1))?;
+    let (lo, hi) = scene_bounds(&scene).context("the scene has no atoms")?;
     if let Some(path) = &args.session {
-        let (lo, hi) = scene_bounds(&scene).context("the scene has no atoms")?;
         let session = orbcloud::scene::Session {
             camera: Camera::framing(lo, hi),
             objects: scene.iter().map(|(_, s)| s.clone()).collect(),
@@ -106,7 +103,6 @@ pub fn bench(args: &SceneBench) -> Result<()> {
     }
     let mut renderer = Renderer::new(&ctx);
     let shown = show_scene(&ctx, &mut renderer, &scene, args.points)?;
-    let (lo, hi) = scene_bounds(&scene).context("the scene has no atoms")?;
     let camera = Camera::framing(lo, hi);
     let size = args.bench.size;
     let quantities: usize = scene.iter().map(|(_, s)| s.quantities.len()).sum();

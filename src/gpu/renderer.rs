@@ -402,7 +402,10 @@ impl Renderer {
             .map(|(n, _)| n)
             .take(MAX_WALKED)
             .collect();
-        let walks = !weighted && (walked.len() > 1 || (walked.len() == 1 && sorted));
+        let lists_bind = if sorted { self.lists.composite_bind() } else { None };
+        // With surfaces, the walk reads their lists: none, no walk (the slices draw the clouds).
+        let walks =
+            !weighted && (walked.len() > 1 || (walked.len() == 1 && sorted)) && (!sorted || lists_bind.is_some());
         for (n, layer) in self.layers.iter_mut().enumerate() {
             layer.volume.set_walked(walks && walked.len() > 1 && walked.contains(&n));
         }
@@ -413,12 +416,9 @@ impl Renderer {
             }
             false => None,
         };
-        let lists_bind = if sorted { self.lists.composite_bind() } else { None };
         let composite = match (oit, self.lists.weighted().filter(|_| weighted), &walk) {
             (true, Some(w), _) => Some(Lists::Weighted(&w.resolve_bind)),
-            (_, _, Some((pipeline, clouds))) if lists_bind.is_some() || !sorted => {
-                Some(Lists::Walk(lists_bind, pipeline, clouds))
-            }
+            (_, _, Some((pipeline, clouds))) => Some(Lists::Walk(lists_bind, pipeline, clouds)),
             (false, _, _) => None,
             (true, _, _) => lists_bind.map(Lists::Sorted),
         };

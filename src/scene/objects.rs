@@ -37,6 +37,13 @@ impl Placement {
     pub fn beside(right_edge: f32, lo: Vec3, gap: f32) -> Self {
         Self { offset: [right_edge + gap - lo.x, 0.0, 0.0], rotation_deg: [0.0; 3] }
     }
+
+    /// The axis-aligned box around the box `lo..hi` of the object's frame, placed.
+    pub fn placed_box(&self, lo: Vec3, hi: Vec3) -> (Vec3, Vec3) {
+        let m = self.world_from_object();
+        let corners = crate::model::octree::box_corners(lo, hi).map(|c| m.transform_point3(c));
+        corners.iter().fold((corners[0], corners[0]), |(l, h), &c| (l.min(c), h.max(c)))
+    }
 }
 
 /// What an object shows and how: plain data, saved in sessions. The one source of truth for
