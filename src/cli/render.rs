@@ -217,13 +217,17 @@ pub fn bench(
     if let Some(v) = h.renderer.main().volume.volume() {
         let s = v.grid_box.slices(settings.volume.mode, settings.volume.slices, eye, -camera.backward());
         println!("slice_spacing_bohr={:.5}", s.spacing);
-        // What the last frame drew against whole slices: the fragments empty space spared.
-        let drawn = h.renderer.main().volume.slice_vertices();
+        // What the last frame drew against whole slices (cut into the same slabs): the
+        // fragments empty space spared.
+        let volume = &h.renderer.main().volume;
+        let planes = volume.planes_per_fragment();
+        let whole = s.slabs(planes, eye).unwrap_or(s.vertices);
+        let drawn = volume.slice_vertices();
         let area = |v: &[glam::Vec3]| v.chunks(3).map(|t| (t[1] - t[0]).cross(t[2] - t[0]).length() * 0.5).sum::<f32>();
         println!(
-            "slice_triangles={} slice_area_fraction={:.3}",
+            "planes_per_fragment={planes} slice_triangles={} slice_area_fraction={:.3}",
             drawn.len() / 3,
-            area(drawn) / area(&s.vertices).max(1e-30)
+            area(drawn) / area(&whole).max(1e-30)
         );
     }
     println!(

@@ -145,6 +145,8 @@ pub struct Prepare<'a> {
     pub layer: u32,
     /// The frame's size in pixels.
     pub size: [u32; 2],
+    /// The opaque scene's depth, which the translucent phase reads.
+    pub depth: &'a wgpu::TextureView,
     /// A later band of a frame drawn in bands: the first band's culling and level of detail
     /// stand (preparing them again would count frames the seen-last-frame lists skip).
     pub later_tile: bool,

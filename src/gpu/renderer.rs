@@ -368,6 +368,7 @@ impl Renderer {
                 view: &view,
                 layer: n as u32,
                 size: frame.size,
+                depth: &targets.depth_view,
                 later_tile,
                 lod_scale: self.lod_scale,
                 first_translucent,

@@ -6,7 +6,7 @@
 use glam::{DVec3, Vec3};
 
 use super::opacity::visibility_threshold;
-use super::slicing::{GridBox, Slices};
+use super::slicing::{GridBox, Slices, convex_hull};
 use super::{DensityScale, SliceMode, TransferKind, VolumeSettings};
 use crate::model::bricks::BrickRanges;
 
@@ -205,41 +205,6 @@ impl Occupancy {
         }
         Slices { vertices, starts, ..whole }
     }
-}
-
-/// The convex hull (counter-clockwise in the basis `bu`, `bv`) of points on one plane:
-/// Andrew's monotone chain on their coordinates in that basis.
-fn convex_hull(points: &mut [Vec3], bu: Vec3, bv: Vec3) -> Vec<Vec3> {
-    if points.len() < 3 {
-        return Vec::new();
-    }
-    let at = |p: Vec3| (p.dot(bu), p.dot(bv));
-    points.sort_by(|&a, &b| {
-        let ((ax, ay), (bx, by)) = (at(a), at(b));
-        ax.total_cmp(&bx).then(ay.total_cmp(&by))
-    });
-    let turns_left = |o: Vec3, a: Vec3, b: Vec3| {
-        let ((ox, oy), (ax, ay), (bx, by)) = (at(o), at(a), at(b));
-        (ax - ox) * (by - oy) - (ay - oy) * (bx - ox) > 0.0
-    };
-    let mut hull: Vec<Vec3> = Vec::with_capacity(2 * points.len());
-    for pass in 0..2 {
-        let floor = hull.len();
-        let push = |p: Vec3, hull: &mut Vec<Vec3>| {
-            while hull.len() >= floor + 2 && !turns_left(hull[hull.len() - 2], hull[hull.len() - 1], p) {
-                hull.pop();
-            }
-            hull.push(p);
-        };
-        if pass == 0 {
-            points.iter().for_each(|&p| push(p, &mut hull));
-        } else {
-            points.iter().rev().for_each(|&p| push(p, &mut hull));
-        }
-        // The chain's last point starts the other chain.
-        hull.pop();
-    }
-    if hull.len() < 3 { Vec::new() } else { hull }
 }
 
 #[cfg(test)]

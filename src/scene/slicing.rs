@@ -140,6 +140,79 @@ impl GridBox {
     }
 }
 
+/// The convex hull (counter-clockwise in the basis `bu`, `bv`) of points on one plane:
+/// Andrew's monotone chain on their coordinates in that basis.
+pub(super) fn convex_hull(points: &mut [Vec3], bu: Vec3, bv: Vec3) -> Vec<Vec3> {
+    if points.len() < 3 {
+        return Vec::new();
+    }
+    let at = |p: Vec3| (p.dot(bu), p.dot(bv));
+    points.sort_by(|&a, &b| {
+        let ((ax, ay), (bx, by)) = (at(a), at(b));
+        ax.total_cmp(&bx).then(ay.total_cmp(&by))
+    });
+    let turns_left = |o: Vec3, a: Vec3, b: Vec3| {
+        let ((ox, oy), (ax, ay), (bx, by)) = (at(o), at(a), at(b));
+        (ax - ox) * (by - oy) - (ay - oy) * (bx - ox) > 0.0
+    };
+    let mut hull: Vec<Vec3> = Vec::with_capacity(2 * points.len());
+    for pass in 0..2 {
+        let floor = hull.len();
+        let push = |p: Vec3, hull: &mut Vec<Vec3>| {
+            while hull.len() >= floor + 2 && !turns_left(hull[hull.len() - 2], hull[hull.len() - 1], p) {
+                hull.pop();
+            }
+            hull.push(p);
+        };
+        if pass == 0 {
+            points.iter().for_each(|&p| push(p, &mut hull));
+        } else {
+            points.iter().rev().for_each(|&p| push(p, &mut hull));
+        }
+        // The chain's last point starts the other chain.
+        hull.pop();
+    }
+    if hull.len() < 3 { Vec::new() } else { hull }
+}
+
+impl Slices {
+    /// The triangles of the same planes taken `k` at a time (back to front): slab s holds planes
+    /// s·k … s·k + k − 1 from the front, and its polygon, on its front plane, is the convex hull
+    /// of its planes' slices projected there from `eye`, so every pixel whose ray meets one of
+    /// them is covered. None where some plane does not lie wholly beyond the eye (the eye among
+    /// the planes): no projection from it covers what lies behind it.
+    pub fn slabs(&self, k: usize, eye: Vec3) -> Option<Vec<Vec3>> {
+        let planes = self.starts.len();
+        let n = self.normal;
+        let eye_depth = n.dot(eye);
+        let beyond = |p: &Vec3| n.dot(*p) - eye_depth > 1e-3 * self.spacing.max(1e-6);
+        if k < 2 || planes == 0 || !self.vertices.iter().all(beyond) {
+            return None;
+        }
+        let (bu, bv) = n.any_orthonormal_pair();
+        let plane = |back: usize| {
+            let end = self.starts.get(back + 1).map_or(self.vertices.len(), |&e| e as usize);
+            &self.vertices[self.starts[back] as usize..end]
+        };
+        let mut vertices = Vec::with_capacity(self.vertices.len() / k + 12);
+        let mut points = Vec::new();
+        for s in (0..planes.div_ceil(k)).rev() {
+            let front = s * k;
+            let depth = self.nearest + front as f32 * self.spacing - eye_depth;
+            points.clear();
+            for j in front..(front + k).min(planes) {
+                let back = planes - 1 - j;
+                points.extend(plane(back).iter().map(|&p| eye + (p - eye) * (depth / (n.dot(p) - eye_depth))));
+            }
+            let hull = convex_hull(&mut points, bu, bv);
+            for t in 1..hull.len().saturating_sub(1) {
+                vertices.extend_from_slice(&[hull[0], hull[t], hull[t + 1]]);
+            }
+        }
+        Some(vertices)
+    }
+}
+
 /// Orders the points of a convex planar polygon by angle around its centroid and emits a fan.
 fn triangulate_convex(poly: &mut [Vec3], normal: Vec3, out: &mut Vec<Vec3>) {
     if poly.len() < 3 {
@@ -229,5 +302,47 @@ mod tests {
                 assert!((d - (s.nearest + j as f32 * s.spacing)).abs() < 1e-4, "plane {j}: {d} vs {}", s.nearest);
             }
         }
+    }
+
+    /// Whether `p` (on the plane of the triangles, normal `n`) lies in one of them.
+    fn covered(tris: &[Vec3], p: Vec3, n: Vec3) -> bool {
+        tris.chunks(3).any(|t| {
+            let side = |a: Vec3, b: Vec3| (b - a).cross(p - a).dot(n);
+            let s = [side(t[0], t[1]), side(t[1], t[2]), side(t[2], t[0])];
+            s.iter().all(|&v| v >= -1e-4) || s.iter().all(|&v| v <= 1e-4)
+        })
+    }
+
+    #[test]
+    fn a_slab_covers_every_ray_that_meets_one_of_its_planes() {
+        let b = GridBox {
+            origin: Vec3::new(-1.0, 0.5, 0.0),
+            edges: [Vec3::X * 4.0, Vec3::new(1.0, 2.0, 0.0), Vec3::Z * 3.0],
+        };
+        let eye = Vec3::new(9.0, -4.0, 14.0);
+        let centre = b.origin + 0.5 * (b.edges[0] + b.edges[1] + b.edges[2]);
+        for (s, k) in [(b.view_aligned(21, centre - eye), 8), (b.axis_aligned(13, eye, centre - eye), 4)] {
+            let tris = s.slabs(k, eye).expect("the eye is before every plane");
+            let planes = s.starts.len();
+            // Fewer, larger polygons; each slab's on its front plane.
+            assert!(tris.len() < s.vertices.len());
+            for (j, &start) in s.starts.iter().rev().enumerate() {
+                let back = planes - 1 - j;
+                let end = s.starts.get(back + 1).map_or(s.vertices.len(), |&e| e as usize);
+                let front_depth = s.nearest + (j / k * k) as f32 * s.spacing;
+                let slab: Vec<Vec3> =
+                    tris.iter().copied().filter(|v| (s.normal.dot(*v) - front_depth).abs() < 1e-4).collect();
+                assert!(!slab.is_empty(), "plane {j}'s slab");
+                // Every point of plane j's slice, seen from the eye, falls inside its slab.
+                let tri = &s.vertices[start as usize..end];
+                let points = tri.chunks(3).flat_map(|t| [t[0], t[1], t[2], (t[0] + t[1] + t[2]) / 3.0]);
+                for p in points {
+                    let q = eye + (p - eye) * ((front_depth - s.normal.dot(eye)) / s.normal.dot(p - eye));
+                    assert!(covered(&slab, q, s.normal), "plane {j}: {p} seen at {q}");
+                }
+            }
+        }
+        // The eye among the planes: no slabs.
+        assert!(b.view_aligned(21, Vec3::Z).slabs(8, centre).is_none());
     }
 }
