@@ -20,34 +20,79 @@ override FIELD: u32 = 1u;
 // more would add samples a slice's polygon leaves out, which a sharp transfer function shows.
 const BOX_SLACK: f32 = 1e-6;
 
+// What a slab's fragment needs beyond `VertexOut`, constant over its polygon (one plane).
+struct SlabOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) uvw: vec3<f32>,
+    @location(1) from_eye: vec3<f32>,
+    @location(2) world: vec3<f32>,
+    // x: the plane's index from the front, y: its depth n·p in spacings, z: spacing / n·(p − eye),
+    // so the step from one plane to the next along the ray through p is z·(p − eye).
+    @location(3) @interpolate(flat) plane: vec3<f32>,
+    // The opaque scene's point at pixel (x, y) and window depth d lies at n·p = (depth_n·v) /
+    // (depth_w·v) spacings, v = (x, y, d, 1): world_from_clip's rows, after the map from pixels
+    // to normalised device coordinates.
+    @location(4) @interpolate(flat) depth_n: vec4<f32>,
+    @location(5) @interpolate(flat) depth_w: vec4<f32>,
+    // The step between planes in texture coordinates, and the position and step in the box's
+    // (0..1 inside): all affine in p over one plane, so interpolated exactly.
+    @location(6) step_uvw: vec3<f32>,
+    @location(7) box: vec3<f32>,
+    @location(8) step_box: vec3<f32>,
+};
+
+// Per vertex, what would otherwise cost every fragment its divisions and matrix products.
+@vertex
+fn vs_slab(@location(0) world: vec3<f32>) -> SlabOut {
+    var out: SlabOut;
+    out.clip = u.clip_from_world * vec4<f32>(world, 1.0);
+    out.uvw = (u.tex_from_world * vec4<f32>(world, 1.0)).xyz;
+    out.from_eye = world - u.eye.xyz;
+    out.world = world;
+    let n = u.plane.xyz;
+    let depth = dot(n, world);
+    let along = max(dot(out.from_eye, n), 1e-6);
+    out.plane = vec3<f32>(round((depth - u.slab.x) / u.plane.w), depth / u.plane.w, u.plane.w / along);
+    // ndc = (2x / width − 1, 1 − 2y / height).
+    let from_pixels = mat4x4<f32>(
+        vec4<f32>(2.0 / u.slab.z, 0.0, 0.0, 0.0),
+        vec4<f32>(0.0, -2.0 / u.slab.w, 0.0, 0.0),
+        vec4<f32>(0.0, 0.0, 1.0, 0.0),
+        vec4<f32>(-1.0, 1.0, 0.0, 1.0),
+    );
+    let m = u.world_from_clip * from_pixels;
+    out.depth_n = vec4<f32>(dot(n, m[0].xyz), dot(n, m[1].xyz), dot(n, m[2].xyz), dot(n, m[3].xyz)) / u.plane.w;
+    out.depth_w = vec4<f32>(m[0].w, m[1].w, m[2].w, m[3].w);
+    let step = out.from_eye * out.plane.z;
+    out.step_uvw = (u.tex_from_world * vec4<f32>(step, 0.0)).xyz;
+    out.box = (u.box_from_world * vec4<f32>(world, 1.0)).xyz;
+    out.step_box = (u.box_from_world * vec4<f32>(step, 0.0)).xyz;
+    return out;
+}
+
 @fragment
-fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
+fn fs_main(in: SlabOut) -> @location(0) vec4<f32> {
     // Read once: the uniforms handed by value to a function called per sample would be loaded
     // whole per call.
     let c = u;
-    let n = c.plane.xyz;
-    let along = dot(in.from_eye, n);
-    // From one plane to the next along this pixel's ray.
-    let step = in.from_eye * (u.plane.w / max(along, 1e-6 * length(in.from_eye)));
-    let step_uvw = (u.tex_from_world * vec4<f32>(step, 0.0)).xyz;
-    let path = plane_path(c, in.from_eye);
+    let step = in.from_eye * in.plane.z;
+    // The opacity law's path between planes (plane_path, without its divisions): the ray
+    // travels |p − eye|·z, at most spacing / 0.05.
+    let path = min(length(in.from_eye) * in.plane.z, c.plane.w * 20.0) / c.ref_step;
     // The samples this ray takes, j in [first, last]: inside the box, not past the cloud's
     // last plane, nor behind the opaque scene.
-    let front = round((dot(n, in.world) - c.slab.x) / c.plane.w);
-    var last = min(f32(SLAB), c.slab.y - front) - 0.5;
+    var last = min(f32(SLAB), c.slab.y - in.plane.x) - 0.5;
     if (SLAB > 1u) {
         let opaque = textureLoad(scene_depth, vec2<i32>(in.clip.xy), 0);
-        let ndc = vec2<f32>(in.clip.x / c.slab.z * 2.0 - 1.0, 1.0 - in.clip.y / c.slab.w * 2.0);
-        let hit = c.world_from_clip * vec4<f32>(ndc, opaque, 1.0);
+        let v = vec4<f32>(in.clip.xy, opaque, 1.0);
+        let hidden = dot(in.depth_n, v) / dot(in.depth_w, v);
         // The front plane passed the depth test itself.
-        last = min(last, max((dot(n, hit.xyz / hit.w) - dot(n, in.world)) / c.plane.w - 1e-3, 0.0));
+        last = min(last, max(hidden - in.plane.y - 1e-3, 0.0));
     }
     // Where the ray is in the box: the box coordinates are affine in j.
-    let box0 = (c.box_from_world * vec4<f32>(in.world, 1.0)).xyz;
-    var step_box = (c.box_from_world * vec4<f32>(step, 0.0)).xyz;
-    step_box = select(step_box, vec3<f32>(1e-30), abs(step_box) < vec3<f32>(1e-30));
-    let to_lo = (vec3<f32>(-BOX_SLACK) - box0) / step_box;
-    let to_hi = (vec3<f32>(1.0 + BOX_SLACK) - box0) / step_box;
+    let inverse = 1.0 / select(in.step_box, vec3<f32>(1e-30), abs(in.step_box) < vec3<f32>(1e-30));
+    let to_lo = (vec3<f32>(-BOX_SLACK) - in.box) * inverse;
+    let to_hi = (vec3<f32>(1.0 + BOX_SLACK) - in.box) * inverse;
     let enter = min(to_lo, to_hi);
     let exit = max(to_lo, to_hi);
     let first = max(max(enter.x, enter.y), enter.z);
@@ -55,7 +100,7 @@ fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
     var acc = vec4<f32>(0.0);
     for (var j = 0u; j < SLAB; j += 1u) {
         let t = f32(j);
-        let uvw = in.uvw + step_uvw * t;
+        let uvw = in.uvw + in.step_uvw * t;
         let inside = t >= first && t <= last && !clipped(in.world + step * t);
         var grad = vec3<f32>(0.0);
         if (needs_gradient()) {

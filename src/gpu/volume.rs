@@ -406,7 +406,8 @@ fn make_pipeline(
         layout: Some(&shader.layout),
         vertex: wgpu::VertexState {
             module: &shader.module,
-            entry_point: Some("vs_main"),
+            // The texture's slices pass their fragments what a slab needs (volume_slices.wgsl).
+            entry_point: Some(if variant.program == Program::Slices { "vs_slab" } else { "vs_main" }),
             compilation_options: options.clone(),
             buffers: &[Some(wgpu::VertexBufferLayout {
                 array_stride: 12,
