@@ -134,52 +134,31 @@ fn transfer_value(c: VolumeUniforms, field: u32, value: f32) -> f32 {
 // transfer function needs it); alpha < 0 means invisible (the caller discards, which skips the
 // frame buffer's read-modify-write).
 fn shade(value: f32, grad: vec3<f32>, from_eye: vec3<f32>) -> vec4<f32> {
-    return shade_with(u, SHAPED, needs_gradient(), value, grad, from_eye);
+    return shade_with(u, u.signed_field, SHAPED, needs_gradient(), value, grad, from_eye);
 }
 
-// `shade` for the cloud `c` describes: `shaped` and `gradient` say which transfer function it
-// uses (constants where one pipeline draws one cloud, flags where a walk takes several).
-fn shade_with(c: VolumeUniforms, shaped: bool, gradient: bool, value: f32, grad: vec3<f32>, from_eye: vec3<f32>) -> vec4<f32> {
-    let e = emission(c, c.signed_field, shaped, gradient, value, grad, from_eye);
-    if (e.a < 0.0) {
-        return vec4<f32>(-1.0);
-    }
-    let alpha = opacity(e.a * plane_path(c, from_eye));
-    return vec4<f32>(e.rgb * alpha, alpha);
-}
-
-// The distance a ray from the eye along `from_eye` travels from one plane to the next, in
-// reference steps (the opacity law's unit).
-fn plane_path(c: VolumeUniforms, from_eye: vec3<f32>) -> f32 {
-    let ray = normalize(from_eye);
-    return c.plane.w / max(abs(dot(ray, c.plane.xyz)), 0.05) / c.ref_step;
-}
-
-// The extinction of one reference step (seed 000's alpha = k1 rho^k2 for the power law)
-// composes exactly over x reference steps of travel: alpha = 1 - exp(-x · extinction); `x` here
-// is that product.
-fn opacity(x: f32) -> f32 {
-    // 1 − e^−x loses its digits to cancellation for small x: use the series there.
-    return select(1.0 - exp2(-1.442695 * x), x * (1.0 - x * (0.5 - x / 6.0)), x < 0.03);
-}
-
-// One sample's colour (rgb, not premultiplied) and extinction per reference step (a); a < 0
-// where it is invisible. `field` is `c.signed_field` (or a constant equal to it). The power law
-// is computed without branches: where the slices' shader takes several samples per fragment, a
-// branch per sample costs a CPU rasteriser both sides.
-fn emission(c: VolumeUniforms, field: u32, shaped: bool, gradient: bool, value: f32, grad: vec3<f32>, from_eye: vec3<f32>) -> vec4<f32> {
+// `shade` for the cloud `c` describes: `field` is its `signed_field`, `shaped` and `gradient`
+// say which transfer function it uses (constants where one pipeline draws one cloud, which
+// settle the branches on them when the pipeline is built; values where a walk takes several).
+// Kept in one piece: split into calls that each take `c`, a walk ran 1.5 times as long on a CPU
+// rasteriser (a copy of the struct per call and sample).
+fn shade_with(c: VolumeUniforms, field: u32, shaped: bool, gradient: bool, value: f32, grad: vec3<f32>, from_eye: vec3<f32>) -> vec4<f32> {
     let scaled = transfer_value(c, field, value);
     var extinction: f32;
     var color: vec3<f32>;
     if (!shaped) {
-        // rho = psi^2 for an orbital, so rho^k2 = |psi|^(2 k2).
-        let signed = field == 1u;
-        let rho = select(max(scaled, 0.0), abs(scaled), signed);
-        let power = select(c.k2, 2.0 * c.k2, signed);
-        // Below `visible_min` (computed on the CPU from k1, k2) a sample is invisible.
-        extinction = select(-1.0, c.k1 * pow(rho, power), abs(scaled) >= c.visible_min);
-        let density_color = mix(c.negative_color.rgb, c.positive_color.rgb, sqrt(clamp(scaled, 0.0, 1.0)));
-        color = select(density_color, select(c.negative_color.rgb, c.positive_color.rgb, value >= 0.0), signed);
+        // Below this magnitude a sample is invisible (computed on the CPU from k1, k2).
+        if (abs(scaled) < c.visible_min) {
+            return vec4<f32>(-1.0);
+        }
+        if (field == 1u) {
+            // rho = psi^2, so rho^k2 = |psi|^(2 k2).
+            extinction = c.k1 * pow(abs(scaled), 2.0 * c.k2);
+            color = select(c.negative_color.rgb, c.positive_color.rgb, value >= 0.0);
+        } else {
+            extinction = c.k1 * pow(max(scaled, 0.0), c.k2);
+            color = mix(c.negative_color.rgb, c.positive_color.rgb, sqrt(min(scaled, 1.0)));
+        }
     } else {
         let positive = value >= 0.0 || field != 1u;
         let lobe = select(c.tf_negative, c.tf_positive, positive);
@@ -191,7 +170,7 @@ fn emission(c: VolumeUniforms, field: u32, shaped: bool, gradient: bool, value: 
         }
         color = select(c.negative_color.rgb, c.positive_color.rgb, positive);
     }
-    if (gradient && extinction >= 0.0) {
+    if (gradient) {
         let g = min(length(grad) * c.inv_max_grad, 1.0);
         if (c.gradient_power > 0.0) {
             extinction *= pow(g, c.gradient_power);
@@ -208,5 +187,13 @@ fn emission(c: VolumeUniforms, field: u32, shaped: bool, gradient: bool, value: 
             color = color * (0.3 + 0.7 * diffuse) + vec3<f32>(0.35 * specular);
         }
     }
-    return vec4<f32>(color, extinction);
+    // The extinction of one reference step (seed 000's alpha = k1 rho^k2 for the power law)
+    // composes exactly over the distance the ray travels between two slices:
+    // alpha = 1 - exp(-extinction * path / step).
+    let ray = normalize(from_eye);
+    let path = c.plane.w / max(abs(dot(ray, c.plane.xyz)), 0.05);
+    let x = extinction * path / c.ref_step;
+    // 1 − e^−x loses its digits to cancellation for small x: use the series there.
+    let alpha = select(1.0 - exp2(-1.442695 * x), x * (1.0 - x * (0.5 - x / 6.0)), x < 0.03);
+    return vec4<f32>(color * alpha, alpha);
 }

@@ -66,7 +66,7 @@ fn sample_cloud(k: u32, p: vec3<f32>, from_eye: vec3<f32>) -> vec4<f32> {
     if (gradient) {
         grad = cloud_gradient(k, c, uvw);
     }
-    return shade_with(c, SHAPED && (c.tf_bits & TF_SHAPED) != 0u, gradient, cloud_value(k, uvw), grad, from_eye);
+    return shade_with(c, c.signed_field, SHAPED && (c.tf_bits & TF_SHAPED) != 0u, gradient, cloud_value(k, uvw), grad, from_eye);
 }
 
 // Each cloud's ray (its object's frame), the planes it crosses and the next one's depth, one

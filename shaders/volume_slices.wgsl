@@ -76,9 +76,6 @@ fn fs_main(in: SlabOut) -> @location(0) vec4<f32> {
     // whole per call.
     let c = u;
     let step = in.from_eye * in.plane.z;
-    // The opacity law's path between planes (plane_path, without its divisions): the ray
-    // travels |p − eye|·z, at most spacing / 0.05.
-    let path = min(length(in.from_eye) * in.plane.z, c.plane.w * 20.0) / c.ref_step;
     // The samples this ray takes, j in [first, last]: inside the box, not past the cloud's
     // last plane, nor behind the opaque scene.
     var last = min(f32(SLAB), c.slab.y - in.plane.x) - 0.5;
@@ -106,9 +103,10 @@ fn fs_main(in: SlabOut) -> @location(0) vec4<f32> {
         if (needs_gradient()) {
             grad = field_gradient(uvw);
         }
-        let e = emission(c, FIELD, SHAPED, GRADIENT, field(uvw), grad, in.from_eye + step * t);
-        let alpha = select(0.0, opacity(max(e.a, 0.0) * path), inside && e.a >= 0.0);
-        acc += (1.0 - acc.a) * vec4<f32>(e.rgb * alpha, alpha);
+        // The direction from the eye is the fragment's for every sample (so is what depends on
+        // it alone, which the compiler takes out of the loop).
+        let sample = shade_with(c, FIELD, SHAPED, GRADIENT, field(uvw), grad, in.from_eye);
+        acc += (1.0 - acc.a) * select(vec4<f32>(0.0), sample, inside && sample.a >= 0.0);
     }
     // Nothing to add: no read-modify-write of the frame buffer.
     if (acc.a <= 0.0) {
