@@ -334,7 +334,19 @@ fn two_clouds(
     ctx: &GpuContext,
     orbital_layer: usize,
     surfaces: bool,
-) -> (image::RgbaImage, [(VolumeGrid, ObjectState); 2]) {
+) -> (image::RgbaImage, Vec<(VolumeGrid, ObjectState)>) {
+    cloud_pairs(ctx, &[DVec3::ZERO], orbital_layer == 1, surfaces, &camera())
+}
+
+/// An orbital and a density overlapping around each of `centres`, each quantity its own layer
+/// (the last pair listed density first when `swap_last`), drawn from `cam`.
+fn cloud_pairs(
+    ctx: &GpuContext,
+    centres: &[DVec3],
+    swap_last: bool,
+    surfaces: bool,
+    cam: &Camera,
+) -> (image::RgbaImage, Vec<(VolumeGrid, ObjectState)>) {
     let look = |grid: VolumeGrid, color: [f32; 3], level: f32| {
         let mut iso = translucent(level, color);
         iso.visible = surfaces;
@@ -348,24 +360,61 @@ fn two_clouds(
         cloud.positive_color = color;
         (grid, state)
     };
-    let orbital = look(wide_cloud(DVec3::new(-0.8, 0.0, 0.0), true), [0.9, 0.3, 0.1], 0.3);
-    let density = look(wide_cloud(DVec3::new(1.0, 0.4, 0.3), false), [0.2, 0.5, 0.95], 0.5);
-    let mut layers = [orbital, density];
-    if orbital_layer == 1 {
-        layers.swap(0, 1);
+    let mut layers = Vec::new();
+    for (n, &centre) in centres.iter().enumerate() {
+        let orbital = look(wide_cloud(centre + DVec3::new(-0.8, 0.0, 0.0), true), [0.9, 0.3, 0.1], 0.3);
+        let density = look(wide_cloud(centre + DVec3::new(1.0, 0.4, 0.3), false), [0.2, 0.5, 0.95], 0.5);
+        match swap_last && n + 1 == centres.len() {
+            true => layers.extend([density, orbital]),
+            false => layers.extend([orbital, density]),
+        }
     }
     let mut renderer = Renderer::new(ctx);
     for (n, (grid, state)) in layers.iter().enumerate() {
         let doc = Document { volumes: vec![grid.clone()], ..Default::default() };
         show_object(ctx, renderer.layer_mut(ctx, n), &doc, state).expect("cloud shown");
     }
-    let cam = camera();
     let target = OffscreenTarget::new(&ctx.device, SIZE);
-    let clouds = layers.each_ref().map(|(_, s)| s.quantities[0].cloud);
-    let frame = FrameInput { camera: &cam, background: BACKGROUND, clouds: &clouds, size: SIZE, tile: None };
+    let clouds: Vec<VolumeSettings> = layers.iter().map(|(_, s)| s.quantities[0].cloud).collect();
+    let frame = FrameInput { camera: cam, background: BACKGROUND, clouds: &clouds, size: SIZE, tile: None };
     // Counts come back only with translucent surfaces.
     let _ = draw_exact(ctx, &mut renderer, &target.color_view, &frame);
     (target.read_rgba(&ctx.device, &ctx.queue).expect("read back"), layers)
+}
+
+#[test]
+fn pairs_of_clouds_apart_on_screen_are_each_walked_in_one_depth_order() {
+    // Three molecules' worth of clouds (six, more than one walk takes): the pairs lie apart on
+    // screen, so each pair is walked on its own and the order of the last pair's quantities
+    // changes nothing, with translucent surfaces or without.
+    let ctx = lavapipe();
+    let centres = [DVec3::new(-20.0, 0.0, 0.0), DVec3::ZERO, DVec3::new(20.0, 0.0, 0.0)];
+    let mut cam = Camera::framing(Vec3::new(-26.0, -5.0, -5.0), Vec3::new(26.0, 5.0, 5.0));
+    cam.orbit(0.15, 0.3);
+    for surfaces in [false, true] {
+        let (first, _) = cloud_pairs(&ctx, &centres, false, surfaces, &cam);
+        let (second, _) = cloud_pairs(&ctx, &centres, true, surfaces, &cam);
+        let swapped = max_difference(&first, &second);
+        // The last pair alone: its pixels are the same in the scene of three.
+        let (alone, _) = cloud_pairs(&ctx, &centres[2..], false, surfaces, &cam);
+        let footprint: Vec<usize> = (alone.pixels().enumerate())
+            .filter(|(_, p)| (0..3).any(|k| p[k].abs_diff((BACKGROUND[k].powf(1.0 / 2.2) * 255.0) as u8) > 8))
+            .map(|(n, _)| n)
+            .collect();
+        let pixels: Vec<_> = first.pixels().collect();
+        let apart = footprint
+            .iter()
+            .map(|&n| (0..3).map(|k| pixels[n][k].abs_diff(alone.pixels().nth(n).unwrap()[k])).max().unwrap_or(0))
+            .max()
+            .unwrap_or(0);
+        eprintln!(
+            "three pairs (surfaces {surfaces}): last pair swapped {swapped}/255; its {} pixels against it alone {apart}/255",
+            footprint.len()
+        );
+        assert!(swapped <= 1, "swapping the last pair's quantities changed the picture by {swapped}/255");
+        assert!(footprint.len() > 500, "the last pair shows");
+        assert!(apart <= 2, "the last pair differs from itself alone by {apart}/255");
+    }
 }
 
 #[test]

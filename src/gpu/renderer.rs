@@ -9,7 +9,7 @@ use super::isosurface::IsosurfacePass;
 use super::occlusion::DepthPyramid;
 use super::oit::{FragmentDump, FragmentLists, FragmentStats, MAX_BANDS, Transparency};
 use super::resolve::{Lists, ResolvePass, Rows};
-use super::volume::{MAX_WALKED, VolumePass, VolumeTexture};
+use super::volume::{MAX_WALKED, VolumePass, VolumeTexture, overlapping_groups, union_rect};
 use super::{GpuContext, GpuError};
 use crate::model::GridSpec;
 use crate::model::cartesian::CartesianExpansion;
@@ -398,25 +398,43 @@ impl Renderer {
         // The clouds drawn from a texture are composited in one depth order with each other and
         // the surfaces, by a walk per pixel (one cloud alone with no surfaces: by its slices).
         let sorted = oit && !weighted;
-        let walked: Vec<usize> = (self.layers.iter().enumerate())
+        let walkable: Vec<usize> = (self.layers.iter().enumerate())
             .filter(|(_, l)| l.visible && l.volume.walkable())
             .map(|(n, _)| n)
-            .take(MAX_WALKED)
+            .collect();
+        // Clouds whose pixels overlap are walked together, up to MAX_WALKED (more are drawn by
+        // their slices, behind); a group apart on screen is walked on its own, in its rectangle.
+        let rects: Vec<[u32; 4]> = walkable.iter().map(|&n| self.layers[n].volume.screen_rect()).collect();
+        let groups: Vec<(Vec<usize>, [u32; 4])> = overlapping_groups(&rects)
+            .into_iter()
+            .map(|g| {
+                let rect = union_rect(g.iter().map(|&i| rects[i]));
+                (g.into_iter().map(|i| walkable[i]).take(MAX_WALKED).collect(), rect)
+            })
             .collect();
         let lists_bind = if sorted { self.lists.composite_bind() } else { None };
         // With surfaces, the walk reads their lists: none, no walk (the slices draw the clouds).
-        let walks =
-            !weighted && (walked.len() > 1 || (walked.len() == 1 && sorted)) && (!sorted || lists_bind.is_some());
+        let walks_group =
+            |g: &[usize]| !weighted && (g.len() > 1 || (g.len() == 1 && sorted)) && (!sorted || lists_bind.is_some());
         for (n, layer) in self.layers.iter_mut().enumerate() {
-            layer.volume.set_walked(walks && walked.len() > 1 && walked.contains(&n));
+            let walked = groups.iter().any(|(g, _)| g.len() > 1 && walks_group(g) && g.contains(&n));
+            layer.volume.set_walked(walked);
         }
-        let walk = match walks {
-            true => {
-                let clouds: Vec<&VolumePass> = walked.iter().map(|&n| &self.layers[n].volume).collect();
-                VolumePass::walk(ctx, &clouds, &targets.depth_view, sorted)
-            }
-            false => None,
-        };
+        let mut walks: Vec<((wgpu::RenderPipeline, wgpu::BindGroup), [u32; 4])> = (groups.iter())
+            .filter(|(g, _)| walks_group(g))
+            .filter_map(|(g, rect)| {
+                let clouds: Vec<&VolumePass> = g.iter().map(|&n| &self.layers[n].volume).collect();
+                Some((VolumePass::walk(ctx, &clouds, &targets.depth_view, sorted)?, *rect))
+            })
+            .collect();
+        // The first group's walk is the resolve of the whole frame; the others follow it in
+        // their rectangles.
+        let further = walks.split_off(walks.len().min(1));
+        let walk = walks.pop().map(|(walk, _)| walk);
+        let further: Vec<(Lists, [u32; 4])> = further
+            .iter()
+            .map(|((pipeline, clouds), rect)| (Lists::Walk(lists_bind, pipeline, clouds), *rect))
+            .collect();
         let composite = match (oit, self.lists.weighted().filter(|_| weighted), &walk) {
             (true, Some(w), _) => Some(Lists::Weighted(&w.resolve_bind)),
             (_, _, Some((pipeline, clouds))) => Some(Lists::Walk(lists_bind, pipeline, clouds)),
@@ -450,12 +468,18 @@ impl Renderer {
                         let rows = Rows { start, count, first: band == 0 };
                         if let Some(rows) = resolve_rows(Some(rows)) {
                             self.resolve.draw(encoder, resolve, output, composite, Some(rows), width);
+                            for &(walk, rect) in &further {
+                                self.resolve.draw_walk(encoder, resolve, output, walk, rect, Some(rows));
+                            }
                         }
                     }
                 }
                 Phase::Resolve => {
                     let rows = resolve_rows(None);
                     self.resolve.draw(encoder, resolve, output, composite, rows, width);
+                    for &(walk, rect) in &further {
+                        self.resolve.draw_walk(encoder, resolve, output, walk, rect, rows);
+                    }
                 }
                 Phase::Fragments if collects && weighted => self.collect_weighted(encoder),
                 Phase::Fragments => {

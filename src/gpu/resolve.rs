@@ -117,6 +117,41 @@ impl ResolvePass {
             Some(Rows { first: false, .. }) => wgpu::LoadOp::Load,
             _ => wgpu::LoadOp::Clear(wgpu::Color::BLACK),
         };
+        let scissor = rows.map(|Rows { start, count, .. }| [0, start, width, count.max(1)]);
+        self.record(encoder, color, output, lists, load, scissor);
+    }
+
+    /// A walk of a further group of clouds ([`Lists::Walk`]) over what the resolve wrote, in
+    /// the pixels of `rect` ([x0, y0, x1, y1)) among `rows`: the group's clouds cover no other.
+    pub fn draw_walk(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        color: &wgpu::BindGroup,
+        output: &wgpu::TextureView,
+        walk: Lists,
+        rect: [u32; 4],
+        rows: Option<Rows>,
+    ) {
+        let (y0, y1) = match rows {
+            Some(r) => (rect[1].max(r.start), rect[3].min(r.start + r.count)),
+            None => (rect[1], rect[3]),
+        };
+        if y1 > y0 && rect[2] > rect[0] {
+            let scissor = [rect[0], y0, rect[2] - rect[0], y1 - y0];
+            self.record(encoder, color, output, Some(walk), wgpu::LoadOp::Load, Some(scissor));
+        }
+    }
+
+    /// One pass of the resolve's program for `lists`, within `scissor` (x, y, width, height).
+    fn record(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        color: &wgpu::BindGroup,
+        output: &wgpu::TextureView,
+        lists: Option<Lists>,
+        load: wgpu::LoadOp<wgpu::Color>,
+        scissor: Option<[u32; 4]>,
+    ) {
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("resolve"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -130,8 +165,8 @@ impl ResolvePass {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        if let Some(Rows { start, count, .. }) = rows {
-            pass.set_scissor_rect(0, start, width, count.max(1));
+        if let Some([x, y, w, h]) = scissor {
+            pass.set_scissor_rect(x, y, w, h);
         }
         match lists {
             Some(Lists::Sorted(lists)) => {

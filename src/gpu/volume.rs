@@ -287,8 +287,6 @@ struct VolumeShaders {
     depth_layout: wgpu::BindGroupLayout,
     /// The walk's group 0: [`MAX_WALKED`] clouds' uniforms and textures and the scene's depth.
     walk_layout: wgpu::BindGroupLayout,
-    /// The walked clouds' uniforms, one array.
-    walk_uniforms: wgpu::Buffer,
     morph_layout: wgpu::BindGroupLayout,
     gto_layout: wgpu::BindGroupLayout,
     sampler: wgpu::Sampler,
@@ -510,11 +508,6 @@ impl VolumePass {
             layout,
             depth_layout,
             walk_layout,
-            walk_uniforms: super::uniform_buffer(
-                device,
-                "cloud walk uniforms",
-                MAX_WALKED * std::mem::size_of::<VolumeUniforms>(),
-            ),
             morph_layout,
             gto_layout,
             sampler,
@@ -793,6 +786,34 @@ impl VolumePass {
         self.bind_group.is_some() && self.variant.program == Program::Slices && self.vertex_count > 0
     }
 
+    /// The pixels this frame's cloud can cover, [x0, y0, x1, y1) (its walked box's corners on
+    /// screen); the whole frame where a corner lies behind the eye.
+    pub fn screen_rect(&self) -> [u32; 4] {
+        let u = &self.frame_uniforms;
+        let [w, h] = [u.slab[2], u.slab[3]];
+        let whole = [0, 0, w as u32, h as u32];
+        let clip_from_world = Mat4::from_cols_array_2d(&u.clip_from_world);
+        let world_from_box = Mat4::from_cols_array_2d(&u.box_from_world).inverse();
+        let mut lo = glam::Vec2::splat(f32::INFINITY);
+        let mut hi = glam::Vec2::splat(f32::NEG_INFINITY);
+        for n in 0..8 {
+            let corner = Vec3::new((n & 1) as f32, ((n >> 1) & 1) as f32, (n >> 2) as f32);
+            let c = clip_from_world * world_from_box.transform_point3(corner).extend(1.0);
+            if c.w <= 1e-6 {
+                return whole;
+            }
+            // Pixels from normalised device coordinates (y down).
+            let p = glam::Vec2::new((c.x / c.w + 1.0) * 0.5 * w, (1.0 - c.y / c.w) * 0.5 * h);
+            (lo, hi) = (lo.min(p), hi.max(p));
+        }
+        // A pixel's centre inside the projected box lies in the rectangle with one pixel spare.
+        let x0 = (lo.x.floor() - 1.0).clamp(0.0, w) as u32;
+        let y0 = (lo.y.floor() - 1.0).clamp(0.0, h) as u32;
+        let x1 = (hi.x.ceil() + 1.0).clamp(0.0, w) as u32;
+        let y1 = (hi.y.ceil() + 1.0).clamp(0.0, h) as u32;
+        [x0, y0, x1, y1]
+    }
+
     /// Leaves this frame's cloud to a walk over several clouds: its slices are not drawn.
     pub fn set_walked(&mut self, walked: bool) {
         self.walked = walked;
@@ -815,11 +836,16 @@ impl VolumePass {
             clouds.iter().map(|c| c.volume.as_ref().map(|v| &v.view)).collect::<Option<_>>()?;
         let uniforms: Vec<VolumeUniforms> =
             (0..MAX_WALKED).map(|k| clouds.get(k).map_or(VolumeUniforms::zeroed(), |c| c.frame_uniforms)).collect();
-        ctx.queue.write_buffer(&shared.walk_uniforms, 0, bytemuck::cast_slice(&uniforms));
+        // A buffer per walk: a frame may walk several groups of clouds.
+        let walk_uniforms = ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("cloud walk uniforms"),
+            contents: bytemuck::cast_slice(&uniforms),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
         let view = |k: usize| wgpu::BindingResource::TextureView(views.get(k).copied().unwrap_or(views[0]));
         let mut entries = vec![
             wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&shared.sampler) },
-            wgpu::BindGroupEntry { binding: WALK_UNIFORMS, resource: shared.walk_uniforms.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: WALK_UNIFORMS, resource: walk_uniforms.as_entire_binding() },
             wgpu::BindGroupEntry { binding: WALK_DEPTH, resource: wgpu::BindingResource::TextureView(depth) },
         ];
         entries.extend(
@@ -841,6 +867,46 @@ impl VolumePass {
         };
         Some((shared.pipeline(&ctx.device, variant), bind_group))
     }
+}
+
+/// The clouds whose rectangles ([x0, y0, x1, y1)) overlap, directly or through others, as
+/// groups of indices in order: no pixel of one group's clouds is another's, so each group can
+/// be walked on its own, in its own rectangle.
+pub fn overlapping_groups(rects: &[[u32; 4]]) -> Vec<Vec<usize>> {
+    let overlap = |a: &[u32; 4], b: &[u32; 4]| a[0] < b[2] && b[0] < a[2] && a[1] < b[3] && b[1] < a[3];
+    let mut group: Vec<usize> = (0..rects.len()).collect();
+    let root = |group: &[usize], mut i: usize| {
+        while group[i] != i {
+            i = group[i];
+        }
+        i
+    };
+    for a in 0..rects.len() {
+        for b in a + 1..rects.len() {
+            if overlap(&rects[a], &rects[b]) {
+                let (ra, rb) = (root(&group, a), root(&group, b));
+                group[ra.max(rb)] = ra.min(rb);
+            }
+        }
+    }
+    let mut groups: Vec<Vec<usize>> = Vec::new();
+    let mut slot: HashMap<usize, usize> = HashMap::new();
+    for i in 0..rects.len() {
+        let r = root(&group, i);
+        let n = *slot.entry(r).or_insert_with(|| {
+            groups.push(Vec::new());
+            groups.len() - 1
+        });
+        groups[n].push(i);
+    }
+    groups
+}
+
+/// The bounding rectangle of some of `rects`.
+pub fn union_rect(rects: impl IntoIterator<Item = [u32; 4]>) -> [u32; 4] {
+    rects
+        .into_iter()
+        .fold([u32::MAX, u32::MAX, 0, 0], |a, r| [a[0].min(r[0]), a[1].min(r[1]), a[2].max(r[2]), a[3].max(r[3])])
 }
 
 /// The bindings of the walked clouds' textures (volume_interleave.wgsl): cloud 0's is the
@@ -974,4 +1040,18 @@ pub fn texel_bytes(format: wgpu::TextureFormat) -> u64 {
 /// the paper's cards: their video memory), and three quarters of it leaves room for the frame.
 pub fn residency_budget(limits: &wgpu::Limits) -> u64 {
     limits.max_buffer_size.min(16 << 30) / 4 * 3
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn clouds_overlapping_on_screen_through_others_form_one_group() {
+        // 0 and 2 overlap through 1; 3 stands apart; 4 touches 3's edge only (half-open).
+        let rects = [[0, 0, 10, 10], [8, 8, 20, 12], [18, 0, 30, 9], [40, 40, 50, 50], [50, 40, 60, 50]];
+        assert_eq!(overlapping_groups(&rects), vec![vec![0, 1, 2], vec![3], vec![4]]);
+        assert_eq!(union_rect([rects[0], rects[2]]), [0, 0, 30, 10]);
+        assert!(overlapping_groups(&[]).is_empty());
+    }
 }
