@@ -73,6 +73,11 @@ struct VertexOut {
 
 @vertex
 fn vs_main(@location(0) world: vec3<f32>) -> VertexOut {
+    return slice_vertex(world);
+}
+
+// A slice's vertex at `world` (shared by the vertex stages that add to it).
+fn slice_vertex(world: vec3<f32>) -> VertexOut {
     var out: VertexOut;
     out.clip = u.clip_from_world * vec4<f32>(world, 1.0);
     out.uvw = (u.tex_from_world * vec4<f32>(world, 1.0)).xyz;

@@ -44,10 +44,11 @@ struct SlabOut {
 // Per vertex, what would otherwise cost every fragment its divisions and matrix products.
 @vertex
 fn vs_slab(@location(0) world: vec3<f32>) -> SlabOut {
+    let slice = slice_vertex(world);
     var out: SlabOut;
-    out.clip = u.clip_from_world * vec4<f32>(world, 1.0);
-    out.uvw = (u.tex_from_world * vec4<f32>(world, 1.0)).xyz;
-    out.from_eye = world - u.eye.xyz;
+    out.clip = slice.clip;
+    out.uvw = slice.uvw;
+    out.from_eye = slice.from_eye;
     out.world = world;
     let n = u.plane.xyz;
     let depth = dot(n, world);
