@@ -243,7 +243,8 @@ impl Variant {
 /// slice per plane (volume_slices.wgsl).
 pub const SLAB_PLANES: usize = 8;
 
-/// The most clouds one walk composites; clouds beyond them are drawn by their slices, behind.
+/// The most clouds one walk composites (one group of clouds that overlap on screen); a group's
+/// further clouds are drawn by their slices, behind.
 pub const MAX_WALKED: usize = 4;
 
 /// A slice shader module and its pipeline layout.
