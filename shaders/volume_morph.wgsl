@@ -1,16 +1,14 @@
 // Seed 000's interpolation between two key volumes A and B on one grid, θ between their
 // angles with ratio k = u.morph_k (`volume` is A).
 //
-// exact (fs_exact): the two volumes sampled and mixed per sample, ψ = (1−k)ψA + kψB, then one
-// premultiplied "over" blend.
-// α-mix (fs_alpha_mix): the two samples' colours and opacities mixed per slice (seed 000's
-// reference). three-pass (fs_three_pass): seed 000's real-time approximation, the attenuation
-// by one key volume's opacity; drawn in one pass (see there).
-// Prepended: volume_common.wgsl, volume_gradient.wgsl.
+// exact: the two volumes sampled and mixed per sample. α-mix: the two samples' colours and
+// opacities mixed per slice (seed 000's reference). three-pass: seed 000's real-time
+// approximation, the attenuation by one key volume's opacity, drawn in one pass (`plane_over`).
+// Prepended: volume_common.wgsl, volume_gradient.wgsl, volume_slab.wgsl.
 
 @group(1) @binding(0) var volume_b: texture_3d<f32>;
 
-// The weights of A and B this fragment samples (set first by each entry point).
+// The weights of A and B the next sample takes (set by `shade_mix`).
 var<private> weights: vec2<f32>;
 
 // weights.x·A + weights.y·B at uvw, sampling only what is weighted.
@@ -25,69 +23,65 @@ fn field(uvw: vec3<f32>) -> f32 {
     return v;
 }
 
-// Premultiplied colour of the mix w at this fragment (alpha < 0: invisible).
-fn shade_mix(in: VertexOut, w: vec2<f32>) -> vec4<f32> {
+// Premultiplied colour of the mix w at uvw (alpha < 0: invisible); `c`: the uniforms.
+fn shade_mix(c: VolumeUniforms, uvw: vec3<f32>, from_eye: vec3<f32>, w: vec2<f32>) -> vec4<f32> {
     weights = w;
     var grad = vec3<f32>(0.0);
     if (needs_gradient()) {
-        grad = field_gradient(in.uvw);
+        grad = field_gradient(uvw);
     }
-    return shade(field(in.uvw), grad, in.from_eye);
+    return shade_with(c, FIELD, SHAPED, GRADIENT, field(uvw), grad, from_eye);
 }
 
-fn k() -> f32 {
-    return u.morph_k;
-}
-
-@fragment
-fn fs_exact(in: VertexOut) -> @location(0) vec4<f32> {
-    if (clipped(in.world)) {
-        discard;
-    }
-    let c = shade_mix(in, vec2<f32>(1.0 - k(), k()));
-    if (c.a < 0.0) {
-        discard;
-    }
-    return c;
-}
-
-// The premultiplied colours of A's and B's samples at this fragment, each alone (an invisible
-// sample counts as clear).
-fn samples(in: VertexOut) -> array<vec4<f32>, 2> {
-    let a = shade_mix(in, vec2<f32>(1.0, 0.0));
-    let b = shade_mix(in, vec2<f32>(0.0, 1.0));
+// The premultiplied colours of A's and B's samples at uvw, each alone (an invisible sample
+// counts as clear).
+fn samples(c: VolumeUniforms, uvw: vec3<f32>, from_eye: vec3<f32>) -> array<vec4<f32>, 2> {
+    let a = shade_mix(c, uvw, from_eye, vec2<f32>(1.0, 0.0));
+    let b = shade_mix(c, uvw, from_eye, vec2<f32>(0.0, 1.0));
     return array<vec4<f32>, 2>(max(a, vec4<f32>(0.0)), max(b, vec4<f32>(0.0)));
 }
 
-// Seed 000's reference (their eq. 5): per slice the colours and opacities mixed, α = (1−k)α_A +
-// kα_B, then one premultiplied "over": d_i = (1−k)C_A α_A + k C_B α_B + d_{i−1}(1 − α).
-@fragment
-fn fs_alpha_mix(in: VertexOut) -> @location(0) vec4<f32> {
-    if (clipped(in.world)) {
-        discard;
+// How the two key volumes are mixed: 0 exact, 1 α-mix, 2 three-pass (a pipeline constant).
+override MIX: u32 = 0u;
+
+// The colour and opacity a plane's slice blends "over" what lies behind it, at uvw:
+//
+// exact: the two volumes sampled and mixed, ψ = (1−k)ψA + kψB, then shaded.
+//
+// α-mix, seed 000's reference (their eq. 5): the colours and opacities mixed, α = (1−k)α_A +
+// kα_B, d_i = (1−k)C_A α_A + k C_B α_B + d_{i−1}(1 − α).
+//
+// three-pass, seed 000's method (their eqs. 6–7): the frame attenuated by A_i's opacity (B_i's
+// when k > 0.5), then (1−k)·A_i and k·B_i added. The three blends of a slice are one
+// premultiplied "over" whose colour is the two additions and whose opacity the attenuation's,
+// so one pass draws them: d_i = (1−k)C_A α_A + k C_B α_B + d_{i−1}(1 − α_{A|B}).
+fn plane_over(c: VolumeUniforms, uvw: vec3<f32>, from_eye: vec3<f32>) -> vec4<f32> {
+    let k = c.morph_k;
+    if (MIX == 0u) {
+        return max(shade_mix(c, uvw, from_eye, vec2<f32>(1.0 - k, k)), vec4<f32>(0.0));
     }
-    let s = samples(in);
-    let c = (1.0 - k()) * s[0] + k() * s[1];
-    if (c.a <= 0.0) {
-        discard;
+    let s = samples(c, uvw, from_eye);
+    let m = (1.0 - k) * s[0] + k * s[1];
+    if (MIX == 1u) {
+        return m;
     }
-    return c;
+    return vec4<f32>(m.rgb, select(s[0].a, s[1].a, k > 0.5));
 }
 
-// Seed 000's three-pass method (their eqs. 6–7): per slice the frame is attenuated by A_i's
-// opacity (B_i's when k > 0.5), then (1−k)·A_i and k·B_i are added. The three blends of a slice
-// are one premultiplied "over" whose colour is the two additions and whose opacity is the
-// attenuation's, so one pass draws them: d_i = (1−k)C_A α_A + k C_B α_B + d_{i−1}(1 − α_{A|B}).
+// A slab of planes per fragment (volume_slab.wgsl), each plane's "over" composed front to back.
 @fragment
-fn fs_three_pass(in: VertexOut) -> @location(0) vec4<f32> {
-    if (clipped(in.world)) {
+fn fs_morph(in: SlabOut) -> @location(0) vec4<f32> {
+    // Read once: handed by value to the functions called per sample.
+    let c = u;
+    let taken = slab_samples(in);
+    var acc = vec4<f32>(0.0);
+    for (var j = 0u; j < SLAB; j += 1u) {
+        let over = plane_over(c, in.uvw + in.step_uvw * f32(j), in.from_eye);
+        acc = behind(acc, over.rgb, over.a, slab_takes(in, taken, j));
+    }
+    // Nothing to add: no read-modify-write of the frame buffer.
+    if (all(acc == vec4<f32>(0.0))) {
         discard;
     }
-    let s = samples(in);
-    let rgb = (1.0 - k()) * s[0].rgb + k() * s[1].rgb;
-    let attenuation = select(s[0].a, s[1].a, k() > 0.5);
-    if (attenuation <= 0.0 && all(rgb <= vec3<f32>(0.0))) {
-        discard;
-    }
-    return vec4<f32>(rgb, attenuation);
+    return acc;
 }

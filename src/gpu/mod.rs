@@ -37,6 +37,7 @@ pub const SHADERS: &[(&str, &str)] = &[
     ("volume_gradient.wgsl", include_str!("../../shaders/volume_gradient.wgsl")),
     ("volume_field.wgsl", include_str!("../../shaders/volume_field.wgsl")),
     ("volume_interleave.wgsl", include_str!("../../shaders/volume_interleave.wgsl")),
+    ("volume_slab.wgsl", include_str!("../../shaders/volume_slab.wgsl")),
     ("volume_slices.wgsl", include_str!("../../shaders/volume_slices.wgsl")),
     ("volume_direct.wgsl", include_str!("../../shaders/volume_direct.wgsl")),
     ("volume_morph.wgsl", include_str!("../../shaders/volume_morph.wgsl")),
@@ -61,7 +62,10 @@ pub const SHADERS: &[(&str, &str)] = &[
 /// Shaders that are only complete with others prepended (WGSL has no includes): the module
 /// for `name` is the concatenation of these files, in order.
 pub const SHADER_MODULES: &[(&str, &[&str])] = &[
-    ("volume_slices.wgsl", &["volume_common.wgsl", "volume_gradient.wgsl", "volume_field.wgsl", "volume_slices.wgsl"]),
+    (
+        "volume_slices.wgsl",
+        &["volume_common.wgsl", "volume_gradient.wgsl", "volume_field.wgsl", "volume_slab.wgsl", "volume_slices.wgsl"],
+    ),
     (
         "volume_interleave.wgsl",
         &[
@@ -75,7 +79,7 @@ pub const SHADER_MODULES: &[(&str, &[&str])] = &[
         ],
     ),
     ("volume_direct.wgsl", &["volume_common.wgsl", "gto_common.wgsl", "volume_direct.wgsl"]),
-    ("volume_morph.wgsl", &["volume_common.wgsl", "volume_gradient.wgsl", "volume_morph.wgsl"]),
+    ("volume_morph.wgsl", &["volume_common.wgsl", "volume_gradient.wgsl", "volume_slab.wgsl", "volume_morph.wgsl"]),
     ("gto_fill.wgsl", &["gto_common.wgsl", "gto_fill.wgsl"]),
     ("atoms.wgsl", &["atoms_common.wgsl", "atoms.wgsl"]),
     ("atoms_splat_pair.wgsl", &["atoms_common.wgsl", "atoms_cull.wgsl", "atoms_splat_pair.wgsl"]),

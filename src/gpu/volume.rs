@@ -202,9 +202,7 @@ impl Program {
         match self {
             Program::Slices => "fs_main",
             Program::Direct => "fs_direct",
-            Program::Exact => "fs_exact",
-            Program::ThreePass => "fs_three_pass",
-            Program::AlphaMix => "fs_alpha_mix",
+            Program::Exact | Program::ThreePass | Program::AlphaMix => "fs_morph",
             Program::Interleave => "fs_interleave",
             Program::Clouds => "fs_clouds",
         }
@@ -212,6 +210,11 @@ impl Program {
 
     fn walks(self) -> bool {
         matches!(self, Program::Interleave | Program::Clouds)
+    }
+
+    /// Whether it samples a texture's slices a slab of planes per fragment (volume_slab.wgsl).
+    fn slabs(self) -> bool {
+        matches!(self, Program::Slices | Program::Exact | Program::ThreePass | Program::AlphaMix)
     }
 }
 
@@ -225,9 +228,9 @@ struct Variant {
     clip: bool,
     /// The clouds a walk takes (0 for the slice programs): with one, its slices drew it first.
     clouds: u8,
-    /// Planes per fragment of the texture's slices (1 for the other programs).
+    /// Planes per fragment of a texture's slices (1 for the programs without slabs).
     slab: u8,
-    /// The texture slices' `signed_field` (0 for the other programs, which read the uniform).
+    /// The cloud's `signed_field` for the slab programs (0 for the others, which read the uniform).
     field: u8,
 }
 
@@ -284,7 +287,7 @@ struct VolumeShaders {
     /// The walk over clouds without fragment lists: the interleave module, no group 2.
     clouds: SliceShader,
     layout: wgpu::BindGroupLayout,
-    /// The texture slices' group 1: the opaque scene's depth, which a slab's samples stop at.
+    /// The slab programs' group 2: the opaque scene's depth, which a slab's samples stop at.
     depth_layout: wgpu::BindGroupLayout,
     /// The walk's group 0: [`MAX_WALKED`] clouds' uniforms and textures and the scene's depth.
     walk_layout: wgpu::BindGroupLayout,
@@ -335,7 +338,7 @@ pub struct VolumePass {
     walked: bool,
     /// This frame's uniforms, as written to `uniforms` (a walk copies them into its array).
     frame_uniforms: VolumeUniforms,
-    /// The texture slices' group 1, for the depth view it was made with.
+    /// The slab programs' group 2, for the depth view it was made with.
     depth_group: Option<(wgpu::TextureView, wgpu::BindGroup)>,
     /// The most planes a fragment of the texture's slices samples ([`SLAB_PLANES`]).
     slab_planes: usize,
@@ -349,9 +352,16 @@ fn constants(variant: Variant) -> Vec<(&'static str, f64)> {
     if variant.program.walks() {
         constants.extend([("CLOUDS", f64::from(variant.clouds)), ("PREDRAWN", flag(variant.clouds == 1))]);
     }
-    if variant.program == Program::Slices {
+    if variant.program.slabs() {
         constants.extend([("SLAB", f64::from(variant.slab)), ("FIELD", f64::from(variant.field))]);
     }
+    let mix = match variant.program {
+        Program::Exact => Some(0.0),
+        Program::AlphaMix => Some(1.0),
+        Program::ThreePass => Some(2.0),
+        _ => None,
+    };
+    constants.extend(mix.map(|m| ("MIX", m)));
     constants
 }
 
@@ -406,7 +416,7 @@ fn make_pipeline(
         vertex: wgpu::VertexState {
             module: &shader.module,
             // The texture's slices pass their fragments what a slab needs (volume_slices.wgsl).
-            entry_point: Some(if variant.program == Program::Slices { "vs_slab" } else { "vs_main" }),
+            entry_point: Some(if variant.program.slabs() { "vs_slab" } else { "vs_main" }),
             compilation_options: options.clone(),
             buffers: &[Some(wgpu::VertexBufferLayout {
                 array_stride: 12,
@@ -481,9 +491,10 @@ impl VolumePass {
             label: Some("volume slices' scene depth"),
             entries: &[depth_entry(0)],
         });
-        let slices = SliceShader::new(device, "volume_slices.wgsl", &[Some(&layout), Some(&depth_layout)]);
+        let slices = SliceShader::new(device, "volume_slices.wgsl", &[Some(&layout), None, Some(&depth_layout)]);
         let direct = SliceShader::new(device, "volume_direct.wgsl", &[Some(&layout), Some(&gto_layout)]);
-        let morph = SliceShader::new(device, "volume_morph.wgsl", &[Some(&layout), Some(&morph_layout)]);
+        let morph =
+            SliceShader::new(device, "volume_morph.wgsl", &[Some(&layout), Some(&morph_layout), Some(&depth_layout)]);
         let walk_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("cloud walk bind group layout"),
             entries: &walk_entries(),
@@ -705,7 +716,7 @@ impl VolumePass {
             },
             (None, None) => Program::Slices,
         };
-        let slabs = (program == Program::Slices)
+        let slabs = (program.slabs())
             .then(|| slices.slabs(self.slab_planes, eye))
             .flatten()
             .filter(|v| before_near_plane(v, view.clip_from_object));
@@ -736,7 +747,7 @@ impl VolumePass {
             clip: clip.is_some(),
             clouds: 0,
             slab,
-            field: if program == Program::Slices { signed_field as u8 } else { 0 },
+            field: if program.slabs() { signed_field as u8 } else { 0 },
         };
         self.frame_pipeline = Some(self.shared.pipeline(device, self.variant));
         let lobe = |l: &crate::scene::transfer::Lobe| [l.center, l.width, l.opacity, 0.0];
@@ -978,7 +989,7 @@ const TF_CLIP: u32 = 8;
 impl super::frame::Draw for VolumePass {
     fn prepare(&mut self, f: &super::frame::Prepare<'_>) {
         self.set_view(&f.ctx.device, &f.ctx.queue, f.view, f.cloud, f.clip, f.size);
-        if self.variant.program == Program::Slices && self.depth_group.as_ref().is_none_or(|(v, _)| v != f.depth) {
+        if self.variant.program.slabs() && self.depth_group.as_ref().is_none_or(|(v, _)| v != f.depth) {
             let group = f.ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("volume slices' scene depth"),
                 layout: &self.shared.depth_layout,
@@ -1007,9 +1018,9 @@ impl super::frame::Draw for VolumePass {
         if let Some(morph) = &self.morph {
             pass.set_bind_group(1, &morph.bind_group, &[]);
         }
-        if self.variant.program == Program::Slices {
+        if self.variant.program.slabs() {
             let Some((_, depth)) = &self.depth_group else { return };
-            pass.set_bind_group(1, depth, &[]);
+            pass.set_bind_group(2, depth, &[]);
         }
         pass.set_vertex_buffer(0, self.vertices.slice(..self.vertex_count as u64 * 12));
         pass.set_pipeline(pipeline);
