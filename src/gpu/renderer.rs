@@ -9,7 +9,7 @@ use super::isosurface::IsosurfacePass;
 use super::occlusion::DepthPyramid;
 use super::oit::{FragmentDump, FragmentLists, FragmentStats, MAX_BANDS, Transparency};
 use super::resolve::{Lists, ResolvePass, Rows};
-use super::volume::{MAX_WALKED, VolumePass, VolumeTexture, overlapping_groups, union_rect};
+use super::volume::{MAX_WALKED, VolumePass, VolumeTexture, overlapping_groups};
 use super::{GpuContext, GpuError};
 use crate::model::GridSpec;
 use crate::model::cartesian::CartesianExpansion;
@@ -407,10 +407,7 @@ impl Renderer {
         let rects: Vec<[u32; 4]> = walkable.iter().map(|&n| self.layers[n].volume.screen_rect()).collect();
         let groups: Vec<(Vec<usize>, [u32; 4])> = overlapping_groups(&rects)
             .into_iter()
-            .map(|g| {
-                let rect = union_rect(g.iter().map(|&i| rects[i]));
-                (g.into_iter().map(|i| walkable[i]).take(MAX_WALKED).collect(), rect)
-            })
+            .map(|(g, rect)| (g.into_iter().map(|i| walkable[i]).take(MAX_WALKED).collect(), rect))
             .collect();
         let lists_bind = if sorted { self.lists.composite_bind() } else { None };
         // With surfaces, the walk reads their lists: none, no walk (the slices draw the clouds).

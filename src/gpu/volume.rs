@@ -881,44 +881,25 @@ impl VolumePass {
     }
 }
 
-/// The clouds whose rectangles ([x0, y0, x1, y1)) overlap, directly or through others, as
-/// groups of indices in order: no pixel of one group's clouds is another's, so each group can
-/// be walked on its own, in its own rectangle.
-pub fn overlapping_groups(rects: &[[u32; 4]]) -> Vec<Vec<usize>> {
+/// The clouds grouped so that no group's rectangle ([x0, y0, x1, y1), the bounds of its
+/// clouds' `rects`) overlaps another's: clouds that overlap, directly or through others, and
+/// groups whose bounds would overlap are merged. Each group (indices in order, with its bounds)
+/// can then be walked on its own, in its own rectangle.
+pub fn overlapping_groups(rects: &[[u32; 4]]) -> Vec<(Vec<usize>, [u32; 4])> {
     let overlap = |a: &[u32; 4], b: &[u32; 4]| a[0] < b[2] && b[0] < a[2] && a[1] < b[3] && b[1] < a[3];
-    let mut group: Vec<usize> = (0..rects.len()).collect();
-    let root = |group: &[usize], mut i: usize| {
-        while group[i] != i {
-            i = group[i];
-        }
-        i
-    };
-    for a in 0..rects.len() {
-        for b in a + 1..rects.len() {
-            if overlap(&rects[a], &rects[b]) {
-                let (ra, rb) = (root(&group, a), root(&group, b));
-                group[ra.max(rb)] = ra.min(rb);
-            }
-        }
-    }
-    let mut groups: Vec<Vec<usize>> = Vec::new();
-    let mut slot: HashMap<usize, usize> = HashMap::new();
-    for i in 0..rects.len() {
-        let r = root(&group, i);
-        let n = *slot.entry(r).or_insert_with(|| {
-            groups.push(Vec::new());
-            groups.len() - 1
-        });
-        groups[n].push(i);
+    let mut groups: Vec<(Vec<usize>, [u32; 4])> = (0..rects.len()).map(|i| (vec![i], rects[i])).collect();
+    // Merge any two whose bounds overlap until none do (bounds only grow, so this ends).
+    while let Some((a, b)) = (0..groups.len())
+        .flat_map(|a| (a + 1..groups.len()).map(move |b| (a, b)))
+        .find(|&(a, b)| overlap(&groups[a].1, &groups[b].1))
+    {
+        let (members, r) = groups.remove(b);
+        let g = &mut groups[a];
+        g.0.extend(members);
+        g.0.sort_unstable();
+        g.1 = [g.1[0].min(r[0]), g.1[1].min(r[1]), g.1[2].max(r[2]), g.1[3].max(r[3])];
     }
     groups
-}
-
-/// The bounding rectangle of some of `rects`.
-pub fn union_rect(rects: impl IntoIterator<Item = [u32; 4]>) -> [u32; 4] {
-    rects
-        .into_iter()
-        .fold([u32::MAX, u32::MAX, 0, 0], |a, r| [a[0].min(r[0]), a[1].min(r[1]), a[2].max(r[2]), a[3].max(r[3])])
 }
 
 /// The bindings of the walked clouds' textures (volume_interleave.wgsl): cloud 0's is the
@@ -1062,8 +1043,14 @@ mod tests {
     fn clouds_overlapping_on_screen_through_others_form_one_group() {
         // 0 and 2 overlap through 1; 3 stands apart; 4 touches 3's edge only (half-open).
         let rects = [[0, 0, 10, 10], [8, 8, 20, 12], [18, 0, 30, 9], [40, 40, 50, 50], [50, 40, 60, 50]];
-        assert_eq!(overlapping_groups(&rects), vec![vec![0, 1, 2], vec![3], vec![4]]);
-        assert_eq!(union_rect([rects[0], rects[2]]), [0, 0, 30, 10]);
+        let groups = overlapping_groups(&rects);
+        let members: Vec<Vec<usize>> = groups.iter().map(|(g, _)| g.clone()).collect();
+        assert_eq!(members, vec![vec![0, 1, 2], vec![3], vec![4]]);
+        assert_eq!(groups[0].1, [0, 0, 30, 12]);
         assert!(overlapping_groups(&[]).is_empty());
+        // An L of two clouds around a third that touches neither: the third lies inside the L's
+        // rectangle, where the L's walk would overwrite it, so all three are one group.
+        let l = [[0, 0, 10, 30], [0, 20, 30, 30], [15, 0, 25, 15]];
+        assert_eq!(overlapping_groups(&l), vec![(vec![0, 1, 2], [0, 0, 30, 30])]);
     }
 }

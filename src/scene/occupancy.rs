@@ -6,7 +6,7 @@
 use glam::{DVec3, Vec3};
 
 use super::opacity::visibility_threshold;
-use super::slicing::{GridBox, Slices, convex_hull};
+use super::slicing::{GridBox, Slices, hull_triangles};
 use super::{DensityScale, SliceMode, TransferKind, VolumeSettings};
 use crate::model::bricks::BrickRanges;
 
@@ -198,10 +198,7 @@ impl Occupancy {
                     }
                 }
             }
-            let hull = convex_hull(&mut section, bu, bv);
-            for t in 1..hull.len().saturating_sub(1) {
-                vertices.extend_from_slice(&[hull[0], hull[t], hull[t + 1]]);
-            }
+            hull_triangles(&mut section, bu, bv, &mut vertices);
         }
         Slices { vertices, starts, ..whole }
     }

@@ -140,9 +140,18 @@ impl GridBox {
     }
 }
 
+/// The convex hull of points on one plane (basis `bu`, `bv`) as a fan of triangles appended
+/// to `out`: one slice's polygon, with no seams inside it.
+pub(super) fn hull_triangles(points: &mut [Vec3], bu: Vec3, bv: Vec3, out: &mut Vec<Vec3>) {
+    let hull = convex_hull(points, bu, bv);
+    for t in 1..hull.len().saturating_sub(1) {
+        out.extend_from_slice(&[hull[0], hull[t], hull[t + 1]]);
+    }
+}
+
 /// The convex hull (counter-clockwise in the basis `bu`, `bv`) of points on one plane:
 /// Andrew's monotone chain on their coordinates in that basis.
-pub(super) fn convex_hull(points: &mut [Vec3], bu: Vec3, bv: Vec3) -> Vec<Vec3> {
+fn convex_hull(points: &mut [Vec3], bu: Vec3, bv: Vec3) -> Vec<Vec3> {
     if points.len() < 3 {
         return Vec::new();
     }
@@ -204,10 +213,7 @@ impl Slices {
                 let back = planes - 1 - j;
                 points.extend(plane(back).iter().map(|&p| eye + (p - eye) * (depth / (n.dot(p) - eye_depth))));
             }
-            let hull = convex_hull(&mut points, bu, bv);
-            for t in 1..hull.len().saturating_sub(1) {
-                vertices.extend_from_slice(&[hull[0], hull[t], hull[t + 1]]);
-            }
+            hull_triangles(&mut points, bu, bv, &mut vertices);
         }
         Some(vertices)
     }
