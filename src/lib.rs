@@ -5,6 +5,7 @@
 
 pub mod app;
 pub mod arithmetic;
+pub mod compute;
 pub mod demo;
 pub mod evaluate;
 pub mod figure;

@@ -18,6 +18,8 @@ use orbcloud::scene::{
 };
 use orbcloud::{demo, formats};
 
+#[path = "cli/compute.rs"]
+mod compute_cli;
 #[path = "cli/modes.rs"]
 mod modes_cli;
 #[path = "cli/molsurface.rs"]
@@ -144,7 +146,11 @@ enum Command {
     /// A movie: a scan's coordinate swept, a file or session turning (--turntable), or a
     /// vibration (--normal-mode K), as PNG frames, GIF, animated PNG, MP4 or WebM.
     Movie(Box<movie_cli::MovieArgs>),
-    /// Dihedral scans: make a manifest, inspect, render or export an angle.
+    /// Compute a wavefunction with PySCF (HF or DFT) and write it as a Molden file, with the
+    /// normal modes on request (--freq).
+    Compute(compute_cli::ComputeArgs),
+    /// Scans of a distance, an angle, a dihedral or a path: compute one with PySCF, make a
+    /// manifest from files, inspect, render or export a value.
     #[command(subcommand)]
     Scan(scan_cli::ScanCommand),
     /// Print performance figures.
@@ -718,20 +724,32 @@ fn main() -> Result<()> {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     // Each quantity after the first comes with its own options ([`quantities_cli`]).
     let (line, later) = quantities_cli::split(std::env::args_os().collect())?;
-    let cli = Cli::parse_from(line);
+    dispatch(Cli::parse_from(line), &later)
+}
+
+/// Runs a command line (`words[0]` the program's name) as the `orbcloud` command does, its
+/// usage errors returned rather than ending the process: the Python package calls it for
+/// `orbcloud.compute` and `orbcloud.scan_compute`.
+pub fn run_words(words: Vec<std::ffi::OsString>) -> Result<()> {
+    let (line, later) = quantities_cli::split(words)?;
+    dispatch(Cli::try_parse_from(line)?, &later)
+}
+
+fn dispatch(cli: Cli, later: &[quantities_cli::Later]) -> Result<()> {
     match cli.command {
         None => Ok(orbcloud::app::run(cli.files, cli.demo.map(DemoArg::demo))?),
         Some(Command::Viewer { files, demo }) => Ok(orbcloud::app::run(files, demo.map(DemoArg::demo))?),
-        Some(Command::Render(args)) => render_cli::render(args, &later),
+        Some(Command::Render(args)) => render_cli::render(args, later),
         Some(Command::Info { file, json }) => values_cli::info(&file, json),
         Some(Command::Eval { file, what, points, minus }) => values_cli::eval(&file, &what, &points, minus.as_deref()),
         Some(Command::Cube { file, what, grid, spacing, margin, minus, output }) => {
             values_cli::cube(&file, &what, (grid, spacing, margin), minus.as_deref(), &output)
         }
+        Some(Command::Compute(args)) => compute_cli::compute(args),
         Some(Command::Scan(command)) => scan_cli::run(command),
         Some(Command::Modes(args)) => modes_cli::write_xyz(&args),
         Some(Command::Movie(args)) => movie_cli::movie(*args),
-        Some(Command::Mesh(args)) => surface_cli::mesh(&args, &quantities_cli::parse_later_meshes(&later)?),
+        Some(Command::Mesh(args)) => surface_cli::mesh(&args, &quantities_cli::parse_later_meshes(later)?),
         Some(Command::Bench(BenchCommand::Keyvolumes(args))) => scan_cli::bench_keyvolumes(args),
         Some(Command::Bench(BenchCommand::Isosurface(args))) => surface_cli::bench(&args),
         Some(Command::Bench(BenchCommand::Load(args))) => structure_cli::bench_load(&args),

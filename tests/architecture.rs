@@ -176,6 +176,26 @@ const MODULE_RULES: &[(&str, &[&str])] = &[
         &["formats", "gpu", "layers", "headless", "key_volumes", "app", "demo", "info", "figure", "movie", "shots"],
     ),
     ("shots.rs", &["formats", "app", "arithmetic", "demo", "info"]),
+    (
+        "compute.rs",
+        &[
+            "formats",
+            "scene",
+            "gpu",
+            "meshes",
+            "evaluate",
+            "layers",
+            "headless",
+            "key_volumes",
+            "app",
+            "arithmetic",
+            "demo",
+            "info",
+            "figure",
+            "movie",
+            "shots",
+        ],
+    ),
     ("app", &[]),
 ];
 
@@ -196,6 +216,7 @@ const CRATE_RULES: &[(&str, &[&str])] = &[
     ("movie.rs", &["thiserror", "image", "gif", "color_quant", "png"]),
     ("shots.rs", &["thiserror", "image"]),
     ("info.rs", &["glam", "serde", "serde_json"]),
+    ("compute.rs", &["serde", "serde_json", "thiserror", "log", "libc"]),
     ("demo.rs", &["flate2"]),
     ("app", &["glam", "serde", "toml", "wgpu", "image", "log", "egui", "eframe", "egui_wgpu", "egui_plot", "rfd"]),
     // The binary: main.rs and its subcommands.

@@ -9,7 +9,7 @@ use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use orbcloud::app::{OrbApp, wgpu_setup};
 use orbcloud::scene::{Shape, SliceMode, TransferKind};
-use viewer_support::{click_at, harness, wait_loaded};
+use viewer_support::{click_at, harness, hover, wait_loaded};
 
 /// A primary-button drag `dx` points to the right from `from`, in five moves; returns the
 /// views' (size on screen, size drawn) in the middle of the drag.
@@ -284,8 +284,7 @@ fn isosurfaces_follow_the_slider_and_atoms_are_picked_and_measured() {
     click_at(&mut h, o, false);
     assert!(h.state().status.starts_with("atom 2 O"), "{}", h.state().status);
     let c = h.state().atom_on_screen(0).unwrap();
-    h.hover_at(c);
-    h.run_steps(2);
+    hover(&mut h, c);
     assert_eq!(h.state().hovered(), Some(orbcloud::gpu::frame::PickId::Atom { object: 0, index: 0 }), "hover");
     click_at(&mut h, c, true);
     let app = h.state();
@@ -640,8 +639,7 @@ fn a_structure_gets_a_molecular_surface_from_the_scene_panel_that_follows_its_se
     assert!(all.starts_with("molecular surface: ") && !all.starts_with("molecular surface: 0 "), "{all}");
     // The surface covers the atoms: what lies under an atom's centre is the surface.
     let atom = h.state().atom_on_screen(0).expect("an atom on screen");
-    h.hover_at(atom);
-    h.run_steps(2);
+    hover(&mut h, atom);
     assert!(matches!(h.state().hovered(), Some(PickId::Surface { object: 0, .. })), "{:?}", h.state().hovered());
     // Leaving the waters out wraps fewer atoms: fewer triangles.
     h.state_mut().objects[0].state.selection = "not resn HOH".into();
@@ -654,8 +652,7 @@ fn a_structure_gets_a_molecular_surface_from_the_scene_panel_that_follows_its_se
     h.run_steps(2);
     h.get_by_label("off").click();
     wait_loaded(&mut h);
-    h.hover_at(atom);
-    h.run_steps(2);
+    hover(&mut h, atom);
     assert!(!matches!(h.state().hovered(), Some(PickId::Surface { .. })), "{:?}", h.state().hovered());
 }
 
@@ -723,8 +720,7 @@ fn the_object_s_clipping_plane_cuts_its_atoms_when_asked() {
     h.run_steps(2);
     let oxygen = h.state().atom_on_screen(1).expect("the oxygen on screen");
     let picks = |h: &mut Harness<'static, OrbApp>| {
-        h.hover_at(oxygen);
-        h.run_steps(3);
+        hover(h, oxygen);
         h.state().hovered()
     };
     let oxygen_id = Some(PickId::Atom { object: 0, index: 1 });

@@ -24,7 +24,21 @@ import numpy as np
 from . import _native
 from ._image import Image
 
-__all__ = ["Document", "Image", "LoadError", "Orbital", "Scan", "from_pyscf", "load", "load_scan", "render", "view", "widget"]
+__all__ = [
+    "Document",
+    "Image",
+    "LoadError",
+    "Orbital",
+    "Scan",
+    "compute",
+    "from_pyscf",
+    "load",
+    "load_scan",
+    "render",
+    "scan_compute",
+    "view",
+    "widget",
+]
 
 PathLike = Union[str, "os.PathLike[str]"]
 
@@ -359,3 +373,116 @@ def widget(doc_or_docs, **options):
     from .notebook import Viewer
 
     return Viewer(doc_or_docs, **options)
+
+
+def _geometry_file(path_or_mol, folder: str) -> tuple[str, dict]:
+    """A file the command reads for ``path_or_mol`` (a path, or a PySCF ``Mole`` written as
+    XYZ), and the charge and spin a ``Mole`` carries."""
+    if isinstance(path_or_mol, (str, os.PathLike)):
+        return os.fspath(path_or_mol), {}
+    mol = path_or_mol
+    coords = mol.atom_coords(unit="Angstrom")
+    path = os.path.join(folder, "molecule.xyz")
+    with open(path, "w") as f:
+        f.write(f"{mol.natm}\nfrom PySCF\n")
+        for i in range(mol.natm):
+            x, y, z = coords[i]
+            f.write(f"{mol.atom_pure_symbol(i)} {x:.10f} {y:.10f} {z:.10f}\n")
+    return path, {"charge": mol.charge, "spin": mol.spin}
+
+
+def _compute_words(method, basis, charge, spin, client, max_cycles=None) -> list[str]:
+    words = ["--method", str(method), "--basis", str(basis), "--charge", str(int(charge)), "--spin", str(int(spin))]
+    if max_cycles is not None:
+        words += ["--max-cycles", str(int(max_cycles))]
+    if client is not None:
+        words += ["--dask", client.scheduler.address]
+    return words
+
+
+def _run_cli(words: list[str]) -> None:
+    """Runs the ``orbcloud`` command line in this process; its computations run in this
+    interpreter (``ORBCLOUD_PYTHON`` unless set already)."""
+    os.environ.setdefault("ORBCLOUD_PYTHON", sys.executable)
+    _native.run_cli([str(w) for w in words])
+
+
+def compute(
+    path_or_mol,
+    method: str = "b3lyp",
+    basis: str = "6-31g*",
+    charge: int | None = None,
+    spin: int | None = None,
+    freq: bool = False,
+    output: PathLike | None = None,
+    client=None,
+    max_cycles: int | None = None,
+) -> Document:
+    """The wavefunction of a geometry (a file orbcloud reads, or a PySCF ``Mole``) computed with
+    PySCF, as ``orbcloud compute`` does: HF or any functional, a basis by name, open shells
+    unrestricted; ``freq=True`` adds the normal modes. Written as a Molden file (``output``, by
+    default a temporary file) and returned as a :class:`Document`. With a
+    ``dask.distributed.Client`` it runs as a task of that cluster."""
+    with tempfile.TemporaryDirectory(prefix="orbcloud-") as folder:
+        path, carried = _geometry_file(path_or_mol, folder)
+        charge = carried.get("charge", 0) if charge is None else charge
+        spin = carried.get("spin", 0) if spin is None else spin
+        if output is None:
+            fd, output = tempfile.mkstemp(prefix="orbcloud-", suffix=".molden")
+            os.close(fd)
+        output = os.fspath(output)
+        words = ["compute", path, *_compute_words(method, basis, charge, spin, client, max_cycles), "-o", output]
+        if freq:
+            words.append("--freq")
+        _run_cli(words)
+    return load(output)
+
+
+def scan_compute(
+    path_or_mol,
+    output: PathLike,
+    distance: Sequence[int] | None = None,
+    angle: Sequence[int] | None = None,
+    dihedral: Sequence[int] | None = None,
+    frames: bool = False,
+    start: float | None = None,
+    stop: float | None = None,
+    step: float | None = None,
+    relaxed: bool = False,
+    method: str = "b3lyp",
+    basis: str = "6-31g*",
+    charge: int | None = None,
+    spin: int | None = None,
+    workers: int | None = None,
+    client=None,
+    max_cycles: int | None = None,
+) -> Scan:
+    """A scan computed with PySCF, as ``orbcloud scan compute`` does: a ``distance``, ``angle``
+    or ``dihedral`` (1-based atoms) from ``start`` to ``stop`` by ``step`` (Å or degrees), rigid
+    or ``relaxed``, or every geometry of a trajectory (``frames=True``). One Molden file per
+    value and the manifest go to ``output``; a second call into the same folder keeps the frames
+    already computed. ``workers`` local processes, or the tasks of a ``dask.distributed.Client``.
+    Returns the :class:`Scan` (:func:`widget` shows it with a slider)."""
+    with tempfile.TemporaryDirectory(prefix="orbcloud-") as folder:
+        path, carried = _geometry_file(path_or_mol, folder)
+        charge = carried.get("charge", 0) if charge is None else charge
+        spin = carried.get("spin", 0) if spin is None else spin
+        words = ["scan", "compute", path]
+        for name, atoms in (("distance", distance), ("angle", angle), ("dihedral", dihedral)):
+            if atoms is not None:
+                words += [f"--{name}", ",".join(str(int(a)) for a in atoms)]
+        if frames:
+            words.append("--frames")
+        for name, value in (("from", start), ("to", stop), ("step", step)):
+            if value is not None:
+                words += [f"--{name}", repr(float(value))]
+        if relaxed:
+            words.append("--relaxed")
+        if workers is not None:
+            words += ["--workers", str(int(workers))]
+        words += [*_compute_words(method, basis, charge, spin, client, max_cycles), "-o", os.fspath(output)]
+        _run_cli(words)
+    # The command names the manifest after the input file's stem.
+    stem = os.path.basename(path)
+    stem = (stem[:-3] if stem.endswith(".gz") else stem).split(".")[0] or "frame"
+    return load_scan(os.path.join(os.fspath(output), f"{stem}.scan.toml"))

@@ -502,6 +502,14 @@ impl Scene {
     }
 }
 
+/// Runs the `orbcloud` command line `words` (after the program's name) in this process, the
+/// GIL released: what it prints goes to this process's output.
+#[pyfunction]
+fn run_cli(py: Python<'_>, words: Vec<String>) -> PyResult<()> {
+    let line = std::iter::once("orbcloud".to_string()).chain(words).map(Into::into).collect();
+    py.detach(|| cli::run_words(line)).map_err(|e| PyRuntimeError::new_err(format!("{e:#}")))
+}
+
 /// Runs the desktop viewer on `files` (blocks until its window closes).
 #[pyfunction]
 fn run_viewer(py: Python<'_>, files: Vec<PathBuf>) -> PyResult<()> {
@@ -517,6 +525,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(load_scan, m)?)?;
     m.add_function(wrap_pyfunction!(render, m)?)?;
     m.add_function(wrap_pyfunction!(run_viewer, m)?)?;
+    m.add_function(wrap_pyfunction!(run_cli, m)?)?;
     m.add("NativeLoadError", m.py().get_type::<NativeLoadError>())?;
     Ok(())
 }

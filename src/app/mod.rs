@@ -488,6 +488,12 @@ impl OrbApp {
         self.viewport.as_ref()?.hovered
     }
 
+    /// Whether a click in a view waits for its picture to be whole before it is picked.
+    pub fn is_picking(&self) -> bool {
+        self.viewport.as_ref().is_some_and(|v| v.is_picking())
+            || self.scan.as_ref().is_some_and(|s| s.views.iter().any(|v| v.is_picking()))
+    }
+
     /// How much of a costly frame (drawn in bands) the single-file view has drawn (0..1);
     /// `None` when no such frame is under way.
     pub fn frame_progress(&self) -> Option<f32> {

@@ -252,6 +252,9 @@ pub struct Viewport {
     pub clouds: Vec<VolumeSettings>,
     /// The last click, until the caller takes it.
     pub click: Option<Click>,
+    /// A click on a picture still being drawn: where, and whether Shift was held. It is picked
+    /// once the whole picture (and so every pixel's id) is there.
+    pending_click: Option<(egui::Pos2, bool)>,
     /// What is under the resting pointer (hover highlight), and where the pointer was.
     pub hovered: Option<PickId>,
     hovered_at: Option<egui::Pos2>,
@@ -308,6 +311,7 @@ impl Viewport {
             repaint: Arc::new(|| {}),
             clouds: Vec::new(),
             click: None,
+            pending_click: None,
             hovered: None,
             hovered_at: None,
             layout: None,
@@ -873,6 +877,10 @@ impl Viewport {
         // Overlays (measurements, labels) are drawn on the first pane.
         self.layout = self.pane_layout.first().copied();
         self.hovered = None;
+        // Panes are drawn whole each time (no bands): a banded single view left unfinished
+        // when the view split is started again from its first band when it comes back.
+        self.progress = None;
+        self.previewing = false;
         if response.clicked_by(PointerButton::Primary)
             && let Some(pos) = response.interact_pointer_pos()
             && let Some(p) = rects.iter().position(|r| r.contains(pos))
@@ -1181,7 +1189,9 @@ impl Viewport {
         self.layout = Some((rect, size));
         // Hover: read the id under the pointer when it moved and no button is held.
         let pointer = response.hover_pos().filter(|_| !ui.input(|i| i.pointer.any_down()));
-        if pointer != self.hovered_at {
+        // Ids are read from the picture on screen: while it is drawn in bands (or a coarse
+        // preview stands in) they hold only part of the view, so hover and clicks wait for it.
+        if pointer != self.hovered_at && self.progress.is_none() {
             self.hovered_at = pointer;
             self.hovered = pointer.and_then(|pos| self.pick_at(pos).ok().flatten());
         }
@@ -1204,12 +1214,22 @@ impl Viewport {
                     })
                     .unwrap_or(i.modifiers.shift)
             });
+            self.pending_click = Some((pos, shift));
+        }
+        if self.progress.is_none()
+            && let Some((pos, shift)) = self.pending_click.take()
+        {
             match self.pick_at(pos) {
                 Ok(picked) => self.click = Some(Click { picked, shift }),
                 Err(e) => log::warn!("picking failed: {e}"),
             }
         }
         twisted
+    }
+
+    /// Whether a click waits for the picture to be whole before it is picked.
+    pub fn is_picking(&self) -> bool {
+        self.pending_click.is_some()
     }
 
     /// Draws the coarse picture of `view` for a view shown at `shown` pixels into the preview

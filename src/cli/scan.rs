@@ -19,6 +19,10 @@ use super::{FigureArgs, ViewArgs, gpu};
 
 #[derive(Subcommand)]
 pub enum ScanCommand {
+    /// Compute a scan with PySCF: one Molden file per value of a distance, angle or dihedral
+    /// (rigid, or --relaxed), or per frame of a trajectory (--frames), and its manifest.
+    /// Rerun into the same directory to resume.
+    Compute(Box<super::compute_cli::ScanComputeArgs>),
     /// Write DIR/<name>.scan.toml from a directory of Molden/fchk files, one per point of a
     /// scan: a bond length, a bond angle, a dihedral, or a path (an IRC, a relaxed scan).
     Init {
@@ -137,7 +141,7 @@ pub struct ScanRenderArgs {
 }
 
 /// N 1-based atom numbers `i,j,…`, returned 0-based.
-fn parse_atoms<const N: usize>(s: &str) -> Result<[usize; N], String> {
+pub(crate) fn parse_atoms<const N: usize>(s: &str) -> Result<[usize; N], String> {
     let v: Vec<usize> =
         s.split(',').map(|t| t.trim().parse::<usize>()).collect::<Result<_, _>>().map_err(|e| e.to_string())?;
     if v.len() != N || v.contains(&0) {
@@ -205,6 +209,7 @@ fn check_angle(scan: &Scan, at: f64) -> Result<()> {
 
 pub fn run(command: ScanCommand) -> Result<()> {
     match command {
+        ScanCommand::Compute(args) => super::compute_cli::scan_compute(*args),
         ScanCommand::Init { dir, distance, angle, dihedral, path, dry_run } => {
             let chosen = (distance.map(Coordinate::Distance))
                 .or(angle.map(Coordinate::Angle))

@@ -52,6 +52,53 @@ struct Manifest {
     captions: Vec<String>,
     #[serde(rename = "frame", default)]
     frames: Vec<toml::Spanned<FrameEntry>>,
+    /// How `scan compute` made the frames: a record, never acted on when read.
+    computed: Option<Computed>,
+}
+
+/// How a computed scan was made (`scan compute`): the level of theory, rigid or relaxed, the
+/// input, the programs' versions and the values whose frames failed. Reading a manifest never
+/// recomputes anything: this is a record for the user.
+#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Computed {
+    pub method: String,
+    pub basis: String,
+    #[serde(default)]
+    pub charge: i32,
+    #[serde(default)]
+    pub spin: u32,
+    #[serde(default)]
+    pub relaxed: bool,
+    /// The input geometry's file, as given.
+    #[serde(default)]
+    pub input: String,
+    #[serde(default)]
+    pub versions: std::collections::BTreeMap<String, String>,
+    /// Values whose frame did not converge (left out of the scan).
+    #[serde(default)]
+    pub failed: Vec<f64>,
+}
+
+impl Computed {
+    /// The `[computed]` table as a manifest holds it.
+    fn toml(&self) -> String {
+        let q = |s: &str| format!("\"{}\"", s.replace('\\', "\\\\").replace('"', "\\\""));
+        let mut out = format!(
+            "\n[computed]\nmethod = {}\nbasis = {}\ncharge = {}\nspin = {}\nrelaxed = {}\ninput = {}\n",
+            q(&self.method),
+            q(&self.basis),
+            self.charge,
+            self.spin,
+            self.relaxed,
+            q(&self.input)
+        );
+        let failed: Vec<String> = self.failed.iter().map(|v| format!("{v:.4}")).collect();
+        out.push_str(&format!("failed = [{}]\n", failed.join(", ")));
+        let versions: Vec<String> = self.versions.iter().map(|(k, v)| format!("{k} = {}", q(v))).collect();
+        out.push_str(&format!("versions = {{ {} }}\n", versions.join(", ")));
+        out
+    }
 }
 
 #[derive(Debug, Deserialize)]
@@ -75,6 +122,8 @@ fn default_orbitals() -> Vec<String> {
 pub struct ScanFile {
     pub scan: Scan,
     pub follow: Follow,
+    /// How `scan compute` made it, when it did.
+    pub computed: Option<Computed>,
 }
 
 fn line_of(text: &str, offset: usize) -> usize {
@@ -228,7 +277,7 @@ pub fn parse_scan(
     scan.captions = manifest.captions;
     // Resolving the orbitals of every frame reports a missing one before anything is evaluated.
     scan.check_orbitals().map_err(|e| error(&name, 1, "the orbitals the manifest names", e.to_string()))?;
-    Ok(ScanFile { scan, follow: manifest.follow })
+    Ok(ScanFile { scan, follow: manifest.follow, computed: manifest.computed })
 }
 
 /// The manifest's coordinate (0-based atoms) and the line that names it: `coordinate` and
@@ -458,22 +507,34 @@ pub fn init(dir: &Path, coordinate: Option<Coordinate>) -> Result<ScanInit, Load
         }
     }
     let how = if found { "the coordinate that explains the change best" } else { "the coordinate given" };
-    let mut text = format!(
-        "# Written by `orbcloud scan init`: {how}, measured in each file's geometry.\ntitle = \"{dir_name}\"\ncoordinate = \"{}\"\n",
-        coordinate.kind()
-    );
+    let header = format!("Written by `orbcloud scan init`: {how}, measured in each file's geometry.");
+    let text = manifest_text(&header, &dir_name, &coordinate, &frames, None);
+    Ok(ScanInit { path: manifest_path, text, coordinate, found, frames })
+}
+
+/// A manifest's text: a comment, the title, the coordinate, HOMO and LUMO, one `[[frame]]` per
+/// (file, value), and how the frames were computed when they were.
+pub fn manifest_text(
+    header: &str,
+    title: &str,
+    coordinate: &Coordinate,
+    frames: &[(String, f64)],
+    computed: Option<&Computed>,
+) -> String {
+    let q = |s: &str| s.replace('\\', "\\\\").replace('"', "\\\"");
+    let mut text = format!("# {header}\ntitle = \"{}\"\ncoordinate = \"{}\"\n", q(title), coordinate.kind());
     if !coordinate.atoms().is_empty() {
         let atoms: Vec<String> = coordinate.atoms().iter().map(|i| (i + 1).to_string()).collect();
         text.push_str(&format!("atoms = [{}]\n", atoms.join(", ")));
     }
     text.push_str("orbitals = [\"homo\", \"lumo\"]\n");
-    for (file, value) in &frames {
-        text.push_str(&format!(
-            "\n[[frame]]\nat = {value:.4}\nfile = \"{}\"\n",
-            file.replace('\\', "\\\\").replace('"', "\\\"")
-        ));
+    for (file, value) in frames {
+        text.push_str(&format!("\n[[frame]]\nat = {value:.4}\nfile = \"{}\"\n", q(file)));
     }
-    Ok(ScanInit { path: manifest_path, text, coordinate, found, frames })
+    if let Some(c) = computed {
+        text.push_str(&c.toml());
+    }
+    text
 }
 
 /// Where each of `molecules` lies along the path a multi-frame XYZ file in `dir` traces (the

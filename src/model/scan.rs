@@ -326,6 +326,40 @@ pub fn moving_atoms(molecule: &Molecule, coordinate: &Coordinate) -> Result<(Vec
     }
 }
 
+/// Moves `moving` atoms (going in `direction`, as [`moving_atoms`] gives them) so that
+/// `coordinate` changes by `delta` (Å or degrees; nothing for a path).
+fn shift(coordinate: &Coordinate, positions: &mut [DVec3], moving: &[usize], direction: f64, delta: f64) {
+    match *coordinate {
+        Coordinate::Distance(d) => stretch(positions, moving, d, direction * delta),
+        Coordinate::Angle(a) => bend(positions, moving, a, delta),
+        Coordinate::Dihedral([_, j, k, _]) => twist(positions, moving, j, k, delta),
+        Coordinate::Path => {}
+    }
+}
+
+/// `molecule` with `coordinate` set to each of `values` (Å or degrees) by the rules a scan's
+/// drag follows: the coordinate's moving side ([`moving_atoms`]) slides along the bond, bends in
+/// the angle's plane or twists about the bond, rigidly; every other coordinate stays as it was.
+pub fn rigid_frames(molecule: &Molecule, coordinate: &Coordinate, values: &[f64]) -> Result<Vec<Molecule>, ScanError> {
+    let (moving, direction) = moving_atoms(molecule, coordinate)?;
+    let Some(now) = coordinate.measure(molecule) else { return Ok(vec![molecule.clone(); values.len()]) };
+    let start: Vec<DVec3> = molecule.atoms.iter().map(|a| a.position).collect();
+    Ok(values
+        .iter()
+        .map(|&value| {
+            let delta = match coordinate {
+                Coordinate::Dihedral(_) => wrap_degrees(value - now),
+                _ => value - now,
+            };
+            let mut positions = start.clone();
+            shift(coordinate, &mut positions, &moving, direction, delta);
+            let atoms =
+                (molecule.atoms.iter().zip(positions)).map(|(a, position)| Atom { position, ..a.clone() }).collect();
+            Molecule { atoms, bonds: molecule.bonds.clone() }
+        })
+        .collect())
+}
+
 /// The bonded torsion i–j–k–l whose angle changes most across `molecules` (all with the same
 /// atoms; bonds from the first), or None when no bond has neighbours on both sides. Ring bonds
 /// are skipped; the outer atoms are each side's heaviest neighbour, lowest number on ties.
@@ -539,12 +573,7 @@ impl Scan {
     /// Moves the coordinate's moving atoms in `positions` so the coordinate changes by `delta`
     /// (Å or degrees; nothing for a path).
     fn shift(&self, positions: &mut [DVec3], delta: f64) {
-        match self.coordinate {
-            Coordinate::Distance(d) => stretch(positions, &self.moving, d, self.direction * delta),
-            Coordinate::Angle(a) => bend(positions, &self.moving, a, delta),
-            Coordinate::Dihedral([_, j, k, _]) => twist(positions, &self.moving, j, k, delta),
-            Coordinate::Path => {}
-        }
+        shift(&self.coordinate, positions, &self.moving, self.direction, delta);
     }
 
     /// The skeleton at θ: each bracketing frame's moving fragment moved towards θ by its share
