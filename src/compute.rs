@@ -120,7 +120,8 @@ pub struct Job {
     pub dir: PathBuf,
     /// Where what PySCF and geomeTRIC print goes (none: nowhere).
     pub output: Option<PathBuf>,
-    /// Local processes (ignored with a Dask scheduler).
+    /// Local cores: frames run in as many processes, one core each, or fewer processes with
+    /// more threads when fewer chains of frames can run at once (ignored with a Dask scheduler).
     pub workers: usize,
     /// A Dask scheduler's address.
     pub dask: Option<String>,

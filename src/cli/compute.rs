@@ -99,7 +99,8 @@ pub struct ScanComputeArgs {
     relaxed: bool,
     #[command(flatten)]
     level: LevelArgs,
-    /// Local processes to compute frames in (default: the cores).
+    /// Cores to compute on (default: all): frames in as many processes, one core each (a
+    /// relaxed scan's two chains share them as threads).
     #[arg(long)]
     workers: Option<usize>,
     /// Send the frames as tasks to this Dask scheduler (tcp://host:port).
@@ -134,7 +135,7 @@ fn run(job: &Job) -> Result<(Vec<compute::FrameReport>, std::collections::BTreeM
             versions = v.clone();
             let level = job.settings.level();
             let place = job.dask.as_deref().map_or_else(
-                || format!("{} local process{}", job.workers, if job.workers == 1 { "" } else { "es" }),
+                || format!("{} local core{}", job.workers, plural(job.workers)),
                 |a| format!("the Dask scheduler at {a}"),
             );
             eprintln!("{level}, {frames} frame{}, {kept} kept from an earlier run, on {place}", plural(*frames));
@@ -179,7 +180,8 @@ pub fn compute(args: ComputeArgs) -> Result<()> {
         start: 0,
         dir,
         output: None,
-        workers: 1,
+        // Every core, as threads of the one process.
+        workers: std::thread::available_parallelism().map_or(1, |n| n.get()),
         dask: args.dask.clone(),
         frames: vec![FrameJob::new(file, 0.0, &doc.molecule)],
     };
