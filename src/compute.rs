@@ -18,8 +18,9 @@ use std::time::Duration;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
+use crate::formats::scan::{Computed, manifest_text};
 use crate::model::Molecule;
-use crate::model::scan::Coordinate;
+use crate::model::scan::{Coordinate, ScanError, rigid_frames, wrap_degrees};
 use crate::model::units::ANGSTROM_PER_BOHR;
 
 /// The Python side: a module of the `orbcloud` package and the script the commands run.
@@ -298,6 +299,77 @@ pub fn values(from: f64, to: f64, step: f64) -> Result<Vec<f64>, String> {
 /// The frame nearest `value` among `values`.
 pub fn nearest(values: &[f64], value: f64) -> usize {
     (0..values.len()).min_by(|&a, &b| (values[a] - value).abs().total_cmp(&(values[b] - value).abs())).unwrap_or(0)
+}
+
+/// The frames of a rigid scan of `coordinate` over `values` from `molecule`, named after
+/// `stem`, and the index of the one nearest the input geometry (chains start there).
+pub fn rigid_scan(
+    molecule: &Molecule,
+    coordinate: &Coordinate,
+    values: &[f64],
+    stem: &str,
+) -> Result<(Vec<FrameJob>, usize), ScanError> {
+    let molecules = rigid_frames(molecule, coordinate, values)?;
+    let now = coordinate.measure(molecule).unwrap_or(0.0);
+    let distance = |v: f64| match coordinate {
+        Coordinate::Dihedral(_) => wrap_degrees(v - now).abs(),
+        _ => (v - now).abs(),
+    };
+    let start = (0..values.len()).min_by(|&a, &b| distance(values[a]).total_cmp(&distance(values[b]))).unwrap_or(0);
+    let frames =
+        values.iter().zip(&molecules).map(|(&v, m)| FrameJob::new(frame_file(stem, coordinate, v), v, m)).collect();
+    Ok((frames, start))
+}
+
+/// Writes `dir/<title>.scan.toml` naming the frames computed so far (file, value), with how
+/// they were computed; returns its path.
+pub fn write_manifest(
+    dir: &Path,
+    title: &str,
+    coordinate: &Coordinate,
+    settings: &Settings,
+    done: &[(String, f64)],
+    computed: Computed,
+) -> Result<PathBuf, ComputeError> {
+    let mut frames = done.to_vec();
+    frames.sort_by(|a, b| a.1.total_cmp(&b.1));
+    let how = if settings.relaxed { "relaxed" } else { "rigid" };
+    let header = format!(
+        "Written by `orbcloud scan compute`: {} {how} scan of {}, {} frames.",
+        settings.level(),
+        coordinate.label(),
+        frames.len()
+    );
+    let text = manifest_text(&header, title, coordinate, &frames, Some(&computed));
+    let path = dir.join(format!("{title}.scan.toml"));
+    // Whole or not at all: the viewer may be reading the previous one.
+    let part = dir.join(format!(".{title}.scan.toml.part"));
+    std::fs::write(&part, text).map_err(|source| io(&part, source))?;
+    std::fs::rename(&part, &path).map_err(|source| io(&path, source))?;
+    Ok(path)
+}
+
+impl Computed {
+    /// The record of a scan computed with `settings` from `input`.
+    pub fn of(settings: &Settings, input: &str, versions: BTreeMap<String, String>, failed: Vec<f64>) -> Self {
+        Self {
+            method: settings.method.clone(),
+            basis: settings.basis.clone(),
+            charge: settings.charge,
+            spin: settings.spin,
+            relaxed: settings.relaxed,
+            input: input.to_string(),
+            versions,
+            failed,
+        }
+    }
+}
+
+/// A file name's stem without its extensions: "h2o2" of "h2o2.xyz.gz".
+pub fn stem(path: &Path) -> String {
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let name = name.strip_suffix(".gz").unwrap_or(&name);
+    name.split('.').next().filter(|s| !s.is_empty()).unwrap_or("frame").to_string()
 }
 
 /// A frame's file name: `stem_<kind><value>.molden` ("water_angle104.50.molden").

@@ -179,7 +179,6 @@ const MODULE_RULES: &[(&str, &[&str])] = &[
     (
         "compute.rs",
         &[
-            "formats",
             "scene",
             "gpu",
             "meshes",

@@ -116,23 +116,29 @@ pub fn overlay(ui: &egui::Ui, vp: &Viewport, camera: &Camera, world: &World, m: 
 }
 
 /// The side-panel list of measurements, each removable.
-pub fn panel(ui: &mut egui::Ui, molecule: &Molecule, m: &mut Measurements) {
+/// The list of measurements; with `scannable`, each has *Scan this…*, whose measurement's
+/// index is returned when clicked.
+pub fn panel(ui: &mut egui::Ui, molecule: &Molecule, m: &mut Measurements, scannable: bool) -> Option<usize> {
     ui.heading("Measurements");
     if m.list.is_empty() {
         ui.label(RichText::new("click an atom; Shift-click 2, 3 or 4 atoms to measure").small().weak());
     }
-    let mut remove = None;
+    let (mut remove, mut scan) = (None, None);
     for (n, measurement) in m.list.iter().enumerate() {
         ui.horizontal(|ui| {
             if ui.small_button("×").on_hover_text("remove").clicked() {
                 remove = Some(n);
             }
             ui.label(measurement.label(molecule));
+            if scannable && ui.small_button("Scan this…").on_hover_text("compute a scan of it with PySCF").clicked() {
+                scan = Some(n);
+            }
         });
     }
     if let Some(n) = remove {
         m.list.remove(n);
     }
+    scan
 }
 
 #[cfg(test)]

@@ -1,5 +1,6 @@
 //! The eframe viewer: the only module that uses egui and rfd.
 
+pub mod compute;
 mod correlation;
 pub mod detail;
 mod difference;
@@ -253,6 +254,12 @@ pub struct OrbApp {
     /// A message that stays in the status line until dismissed (the scene came back on a new
     /// device).
     pub notice: Option<String>,
+    /// The *Scan* window's choices (*Scan this…* on a measurement), and the computation under
+    /// way (a scan, or a structure's orbitals).
+    pub scan_dialog: compute::ScanDialog,
+    pub computing: Option<compute::ComputeRun>,
+    /// The *Compute orbitals* window: the object and the level of theory.
+    pub orbitals_dialog: Option<(usize, crate::compute::Settings)>,
     /// The *Record…* window's choices, and the recording under way.
     pub record: record::RecordDialog,
     /// The *Save PNG* window's choices.
@@ -412,6 +419,9 @@ impl OrbApp {
             restart: None,
             rehearsal: None,
             notice: None,
+            scan_dialog: compute::ScanDialog::default(),
+            computing: None,
+            orbitals_dialog: None,
             record: record::RecordDialog::default(),
             picture: picture::PictureDialog::default(),
             recording: None,
@@ -486,6 +496,78 @@ impl OrbApp {
     /// What is under the resting pointer in the single-file view.
     pub fn hovered(&self) -> Option<crate::gpu::frame::PickId> {
         self.viewport.as_ref()?.hovered
+    }
+
+    /// *Scan this…* on measurement `n`: the *Scan* window for its coordinate, when its atoms
+    /// are one object's.
+    pub fn scan_measurement(&mut self, n: usize) {
+        let Some(m) = self.measurements.list.get(n) else { return };
+        let object = |atom: usize| self.world.offsets.iter().rposition(|&first| first <= atom);
+        let Some(o) = object(m.atoms[0]) else { return };
+        if m.atoms.iter().any(|&a| object(a) != Some(o)) {
+            self.status = "a scan moves atoms of one molecule: measure within one file".into();
+            return;
+        }
+        let first = self.world.offsets[o];
+        let atoms: Vec<usize> = m.atoms.iter().map(|a| a - first).collect();
+        let coordinate = match *atoms.as_slice() {
+            [i, j] => crate::model::scan::Coordinate::Distance([i, j]),
+            [i, j, k] => crate::model::scan::Coordinate::Angle([i, j, k]),
+            [i, j, k, l] => crate::model::scan::Coordinate::Dihedral([i, j, k, l]),
+            _ => return,
+        };
+        if let Err(e) = crate::model::scan::moving_atoms(&self.objects[o].doc.molecule, &coordinate) {
+            self.status = format!("{} cannot be scanned: {e}", coordinate.label());
+            return;
+        }
+        self.scan_dialog = compute::ScanDialog::for_coordinate(o, coordinate, &self.objects[o].doc);
+    }
+
+    /// The *Scan* and *Compute orbitals* windows, and the computation's progress: frames done
+    /// open as a scan, a computed wavefunction opens in place of its structure.
+    fn compute_windows(&mut self, ctx: &egui::Context) {
+        let (start, cancel) = compute::scan_window(ctx, &mut self.scan_dialog, self.computing.as_ref());
+        let running = self.computing.as_ref().is_some_and(|c| !c.ended);
+        if cancel && let Some(c) = &self.computing {
+            c.cancel();
+        }
+        let repaint = {
+            let ctx = ctx.clone();
+            move || ctx.request_repaint()
+        };
+        if start && !running {
+            let Some(o) = self.objects.get(self.scan_dialog.object) else { return };
+            match compute::ComputeRun::scan(&self.scan_dialog, &o.doc, repaint.clone()) {
+                Ok(run) => self.computing = Some(run),
+                Err(e) => self.error = Some(format!("Scan: {e}")),
+            }
+        }
+        if let Some((o, settings)) = &mut self.orbitals_dialog
+            && compute::orbitals_window(ctx, settings)
+            && !running
+            && let Some(object) = self.objects.get(*o)
+        {
+            let source = std::path::Path::new(&object.doc.source);
+            let name = format!("{}_{}.molden", crate::compute::stem(source), settings.level().replace(['/', '*'], "_"));
+            let output = compute::beside(source).join(name);
+            self.computing = Some(compute::ComputeRun::orbitals(&object.doc, settings.clone(), output, repaint));
+            self.orbitals_dialog = None;
+        }
+        let loading = self.scan_job.is_some() || self.job.is_some();
+        let Some(run) = &mut self.computing else { return };
+        let opened = run.poll(loading);
+        if run.announced != run.progress {
+            run.announced = run.progress.clone();
+            self.status = run.progress.clone();
+        }
+        match opened {
+            compute::Opened::Scan(path) => self.open_scan(scan::ScanSource::File(path), ctx),
+            compute::Opened::File(path) => {
+                let how = if self.objects.len() <= 1 { Opening::Replace } else { Opening::Add };
+                self.open_as(path, how, ctx);
+            }
+            compute::Opened::Nothing => {}
+        }
     }
 
     /// Whether a click in a view waits for its picture to be whole before it is picked.
@@ -1068,6 +1150,7 @@ impl eframe::App for OrbApp {
         let action = panels::top_bar(ui, self);
         panels::status_bar(ui, self);
         record::record_window(&ctx, self);
+        self.compute_windows(&ctx);
         picture::picture_window(&ctx, self);
         panels::side_panel(ui, self);
         let defaults = self.defaults;

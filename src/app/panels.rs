@@ -274,8 +274,21 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
             ui.separator();
             match &app.scan {
                 // The measured values follow θ.
-                Some(s) => super::measure::panel(ui, &s.scene.scan.geometry_at(s.theta), &mut app.measurements),
-                None => super::measure::panel(ui, &app.world.molecule, &mut app.measurements),
+                Some(s) => {
+                    super::measure::panel(ui, &s.scene.scan.geometry_at(s.theta), &mut app.measurements, false);
+                }
+                None => {
+                    if let Some(n) = super::measure::panel(ui, &app.world.molecule, &mut app.measurements, true) {
+                        app.scan_measurement(n);
+                    }
+                }
+            }
+            // A structure without orbitals offers to compute them (small molecules: PySCF).
+            let bare = app.objects.get(app.active).filter(|o| {
+                app.scan.is_none() && o.doc.wavefunction.is_none() && (1..=60).contains(&o.doc.molecule.atoms.len())
+            });
+            if bare.is_some() && ui.button("Compute orbitals…").on_hover_text("with PySCF").clicked() {
+                app.orbitals_dialog = Some((app.active, crate::compute::Settings::default()));
             }
 
             ui.separator();

@@ -7,11 +7,11 @@ use std::sync::atomic::AtomicBool;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use orbcloud::compute::{self, Event, FrameJob, Held, Job, Settings};
-use orbcloud::formats::scan::{Computed, manifest_text};
-use orbcloud::model::scan::{Coordinate, rigid_frames, wrap_degrees};
+use orbcloud::formats::scan::Computed;
+use orbcloud::model::scan::Coordinate;
 use orbcloud::model::{Document, Molecule};
 
-use super::scan_cli::parse_atoms;
+use super::scan_cli::CoordinateArgs;
 
 /// How to compute: method, basis, charge and spin.
 #[derive(Args, Clone)]
@@ -73,15 +73,8 @@ pub struct ScanComputeArgs {
     /// The geometry to start from (any file orbcloud reads), or with --frames a multi-frame
     /// XYZ file whose every frame is computed.
     file: PathBuf,
-    /// The bond length between these atoms (1-based), Å.
-    #[arg(long, value_parser = parse_atoms::<2>, group = "coordinate")]
-    distance: Option<[usize; 2]>,
-    /// The angle i-j-k at j (1-based), degrees.
-    #[arg(long, value_parser = parse_atoms::<3>, group = "coordinate")]
-    angle: Option<[usize; 3]>,
-    /// The dihedral i-j-k-l about the j-k bond (1-based), degrees.
-    #[arg(long, value_parser = parse_atoms::<4>, group = "coordinate")]
-    dihedral: Option<[usize; 4]>,
+    #[command(flatten)]
+    coordinate: CoordinateArgs,
     /// Every frame of FILE (a trajectory, an IRC) as a path.
     #[arg(long, group = "coordinate")]
     frames: bool,
@@ -117,12 +110,6 @@ fn load(path: &Path) -> Result<Document> {
         bail!("{}: dummy atoms or unknown elements cannot be computed", path.display());
     }
     Ok(doc)
-}
-
-fn stem(path: &Path) -> String {
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "frame".into());
-    let name = name.strip_suffix(".gz").unwrap_or(&name);
-    name.split('.').next().filter(|s| !s.is_empty()).unwrap_or("frame").to_string()
 }
 
 /// Runs a job, printing each frame as it ends; Ctrl-C ends it (frames written so far stay).
@@ -170,8 +157,10 @@ fn plural(n: usize) -> &'static str {
 
 pub fn compute(args: ComputeArgs) -> Result<()> {
     let doc = load(&args.file)?;
-    let output =
-        args.output.clone().unwrap_or_else(|| args.file.with_file_name(format!("{}.molden", stem(&args.file))));
+    let output = args
+        .output
+        .clone()
+        .unwrap_or_else(|| args.file.with_file_name(format!("{}.molden", compute::stem(&args.file))));
     let dir = output.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new(".")).to_path_buf();
     let file = output.file_name().context("-o names no file")?.to_string_lossy().into_owned();
     let job = Job {
@@ -196,13 +185,10 @@ pub fn compute(args: ComputeArgs) -> Result<()> {
     }
 }
 
-/// A frame to compute: its file's name, the coordinate's value and the geometry.
-type Planned = (String, f64, Molecule);
-
 /// The frames a scan computes, in order of value, and the index of the one nearest the input
 /// geometry.
-fn scan_frames(args: &ScanComputeArgs, doc: &Document) -> Result<(Coordinate, Vec<Planned>, usize)> {
-    let stem = stem(&args.file);
+fn scan_frames(args: &ScanComputeArgs, doc: &Document) -> Result<(Coordinate, Vec<FrameJob>, usize)> {
+    let stem = compute::stem(&args.file);
     if args.frames {
         if args.relaxed {
             bail!("--relaxed holds a coordinate: give --distance, --angle or --dihedral, not --frames");
@@ -219,13 +205,11 @@ fn scan_frames(args: &ScanComputeArgs, doc: &Document) -> Result<(Coordinate, Ve
         let frames = models
             .into_iter()
             .enumerate()
-            .map(|(i, m)| (compute::frame_file(&stem, &c, i as f64), i as f64, m))
+            .map(|(i, m)| FrameJob::new(compute::frame_file(&stem, &c, i as f64), i as f64, &m))
             .collect();
         return Ok((c, frames, 0));
     }
-    let coordinate = (args.distance.map(Coordinate::Distance))
-        .or(args.angle.map(Coordinate::Angle))
-        .or(args.dihedral.map(Coordinate::Dihedral))
+    let coordinate = (args.coordinate.coordinate())
         .context("say what to scan: --distance i,j, --angle i,j,k, --dihedral i,j,k,l, or --frames")?;
     let n = doc.molecule.atoms.len();
     if let Some(&bad) = coordinate.atoms().iter().find(|&&i| i >= n) {
@@ -241,15 +225,7 @@ fn scan_frames(args: &ScanComputeArgs, doc: &Document) -> Result<(Coordinate, Ve
     if matches!(coordinate, Coordinate::Angle(_)) && values.iter().any(|&v| !(0.5..=179.5).contains(&v)) {
         bail!("--from {from} --to {to}: angles between 0.5° and 179.5°");
     }
-    let molecules = rigid_frames(&doc.molecule, &coordinate, &values)?;
-    let now = coordinate.measure(&doc.molecule).unwrap_or(0.0);
-    let distance = |v: f64| match coordinate {
-        Coordinate::Dihedral(_) => wrap_degrees(v - now).abs(),
-        _ => (v - now).abs(),
-    };
-    let start = (0..values.len()).min_by(|&a, &b| distance(values[a]).total_cmp(&distance(values[b]))).unwrap_or(0);
-    let frames =
-        values.iter().zip(molecules).map(|(&v, m)| (compute::frame_file(&stem, &coordinate, v), v, m)).collect();
+    let (frames, start) = compute::rigid_scan(&doc.molecule, &coordinate, &values, &stem)?;
     Ok((coordinate, frames, start))
 }
 
@@ -289,41 +265,20 @@ pub fn scan_compute(args: ScanComputeArgs) -> Result<()> {
         output: Some(args.output.join("compute-output.txt")),
         workers,
         dask: args.dask.clone(),
-        frames: frames.iter().map(|(file, at, m)| FrameJob::new(file.clone(), *at, m)).collect(),
+        frames,
     };
     let (reports, versions) = run(&job)?;
-    let done: Vec<(String, f64)> = (frames.iter())
-        .filter(|(file, ..)| reports.iter().any(|r| r.ok && &r.file == file))
-        .map(|(file, at, _)| (file.clone(), *at))
-        .collect();
+    let done: Vec<(String, f64)> = reports.iter().filter(|r| r.ok).map(|r| (r.file.clone(), r.at)).collect();
     let failed: Vec<f64> = reports.iter().filter(|r| !r.ok).map(|r| r.at).collect();
     for r in reports.iter().filter(|r| !r.ok) {
         eprintln!("frame at {} left out: {}", coordinate.value_text(r.at), r.error.as_deref().unwrap_or("failed"));
     }
     if done.len() < 2 {
-        bail!("{} of {} frames computed: a scan needs two", done.len(), frames.len());
+        bail!("{} of {} frames computed: a scan needs two", done.len(), job.frames.len());
     }
-    let title = stem(&args.file);
-    let how = if args.relaxed { "relaxed" } else { "rigid" };
-    let header = format!(
-        "Written by `orbcloud scan compute`: {} {how} scan of {}, {} frames.",
-        settings.level(),
-        coordinate.label(),
-        done.len()
-    );
-    let computed = Computed {
-        method: settings.method.clone(),
-        basis: settings.basis.clone(),
-        charge: settings.charge,
-        spin: settings.spin,
-        relaxed: settings.relaxed,
-        input: args.file.display().to_string(),
-        versions,
-        failed,
-    };
-    let text = manifest_text(&header, &title, &coordinate, &done, Some(&computed));
-    let path = args.output.join(format!("{title}.scan.toml"));
-    std::fs::write(&path, text).with_context(|| format!("writing {}", path.display()))?;
+    let computed = Computed::of(&settings, &args.file.display().to_string(), versions, failed);
+    let title = compute::stem(&args.file);
+    let path = compute::write_manifest(&args.output, &title, &coordinate, &settings, &done, computed)?;
     println!("{}", path.display());
     Ok(())
 }

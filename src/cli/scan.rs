@@ -27,16 +27,10 @@ pub enum ScanCommand {
     /// scan: a bond length, a bond angle, a dihedral, or a path (an IRC, a relaxed scan).
     Init {
         dir: PathBuf,
-        /// The bond length between these atoms, 1-based (default: the bonded distance, angle or
-        /// dihedral that explains the change across the frames best, or a path).
-        #[arg(long, value_parser = parse_atoms::<2>, group = "coordinate")]
-        distance: Option<[usize; 2]>,
-        /// The angle i-j-k at j, 1-based.
-        #[arg(long, value_parser = parse_atoms::<3>, group = "coordinate")]
-        angle: Option<[usize; 3]>,
-        /// The dihedral i-j-k-l about the j-k bond, 1-based.
-        #[arg(long, value_parser = parse_atoms::<4>, group = "coordinate")]
-        dihedral: Option<[usize; 4]>,
+        /// Default: the bonded distance, angle or dihedral that explains the change across the
+        /// frames best, or a path.
+        #[command(flatten)]
+        coordinate: CoordinateArgs,
         /// The frames as a path, in the order of their file names.
         #[arg(long, group = "coordinate")]
         path: bool,
@@ -73,6 +67,29 @@ pub enum ScanCommand {
         #[arg(short, long)]
         output: PathBuf,
     },
+}
+
+/// A scan's coordinate by its atoms (1-based), one of the `coordinate` group.
+#[derive(Args)]
+pub struct CoordinateArgs {
+    /// The bond length between these atoms (Å).
+    #[arg(long, value_parser = parse_atoms::<2>, group = "coordinate")]
+    distance: Option<[usize; 2]>,
+    /// The angle i-j-k at j (degrees).
+    #[arg(long, value_parser = parse_atoms::<3>, group = "coordinate")]
+    angle: Option<[usize; 3]>,
+    /// The dihedral i-j-k-l about the j-k bond (degrees).
+    #[arg(long, value_parser = parse_atoms::<4>, group = "coordinate")]
+    dihedral: Option<[usize; 4]>,
+}
+
+impl CoordinateArgs {
+    /// The coordinate given (0-based atoms), if any.
+    pub fn coordinate(&self) -> Option<Coordinate> {
+        (self.distance.map(Coordinate::Distance))
+            .or(self.angle.map(Coordinate::Angle))
+            .or(self.dihedral.map(Coordinate::Dihedral))
+    }
 }
 
 #[derive(Args)]
@@ -141,7 +158,7 @@ pub struct ScanRenderArgs {
 }
 
 /// N 1-based atom numbers `i,j,…`, returned 0-based.
-pub(crate) fn parse_atoms<const N: usize>(s: &str) -> Result<[usize; N], String> {
+fn parse_atoms<const N: usize>(s: &str) -> Result<[usize; N], String> {
     let v: Vec<usize> =
         s.split(',').map(|t| t.trim().parse::<usize>()).collect::<Result<_, _>>().map_err(|e| e.to_string())?;
     if v.len() != N || v.contains(&0) {
@@ -210,11 +227,8 @@ fn check_angle(scan: &Scan, at: f64) -> Result<()> {
 pub fn run(command: ScanCommand) -> Result<()> {
     match command {
         ScanCommand::Compute(args) => super::compute_cli::scan_compute(*args),
-        ScanCommand::Init { dir, distance, angle, dihedral, path, dry_run } => {
-            let chosen = (distance.map(Coordinate::Distance))
-                .or(angle.map(Coordinate::Angle))
-                .or(dihedral.map(Coordinate::Dihedral))
-                .or(path.then_some(Coordinate::Path));
+        ScanCommand::Init { dir, coordinate, path, dry_run } => {
+            let chosen = coordinate.coordinate().or(path.then_some(Coordinate::Path));
             let made = init(&dir, chosen)?;
             let c = made.coordinate;
             let (lo, hi) = (made.frames[0].1, made.frames[made.frames.len() - 1].1);
