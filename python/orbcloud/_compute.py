@@ -132,9 +132,39 @@ def _molden_text(mf, modes=None) -> str:
     return text
 
 
+# km/mol per (e²/amu): an IR intensity from a dipole derivative along a mass-weighted normal
+# coordinate in atomic units (e/√amu).
+KM_PER_MOL = 974.8801
+
+
+def dipole_derivatives(mf, step: float = 1e-3):
+    """∂μ/∂x (3N × 3, atomic units) by central differences of the SCF dipole, each displaced
+    geometry's SCF starting from the last one's density (PySCF's scanner)."""
+    import numpy as np
+
+    mol = mf.mol
+    scanner = mf.as_scanner()
+    coords = mol.atom_coords()
+    out = np.zeros((mol.natm * 3, 3))
+    for a in range(mol.natm):
+        for x in range(3):
+            mu = []
+            for sign in (1.0, -1.0):
+                c = coords.copy()
+                c[a, x] += sign * step
+                moved = mol.set_geom_(c, unit="Bohr", inplace=False)
+                scanner(moved)
+                if not scanner.converged:
+                    raise ComputeError(f"the SCF at a displaced geometry (atom {a + 1}) did not converge")
+                mu.append(scanner.dip_moment(unit="AU", verbose=0))
+            out[3 * a + x] = (mu[0] - mu[1]) / (2 * step)
+    return out
+
+
 def _normal_modes(mf) -> str:
     """The Hessian's normal modes as Molden sections: wavenumbers (cm⁻¹, imaginary ones
-    negative), the geometry (bohr) and each mode's Cartesian displacements."""
+    negative), the geometry (bohr), each mode's Cartesian displacements, and IR intensities
+    (km/mol) from the dipole's derivatives along each mode."""
     import numpy as np
     from pyscf.hessian import thermo
 
@@ -145,6 +175,9 @@ def _normal_modes(mf) -> str:
     # Imaginary wavenumbers come back complex (or NaN-free imaginary parts): Molden writes them negative.
     wavenumbers = np.where(np.abs(np.imag(freq)) > np.abs(np.real(freq)), -np.abs(np.imag(freq)), np.real(freq))
     modes = np.asarray(result["norm_mode"]).reshape(len(wavenumbers), mol.natm, 3)
+    # PySCF's modes are mass-weighted eigenvectors over √mass (amu): x = mode · Q.
+    along = modes.reshape(len(wavenumbers), -1) @ dipole_derivatives(mf)
+    intensities = KM_PER_MOL * (along**2).sum(axis=1)
     lines = ["[FREQ]"] + [f"{w:.4f}" for w in wavenumbers]
     lines.append("[FR-COORD]")
     for i in range(mol.natm):
@@ -154,6 +187,8 @@ def _normal_modes(mf) -> str:
     for k, mode in enumerate(modes):
         lines.append(f"vibration {k + 1}")
         lines += [f"{dx:.8f} {dy:.8f} {dz:.8f}" for dx, dy, dz in mode]
+    lines.append("[INT]")
+    lines += [f"{i:.6f}" for i in intensities]
     return "\n".join(lines) + "\n"
 
 

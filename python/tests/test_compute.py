@@ -258,6 +258,49 @@ def test_a_single_point_with_normal_modes(command, tmp_path):
     molden = path.read_text()
     written = [float(x) for x in molden.split("[FREQ]")[1].split("[FR-COORD]")[0].split()]
     assert len(written) == 3 and np.abs(np.sort(written) - wavenumbers).max() < 1e-2, (written, wavenumbers)
+    # orbcloud reads the intensities as the spectrum's heights.
+    modes = json.loads(command("info", path, "--json").stdout)["modes"]
+    assert all(m["ir_intensity"] is not None and m["ir_intensity"] > 1.0 for m in modes), modes
+
+
+def intensities_along_modes(mol, mf, step=1e-3):
+    """IR intensities (km/mol) from the dipole displaced along each normal mode itself, a
+    different route from the file's (Cartesian derivatives projected on the modes)."""
+    from pyscf.hessian import thermo
+
+    modes = thermo.harmonic_analysis(mol, mf.Hessian().kernel())["norm_mode"]
+    scanner, out = mf.as_scanner(), []
+    for mode in modes:
+        mu = []
+        for sign in (1, -1):
+            scanner(mol.set_geom_(mol.atom_coords() + sign * step * mode, unit="Bohr", inplace=False))
+            mu.append(scanner.dip_moment(unit="AU", verbose=0))
+        out.append(974.8801 * (((mu[0] - mu[1]) / (2 * step)) ** 2).sum())
+    return np.array(out)
+
+
+def test_ir_intensities_follow_the_dipole_and_vanish_where_symmetry_forbids(command, tmp_path):
+    # CO2: the symmetric stretch leaves the dipole zero (IR-inactive); the bends and the
+    # asymmetric stretch are active.
+    xyz = write(tmp_path, "co2.xyz", "3\ncarbon dioxide\nO 0 0 0\nC 0 0 1.16\nO 0 0 2.32\n")
+    command("compute", xyz, "--method", "hf", "--basis", "sto-3g", "--freq")
+    molden = (tmp_path / "co2.molden").read_text()
+    freq = [float(x) for x in molden.split("[FREQ]")[1].split("[FR-COORD]")[0].split()]
+    inten = np.array([float(x) for x in molden.split("[INT]")[1].split()])
+    assert len(freq) == len(inten) == 4
+    doc = orbcloud.load(tmp_path / "co2.molden")
+    mol = gto.M(atom=[(int(a), tuple(p)) for a, p in zip(doc.atoms.numbers, doc.atoms.positions)], basis="sto-3g", unit="Bohr", verbose=0)
+    mf = scf.RHF(mol)
+    mf.conv_tol = 1e-11
+    mf.run()
+    reference = intensities_along_modes(mol, mf)
+    # Both lists in PySCF's order of wavenumbers: the bends (a degenerate pair, any rotation of
+    # it: compared as a pair), the symmetric stretch, the asymmetric stretch.
+    assert list(np.argsort(freq)) == [0, 1, 2, 3], freq
+    assert inten[2] < 0.01 and reference[2] < 0.01, (inten, reference)
+    assert inten[3] > 100, inten
+    assert abs(inten[:2].sum() - reference[:2].sum()) < 0.01 * reference[:2].sum(), (inten, reference)
+    assert abs(inten[3] - reference[3]) < 0.01 * reference[3], (inten, reference)
 
 
 def test_the_python_functions_compute_and_scan(tmp_path):
