@@ -207,6 +207,21 @@ impl WavefunctionArgs {
     /// behind it. In direct mode a grid is filled only when `grid` says its values are wanted.
     fn apply(&self, ctx: &GpuContext, h: &mut Headless, doc: &Document, grid: bool) -> Result<Option<(f64, Values)>> {
         if doc.wavefunction.is_none() {
+            // A quantity only a wavefunction has, asked of atoms alone, is an error, not a
+            // picture of the atoms.
+            let w = &self.what;
+            let asked = [(w.density, "--density"), (w.spin_density, "--spin-density"), (w.esp, "--esp")]
+                .into_iter()
+                .find(|(on, _)| *on)
+                .map(|(_, flag)| flag)
+                .or(w.basis_function.as_ref().map(|_| "--basis-function"));
+            if let Some(flag) = asked {
+                bail!(
+                    "{}: {flag} needs a wavefunction (Molden, fchk, wfn, wfx or MKL), and this file has none: `orbcloud compute {}` computes one with PySCF",
+                    doc.source,
+                    doc.source
+                );
+            }
             return Ok(None);
         }
         let start = Instant::now();
@@ -248,7 +263,7 @@ impl WhatArgs {
         };
         wf.resolve(self.orbital, spin)
             .map(Quantity::Orbital)
-            .ok_or_else(|| anyhow::anyhow!("no orbital {:?} of spin {spin:?} in this file", self.orbital))
+            .ok_or_else(|| anyhow::anyhow!("--orbital {}: {}", self.orbital, wf.available(spin)))
     }
 
     /// A short name for what is asked for: `homo`, `lumo+1`, `mo12_beta`, `density`, `ao_C3_2pz`.
@@ -720,6 +735,13 @@ fn main() -> Result<()> {
     // SAFETY: setting a signal's disposition to its default before any thread starts.
     unsafe {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+    // Mesa's device-select layer connects to a Wayland display to order the GPUs, and prints
+    // "XDG_RUNTIME_DIR is invalid" twice where there is none (ssh, cron, CI); orbcloud chooses
+    // its adapter itself.
+    if std::env::var_os("XDG_RUNTIME_DIR").is_none() && std::env::var_os("NODEVICE_SELECT").is_none() {
+        // SAFETY: no other thread has started yet.
+        unsafe { std::env::set_var("NODEVICE_SELECT", "1") };
     }
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     // Each quantity after the first comes with its own options ([`quantities_cli`]).

@@ -2,6 +2,7 @@
 //! file the cube reader reads back with the same numbers, `info --json` describes wavefunctions,
 //! and bad input fails with a message, not a panic.
 
+use std::path::Path;
 use std::process::Command;
 
 mod common;
@@ -707,4 +708,50 @@ fn the_clipping_plane_cuts_what_render_draws_and_atoms_only_when_asked() {
     let only_density = render_png(&[&density[..], &["--clip", "0,0,1,-0.5"], &homo].concat()).0;
     assert_ne!(whole.as_raw(), cut.as_raw());
     assert_eq!(cut.as_raw(), only_density.as_raw(), "--clip belongs to the picture, not a quantity");
+}
+
+/// What a newcomer types wrong gets a message that says what there is: an orbital past the
+/// last, a directory with no frames (no "line 0"), an empty points file, a density asked of
+/// atoms alone; and no display is needed for `render` to stay quiet.
+#[test]
+fn first_hour_mistakes_get_messages_that_say_what_there_is() {
+    let dir = tempfile::tempdir().unwrap();
+    let molden = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/wavefunctions/h2o_cart_631gs.molden");
+    let molden = molden.to_str().unwrap();
+    let fails = |args: &[&str]| {
+        let out = orbcloud(args);
+        assert!(!out.status.success(), "{args:?} succeeded");
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    let err = fails(&["render", molden, "--orbital", "999", "-o", "/dev/null", "--lavapipe"]);
+    assert!(err.contains("--orbital 999: the file has 19 orbitals (1–19), the HOMO is 5"), "{err}");
+    assert!(!err.contains("Index(") && !err.contains("Alpha"), "no debug text: {err}");
+
+    let empty = dir.path().join("frames");
+    std::fs::create_dir(&empty).unwrap();
+    let err = fails(&["scan", "init", empty.to_str().unwrap()]);
+    assert!(err.contains("frames: expected a directory with at least two"), "{err}");
+    assert!(!err.contains(":0:"), "no line 0: {err}");
+
+    let points = dir.path().join("points.txt");
+    std::fs::write(&points, "# nothing yet\n").unwrap();
+    let err = fails(&["eval", molden, "--points", points.to_str().unwrap()]);
+    assert!(err.contains("points.txt: expected lines of `x y z` in bohr, found none"), "{err}");
+
+    let xyz = dir.path().join("water.xyz");
+    std::fs::write(&xyz, "3\nwater\nO 0 0 0\nH 0.96 0 0\nH -0.24 0.93 0\n").unwrap();
+    let err = fails(&["render", xyz.to_str().unwrap(), "--density", "-o", "/dev/null", "--lavapipe"]);
+    assert!(err.contains("--density needs a wavefunction") && err.contains("orbcloud compute"), "{err}");
+
+    // Without XDG_RUNTIME_DIR (ssh, cron, CI) nothing is printed about it.
+    let png = dir.path().join("w.png");
+    let out = Command::new(env!("CARGO_BIN_EXE_orbcloud"))
+        .args(["render", molden, "--size", "64x48", "-o", png.to_str().unwrap()])
+        .env_remove("XDG_RUNTIME_DIR")
+        .env_remove("NODEVICE_SELECT")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(!err.contains("XDG_RUNTIME_DIR"), "{err}");
 }

@@ -102,7 +102,7 @@ pub fn plot(ui: &mut egui::Ui, scan: &mut ScanView) -> Option<String> {
                     );
                 }
             }
-            plot.vline(VLine::new("θ", theta));
+            plot.vline(VLine::new(c.kind(), theta));
             let response = plot.response();
             let pointer = plot.pointer_coordinate();
             if let Some(p) = pointer.filter(|_| response.dragged()) {

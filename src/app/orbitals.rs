@@ -60,7 +60,7 @@ pub fn panel(
         );
         if n.residual > ORTHONORMAL_TOLERANCE {
             ui.label(
-                RichText::new("⚠ these orbitals are not orthonormal in this basis: the file may be wrong")
+                RichText::new("Warning: these orbitals are not orthonormal in this basis: the file may be wrong")
                     .color(ui.visuals().warn_fg_color),
             );
         }

@@ -316,11 +316,15 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
             });
             ui.separator();
             let help = match &app.scan {
-                Some(s) if s.drag_twists => {
-                    "drag: twist θ · right/middle drag: pan · wheel: zoom · arrows: rotate · Space: play · [ ]: key angles"
-                }
-                Some(_) => "drag: rotate (from the bond: twist) · right/middle drag: pan · wheel: zoom · Space: play",
-                None => "drag: rotate · right/middle drag: pan · wheel: zoom · arrows, +/−: keys",
+                Some(s) if s.drag_twists => format!(
+                    "drag: {} · right/middle drag: pan · wheel: zoom · arrows: rotate · Space: play · [ ]: key values",
+                    super::scan::drag_words(&s.scene.scan.coordinate)
+                ),
+                Some(s) => format!(
+                    "drag: rotate (from the bond: {}) · right/middle drag: pan · wheel: zoom · Space: play",
+                    super::scan::drag_words(&s.scene.scan.coordinate)
+                ),
+                None => "drag: rotate · right/middle drag: pan · wheel: zoom · arrows, +/−: keys".into(),
             };
             ui.label(RichText::new(help).small().weak());
         });

@@ -277,7 +277,7 @@ impl ScanView {
     }
 }
 
-/// The bottom panel: θ slider with key ticks, play/loop, interpolation mode, how orbitals are
+/// The bottom panel: the coordinate's slider with key ticks, play/loop, interpolation mode, how orbitals are
 /// followed, energy plot. Returns a change of the following, which needs the key volumes anew.
 pub fn controls(ui: &mut egui::Ui, scan: &mut ScanView) -> Option<ScanRequest> {
     let mut follow = None;
@@ -286,7 +286,8 @@ pub fn controls(ui: &mut egui::Ui, scan: &mut ScanView) -> Option<ScanRequest> {
         ui.horizontal(|ui| {
             let play = if scan.playing { "Pause" } else { "Play" };
             // One width for both words: the slider beside it stays where it is.
-            if ui.add_sized([58.0, 22.0], egui::Button::new(play)).on_hover_text("Animate θ (Space)").clicked() {
+            let hover = format!("Animate the {} (Space)", scan.scene.scan.coordinate.kind());
+            if ui.add_sized([58.0, 22.0], egui::Button::new(play)).on_hover_text(hover).clicked() {
                 scan.playing = !scan.playing;
             }
             ui.checkbox(&mut scan.looping, "loop");
@@ -295,7 +296,6 @@ pub fn controls(ui: &mut egui::Ui, scan: &mut ScanView) -> Option<ScanRequest> {
             ui.add(egui::DragValue::new(&mut scan.speed).range(span / 60.0..=span * 2.0).suffix(format!(" {unit}/s")))
                 .on_hover_text("animation speed");
             ui.separator();
-            ui.label("θ");
             // Room for the value box and the slider's label after the rail.
             let width = (ui.available_width() - 150.0).max(160.0);
             ui.spacing_mut().slider_width = width;
@@ -473,5 +473,16 @@ pub fn views(
 pub fn restyle(scan: &mut ScanView) {
     for vp in &mut scan.views {
         vp.scan_shown = None;
+    }
+}
+
+/// What a drag does to a scan's coordinate, in the status line's help: "twist the dihedral".
+pub fn drag_words(coordinate: &crate::model::scan::Coordinate) -> &'static str {
+    use crate::model::scan::Coordinate;
+    match coordinate {
+        Coordinate::Dihedral(_) => "twist the dihedral",
+        Coordinate::Angle(_) => "bend the angle",
+        Coordinate::Distance(_) => "stretch the bond",
+        Coordinate::Path => "move along the path",
     }
 }

@@ -1,4 +1,4 @@
-//! `orbcloud scan …` and `orbcloud bench keyvolumes`: dihedral scans from the command line.
+//! `orbcloud scan …` and `orbcloud bench keyvolumes`: scans of a distance, angle, dihedral or path from the command line.
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -264,7 +264,16 @@ pub fn run(command: ScanCommand) -> Result<()> {
             }
             let tracks = file.scan.track(follow_of(follow, &file))?;
             let s = &file.scan;
-            println!("{}\n{}, {} frames, {} atoms move", s.title, s.coordinate.label(), s.frames.len(), s.moving.len());
+            let moving = match s.moving.len() {
+                1 => "1 atom moves".to_string(),
+                n => format!("{n} atoms move"),
+            };
+            println!("{}\n{}, {} frames, {moving}", s.title, s.coordinate.label(), s.frames.len());
+            if let Some(c) = &file.computed {
+                let how = if c.relaxed { "relaxed" } else { "rigid" };
+                let versions: Vec<String> = c.versions.iter().map(|(k, v)| format!("{k} {v}")).collect();
+                println!("computed: {}/{} {how} from {} ({})", c.method, c.basis, c.input, versions.join(", "));
+            }
             print!("{:>9}  {:<28}", s.coordinate.kind(), "file");
             for o in &s.orbitals {
                 print!("  {:>12} {:>5}", format!("E({o})"), "sign");

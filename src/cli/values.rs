@@ -143,5 +143,8 @@ fn read_points(path: &Path) -> Result<Vec<DVec3>> {
         }
         points.push(DVec3::new(v[0], v[1], v[2]));
     }
+    if points.is_empty() {
+        bail!("{}: expected lines of `x y z` in bohr, found none", path.display());
+    }
     Ok(points)
 }

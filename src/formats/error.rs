@@ -2,13 +2,22 @@ use thiserror::Error;
 
 /// A malformed file: where, and what the reader expected there.
 #[derive(Debug, Clone, PartialEq, Error)]
-#[error("{file}:{line}: expected {expected}, found {found}")]
 pub struct ParseError {
     pub file: String,
-    /// 1-based line number.
+    /// 1-based line number; 0 when the error is the file's (or a directory's) as a whole.
     pub line: usize,
     pub expected: String,
     pub found: String,
+}
+
+impl std::fmt::Display for ParseError {
+    /// `file:line: expected …, found …`, or `file: expected …` when no line is at fault.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.line {
+            0 => write!(f, "{}: expected {}, found {}", self.file, self.expected, self.found),
+            line => write!(f, "{}:{line}: expected {}, found {}", self.file, self.expected, self.found),
+        }
+    }
 }
 
 #[derive(Debug, Error)]

@@ -100,16 +100,15 @@ fn describe(info: &wgpu::AdapterInfo) -> String {
 impl GpuContext {
     /// Opens a device without a window.
     pub fn headless(pref: AdapterPreference) -> Result<Self, GpuError> {
-        let backends = match pref {
-            AdapterPreference::LavapipeOnly => wgpu::Backends::VULKAN,
-            AdapterPreference::HighPerformance => wgpu::Backends::all(),
+        let instance = |backends| {
+            let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+            desc.backends = backends;
+            wgpu::Instance::new(desc)
         };
-        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
-        desc.backends = backends;
-        let instance = wgpu::Instance::new(desc);
         let adapter = match pref {
             AdapterPreference::LavapipeOnly => {
-                let adapters = pollster::block_on(instance.enumerate_adapters(backends));
+                let backends = wgpu::Backends::VULKAN;
+                let adapters = pollster::block_on(instance(backends).enumerate_adapters(backends));
                 let found: Vec<String> = adapters.iter().map(|a| describe(&a.get_info())).collect();
                 adapters
                     .into_iter()
@@ -123,11 +122,19 @@ impl GpuContext {
                     })?
             }
             AdapterPreference::HighPerformance => {
-                pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+                let options = wgpu::RequestAdapterOptions {
                     power_preference: wgpu::PowerPreference::HighPerformance,
                     ..Default::default()
-                }))
-                .map_err(|e| GpuError::NoAdapter(e.to_string()))?
+                };
+                // Vulkan, Metal or DirectX 12 first; OpenGL only when none is there. Probing
+                // OpenGL starts EGL, which prints warnings of its own (XDG_RUNTIME_DIR, DRI2)
+                // wherever there is no display: ssh, cron, CI.
+                let primary = pollster::block_on(instance(wgpu::Backends::PRIMARY).request_adapter(&options));
+                match primary {
+                    Ok(adapter) => adapter,
+                    Err(_) => pollster::block_on(instance(wgpu::Backends::all()).request_adapter(&options))
+                        .map_err(|e| GpuError::NoAdapter(e.to_string()))?,
+                }
             }
         };
         let (device, queue) = pollster::block_on(adapter.request_device(&device_descriptor(&adapter)))

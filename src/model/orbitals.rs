@@ -170,7 +170,31 @@ impl std::str::FromStr for OrbitalSpec {
     }
 }
 
+impl std::fmt::Display for OrbitalSpec {
+    /// As a user writes it: "homo", "homo-2", "lumo+1", "12".
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            Self::Homo(0) => write!(f, "homo"),
+            Self::Homo(k) => write!(f, "homo-{k}"),
+            Self::Lumo(0) => write!(f, "lumo"),
+            Self::Lumo(k) => write!(f, "lumo+{k}"),
+            Self::Index(n) => write!(f, "{n}"),
+        }
+    }
+}
+
 impl Wavefunction {
+    /// What orbitals of `spin` there are, for a request that named none: "the file has 12
+    /// orbitals (1–12), the HOMO is 9".
+    pub fn available(&self, spin: Spin) -> String {
+        let spin = self.effective_spin(spin);
+        let n = self.of_spin(spin).count();
+        let which = if self.restricted { String::new() } else { format!(" {spin:?}").to_lowercase() };
+        let homo = (self.homo(spin).and_then(|h| self.of_spin(spin).position(|(i, _)| i == h)))
+            .map_or(String::new(), |p| format!(", the HOMO is {}", p + 1));
+        format!("the file has {n}{which} orbitals (1–{n}){homo}")
+    }
+
     /// Indices into `orbitals` of one spin, sorted by energy (stable for equal energies); natural
     /// orbitals, whose energies mean nothing, by falling occupation (the most occupied "lowest").
     pub fn by_energy(&self, spin: Spin) -> Vec<usize> {
