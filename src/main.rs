@@ -754,7 +754,15 @@ fn main() -> Result<()> {
 /// `orbcloud.compute` and `orbcloud.scan_compute`.
 pub fn run_words(words: Vec<std::ffi::OsString>) -> Result<()> {
     let (line, later) = quantities_cli::split(words)?;
-    dispatch(Cli::try_parse_from(line)?, &later)
+    match Cli::try_parse_from(line) {
+        Ok(cli) => dispatch(cli, &later),
+        // --help and --version are answers, not errors.
+        Err(e) if !e.use_stderr() => {
+            print!("{e}");
+            Ok(())
+        }
+        Err(e) => Err(e.into()),
+    }
 }
 
 fn dispatch(cli: Cli, later: &[quantities_cli::Later]) -> Result<()> {
