@@ -192,7 +192,7 @@ fn the_command_line_takes_any_coordinate() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success() && err.contains("--at 170 is outside the scan's 80°..160°"), "{err}");
     let out = orbcloud(&["scan", "info", m]);
-    assert!(String::from_utf8_lossy(&out.stdout).contains("angle 2-1-3, 9 frames, 1 atoms move"));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("angle 2-1-3, 9 frames, 1 atom moves"));
 }
 
 #[test]

@@ -423,7 +423,7 @@ struct Pipelines {
     lines: wgpu::RenderPipeline,
 }
 
-/// Default splat threshold: measured on lavapipe, see README (`orbcloud bench spheres`).
+/// Default splat threshold: measured on lavapipe, see docs/performance.md (`orbcloud bench spheres`).
 pub const SPLAT_RADIUS_PX: f32 = 8.0;
 
 /// How the compute rasteriser keeps a pixel's nearest depth and atom id.
