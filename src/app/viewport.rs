@@ -1189,9 +1189,9 @@ impl Viewport {
         self.layout = Some((rect, size));
         // Hover: read the id under the pointer when it moved and no button is held.
         let pointer = response.hover_pos().filter(|_| !ui.input(|i| i.pointer.any_down()));
-        // Ids are read from the picture on screen: while it is drawn in bands (or a coarse
-        // preview stands in) they hold only part of the view, so hover and clicks wait for it.
-        if pointer != self.hovered_at && self.progress.is_none() {
+        // Ids are read from the picture being drawn: while it is drawn in bands they hold the
+        // rows drawn so far, so hover and clicks below those rows wait for their band.
+        if pointer != self.hovered_at && pointer.is_none_or(|p| self.ids_ready(p)) {
             self.hovered_at = pointer;
             self.hovered = pointer.and_then(|pos| self.pick_at(pos).ok().flatten());
         }
@@ -1216,9 +1216,8 @@ impl Viewport {
             });
             self.pending_click = Some((pos, shift));
         }
-        if self.progress.is_none()
-            && let Some((pos, shift)) = self.pending_click.take()
-        {
+        if let Some((pos, shift)) = self.pending_click.filter(|&(pos, _)| self.ids_ready(pos)) {
+            self.pending_click = None;
             match self.pick_at(pos) {
                 Ok(picked) => self.click = Some(Click { picked, shift }),
                 Err(e) => log::warn!("picking failed: {e}"),
@@ -1227,7 +1226,17 @@ impl Viewport {
         twisted
     }
 
-    /// Whether a click waits for the picture to be whole before it is picked.
+    /// Whether the ids at window position `pos` are the current picture's: it is whole, or
+    /// drawn in bands past that row (a band restarts from the top when the view changes, and a
+    /// coarse preview drawn in between leaves the full-size ids from the first band on). A
+    /// picture that keeps changing (a vibration playing) still reaches every row in turn.
+    fn ids_ready(&self, pos: egui::Pos2) -> bool {
+        let (Some(p), Some((rect, size))) = (self.progress, self.layout) else { return true };
+        let row = ((pos.y - rect.min.y) / rect.height().max(1.0) * size[1] as f32).max(0.0) as u32;
+        row < p.next_row
+    }
+
+    /// Whether a click waits for its row of the picture to be drawn before it is picked.
     pub fn is_picking(&self) -> bool {
         self.pending_click.is_some()
     }

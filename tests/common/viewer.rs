@@ -38,7 +38,14 @@ pub fn click_at(h: &mut Harness<'static, OrbApp>, pos: egui::Pos2, shift: bool) 
     h.run_steps(1);
     h.event(button(false));
     h.run_steps(1);
-    settle(h);
+    // The pick waits for its row of a picture drawn in bands, which a busy machine draws over
+    // many frames.
+    let start = std::time::Instant::now();
+    while h.state().is_picking() {
+        assert!(start.elapsed().as_secs() < 60, "the click was not picked after a minute");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+        h.run_steps(1);
+    }
     h.event(egui::Event::ModifiersChanged(egui::Modifiers::NONE));
     h.run_steps(1);
 }
@@ -47,15 +54,8 @@ pub fn click_at(h: &mut Harness<'static, OrbApp>, pos: egui::Pos2, shift: bool) 
 pub fn hover(h: &mut Harness<'static, OrbApp>, pos: egui::Pos2) {
     h.hover_at(pos);
     h.run_steps(1);
-    settle(h);
-}
-
-/// Steps the app until the view's picture is whole and no click waits for it (failing after a
-/// minute): a pick reads the ids of the picture on screen, which a busy machine draws in bands
-/// over several frames.
-pub fn settle(h: &mut Harness<'static, OrbApp>) {
     let start = std::time::Instant::now();
-    while h.state().is_picking() || h.state().frame_progress().is_some() {
+    while h.state().frame_progress().is_some() {
         assert!(start.elapsed().as_secs() < 60, "the picture is still being drawn after a minute");
         std::thread::sleep(std::time::Duration::from_millis(20));
         h.run_steps(1);
