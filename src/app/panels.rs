@@ -161,11 +161,16 @@ fn status_line(ui: &mut egui::Ui, app: &OrbApp, cancel: &mut bool, dismiss: &mut
             if let (Some(wf), Some(i)) = (&app.doc().wavefunction, selected.and_then(Source::orbital)) {
                 let o = &wf.orbitals[i];
                 ui.separator();
+                // "HOMO a1 −0.4985 Eh": the spin only where it tells something (unrestricted).
+                let spin = match (wf.restricted, o.spin) {
+                    (true, _) => "",
+                    (false, crate::model::Spin::Alpha) => " α",
+                    (false, crate::model::Spin::Beta) => " β",
+                };
+                let symmetry = if o.symmetry.is_empty() { String::new() } else { format!(" {}", o.symmetry) };
                 ui.label(format!(
-                    "{} {:?} {} {}, occupation {:.2}",
+                    "{}{spin}{symmetry} {}, occupation {:.2}",
                     wf.frontier_label(i, 50).unwrap_or_else(|| format!("MO {}", i + 1)),
-                    o.spin,
-                    o.symmetry,
                     wf.energy_text(i),
                     o.occupation
                 ));

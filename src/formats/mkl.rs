@@ -138,6 +138,11 @@ pub fn read(file: &str, text: &str) -> Result<MoldenFile, ParseError> {
         set_occupations(file, find("OCC_BETA").ok_or_else(|| missing("OCC_BETA"))?, &mut b)?;
         orbitals.extend(b);
     }
+    // ORCA writes "a1g" for every orbital of a calculation run without symmetry: one label
+    // for all of them names nothing, and shown on each orbital it misleads.
+    if orbitals.len() > 1 && orbitals.iter().all(|o| o.symmetry == orbitals[0].symmetry) {
+        orbitals.iter_mut().for_each(|o| o.symmetry.clear());
+    }
     Ok(MoldenFile { title, atoms, angstrom: true, shells, pure, orbitals, mo_line: alpha.line, ..Default::default() })
 }
 
@@ -408,6 +413,15 @@ $OCC_ALPHA
         let wf = doc(&beta).wavefunction.expect("wf");
         assert!(!wf.restricted);
         assert_eq!(wf.of_spin(Spin::Beta).count(), 1);
+    }
+
+    #[test]
+    fn one_label_on_every_orbital_is_dropped_and_real_labels_kept() {
+        let wf = doc(H2).wavefunction.expect("wf");
+        assert!(wf.orbitals.iter().all(|o| o.symmetry.is_empty()), "ORCA's a1g on every orbital names nothing");
+        let labelled = H2.replacen(" a1g  a1g", " ag  b1u", 1);
+        let wf = doc(&labelled).wavefunction.expect("wf");
+        assert_eq!(wf.orbitals.iter().map(|o| o.symmetry.as_str()).collect::<Vec<_>>(), ["ag", "b1u"]);
     }
 
     #[test]
