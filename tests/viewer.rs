@@ -143,7 +143,6 @@ fn a_molden_file_opens_on_its_homo_and_the_browser_switches_orbitals() {
     // The status line names a restricted file's orbital without a spin.
     h.get_by_label_contains("occupation 2.00");
     assert!(h.query_by_label_contains("Alpha").is_none() && h.query_by_label_contains(" α ").is_none());
-    let app = h.state();
     let lumo = wf.lumo(orbcloud::model::Spin::Alpha).unwrap();
     h.get_by_label_contains(&format!("MO {} ", lumo + 1)).click();
     h.run_steps(2);
