@@ -130,11 +130,16 @@ impl QuantityState {
     }
 
     /// A new quantity of an object that already shows `others`: the cloud and isosurface
-    /// colours of the first preset none of them uses, so each quantity reads as its own.
+    /// colours of the first preset whose colours are all unlike theirs, so each quantity reads
+    /// as its own (a density beside an orbital is not the orbital's red: red / white, the next
+    /// preset, shares red / blue's red).
     pub fn joining(source: Source, defaults: &RenderSettings, others: &[QuantityState]) -> Self {
         let mut q = Self::new(source, defaults);
-        let used = |c: [f32; 3]| others.iter().any(|o| o.cloud.positive_color == c);
-        if let Some(&(_, positive, negative)) = super::transfer::PRESETS.iter().find(|(_, p, _)| !used(*p))
+        let taken: Vec<[f32; 3]> =
+            others.iter().flat_map(|o| [o.cloud.positive_color, o.cloud.negative_color]).collect();
+        let alike = |a: [f32; 3], b: [f32; 3]| a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum::<f32>() < 0.1;
+        let free = |c: [f32; 3]| !taken.iter().any(|&t| alike(c, t));
+        if let Some(&(_, positive, negative)) = super::transfer::PRESETS.iter().find(|&&(_, p, n)| free(p) && free(n))
             && !others.is_empty()
         {
             (q.cloud.positive_color, q.cloud.negative_color) = (positive, negative);
@@ -317,8 +322,15 @@ mod tests {
         assert_eq!(first.cloud.positive_color, defaults.volume.positive_color, "alone: the defaults");
         let second = QuantityState::joining(Source::Volume(1), &defaults, std::slice::from_ref(&first));
         let third = QuantityState::joining(Source::Volume(2), &defaults, &[first.clone(), second.clone()]);
-        let colours = [first.cloud.positive_color, second.cloud.positive_color, third.cloud.positive_color];
-        assert!(colours[0] != colours[1] && colours[1] != colours[2] && colours[0] != colours[2], "{colours:?}");
+        let colours: Vec<[f32; 3]> =
+            [&first, &second, &third].iter().flat_map(|q| [q.cloud.positive_color, q.cloud.negative_color]).collect();
+        // No two of the six colours alike: the density beside a HOMO is not its red.
+        for (i, a) in colours.iter().enumerate() {
+            for b in &colours[i + 1..] {
+                let d: f32 = a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum();
+                assert!(d > 0.1, "{a:?} and {b:?} look alike: {colours:?}");
+            }
+        }
         assert_eq!(second.isosurfaces[0].positive_color, second.cloud.positive_color);
     }
 
