@@ -753,3 +753,43 @@ fn the_object_s_clipping_plane_cuts_its_atoms_when_asked() {
     let hovered = picks(&mut h);
     assert_ne!(hovered, oxygen_id, "the oxygen beyond the plane is cut away");
 }
+
+/// Files opened one after another stand side by side across the view, each visible, not one
+/// behind another along the line of sight; *Reset view* frames them the same way.
+#[test]
+fn files_opened_together_stand_side_by_side_across_the_view() {
+    let fixture =
+        |n: &str| std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/wavefunctions").join(n);
+    // Water first: it lies in the yz plane, so it is seen along x, the axis files once lined up on.
+    let files = vec![fixture("h2o_ccpvtz.fchk"), fixture("benzene_631gs.fchk"), fixture("h3o_cation_631gss.fchk")];
+    let mut h = Harness::builder()
+        .with_size([1280.0, 800.0])
+        .wgpu_setup(wgpu_setup(true))
+        .build_eframe(move |cc| OrbApp::new(cc, files));
+    wait_loaded(&mut h);
+    let centres = |app: &OrbApp| -> Vec<egui::Pos2> {
+        let world = app.world();
+        (0..app.objects.len())
+            .map(|o| {
+                let first = world.offsets[o];
+                let n = app.objects[o].doc.molecule.atoms.len();
+                let points: Vec<egui::Pos2> =
+                    (first..first + n).map(|a| app.atom_on_screen(a).expect("on screen")).collect();
+                let sum = points.iter().fold(egui::Vec2::ZERO, |s, p| s + p.to_vec2());
+                (sum / n as f32).to_pos2()
+            })
+            .collect()
+    };
+    assert_eq!(h.state().objects.len(), 3);
+    let check = |c: Vec<egui::Pos2>| {
+        let mut xs: Vec<f32> = c.iter().map(|p| p.x).collect();
+        xs.sort_by(f32::total_cmp);
+        // Apart across the screen by more than a tenth of the window's width each.
+        assert!(xs[1] - xs[0] > 128.0 && xs[2] - xs[1] > 128.0, "side by side: {c:?}");
+        assert!(c.iter().all(|p| (0.0..1280.0).contains(&p.x) && (0.0..800.0).contains(&p.y)), "{c:?}");
+    };
+    check(centres(h.state()));
+    h.get_by_label("Reset view").click();
+    h.run_steps(2);
+    check(centres(h.state()));
+}

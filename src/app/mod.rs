@@ -714,11 +714,16 @@ impl OrbApp {
             self.clear_scene();
         }
         let keep = self.objects.len();
-        if !restoring && keep > 0 {
-            // Beside the scene: 4 bohr past its largest x.
-            let right = self.world.molecule.bounds().map_or(0.0, |(_, hi)| hi.x as f32);
-            let lo = doc.bounds().map_or(glam::Vec3::ZERO, |(lo, _)| lo.as_vec3());
-            state.placement = crate::scene::Placement::beside(right, lo, 4.0);
+        if !restoring
+            && keep > 0
+            && let (Some((lo, hi)), Some((s_lo, s_hi))) = (doc.bounds(), self.world.molecule.bounds())
+        {
+            // Beside the scene across the view it opens in: 4 bohr past it along the screen's
+            // right, so files opened one after another stand side by side, never one behind
+            // another.
+            let (right, _) = self.scene_camera().screen_axes();
+            let scene = (s_lo.as_vec3(), s_hi.as_vec3());
+            state.placement = crate::scene::Placement::beside_along(right, scene, lo.as_vec3(), hi.as_vec3(), 4.0);
         }
         let Some(vp) = &mut self.viewport else { return };
         if vp.room() < 1 + state.quantities.len() {

@@ -38,6 +38,22 @@ impl Placement {
         Self { offset: [right_edge + gap - lo.x, 0.0, 0.0], rotation_deg: [0.0; 3] }
     }
 
+    /// The offset that puts the box `lo..hi` (object frame) `gap` beyond the scene along
+    /// `axis` (a unit vector: the screen's right as the scene is seen), centred on the scene
+    /// across it. `scene` is the scene's atoms' box: a new molecule lands beside the others as
+    /// the view shows them, not behind them along the line of sight.
+    pub fn beside_along(axis: Vec3, scene: (Vec3, Vec3), lo: Vec3, hi: Vec3, gap: f32) -> Self {
+        let extent = |(l, h): (Vec3, Vec3)| {
+            let dots = crate::model::octree::box_corners(l, h).map(|c| c.dot(axis));
+            dots.iter().fold((f32::MAX, f32::MIN), |(a, b), &d| (a.min(d), b.max(d)))
+        };
+        let (_, far) = extent(scene);
+        let (near, _) = extent((lo, hi));
+        let across = (scene.0 + scene.1) / 2.0 - (lo + hi) / 2.0;
+        let offset = axis * (far + gap - near) + (across - axis * across.dot(axis));
+        Self { offset: offset.to_array(), rotation_deg: [0.0; 3] }
+    }
+
     /// The axis-aligned box around the box `lo..hi` of the object's frame, placed.
     pub fn placed_box(&self, lo: Vec3, hi: Vec3) -> (Vec3, Vec3) {
         let m = self.world_from_object();
@@ -426,6 +442,14 @@ mod tests {
         assert!((moved(Vec3::ZERO) - Vec3::new(1.0, 2.0, 3.0)).length() < 1e-6);
         let z90 = Placement { rotation_deg: [0.0, 0.0, 90.0], ..Default::default() }.world_from_object();
         assert!((z90.transform_vector3(Vec3::X) - Vec3::Y).length() < 1e-6, "z rotation is counter-clockwise");
+        // Across a view that looks along x (the screen's right is −z): the new box lies 4 bohr
+        // past the scene along −z, centred on it in x and y.
+        let scene = (Vec3::new(-1.0, -2.0, -3.0), Vec3::new(1.0, 2.0, 3.0));
+        let across =
+            Placement::beside_along(Vec3::NEG_Z, scene, Vec3::new(10.0, 10.0, 0.0), Vec3::new(12.0, 14.0, 2.0), 4.0);
+        let (lo, hi) = across.placed_box(Vec3::new(10.0, 10.0, 0.0), Vec3::new(12.0, 14.0, 2.0));
+        assert!((hi.z - (-7.0)).abs() < 1e-5, "4 bohr beyond z = −3: {hi}");
+        assert!(((lo + hi) / 2.0).truncate().length() < 1e-5, "centred across: {lo} {hi}");
         let beside = Placement::beside(5.0, Vec3::new(-3.0, 0.0, 0.0), 4.0);
         assert_eq!(beside.offset, [12.0, 0.0, 0.0], "the new box starts 4 bohr past x = 5");
         assert!(Placement::default().is_identity() && !p.is_identity());
