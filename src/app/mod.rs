@@ -493,6 +493,11 @@ impl OrbApp {
         self.viewport.as_ref()?.to_screen(&self.view.camera, position)
     }
 
+    /// Where the 3-D view lies in the window (as last laid out).
+    pub fn view_rect(&self) -> Option<egui::Rect> {
+        self.viewport.as_ref()?.rect()
+    }
+
     /// What is under the resting pointer in the single-file view.
     pub fn hovered(&self) -> Option<crate::gpu::frame::PickId> {
         self.viewport.as_ref()?.hovered
@@ -777,6 +782,13 @@ impl OrbApp {
             let view = crate::scene::view::first_view(&first.doc.molecule);
             let m = first.state.placement.world_from_object();
             camera.look_along(m.transform_vector3(view.direction), m.transform_vector3(view.up));
+        }
+        // Several molecules side by side are wider than tall: every atom (2 bohr inside the
+        // edges) in the view as it is laid out, not only in its height.
+        if self.objects.len() > 1
+            && let Some(aspect) = self.viewport.as_ref().and_then(|v| v.aspect())
+        {
+            camera.fit_points(self.world.molecule.atoms.iter().map(|a| a.position.as_vec3()), aspect, 2.0);
         }
         camera
     }

@@ -1368,6 +1368,17 @@ impl Viewport {
     pub fn rendered_size(&self) -> Option<[u32; 2]> {
         self.target.as_ref().map(|(t, _)| t.size)
     }
+
+    /// Where the view was last laid out in the window.
+    pub fn rect(&self) -> Option<egui::Rect> {
+        self.layout.map(|(rect, _)| rect)
+    }
+
+    /// Width over height of the view as last laid out.
+    pub fn aspect(&self) -> Option<f32> {
+        let [w, h] = self.shown_size?;
+        (h > 0).then(|| w as f32 / h as f32)
+    }
 }
 
 /// `camera` stood back so that what fits its height fits a view of `size` narrower than it is

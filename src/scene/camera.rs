@@ -53,6 +53,21 @@ impl Camera {
         self.distance = radius / (0.5 * self.fov_y).sin();
     }
 
+    /// Moves back (never closer) until every point of `points` lies at least `margin` inside a
+    /// view of width/height `aspect`, keeping the direction and the target: a wide scene framed
+    /// for a narrow view, where the bounding sphere fits only its height.
+    pub fn fit_points(&mut self, points: impl IntoIterator<Item = Vec3>, aspect: f32, margin: f32) {
+        let (right, up) = self.screen_axes();
+        let back = self.backward();
+        let tan_v = (0.5 * self.fov_y).tan();
+        let tan_h = tan_v * aspect.max(1e-3);
+        for p in points {
+            let d = p - self.target;
+            let (x, y, z) = (d.dot(right).abs() + margin, d.dot(up).abs() + margin, d.dot(back));
+            self.distance = self.distance.max(z + x / tan_h).max(z + y / tan_v);
+        }
+    }
+
     /// Unit vector from the target towards the eye.
     pub fn backward(&self) -> Vec3 {
         let (sy, cy) = self.yaw.sin_cos();
