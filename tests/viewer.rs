@@ -325,11 +325,15 @@ fn files_join_the_scene_are_measured_across_and_a_session_reopens_them() {
     let app = h.state();
     assert_eq!(app.objects.len(), 2);
     assert_eq!(app.active, 1, "the new file is the one the panels edit");
-    let offset = app.objects[1].state.placement.offset;
-    let (_, hi) = demo.molecule.bounds().unwrap();
-    let (lo, _) = demo.bounds().unwrap();
-    assert!(offset[0] as f64 + lo.x > hi.x, "placed beside the first: {offset:?}");
+    let offset = glam::Vec3::from(app.objects[1].state.placement.offset);
     assert_eq!(app.world().molecule.atoms.len(), 8);
+    // Beside the first across the view: every atom of the second right of every atom of the first.
+    let xs = |range: std::ops::Range<usize>| -> Vec<f32> { range.map(|a| app.atom_on_screen(a).unwrap().x).collect() };
+    let (first, second) = (xs(0..4), xs(4..8));
+    assert!(
+        second.iter().all(|x| first.iter().all(|f| x > f)),
+        "placed beside the first: {first:?} then {second:?}, offset {offset}"
+    );
 
     // Hide the active object's cloud; the other keeps its own.
     h.get_by_label("show cloud").click();
@@ -341,7 +345,7 @@ fn files_join_the_scene_are_measured_across_and_a_session_reopens_them() {
     click_at(&mut h, o1, false);
     assert!(h.state().status.starts_with("atom 2 O"), "{}", h.state().status);
     click_at(&mut h, o2, true);
-    let expected = offset[0] as f64 * orbcloud::model::units::ANGSTROM_PER_BOHR;
+    let expected = offset.length() as f64 * orbcloud::model::units::ANGSTROM_PER_BOHR;
     assert!(h.state().status.ends_with(&format!("{expected:.3} Å")), "{} (expected {expected:.3})", h.state().status);
     // A second isosurface for object 2.
     h.get_by_label("+ isosurface").click();
