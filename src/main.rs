@@ -397,6 +397,10 @@ struct RenderArgs {
     /// Print what is drawn at pixel X,Y of the image (an atom, a surface, or nothing).
     #[arg(long, value_parser = surface_cli::parse_pixel)]
     pick: Option<[u32; 2]>,
+    /// Leave out the captions of panes side by side (--beside): each pane's quantities and an
+    /// orbital's energy.
+    #[arg(long)]
+    no_captions: bool,
     /// Render a bundled demo scene instead of a file (cycloaddition: several objects).
     #[arg(long, value_enum)]
     demo: Option<DemoArg>,

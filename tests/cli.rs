@@ -540,6 +540,27 @@ fn render_draws_several_quantities_of_one_file_and_panes_side_by_side() {
         render_png(&[file.as_str(), "--size", "320x120", "--orbital", "homo", "--beside", "--orbital", "lumo"]);
     assert!(said.contains("pane 1: HOMO") && said.contains("pane 2: LUMO"), "{said}");
     assert_eq!(beside.dimensions(), (320, 120));
+    // Each pane is captioned with its quantity at its top left; without captions each pane is
+    // what its quantity alone draws.
+    let (bare, _) = render_png(&[
+        file.as_str(),
+        "--size",
+        "320x120",
+        "--orbital",
+        "homo",
+        "--beside",
+        "--orbital",
+        "lumo",
+        "--no-captions",
+    ]);
+    let corner = |img: &image::RgbaImage, x| image::imageops::crop_imm(img, x, 0, 40, 12).to_image();
+    for x in [0, 160] {
+        let d = common::mean_difference(&corner(&beside, x), &corner(&bare, x));
+        assert!(d > 3.0, "a caption at the top left of the pane at x = {x}: {d}");
+    }
+    let below = |img: &image::RgbaImage, x| image::imageops::crop_imm(img, x, 40, 160, 80).to_image();
+    assert_eq!(common::mean_difference(&below(&beside, 0), &below(&bare, 0)), 0.0, "only the caption differs");
+    let beside = bare;
     let left = image::imageops::crop_imm(&beside, 0, 0, 160, 120).to_image();
     let right = image::imageops::crop_imm(&beside, 160, 0, 160, 120).to_image();
     let (lumo, homo) = (one(&["--orbital", "lumo"]), one(&["--orbital", "homo"]));
@@ -547,8 +568,17 @@ fn render_draws_several_quantities_of_one_file_and_panes_side_by_side() {
     assert!(common::mean_difference(&right, &lumo) < 0.5, "right pane: {}", common::mean_difference(&right, &lumo));
     assert!(common::mean_difference(&left, &right) > 2.0, "HOMO and LUMO differ");
     // Options of the whole picture may come after the second quantity too.
-    let (late, _) =
-        render_png(&[file.as_str(), "--orbital", "homo", "--beside", "--orbital", "lumo", "--size", "320x120"]);
+    let (late, _) = render_png(&[
+        file.as_str(),
+        "--orbital",
+        "homo",
+        "--beside",
+        "--orbital",
+        "lumo",
+        "--size",
+        "320x120",
+        "--no-captions",
+    ]);
     assert_eq!(common::mean_difference(&late, &beside), 0.0, "--size after the quantities");
 }
 

@@ -23,7 +23,7 @@ const BESIDE: &str = "--beside";
 /// Options that belong to the whole picture or file, not to a quantity: wherever they are
 /// given, they join the first part of the command line (`mesh FILE --density --iso 0.1
 /// --orbital homo --iso 0.05 -o out.glb`).
-const WHOLE_PICTURE: [&str; 31] = [
+const WHOLE_PICTURE: [&str; 32] = [
     "--output",
     "-o",
     "--size",
@@ -55,9 +55,11 @@ const WHOLE_PICTURE: [&str; 31] = [
     "--transparent",
     "--clip",
     "--clip-atoms",
+    "--no-captions",
 ];
 /// Those of them that take no value.
-const WHOLE_PICTURE_FLAGS: [&str; 5] = ["--lavapipe", "--direct", "--arrows", "--transparent", "--clip-atoms"];
+const WHOLE_PICTURE_FLAGS: [&str; 6] =
+    ["--lavapipe", "--direct", "--arrows", "--transparent", "--clip-atoms", "--no-captions"];
 
 /// A quantity given after the first, with the options that followed it.
 pub struct Later {
@@ -237,6 +239,7 @@ pub fn render(
             panes[k - 1] == p
         });
         let names: Vec<String> = state.quantities.iter().map(|q| describe(doc, q.source)).collect();
+        let lines: Vec<String> = state.quantities.iter().map(|q| caption(doc, q.source)).collect();
         eprintln!("pane {}: {}", p + 1, if names.is_empty() { "atoms".into() } else { names.join(" + ") });
         let pane_scene = [(doc, state)];
         let mut renderer = Renderer::new(ctx);
@@ -248,9 +251,25 @@ pub fn render(
         if let Some((map, name)) = &shown.color_map {
             orbcloud::shots::value_bar(&mut picture, map, name);
         }
+        // Panes side by side say what each shows, as the window's panes do.
+        if count > 1 && !first.no_captions {
+            orbcloud::figure::caption(&mut picture, 0, pane_width, &lines);
+        }
         image::imageops::replace(&mut image, &picture, (p as u32 * pane_width) as i64, 0);
     }
     Ok(image)
+}
+
+/// A pane's caption line: the quantity, with an orbital's energy ("HOMO  −0.2467 Eh").
+fn caption(doc: &Document, source: Source) -> String {
+    let name = source.name(doc);
+    match (source.orbital(), &doc.wavefunction) {
+        (Some(i), Some(wf)) => match wf.energy(i) {
+            Some(e) => format!("{name}  {:.4} Eh", e).replace('-', "−"),
+            None => name,
+        },
+        _ => name,
+    }
 }
 
 /// A quantity in words, with an orbital's energy: "HOMO: E = -0.24666 Eh, occupation 2.00"
