@@ -96,12 +96,22 @@ fn homo_and_lumo_of_one_file_side_by_side_in_linked_panes_and_a_session_keeps_th
     let dir = tempfile::tempdir().unwrap();
     let wf = h.state().doc().wavefunction.clone().unwrap();
     let (homo, lumo) = (wf.homo(Spin::Alpha).unwrap(), wf.lumo(Spin::Alpha).unwrap());
+    // The HOMO shown with its ±ψ surfaces: the LUMO beside it is drawn the same way.
+    h.get_by_label("show ψ = ±value").click();
+    wait_loaded(&mut h);
     h.get_by_label_contains(&format!("MO {} ", lumo + 1)).click_secondary();
     h.run_steps(2);
     h.get_by_label("show beside (a pane of its own)").click();
     wait_loaded(&mut h);
     let app = h.state();
     assert_eq!(app.view.panes.count, 2);
+    let state = &app.objects[0].state;
+    assert!(state.quantities.iter().all(|q| q.isosurfaces[0].visible), "both panes keep the isosurfaces");
+    assert_eq!(state.quantities[1].isosurfaces, state.quantities[0].isosurfaces);
+    // Surfaces off again: the clicks below pick atoms, not surfaces.
+    h.state_mut().objects[0].state.quantities.iter_mut().for_each(|q| q.isosurfaces[0].visible = false);
+    wait_loaded(&mut h);
+    let app = h.state();
     let state = &app.objects[0].state;
     let placed: Vec<_> = state.quantities.iter().map(|q| (q.source, q.pane)).collect();
     assert_eq!(

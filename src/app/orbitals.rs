@@ -162,11 +162,15 @@ pub fn panel(
                 // What was shown stays in the first pane; the new one goes beside it.
                 state.quantities.iter_mut().filter(|q| q.pane.is_none()).for_each(|q| q.pane = Some(0));
             }
-            // In a pane of its own, in the same colours as the orbital it is compared with.
+            // In a pane of its own, drawn as the orbital it is compared with is drawn (cloud,
+            // isosurfaces, colours): the two panes differ only in the orbital.
             let pane = panes.add(*camera);
-            state
-                .quantities
-                .push(QuantityState { pane: Some(pane), ..QuantityState::new(Source::Wavefunction(q), defaults) });
+            let mut beside =
+                QuantityState { pane: Some(pane), ..QuantityState::new(Source::Wavefunction(q), defaults) };
+            if let Some(shown) = state.quantities.get(state.selected).filter(|s| s.source.orbital().is_some()) {
+                (beside.cloud, beside.isosurfaces) = (shown.cloud, shown.isosurfaces.clone());
+            }
+            state.quantities.push(beside);
             state.selected = state.quantities.len() - 1;
         }
         None => {}
