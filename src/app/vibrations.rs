@@ -115,7 +115,7 @@ fn ir_spectrum(ui: &mut egui::Ui, modes: &Vibrations, v: &mut VibrationState) ->
             clicked.then(|| plot.pointer_coordinate()).flatten()
         });
     if let Some(PlotPoint { x, .. }) = response.inner
-        && let Some(k) = modes.mode_at(x, (v.fwhm as f64).max(top / 100.0))
+        && let Some(k) = modes.band_at(x, v.fwhm as f64, v.lorentzian, (v.fwhm as f64).max(top / 100.0))
     {
         v.mode = Some(k);
     }

@@ -62,15 +62,26 @@ impl Vibrations {
             .map(|(k, _)| k)
     }
 
+    /// The mode whose band is highest at wavenumber `x` in the spectrum broadened as
+    /// [`Self::ir_spectrum`] says: the band under a click, so a click on a tall band picks it,
+    /// not a weak neighbour a little nearer. Without intensities (or where no band rises), the
+    /// nearest real mode within `tolerance` cm⁻¹.
+    pub fn band_at(&self, x: f64, fwhm: f64, lorentzian: bool, tolerance: f64) -> Option<usize> {
+        let shape = band_shape(fwhm, lorentzian);
+        let tallest = (self.modes.iter().enumerate())
+            .filter(|(_, m)| !m.is_imaginary() && (m.frequency_cm1 - x).abs() <= tolerance.max(2.0 * fwhm))
+            .filter_map(|(k, m)| Some((k, m.ir_intensity? * shape(x - m.frequency_cm1))))
+            .filter(|&(_, height)| height > 0.0)
+            // The first of equal bands (a degenerate pair): as the list orders them.
+            .reduce(|best, c| if c.1 > best.1 { c } else { best });
+        tallest.map(|(k, _)| k).or_else(|| self.mode_at(x, tolerance))
+    }
+
     /// The IR spectrum from `from` to `to` cm⁻¹ in `points` steps: every mode with an intensity
     /// broadened to a Lorentzian (or a Gaussian) of full width `fwhm` cm⁻¹ at half maximum and
     /// peak height its intensity. Imaginary modes are left out.
     pub fn ir_spectrum(&self, (from, to): (f64, f64), points: usize, fwhm: f64, lorentzian: bool) -> Vec<[f64; 2]> {
-        let half = (fwhm * 0.5).max(1e-6);
-        let shape = |dx: f64| match lorentzian {
-            true => half * half / (dx * dx + half * half),
-            false => (-std::f64::consts::LN_2 * (dx / half).powi(2)).exp(),
-        };
+        let shape = band_shape(fwhm, lorentzian);
         let peaks: Vec<(f64, f64)> = (self.modes.iter())
             .filter(|m| !m.is_imaginary())
             .filter_map(|m| Some((m.frequency_cm1, m.ir_intensity?)))
@@ -81,6 +92,16 @@ impl Vibrations {
                 [x, peaks.iter().map(|&(f, i)| i * shape(x - f)).sum()]
             })
             .collect()
+    }
+}
+
+/// A band's shape, 1 at its centre: a Lorentzian or a Gaussian of full width `fwhm` at half
+/// maximum, of the distance from the centre.
+fn band_shape(fwhm: f64, lorentzian: bool) -> impl Fn(f64) -> f64 {
+    let half = (fwhm * 0.5).max(1e-6);
+    move |dx: f64| match lorentzian {
+        true => half * half / (dx * dx + half * half),
+        false => (-std::f64::consts::LN_2 * (dx / half).powi(2)).exp(),
     }
 }
 
@@ -132,5 +153,20 @@ mod tests {
         assert_eq!(v.mode_at(1590.0, 20.0), Some(1), "the band nearest the click");
         assert_eq!(v.mode_at(2500.0, 20.0), None, "nothing within the tolerance");
         assert_eq!(v.mode_at(-250.0, 20.0), None, "imaginary modes have no band");
+    }
+
+    #[test]
+    fn a_click_picks_the_band_under_it_not_the_nearest_weak_one() {
+        // A weak band 30 cm-1 from a tall one, 40 cm-1 wide: on the tall band's flank, nearer
+        // the weak one's centre, the tall band is what the curve shows.
+        let mut v = water();
+        v.modes[2] = NormalMode { frequency_cm1: 1630.0, ir_intensity: Some(2.0), ..v.modes[2].clone() };
+        assert_eq!(v.mode_at(1622.0, 20.0), Some(2), "the nearest centre is the weak band's");
+        assert_eq!(v.band_at(1622.0, 40.0, true, 20.0), Some(1), "the band under the click is the tall one");
+        assert_eq!(v.band_at(1630.0, 4.0, true, 20.0), Some(2), "narrow bands: each its own peak");
+        assert_eq!(v.band_at(2500.0, 20.0, true, 20.0), None, "nothing under it");
+        // Without intensities: the nearest mode.
+        v.modes.iter_mut().for_each(|m| m.ir_intensity = None);
+        assert_eq!(v.band_at(1622.0, 40.0, true, 20.0), Some(2));
     }
 }
