@@ -425,7 +425,7 @@ fn a_normal_mode_animates_with_arrows_and_a_click_on_its_band_picks_it() {
 
     // A click on the 1852 cm⁻¹ band picks its mode.
     let transform = h.state().spectrum.expect("the spectrum is drawn");
-    let band = transform.position_from_point(&egui_plot::PlotPoint::new(1851.99, 3.0));
+    let band = transform.position_from_point(&egui_plot::PlotPoint::new(-1851.99, 3.0));
     click_at(&mut h, band, false);
     h.run_steps(2);
     assert_eq!(h.state().objects[0].state.vibration.mode, Some(1), "the band's mode");

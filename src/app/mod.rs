@@ -205,7 +205,8 @@ pub struct OrbApp {
     /// Each object's state as the GPU shows it: what the next frame's edits are compared with
     /// ([`Self::apply_changes`]), wherever they came from (a panel, a test, a script).
     applied: Vec<ObjectState>,
-    /// Where the IR spectrum was last drawn (tests click its peaks).
+    /// Where the IR spectrum was last drawn (tests click its peaks); its x is the negated
+    /// wavenumber (wavenumbers fall from left to right).
     pub spectrum: Option<egui_plot::PlotTransform>,
     /// A session's measurements, kept until its files have loaded.
     restoring_measurements: Option<Vec<crate::model::measure::Measurement>>,

@@ -88,34 +88,42 @@ fn ir_spectrum(ui: &mut egui::Ui, modes: &Vibrations, v: &mut VibrationState) ->
         ui.selectable_value(&mut v.lorentzian, false, "Gauss");
     });
     let top = modes.modes.iter().map(|m| m.frequency_cm1).fold(1000.0, f64::max) + 200.0;
-    let curve = modes.ir_spectrum((0.0, top), 1200, v.fwhm as f64, v.lorentzian);
+    // Wavenumbers fall from left to right, as spectra are drawn: the plot's x is the negated
+    // wavenumber, labelled as the wavenumber (egui_plot's own inverted axis labels only its 0).
+    let curve: Vec<[f64; 2]> =
+        modes.ir_spectrum((0.0, top), 1200, v.fwhm as f64, v.lorentzian).into_iter().map(|[x, y]| [-x, y]).collect();
     let peak = curve.iter().map(|p| p[1]).fold(1.0, f64::max);
+    // Labels at every 1000 cm-1 however narrow the panel: egui_plot's default spacing hides
+    // labels closer than 60 points, which left this axis with its 0 alone.
+    let axis = egui_plot::AxisHints::new_x()
+        .label("wavenumber (cm-1)")
+        .formatter(|mark, _| format!("{:.0}", (-mark.value).abs()))
+        .label_spacing(32.0..=48.0);
     let response = Plot::new("ir spectrum")
-        .invert_x(true)
-        .x_axis_label("wavenumber (cm-1)")
+        .custom_x_axes(vec![axis])
         .y_axis_label("IR (km/mol)")
         .allow_zoom(false)
         .allow_drag(false)
         .allow_scroll(false)
         .allow_boxed_zoom(false)
         .include_x(0.0)
-        .include_x(top)
+        .include_x(-top)
         .include_y(0.0)
         .include_y(peak * 1.1)
         .show(ui, |plot| {
             plot.line(Line::new("spectrum", curve));
             for m in modes.modes.iter().filter(|m| !m.is_imaginary()) {
                 let i = m.ir_intensity.unwrap_or(0.0);
-                plot.line(Line::new("", vec![[m.frequency_cm1, 0.0], [m.frequency_cm1, i]]).width(1.0));
+                plot.line(Line::new("", vec![[-m.frequency_cm1, 0.0], [-m.frequency_cm1, i]]).width(1.0));
             }
             if let Some(m) = v.mode.and_then(|k| modes.modes.get(k)).filter(|m| !m.is_imaginary()) {
-                plot.vline(VLine::new("shown", m.frequency_cm1));
+                plot.vline(VLine::new("shown", -m.frequency_cm1));
             }
             let clicked = plot.response().clicked();
             clicked.then(|| plot.pointer_coordinate()).flatten()
         });
     if let Some(PlotPoint { x, .. }) = response.inner
-        && let Some(k) = modes.band_at(x, v.fwhm as f64, v.lorentzian, (v.fwhm as f64).max(top / 100.0))
+        && let Some(k) = modes.band_at(-x, v.fwhm as f64, v.lorentzian, (v.fwhm as f64).max(top / 100.0))
     {
         v.mode = Some(k);
     }
