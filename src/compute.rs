@@ -173,6 +173,11 @@ pub enum ComputeError {
     Io { path: String, source: std::io::Error },
 }
 
+/// This machine's cores: what computing uses unless told otherwise.
+pub fn cores() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
+}
+
 /// The interpreter that computes: `ORBCLOUD_PYTHON`, or `python3`.
 pub fn python() -> String {
     std::env::var("ORBCLOUD_PYTHON").ok().filter(|s| !s.trim().is_empty()).unwrap_or_else(|| "python3".into())
@@ -294,11 +299,6 @@ pub fn values(from: f64, to: f64, step: f64) -> Result<Vec<f64>, String> {
         return Err(format!("{n} frames from {from} to {to} by {step}: at most 1000"));
     }
     Ok((0..n).map(|i| from + i as f64 * step).collect())
-}
-
-/// The frame nearest `value` among `values`.
-pub fn nearest(values: &[f64], value: f64) -> usize {
-    (0..values.len()).min_by(|&a, &b| (values[a] - value).abs().total_cmp(&(values[b] - value).abs())).unwrap_or(0)
 }
 
 /// The frames of a rigid scan of `coordinate` over `values` from `molecule`, named after

@@ -392,15 +392,13 @@ def run(job: dict, emit=lambda event: None, client=None) -> list[dict]:
         if r and r.get("ok") and r.get("key") == keys[i] and os.path.exists(os.path.join(directory, f["file"])):
             records[i] = dict(r, index=i, kept=True)
     workers = max(1, int(job.get("workers") or 1))
-    if dask and client is None:
+    # The scheduler at the address the job names (the user's), disconnected at the end.
+    own_client = dask and client is None
+    if own_client:
         from distributed import Client
 
         client = Client(job["dask"], timeout=30)
-        parallel = max(1, len(client.scheduler_info().get("workers", {})))
-    elif client is not None:
-        parallel = max(1, len(client.scheduler_info().get("workers", {})))
-    else:
-        parallel = workers
+    parallel = max(1, len(client.scheduler_info().get("workers", {}))) if dask else workers
     emit({"event": "start", "frames": len(frames), "kept": sum(r is not None for r in records), "versions": versions(relaxed, dask)})
     for r in records:
         if r is not None:
@@ -448,6 +446,8 @@ def run(job: dict, emit=lambda event: None, client=None) -> list[dict]:
                     next_of[rest[0]] = rest[1:]
     finally:
         pool.close()
+        if own_client:
+            client.close()
     done = [dict(r, dm=None) if r else r for r in records]
     emit({
         "event": "done",

@@ -46,7 +46,7 @@ impl Default for ScanDialog {
             to: 0.0,
             step: 1.0,
             settings: Settings::default(),
-            workers: cores(),
+            workers: compute::cores(),
             dask: String::new(),
             folder: String::new(),
         }
@@ -58,10 +58,6 @@ impl Default for ScanDialog {
 pub fn beside(source: &Path) -> PathBuf {
     let file = std::fs::canonicalize(source).ok().filter(|p| p.is_file());
     file.and_then(|p| p.parent().map(Path::to_path_buf)).unwrap_or_else(std::env::temp_dir)
-}
-
-fn cores() -> usize {
-    std::thread::available_parallelism().map_or(1, |n| n.get())
 }
 
 impl ScanDialog {
@@ -207,7 +203,7 @@ impl ComputeRun {
             start: 0,
             dir,
             output: None,
-            workers: cores(),
+            workers: compute::cores(),
             dask: None,
             frames: vec![FrameJob::new(file, 0.0, &doc.molecule)],
         };
@@ -270,11 +266,11 @@ impl ComputeRun {
     }
 
     /// The failures to tell, each with its value.
-    pub fn failures(&self, coordinate: Option<&Coordinate>) -> Vec<String> {
-        let c = coordinate.or(match &self.purpose {
+    pub fn failures(&self) -> Vec<String> {
+        let c = match &self.purpose {
             Purpose::Scan { coordinate, .. } => Some(coordinate),
             Purpose::Orbitals { .. } => None,
-        });
+        };
         self.failed
             .iter()
             .map(|(at, why)| match c {
@@ -355,7 +351,7 @@ pub fn scan_window(ctx: &egui::Context, dialog: &mut ScanDialog, run: Option<&Co
             (_, Ok(values)) => {
                 if let Some(r) = run {
                     ui.label(&r.progress);
-                    for f in r.failures(Some(&dialog.coordinate)) {
+                    for f in r.failures() {
                         ui.label(egui::RichText::new(format!("left out: {f}")).small());
                     }
                 }

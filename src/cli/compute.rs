@@ -170,7 +170,7 @@ pub fn compute(args: ComputeArgs) -> Result<()> {
         dir,
         output: None,
         // Every core, as threads of the one process.
-        workers: std::thread::available_parallelism().map_or(1, |n| n.get()),
+        workers: compute::cores(),
         dask: args.dask.clone(),
         frames: vec![FrameJob::new(file, 0.0, &doc.molecule)],
     };
@@ -234,11 +234,7 @@ fn trajectory(doc: &Document) -> Vec<Molecule> {
     let Some(s) = doc.structure.as_ref().map(|v| &v.structure).filter(|s| s.models.len() > 1) else {
         return vec![doc.molecule.clone()];
     };
-    let n = doc.molecule.atoms.len();
-    s.models
-        .iter()
-        .map(|m| s.position[m.atoms.start as usize..m.atoms.end as usize].to_vec())
-        .filter(|p| p.len() == n)
+    (s.model_positions(doc.molecule.atoms.len()).into_iter())
         .map(|positions| {
             let atoms = doc
                 .molecule
@@ -254,8 +250,7 @@ fn trajectory(doc: &Document) -> Vec<Molecule> {
 pub fn scan_compute(args: ScanComputeArgs) -> Result<()> {
     let doc = load(&args.file)?;
     let (coordinate, frames, start) = scan_frames(&args, &doc)?;
-    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let workers = args.workers.unwrap_or(cores).clamp(1, frames.len().max(1));
+    let workers = args.workers.unwrap_or_else(compute::cores).clamp(1, frames.len().max(1));
     let settings = Settings { relaxed: args.relaxed, ..args.level.settings() };
     let job = Job {
         settings: settings.clone(),

@@ -550,10 +550,7 @@ fn path_order(dir: &Path, molecules: &[Molecule]) -> Result<Option<Vec<f64>>, Lo
     for path in xyz {
         let doc = super::load(&path)?;
         let Some(s) = doc.structure.as_ref().map(|v| &v.structure).filter(|s| s.models.len() > 1) else { continue };
-        let frames: Vec<Vec<glam::DVec3>> = (s.models.iter())
-            .map(|m| s.position[m.atoms.start as usize..m.atoms.end as usize].to_vec())
-            .filter(|p| p.len() == n)
-            .collect();
+        let frames = s.model_positions(n);
         if frames.len() < 2 {
             continue;
         }

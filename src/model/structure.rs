@@ -142,6 +142,15 @@ impl Structure {
         self.z.is_empty()
     }
 
+    /// Each model's positions (bohr), for the models of exactly `atoms` atoms: the frames of a
+    /// trajectory, as a scan's path or a computation reads them.
+    pub fn model_positions(&self, atoms: usize) -> Vec<Vec<DVec3>> {
+        (self.models.iter())
+            .map(|m| self.position[m.atoms.start as usize..m.atoms.end as usize].to_vec())
+            .filter(|p| p.len() == atoms)
+            .collect()
+    }
+
     pub fn with_capacity(n: usize) -> Self {
         Self {
             z: Vec::with_capacity(n),
