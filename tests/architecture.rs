@@ -4,198 +4,31 @@
 
 use std::path::{Path, PathBuf};
 
-/// For each layer (a directory or file under src/), the crate modules it must not name.
-const MODULE_RULES: &[(&str, &[&str])] = &[
-    (
-        "model",
-        &[
-            "formats",
-            "scene",
-            "gpu",
-            "meshes",
-            "evaluate",
-            "layers",
-            "headless",
-            "key_volumes",
-            "app",
-            "arithmetic",
-            "demo",
-            "info",
-            "figure",
-            "movie",
-            "shots",
-        ],
-    ),
-    (
-        "formats",
-        &[
-            "scene",
-            "gpu",
-            "meshes",
-            "evaluate",
-            "layers",
-            "headless",
-            "key_volumes",
-            "app",
-            "arithmetic",
-            "demo",
-            "info",
-            "figure",
-            "movie",
-            "shots",
-        ],
-    ),
-    (
-        "scene",
-        &[
-            "formats",
-            "gpu",
-            "meshes",
-            "evaluate",
-            "layers",
-            "headless",
-            "key_volumes",
-            "app",
-            "arithmetic",
-            "demo",
-            "info",
-            "figure",
-            "movie",
-            "shots",
-        ],
-    ),
-    (
-        "gpu",
-        &[
-            "formats",
-            "meshes",
-            "evaluate",
-            "layers",
-            "headless",
-            "key_volumes",
-            "app",
-            "arithmetic",
-            "demo",
-            "info",
-            "figure",
-            "movie",
-            "shots",
-        ],
-    ),
-    (
-        "meshes.rs",
-        &[
-            "formats",
-            "gpu",
-            "evaluate",
-            "layers",
-            "headless",
-            "key_volumes",
-            "app",
-            "arithmetic",
-            "demo",
-            "info",
-            "figure",
-            "movie",
-            "shots",
-        ],
-    ),
-    (
-        "evaluate.rs",
-        &[
-            "formats",
-            "meshes",
-            "layers",
-            "headless",
-            "key_volumes",
-            "app",
-            "arithmetic",
-            "demo",
-            "info",
-            "figure",
-            "movie",
-            "shots",
-        ],
-    ),
-    (
-        "layers.rs",
-        &["formats", "headless", "key_volumes", "app", "arithmetic", "demo", "info", "figure", "movie", "shots"],
-    ),
-    ("headless.rs", &["formats", "key_volumes", "app", "arithmetic", "demo", "info", "shots"]),
-    ("key_volumes.rs", &["formats", "headless", "app", "arithmetic", "demo", "info", "shots"]),
-    (
-        "info.rs",
-        &["gpu", "meshes", "evaluate", "layers", "headless", "key_volumes", "app", "arithmetic", "demo", "shots"],
-    ),
-    (
-        "demo.rs",
-        &["gpu", "meshes", "evaluate", "layers", "headless", "key_volumes", "app", "arithmetic", "info", "shots"],
-    ),
-    (
-        "figure.rs",
-        &[
-            "model",
-            "formats",
-            "scene",
-            "gpu",
-            "meshes",
-            "evaluate",
-            "layers",
-            "headless",
-            "key_volumes",
-            "app",
-            "arithmetic",
-            "demo",
-            "info",
-            "movie",
-            "shots",
-        ],
-    ),
-    (
-        "movie.rs",
-        &[
-            "model",
-            "formats",
-            "scene",
-            "gpu",
-            "meshes",
-            "evaluate",
-            "layers",
-            "headless",
-            "key_volumes",
-            "app",
-            "arithmetic",
-            "demo",
-            "info",
-            "figure",
-            "shots",
-        ],
-    ),
-    (
-        "arithmetic.rs",
-        &["formats", "gpu", "layers", "headless", "key_volumes", "app", "demo", "info", "figure", "movie", "shots"],
-    ),
-    ("shots.rs", &["formats", "app", "arithmetic", "demo", "info"]),
-    (
-        "compute.rs",
-        &[
-            "scene",
-            "gpu",
-            "meshes",
-            "evaluate",
-            "layers",
-            "headless",
-            "key_volumes",
-            "app",
-            "arithmetic",
-            "demo",
-            "info",
-            "figure",
-            "movie",
-            "shots",
-        ],
-    ),
-    ("app", &[]),
+/// The library's layers in order, each a room under src/ with the crate modules it may name
+/// (always those before it, never those after): nothing points up.
+const LAYERS: &[(&str, &[&str])] = &[
+    ("model", &[]),
+    ("formats", &["model"]),
+    ("scene", &["model"]),
+    ("sources", &["model", "formats", "scene"]),
+    ("gpu", &["model", "scene"]),
+    ("evaluate", &["model", "scene", "gpu"]),
+    ("layers", &["model", "scene", "gpu", "evaluate"]),
+    ("pictures", &["model", "scene", "gpu", "evaluate", "layers"]),
+    ("app", &["model", "formats", "scene", "sources", "gpu", "evaluate", "layers", "pictures"]),
+    ("cli", &["model", "formats", "scene", "sources", "gpu", "evaluate", "layers", "pictures", "app"]),
+];
+
+/// Files that stay below the rest of their room: plain image and file work, meshes and volume
+/// arithmetic on the CPU, PySCF's jobs, the `info` report.
+const NARROWER: &[(&str, &[&str])] = &[
+    ("evaluate/meshes.rs", &["model", "scene"]),
+    ("evaluate/arithmetic.rs", &["model", "scene"]),
+    ("pictures/figure.rs", &[]),
+    ("pictures/movie.rs", &[]),
+    ("pictures/headless.rs", &["model", "scene", "gpu", "evaluate", "layers"]),
+    ("sources/compute.rs", &["model", "formats"]),
+    ("cli/info.rs", &["model"]),
 ];
 
 /// For each layer, the external crates (of Cargo.toml's dependencies) it may name; the table in
@@ -204,23 +37,17 @@ const CRATE_RULES: &[(&str, &[&str])] = &[
     ("model", &["glam", "serde", "rayon", "thiserror", "bytemuck", "meshopt"]),
     ("formats", &["glam", "serde", "rayon", "thiserror", "flate2", "fast_float2", "toml", "bytemuck"]),
     ("scene", &["glam", "serde"]),
+    ("sources", &["flate2", "serde", "serde_json", "thiserror", "log", "libc"]),
     ("gpu", &["glam", "thiserror", "wgpu", "bytemuck", "half", "image", "pollster", "log"]),
-    ("meshes.rs", &["glam"]),
-    ("evaluate.rs", &["wgpu"]),
-    ("arithmetic.rs", &["glam"]),
-    ("layers.rs", &["glam"]),
-    ("headless.rs", &["wgpu", "image"]),
-    ("key_volumes.rs", &["glam", "thiserror", "wgpu", "image"]),
-    ("figure.rs", &["image", "ab_glyph", "epaint_default_fonts"]),
-    ("movie.rs", &["thiserror", "image", "gif", "color_quant", "png"]),
-    ("shots.rs", &["thiserror", "image"]),
-    ("info.rs", &["glam", "serde", "serde_json"]),
-    ("compute.rs", &["serde", "serde_json", "thiserror", "log", "libc"]),
-    ("demo.rs", &["flate2"]),
+    ("evaluate", &["glam", "wgpu"]),
+    ("evaluate/meshes.rs", &["glam"]),
+    ("evaluate/arithmetic.rs", &["glam"]),
+    ("layers", &["glam", "thiserror", "wgpu", "image"]),
+    ("pictures", &["thiserror", "wgpu", "image", "ab_glyph", "epaint_default_fonts", "gif", "color_quant", "png"]),
     ("app", &["glam", "serde", "toml", "wgpu", "image", "log", "egui", "eframe", "egui_wgpu", "egui_plot", "rfd"]),
-    // The binary: main.rs and its subcommands.
-    ("cli", &["wgpu", "glam", "rayon", "clap", "anyhow", "image", "serde_json", "toml"]),
-    ("main.rs", &["clap", "anyhow", "env_logger", "libc"]),
+    ("cli", &["wgpu", "glam", "rayon", "clap", "anyhow", "image", "serde", "serde_json", "toml"]),
+    // The binary: the process's setup around the command line.
+    ("main.rs", &["anyhow", "env_logger", "libc"]),
 ];
 
 fn rust_files(path: &Path, out: &mut Vec<PathBuf>) {
@@ -294,12 +121,16 @@ fn modules_after(code: &str, prefix: &str) -> Vec<(String, usize)> {
 #[test]
 fn layers_name_only_the_modules_below_them() {
     let mut violations = Vec::new();
-    for (layer, forbidden) in MODULE_RULES {
+    for (layer, allowed) in LAYERS.iter().chain(NARROWER) {
+        // A room names its own parts freely.
+        let room = layer.split('/').next().unwrap();
         for f in layer_files(layer) {
             let code = code(&std::fs::read_to_string(&f).unwrap());
             for prefix in ["crate::", "super::super::"] {
                 for (name, line) in modules_after(&code, prefix) {
-                    if forbidden.contains(&name.as_str()) {
+                    // `super::super::x` inside a room is one of its own parts unless x is a room.
+                    let is_room = LAYERS.iter().any(|(l, _)| *l == name);
+                    if (prefix == "crate::" || is_room) && name != room && !allowed.contains(&name.as_str()) {
                         violations.push(format!("{}:{line}: {layer} names {name}", f.display()));
                     }
                 }
@@ -307,6 +138,37 @@ fn layers_name_only_the_modules_below_them() {
         }
     }
     assert!(violations.is_empty(), "layering violations:\n{}", violations.join("\n"));
+}
+
+/// Every module of lib.rs is a room of the table, and src/ holds only rooms, lib.rs and main.rs:
+/// a new module is placed among the layers, not beside them.
+#[test]
+fn every_module_is_a_room_of_the_table() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let lib = std::fs::read_to_string(src.join("lib.rs")).unwrap();
+    let modules: Vec<&str> =
+        lib.lines().filter_map(|l| l.strip_prefix("pub mod ")).map(|l| l.trim_end_matches(';')).collect();
+    let rooms: Vec<&str> = LAYERS.iter().map(|(l, _)| *l).collect();
+    for m in &modules {
+        assert!(rooms.contains(m), "src/lib.rs: module {m} has no row in LAYERS (and ARCHITECTURE.md)");
+    }
+    for e in std::fs::read_dir(&src).unwrap() {
+        let path = e.unwrap().path();
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        assert!(
+            path.is_dir() || name == "lib.rs" || name == "main.rs",
+            "src/{name}: a loose file at the top of src/; put it in the room it belongs to"
+        );
+        if path.is_dir() {
+            assert!(rooms.contains(&name.as_str()), "src/{name}/ is not a room of LAYERS");
+        }
+    }
+    // Each room names only rooms before it.
+    for (k, (layer, allowed)) in LAYERS.iter().enumerate() {
+        for a in *allowed {
+            assert!(rooms[..k].contains(a), "{layer} may name {a}, which is not below it");
+        }
+    }
 }
 
 /// The dependencies of Cargo.toml, as Rust names them.
@@ -358,7 +220,7 @@ fn only_the_binary_uses_anyhow() {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
     let mut files = Vec::new();
     rust_files(&src, &mut files);
-    // The binary: main.rs and its subcommand modules under cli/.
+    // The binary (main.rs) and the command line's library (cli/).
     let binary = |f: &Path| f.ends_with("main.rs") || f.starts_with(src.join("cli"));
     for f in files.iter().filter(|f| !binary(f)) {
         let text = std::fs::read_to_string(f).unwrap();

@@ -10,12 +10,12 @@ use std::sync::atomic::{AtomicBool, AtomicU32};
 
 use common::{assert_golden, lavapipe, p_orbital, scene};
 use glam::{DMat4, DVec3, Vec4};
-use orbcloud::headless::Headless;
+use orbcloud::evaluate::meshes::molecular_surface;
 use orbcloud::layers::{object_centre, show_meshes};
-use orbcloud::meshes::molecular_surface;
 use orbcloud::model::isosurface::Mesh;
 use orbcloud::model::units::BOHR_PER_ANGSTROM;
 use orbcloud::model::{Atom, Document, Molecule};
+use orbcloud::pictures::headless::Headless;
 use orbcloud::scene::translucency::SurfaceLook;
 use orbcloud::scene::{
     AtomStyle, Camera, ClipPlane, IsoLevel, RenderSettings, SurfaceChoice, SurfaceSettings, VolumeSettings,

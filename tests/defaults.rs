@@ -6,8 +6,8 @@ mod common;
 
 use orbcloud::evaluate::{WavefunctionView, auto_opacity, evaluate_wavefunction};
 use orbcloud::gpu::gto::GtoFillPass;
-use orbcloud::headless::Headless;
 use orbcloud::model::orbitals::{Quantity, Spin};
+use orbcloud::pictures::headless::Headless;
 use orbcloud::scene::framing::camera_for;
 use orbcloud::scene::{AtomStyle, DensityScale, RenderSettings, ViewPreset};
 

@@ -121,7 +121,7 @@ fn files_in(dir: &str, ext: &str) -> Vec<Vec<u8>> {
 }
 
 fn cube_seed() -> Vec<u8> {
-    let demo = orbcloud::demo::document().unwrap();
+    let demo = orbcloud::sources::demo::document().unwrap();
     let small = demo.volumes[0].subsampled(10);
     orbcloud::formats::cube_write::write("demo", "every tenth point", &demo.molecule, &[(&small, 1)]).into_bytes()
 }

@@ -72,8 +72,8 @@ fn an_empty_expansion_fills_zeros() {
 #[test]
 fn direct_mode_matches_slicing_the_filled_grid() {
     use orbcloud::gpu::gto::volume_from_texture;
-    use orbcloud::headless::Headless;
     use orbcloud::model::{Document, Molecule};
+    use orbcloud::pictures::headless::Headless;
     use orbcloud::scene::{AtomStyle, Camera, RenderSettings};
 
     let ctx = common::lavapipe();

@@ -8,10 +8,10 @@ use common::{assert_golden, coverage, lavapipe, p_orbital, scene};
 use glam::DVec3;
 use orbcloud::formats::mesh_write::{self, MeshFormat, NamedMesh};
 use orbcloud::gpu::frame::PickId;
-use orbcloud::headless::Headless;
 use orbcloud::layers::show_isosurfaces;
 use orbcloud::model::isosurface::{self, Level, Mesh};
 use orbcloud::model::{Document, VolumeGrid};
+use orbcloud::pictures::headless::Headless;
 use orbcloud::scene::framing::default_camera;
 use orbcloud::scene::{AtomStyle, Camera, IsoLevel, RenderSettings};
 

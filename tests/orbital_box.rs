@@ -76,7 +76,7 @@ fn orbitals_and_densities_decay_inside_their_box() {
 #[test]
 fn a_scans_key_grid_holds_every_key_orbital() {
     use orbcloud::model::scan::Follow;
-    let file = orbcloud::demo::scan().unwrap();
+    let file = orbcloud::sources::demo::scan().unwrap();
     let scan = &file.scan;
     let tracks = scan.track(Follow::Index).unwrap();
     let grid = scan.key_grid(&tracks, orbcloud::scene::framing::ORBITAL_MARGIN, 40);

@@ -4,7 +4,7 @@
 mod common;
 
 use common::{assert_golden, compact_p_orbital, coverage, lavapipe, p_orbital, scene};
-use orbcloud::headless::render_document;
+use orbcloud::pictures::headless::render_document;
 use orbcloud::scene::framing::default_camera;
 use orbcloud::scene::{AtomStyle, RenderSettings, SliceMode};
 

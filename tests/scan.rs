@@ -6,15 +6,15 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use orbcloud::demo;
 use orbcloud::formats::cube_write;
 use orbcloud::formats::scan::{init, load_scan};
 use orbcloud::gpu::volume::VolumeTexture;
 use orbcloud::gpu::{FrameInput, OffscreenTarget, Renderer};
-use orbcloud::key_volumes::{KeyOptions, ScanScene};
+use orbcloud::layers::key_volumes::{KeyOptions, ScanScene};
 use orbcloud::model::VolumeGrid;
 use orbcloud::model::scan::{Coordinate, Follow, Scan, Tracks};
 use orbcloud::scene::{Interpolation, RenderSettings};
+use orbcloud::sources::demo;
 
 fn psb3() -> Scan {
     demo::scan().expect("bundled scan loads").scan
@@ -437,7 +437,7 @@ fn key_volumes_respect_the_budget_and_can_be_cancelled() {
     let e = ScanScene::build(&ctx, psb3(), &options, &mut |_, _| true).err().expect("1 MiB cannot hold 30 volumes");
     let msg = e.to_string();
     assert!(msg.contains("30 key volumes") && msg.contains("points along the longest side fits"), "{msg}");
-    let orbcloud::key_volumes::ScanSceneError::OverBudget { fits, .. } = e else { panic!("{e}") };
+    let orbcloud::layers::key_volumes::ScanSceneError::OverBudget { fits, .. } = e else { panic!("{e}") };
     // The grid offered does fit.
     let options = KeyOptions { points: fits, budget: Some(1 << 20), ..KeyOptions::default() };
     let scene = ScanScene::build(&ctx, psb3(), &options, &mut |_, _| true).expect("the offered grid fits");
@@ -451,7 +451,7 @@ fn key_volumes_respect_the_budget_and_can_be_cancelled() {
     })
     .err()
     .expect("cancelled");
-    assert!(matches!(e, orbcloud::key_volumes::ScanSceneError::Cancelled), "{e}");
+    assert!(matches!(e, orbcloud::layers::key_volumes::ScanSceneError::Cancelled), "{e}");
     assert_eq!(calls, 3, "stops at the first refusal");
 }
 

@@ -237,9 +237,9 @@ fn a_frame_drawn_in_bands_equals_the_frame_drawn_at_once() {
 
 #[test]
 fn grids_over_the_gpus_limits_are_shown_coarser_with_a_note() {
+    use orbcloud::evaluate::meshes::isosurfaces_within;
     use orbcloud::evaluate::{WavefunctionView, evaluate_within};
     use orbcloud::layers::coarser_note;
-    use orbcloud::meshes::isosurfaces_within;
     let ctx = lavapipe();
     // One side longer than any 3D texture this device makes: shown with every 2nd point.
     let max = ctx.device.limits().max_texture_dimension_3d as usize;

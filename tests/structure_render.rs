@@ -4,8 +4,8 @@
 mod common;
 
 use common::{assert_golden, lavapipe};
-use orbcloud::headless::render_document;
 use orbcloud::model::Document;
+use orbcloud::pictures::headless::render_document;
 use orbcloud::scene::framing::default_camera;
 use orbcloud::scene::{AtomColoring, AtomStyle, RenderSettings};
 

@@ -6,9 +6,9 @@ mod common;
 
 use std::sync::atomic::AtomicBool;
 
+use orbcloud::evaluate::meshes::molecular_surface;
 use orbcloud::gpu::frame::PickId;
 use orbcloud::gpu::{FrameInput, OffscreenTarget, Renderer};
-use orbcloud::meshes::molecular_surface;
 use orbcloud::model::isosurface::Mesh;
 use orbcloud::model::octree::{LodLevel, SurfaceOctree};
 use orbcloud::scene::translucency::SurfaceLook;
@@ -107,7 +107,7 @@ fn a_surface_coloured_by_element_takes_each_vertex_from_its_nearest_atom() {
         color_by: Some(AtomColoring::Element),
         ..Default::default()
     };
-    orbcloud::meshes::color_surface(&mut mesh, &doc, &settings, "not resn HOH", None);
+    orbcloud::evaluate::meshes::color_surface(&mut mesh, &doc, &settings, "not resn HOH", None);
     assert_eq!(mesh.colors.len(), mesh.positions.len());
     let selection = orbcloud::scene::selection::Selection::parse("not resn HOH").unwrap();
     let mask = selection.mask(&doc.molecule, doc.structure.as_ref());
@@ -147,7 +147,7 @@ fn a_surface_coloured_by_a_volume_shows_the_sign_of_its_values() {
     );
     let points =
         [Vec3::new(-4.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0), Vec3::new(4.0, 0.0, 0.0), Vec3::new(9.0, 0.0, 0.0)];
-    let (colors, _) = orbcloud::meshes::color_by_values(&points, &grid);
+    let (colors, _) = orbcloud::evaluate::meshes::color_by_values(&points, &grid);
     let [neg, zero, pos, outside] = [colors[0], colors[1], colors[2], colors[3]];
     assert!(neg[0] > 0.8 && neg[2] < 0.3, "negative is red: {neg:?}");
     assert!(pos[2] > 0.8 && pos[0] < 0.3, "positive is blue: {pos:?}");

@@ -9,11 +9,11 @@ mod common;
 use common::cloud::{CloudReference, srgb_encode};
 use common::{formaldehyde, lavapipe, p_orbital};
 use glam::{DVec3, Vec3};
+use orbcloud::evaluate::meshes::isosurfaces;
 use orbcloud::gpu::{FrameInput, GpuContext, OffscreenTarget, Renderer};
-use orbcloud::headless::draw_exact;
 use orbcloud::layers::{show_meshes, show_object, show_scene};
-use orbcloud::meshes::isosurfaces;
 use orbcloud::model::{Document, VolumeGrid};
+use orbcloud::pictures::headless::draw_exact;
 use orbcloud::scene::translucency::{Walk, composite, sort_fragments};
 use orbcloud::scene::{AtomStyle, Camera, IsoLevel, IsosurfaceSettings, ObjectState, OpticsPreset, VolumeSettings};
 
@@ -483,7 +483,7 @@ fn overlapping_clouds_with_translucent_surfaces_give_one_picture_whichever_is_li
 fn the_diene_so2_demo_and_nested_shells_match_their_golden_images() {
     let ctx = lavapipe();
     let size = [240, 180];
-    let scene = orbcloud::demo::cycloaddition().expect("the bundled demo loads");
+    let scene = orbcloud::sources::demo::cycloaddition().expect("the bundled demo loads");
     let quantities: Vec<Vec<_>> = scene.iter().map(|(_, s)| s.quantities.iter().map(|q| q.source).collect()).collect();
     // Butadiene's HOMO is MO 15, SO₂'s LUMO MO 17 (scripts/make_cycloaddition_demo.py); each
     // inside its molecule's total density.
@@ -497,7 +497,7 @@ fn the_diene_so2_demo_and_nested_shells_match_their_golden_images() {
     let shown = show_scene(&ctx, &mut renderer, &scene, 48).expect("scene shown");
     let (clouds, (lo, hi)) = (shown.clouds, shown.bounds.expect("bounds"));
     let mut cam = Camera::framing(lo.as_vec3(), hi.as_vec3());
-    let (yaw, pitch) = orbcloud::demo::CYCLOADDITION_VIEW;
+    let (yaw, pitch) = orbcloud::sources::demo::CYCLOADDITION_VIEW;
     cam.orbit(yaw, pitch);
     let target = OffscreenTarget::new(&ctx.device, size);
     let frame = FrameInput { camera: &cam, background: BACKGROUND, clouds: &clouds, size, tile: None };

@@ -303,7 +303,7 @@ fn isosurfaces_follow_the_slider_and_atoms_are_picked_and_measured() {
 #[test]
 fn files_join_the_scene_are_measured_across_and_a_session_reopens_them() {
     use orbcloud::app::Opening;
-    let demo = orbcloud::demo::document().unwrap();
+    let demo = orbcloud::sources::demo::document().unwrap();
     let dir = tempfile::tempdir().unwrap();
     let files: Vec<_> = ["a.cube", "b.cube"].iter().map(|n| dir.path().join(n)).collect();
     // The second a slightly different geometry (one hydrogen 0.01 bohr away): a cube of the
@@ -439,7 +439,7 @@ fn a_scan_shows_isosurfaces_at_theta_and_its_measured_dihedral_follows_theta() {
 
 #[test]
 fn files_open_without_a_system_dialog_and_a_failed_file_leaves_the_demo() {
-    let demo = orbcloud::demo::document().unwrap();
+    let demo = orbcloud::sources::demo::document().unwrap();
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("copy.cube");
     std::fs::write(

@@ -35,7 +35,7 @@ fn h2o2(dir: &std::path::Path) -> Harness<'static, OrbApp> {
 
 /// Fails at once, saying what to install, when the computing Python lacks PySCF.
 fn require_pyscf() {
-    let python = orbcloud::compute::python();
+    let python = orbcloud::sources::compute::python();
     let ok =
         std::process::Command::new(&python).args(["-c", "import pyscf"]).output().is_ok_and(|o| o.status.success());
     assert!(ok, "`{python}` cannot import pyscf: run scripts/test (it sets ORBCLOUD_PYTHON) or pip install pyscf");

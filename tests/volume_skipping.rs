@@ -8,8 +8,8 @@ use common::{compact_p_orbital, lavapipe, scene};
 use glam::{Vec2, Vec3};
 use orbcloud::gpu::GpuContext;
 use orbcloud::gpu::volume::VolumeTexture;
-use orbcloud::headless::Headless;
 use orbcloud::model::Document;
+use orbcloud::pictures::headless::Headless;
 use orbcloud::scene::framing::default_camera;
 use orbcloud::scene::{AtomStyle, Camera, Interpolation, RenderSettings, Shape, SliceMode, TransferKind};
 

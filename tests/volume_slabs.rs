@@ -10,8 +10,8 @@ mod common;
 use common::{lavapipe, p_orbital, scene};
 use orbcloud::gpu::GpuContext;
 use orbcloud::gpu::volume::{SLAB_PLANES, VolumeTexture};
-use orbcloud::headless::Headless;
 use orbcloud::model::{Document, VolumeGrid};
+use orbcloud::pictures::headless::Headless;
 use orbcloud::scene::framing::default_camera;
 use orbcloud::scene::{AtomStyle, Camera, DensityScale, Interpolation, RenderSettings, SliceMode, TransferKind};
 

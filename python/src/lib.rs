@@ -17,11 +17,8 @@ use orbcloud::scene::Camera;
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 
-/// The command line, compiled here so that `render` parses and draws exactly as
-/// `orbcloud render` does.
-#[allow(dead_code, unused_imports, reason = "of the command line only `render` is called from here")]
-#[path = "../../src/main.rs"]
-mod cli;
+// The command line's library: `render` parses and draws exactly as `orbcloud render` does.
+use orbcloud::cli;
 
 pyo3::create_exception!(_native, NativeLoadError, pyo3::exceptions::PyException);
 

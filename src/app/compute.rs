@@ -1,5 +1,5 @@
 //! *Scan this…* (a measured distance, angle or dihedral scanned with PySCF) and *Compute
-//! orbitals* (a structure's wavefunction): computations of [`crate::compute`] run in the
+//! orbitals* (a structure's wavefunction): computations of [`crate::sources::compute`] run in the
 //! background from the window. A scan's frames open as they finish: the manifest of the frames
 //! done so far is written and opened again whenever more are done, so the slider's range grows
 //! while the rest are computed.
@@ -9,10 +9,10 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc;
 
-use crate::compute::{self, Event, FrameJob, Held, Job, Settings};
 use crate::formats::scan::Computed;
 use crate::model::Document;
 use crate::model::scan::Coordinate;
+use crate::sources::compute::{self, Event, FrameJob, Held, Job, Settings};
 
 /// The choices of the *Scan* window: plain data.
 #[derive(Debug, Clone, PartialEq)]

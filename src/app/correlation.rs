@@ -7,8 +7,8 @@
 use egui::{Color32, RichText};
 use egui_plot::{Line, LineStyle, MarkerShape, Plot, PlotPoint, Points, Text, VLine};
 
-use super::scan::ScanView;
 use crate::model::correlation::{Diagram, correlation};
+use crate::model::scan::Scan;
 use crate::model::units::EV_PER_HARTREE;
 
 /// How many orbitals below the HOMO and above the LUMO the diagram shows, and the diagram
@@ -26,7 +26,7 @@ impl Default for DiagramView {
 
 impl DiagramView {
     /// The diagram for the current window (None for cube series or files without energies).
-    pub fn diagram(&mut self, scan: &crate::model::scan::Scan) -> Option<&Diagram> {
+    pub fn diagram(&mut self, scan: &Scan) -> Option<&Diagram> {
         if self.made.as_ref().is_none_or(|(w, _)| *w != self.window) {
             self.made = Some((self.window, correlation(scan, self.window, self.window)));
         }
@@ -47,21 +47,28 @@ fn energy_at(points: &[(f64, f64, usize)], x: f64) -> Option<f64> {
     Some((w[0].1 + k * (w[1].1 - w[0].1)) * EV_PER_HARTREE)
 }
 
-/// Draws the diagram; a drag on it moves θ. Returns the orbital (as manifests name it) whose
-/// line was clicked.
-pub fn plot(ui: &mut egui::Ui, scan: &mut ScanView) -> Option<String> {
-    let shown = &scan.scene.scan.orbitals;
-    let c = scan.scene.scan.coordinate;
+/// What a drag or click on the diagram asks of its scan.
+#[derive(Default)]
+pub struct Asked {
+    /// The orbital (as manifests name it) whose line was clicked.
+    pub orbital: Option<String>,
+    /// The coordinate's value dragged to, or clicked away from every line (within the scan).
+    pub value: Option<f64>,
+}
+
+/// Draws `view`'s diagram of `scan`, the coordinate at `value` marked.
+pub fn plot(ui: &mut egui::Ui, view: &mut DiagramView, scan: &Scan, value: f64) -> Asked {
+    let shown = &scan.orbitals;
+    let c = scan.coordinate;
     let x_label = match c.unit().trim() {
         "" => c.label(),
         u => format!("{} ({u})", c.label()),
     };
-    let theta = scan.theta;
-    let (lo, hi) = scan.scene.scan.range();
+    let (lo, hi) = scan.range();
     // Borrowed, not copied: the diagram is drawn every frame.
-    let Some(diagram) = scan.diagram.diagram(&scan.scene.scan) else {
+    let Some(diagram) = view.diagram(scan) else {
         ui.label(RichText::new("no orbital energies in these files").weak());
-        return None;
+        return Asked::default();
     };
     let mut clicked = None;
     let mut scrub = None;
@@ -102,7 +109,7 @@ pub fn plot(ui: &mut egui::Ui, scan: &mut ScanView) -> Option<String> {
                     );
                 }
             }
-            plot.vline(VLine::new(c.kind(), theta));
+            plot.vline(VLine::new(c.kind(), value));
             let response = plot.response();
             let pointer = plot.pointer_coordinate();
             if let Some(p) = pointer.filter(|_| response.dragged()) {
@@ -119,8 +126,5 @@ pub fn plot(ui: &mut egui::Ui, scan: &mut ScanView) -> Option<String> {
                 }
             }
         });
-    if let Some(x) = scrub {
-        scan.set_theta(x.clamp(lo, hi));
-    }
-    clicked
+    Asked { orbital: clicked, value: scrub.map(|x| x.clamp(lo, hi)) }
 }

@@ -6,7 +6,7 @@ use std::sync::Arc;
 
 use super::jobs::{Pending, spawn};
 use super::{OrbApp, SceneObject};
-use crate::arithmetic::{counterpart, difference};
+use crate::evaluate::arithmetic::{counterpart, difference};
 use crate::model::{Document, VolumeGrid};
 use crate::scene::objects::AddedVolume;
 use crate::scene::{QuantityState, Source};

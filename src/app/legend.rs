@@ -16,7 +16,7 @@ pub fn value_bar(ui: &mut egui::Ui, rect: Rect, map: &ValueMap, name: &str) {
     let steps = 64;
     for i in 0..steps {
         let t = 1.0 - 2.0 * (i as f32 + 0.5) / steps as f32;
-        let [r, g, b] = map.at(t).map(crate::figure::encoded);
+        let [r, g, b] = map.at(t).map(crate::pictures::figure::encoded);
         let y = top.y + bar_h * i as f32 / steps as f32;
         let cell = Rect::from_min_size(Pos2::new(top.x, y), vec2(bar_w, bar_h / steps as f32 + 0.5));
         painter.rect_filled(cell, 0.0, Color32::from_rgb(r, g, b));

@@ -260,7 +260,7 @@ pub struct OrbApp {
     pub scan_dialog: compute::ScanDialog,
     pub computing: Option<compute::ComputeRun>,
     /// The *Compute orbitals* window: the object and the level of theory.
-    pub orbitals_dialog: Option<(usize, crate::compute::Settings)>,
+    pub orbitals_dialog: Option<(usize, crate::sources::compute::Settings)>,
     /// The *Record…* window's choices, and the recording under way.
     pub record: record::RecordDialog,
     /// The *Save PNG* window's choices.
@@ -339,20 +339,20 @@ impl OrbApp {
     pub fn open_demo(&mut self, demo: Demo, ctx: &egui::Context) {
         match demo {
             Demo::Scan => self.open_scan(ScanSource::Demo, ctx),
-            Demo::Cube => match crate::demo::document() {
+            Demo::Cube => match crate::sources::demo::document() {
                 Ok(doc) => self.add_object(doc, Opening::Replace),
                 Err(e) => self.error = Some(e.to_string()),
             },
-            Demo::Cycloaddition => match crate::demo::cycloaddition() {
+            Demo::Cycloaddition => match crate::sources::demo::cycloaddition() {
                 Ok(scene) => {
                     self.clear_scene();
                     for (doc, state) in scene {
                         self.add_object(doc, Opening::Restore(Box::new(state)));
                     }
                     self.view.camera = self.framing_camera();
-                    let (yaw, pitch) = crate::demo::CYCLOADDITION_VIEW;
+                    let (yaw, pitch) = crate::sources::demo::CYCLOADDITION_VIEW;
                     self.view.camera.orbit(yaw, pitch);
-                    self.status = format!("opened {}", crate::demo::CYCLOADDITION_NAME);
+                    self.status = format!("opened {}", crate::sources::demo::CYCLOADDITION_NAME);
                 }
                 Err(e) => self.error = Some(e.to_string()),
             },
@@ -406,7 +406,7 @@ impl OrbApp {
             scan: None,
             scan_job: None,
             difference: None,
-            scan_points: crate::key_volumes::DEFAULT_SCAN_POINTS,
+            scan_points: crate::layers::key_volumes::DEFAULT_SCAN_POINTS,
             scan_retry: None,
             scan_budget: None,
             measurements: measure::Measurements::default(),
@@ -554,7 +554,11 @@ impl OrbApp {
             && let Some(object) = self.objects.get(*o)
         {
             let source = std::path::Path::new(&object.doc.source);
-            let name = format!("{}_{}.molden", crate::compute::stem(source), settings.level().replace(['/', '*'], "_"));
+            let name = format!(
+                "{}_{}.molden",
+                crate::sources::compute::stem(source),
+                settings.level().replace(['/', '*'], "_")
+            );
             let output = compute::beside(source).join(name);
             self.computing = Some(compute::ComputeRun::orbitals(&object.doc, settings.clone(), output, repaint));
             self.orbitals_dialog = None;
@@ -681,8 +685,11 @@ impl OrbApp {
             job.cancel();
         }
         let ctx = ctx.clone();
-        let options =
-            crate::key_volumes::KeyOptions { points: self.scan_points, budget: self.scan_budget, ..Default::default() };
+        let options = crate::layers::key_volumes::KeyOptions {
+            points: self.scan_points,
+            budget: self.scan_budget,
+            ..Default::default()
+        };
         self.scan_job = Some(ScanJob::start(gpu, source, options, follow, orbitals, move || ctx.request_repaint()));
     }
 

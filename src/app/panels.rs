@@ -293,7 +293,7 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
                 app.scan.is_none() && o.doc.wavefunction.is_none() && (1..=60).contains(&o.doc.molecule.atoms.len())
             });
             if bare.is_some() && ui.button("Compute orbitals…").on_hover_text("with PySCF").clicked() {
-                app.orbitals_dialog = Some((app.active, crate::compute::Settings::default()));
+                app.orbitals_dialog = Some((app.active, crate::sources::compute::Settings::default()));
             }
 
             ui.separator();

@@ -5,9 +5,9 @@
 use std::path::Path;
 
 use super::{OrbApp, files};
-use crate::figure::{Figure, MAX_SCALE};
 use crate::gpu::GpuError;
-use crate::shots::caption_views;
+use crate::pictures::figure::{Figure, MAX_SCALE};
+use crate::pictures::shots::caption_views;
 
 /// The choices of the *Save PNG* window.
 pub struct PictureDialog {

@@ -10,9 +10,9 @@ use egui::RichText;
 
 use super::OrbApp;
 use super::jobs::{Pending, spawn};
-use crate::figure::Figure;
-use crate::movie::{MovieFormat, MovieWriter, sweep};
-use crate::shots::{Motion, Progress, ScanShots, SceneShots, ShotError, record};
+use crate::pictures::figure::Figure;
+use crate::pictures::movie::{MovieFormat, MovieWriter, sweep};
+use crate::pictures::shots::{Motion, Progress, ScanShots, SceneShots, ShotError, record};
 
 /// What a recording shows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -119,7 +119,7 @@ impl OrbApp {
             return;
         }
         let Some(ctx) = self.viewport.as_ref().map(|v| v.ctx.clone()) else { return };
-        let figure = Figure { scale: d.scale.clamp(1, crate::figure::MAX_SCALE), transparent: false };
+        let figure = Figure { scale: d.scale.clamp(1, crate::pictures::figure::MAX_SCALE), transparent: false };
         let (frames, fps, size) = (d.frames.clamp(1, 10_000), d.fps, d.size.map(|s| s.clamp(16, 4096)));
         let progress = Arc::new(Progress::default());
         let job_progress = progress.clone();
@@ -234,7 +234,7 @@ pub fn record_window(ctx: &egui::Context, app: &mut OrbApp) {
             });
             ui.end_row();
             ui.label("supersampling");
-            ui.add(egui::DragValue::new(&mut d.scale).range(1..=crate::figure::MAX_SCALE).suffix("×"));
+            ui.add(egui::DragValue::new(&mut d.scale).range(1..=crate::pictures::figure::MAX_SCALE).suffix("×"));
             ui.end_row();
             if d.what == RecordWhat::Sweep {
                 ui.label("");

@@ -13,10 +13,10 @@ use super::detail::{Detail, interacting};
 use super::measure::{self, Measurements};
 use super::state::ViewState;
 use super::viewport::{TwistInput, Viewport};
+use crate::evaluate::meshes::isosurfaces_within;
 use crate::formats::scan::{ScanFile, load_scan};
 use crate::gpu::GpuContext;
-use crate::key_volumes::{KeyOptions, ScanScene, ScanSceneError, mix};
-use crate::meshes::isosurfaces_within;
+use crate::layers::key_volumes::{KeyOptions, ScanScene, ScanSceneError, mix};
 use crate::model::scan::{Coordinate, Follow};
 use crate::scene::{AtomStyle, Interpolation, RenderSettings};
 
@@ -63,7 +63,7 @@ impl ScanJob {
     ) -> Self {
         let name = match &source {
             ScanSource::File(p) => p.display().to_string(),
-            ScanSource::Demo => crate::demo::SCAN_NAME.to_string(),
+            ScanSource::Demo => crate::sources::demo::SCAN_NAME.to_string(),
         };
         let (done, total, cancel) =
             (Arc::new(AtomicUsize::new(0)), Arc::new(AtomicUsize::new(0)), Arc::new(AtomicBool::new(false)));
@@ -75,7 +75,7 @@ impl ScanJob {
             let run = || -> Result<ScanScene, ScanFailure> {
                 let mut file: ScanFile = match &source {
                     ScanSource::File(p) => load_scan(p),
-                    ScanSource::Demo => crate::demo::scan(),
+                    ScanSource::Demo => crate::sources::demo::scan(),
                 }
                 .map_err(|e| ScanFailure::Other(e.to_string()))?;
                 if let Some(names) = orbitals {
@@ -337,7 +337,11 @@ pub fn controls(ui: &mut egui::Ui, scan: &mut ScanView) -> Option<ScanRequest> {
                 "the orbitals the correlation diagram shows; a click on a line shows it in the first view",
             );
         });
-        if let Some(name) = super::correlation::plot(ui, scan) {
+        let asked = super::correlation::plot(ui, &mut scan.diagram, &scan.scene.scan, scan.theta);
+        if let Some(value) = asked.value {
+            scan.set_theta(value);
+        }
+        if let Some(name) = asked.orbital {
             follow = Some(ScanRequest::Show(name));
         }
     });

@@ -53,7 +53,7 @@ pub fn add_volume(doc: &mut Document, added: &AddedVolume) -> Result<(), String>
         }
         AddedVolume::Difference { of, minus, points } => {
             let other = crate::formats::load(minus).map_err(|e| e.to_string())?;
-            let grid = crate::arithmetic::difference(doc, *of, *points, &other)?;
+            let grid = crate::evaluate::arithmetic::difference(doc, *of, *points, &other)?;
             doc.volumes.push(grid);
             Ok(())
         }

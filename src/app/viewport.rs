@@ -6,14 +6,14 @@ use egui::{Key, PointerButton, Sense};
 use super::detail::Detail;
 use super::jobs::Latest;
 use super::state::{DRAG_ROTATE, KEY_ROTATE, KEY_ZOOM, ViewState};
+use crate::evaluate::meshes::{color_isosurfaces, isosurfaces_within, molecular_surface};
 use crate::evaluate::{Evaluated, WavefunctionView, evaluate_within};
 use crate::gpu::context::guarded;
 use crate::gpu::frame::PickId;
 use crate::gpu::gto::GtoFillPass;
 use crate::gpu::oit::FragmentStats;
 use crate::gpu::{FrameInput, GpuContext, GpuError, OffscreenTarget, Renderer, Tile};
-use crate::key_volumes::ScanScene;
-use crate::meshes::{color_isosurfaces, isosurfaces_within, molecular_surface};
+use crate::layers::key_volumes::ScanScene;
 use crate::model::isosurface::Mesh;
 use crate::model::{Document, VolumeGrid};
 use crate::scene::objects::Part;
@@ -904,7 +904,7 @@ impl Viewport {
         }
         let size = self.split[p].target.size;
         let frame = FrameInput { camera: &pane.camera, background, clouds, size, tile: None };
-        crate::headless::draw_exact(&self.ctx, &mut self.renderer, &self.split[p].target.color_view, &frame);
+        crate::pictures::headless::draw_exact(&self.ctx, &mut self.renderer, &self.split[p].target.color_view, &frame);
         for (l, v) in kept.into_iter().enumerate() {
             self.renderer.layer_mut(&self.ctx, l).visible = v;
         }
@@ -1339,7 +1339,7 @@ impl Viewport {
     pub fn snapshot(&mut self, view: &ViewState, size: [u32; 2]) -> Result<image::RgbaImage, GpuError> {
         let target = OffscreenTarget::new(&self.ctx.device, size);
         // Every translucent fragment kept, as `render` draws it.
-        let (picture, _) = crate::headless::picture(
+        let (picture, _) = crate::pictures::headless::picture(
             &self.ctx,
             &mut self.renderer,
             &target,
@@ -1472,6 +1472,6 @@ fn molecular_surface_cached(
     }
     let built = cache.as_mut().expect("just built");
     let mut mesh = built.mesh.clone();
-    built.map = crate::meshes::color_surface(&mut mesh, doc, settings, selection, grid);
+    built.map = crate::evaluate::meshes::color_surface(&mut mesh, doc, settings, selection, grid);
     (Some((mesh, settings.look())), built.note.clone())
 }

@@ -1,17 +1,17 @@
 //! `orbcloud compute` and `orbcloud scan compute`: wavefunctions computed with PySCF
-//! ([`orbcloud::compute`]), written as Molden files, and a scan's manifest.
+//! ([`crate::sources::compute`]), written as Molden files, and a scan's manifest.
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
+use crate::formats::scan::Computed;
+use crate::model::scan::Coordinate;
+use crate::model::{Document, Molecule};
+use crate::sources::compute::{self, Event, FrameJob, Held, Job, Settings};
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use orbcloud::compute::{self, Event, FrameJob, Held, Job, Settings};
-use orbcloud::formats::scan::Computed;
-use orbcloud::model::scan::Coordinate;
-use orbcloud::model::{Document, Molecule};
 
-use super::scan_cli::CoordinateArgs;
+use super::scan::CoordinateArgs;
 
 /// How to compute: method, basis, charge and spin.
 #[derive(Args, Clone)]
@@ -105,7 +105,7 @@ pub struct ScanComputeArgs {
 }
 
 fn load(path: &Path) -> Result<Document> {
-    let doc = orbcloud::formats::load(path)?;
+    let doc = crate::formats::load(path)?;
     if doc.molecule.atoms.iter().any(|a| a.z == 0) {
         bail!("{}: dummy atoms or unknown elements cannot be computed", path.display());
     }
@@ -241,7 +241,7 @@ fn trajectory(doc: &Document) -> Vec<Molecule> {
                 .atoms
                 .iter()
                 .zip(positions)
-                .map(|(a, position)| orbcloud::model::Atom { position, ..a.clone() });
+                .map(|(a, position)| crate::model::Atom { position, ..a.clone() });
             Molecule { atoms: atoms.collect(), bonds: doc.molecule.bonds.clone() }
         })
         .collect()

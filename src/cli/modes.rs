@@ -5,12 +5,12 @@
 use std::io::Write;
 use std::path::PathBuf;
 
+use crate::model::Document;
+use crate::model::arrow::{Arrow, mode_arrows};
+use crate::model::units::ANGSTROM_PER_BOHR;
+use crate::model::vibrations::Vibrations;
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use orbcloud::model::Document;
-use orbcloud::model::arrow::{Arrow, mode_arrows};
-use orbcloud::model::units::ANGSTROM_PER_BOHR;
-use orbcloud::model::vibrations::Vibrations;
 
 /// Which mode to show, where in its oscillation and how far.
 #[derive(Args, Clone)]
@@ -93,7 +93,7 @@ pub struct ModesArgs {
 }
 
 pub fn write_xyz(args: &ModesArgs) -> Result<()> {
-    let doc = orbcloud::formats::load(&args.file)?;
+    let doc = crate::formats::load(&args.file)?;
     let (v, k) = chosen(&doc, args.mode)?;
     let frames = args.frames.clamp(2, 10_000);
     let file = std::fs::File::create(&args.output).with_context(|| format!("creating {}", args.output.display()))?;

@@ -4,16 +4,16 @@
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
+use crate::evaluate::meshes::molecular_surface;
+use crate::model::Document;
+use crate::model::isosurface::Mesh;
+use crate::model::surface::{self, Sphere, SurfaceParams};
+use crate::model::units::BOHR_PER_ANGSTROM;
+use crate::scene::coloring::ValueMap;
+use crate::scene::translucency::SurfaceLook;
+use crate::scene::{AtomColoring, SurfaceChoice, SurfaceSettings};
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
-use orbcloud::meshes::molecular_surface;
-use orbcloud::model::Document;
-use orbcloud::model::isosurface::Mesh;
-use orbcloud::model::surface::{self, Sphere, SurfaceParams};
-use orbcloud::model::units::BOHR_PER_ANGSTROM;
-use orbcloud::scene::coloring::ValueMap;
-use orbcloud::scene::translucency::SurfaceLook;
-use orbcloud::scene::{AtomColoring, SurfaceChoice, SurfaceSettings};
 
 #[derive(Clone, Copy, ValueEnum)]
 pub enum SurfaceArg {
@@ -102,7 +102,7 @@ impl MolSurfaceArgs {
         &self,
         doc: &Document,
         translucent: bool,
-        grid: Option<&orbcloud::model::VolumeGrid>,
+        grid: Option<&crate::model::VolumeGrid>,
     ) -> Result<Option<(Mesh, SurfaceLook, Option<ValueMap>)>> {
         let settings = self.settings(translucent);
         let t = Instant::now();
@@ -115,7 +115,7 @@ impl MolSurfaceArgs {
                 doc.source
             );
         }
-        let map = orbcloud::meshes::color_surface(&mut mesh, doc, &settings, "", grid);
+        let map = crate::evaluate::meshes::color_surface(&mut mesh, doc, &settings, "", grid);
         eprintln!(
             "{} surface: {} triangles, area {:.1} Å², volume {:.1} Å³, {:.0} ms",
             settings.choice.name(),
@@ -168,9 +168,9 @@ pub struct SurfaceBench {
 /// every triangle and with seed 002's level of detail (occlusion culled unless asked not to), and
 /// how far apart the two images are.
 pub fn bench(args: &SurfaceBench) -> Result<()> {
-    use orbcloud::gpu::{FrameInput, OffscreenTarget, Renderer};
-    use orbcloud::scene::{AtomStyle, Camera, RenderSettings};
-    let doc = orbcloud::formats::load(&args.file)?;
+    use crate::gpu::{FrameInput, OffscreenTarget, Renderer};
+    use crate::scene::{AtomStyle, Camera, RenderSettings};
+    let doc = crate::formats::load(&args.file)?;
     let spheres = Sphere::of_molecule(&doc.molecule, None);
     let kinds = match args.surface.surface {
         Some(k) => vec![k],
@@ -197,7 +197,7 @@ pub fn bench(args: &SurfaceBench) -> Result<()> {
         // Building the levels of detail (what the viewer does in the background after the
         // surface): the coarser versions and every level's octree.
         let t = Instant::now();
-        let mut levels = orbcloud::gpu::isosurface::lod_levels(&s.mesh);
+        let mut levels = crate::gpu::isosurface::lod_levels(&s.mesh);
         let levels_ms = t.elapsed().as_secs_f64() * 1e3;
         if args.no_coarser {
             levels.truncate(1);
@@ -218,7 +218,7 @@ pub fn bench(args: &SurfaceBench) -> Result<()> {
         camera.zoom(1.0 / args.zoom.max(1e-3));
         let [full, lod] = &mut renderers;
         let frames =
-            super::render_cli::time_frames_of(&ctx, &mut [full, lod], &camera, args.bench.size, args.bench.frames)?;
+            super::render::time_frames_of(&ctx, &mut [full, lod], &camera, args.bench.size, args.bench.frames)?;
         let [full_ms, lod_ms] = [0, 1].map(|k| frames[k][frames[k].len() / 2]);
         // The last frame again, into a target to read.
         let target = OffscreenTarget::new(&ctx.device, args.bench.size);
@@ -243,7 +243,7 @@ pub fn bench(args: &SurfaceBench) -> Result<()> {
             (renderer.main().surfaces.lod_stats(), renderer.main().surfaces.occlusion_stats(&ctx)?);
         // The CPU's share of a frame with the level of detail: walking the octree.
         let tree = &levels[stats.level].tree;
-        let view = orbcloud::model::octree::LodView {
+        let view = crate::model::octree::LodView {
             clip_from_object: renderer.clip_from_world(&camera, args.bench.size),
             eye: camera.eye(),
             height_px: args.bench.size[1] as f32,
@@ -259,7 +259,7 @@ pub fn bench(args: &SurfaceBench) -> Result<()> {
             })
             .collect();
         let walk_ms = walks.iter().copied().fold(f64::INFINITY, f64::min);
-        let (mean, covered) = super::surface_cli::image_error(&full, &lod, &settings.background);
+        let (mean, covered) = super::surface::image_error(&full, &lod, &settings.background);
         if let Some(dir) = &args.images {
             std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
             for (name, img) in [("full", &full), ("lod", &lod)] {

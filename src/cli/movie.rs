@@ -6,16 +6,16 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
 
+use crate::formats::scan::load_scan;
+use crate::model::Document;
+use crate::pictures::movie::{MovieFormat, MovieWriter, sweep};
+use crate::pictures::shots::{Motion, Progress, ScanShots, SceneShots, ShotError, record};
+use crate::scene::{Camera, ObjectState};
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use orbcloud::formats::scan::load_scan;
-use orbcloud::model::Document;
-use orbcloud::movie::{MovieFormat, MovieWriter, sweep};
-use orbcloud::scene::{Camera, ObjectState};
-use orbcloud::shots::{Motion, Progress, ScanShots, SceneShots, ShotError, record};
 
-use super::scan_cli::{InterpolationArg, KeyArgs, build};
-use super::{FigureArgs, ViewArgs, WavefunctionArgs, gpu, quantities_cli, surface_cli};
+use super::scan::{InterpolationArg, KeyArgs, build};
+use super::{FigureArgs, ViewArgs, WavefunctionArgs, gpu, quantities, surface};
 
 #[derive(Args)]
 pub struct MovieArgs {
@@ -55,7 +55,7 @@ pub struct MovieArgs {
     #[command(flatten)]
     wavefunction: WavefunctionArgs,
     #[command(flatten)]
-    iso: surface_cli::IsoArgs,
+    iso: surface::IsoArgs,
     /// One period of this normal mode (1-based, as `info` lists them), the atoms moving along it.
     #[arg(long)]
     normal_mode: Option<usize>,
@@ -75,7 +75,7 @@ fn is_scan(path: &Path) -> bool {
 }
 
 fn is_session(path: &Path) -> bool {
-    path.to_string_lossy().to_lowercase().ends_with(orbcloud::scene::objects::SESSION_SUFFIX)
+    path.to_string_lossy().to_lowercase().ends_with(crate::scene::objects::SESSION_SUFFIX)
 }
 
 pub fn movie(args: MovieArgs) -> Result<()> {
@@ -129,7 +129,7 @@ fn write_frames(
 fn scan_sweep(args: &MovieArgs) -> Result<(usize, f64)> {
     let file = match &args.input {
         Some(path) => load_scan(path)?,
-        None => orbcloud::demo::scan()?,
+        None => crate::sources::demo::scan()?,
     };
     let (lo, hi) = file.scan.range();
     let (from, to) = (args.from.unwrap_or(lo), args.to.unwrap_or(hi));
@@ -161,9 +161,9 @@ fn file_movie(args: &MovieArgs, scan_input: bool) -> Result<(usize, f64)> {
         let (scene, camera, background) = session_scene(input)?;
         (scene, args.view.orbit(camera), background)
     } else {
-        let mut doc = orbcloud::formats::load(input)?;
+        let mut doc = crate::formats::load(input)?;
         let camera = args.view.camera(&doc)?;
-        let mut object = quantities_cli::object_of(&doc, &args.view, &args.wavefunction, &args.iso)?;
+        let mut object = quantities::object_of(&doc, &args.view, &args.wavefunction, &args.iso)?;
         args.iso.color_object(&mut doc, &mut object)?;
         (vec![(doc, object)], camera, args.view.settings().background)
     };
@@ -189,22 +189,21 @@ type Objects = Vec<(Document, ObjectState)>;
 
 /// A session's objects (each file loaded), its camera and background.
 fn session_scene(path: &Path) -> Result<(Objects, Camera, [f32; 3])> {
-    let session = orbcloud::app::session::read(path).map_err(anyhow::Error::msg)?;
+    let session = crate::app::session::read(path).map_err(anyhow::Error::msg)?;
     let mut scene = Vec::new();
     for mut state in session.objects {
         let Some(file) = state.path.clone() else { continue };
-        let mut doc = orbcloud::formats::load(&file)
-            .with_context(|| format!("{}: opening {}", path.display(), file.display()))?;
+        let mut doc =
+            crate::formats::load(&file).with_context(|| format!("{}: opening {}", path.display(), file.display()))?;
         for added in &state.added {
-            orbcloud::app::session::add_volume(&mut doc, added)
-                .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+            crate::app::session::add_volume(&mut doc, added).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
         }
-        state.fit_to(&doc, &orbcloud::scene::RenderSettings::default());
+        state.fit_to(&doc, &crate::scene::RenderSettings::default());
         scene.push((doc, state));
     }
     if scene.is_empty() {
         bail!("{}: the session opens no files", path.display());
     }
-    let background = session.background.unwrap_or(orbcloud::scene::RenderSettings::default().background);
+    let background = session.background.unwrap_or(crate::scene::RenderSettings::default().background);
     Ok((scene, session.camera, background))
 }

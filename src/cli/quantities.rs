@@ -6,14 +6,14 @@
 
 use std::ffi::OsString;
 
+use crate::gpu::{GpuContext, OffscreenTarget, Renderer};
+use crate::layers::show_scene;
+use crate::model::Document;
+use crate::scene::{Camera, Evaluation, ObjectState, QuantityState, Source};
 use anyhow::{Result, bail};
 use clap::Parser;
-use orbcloud::gpu::{GpuContext, OffscreenTarget, Renderer};
-use orbcloud::layers::show_scene;
-use orbcloud::model::Document;
-use orbcloud::scene::{Camera, Evaluation, ObjectState, QuantityState, Source};
 
-use super::surface_cli::IsoArgs;
+use super::surface::IsoArgs;
 use super::{Cli, Command, RenderArgs, ViewArgs, WavefunctionArgs};
 
 /// The options that start a quantity.
@@ -155,7 +155,7 @@ pub fn quantity_of(
 fn bare_object(view: &ViewArgs, what: &WavefunctionArgs) -> ObjectState {
     let settings = view.settings();
     ObjectState {
-        atoms: orbcloud::scene::AtomLook::of(&settings),
+        atoms: crate::scene::AtomLook::of(&settings),
         clip: settings.clip,
         evaluation: Evaluation {
             direct: what.direct,
@@ -190,7 +190,7 @@ pub fn parse_later(later: &[Later]) -> Result<Vec<(bool, RenderArgs)>> {
 }
 
 /// The later quantities' own options, parsed as `mesh` parses them.
-pub fn parse_later_meshes(later: &[Later]) -> Result<Vec<super::surface_cli::MeshArgs>> {
+pub fn parse_later_meshes(later: &[Later]) -> Result<Vec<super::surface::MeshArgs>> {
     later
         .iter()
         .map(|l| {
@@ -247,13 +247,13 @@ pub fn render(
         let shown = show_scene(ctx, &mut renderer, &pane_scene, points)?;
         let target = OffscreenTarget::new(&ctx.device, [pane_width, height]);
         let (mut picture, _) =
-            orbcloud::headless::picture(ctx, &mut renderer, &target, camera, background, &shown.clouds)?;
+            crate::pictures::headless::picture(ctx, &mut renderer, &target, camera, background, &shown.clouds)?;
         if let Some((map, name)) = &shown.color_map {
-            orbcloud::shots::value_bar(&mut picture, map, name);
+            crate::pictures::shots::value_bar(&mut picture, map, name);
         }
         // Panes side by side say what each shows, as the window's panes do.
         if count > 1 && !first.no_captions {
-            orbcloud::figure::caption(&mut picture, 0, pane_width, &lines);
+            crate::pictures::figure::caption(&mut picture, 0, pane_width, &lines);
         }
         image::imageops::replace(&mut image, &picture, (p as u32 * pane_width) as i64, 0);
     }

@@ -4,20 +4,20 @@
 use std::path::Path;
 use std::time::Instant;
 
+use crate::gpu::GpuContext;
+use crate::model::Document;
+use crate::pictures::figure::Figure;
+use crate::pictures::headless::Headless;
+use crate::scene::coloring::ValueMap;
+use crate::scene::{Camera, RenderSettings};
+use crate::sources::demo;
 use anyhow::{Context, Result, bail};
-use orbcloud::demo;
-use orbcloud::figure::Figure;
-use orbcloud::gpu::GpuContext;
-use orbcloud::headless::Headless;
-use orbcloud::model::Document;
-use orbcloud::scene::coloring::ValueMap;
-use orbcloud::scene::{Camera, RenderSettings};
 
-use super::quantities_cli::{self, Later};
-use super::{DemoArg, RenderArgs, ViewArgs, WavefunctionArgs, gpu, load, surface_cli};
+use super::quantities::{self, Later};
+use super::{DemoArg, RenderArgs, ViewArgs, WavefunctionArgs, gpu, load, surface};
 
 /// `render`: `args`'s file (or the bundled demo) to a PNG; `later` are further quantities of the
-/// file, each with its options ([`quantities_cli`]).
+/// file, each with its options ([`quantities`]).
 pub fn render(args: RenderArgs, later: &[Later]) -> Result<()> {
     match drawing(&args, None, later)? {
         Drawing::Drawn(img, ctx) => save(&img, &args.output, &ctx),
@@ -28,7 +28,7 @@ pub fn render(args: RenderArgs, later: &[Later]) -> Result<()> {
             let img = picture.draw(&picture.camera.clone())?;
             save(&img, &args.output, &picture.ctx)?;
             if let Some(pixel) = args.pick {
-                surface_cli::print_pick(&picture.ctx, &picture.headless.renderer, &picture.doc, pixel)?;
+                surface::print_pick(&picture.ctx, &picture.headless.renderer, &picture.doc, pixel)?;
             }
             Ok(())
         }
@@ -51,7 +51,7 @@ pub fn drawing(args: &RenderArgs, doc: Option<Document>, later: &[Later]) -> Res
             let ctx = gpu(args.lavapipe)?;
             let scene = demo::cycloaddition().context("the bundled demo did not load")?;
             let background = RenderSettings::default().background;
-            let mut shown = surface_cli::SceneShown::new(&ctx, scene, &args.iso, size)?;
+            let mut shown = surface::SceneShown::new(&ctx, scene, &args.iso, size)?;
             let img = figure.draw(background, |bg| shown.draw(&ctx, bg))?;
             return Ok(Drawing::Drawn(img, Box::new(ctx)));
         }
@@ -68,13 +68,13 @@ pub fn drawing(args: &RenderArgs, doc: Option<Document>, later: &[Later]) -> Res
     args.vibration.apply(&mut doc)?;
     args.view.volume_index(&doc)?;
     if !later.is_empty() {
-        let later = quantities_cli::parse_later(later)?;
+        let later = quantities::parse_later(later)?;
         if args.pick.is_some() {
             bail!("--pick reads one quantity's picture: give one quantity option");
         }
         let ctx = gpu(args.lavapipe)?;
         let background = RenderSettings::default().background;
-        let img = figure.draw(background, |bg| quantities_cli::render(&ctx, &doc, args, &later, &camera, size, bg))?;
+        let img = figure.draw(background, |bg| quantities::render(&ctx, &doc, args, &later, &camera, size, bg))?;
         return Ok(Drawing::Drawn(img, Box::new(ctx)));
     }
     if args.pick.is_some() && figure != Figure::default() {
@@ -118,15 +118,15 @@ impl Picture {
         let grid = computed.as_ref().and_then(|v| v.grid.as_ref()).or(volume.and_then(|i| doc.volumes.get(i)));
         match (&computed, grid) {
             (Some(values), _) => values.auto_opacity(&mut settings.volume),
-            (None, Some(grid)) => orbcloud::evaluate::auto_opacity(&mut settings.volume, grid),
+            (None, Some(grid)) => crate::evaluate::auto_opacity(&mut settings.volume, grid),
             (None, None) => {}
         }
         let molsurface = args.molsurface.mesh(&doc, args.iso.translucent, grid)?;
         let map = molsurface.as_ref().and_then(|(_, _, map)| *map);
         let meshes = molsurface.into_iter().map(|(mesh, look, _)| (mesh, look)).collect();
-        let (colored, said) = surface_cli::show(&ctx, &mut h.renderer, (grid, &doc), &args.iso, color, meshes);
+        let (colored, said) = surface::show(&ctx, &mut h.renderer, (grid, &doc), &args.iso, color, meshes);
         let arrows = args.vibration.arrows(&doc)?;
-        h.renderer.main().arrows.set_arrows(&ctx, &arrows, orbcloud::scene::vibration::ARROW_COLOR);
+        h.renderer.main().arrows.set_arrows(&ctx, &arrows, crate::scene::vibration::ARROW_COLOR);
         let bar = match colored {
             Some(c) => Some((c.map, c.name)),
             None => map.zip(grid.map(|g| g.label.clone())),
@@ -142,7 +142,7 @@ impl Picture {
             headless.render(ctx, camera, &settings)
         })?;
         if let Some((map, name)) = &self.bar {
-            orbcloud::shots::value_bar(&mut img, map, name);
+            crate::pictures::shots::value_bar(&mut img, map, name);
         }
         Ok(img)
     }
@@ -243,7 +243,7 @@ pub fn bench(
 /// warm-up frames; sorted.
 pub fn time_frames(
     ctx: &GpuContext,
-    renderer: &mut orbcloud::gpu::Renderer,
+    renderer: &mut crate::gpu::Renderer,
     camera: &Camera,
     size: [u32; 2],
     frames: u32,
@@ -255,12 +255,12 @@ pub fn time_frames(
 /// speed drifts slows them alike: one sorted list per renderer.
 pub fn time_frames_of(
     ctx: &GpuContext,
-    renderers: &mut [&mut orbcloud::gpu::Renderer],
+    renderers: &mut [&mut crate::gpu::Renderer],
     camera: &Camera,
     size: [u32; 2],
     frames: u32,
 ) -> Result<Vec<Vec<f64>>> {
-    let target = orbcloud::gpu::OffscreenTarget::new(&ctx.device, size);
+    let target = crate::gpu::OffscreenTarget::new(&ctx.device, size);
     let settings = RenderSettings::default();
     let mut times = vec![Vec::new(); renderers.len()];
     for f in 0..frames.max(1) + 2 {
@@ -273,7 +273,7 @@ pub fn time_frames_of(
                 ctx,
                 &mut encoder,
                 &target.color_view,
-                &orbcloud::gpu::FrameInput::single(&cam, &settings, size),
+                &crate::gpu::FrameInput::single(&cam, &settings, size),
             );
             ctx.queue.submit([encoder.finish()]);
             ctx.device.poll(wgpu::PollType::wait_indefinitely())?;

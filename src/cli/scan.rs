@@ -3,17 +3,17 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
+use crate::formats::cube_write;
+use crate::formats::scan::{Follow, ScanFile, init, load_scan};
+use crate::gpu::volume::{VolumeTexture, residency_budget, texel_bytes};
+use crate::gpu::{GpuContext, OffscreenTarget, Renderer};
+use crate::layers::key_volumes::{DEFAULT_SCAN_POINTS, KeyOptions, ScanScene};
+use crate::model::VolumeGrid;
+use crate::model::scan::{Coordinate, Scan};
+use crate::pictures::shots::ScanShots;
+use crate::scene::Interpolation;
 use anyhow::{Context, Result, bail};
 use clap::{Args, Subcommand, ValueEnum};
-use orbcloud::formats::cube_write;
-use orbcloud::formats::scan::{Follow, ScanFile, init, load_scan};
-use orbcloud::gpu::volume::{VolumeTexture, residency_budget, texel_bytes};
-use orbcloud::gpu::{GpuContext, OffscreenTarget, Renderer};
-use orbcloud::key_volumes::{DEFAULT_SCAN_POINTS, KeyOptions, ScanScene};
-use orbcloud::model::VolumeGrid;
-use orbcloud::model::scan::{Coordinate, Scan};
-use orbcloud::scene::Interpolation;
-use orbcloud::shots::ScanShots;
 
 use super::{FigureArgs, ViewArgs, gpu};
 
@@ -22,7 +22,7 @@ pub enum ScanCommand {
     /// Compute a scan with PySCF: one Molden file per value of a distance, angle or dihedral
     /// (rigid, or --relaxed), or per frame of a trajectory (--frames), and its manifest.
     /// Rerun into the same directory to resume.
-    Compute(Box<super::compute_cli::ScanComputeArgs>),
+    Compute(Box<super::compute::ScanComputeArgs>),
     /// Write DIR/<name>.scan.toml from a directory of Molden/fchk files, one per point of a
     /// scan: a bond length, a bond angle, a dihedral, or a path (an IRC, a relaxed scan).
     Init {
@@ -226,7 +226,7 @@ fn check_angle(scan: &Scan, at: f64) -> Result<()> {
 
 pub fn run(command: ScanCommand) -> Result<()> {
     match command {
-        ScanCommand::Compute(args) => super::compute_cli::scan_compute(*args),
+        ScanCommand::Compute(args) => super::compute::scan_compute(*args),
         ScanCommand::Init { dir, coordinate, path, dry_run } => {
             let chosen = coordinate.coordinate().or(path.then_some(Coordinate::Path));
             let made = init(&dir, chosen)?;
@@ -252,7 +252,7 @@ pub fn run(command: ScanCommand) -> Result<()> {
             let file = load_scan(&scan)?;
             if csv {
                 let s = &file.scan;
-                let diagram = orbcloud::model::correlation::correlation(s, window, window)
+                let diagram = crate::model::correlation::correlation(s, window, window)
                     .context("a correlation diagram needs Molden/fchk frames with orbital energies")?;
                 let unit = match s.coordinate.unit().trim() {
                     "" => String::new(),
@@ -336,7 +336,7 @@ pub fn run(command: ScanCommand) -> Result<()> {
             let slot = slot_of(s, &orbital)?;
             check_angle(s, angle)?;
             let tracks = s.track(follow)?;
-            let grid = s.key_grid(&tracks, orbcloud::scene::framing::ORBITAL_MARGIN, keys.points.clamp(8, 512));
+            let grid = s.key_grid(&tracks, crate::scene::framing::ORBITAL_MARGIN, keys.points.clamp(8, 512));
             let label = format!("{orbital} at {} (interpolated)", s.coordinate.value_text(angle));
             let volume = s.interpolated_grid(&tracks, slot, angle, &grid, &label);
             let molecule = s.geometry_at(angle);
@@ -367,7 +367,7 @@ pub struct KeyVolumeBench {
     #[arg(long, default_value = "400x300", value_parser = super::parse_size)]
     size: [u32; 2],
     /// View-aligned slices per frame (the viewer draws 64 at most while θ is dragged).
-    #[arg(long, default_value_t = orbcloud::scene::RenderSettings::default().volume.slices)]
+    #[arg(long, default_value_t = crate::scene::RenderSettings::default().volume.slices)]
     slices: u32,
     #[arg(long)]
     lavapipe: bool,
@@ -377,11 +377,11 @@ pub fn bench_keyvolumes(args: KeyVolumeBench) -> Result<()> {
     let ctx = gpu(args.lavapipe)?;
     let file = match &args.scan {
         Some(path) => load_scan(path)?,
-        None => orbcloud::demo::scan()?,
+        None => crate::sources::demo::scan()?,
     };
     let s = &file.scan;
     let tracks = s.track(file.follow)?;
-    let grid = s.key_grid(&tracks, orbcloud::scene::framing::ORBITAL_MARGIN, args.points.clamp(8, 512));
+    let grid = s.key_grid(&tracks, crate::scene::framing::ORBITAL_MARGIN, args.points.clamp(8, 512));
     // The real key volumes of the first orbital, cycled to make K distinct textures.
     let sources: Vec<VolumeGrid> = (0..s.frames.len())
         .map(|f| {
@@ -401,10 +401,10 @@ pub fn bench_keyvolumes(args: KeyVolumeBench) -> Result<()> {
         ctx.device.limits().max_buffer_size >> 20,
         budget / per_volume
     );
-    let mut settings = orbcloud::scene::RenderSettings::default();
+    let mut settings = crate::scene::RenderSettings::default();
     settings.volume.slices = args.slices.clamp(1, 4096);
     let (lo, hi) = grid.bounds();
-    let camera = orbcloud::scene::Camera::framing(lo.as_vec3(), hi.as_vec3());
+    let camera = crate::scene::Camera::framing(lo.as_vec3(), hi.as_vec3());
     let molecule = s.geometry_at(s.frames[0].at);
     let target = OffscreenTarget::new(&ctx.device, args.size);
     println!(
@@ -439,7 +439,7 @@ pub fn bench_keyvolumes(args: KeyVolumeBench) -> Result<()> {
                 let t = Instant::now();
                 let mut encoder =
                     ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("bench") });
-                let frame = orbcloud::gpu::FrameInput::single(&camera, &settings, args.size);
+                let frame = crate::gpu::FrameInput::single(&camera, &settings, args.size);
                 renderer.render(&ctx, &mut encoder, &target.color_view, &frame);
                 ctx.queue.submit([encoder.finish()]);
                 ctx.device.poll(wgpu::PollType::wait_indefinitely())?;

@@ -3,9 +3,9 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
+use crate::formats;
 use anyhow::Result;
 use clap::Args;
-use orbcloud::formats;
 
 #[derive(Args)]
 pub struct LoadBench {
@@ -64,7 +64,7 @@ pub struct SpheresBench {
     pub style: super::AtomsArg,
     /// Spheres up to this projected radius (pixels) are rasterised in compute; 0 draws every
     /// sphere as an impostor quad.
-    #[arg(long, default_value_t = orbcloud::gpu::atoms::SPLAT_RADIUS_PX)]
+    #[arg(long, default_value_t = crate::gpu::atoms::SPLAT_RADIUS_PX)]
     pub splat_px: f32,
     #[command(flatten)]
     bench: super::BenchFrames,
@@ -73,14 +73,14 @@ pub struct SpheresBench {
 /// Prints ms per frame of atoms alone, the whole structure in view and turning a little each
 /// frame as in the viewer, and the GPU memory per atom.
 pub fn bench_spheres(args: &SpheresBench) -> Result<()> {
-    use orbcloud::gpu::Renderer;
-    use orbcloud::scene::Camera;
+    use crate::gpu::Renderer;
+    use crate::scene::Camera;
     let (molecule, what) = match &args.file {
         Some(path) => {
             let doc = formats::load(path)?;
             (doc.molecule, path.display().to_string())
         }
-        None => (orbcloud::model::synthetic::atom_box(args.atoms), "synthetic protein-dense box".to_string()),
+        None => (crate::model::synthetic::atom_box(args.atoms), "synthetic protein-dense box".to_string()),
     };
     let Some((lo, hi)) = molecule.bounds() else { anyhow::bail!("{what}: no atoms to draw") };
     let ctx = super::gpu(args.bench.lavapipe)?;
@@ -90,7 +90,7 @@ pub fn bench_spheres(args: &SpheresBench) -> Result<()> {
     renderer.main().atoms.splat_radius_px = args.splat_px;
     let gpu_bytes = renderer.main().atoms.gpu_bytes();
     let camera = Camera::framing(lo.as_vec3(), hi.as_vec3());
-    let times = super::render_cli::time_frames(&ctx, &mut renderer, &camera, args.bench.size, args.bench.frames)?;
+    let times = super::render::time_frames(&ctx, &mut renderer, &camera, args.bench.size, args.bench.frames)?;
     let n = molecule.atoms.len();
     println!("adapter: {}", ctx.describe());
     println!(

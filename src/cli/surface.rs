@@ -4,23 +4,23 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
+use crate::evaluate::meshes::{color_meshes, color_name, isosurfaces, values_on};
+use crate::evaluate::orbital_geometry;
+use crate::formats::mesh_write::{self, MeshFormat, NamedMesh};
+use crate::gpu::frame::PickId;
+use crate::gpu::{GpuContext, Renderer};
+use crate::layers::show_meshes;
+use crate::model::gto::PreparedBasis;
+use crate::model::isosurface::{self, Level, Mesh};
+use crate::model::orbitals::{OrbitalSpec, Quantity, Spin};
+use crate::model::units::BOHR_PER_ANGSTROM;
+use crate::model::{Document, VolumeGrid};
+use crate::scene::Source;
+use crate::scene::coloring::ValueMap;
+use crate::scene::translucency::{OpticsTuning, SurfaceLook};
+use crate::scene::{IsoLevel, IsosurfaceSettings, OpticsPreset};
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
-use orbcloud::evaluate::orbital_geometry;
-use orbcloud::formats::mesh_write::{self, MeshFormat, NamedMesh};
-use orbcloud::gpu::frame::PickId;
-use orbcloud::gpu::{GpuContext, Renderer};
-use orbcloud::layers::show_meshes;
-use orbcloud::meshes::{color_meshes, color_name, isosurfaces, values_on};
-use orbcloud::model::gto::PreparedBasis;
-use orbcloud::model::isosurface::{self, Level, Mesh};
-use orbcloud::model::orbitals::{OrbitalSpec, Quantity, Spin};
-use orbcloud::model::units::BOHR_PER_ANGSTROM;
-use orbcloud::model::{Document, VolumeGrid};
-use orbcloud::scene::Source;
-use orbcloud::scene::coloring::ValueMap;
-use orbcloud::scene::translucency::{OpticsTuning, SurfaceLook};
-use orbcloud::scene::{IsoLevel, IsosurfaceSettings, OpticsPreset};
 
 use super::{WhatArgs, load, wavefunction_of};
 
@@ -100,7 +100,7 @@ impl IsoArgs {
 
     /// Every isosurface of `object` coloured by what `--color-by` names (a cube file's data set
     /// joins `doc`), saturating at `--color-range`.
-    pub fn color_object(&self, doc: &mut Document, object: &mut orbcloud::scene::ObjectState) -> Result<()> {
+    pub fn color_object(&self, doc: &mut Document, object: &mut crate::scene::ObjectState) -> Result<()> {
         let Some(source) = self.color_source(doc)? else { return Ok(()) };
         for iso in object.quantities.iter_mut().flat_map(|q| &mut q.isosurfaces) {
             (iso.color_by, iso.color_range) = (Some(source), self.color_range.map(|r| r as f32));
@@ -166,7 +166,7 @@ impl IsoArgs {
 
     /// Puts these levels (when any were given) in place of a quantity's isosurfaces, drawn as
     /// its first one is and told apart by colour ([`IsosurfaceSettings::nested`]).
-    pub fn apply_to(&self, quantity: &mut orbcloud::scene::QuantityState) {
+    pub fn apply_to(&self, quantity: &mut crate::scene::QuantityState) {
         let mut levels = self.levels();
         if levels.is_empty() {
             return;
@@ -218,7 +218,7 @@ impl IsoArgs {
         stem: Option<&str>,
     ) -> Vec<(String, Mesh, SurfaceLook)> {
         let sigma = grid.stats.sigma;
-        let signed = grid.kind == orbcloud::model::grid::ValueKind::Signed;
+        let signed = grid.kind == crate::model::grid::ValueKind::Signed;
         let mut levels = self.levels();
         levels.sort_by(|a, b| a.value(sigma).total_cmp(&b.value(sigma)));
         levels.dedup_by(|a, b| a.value(sigma) == b.value(sigma));
@@ -346,14 +346,14 @@ pub struct MeshArgs {
     #[command(flatten)]
     grid: GridArgs,
     #[command(flatten)]
-    molsurface: super::molsurface_cli::MolSurfaceArgs,
+    molsurface: super::molsurface::MolSurfaceArgs,
     /// Output: .obj (Wavefront), .ply (binary) or .glb (glTF binary); positions in ångström.
     #[arg(short, long)]
     output: PathBuf,
 }
 
 /// Writes the surfaces `args` asks for; `later` are further quantities of the same file
-/// ([`super::quantities_cli`]), each with its own levels, their surfaces named after them.
+/// ([`super::quantities`]), each with its own levels, their surfaces named after them.
 pub fn mesh(args: &MeshArgs, later: &[MeshArgs]) -> Result<()> {
     let format = MeshFormat::from_path(&args.output)
         .with_context(|| format!("{}: the extension must be .obj, .ply or .glb", args.output.display()))?;
@@ -366,7 +366,7 @@ pub fn mesh(args: &MeshArgs, later: &[MeshArgs]) -> Result<()> {
     let mut doc = load(Some(&args.file))?;
     let color = args.iso.color_source(&mut doc)?;
     let (meshes, names) = if args.molsurface.surface.is_some() {
-        let by_volume = matches!(args.molsurface.surface_color, super::molsurface_cli::SurfaceColorArg::Volume);
+        let by_volume = matches!(args.molsurface.surface_color, super::molsurface::SurfaceColorArg::Volume);
         let grid = by_volume.then(|| args.grid.grid(&doc)).transpose()?;
         let built = args.molsurface.mesh(&doc, false, grid.as_ref())?;
         (built.into_iter().map(|(mesh, look, _)| (mesh, look)).collect(), vec![args.molsurface.name().to_string()])
@@ -445,7 +445,7 @@ pub fn bench(args: &IsoBench) -> Result<()> {
     let doc = load(Some(&args.file))?;
     let grid = args.grid.grid(&doc)?;
     let level = args.iso.levels().first().copied().unwrap_or(IsoLevel::Absolute(0.05));
-    let levels = Level::pair(level.value(grid.stats.sigma), grid.kind == orbcloud::model::grid::ValueKind::Signed);
+    let levels = Level::pair(level.value(grid.stats.sigma), grid.kind == crate::model::grid::ValueKind::Signed);
     let mut times = Vec::new();
     let mut meshes = isosurface::extract(&grid, &levels);
     for _ in 0..args.runs.max(1) {
@@ -490,18 +490,18 @@ pub struct TranslucentBench {
 struct Timed {
     ms: f64,
     image: image::RgbaImage,
-    stats: Option<orbcloud::gpu::oit::FragmentStats>,
+    stats: Option<crate::gpu::oit::FragmentStats>,
 }
 
 /// `orbcloud bench surfaces`: ms per frame of 2, 4 and 16 translucent surfaces (nested ± shells
 /// of an orbital) in exact order and with weighted blending, the fragment memory, and how far
 /// weighted blending's image is from the exact one.
 pub fn bench_translucent(args: &TranslucentBench) -> Result<()> {
-    use orbcloud::gpu::oit::Transparency;
-    use orbcloud::gpu::{FrameInput, OffscreenTarget};
-    use orbcloud::headless::draw_exact;
-    use orbcloud::scene::RenderSettings;
-    use orbcloud::scene::framing::default_camera;
+    use crate::gpu::oit::Transparency;
+    use crate::gpu::{FrameInput, OffscreenTarget};
+    use crate::pictures::headless::draw_exact;
+    use crate::scene::RenderSettings;
+    use crate::scene::framing::default_camera;
     let doc = load(args.file.as_deref())?;
     let grid = doc.volumes.first().context("the file has no volume")?;
     let ctx = super::gpu(args.bench.lavapipe)?;
@@ -524,7 +524,7 @@ pub fn bench_translucent(args: &TranslucentBench) -> Result<()> {
         };
         let meshes = iso.meshes(grid, &iso.base());
         let triangles: usize = meshes.iter().map(|(m, _)| m.triangle_count()).sum();
-        let mut h = orbcloud::headless::Headless::new(&ctx, &doc, None, &settings, args.bench.size)?;
+        let mut h = crate::pictures::headless::Headless::new(&ctx, &doc, None, &settings, args.bench.size)?;
         show_meshes(&ctx, h.renderer.main(), &meshes);
         let target = OffscreenTarget::new(&ctx.device, args.bench.size);
         let mut time = |transparency| -> Result<Timed> {
@@ -567,7 +567,7 @@ pub fn bench_translucent(args: &TranslucentBench) -> Result<()> {
             stats.needed,
             stats.bands,
             stats.deep_pixels,
-            (heads + stats.needed as u64 * orbcloud::gpu::oit::NODE_BYTES) as f64 / (1u64 << 20) as f64,
+            (heads + stats.needed as u64 * crate::gpu::oit::NODE_BYTES) as f64 / (1u64 << 20) as f64,
             (heads + stats.node_bytes()) as f64 / (1u64 << 20) as f64,
         );
     }
@@ -593,20 +593,20 @@ pub fn image_error(a: &image::RgbaImage, b: &image::RgbaImage, background: &[f32
 }
 
 /// A scene of several objects (a bundled demo) shown in a renderer, framed as the demo's view
-/// ([`orbcloud::demo::CYCLOADDITION_VIEW`]). `--iso` values, when given, replace each object's
+/// ([`crate::sources::demo::CYCLOADDITION_VIEW`]). `--iso` values, when given, replace each object's
 /// isosurface levels (drawn as its first isosurface is, told apart by colour).
 pub struct SceneShown {
     renderer: Renderer,
-    clouds: Vec<orbcloud::scene::VolumeSettings>,
-    color_map: Option<(orbcloud::scene::coloring::ValueMap, String)>,
-    camera: orbcloud::scene::Camera,
-    target: orbcloud::gpu::OffscreenTarget,
+    clouds: Vec<crate::scene::VolumeSettings>,
+    color_map: Option<(crate::scene::coloring::ValueMap, String)>,
+    camera: crate::scene::Camera,
+    target: crate::gpu::OffscreenTarget,
 }
 
 impl SceneShown {
     pub fn new(
         ctx: &GpuContext,
-        mut scene: Vec<(Document, orbcloud::scene::ObjectState)>,
+        mut scene: Vec<(Document, crate::scene::ObjectState)>,
         iso: &IsoArgs,
         size: [u32; 2],
     ) -> Result<Self> {
@@ -614,22 +614,28 @@ impl SceneShown {
             state.quantities.iter_mut().for_each(|q| iso.apply_to(q));
         }
         let mut renderer = Renderer::new(ctx);
-        let shown = orbcloud::layers::show_scene(ctx, &mut renderer, &scene, 64)?;
+        let shown = crate::layers::show_scene(ctx, &mut renderer, &scene, 64)?;
         let (clouds, color_map) = (shown.clouds, shown.color_map);
         let (lo, hi) = shown.bounds.context("the scene is empty")?;
-        let mut camera = orbcloud::scene::Camera::framing(lo.as_vec3(), hi.as_vec3());
-        let (yaw, pitch) = orbcloud::demo::CYCLOADDITION_VIEW;
+        let mut camera = crate::scene::Camera::framing(lo.as_vec3(), hi.as_vec3());
+        let (yaw, pitch) = crate::sources::demo::CYCLOADDITION_VIEW;
         camera.orbit(yaw, pitch);
-        let target = orbcloud::gpu::OffscreenTarget::new(&ctx.device, size);
+        let target = crate::gpu::OffscreenTarget::new(&ctx.device, size);
         Ok(Self { renderer, clouds, color_map, camera, target })
     }
 
     /// The picture over `background`.
     pub fn draw(&mut self, ctx: &GpuContext, background: [f32; 3]) -> Result<image::RgbaImage> {
-        let (mut img, stats) =
-            orbcloud::headless::picture(ctx, &mut self.renderer, &self.target, &self.camera, background, &self.clouds)?;
+        let (mut img, stats) = crate::pictures::headless::picture(
+            ctx,
+            &mut self.renderer,
+            &self.target,
+            &self.camera,
+            background,
+            &self.clouds,
+        )?;
         if let Some((map, name)) = &self.color_map {
-            orbcloud::shots::value_bar(&mut img, map, name);
+            crate::pictures::shots::value_bar(&mut img, map, name);
         }
         if let Some(s) = stats {
             eprintln!("translucent surfaces: {} fragments in {} band(s), exact order", s.needed, s.bands);

@@ -4,14 +4,14 @@
 use std::path::Path;
 use std::time::Instant;
 
+use super::info;
+use crate::formats::{self, cube_write};
+use crate::model::gto::PreparedBasis;
+use crate::model::orbitals::Quantity;
+use crate::model::{GridSpec, VolumeGrid};
+use crate::scene::Source;
 use anyhow::{Context, Result, bail};
 use glam::DVec3;
-use orbcloud::formats::{self, cube_write};
-use orbcloud::info;
-use orbcloud::model::gto::PreparedBasis;
-use orbcloud::model::orbitals::Quantity;
-use orbcloud::model::{GridSpec, VolumeGrid};
-use orbcloud::scene::Source;
 
 use super::{WhatArgs, wavefunction_of};
 
@@ -62,7 +62,7 @@ pub fn cube(
     let q = what.resolve(&doc)?;
     let (lo, hi) = match margin {
         Some(m) => doc.molecule.bounds().map(|(lo, hi)| (lo - DVec3::splat(m), hi + DVec3::splat(m))),
-        None => orbcloud::model::extent::quantity_box(wf, &doc.molecule, q),
+        None => crate::model::extent::quantity_box(wf, &doc.molecule, q),
     }
     .ok_or_else(|| anyhow::anyhow!("{}: no atoms", doc.source))?;
     let spec = match spacing {
@@ -80,7 +80,7 @@ pub fn cube(
     let mut values = prepared.quantity_grid_f32(wf, &doc.molecule, q, &spec);
     let mut label = what.label(&q, &doc);
     if let Some(other) = minus {
-        let points = orbcloud::arithmetic::grid_points(dims, |i, j, k| spec.point(i, j, k));
+        let points = crate::evaluate::arithmetic::grid_points(dims, |i, j, k| spec.point(i, j, k));
         for (v, o) in values.iter_mut().zip(other_values(other, what, &points)?) {
             *v -= o as f32;
         }
@@ -111,7 +111,7 @@ fn other_values(other: &Path, what: &WhatArgs, points: &[DVec3]) -> Result<Vec<f
         None if doc.volumes.is_empty() => bail!("{}: no wavefunction and no data set to subtract", doc.source),
         None => Source::Volume(0),
     };
-    let (values, outside) = orbcloud::arithmetic::values_of(&doc, source, points).map_err(anyhow::Error::msg)?;
+    let (values, outside) = crate::evaluate::arithmetic::values_of(&doc, source, points).map_err(anyhow::Error::msg)?;
     if outside > 0 {
         eprintln!(
             "{}: {outside} of {} points lie outside its grid; its value there is taken as 0",

@@ -6,6 +6,7 @@
 //! the renderer opens that phase's render pass. Adding one means adding a drawer, not editing the
 //! frame.
 
+use super::target::target_texture;
 use super::{DEPTH_FORMAT, SCENE_FORMAT};
 
 /// Per-pixel object ids for picking (0: nothing).
@@ -313,26 +314,6 @@ impl FrameTargets {
             multiview_mask: None,
         })
     }
-}
-
-/// A 2D target of the frame's `size` in `format`, renderable and usable as `usage` says.
-pub fn target_texture(
-    device: &wgpu::Device,
-    label: &str,
-    size: [u32; 2],
-    format: wgpu::TextureFormat,
-    usage: wgpu::TextureUsages,
-) -> wgpu::Texture {
-    device.create_texture(&wgpu::TextureDescriptor {
-        label: Some(label),
-        size: wgpu::Extent3d { width: size[0], height: size[1], depth_or_array_layers: 1 },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | usage,
-        view_formats: &[],
-    })
 }
 
 /// The colour targets of a pipeline drawing in [`Phase::Opaque`]: scene colour, then ids.

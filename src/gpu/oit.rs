@@ -357,7 +357,7 @@ impl FragmentLists {
         let layout = &self.weighted_layout;
         self.weighted.get_or_insert_with(|| {
             let texture = |label, format| {
-                super::frame::target_texture(&ctx.device, label, size, format, wgpu::TextureUsages::TEXTURE_BINDING)
+                super::target::target_texture(&ctx.device, label, size, format, wgpu::TextureUsages::TEXTURE_BINDING)
                     .create_view(&Default::default())
             };
             let accum = texture("weighted colour", ACCUM_FORMAT);

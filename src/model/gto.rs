@@ -31,9 +31,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::basis::{Basis, ShellKind, cartesian_powers, n_cartesian};
-use super::molecule::Molecule;
 use super::orbitals::{Quantity, Spin, Wavefunction};
-use super::separable;
 use super::solid_harmonics::{cart_to_pure, component_factor, double_factorial_m1};
 
 /// Default absolute cutoff threshold for basis-function values (bohr^−3/2).
@@ -364,7 +362,7 @@ impl PreparedBasis {
     /// An orbital, a bare basis function, the total density or the spin density of `wf` at each
     /// of `points` (what [`Self::orbital_value`], [`Self::density`]… give), one scratch for all;
     /// NaN for the potential, which needs the nuclei ([`Self::quantity_at_points`]).
-    fn quantity_at(&self, wf: &Wavefunction, quantity: Quantity, points: &[DVec3]) -> Vec<f64> {
+    pub(super) fn quantity_at(&self, wf: &Wavefunction, quantity: Quantity, points: &[DVec3]) -> Vec<f64> {
         let mut values = vec![0.0; self.n_functions];
         let (mut c, mut cg) = (Vec::new(), Vec::new());
         points
@@ -439,103 +437,6 @@ impl PreparedBasis {
             active[si] = out.iter().any(|v| *v != 0.0);
         }
         (d, active)
-    }
-
-    /// An orbital (or any combination of basis functions) on a grid, cube order.
-    pub fn eval_grid(&self, coefficients: &[f64], grid: &GridSpec) -> Vec<f64> {
-        self.grid_sum(&[(coefficients, 1.0)], false, grid)
-    }
-
-    /// As [`Self::eval_grid`], stored as f32 (what [`super::VolumeGrid`] holds).
-    pub fn eval_grid_f32(&self, coefficients: &[f64], grid: &GridSpec) -> Vec<f32> {
-        if separable::is_axis_aligned(grid) {
-            return separable::grid_sum(self, &[(coefficients, 1.0)], false, grid);
-        }
-        self.eval_grid(coefficients, grid).into_iter().map(|v| v as f32).collect()
-    }
-
-    /// Only the basis functions in `subset` of an orbital, on a grid.
-    pub fn eval_grid_subset(&self, coefficients: &[f64], subset: &[usize], grid: &GridSpec) -> Vec<f64> {
-        self.eval_grid(&self.masked_coefficients(coefficients, subset), grid)
-    }
-
-    /// Electron density on a grid.
-    pub fn density_grid(&self, wf: &Wavefunction, grid: &GridSpec) -> Vec<f64> {
-        let sets: Vec<(&[f64], f64)> = wf
-            .orbitals
-            .iter()
-            .filter(|o| o.occupation != 0.0)
-            .map(|o| (o.coefficients.as_slice(), o.occupation))
-            .collect();
-        self.grid_sum(&sets, true, grid)
-    }
-
-    /// `quantity` at each of `points` (bohr), in parallel: what `eval` prints and what colours a
-    /// surface by a wavefunction's quantity.
-    pub fn quantity_at_points(
-        &self,
-        wf: &Wavefunction,
-        molecule: &Molecule,
-        quantity: Quantity,
-        points: &[DVec3],
-    ) -> Vec<f64> {
-        if quantity == Quantity::Potential {
-            return super::esp::Potential::new(molecule, wf).at_points(points);
-        }
-        points.par_chunks(1024).flat_map_iter(|chunk| self.quantity_at(wf, quantity, chunk)).collect()
-    }
-
-    /// An orbital, the total density, the spin density or the electrostatic potential (of
-    /// `molecule`'s nuclei and `wf`'s electrons) on a grid.
-    pub fn quantity_grid(
-        &self,
-        wf: &Wavefunction,
-        molecule: &Molecule,
-        quantity: Quantity,
-        grid: &GridSpec,
-    ) -> Vec<f64> {
-        match quantity {
-            Quantity::Potential => super::esp::Potential::new(molecule, wf).on_grid(grid),
-            Quantity::Orbital(i) => self.eval_grid(&wf.orbitals[i].coefficients, grid),
-            Quantity::BasisFunction(k) => self.eval_grid(&self.unit_coefficients(k), grid),
-            Quantity::Density => self.density_grid(wf, grid),
-            Quantity::SpinDensity => self.spin_density_grid(wf, grid),
-        }
-    }
-
-    /// [`Self::quantity_grid`] in single precision (an orbital evaluated straight to f32).
-    pub fn quantity_grid_f32(
-        &self,
-        wf: &Wavefunction,
-        molecule: &Molecule,
-        quantity: Quantity,
-        grid: &GridSpec,
-    ) -> Vec<f32> {
-        match quantity {
-            Quantity::Orbital(i) => self.eval_grid_f32(&wf.orbitals[i].coefficients, grid),
-            Quantity::BasisFunction(k) => self.eval_grid_f32(&self.unit_coefficients(k), grid),
-            _ => self.quantity_grid(wf, molecule, quantity, grid).iter().map(|&v| v as f32).collect(),
-        }
-    }
-
-    /// Spin density on a grid.
-    pub fn spin_density_grid(&self, wf: &Wavefunction, grid: &GridSpec) -> Vec<f64> {
-        let sets: Vec<(&[f64], f64)> = wf
-            .orbitals
-            .iter()
-            .map(|o| (o.coefficients.as_slice(), spin_weight(wf, o.occupation, o.spin)))
-            .filter(|(_, w)| *w != 0.0)
-            .collect();
-        self.grid_sum(&sets, true, grid)
-    }
-
-    /// Σ_s w_s ψ_s (or Σ_s w_s ψ_s² when `square`) on a grid: separated along the axes when
-    /// the grid's steps run along them ([`separable`]), row by row otherwise.
-    fn grid_sum(&self, sets: &[(&[f64], f64)], square: bool, grid: &GridSpec) -> Vec<f64> {
-        if separable::is_axis_aligned(grid) {
-            return separable::grid_sum(self, sets, square, grid);
-        }
-        self.grid_sum_rows(sets, square, grid)
     }
 
     /// [`Self::grid_sum`] on any grid, row by row.

@@ -17,6 +17,7 @@ pub mod eigen;
 mod element_table;
 pub mod elements;
 pub mod esp;
+mod evaluation;
 pub mod extent;
 pub mod grid;
 pub mod gto;

@@ -24,7 +24,7 @@ use crate::model::scan::{Coordinate, ScanError, rigid_frames, wrap_degrees};
 use crate::model::units::ANGSTROM_PER_BOHR;
 
 /// The Python side: a module of the `orbcloud` package and the script the commands run.
-pub const SCRIPT: &str = include_str!("../python/orbcloud/_compute.py");
+pub const SCRIPT: &str = include_str!("../../python/orbcloud/_compute.py");
 
 /// What every computing error that lacks a package tells the user to install.
 pub const INSTALL: &str = "pip install pyscf geometric 'dask[distributed]'";

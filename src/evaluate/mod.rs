@@ -3,6 +3,9 @@
 //! orbital's range measured from CPU samples, a grid filled only when isosurfaces want one), on
 //! grids the device holds; and the opacity a cloud of the values starts with.
 
+pub mod arithmetic;
+pub mod meshes;
+
 use crate::gpu::gto::{GtoFillPass, read_volume, volume_from_texture};
 use crate::gpu::renderer::Layer;
 use crate::gpu::volume::VolumeTexture;

@@ -10,7 +10,7 @@ use crate::model::orbitals::{Quantity, Spin};
 use crate::scene::{IsoLevel, IsosurfaceSettings, ObjectState, OpticsPreset, QuantityState, Source, VolumeSettings};
 
 /// Formaldehyde's HOMO on a 48³ grid, written by scripts/make_assets.py (PySCF).
-const DEMO_CUBE_GZ: &[u8] = include_bytes!("../assets/demo.cube.gz");
+const DEMO_CUBE_GZ: &[u8] = include_bytes!("../../assets/demo.cube.gz");
 pub const DEMO_NAME: &str = "demo.cube.gz (formaldehyde HOMO, bundled)";
 
 pub fn document() -> Result<Document, LoadError> {
@@ -23,11 +23,11 @@ pub fn document() -> Result<Document, LoadError> {
 /// The bundled scan: the PSB3 cation (retinal model) twisted about its central C=C at seed
 /// 000's 15 angles, RHF/6-31G*, written by scripts/make_psb3_scan.py (PySCF). Embedded, so the
 /// viewer needs no files beside it.
-const SCAN_MANIFEST: &str = include_str!("../assets/psb3/psb3.scan.toml");
+const SCAN_MANIFEST: &str = include_str!("../../assets/psb3/psb3.scan.toml");
 pub const SCAN_NAME: &str = "psb3.scan.toml (PSB3 twist, bundled)";
 macro_rules! frames {
     ($($name:literal),* $(,)?) => {
-        &[$(($name, include_bytes!(concat!("../assets/psb3/", $name)))),*]
+        &[$(($name, include_bytes!(concat!("../../assets/psb3/", $name)))),*]
     };
 }
 const SCAN_FRAMES: &[(&str, &[u8])] = frames![
@@ -62,8 +62,8 @@ pub fn scan() -> Result<ScanFile, LoadError> {
 
 /// The diene + SO₂ demo (seed 003's picture): s-cis butadiene and SO₂ placed as in a
 /// cheletropic approach, RHF/6-31G*, written by scripts/make_cycloaddition_demo.py (PySCF).
-const BUTADIENE_MOLDEN_GZ: &[u8] = include_bytes!("../assets/cycloaddition/butadiene.molden.gz");
-const SO2_MOLDEN_GZ: &[u8] = include_bytes!("../assets/cycloaddition/so2.molden.gz");
+const BUTADIENE_MOLDEN_GZ: &[u8] = include_bytes!("../../assets/cycloaddition/butadiene.molden.gz");
+const SO2_MOLDEN_GZ: &[u8] = include_bytes!("../../assets/cycloaddition/so2.molden.gz");
 pub const CYCLOADDITION_NAME: &str = "diene + SO₂ (bundled)";
 /// How the demo is first seen, as yaw and pitch (radians) from the camera that frames it: from
 /// the side and a little above, the diene's π lobes rising to SO₂'s.

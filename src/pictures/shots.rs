@@ -6,14 +6,14 @@
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
-use crate::figure::{Figure, caption};
 use crate::gpu::{GpuContext, GpuError, OffscreenTarget, Renderer};
-use crate::headless::picture;
-use crate::key_volumes::{ScanPainter, ScanScene};
+use crate::layers::key_volumes::{ScanPainter, ScanScene};
 use crate::layers::{show_atoms, show_scene};
 use crate::model::Document;
 use crate::model::arrow::mode_arrows;
-use crate::movie::{MovieError, MovieWriter, full_turn};
+use crate::pictures::figure::{Figure, caption};
+use crate::pictures::headless::picture;
+use crate::pictures::movie::{MovieError, MovieWriter, full_turn};
 use crate::scene::coloring::ValueMap;
 use crate::scene::vibration::ARROW_COLOR;
 use crate::scene::{Camera, Interpolation, ObjectState, RenderSettings, VolumeSettings};
@@ -214,9 +214,9 @@ impl<D: std::borrow::Borrow<Document>> SceneShots<D> {
 /// The colour bar of a surface coloured by a volume's values, at the right of `img`: the map's
 /// range, in atomic units, titled with the volume's name.
 pub fn value_bar(img: &mut image::RgbaImage, map: &ValueMap, name: &str) {
-    let color = |t: f32| map.at(t).map(crate::figure::encoded);
+    let color = |t: f32| map.at(t).map(crate::pictures::figure::encoded);
     let [lo, mid, hi] = map.ticks();
-    crate::figure::color_bar(img, color, [&lo, &mid, &hi], &ValueMap::title(name));
+    crate::pictures::figure::color_bar(img, color, [&lo, &mid, &hi], &ValueMap::title(name));
 }
 
 /// How far a recording has got, shared with whoever shows it, and a flag that stops it.

@@ -3,8 +3,8 @@
 
 use glam::DVec3;
 
+use crate::evaluate::meshes::sample_grid;
 use crate::evaluate::orbital_geometry;
-use crate::meshes::sample_grid;
 use crate::model::gto::PreparedBasis;
 use crate::model::orbitals::Quantity;
 use crate::model::{Document, VolumeGrid};

@@ -2,12 +2,14 @@
 //! colours, the atoms a selection shows), each quantity in a layer of its own (a data set, or an
 //! orbital or density evaluated), their isosurfaces, placement and visibility.
 
+pub mod key_volumes;
+
+use crate::evaluate::meshes::{color_isosurfaces, isosurfaces};
 use crate::evaluate::{Values, WavefunctionView, evaluate_wavefunction};
 use crate::gpu::atoms::AtomSizes;
 use crate::gpu::gto::GtoFillPass;
 use crate::gpu::renderer::Layer;
 use crate::gpu::{GpuContext, GpuError, Renderer};
-use crate::meshes::{color_isosurfaces, isosurfaces};
 use crate::model::isosurface::Mesh;
 use crate::model::{Document, VolumeGrid};
 use crate::scene::coloring::{AtomColors, ValueMap, atom_colors};

@@ -4,13 +4,13 @@
 
 use std::time::Instant;
 
+use crate::gpu::{FrameInput, OffscreenTarget, Renderer, Tile};
+use crate::layers::show_scene;
+use crate::pictures::headless::draw_exact;
+use crate::scene::detail::Detail;
+use crate::scene::{Camera, ObjectState, Placement};
 use anyhow::{Context, Result};
 use clap::Args;
-use orbcloud::gpu::{FrameInput, OffscreenTarget, Renderer, Tile};
-use orbcloud::headless::draw_exact;
-use orbcloud::layers::show_scene;
-use orbcloud::scene::detail::Detail;
-use orbcloud::scene::{Camera, ObjectState, Placement};
 
 #[derive(Args)]
 pub struct SceneBench {
@@ -36,21 +36,21 @@ pub struct SceneBench {
 /// The molecules of `files` (each with its density and HOMO) or of the demo, each quantity with
 /// its cloud shown beside its translucent surface, repeated to `count` molecules in a row along
 /// x, 4 bohr apart.
-fn molecules(files: &[std::path::PathBuf], count: usize) -> Result<Vec<(orbcloud::model::Document, ObjectState)>> {
+fn molecules(files: &[std::path::PathBuf], count: usize) -> Result<Vec<(crate::model::Document, ObjectState)>> {
     const COLOURS: [([f32; 3], [f32; 3]); 3] = [
         ([0.9, 0.2, 0.12], [0.15, 0.35, 0.95]),
         ([0.95, 0.7, 0.15], [0.2, 0.8, 0.4]),
         ([0.85, 0.3, 0.8], [0.2, 0.75, 0.75]),
     ];
     let demo = match files {
-        [] => orbcloud::demo::cycloaddition()?,
+        [] => crate::sources::demo::cycloaddition()?,
         _ => (files.iter().zip(COLOURS.iter().cycle()))
             .map(|(path, &(positive, negative))| {
-                let doc = orbcloud::formats::load(path)?;
-                let homo = doc.wavefunction.as_ref().and_then(|wf| wf.homo(orbcloud::model::orbitals::Spin::Alpha));
+                let doc = crate::formats::load(path)?;
+                let homo = doc.wavefunction.as_ref().and_then(|wf| wf.homo(crate::model::orbitals::Spin::Alpha));
                 let state = ObjectState {
                     path: Some(std::fs::canonicalize(path)?),
-                    ..orbcloud::demo::density_and_orbital(homo, positive, negative)
+                    ..crate::sources::demo::density_and_orbital(homo, positive, negative)
                 };
                 Ok((doc, state))
             })
@@ -75,7 +75,7 @@ fn molecules(files: &[std::path::PathBuf], count: usize) -> Result<Vec<(orbcloud
 }
 
 /// The placed atoms' bounds over the scene.
-fn scene_bounds(scene: &[(orbcloud::model::Document, ObjectState)]) -> Option<(glam::Vec3, glam::Vec3)> {
+fn scene_bounds(scene: &[(crate::model::Document, ObjectState)]) -> Option<(glam::Vec3, glam::Vec3)> {
     scene
         .iter()
         .filter_map(|(doc, state)| {
@@ -93,7 +93,7 @@ pub fn bench(args: &SceneBench) -> Result<()> {
     let scene = molecules(&args.files, args.molecules.max(1))?;
     let (lo, hi) = scene_bounds(&scene).context("the scene has no atoms")?;
     if let Some(path) = &args.session {
-        let session = orbcloud::scene::Session {
+        let session = crate::scene::Session {
             camera: Camera::framing(lo, hi),
             objects: scene.iter().map(|(_, s)| s.clone()).collect(),
             ..Default::default()

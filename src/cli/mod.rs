@@ -1,0 +1,776 @@
+//! The orbcloud command line as a library: the arguments (clap), each command's body in a module
+//! of its own, and [`run_words`] that runs a line. `main.rs` calls it; the Python package runs
+//! `render`'s options and `compute` through it.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use crate::evaluate::{Values, WavefunctionView};
+use crate::formats;
+use crate::gpu::{AdapterPreference, GpuContext};
+use crate::layers::show_wavefunction;
+use crate::model::Document;
+use crate::model::orbitals::{OrbitalSpec, Quantity, Spin, Wavefunction};
+use crate::pictures::headless::Headless;
+use crate::scene::framing::camera_for;
+use crate::scene::transfer::PRESETS;
+use crate::scene::{
+    AtomColoring, AtomStyle, Camera, ClipPlane, RenderSettings, Shape, SliceMode, TransferKind, ViewPreset,
+};
+use crate::sources::demo;
+use anyhow::{Context, Result, bail};
+use clap::{Args, Parser, Subcommand, ValueEnum};
+
+mod bench_scene;
+mod compute;
+pub mod info;
+mod modes;
+mod molsurface;
+mod movie;
+mod quantities;
+mod render;
+mod scan;
+mod structure;
+mod surface;
+mod values;
+
+#[derive(Parser)]
+#[command(name = "orbcloud", version, about = "Molecular orbitals and densities as GPU-rendered clouds")]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+    /// Files to open in the viewer: Gaussian cube (.cube, .cub), Molden (.molden, .molden.input,
+    /// .mold), Gaussian formatted checkpoint (.fchk, .fch), AIM wavefunction (.wfn, .wfx), ORCA
+    /// Molekel (.mkl), PDB (.pdb, .ent), mmCIF (.cif, .mmcif), XYZ (.xyz), each also gzipped
+    /// (.gz), or a scan manifest (.scan.toml); the bundled demo when none.
+    files: Vec<PathBuf>,
+    /// Open a bundled demo instead of files.
+    #[arg(long, value_enum)]
+    demo: Option<DemoArg>,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum DemoArg {
+    /// The PSB3 twist scan (what opens with no file).
+    Scan,
+    /// Formaldehyde's HOMO as a cube.
+    Cube,
+    /// Butadiene's HOMO meeting SO₂'s LUMO, translucent and glowing where they overlap.
+    Cycloaddition,
+}
+
+impl DemoArg {
+    fn demo(self) -> crate::app::Demo {
+        match self {
+            DemoArg::Scan => crate::app::Demo::Scan,
+            DemoArg::Cube => crate::app::Demo::Cube,
+            DemoArg::Cycloaddition => crate::app::Demo::Cycloaddition,
+        }
+    }
+}
+
+// Parsed once per process: boxing the larger variants would save nothing worth the noise.
+#[allow(clippy::large_enum_variant)]
+#[derive(Subcommand)]
+enum Command {
+    /// Open the interactive viewer (the default).
+    Viewer {
+        /// Files to open: Gaussian cube (.cube, .cub), Molden (.molden, .molden.input, .mold),
+        /// Gaussian formatted checkpoint (.fchk, .fch), AIM wavefunction (.wfn, .wfx), ORCA Molekel
+        /// (.mkl), PDB (.pdb, .ent), mmCIF (.cif, .mmcif), XYZ (.xyz), each also gzipped (.gz), or a
+        /// scan manifest (.scan.toml); the bundled demo when none.
+        files: Vec<PathBuf>,
+        /// Open a bundled demo instead of files.
+        #[arg(long, value_enum)]
+        demo: Option<DemoArg>,
+    },
+    /// Render a file to a PNG without a window.
+    Render(RenderArgs),
+    /// Print atoms and grids of a file.
+    Info {
+        /// Gaussian cube (.cube, .cub), Molden (.molden, .molden.input, .mold), Gaussian formatted
+        /// checkpoint (.fchk, .fch), AIM wavefunction (.wfn, .wfx), ORCA Molekel (.mkl), PDB (.pdb,
+        /// .ent), mmCIF (.cif, .mmcif) or XYZ (.xyz), each also gzipped (.gz).
+        file: PathBuf,
+        /// Machine-readable JSON instead of text.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Evaluate an orbital or the density at points (bohr in, `x y z value` out).
+    Eval {
+        file: PathBuf,
+        #[command(flatten)]
+        what: WhatArgs,
+        /// File of points, one `x y z` (bohr) per line; `-` reads standard input.
+        #[arg(long)]
+        points: PathBuf,
+        /// Subtract the same quantity of another file (two states, two methods, a complex
+        /// minus a part): its wavefunction's, or its first data set's, resampled trilinearly.
+        #[arg(long, value_name = "FILE")]
+        minus: Option<PathBuf>,
+    },
+    /// Write an orbital or the density on a grid as a Gaussian cube file (like cubegen).
+    Cube {
+        file: PathBuf,
+        #[command(flatten)]
+        what: WhatArgs,
+        /// Points per axis (ignored with --spacing).
+        #[arg(long, default_value_t = 80)]
+        grid: usize,
+        /// Grid spacing in bohr (same on every axis).
+        #[arg(long)]
+        spacing: Option<f64>,
+        /// Space around the atoms, bohr (default: the box where the orbital decays to 1 % of
+        /// its largest value, a density to 1e-4 a.u.).
+        #[arg(long)]
+        margin: Option<f64>,
+        /// Subtract the same quantity of another file on this grid: its wavefunction's, or its
+        /// first data set's, resampled trilinearly (refused when the grids do not overlap).
+        #[arg(long, value_name = "FILE")]
+        minus: Option<PathBuf>,
+        #[arg(short, long)]
+        output: PathBuf,
+    },
+    /// Write isosurfaces (both signs of an orbital, or a density's) or a molecular surface
+    /// (--surface) as OBJ, PLY or glTF.
+    Mesh(surface::MeshArgs),
+    /// Write one period of a normal mode as a multi-frame XYZ file (Å).
+    Modes(modes::ModesArgs),
+    /// A movie: a scan's coordinate swept, a file or session turning (--turntable), or a
+    /// vibration (--normal-mode K), as PNG frames, GIF, animated PNG, MP4 or WebM.
+    Movie(Box<movie::MovieArgs>),
+    /// Compute a wavefunction with PySCF (HF or DFT) and write it as a Molden file, with the
+    /// normal modes on request (--freq).
+    Compute(compute::ComputeArgs),
+    /// Scans of a distance, an angle, a dihedral or a path: compute one with PySCF, make a
+    /// manifest from files, inspect, render or export a value.
+    #[command(subcommand)]
+    Scan(scan::ScanCommand),
+    /// Print performance figures.
+    #[command(subcommand)]
+    Bench(BenchCommand),
+}
+
+#[derive(Args, Clone)]
+struct WhatArgs {
+    /// homo, lumo, homo-N, lumo+N, or a 1-based orbital number of the chosen spin.
+    #[arg(long, default_value = "homo", allow_hyphen_values = true)]
+    orbital: OrbitalSpec,
+    /// Spin of the orbital (unrestricted wavefunctions).
+    #[arg(long, value_enum, default_value_t = SpinArg::Alpha)]
+    spin: SpinArg,
+    /// The total electron density instead of an orbital.
+    #[arg(long, conflicts_with = "spin_density")]
+    density: bool,
+    /// The spin density (α − β) instead of an orbital.
+    #[arg(long)]
+    spin_density: bool,
+    /// The electrostatic potential of the nuclei and electrons (a.u.) instead of an orbital.
+    #[arg(long, conflicts_with_all = ["density", "spin_density", "basis_function"])]
+    esp: bool,
+    /// A bare basis function (atomic orbital) instead of an orbital, named as the viewer's
+    /// atomic-orbital selector names it: "C3 2pz", "O1 3dz2", "O1 3dxy", "H2 3dxx".
+    #[arg(long, conflicts_with_all = ["density", "spin_density"])]
+    basis_function: Option<String>,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum SpinArg {
+    Alpha,
+    Beta,
+}
+
+/// How `render` and `bench` show a wavefunction (Molden, fchk).
+#[derive(Args)]
+struct WavefunctionArgs {
+    #[command(flatten)]
+    what: WhatArgs,
+    /// Evaluate the orbital per slice sample from the basis functions (direct mode)
+    /// instead of on a GPU-filled grid.
+    #[arg(long)]
+    direct: bool,
+    /// Points per axis of the grid orbitals are evaluated on.
+    #[arg(long, default_value_t = 72)]
+    grid_points: usize,
+}
+
+impl WavefunctionArgs {
+    /// Puts the requested quantity into the headless renderer, when the document has a
+    /// wavefunction; returns how long that took (GPU fill and read-back included) and the values
+    /// behind it. In direct mode a grid is filled only when `grid` says its values are wanted.
+    fn apply(&self, ctx: &GpuContext, h: &mut Headless, doc: &Document, grid: bool) -> Result<Option<(f64, Values)>> {
+        if doc.wavefunction.is_none() {
+            // A quantity only a wavefunction has, asked of atoms alone, is an error, not a
+            // picture of the atoms.
+            let w = &self.what;
+            let asked = [(w.density, "--density"), (w.spin_density, "--spin-density"), (w.esp, "--esp")]
+                .into_iter()
+                .find(|(on, _)| *on)
+                .map(|(_, flag)| flag)
+                .or(w.basis_function.as_ref().map(|_| "--basis-function"));
+            if let Some(flag) = asked {
+                bail!(
+                    "{}: {flag} needs a wavefunction (Molden, fchk, wfn, wfx or MKL), and this file has none: `orbcloud compute {}` computes one with PySCF",
+                    doc.source,
+                    doc.source
+                );
+            }
+            return Ok(None);
+        }
+        let start = Instant::now();
+        let view = WavefunctionView {
+            quantity: self.what.resolve(doc)?,
+            direct: self.direct,
+            points: self.grid_points.clamp(8, 512),
+            functions: None,
+            grid,
+        };
+        let mut fill = None;
+        let values = show_wavefunction(ctx, h.renderer.main(), &mut fill, doc, &view)?;
+        Ok(values.map(|v| (start.elapsed().as_secs_f64(), v)))
+    }
+}
+
+impl WhatArgs {
+    fn resolve(&self, doc: &Document) -> Result<Quantity> {
+        let wf = wavefunction_of(doc)?;
+        if let Some(name) = &self.basis_function {
+            return crate::model::basis_labels::find_function(&doc.molecule, &wf.basis, name)
+                .map(Quantity::BasisFunction)
+                .ok_or_else(|| {
+                    anyhow::anyhow!("no basis function {name:?} in this file (names look like \"C3 2pz\")")
+                });
+        }
+        if self.density {
+            return Ok(Quantity::Density);
+        }
+        if self.esp {
+            return Ok(Quantity::Potential);
+        }
+        if self.spin_density {
+            return Ok(Quantity::SpinDensity);
+        }
+        let spin = match self.spin {
+            SpinArg::Alpha => Spin::Alpha,
+            SpinArg::Beta => Spin::Beta,
+        };
+        wf.resolve(self.orbital, spin)
+            .map(Quantity::Orbital)
+            .ok_or_else(|| anyhow::anyhow!("--orbital {}: {}", self.orbital, wf.available(spin)))
+    }
+
+    /// A short name for what is asked for: `homo`, `lumo+1`, `mo12_beta`, `density`, `ao_C3_2pz`.
+    fn short_name(&self) -> String {
+        if let Some(name) = &self.basis_function {
+            let name: String = name.split_whitespace().collect::<Vec<_>>().join("_");
+            return format!("ao_{name}");
+        }
+        if self.density {
+            return "density".into();
+        }
+        if self.esp {
+            return "esp".into();
+        }
+        if self.spin_density {
+            return "spin_density".into();
+        }
+        let name = match self.orbital {
+            OrbitalSpec::Homo(0) => "homo".to_string(),
+            OrbitalSpec::Homo(n) => format!("homo-{n}"),
+            OrbitalSpec::Lumo(0) => "lumo".to_string(),
+            OrbitalSpec::Lumo(n) => format!("lumo+{n}"),
+            OrbitalSpec::Index(n) => format!("mo{n}"),
+        };
+        match self.spin {
+            SpinArg::Alpha => name,
+            SpinArg::Beta => format!("{name}_beta"),
+        }
+    }
+
+    /// The quantity option as given, for messages: `--orbital lumo+1`, `--density`.
+    fn describe(&self) -> String {
+        if let Some(name) = &self.basis_function {
+            return format!("--basis-function {name:?}");
+        }
+        match self.short_name().as_str() {
+            "density" => "--density".into(),
+            "esp" => "--esp".into(),
+            "spin_density" => "--spin-density".into(),
+            name => format!("--orbital {name}"),
+        }
+    }
+
+    fn label(&self, q: &Quantity, doc: &Document) -> String {
+        let Some(wf) = &doc.wavefunction else { return String::new() };
+        match q {
+            Quantity::Density => "total electron density".into(),
+            Quantity::SpinDensity => "spin density".into(),
+            Quantity::Potential => "electrostatic potential (a.u.)".into(),
+            Quantity::BasisFunction(k) => {
+                let name = crate::model::basis_labels::function_name(&doc.molecule, &wf.basis, *k);
+                format!("basis function {}", name.unwrap_or_default())
+            }
+            Quantity::Orbital(i) => {
+                let o = &wf.orbitals[*i];
+                let n = wf.of_spin(o.spin).position(|(j, _)| j == *i).map_or(0, |p| p + 1);
+                format!("MO {n} ({:?}) E={:.6} Eh occ={:.3} {}", o.spin, o.energy, o.occupation, o.symmetry)
+            }
+        }
+    }
+}
+
+fn wavefunction_of(doc: &Document) -> Result<&Wavefunction> {
+    doc.wavefunction.as_ref().ok_or_else(|| {
+        anyhow::anyhow!(
+            "{} holds no basis set or orbitals (a Molden, fchk, wfn, wfx or MKL file is needed)",
+            doc.source
+        )
+    })
+}
+
+#[derive(Subcommand)]
+enum BenchCommand {
+    /// ms per frame of the scene (atoms + volume slices) at a given size and slice count.
+    Render {
+        /// A cube file; the bundled demo when omitted.
+        file: Option<PathBuf>,
+        #[command(flatten)]
+        view: ViewArgs,
+        /// Frames to time (after two warm-up frames).
+        #[arg(long, default_value_t = 10)]
+        frames: u32,
+        /// Use the CPU Vulkan adapter (lavapipe) even when a GPU is present.
+        #[arg(long)]
+        lavapipe: bool,
+        #[command(flatten)]
+        wavefunction: WavefunctionArgs,
+    },
+    /// Frame time against the number of resident key volumes K of a scan.
+    Keyvolumes(scan::KeyVolumeBench),
+    /// ms to extract an isosurface (both signs of an orbital) from a grid.
+    Isosurface(surface::IsoBench),
+    /// ms to read a file (PDB, mmCIF, XYZ, or any other the viewer opens) and atoms per second.
+    Load(structure::LoadBench),
+    /// ms per frame of many atoms (synthetic, or a file's) and GPU bytes per atom.
+    Spheres(structure::SpheresBench),
+    /// ms per frame of 2, 4 and 16 translucent surfaces, exact order against weighted blending,
+    /// with the fragment memory and weighted blending's image error.
+    Surfaces(surface::TranslucentBench),
+    /// ms to build a molecular surface (Gaussian, solvent-excluded) of a file's atoms, and ms
+    /// per frame drawing it.
+    Surface(molsurface::SurfaceBench),
+    /// ms from a change to the coarse preview and to the full picture of several molecules
+    /// with clouds and translucent surfaces.
+    Scene(bench_scene::SceneBench),
+}
+
+#[derive(Args)]
+struct RenderArgs {
+    /// Gaussian cube (.cube, .cub), Molden (.molden, .molden.input, .mold), Gaussian formatted
+    /// checkpoint (.fchk, .fch), AIM wavefunction (.wfn, .wfx), ORCA Molekel (.mkl), PDB (.pdb,
+    /// .ent), mmCIF (.cif, .mmcif) or XYZ (.xyz), each also gzipped (.gz); the bundled demo when
+    /// omitted.
+    file: Option<PathBuf>,
+    /// Output PNG.
+    #[arg(short, long)]
+    output: PathBuf,
+    #[command(flatten)]
+    view: ViewArgs,
+    /// Use the CPU Vulkan adapter (lavapipe) even when a GPU is present.
+    #[arg(long)]
+    lavapipe: bool,
+    #[command(flatten)]
+    figure: FigureArgs,
+    #[command(flatten)]
+    wavefunction: WavefunctionArgs,
+    #[command(flatten)]
+    iso: surface::IsoArgs,
+    #[command(flatten)]
+    molsurface: molsurface::MolSurfaceArgs,
+    /// Print what is drawn at pixel X,Y of the image (an atom, a surface, or nothing).
+    #[arg(long, value_parser = surface::parse_pixel)]
+    pick: Option<[u32; 2]>,
+    /// Leave out the captions of panes side by side (--beside): each pane's quantities and an
+    /// orbital's energy.
+    #[arg(long)]
+    no_captions: bool,
+    /// Render a bundled demo scene instead of a file (cycloaddition: several objects).
+    #[arg(long, value_enum)]
+    demo: Option<DemoArg>,
+    #[command(flatten)]
+    vibration: modes::ModeArgs,
+}
+
+/// How a picture is made: supersampled, with a transparent background.
+#[derive(Args, Clone, Copy)]
+struct FigureArgs {
+    /// Draw at K× the size and filter down (1 to 4): smooth edges on atoms and thin sticks.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=4))]
+    scale: u32,
+    /// A transparent background (PNG alpha), for figures laid over other material.
+    #[arg(long)]
+    transparent: bool,
+}
+
+impl FigureArgs {
+    fn figure(&self) -> crate::pictures::figure::Figure {
+        crate::pictures::figure::Figure { scale: self.scale, transparent: self.transparent }
+    }
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum ModeArg {
+    /// Slices perpendicular to the view direction.
+    View,
+    /// Three stacks of slices along the grid's axes, the one facing the viewer drawn.
+    Axis,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum AtomsArg {
+    BallAndStick,
+    SpaceFilling,
+    Sticks,
+    Licorice,
+    Lines,
+    Hidden,
+}
+
+impl AtomsArg {
+    fn style(self) -> AtomStyle {
+        match self {
+            AtomsArg::BallAndStick => AtomStyle::BallAndStick,
+            AtomsArg::SpaceFilling => AtomStyle::SpaceFilling,
+            AtomsArg::Sticks => AtomStyle::Sticks,
+            AtomsArg::Licorice => AtomStyle::Licorice,
+            AtomsArg::Lines => AtomStyle::Lines,
+            AtomsArg::Hidden => AtomStyle::Hidden,
+        }
+    }
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum ColorArg {
+    Element,
+    Chain,
+    Residue,
+    BFactor,
+    Secondary,
+}
+
+#[derive(Args)]
+struct ViewArgs {
+    /// Image size, WIDTHxHEIGHT.
+    #[arg(long, default_value = "800x600", value_parser = parse_size)]
+    size: [u32; 2],
+    /// Which volume of a multi-orbital cube (0-based, in file order; see `info`).
+    #[arg(long, default_value_t = 0)]
+    volume: usize,
+    /// Which way to look: `auto` (the molecule's principal axes, tilted so no bond points at
+    /// the viewer), `x`, `y`, `z` (along the file's axis), `bond:I,J` (from atom I down the bond
+    /// to J) or `plane:I,J,K` (perpendicular to three atoms' plane); atoms count from 1.
+    #[arg(long, default_value = "auto", value_parser = ViewPreset::parse)]
+    view: ViewPreset,
+    /// Camera rotation about the vertical axis, degrees (after `--view`).
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    yaw: f32,
+    /// Camera elevation, degrees.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pitch: f32,
+    /// Zoom factor (> 1 comes closer).
+    #[arg(long, default_value_t = 1.0)]
+    zoom: f32,
+    #[arg(long, value_enum, default_value_t = ModeArg::View)]
+    mode: ModeArg,
+    /// Number of slices.
+    #[arg(long)]
+    slices: Option<u32>,
+    /// Opacity scale k1 in α = k1·ρ^k2 (default: chosen from the grid so its densest lines of
+    /// sight reach an optical depth of 2.5).
+    #[arg(long)]
+    k1: Option<f32>,
+    /// Opacity exponent k2 in α = k1·ρ^k2.
+    #[arg(long)]
+    k2: Option<f32>,
+    #[arg(long, value_enum, default_value_t = AtomsArg::BallAndStick)]
+    atoms: AtomsArg,
+    /// What colours the atoms (chains, residues, B-factors and secondary structure come from
+    /// PDB and mmCIF files; other files are coloured by element).
+    #[arg(long, value_enum, default_value_t = ColorArg::Element)]
+    color: ColorArg,
+    /// Darken atoms with depth by up to this fraction (0 to 1; the viewer opens big structures
+    /// at 0.6): the front of a big structure reads from its back.
+    #[arg(long, default_value_t = 0.0)]
+    depth_cue: f32,
+    /// Factor on the style's ball radii (0.3 to 3).
+    #[arg(long, default_value_t = 1.0)]
+    ball_scale: f32,
+    /// Factor on the style's stick radius (0.3 to 3).
+    #[arg(long, default_value_t = 1.0)]
+    stick_scale: f32,
+    /// Hide the volume (atoms only).
+    #[arg(long)]
+    no_volume: bool,
+    /// Draw every slice whole, also through the bricks where the transfer function shows
+    /// nothing (the same picture, more fragments: to compare).
+    #[arg(long)]
+    full_slices: bool,
+    /// Transfer function: the power law α = k1·ρ^k2, a shape of the value (both signs), or
+    /// nested-cores (left half on ψ > 0, right half on ψ < 0, peaked at the extremes).
+    #[arg(long, value_enum, default_value_t = TfArg::Power)]
+    tf: TfArg,
+    /// Shape centre (iso-value), a fraction of max|value|.
+    #[arg(long)]
+    tf_center: Option<f32>,
+    /// Shape width, a fraction of max|value| (the contour spacing for `sinusoidal`).
+    #[arg(long)]
+    tf_width: Option<f32>,
+    /// Shape peak opacity per grid step.
+    #[arg(long)]
+    tf_opacity: Option<f32>,
+    /// Light the cloud with the gradient as the normal.
+    #[arg(long)]
+    shading: bool,
+    /// Boundary enhancement 0..1 (opacity rises with the gradient magnitude).
+    #[arg(long)]
+    boundary: Option<f32>,
+    /// 2D transfer function: opacity × (|∇|/max|∇|)^P.
+    #[arg(long)]
+    gradient_power: Option<f32>,
+    /// Clipping plane NX,NY,NZ[,OFFSET]: cut away what lies beyond it from the clouds,
+    /// isosurfaces and molecular surface (offset in bohr from the centre of the molecule's and
+    /// grids' bounds, along the normal).
+    #[arg(long, value_parser = parse_clip, allow_hyphen_values = true)]
+    clip: Option<[f32; 4]>,
+    /// Let the clipping plane cut the atoms and bonds too (a cut sphere or stick shows its flat
+    /// face).
+    #[arg(long, requires = "clip")]
+    clip_atoms: bool,
+    /// Colours for ψ > 0 and ψ < 0: red-blue, red-white, orange-teal, gold-purple or
+    /// green-magenta.
+    #[arg(long, value_parser = parse_preset)]
+    colors: Option<([f32; 3], [f32; 3])>,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum TfArg {
+    Power,
+    Uniform,
+    Gaussian,
+    LeftHalf,
+    RightHalf,
+    Sinusoidal,
+    NestedCores,
+}
+
+fn parse_preset(s: &str) -> Result<([f32; 3], [f32; 3]), String> {
+    let key = |n: &str| n.chars().filter(|c| c.is_alphanumeric()).collect::<String>().to_lowercase();
+    PRESETS
+        .iter()
+        .find(|(n, _, _)| key(n).starts_with(&key(s)))
+        .map(|(_, pos, neg)| (*pos, *neg))
+        .ok_or_else(|| format!("unknown colour preset {s:?}"))
+}
+
+fn parse_clip(s: &str) -> Result<[f32; 4], String> {
+    let v: Vec<f32> =
+        s.split(',').map(|t| t.trim().parse::<f32>()).collect::<Result<_, _>>().map_err(|e| e.to_string())?;
+    match v[..] {
+        [x, y, z] => Ok([x, y, z, 0.0]),
+        [x, y, z, o] => Ok([x, y, z, o]),
+        _ => Err(format!("expected NX,NY,NZ[,OFFSET], got {s:?}")),
+    }
+}
+
+fn parse_size(s: &str) -> Result<[u32; 2], String> {
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("expected WIDTHxHEIGHT, got {s:?}"))?;
+    let parse = |v: &str| v.trim().parse::<u32>().ok().filter(|&n| (1..=16384).contains(&n));
+    match (parse(w), parse(h)) {
+        (Some(w), Some(h)) => Ok([w, h]),
+        _ => Err(format!("expected WIDTHxHEIGHT with sides 1..16384, got {s:?}")),
+    }
+}
+
+impl ViewArgs {
+    fn settings(&self) -> RenderSettings {
+        let mut s = RenderSettings::default();
+        s.volume.mode = match self.mode {
+            ModeArg::View => SliceMode::ViewAligned,
+            ModeArg::Axis => SliceMode::AxisAligned,
+        };
+        s.volume.visible = !self.no_volume;
+        s.volume.skip_empty = !self.full_slices;
+        if let Some(n) = self.slices {
+            s.volume.slices = n.clamp(1, 4096);
+        }
+        s.volume.auto_k1 = self.k1.is_none();
+        if let Some(k1) = self.k1 {
+            s.volume.k1 = k1;
+        }
+        if let Some(k2) = self.k2 {
+            s.volume.k2 = k2;
+        }
+        let t = &mut s.volume.transfer;
+        if matches!(self.tf, TfArg::NestedCores) {
+            t.nested_cores();
+        }
+        let shape = match self.tf {
+            TfArg::Power | TfArg::NestedCores => None,
+            TfArg::Uniform => Some(Shape::Uniform),
+            TfArg::Gaussian => Some(Shape::Gaussian),
+            TfArg::LeftHalf => Some(Shape::LeftHalfGaussian),
+            TfArg::RightHalf => Some(Shape::RightHalfGaussian),
+            TfArg::Sinusoidal => Some(Shape::Sinusoidal),
+        };
+        if let Some(shape) = shape {
+            t.kind = TransferKind::Shaped;
+            t.positive.shape = shape;
+            t.negative.shape = shape;
+        }
+        if t.kind == TransferKind::Shaped {
+            for lobe in [&mut t.positive, &mut t.negative] {
+                lobe.center = self.tf_center.unwrap_or(lobe.center);
+                lobe.width = self.tf_width.unwrap_or(lobe.width);
+                lobe.opacity = self.tf_opacity.unwrap_or(lobe.opacity);
+            }
+        }
+        t.shading = self.shading;
+        t.boundary = self.boundary.unwrap_or(0.0).clamp(0.0, 1.0);
+        t.gradient_power = self.gradient_power.unwrap_or(0.0).max(0.0);
+        if let Some([x, y, z, offset]) = self.clip {
+            s.clip = ClipPlane { enabled: true, normal: [x, y, z], offset, atoms: self.clip_atoms };
+        }
+        if let Some((pos, neg)) = self.colors {
+            s.volume.positive_color = pos;
+            s.volume.negative_color = neg;
+        }
+        s.atoms = self.atoms.style();
+        s.atom_colors = match self.color {
+            ColorArg::Element => AtomColoring::Element,
+            ColorArg::Chain => AtomColoring::Chain,
+            ColorArg::Residue => AtomColoring::Residue,
+            ColorArg::BFactor => AtomColoring::BFactor,
+            ColorArg::Secondary => AtomColoring::Secondary,
+        };
+        s.depth_cue = self.depth_cue.clamp(0.0, 1.0);
+        s.ball_scale = self.ball_scale.clamp(0.3, 3.0);
+        s.stick_scale = self.stick_scale.clamp(0.3, 3.0);
+        s
+    }
+
+    fn camera(&self, doc: &Document) -> Result<Camera> {
+        let cam = camera_for(doc, self.view).map_err(|e| anyhow::anyhow!("--view {e}"))?;
+        Ok(self.orbit(cam))
+    }
+
+    /// `camera` turned by `--yaw` and `--pitch` and zoomed by `--zoom`.
+    fn orbit(&self, mut camera: Camera) -> Camera {
+        camera.orbit(self.yaw.to_radians(), self.pitch.to_radians());
+        camera.zoom(1.0 / self.zoom.max(1e-3));
+        camera
+    }
+
+    fn volume_index(&self, doc: &Document) -> Result<Option<usize>> {
+        if doc.volumes.is_empty() {
+            return Ok(None);
+        }
+        if self.volume >= doc.volumes.len() {
+            bail!("--volume {} is out of range: the file has {} volume(s)", self.volume, doc.volumes.len());
+        }
+        Ok(Some(self.volume))
+    }
+}
+
+fn load(file: Option<&Path>) -> Result<Document> {
+    match file {
+        Some(p) => formats::load(p).map_err(anyhow::Error::from),
+        None => demo::document().context("the bundled demo did not load"),
+    }
+}
+
+/// What `render` makes of its options, given as words after `orbcloud render` (a file or not,
+/// `--orbital lumo --iso 0.05`, …), without a file written; `doc` replaces the file they name.
+/// The Python package takes `render`'s options this way.
+pub fn render_drawing(doc: Option<Document>, words: &[String]) -> Result<render::Drawing> {
+    let head = ["orbcloud", "render", "--output", "unused.png"].map(String::from);
+    let line = head.into_iter().chain(words.iter().cloned()).map(std::ffi::OsString::from).collect();
+    let (line, later) = quantities::split(line)?;
+    match Cli::try_parse_from(line) {
+        Ok(Cli { command: Some(Command::Render(args)), .. }) => render::drawing(&args, doc, &later),
+        Ok(_) => bail!("expected the options of `render`"),
+        Err(e) => bail!("{}", e.to_string().trim()),
+    }
+}
+
+pub use render::{Drawing, Picture};
+
+/// Image size, frame count and adapter of a frame-time benchmark.
+#[derive(Args)]
+struct BenchFrames {
+    /// Image size, WIDTHxHEIGHT.
+    #[arg(long, default_value = "800x600", value_parser = parse_size)]
+    size: [u32; 2],
+    /// Frames to time (after two warm-up frames).
+    #[arg(long, default_value_t = 10)]
+    frames: u32,
+    /// Use the CPU Vulkan adapter (lavapipe) even when a GPU is present.
+    #[arg(long)]
+    lavapipe: bool,
+}
+
+fn gpu(lavapipe: bool) -> Result<GpuContext> {
+    let pref = if lavapipe { AdapterPreference::LavapipeOnly } else { AdapterPreference::HighPerformance };
+    Ok(GpuContext::headless(pref)?)
+}
+
+/// Runs the process's command line (`words[0]` the program's name): a usage error, `--help` or
+/// `--version` print clap's answer and end the process, as a command does.
+pub fn run(words: Vec<std::ffi::OsString>) -> Result<()> {
+    // Each quantity after the first comes with its own options ([`quantities`]).
+    let (line, later) = quantities::split(words)?;
+    dispatch(Cli::parse_from(line), &later)
+}
+
+/// Runs a command line (`words[0]` the program's name) as the `orbcloud` command does, its
+/// usage errors returned rather than ending the process: the Python package calls it for
+/// `orbcloud.compute` and `orbcloud.scan_compute`.
+pub fn run_words(words: Vec<std::ffi::OsString>) -> Result<()> {
+    let (line, later) = quantities::split(words)?;
+    match Cli::try_parse_from(line) {
+        Ok(cli) => dispatch(cli, &later),
+        // --help and --version are answers, not errors.
+        Err(e) if !e.use_stderr() => {
+            print!("{e}");
+            Ok(())
+        }
+        Err(e) => Err(e.into()),
+    }
+}
+
+fn dispatch(cli: Cli, later: &[quantities::Later]) -> Result<()> {
+    match cli.command {
+        None => Ok(crate::app::run(cli.files, cli.demo.map(DemoArg::demo))?),
+        Some(Command::Viewer { files, demo }) => Ok(crate::app::run(files, demo.map(DemoArg::demo))?),
+        Some(Command::Render(args)) => render::render(args, later),
+        Some(Command::Info { file, json }) => values::info(&file, json),
+        Some(Command::Eval { file, what, points, minus }) => values::eval(&file, &what, &points, minus.as_deref()),
+        Some(Command::Cube { file, what, grid, spacing, margin, minus, output }) => {
+            values::cube(&file, &what, (grid, spacing, margin), minus.as_deref(), &output)
+        }
+        Some(Command::Compute(args)) => compute::compute(args),
+        Some(Command::Scan(command)) => scan::run(command),
+        Some(Command::Modes(args)) => modes::write_xyz(&args),
+        Some(Command::Movie(args)) => movie::movie(*args),
+        Some(Command::Mesh(args)) => surface::mesh(&args, &quantities::parse_later_meshes(later)?),
+        Some(Command::Bench(BenchCommand::Keyvolumes(args))) => scan::bench_keyvolumes(args),
+        Some(Command::Bench(BenchCommand::Isosurface(args))) => surface::bench(&args),
+        Some(Command::Bench(BenchCommand::Load(args))) => structure::bench_load(&args),
+        Some(Command::Bench(BenchCommand::Spheres(args))) => structure::bench_spheres(&args),
+        Some(Command::Bench(BenchCommand::Surfaces(args))) => surface::bench_translucent(&args),
+        Some(Command::Bench(BenchCommand::Surface(args))) => molsurface::bench(&args),
+        Some(Command::Bench(BenchCommand::Scene(args))) => bench_scene::bench(&args),
+        Some(Command::Bench(BenchCommand::Render { file, view, frames, lavapipe, wavefunction })) => {
+            render::bench(file.as_deref(), &view, frames, lavapipe, &wavefunction)
+        }
+    }
+}

@@ -1,0 +1,5 @@
+//! Where documents come from besides the files a user opens: the bundled demos and the
+//! wavefunctions computed with PySCF.
+
+pub mod compute;
+pub mod demo;
