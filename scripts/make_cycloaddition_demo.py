@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Generate the bundled diene + SO2 demo (seed 003's picture): assets/cycloaddition/.
+"""Generate the bundled diene + SO2 demo (Koide and Miyata's picture): assets/cycloaddition/.
 
     python3 scripts/make_cycloaddition_demo.py [--out-dir assets/cycloaddition]
 

@@ -91,7 +91,7 @@ fn radius_of(i: u32) -> f32 {
 }
 
 // The radius the compute rasteriser and its resolve use: never under half a pixel, so a far
-// atom still covers the pixel it falls in (seed 002's point of the projected size).
+// atom still covers the pixel it falls in (Lee et al.'s point of the projected size).
 fn splat_radius(i: u32) -> f32 {
     let r = radius_of(i);
     let w = (g.clip_from_world * vec4<f32>(positions[i].xyz, 1.0)).w;

@@ -1,4 +1,4 @@
-// Contracted Gaussian basis functions evaluated on the GPU (seed 004): the molecular orbital
+// Contracted Gaussian basis functions evaluated on the GPU (Jang and Varetto, docs/references.md): the molecular orbital
 // ψ(r) = Σ_shells R_s(|r − A_s|) · Σ_c w_sc x^a y^b z^c, with R_s(r) = Σ_p d_p e^(−α_p r²) and the
 // per-orbital cartesian weights w_sc prepared on the CPU (pure shells folded into cartesian
 // weights, component normalisation included).

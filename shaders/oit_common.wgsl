@@ -1,4 +1,4 @@
-// Per-pixel fragment lists of translucent surfaces (seed 003): every fragment of every
+// Per-pixel fragment lists of translucent surfaces (Koide and Miyata, docs/references.md): every fragment of every
 // translucent surface is kept, with what its optics need, in a linked list per pixel. The
 // lists are sorted and composited in exact depth order when the frame resolves.
 

@@ -1,4 +1,4 @@
-// Each pixel's fragment list gathered, sorted front to back and walked (seed 003): shared by
+// Each pixel's fragment list gathered, sorted front to back and walked (Koide and Miyata, docs/references.md): shared by
 // the resolve (resolve.wgsl) and a cloud the surfaces run through (volume_interleave.wgsl).
 // Prepended: oit_common.wgsl.
 

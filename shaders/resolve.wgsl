@@ -8,7 +8,7 @@ fn fs_main(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
     return vec4<f32>(c.rgb, 1.0);
 }
 
-// Translucent surfaces over the scene, in exact depth order (seed 003). Prepended:
+// Translucent surfaces over the scene, in exact depth order (Koide and Miyata, docs/references.md). Prepended:
 // oit_common.wgsl, oit_sort.wgsl.
 
 @fragment

@@ -1,5 +1,5 @@
 // Occlusion culling of a big surface's batches (runs of triangles of one octree cluster, chosen
-// on the CPU by seed 002's level of detail) in two phases, into indirect draws:
+// on the CPU by Lee et al.'s level of detail) in two phases, into indirect draws:
 // - cs_split, before drawing: the batches whose cluster was seen last frame are drawn first;
 // - cs_cull, after the depth pyramid is built from what the first draws left: every batch whose
 //   box the pyramid does not hide is marked seen, and those not drawn yet are drawn next.

@@ -1,7 +1,7 @@
 // Slice-based volume rendering, shared part: slice polygons in world space, and the opacity law
-// that turns a value into premultiplied colour (seed 000's emission–absorption clouds). The
+// that turns a value into premultiplied colour (Naka et al.'s emission–absorption clouds). The
 // fragment shaders that sample a value are in volume_slices.wgsl (a 3D texture) and
-// volume_direct.wgsl (the orbital evaluated from its basis functions, seed 004).
+// volume_direct.wgsl (the orbital evaluated from its basis functions, Jang and Varetto).
 
 struct VolumeUniforms {
     clip_from_world: mat4x4<f32>,
@@ -192,7 +192,7 @@ fn shade_with(c: VolumeUniforms, field: u32, shaped: bool, gradient: bool, value
             color = color * (0.3 + 0.7 * diffuse) + vec3<f32>(0.35 * specular);
         }
     }
-    // The extinction of one reference step (seed 000's alpha = k1 rho^k2 for the power law)
+    // The extinction of one reference step (Naka et al.'s alpha = k1 rho^k2 for the power law)
     // composes exactly over the distance the ray travels between two slices:
     // alpha = 1 - exp(-extinction * path / step).
     let ray = normalize(from_eye);

@@ -1,4 +1,4 @@
-// Clouds and translucent surfaces in one depth order (seed 003 with seed 000's clouds): per
+// Clouds and translucent surfaces in one depth order (Koide and Miyata with Naka et al.'s clouds): per
 // pixel, the sorted fragments and the samples of up to four clouds are composited front to
 // back in one walk. Each cloud is sampled where its slices would sample it (its own planes, its
 // own opacity law); the clouds' samples are merged by depth, and samples of several clouds at

@@ -2,7 +2,7 @@
 // angles with ratio k = u.morph_k (`volume` is A).
 //
 // exact: the two volumes sampled and mixed per sample. α-mix: the two samples' colours and
-// opacities mixed per slice (seed 000's reference). three-pass: seed 000's real-time
+// opacities mixed per slice (Naka et al.'s reference). three-pass: Naka et al.'s real-time
 // approximation, the attenuation by one key volume's opacity, drawn in one pass (`plane_over`).
 // Prepended: volume_common.wgsl, volume_gradient.wgsl, volume_slab.wgsl.
 
@@ -48,10 +48,10 @@ override MIX: u32 = 0u;
 //
 // exact: the two volumes sampled and mixed, ψ = (1−k)ψA + kψB, then shaded.
 //
-// α-mix, seed 000's reference (their eq. 5): the colours and opacities mixed, α = (1−k)α_A +
+// α-mix, Naka et al.'s reference (their eq. 5): the colours and opacities mixed, α = (1−k)α_A +
 // kα_B, d_i = (1−k)C_A α_A + k C_B α_B + d_{i−1}(1 − α).
 //
-// three-pass, seed 000's method (their eqs. 6–7): the frame attenuated by A_i's opacity (B_i's
+// three-pass, Naka et al.'s method (their eqs. 6–7): the frame attenuated by A_i's opacity (B_i's
 // when k > 0.5), then (1−k)·A_i and k·B_i added. The three blends of a slice are one
 // premultiplied "over" whose colour is the two additions and whose opacity the attenuation's,
 // so one pass draws them: d_i = (1−k)C_A α_A + k C_B α_B + d_{i−1}(1 − α_{A|B}).

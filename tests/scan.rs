@@ -201,7 +201,7 @@ fn three_pass_stays_close_to_exact_and_equals_it_at_key_angles() {
         common::mean_max_difference(&render(-90.0, Interpolation::Exact), &render(-90.0, Interpolation::ThreePass));
     // Only the rounding of two half-float blends instead of one separates them.
     assert!(mean < 1.0 && max <= 4, "at a key angle three-pass differs from exact: mean {mean}, max {max}");
-    // Between: seed 000's approximation; report and bound its error.
+    // Between: Naka et al.'s approximation; report and bound its error.
     let mut worst: f64 = 0.0;
     for theta in [-97.5, -87.5, -45.0] {
         let exact = render(theta, Interpolation::Exact);

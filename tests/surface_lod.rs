@@ -1,5 +1,5 @@
 //! Molecular surfaces on the GPU (lavapipe): the solvent-excluded surface of a protein fragment
-//! against its golden image, and seed 002's level of detail against every triangle: parts far
+//! against its golden image, and Lee et al.'s level of detail against every triangle: parts far
 //! away become points, the picture stays within 2/255, picking still finds the surface.
 
 mod common;

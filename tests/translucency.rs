@@ -1,4 +1,4 @@
-//! Translucent isosurfaces (seed 003) on lavapipe: the GPU's sorted fragment lists against a
+//! Translucent isosurfaces (Koide and Miyata, docs/references.md) on lavapipe: the GPU's sorted fragment lists against a
 //! CPU reference that sorts every fragment, independence of the order surfaces are given in,
 //! frames over the fragment budget drawn in bands, the glow where surfaces of two objects
 //! overlap, surfaces inside a cloud against a CPU reference that walks both, and overlapping

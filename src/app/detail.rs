@@ -1,5 +1,5 @@
-//! How much a view draws while the user drags or the animation plays (seed 001's dynamic level
-//! of detail): fewer slices on every adapter, more of a big surface as points (seed 002), and on
+//! How much a view draws while the user drags or the animation plays (Kikuchi et al.'s dynamic level
+//! of detail): fewer slices on every adapter, more of a big surface as points (Lee et al., docs/references.md), and on
 //! a CPU rasteriser fewer pixels too, which the texture filter scales up. The full picture
 //! returns with the first frame after.
 
@@ -21,7 +21,7 @@ pub const INTERACTIVE_LOD_SCALE: f32 = 4.0;
 /// The frame time a dragged view aims for, ms.
 pub const LOD_FRAME_BUDGET_MS: f64 = 50.0;
 
-/// The level of detail tied to the frame time while interacting (seed 002's threshold "tied
+/// The level of detail tied to the frame time while interacting (Lee et al.'s threshold "tied
 /// to the frame-time budget"): each picture slower than the budget makes points of bigger
 /// parts, each one well within it (under half) makes them smaller again; still frames are
 /// drawn at the threshold itself. The scale carries over from one drag to the next.

@@ -39,11 +39,11 @@ use viewport::Viewport;
 /// A bundled demo the viewer can open.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Demo {
-    /// The PSB3 twist scan (seed 000): what the viewer opens with no file.
+    /// The PSB3 twist scan (Naka et al., docs/references.md): what the viewer opens with no file.
     Scan,
     /// Formaldehyde's HOMO as a cube.
     Cube,
-    /// Butadiene's HOMO meeting SO₂'s LUMO, translucent (seed 003).
+    /// Butadiene's HOMO meeting SO₂'s LUMO, translucent (Koide and Miyata, docs/references.md).
     Cycloaddition,
 }
 

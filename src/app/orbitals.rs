@@ -1,4 +1,4 @@
-//! The orbital browser (seed 004's orbital UI): every orbital with its spin, symmetry, energy
+//! The orbital browser (Jang and Varetto's orbital UI): every orbital with its spin, symmetry, energy
 //! and occupation, HOMO/LUMO labels, the density, and the atomic-orbital selector (single basis
 //! functions: an orbital restricted to them, or one alone).
 

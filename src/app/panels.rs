@@ -540,7 +540,7 @@ pub fn error_window(ui: &mut egui::Ui, app: &mut OrbApp) {
 }
 
 /// One lobe's shape, centre, width and opacity, and its curve over the signed value: 0 … 1 for
-/// ψ > 0 (and densities), −1 … 0 for ψ < 0 (`sign` −1), as seed 004 draws its shapes.
+/// ψ > 0 (and densities), −1 … 0 for ψ < 0 (`sign` −1), as Jang and Varetto draws its shapes.
 fn lobe_editor(ui: &mut egui::Ui, label: &str, lobe: &mut Lobe, sign: f32) {
     ui.horizontal(|ui| {
         ui.label(label);
@@ -720,7 +720,7 @@ fn color_by_editor(ui: &mut egui::Ui, iso: &mut IsosurfaceSettings, choices: &[(
     }
 }
 
-/// Translucent or opaque, and the look of a translucent surface (seed 003's optics).
+/// Translucent or opaque, and the look of a translucent surface (Koide and Miyata's optics).
 pub fn translucency_editor(ui: &mut egui::Ui, iso: &mut IsosurfaceSettings) -> bool {
     ui.horizontal(|ui| {
         let mut changed = ui

@@ -126,7 +126,7 @@ pub struct ScanView {
     pub looping: bool,
     /// Animation speed, degrees per second.
     pub speed: f64,
-    /// Primary drags twist θ (seed 000); else they orbit and only a drag on the bond twists.
+    /// Primary drags twist θ (Naka et al., docs/references.md); else they orbit and only a drag on the bond twists.
     pub drag_twists: bool,
     direction: f64,
     pub(super) views: Vec<Viewport>,

@@ -57,7 +57,7 @@ struct PaneTarget {
     drawn: Option<PaneDrawn>,
 }
 
-/// How a drag in a scan view twists the dihedral (seed 000: horizontal drag changes θ).
+/// How a drag in a scan view twists the dihedral (Naka et al.: horizontal drag changes θ).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct TwistInput {
     /// Every primary drag twists (else the view orbits, unless the drag starts on the bond).

@@ -165,7 +165,7 @@ pub struct SurfaceBench {
 
 /// `orbcloud bench surface`: the build time of each surface (or the one `--surface` names),
 /// its size, and ms per frame drawing it at the given size, turning a little each frame, with
-/// every triangle and with seed 002's level of detail (occlusion culled unless asked not to), and
+/// every triangle and with Lee et al.'s level of detail (occlusion culled unless asked not to), and
 /// how far apart the two images are.
 pub fn bench(args: &SurfaceBench) -> Result<()> {
     use crate::gpu::{FrameInput, OffscreenTarget, Renderer};
@@ -193,7 +193,7 @@ pub fn bench(args: &SurfaceBench) -> Result<()> {
         times.sort_by(f64::total_cmp);
         let s = built.context("no surface was built")?;
         // Drawn alone, opaque, as the viewer draws a surface: with every triangle and with
-        // seed 002's level of detail, one renderer each, taking turns frame by frame.
+        // Lee et al.'s level of detail, one renderer each, taking turns frame by frame.
         // Building the levels of detail (what the viewer does in the background after the
         // surface): the coarser versions and every level's octree.
         let t = Instant::now();

@@ -1,5 +1,5 @@
 //! Evaluating a wavefunction's quantities for display: orbitals filled on the GPU (a 3D texture,
-//! read back once for isosurfaces), densities on the CPU, seed 004's direct mode (no grid: the
+//! read back once for isosurfaces), densities on the CPU, Jang and Varetto's direct mode (no grid: the
 //! orbital's range measured from CPU samples, a grid filled only when isosurfaces want one), on
 //! grids the device holds; and the opacity a cloud of the values starts with.
 

@@ -1,6 +1,6 @@
-//! Atoms and bonds from GPU storage buffers (seed 001): positions, packed attributes and bonds
+//! Atoms and bonds from GPU storage buffers (Kikuchi et al., docs/references.md): positions, packed attributes and bonds
 //! are uploaded once; a colour change rewrites only the attributes, a style change only the
-//! small radius table. Each frame a compute pass culls to the frustum and applies seed 002's
+//! small radius table. Each frame a compute pass culls to the frustum and applies Lee et al.'s
 //! screen-size level of detail: spheres of at most [`AtomsPass::splat_radius_px`] pixels are
 //! rasterised in compute (exact per-pixel ray–sphere depth, nearest wins by an atomic maximum)
 //! and resolved in one full-screen pass; bigger ones, and bonds thicker than a third of a

@@ -49,7 +49,7 @@ pub enum Phase {
     /// Translucent clouds back to front: blends over colour, tests depth without writing it.
     Translucent,
     /// Translucent surfaces append their fragments in front of the opaque depth to per-pixel
-    /// lists (seed 003); a frame whose lists overflow their budget repeats this and the
+    /// lists (Koide and Miyata, docs/references.md); a frame whose lists overflow their budget repeats this and the
     /// resolve band by band.
     Fragments,
     /// Sorts each pixel's fragments and composites them over the float colour, exactly in

@@ -1,5 +1,5 @@
 //! Lit isosurfaces: one triangle mesh per surface (an orbital's +v and −v, a density's one).
-//! Opaque ones draw in the opaque phase with depth and pick ids; translucent ones (seed 003)
+//! Opaque ones draw in the opaque phase with depth and pick ids; translucent ones (Koide and Miyata, docs/references.md)
 //! append their fragments to the frame's per-pixel lists ([`super::oit`]).
 
 use bytemuck::{Pod, Zeroable};

@@ -1,11 +1,11 @@
-//! Exact order-independent transparency for seed 003's translucent surfaces: per-pixel
+//! Exact order-independent transparency for Koide and Miyata's translucent surfaces: per-pixel
 //! fragment lists built by the surfaces' collect pass (isosurface.wgsl), sorted and composited
 //! by the resolve (resolve.wgsl).
 //!
 //! Memory is bounded: the node buffer holds a budget of fragments fixed from the device's
 //! limits. A frame that needs more is not cut short: the count of what it needed is read back
 //! and the frame is drawn again in horizontal bands, each collected and composited on its own
-//! ([`FragmentLists::bands`]), as seed 003 drew its tiles.
+//! ([`FragmentLists::bands`]), as Koide and Miyata drew its tiles.
 
 use std::sync::Arc;
 use std::sync::Mutex;
@@ -109,7 +109,7 @@ impl FragmentStats {
 /// How translucent surfaces are composited.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Transparency {
-    /// Per-pixel fragment lists sorted in exact depth order, with seed 003's glow.
+    /// Per-pixel fragment lists sorted in exact depth order, with Koide and Miyata's glow.
     #[default]
     Exact,
     /// Weighted blended order-independent transparency (McGuire & Bavoil 2013): one pass,

@@ -107,7 +107,7 @@ impl Layer {
         self.volume.set_texture(ctx, Some(volume));
     }
 
-    /// Shows θ between two key volumes of a scan (seed 000), mixed (1−k):k.
+    /// Shows θ between two key volumes of a scan (Naka et al., docs/references.md), mixed (1−k):k.
     pub fn set_morph(
         &mut self,
         ctx: &GpuContext,
@@ -119,7 +119,7 @@ impl Layer {
         self.volume.set_morph(ctx, a, b, k, mode);
     }
 
-    /// Shows an orbital evaluated per fragment from its basis functions (seed 004's direct mode),
+    /// Shows an orbital evaluated per fragment from its basis functions (Jang and Varetto's direct mode),
     /// its opacity and gradient scaled to `(max |ψ|, max |∇ψ|)`.
     pub fn set_direct(
         &mut self,
@@ -221,7 +221,7 @@ impl Renderer {
         self.transparency = transparency;
     }
 
-    /// Multiplies every surface's level-of-detail threshold (seed 002) and the error its coarser
+    /// Multiplies every surface's level-of-detail threshold (Lee et al., docs/references.md) and the error its coarser
     /// versions may show: above 1 while the user drags, so more of a big surface is drawn as
     /// points or coarser and the view keeps up.
     pub fn set_lod_scale(&mut self, scale: f32) {
@@ -292,7 +292,7 @@ impl Renderer {
     }
 
     /// Whether a frame is costly enough to draw in tiles: a visible cloud evaluates its orbital
-    /// per sample (seed 004's direct mode).
+    /// per sample (Jang and Varetto's direct mode).
     pub fn is_costly(&self) -> bool {
         self.layers.iter().any(|l| l.visible && l.volume.is_direct())
     }

@@ -1,4 +1,4 @@
-//! A dihedral scan on the GPU (seed 000): every key volume of the chosen orbitals evaluated on
+//! A dihedral scan on the GPU (Naka et al., docs/references.md): every key volume of the chosen orbitals evaluated on
 //! one common grid and kept resident as a 3D texture, so any θ is drawn by mixing the two key
 //! volumes around it, with the skeleton turned to θ.
 

@@ -107,7 +107,7 @@ pub struct Batch {
 
 impl LodView {
     /// Pixels per object unit at clip w = 1: the projection's y scale times half the height
-    /// (Size = r·(n/z_eye)·(h/(t − b)), seed 002).
+    /// (Size = r·(n/z_eye)·(h/(t − b)), Lee et al.).
     pub fn px_per_unit(&self) -> f32 {
         let m = self.clip_from_object;
         Vec3::new(m.x_axis.y, m.y_axis.y, m.z_axis.y).length() * 0.5 * self.height_px

@@ -1,4 +1,4 @@
-//! Scans (seed 000): key frames computed at known values of a coordinate — a bond length, a
+//! Scans (Naka et al., docs/references.md): key frames computed at known values of a coordinate — a bond length, a
 //! bond angle, a dihedral, or a position along a path (an IRC, a relaxed scan) — the skeleton
 //! at any value between them, and which orbital of each frame continues which orbital of the
 //! previous one.

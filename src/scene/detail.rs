@@ -11,7 +11,7 @@ pub struct Detail {
     pub max_slices: u32,
     /// At most this many pixels; the view's size is scaled down to fit, keeping its aspect.
     pub max_pixels: u32,
-    /// The factor on surfaces' level-of-detail thresholds (seed 002).
+    /// The factor on surfaces' level-of-detail thresholds (Lee et al., docs/references.md).
     pub lod_scale: f32,
 }
 

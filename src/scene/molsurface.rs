@@ -53,7 +53,7 @@ pub struct SurfaceSettings {
     pub smoothness: f32,
     /// Linear RGB.
     pub color: [f32; 3],
-    /// Translucent with seed 003's optics, in exact order with every other translucent surface.
+    /// Translucent with Koide and Miyata's optics, in exact order with every other translucent surface.
     pub translucent: bool,
     /// Seed 002's level of detail: parts of the surface smaller than this many pixels on screen
     /// are drawn as points (0: every triangle); the viewer scales it up while the view is

@@ -224,7 +224,7 @@ pub struct Evaluation {
     pub spin: Spin,
     /// Evaluate orbitals per slice sample instead of on a GPU-filled grid.
     pub direct: bool,
-    /// Restrict orbitals to the basis functions ticked in `functions` (seed 004's
+    /// Restrict orbitals to the basis functions ticked in `functions` (Jang and Varetto's
     /// atomic-orbital selector).
     pub ao_filter: bool,
     /// Per basis function (the model's order), whether it contributes when the filter is on.

@@ -15,7 +15,7 @@ pub enum SliceMode {
     AxisAligned,
 }
 
-/// How a frame between two key volumes (a dihedral scan, seed 000) mixes them.
+/// How a frame between two key volumes (a dihedral scan, Naka et al.) mixes them.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
 pub enum Interpolation {
     /// Both volumes sampled and mixed per sample, ψ = (1−k)ψA + kψB: the interpolated orbital.
@@ -187,7 +187,7 @@ pub struct IsosurfaceSettings {
     pub negative_color: [f32; 3],
     /// Linear RGB of a density's surface.
     pub density_color: [f32; 3],
-    /// Drawn translucent with seed 003's optics, in exact depth order with every other
+    /// Drawn translucent with Koide and Miyata's optics, in exact depth order with every other
     /// translucent surface.
     #[serde(default)]
     pub translucent: bool,

@@ -1,6 +1,6 @@
 //! Transfer functions: how a sample's value (and gradient) becomes colour and opacity.
 //!
-//! Two families: seed 000's power law α = k1·ρ^k2 (the default), and seed 004's shaped
+//! Two families: Naka et al.'s power law α = k1·ρ^k2 (the default), and Jang and Varetto's shaped
 //! functions of the normalised value, one per sign, optionally weighted by the gradient
 //! magnitude (a 2D transfer function), lit from the gradient and with boundaries enhanced.
 

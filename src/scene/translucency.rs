@@ -7,7 +7,7 @@
 //! B₍ₙ₋₁₎ = Iₙ + tₙ·Bₙ: no (1 − t) factor on I. Every coefficient is per RGB channel.
 //!
 //! Where the ray runs inside a surface of another object (the HOMO of one molecule meeting the
-//! LUMO of another, seed 003's collision), a surface's d, f, g switch to its glow values, so
+//! LUMO of another, Koide and Miyata's collision), a surface's d, f, g switch to its glow values, so
 //! the overlap glows.
 
 use serde::{Deserialize, Serialize};
@@ -159,7 +159,7 @@ impl OpticsTuning {
     }
 }
 
-/// How one isosurface mesh is drawn: opaque in a colour, or translucent with seed 003's optics.
+/// How one isosurface mesh is drawn: opaque in a colour, or translucent with Koide and Miyata's optics.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SurfaceLook {
     /// Linear RGB (of the opaque surface; a translucent one's optics were made from it).
@@ -279,7 +279,7 @@ impl Walk {
     }
 
     /// Composites a cloud sample of colour `color` and opacity `alpha` behind what the walk
-    /// holds (seed 000's emission–absorption, premultiplied).
+    /// holds (Naka et al.'s emission–absorption, premultiplied).
     pub fn sample(&mut self, color: [f32; 3], alpha: f32) {
         self.add(color.map(|c| c * alpha), [1.0 - alpha; 3]);
     }

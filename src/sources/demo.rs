@@ -60,7 +60,7 @@ pub fn scan() -> Result<ScanFile, LoadError> {
     formats::scan::parse_scan(Path::new(SCAN_NAME), SCAN_MANIFEST, &mut load)
 }
 
-/// The diene + SO₂ demo (seed 003's picture): s-cis butadiene and SO₂ placed as in a
+/// The diene + SO₂ demo (Koide and Miyata's picture): s-cis butadiene and SO₂ placed as in a
 /// cheletropic approach, RHF/6-31G*, written by scripts/make_cycloaddition_demo.py (PySCF).
 const BUTADIENE_MOLDEN_GZ: &[u8] = include_bytes!("../../assets/cycloaddition/butadiene.molden.gz");
 const SO2_MOLDEN_GZ: &[u8] = include_bytes!("../../assets/cycloaddition/so2.molden.gz");

@@ -104,7 +104,7 @@ impl<'a> CloudReference<'a> {
         (far - self.eye).normalize()
     }
 
-    /// Extinction of one reference step for a value: seed 000's k1·ρ^k2 or seed 004's shapes.
+    /// Extinction of one reference step for a value: Naka et al.'s k1·ρ^k2 or Jang and Varetto's shapes.
     fn extinction(&self, v: f64) -> f64 {
         let vs = &self.vs;
         let signed = self.grid.kind == ValueKind::Signed;
