@@ -60,10 +60,10 @@ fn bench(c: &mut Criterion) {
     group.throughput(Throughput::Bytes(text.len() as u64));
     group.sample_size(20);
     group.bench_function("parse_128^3", |b| {
-        b.iter(|| orbcloud::formats::cube::parse("synthetic.cube", black_box(&text)).expect("parses"))
+        b.iter(|| orbcloud::formats::cube::parse("synthetic.cube", black_box(&text)).expect("parses"));
     });
     group.bench_function("read_128^3", |b| {
-        b.iter(|| orbcloud::formats::cube::CubeFile::parse("synthetic.cube", black_box(&text)).expect("parses"))
+        b.iter(|| orbcloud::formats::cube::CubeFile::parse("synthetic.cube", black_box(&text)).expect("parses"));
     });
     // Baseline: the standard library's tokenizer and float parser, one thread, data section only.
     let data = &text[text.match_indices('\n').nth(7).map_or(0, |(i, _)| i + 1)..];
@@ -71,7 +71,7 @@ fn bench(c: &mut Criterion) {
     group.bench_function("std_split_parse_f32_128^3", |b| {
         b.iter(|| {
             black_box(data).split_ascii_whitespace().map(|t| t.parse::<f32>().expect("a number")).collect::<Vec<f32>>()
-        })
+        });
     });
     group.finish();
 }

@@ -70,7 +70,7 @@ fn bench(c: &mut Criterion) {
     group.sample_size(20);
     group.throughput(Throughput::Elements(grid.len() as u64));
     group.bench_function("benzene_homo_80cubed", |b| {
-        b.iter(|| black_box(prepared.eval_grid_f32(black_box(&homo), &grid)))
+        b.iter(|| black_box(prepared.eval_grid_f32(black_box(&homo), &grid)));
     });
     group.bench_function("prepare_basis", |b| b.iter(|| black_box(PreparedBasis::new(black_box(&basis)))));
     group.finish();

@@ -42,7 +42,7 @@ fn eval_reproduces_expected_values() {
         let text: String = expected.iter().map(|v| format!("{} {} {}\n", v[0], v[1], v[2])).collect();
         std::fs::write(&points, text).unwrap();
         let mut args = vec!["eval", &refdata(file)].into_iter().map(String::from).collect::<Vec<_>>();
-        args.extend(flags.iter().map(|s| s.to_string()));
+        args.extend(flags.iter().map(std::string::ToString::to_string));
         args.extend(["--points".to_string(), points.display().to_string()]);
         let out = orbcloud(&args.iter().map(String::as_str).collect::<Vec<_>>());
         assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));

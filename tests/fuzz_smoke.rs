@@ -99,7 +99,7 @@ fn fuzz(name: &str, seeds: &[Vec<u8>], read: impl Fn(&[u8])) -> usize {
         }
         count += 1;
     }
-    eprintln!("{name}: {count} mutated inputs in {:?}, none panicked", BUDGET);
+    eprintln!("{name}: {count} mutated inputs in {BUDGET:?}, none panicked");
     count
 }
 

@@ -188,7 +188,7 @@ fn overlap_matches_pyscf_and_orbitals_are_orthonormal() {
             .filter(|o| o.spin == Spin::Alpha)
             .map(|o| o.coefficients.iter().map(|c| c * 1.1).collect())
             .collect();
-        let refs: Vec<&[f64]> = broken.iter().map(|c| c.as_slice()).collect();
+        let refs: Vec<&[f64]> = broken.iter().map(std::vec::Vec::as_slice).collect();
         assert!(orthonormality_error(&s, n, &refs) > 0.1);
     }
 }

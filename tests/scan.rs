@@ -297,7 +297,7 @@ fn manifest_errors_name_the_file_and_line() {
     let water = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/wavefunctions");
     let water = std::fs::read_dir(&water)
         .unwrap()
-        .filter_map(|e| e.ok())
+        .filter_map(std::result::Result::ok)
         .map(|e| e.path())
         .find(|p| p.to_string_lossy().contains("h2o") && p.to_string_lossy().ends_with(".molden"))
         .expect("a water Molden fixture");
@@ -391,7 +391,7 @@ fn init_measures_the_most_changing_dihedral_and_sorts() {
     let water = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/wavefunctions");
     let w = std::fs::read_dir(&water)
         .unwrap()
-        .filter_map(|e| e.ok())
+        .filter_map(std::result::Result::ok)
         .map(|e| e.path())
         .find(|p| p.to_string_lossy().ends_with(".molden"))
         .unwrap();

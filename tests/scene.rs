@@ -178,7 +178,7 @@ fn gpu_errors_inside_a_guard_become_messages() {
     });
     match result {
         Err(GpuError::Rejected(message)) => {
-            assert!(message.contains("over the limit") || message.contains("imension"), "{message}")
+            assert!(message.contains("over the limit") || message.contains("imension"), "{message}");
         }
         other => panic!("the texture over the limit was not caught: {other:?}"),
     }

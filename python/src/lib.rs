@@ -301,7 +301,7 @@ fn load(py: Python<'_>, path: PathBuf) -> PyResult<PyDocument> {
 /// energies, occupations and spins. The contractions are normalised here and the orbitals
 /// checked (CᵀSC) as a file's are.
 #[pyfunction]
-#[allow(clippy::too_many_arguments)]
+#[allow(clippy::too_many_arguments, reason = "the Python function's keyword arguments, one each")]
 fn from_parts(
     source: String,
     program: String,
@@ -439,7 +439,7 @@ struct SceneState {
 impl Scene {
     fn state(&self) -> std::sync::MutexGuard<'_, SceneState> {
         // A panic while drawing leaves the scene as it was: keep using it.
-        self.state.lock().unwrap_or_else(|e| e.into_inner())
+        self.state.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
     }
 }
 

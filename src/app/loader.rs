@@ -23,7 +23,7 @@ impl LoadJob {
     /// Loads `path`, then makes the data sets a session's object had added to it
     /// ([`super::session::add_volume`]).
     pub fn start(path: PathBuf, added: Vec<AddedVolume>, repaint: impl Fn() + Send + Sync + 'static) -> Self {
-        let total = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
+        let total = std::fs::metadata(&path).map_or(0, |m| m.len());
         let read = Arc::new(AtomicU64::new(0));
         let (p, counter) = (path.clone(), read.clone());
         let repaint = Arc::new(repaint);

@@ -78,7 +78,7 @@ pub fn run(files: Vec<PathBuf>, demo: Option<Demo>) -> eframe::Result<()> {
             run_and_return: true,
             ..Default::default()
         };
-        let carried = slot.lock().unwrap_or_else(|p| p.into_inner()).take();
+        let carried = slot.lock().unwrap_or_else(std::sync::PoisonError::into_inner).take();
         let opening = first.take();
         let next = slot.clone();
         eframe::run_native(
@@ -106,7 +106,7 @@ pub fn run(files: Vec<PathBuf>, demo: Option<Demo>) -> eframe::Result<()> {
                 Ok(Box::new(app))
             }),
         )?;
-        if slot.lock().unwrap_or_else(|p| p.into_inner()).is_none() {
+        if slot.lock().unwrap_or_else(std::sync::PoisonError::into_inner).is_none() {
             return Ok(());
         }
     }
@@ -375,14 +375,17 @@ impl OrbApp {
             let (errors, repaint) = (gpu_errors.clone(), cc.egui_ctx.clone());
             vp.ctx.device.on_uncaptured_error(Arc::new(move |e| {
                 log::error!("GPU: {e}");
-                errors.lock().unwrap_or_else(|p| p.into_inner()).push(e.to_string());
+                errors.lock().unwrap_or_else(std::sync::PoisonError::into_inner).push(e.to_string());
                 repaint.request_repaint();
             }));
             // A lost device: the scene moves to a new window on a new device (`restart`).
             let (errors, repaint) = (gpu_errors.clone(), cc.egui_ctx.clone());
             vp.ctx.device.set_device_lost_callback(move |reason, message| {
                 if reason != wgpu::DeviceLostReason::Destroyed {
-                    errors.lock().unwrap_or_else(|p| p.into_inner()).push(format!("{DEVICE_LOST} ({message})"));
+                    errors
+                        .lock()
+                        .unwrap_or_else(std::sync::PoisonError::into_inner)
+                        .push(format!("{DEVICE_LOST} ({message})"));
                     repaint.request_repaint();
                 }
             });
@@ -582,8 +585,8 @@ impl OrbApp {
 
     /// Whether a click in a view waits for its picture to be whole before it is picked.
     pub fn is_picking(&self) -> bool {
-        self.viewport.as_ref().is_some_and(|v| v.is_picking())
-            || self.scan.as_ref().is_some_and(|s| s.views.iter().any(|v| v.is_picking()))
+        self.viewport.as_ref().is_some_and(viewport::Viewport::is_picking)
+            || self.scan.as_ref().is_some_and(|s| s.views.iter().any(viewport::Viewport::is_picking))
     }
 
     /// How much of a costly frame (drawn in bands) the single-file view has drawn (0..1);
@@ -594,7 +597,7 @@ impl OrbApp {
 
     /// Whether a coarse picture stands in while the single-file view's costly frame is drawn.
     pub fn previewing(&self) -> bool {
-        self.viewport.as_ref().is_some_and(|vp| vp.is_previewing())
+        self.viewport.as_ref().is_some_and(viewport::Viewport::is_previewing)
     }
 
     /// What the single-file view's translucent surfaces took (fragments, bands).
@@ -794,7 +797,7 @@ impl OrbApp {
         // Several molecules side by side are wider than tall: every atom (2 bohr inside the
         // edges) in the view as it is laid out, not only in its height.
         if self.objects.len() > 1
-            && let Some(aspect) = self.viewport.as_ref().and_then(|v| v.aspect())
+            && let Some(aspect) = self.viewport.as_ref().and_then(viewport::Viewport::aspect)
         {
             camera.fit_points(self.world.molecule.atoms.iter().map(|a| a.position.as_vec3()), aspect, 2.0);
         }
@@ -1067,7 +1070,8 @@ impl OrbApp {
     fn poll_job(&mut self, ctx: &egui::Context) {
         self.poll_object_jobs();
         self.poll_difference();
-        let reported: Vec<String> = std::mem::take(&mut *self.gpu_errors.lock().unwrap_or_else(|p| p.into_inner()));
+        let reported: Vec<String> =
+            std::mem::take(&mut *self.gpu_errors.lock().unwrap_or_else(std::sync::PoisonError::into_inner));
         if let Some(lost) = reported.iter().find(|e| e.starts_with(DEVICE_LOST)) {
             self.save_last_session();
             let reason = lost.trim_start_matches(DEVICE_LOST).trim_matches([' ', '(', ')']).to_string();
@@ -1091,7 +1095,7 @@ impl OrbApp {
             match result {
                 Ok(doc) => self.add_or_join(doc, how),
                 Err(e) => {
-                    self.error = Some(e.to_string());
+                    self.error = Some(e.clone());
                     self.show_demo_if_empty(ctx);
                 }
             }

@@ -367,7 +367,7 @@ fn data_set_choice(ui: &mut egui::Ui, doc: &crate::model::Document, source: &mut
     let Source::Volume(shown) = source else { return };
     ComboBox::from_id_salt("data set")
         .width(220.0)
-        .selected_text(doc.volumes.get(*shown).map(|v| v.label.as_str()).unwrap_or("?"))
+        .selected_text(doc.volumes.get(*shown).map_or("?", |v| v.label.as_str()))
         .show_ui(ui, |ui| {
             for (i, v) in doc.volumes.iter().enumerate() {
                 ui.selectable_value(shown, i, &v.label);

@@ -54,8 +54,8 @@ impl OrbApp {
     /// The size of the view on screen (each scan view's).
     fn shown_size(&self) -> [u32; 2] {
         let shown = match &self.scan {
-            Some(scan) => scan.views.first().and_then(|v| v.size()),
-            None => self.viewport.as_ref().and_then(|v| v.size()),
+            Some(scan) => scan.views.first().and_then(super::viewport::Viewport::size),
+            None => self.viewport.as_ref().and_then(super::viewport::Viewport::size),
         };
         shown.unwrap_or([1280, 800])
     }
@@ -118,7 +118,7 @@ impl OrbApp {
             None if !vp.pane_sizes().is_empty() => {
                 let pictures: Result<Vec<_>, _> = (0..vp.pane_sizes().len()).map(|p| vp.pane_picture(p)).collect();
                 pictures.map(|pictures| {
-                    let (w, h) = pictures.first().map_or((1, 1), |p| p.dimensions());
+                    let (w, h) = pictures.first().map_or((1, 1), image::ImageBuffer::dimensions);
                     let mut out = image::RgbaImage::new(w * pictures.len() as u32, h);
                     for (n, picture) in pictures.iter().enumerate() {
                         image::imageops::replace(&mut out, picture, (n as u32 * w) as i64, 0);

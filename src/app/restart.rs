@@ -34,7 +34,10 @@ impl OrbApp {
     /// The device is lost (`reason`: what the driver said); what the device's handler calls,
     /// and the way to rehearse it.
     pub fn lose_device(&self, reason: &str) {
-        self.gpu_errors.lock().unwrap_or_else(|p| p.into_inner()).push(format!("{} ({reason})", super::DEVICE_LOST));
+        self.gpu_errors
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .push(format!("{} ({reason})", super::DEVICE_LOST));
     }
 
     /// Hands the scene to the next window when there is one to hand it to; `false` when the
@@ -49,7 +52,7 @@ impl OrbApp {
             scan: self.scan.as_ref().map(|s| s.source.clone()),
             reason: reason.to_string(),
         };
-        *slot.lock().unwrap_or_else(|p| p.into_inner()) = Some(carried);
+        *slot.lock().unwrap_or_else(std::sync::PoisonError::into_inner) = Some(carried);
         ctx.send_viewport_cmd(egui::ViewportCommand::Close);
         true
     }

@@ -441,7 +441,7 @@ pub fn views(
                         "{}isosurfaces at {}: {n} triangles",
                         note.map_or(String::new(), |n| n + "; "),
                         scan.scene.coordinate_label(scan.theta)
-                    ))
+                    ));
                 }
                 Some(Err(e)) => said = Some(e),
                 _ => {}

@@ -144,7 +144,7 @@ fn run(job: &Job) -> Result<(Vec<compute::FrameReport>, std::collections::BTreeM
             r.error.as_deref().unwrap_or("?")
         ),
         Event::Done { computed, kept, failed } => {
-            eprintln!("{computed} computed, {kept} kept, {failed} failed")
+            eprintln!("{computed} computed, {kept} kept, {failed} failed");
         }
         Event::Error { .. } => {}
     })?;

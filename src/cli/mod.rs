@@ -70,7 +70,7 @@ impl DemoArg {
 }
 
 // Parsed once per process: boxing the larger variants would save nothing worth the noise.
-#[allow(clippy::large_enum_variant)]
+#[allow(clippy::large_enum_variant, reason = "parsed once per process")]
 #[derive(Subcommand)]
 enum Command {
     /// Open the interactive viewer (the default).
@@ -299,22 +299,23 @@ impl WhatArgs {
             name => format!("--orbital {name}"),
         }
     }
+}
 
-    fn label(&self, q: &Quantity, doc: &Document) -> String {
-        let Some(wf) = &doc.wavefunction else { return String::new() };
-        match q {
-            Quantity::Density => "total electron density".into(),
-            Quantity::SpinDensity => "spin density".into(),
-            Quantity::Potential => "electrostatic potential (a.u.)".into(),
-            Quantity::BasisFunction(k) => {
-                let name = crate::model::basis_labels::function_name(&doc.molecule, &wf.basis, *k);
-                format!("basis function {}", name.unwrap_or_default())
-            }
-            Quantity::Orbital(i) => {
-                let o = &wf.orbitals[*i];
-                let n = wf.of_spin(o.spin).position(|(j, _)| j == *i).map_or(0, |p| p + 1);
-                format!("MO {n} ({:?}) E={:.6} Eh occ={:.3} {}", o.spin, o.energy, o.occupation, o.symmetry)
-            }
+/// What the grid of `q` holds, for a cube file's title line and `eval`'s header.
+fn quantity_label(q: &Quantity, doc: &Document) -> String {
+    let Some(wf) = &doc.wavefunction else { return String::new() };
+    match q {
+        Quantity::Density => "total electron density".into(),
+        Quantity::SpinDensity => "spin density".into(),
+        Quantity::Potential => "electrostatic potential (a.u.)".into(),
+        Quantity::BasisFunction(k) => {
+            let name = crate::model::basis_labels::function_name(&doc.molecule, &wf.basis, *k);
+            format!("basis function {}", name.unwrap_or_default())
+        }
+        Quantity::Orbital(i) => {
+            let o = &wf.orbitals[*i];
+            let n = wf.of_spin(o.spin).position(|(j, _)| j == *i).map_or(0, |p| p + 1);
+            format!("MO {n} ({:?}) E={:.6} Eh occ={:.3} {}", o.spin, o.energy, o.occupation, o.symmetry)
         }
     }
 }

@@ -265,7 +265,7 @@ fn caption(doc: &Document, source: Source) -> String {
     let name = source.name(doc);
     match (source.orbital(), &doc.wavefunction) {
         (Some(i), Some(wf)) => match wf.energy(i) {
-            Some(e) => format!("{name}  {:.4} Eh", e).replace('-', "−"),
+            Some(e) => format!("{name}  {e:.4} Eh").replace('-', "−"),
             None => name,
         },
         _ => name,

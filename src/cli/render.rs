@@ -193,7 +193,7 @@ pub fn bench(
     }
     times.sort_by(f64::total_cmp);
     let median = times[times.len() / 2];
-    let grid = doc.volumes.get(view.volume).map(|g| format!("{:?}", g.dims)).unwrap_or("none".into());
+    let grid = doc.volumes.get(view.volume).map_or("none".into(), |g| format!("{:?}", g.dims));
     println!("adapter: {}", ctx.describe());
     println!(
         "scene: {} atoms, grid {grid}, {}x{}, {:?}, {} slices",

@@ -334,7 +334,7 @@ impl GridArgs {
         let spec = g;
         let prepared = PreparedBasis::new(&wf.basis);
         let values = prepared.quantity_grid_f32(wf, &doc.molecule, q, &spec);
-        Ok(VolumeGrid::new(self.what.label(&q, doc), g.dims, g.world_from_grid, values))
+        Ok(VolumeGrid::new(super::quantity_label(&q, doc), g.dims, g.world_from_grid, values))
     }
 }
 

@@ -78,7 +78,7 @@ pub fn cube(
     let prepared = PreparedBasis::new(&wf.basis);
     let t = Instant::now();
     let mut values = prepared.quantity_grid_f32(wf, &doc.molecule, q, &spec);
-    let mut label = what.label(&q, &doc);
+    let mut label = super::quantity_label(&q, &doc);
     if let Some(other) = minus {
         let points = crate::evaluate::arithmetic::grid_points(dims, |i, j, k| spec.point(i, j, k));
         for (v, o) in values.iter_mut().zip(other_values(other, what, &points)?) {

@@ -115,7 +115,7 @@ impl<'a> Tokens<'a> {
                     None | Some(b'\n') => {
                         return Err(self.error(line, format!("a closing {} on the same line", c as char), "none"));
                     }
-                    Some(&q) if q == c && b.get(p + 1).is_none_or(|n| n.is_ascii_whitespace()) => {
+                    Some(&q) if q == c && b.get(p + 1).is_none_or(u8::is_ascii_whitespace) => {
                         self.pos = p + 1;
                         return Ok(Some(Token { kind: Kind::Quoted, text: &self.text[start + 1..p], line }));
                     }

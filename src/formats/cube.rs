@@ -423,10 +423,7 @@ fn declared(prefix: &[u8]) -> Declared {
     let ints = |l: &str| l.split_whitespace().map(|t| t.parse::<i64>().ok()).collect::<Vec<_>>();
     let Some(line3) = complete_line(prefix, &mut pos) else { return Declared::NeedMore };
     let t: Vec<&str> = line3.split_whitespace().collect();
-    let natoms = match t.first().map(|n| n.parse::<i64>()) {
-        Some(Ok(n)) => n,
-        _ => return Declared::Broken,
-    };
+    let Some(Ok(natoms)) = t.first().map(|n| n.parse::<i64>()) else { return Declared::Broken };
     let nval = match t.get(4).map(|n| n.parse::<u64>()) {
         None => 1,
         Some(Ok(n)) if n >= 1 => n,

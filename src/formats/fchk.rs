@@ -712,7 +712,7 @@ mod tests {
     #[test]
     fn malformed_files_name_their_line() {
         let good = file(false, "");
-        let line_of = |needle: &str| good.lines().position(|l| l.starts_with(needle)).map(|i| i + 1).unwrap_or(0);
+        let line_of = |needle: &str| good.lines().position(|l| l.starts_with(needle)).map_or(0, |i| i + 1);
         let n_lines = good.lines().count();
         let mo = line_of("Alpha MO coefficients");
         let cases: Vec<(String, usize, &str)> = vec![

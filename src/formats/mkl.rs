@@ -458,7 +458,7 @@ $OCC_ALPHA
             match parse("t.mkl", &text, None) {
                 Ok(_) => wrong.push(format!("wanted line {line} \"{expected}\", but it parsed")),
                 Err(e) if e.line != line || !e.expected.contains(expected) || e.file != "t.mkl" => {
-                    wrong.push(format!("wanted line {line} \"{expected}\", got {e}"))
+                    wrong.push(format!("wanted line {line} \"{expected}\", got {e}"));
                 }
                 Err(_) => {}
             }

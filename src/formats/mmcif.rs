@@ -196,7 +196,7 @@ pub fn parse(file: &str, text: &str) -> Result<Document, ParseError> {
                 let mut count = 0usize;
                 let mut last_line = header_line;
                 // Values until the next tag, loop_ or data_.
-                while let Some(v) = next.filter(|n| n.is_value()) {
+                while let Some(v) = next.filter(super::cif::Token::is_value) {
                     last_line = v.line;
                     count += 1;
                     if site.is_some() || keep {
@@ -230,7 +230,7 @@ pub fn parse(file: &str, text: &str) -> Result<Document, ParseError> {
             Kind::Tag => {
                 let value = t
                     .next_token()?
-                    .filter(|v| v.is_value())
+                    .filter(super::cif::Token::is_value)
                     .ok_or_else(|| t.error(tok.line, format!("a value after {}", tok.text), "none"))?;
                 let (cat, item) = tok.text.split_once('.').unwrap_or((tok.text, ""));
                 let cat = cat.to_ascii_lowercase();

@@ -246,7 +246,7 @@ fn read_stream(
             return Err(e.into());
         }
         let inflated = out.len() as u64;
-        if let Some(c) = compressed.map(|c| c.get())
+        if let Some(c) = compressed.map(std::cell::Cell::get)
             && cube.is_none()
             && inflated > INFLATION_FLOOR.max(c.saturating_mul(MAX_INFLATION))
         {
@@ -265,7 +265,7 @@ fn read_stream(
         {
             // Keep whole tokens only, so that the text stays valid UTF-8 and the parser sees
             // no half value.
-            let keep = out.iter().rposition(|b| b.is_ascii_whitespace()).map_or(0, |p| p + 1);
+            let keep = out.iter().rposition(u8::is_ascii_whitespace).map_or(0, |p| p + 1);
             out.truncate(keep);
             stopped = Some(ParseError {
                 file: name.to_string(),

@@ -249,7 +249,7 @@ impl MoldenFile {
             .atoms
             .iter()
             .map(|a| {
-                let symbol: String = a.name.chars().take_while(|c| c.is_ascii_alphabetic()).collect();
+                let symbol: String = a.name.chars().take_while(char::is_ascii_alphabetic).collect();
                 let named = atomic_number(&symbol);
                 let column = a.charge.round();
                 let (z, ghost) = if column >= 1.0 { (column as u32, false) } else { (named.unwrap_or(0), true) };
@@ -501,13 +501,13 @@ fn parse_mo(file: &str, lines: &[&str], start: usize, end: usize) -> Result<Vec<
                 "ene" => {
                     o.energy = Some(
                         parse_real(value).ok_or_else(|| error(file, line_no, "an energy `Ene= value`", excerpt(l)))?,
-                    )
+                    );
                 }
                 "occup" => {
                     o.occupation = Some(
                         parse_real(value)
                             .ok_or_else(|| error(file, line_no, "an occupation `Occup= value`", excerpt(l)))?,
-                    )
+                    );
                 }
                 "spin" => {
                     o.spin = match value.to_ascii_lowercase().as_str() {

@@ -54,7 +54,7 @@ fn col_byte(line: &str, c: usize) -> u8 {
 /// four-letter hydrogen names of ATOM records ("HG21").
 fn element_from_name(name: &str, hetero: bool) -> Option<u8> {
     let b = name.as_bytes();
-    let letter = |i: usize| b.get(i).copied().filter(|c| c.is_ascii_alphabetic());
+    let letter = |i: usize| b.get(i).copied().filter(u8::is_ascii_alphabetic);
     match (letter(0), letter(1)) {
         (None, Some(c)) => element_of(&(c as char).to_string()),
         (Some(c0), Some(c1)) => {

@@ -410,7 +410,7 @@ pub fn init(dir: &Path, coordinate: Option<Coordinate>) -> Result<ScanInit, Load
     let io = |source| LoadError::Io { path: dir.display().to_string(), source };
     let mut names: Vec<String> = std::fs::read_dir(dir)
         .map_err(io)?
-        .filter_map(|e| e.ok())
+        .filter_map(std::result::Result::ok)
         .filter(|e| e.path().is_file())
         .map(|e| e.file_name().to_string_lossy().into_owned())
         .filter(|n| is_wavefunction_file(n))

@@ -203,7 +203,7 @@ fn parse_atom(line: &str) -> Result<Atom, String> {
     let charge_text = line[charge_at + "CHARGE".len()..].trim_start().trim_start_matches('=');
     let charge = fortran_fields(charge_text).first().and_then(|f| parse_fortran_real(f)).ok_or_else(bad)?;
     let name = line[..open].split_whitespace().next().unwrap_or("");
-    let letters: String = name.chars().take_while(|c| c.is_ascii_alphabetic()).collect();
+    let letters: String = name.chars().take_while(char::is_ascii_alphabetic).collect();
     let z = atomic_number(&letters)
         .or_else(|| (0.0..=f64::from(MAX_Z)).contains(&charge.round()).then_some(charge.round() as u32))
         .ok_or_else(|| format!("an element name or a nuclear charge 0..={MAX_Z}"))?;
@@ -499,7 +499,7 @@ END DATA
             match parse("t.wfn", &text, None) {
                 Ok(_) => wrong.push(format!("wanted line {line} \"{expected}\", but it parsed")),
                 Err(e) if e.line != line || !e.expected.contains(expected) || e.file != "t.wfn" => {
-                    wrong.push(format!("wanted line {line} \"{expected}\", got {e}"))
+                    wrong.push(format!("wanted line {line} \"{expected}\", got {e}"));
                 }
                 Err(_) => {}
             }

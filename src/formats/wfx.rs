@@ -48,6 +48,13 @@ struct Section<'a> {
     body: Vec<(usize, Cow<'a, str>)>,
 }
 
+impl Section<'_> {
+    /// Every whitespace-separated value of the section, with its line.
+    fn tokens(&self) -> impl Iterator<Item = (usize, &str)> {
+        self.body.iter().flat_map(|(line, text)| text.split_whitespace().map(move |t| (*line, t)))
+    }
+}
+
 struct WfxFile<'a> {
     file: &'a str,
     /// By tag name, lower case without spaces.
@@ -173,11 +180,6 @@ impl<'a> WfxFile<'a> {
             .ok_or_else(|| error(self.file, self.n_lines.max(1), format!("a <{name}> section"), "none in the file"))
     }
 
-    /// Every whitespace-separated value of a section, with its line.
-    fn tokens<'s>(&'s self, section: &'s Section<'a>) -> impl Iterator<Item = (usize, &'s str)> {
-        section.body.iter().flat_map(|(line, text)| text.split_whitespace().map(move |t| (*line, t)))
-    }
-
     /// The `n` values of a section (all of them when `n` is `None`), each parsed by `read`.
     fn values<T>(
         &self,
@@ -188,7 +190,7 @@ impl<'a> WfxFile<'a> {
     ) -> Result<Vec<T>, ParseError> {
         let section = self.section(name)?;
         let mut out = Vec::new();
-        for (line, token) in self.tokens(section) {
+        for (line, token) in section.tokens() {
             if n.is_some_and(|n| out.len() == n) {
                 let n = n.unwrap_or(0);
                 return Err(error(self.file, line, format!("{n} values in <{name}>"), "more"));
@@ -302,7 +304,7 @@ impl<'a> WfxFile<'a> {
         let mut atoms = Vec::with_capacity(n);
         for i in 0..n {
             let named = names.as_ref().and_then(|v| {
-                let letters: String = v[i].1.chars().take_while(|c| c.is_ascii_alphabetic()).collect();
+                let letters: String = v[i].1.chars().take_while(char::is_ascii_alphabetic).collect();
                 atomic_number(&letters)
             });
             let charge = charges.as_ref().map(|c| c[i]);
@@ -558,7 +560,7 @@ mod tests {
             match parse("t.wfx", &text, None) {
                 Ok(_) => wrong.push(format!("wanted line {line} \"{expected}\", but it parsed")),
                 Err(e) if e.line != line || !e.expected.contains(expected) || e.file != "t.wfx" => {
-                    wrong.push(format!("wanted line {line} \"{expected}\", got {e}"))
+                    wrong.push(format!("wanted line {line} \"{expected}\", got {e}"));
                 }
                 Err(_) => {}
             }

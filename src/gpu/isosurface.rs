@@ -469,7 +469,10 @@ impl IsosurfacePass {
     /// frame's; past [`MAX_TRANSLUCENT_SURFACES`] they are drawn opaque. `lists`: the frame's
     /// fragment lists, and how they are composited. `clip`: the object's clipping plane (a
     /// closed surface cut open shows its inside).
-    #[allow(clippy::too_many_arguments)]
+    #[allow(
+        clippy::too_many_arguments,
+        reason = "a frame's per-view inputs, each named where the renderer calls it once"
+    )]
     pub fn set_view(
         &mut self,
         ctx: &GpuContext,

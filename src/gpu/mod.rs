@@ -151,9 +151,5 @@ pub(crate) fn uniform_buffer(device: &wgpu::Device, label: &str, size: usize) ->
 }
 
 pub(crate) fn shader_source(name: &str) -> &'static str {
-    SHADERS
-        .iter()
-        .find(|(n, _)| *n == name)
-        .map(|(_, s)| *s)
-        .unwrap_or_else(|| panic!("shader {name} is not in gpu::SHADERS"))
+    SHADERS.iter().find(|(n, _)| *n == name).map_or_else(|| panic!("shader {name} is not in gpu::SHADERS"), |(_, s)| *s)
 }

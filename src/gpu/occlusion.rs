@@ -257,7 +257,7 @@ impl CulledBatches {
         Self { uniforms, seen, capacity, batches, early, late, group, count: 0, frame: 1, staged: Vec::new() }
     }
 
-    #[allow(clippy::type_complexity)]
+    #[allow(clippy::type_complexity, reason = "the two passes' buffers and bind groups, returned together once")]
     fn lists(
         device: &wgpu::Device,
         culler: &BatchCuller,

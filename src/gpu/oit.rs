@@ -428,7 +428,8 @@ impl FragmentLists {
                 buffer.unmap();
                 if let Some(words) = words {
                     let needed = words[..MAX_BANDS as usize].iter().copied().max().unwrap_or(0);
-                    *last.lock().unwrap_or_else(|e| e.into_inner()) = Some((needed, words[MAX_BANDS as usize]));
+                    *last.lock().unwrap_or_else(std::sync::PoisonError::into_inner) =
+                        Some((needed, words[MAX_BANDS as usize]));
                 }
             }
             state.store(0, Ordering::Release);
@@ -437,7 +438,7 @@ impl FragmentLists {
 
     /// What the last mapped frame held, once: `None` until a new read-back has landed.
     pub fn take_stats(&self) -> Option<FragmentStats> {
-        let (needed, deep_pixels) = self.last.lock().unwrap_or_else(|e| e.into_inner()).take()?;
+        let (needed, deep_pixels) = self.last.lock().unwrap_or_else(std::sync::PoisonError::into_inner).take()?;
         Some(FragmentStats { needed, capacity: self.capacity, bands: self.bands, deep_pixels })
     }
 

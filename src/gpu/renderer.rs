@@ -309,10 +309,8 @@ impl Renderer {
     /// The projection a frame of `size` pixels uses: the depth range holds everything drawn.
     pub fn clip_from_world(&self, camera: &Camera, size: [u32; 2]) -> glam::Mat4 {
         let aspect = size[0].max(1) as f32 / size[1].max(1) as f32;
-        let radius = self
-            .bounds()
-            .map(|(lo, hi)| (hi - camera.target).abs().max((camera.target - lo).abs()).length())
-            .unwrap_or(10.0);
+        let radius =
+            self.bounds().map_or(10.0, |(lo, hi)| (hi - camera.target).abs().max((camera.target - lo).abs()).length());
         camera.clip_from_world(aspect, radius)
     }
 

@@ -300,7 +300,7 @@ struct VolumeShaders {
 impl VolumeShaders {
     /// The pipeline of `variant`, built now if no cloud has needed it before.
     fn pipeline(&self, device: &wgpu::Device, variant: Variant) -> wgpu::RenderPipeline {
-        let mut pipelines = self.pipelines.lock().unwrap_or_else(|e| e.into_inner());
+        let mut pipelines = self.pipelines.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
         pipelines
             .entry(variant)
             .or_insert_with(|| match variant.program {
@@ -683,7 +683,10 @@ impl VolumePass {
 
     /// Cuts this frame's slices and uploads them with the uniforms; `clip`: the object's
     /// clipping plane ([`super::frame::Prepare::clip`]).
-    #[allow(clippy::too_many_arguments)]
+    #[allow(
+        clippy::too_many_arguments,
+        reason = "a frame's per-view inputs, each named where the renderer calls it once"
+    )]
     pub fn set_view(
         &mut self,
         device: &wgpu::Device,

@@ -198,7 +198,7 @@ impl ScanScene {
     }
 
     /// Renders `slots` at θ side by side (left to right), each `size`, into one image.
-    #[allow(clippy::too_many_arguments)]
+    #[allow(clippy::too_many_arguments, reason = "a side-by-side picture's inputs, as `scan render` names them")]
     pub fn render(
         &self,
         ctx: &GpuContext,
@@ -264,7 +264,7 @@ impl ScanPainter {
     }
 
     /// `slots` of `scene` at θ side by side (left to right), each the painter's size.
-    #[allow(clippy::too_many_arguments)]
+    #[allow(clippy::too_many_arguments, reason = "a side-by-side picture's inputs, as `scan render` names them")]
     pub fn paint(
         &mut self,
         scene: &ScanScene,

@@ -31,7 +31,7 @@ impl Document {
             let r = glam::DVec3::splat(a.element().covalent_radius as f64 * super::units::BOHR_PER_ANGSTROM);
             [a.position - r, a.position + r]
         });
-        let points = atoms.chain(self.volumes.iter().flat_map(|v| v.corners()));
+        let points = atoms.chain(self.volumes.iter().flat_map(super::grid::VolumeGrid::corners));
         points.fold(None, |acc, p| match acc {
             None => Some((p, p)),
             Some((lo, hi)) => Some((lo.min(p), hi.max(p))),

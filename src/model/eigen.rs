@@ -18,7 +18,7 @@ pub fn symmetric_eigen<const N: usize>(mut a: [[f64; N]; N], rotations: usize) -
         }
         let theta = 0.5 * (2.0 * a[p][q]).atan2(a[q][q] - a[p][p]);
         let (s, c) = theta.sin_cos();
-        for row in a.iter_mut() {
+        for row in &mut a {
             let (akp, akq) = (row[p], row[q]);
             row[p] = c * akp - s * akq;
             row[q] = s * akp + c * akq;

@@ -195,9 +195,9 @@ fn hermite_r(l: usize, p: f64, x: DVec3, far: bool, scratch: &mut Scratch) {
     let mut f = [0.0; boys::MAX_N + 1];
     let t2 = p * x.length_squared();
     if far {
-        boys::asymptotic(l, t2, &mut f)
+        boys::asymptotic(l, t2, &mut f);
     } else {
-        boys(l, t2, &mut f)
+        boys(l, t2, &mut f);
     }
     let mut factor = 1.0;
     for (n, &start) in recipe.levels.iter().enumerate() {
@@ -393,7 +393,7 @@ impl Potential {
             out.coefficients.extend(coefficients);
         }
         let centres: Vec<DVec3> = {
-            let mut c: Vec<DVec3> = shells.iter().map(|s| s.center()).collect();
+            let mut c: Vec<DVec3> = shells.iter().map(super::gto::PreparedShell::center).collect();
             c.sort_by(|a, b| a.to_array().partial_cmp(&b.to_array()).unwrap_or(std::cmp::Ordering::Equal));
             c.dedup();
             c

@@ -485,7 +485,10 @@ impl PreparedBasis {
     }
 
     /// One grid row: points p0 + k·v, k = 0..out.len().
-    #[allow(clippy::too_many_arguments)]
+    #[allow(
+        clippy::too_many_arguments,
+        reason = "the inner loop's row: scratch buffers passed in to avoid allocating per row"
+    )]
     fn row(
         &self,
         sets: &[(Vec<f64>, Vec<bool>, f64)],
@@ -499,7 +502,7 @@ impl PreparedBasis {
         let n = out.len();
         let single = sets.len() == 1 && !square;
         if !single {
-            for acc in scratch.psi.iter_mut() {
+            for acc in &mut scratch.psi {
                 acc.fill(0.0);
             }
         }

@@ -58,7 +58,7 @@ impl Measurement {
             .collect();
         let value = match self.value(molecule) {
             Some(v) if self.atoms.len() == 2 => format!("{v:.3} Å"),
-            Some(v) => format!("{:.1}°", v).replace('-', "−"),
+            Some(v) => format!("{v:.1}°").replace('-', "−"),
             None => "—".into(),
         };
         format!("{} {value}", names.join("–"))

@@ -18,7 +18,7 @@ pub struct NormalMode {
 }
 
 fn as_triples<S: serde::Serializer>(v: &[DVec3], s: S) -> Result<S::Ok, S::Error> {
-    s.collect_seq(v.iter().map(|d| d.to_array()))
+    s.collect_seq(v.iter().map(glam::DVec3::to_array))
 }
 
 impl NormalMode {

@@ -57,7 +57,7 @@ pub struct ScanShots {
 }
 
 impl ScanShots {
-    #[allow(clippy::too_many_arguments)]
+    #[allow(clippy::too_many_arguments, reason = "a movie's inputs, as the command line and *Record…* name them")]
     pub fn new(
         ctx: &GpuContext,
         scene: Arc<ScanScene>,
@@ -118,7 +118,7 @@ pub struct SceneShots<D> {
 impl<D: std::borrow::Borrow<Document>> SceneShots<D> {
     /// Shows `scene` (orbitals evaluated on grids of `points` per side) for `frames` frames of
     /// `size` each.
-    #[allow(clippy::too_many_arguments)]
+    #[allow(clippy::too_many_arguments, reason = "a movie's inputs, as the command line and *Record…* name them")]
     pub fn new(
         ctx: &GpuContext,
         scene: Vec<(D, ObjectState)>,

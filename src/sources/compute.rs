@@ -175,7 +175,7 @@ pub enum ComputeError {
 
 /// This machine's cores: what computing uses unless told otherwise.
 pub fn cores() -> usize {
-    std::thread::available_parallelism().map_or(1, |n| n.get())
+    std::thread::available_parallelism().map_or(1, std::num::NonZero::get)
 }
 
 /// The interpreter that computes: `ORBCLOUD_PYTHON`, or `python3`.

@@ -81,7 +81,7 @@ impl<'a> CloudReference<'a> {
         let vs = s.volume;
         // The test scenes' atoms lie inside their grid: the object's centre is the grid's.
         let centre = gbox.origin + 0.5 * (gbox.edges[0] + gbox.edges[1] + gbox.edges[2]);
-        let plane = s.clip.plane(centre).map(|p| p.as_dvec4());
+        let plane = s.clip.plane(centre).map(glam::Vec4::as_dvec4);
         Self {
             grid,
             vs,

@@ -1,5 +1,5 @@
 //! Shared by the GPU tests: the lavapipe context, synthetic scenes and golden-image checks.
-#![allow(dead_code)]
+#![allow(dead_code, reason = "each test binary uses some of these helpers")]
 
 pub mod cloud;
 
@@ -124,8 +124,7 @@ pub fn bless_value(v: Option<&std::ffi::OsStr>) -> bool {
 /// `ORBCLOUD_REFDATA`.
 pub fn refdata_dir() -> PathBuf {
     std::env::var_os("ORBCLOUD_REFDATA")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/refdata/real-world"))
+        .map_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/refdata/real-world"), PathBuf::from)
 }
 
 /// [`refdata_dir`] when it exists. `None` when it is absent: the test prints one line saying it

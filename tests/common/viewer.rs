@@ -1,6 +1,6 @@
 //! Shared by the viewer's tests (egui_kittest on lavapipe): waiting for files and jobs, and
 //! clicking in the view.
-#![allow(dead_code)]
+#![allow(dead_code, reason = "each test binary uses some of these helpers")]
 
 use egui_kittest::Harness;
 use orbcloud::app::{OrbApp, wgpu_setup};
