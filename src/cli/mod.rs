@@ -34,15 +34,17 @@ mod structure;
 mod surface;
 mod values;
 
+/// The viewer's files argument: every format ([`formats::FORMATS`]) and scan manifests.
+fn files_help(lead: &str) -> String {
+    format!("{lead}: {}, or a scan manifest (.scan.toml); the bundled demo when none", formats::described())
+}
+
 #[derive(Parser)]
 #[command(name = "orbcloud", version, about = "Molecular orbitals and densities as GPU-rendered clouds")]
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
-    /// Files to open in the viewer: Gaussian cube (.cube, .cub), Molden (.molden, .molden.input,
-    /// .mold), Gaussian formatted checkpoint (.fchk, .fch), AIM wavefunction (.wfn, .wfx), ORCA
-    /// Molekel (.mkl), PDB (.pdb, .ent), mmCIF (.cif, .mmcif), XYZ (.xyz), each also gzipped
-    /// (.gz), or a scan manifest (.scan.toml); the bundled demo when none.
+    #[arg(help = files_help("Files to open in the viewer"))]
     files: Vec<PathBuf>,
     /// Open a bundled demo instead of files.
     #[arg(long, value_enum)]
@@ -75,10 +77,7 @@ impl DemoArg {
 enum Command {
     /// Open the interactive viewer (the default).
     Viewer {
-        /// Files to open: Gaussian cube (.cube, .cub), Molden (.molden, .molden.input, .mold),
-        /// Gaussian formatted checkpoint (.fchk, .fch), AIM wavefunction (.wfn, .wfx), ORCA Molekel
-        /// (.mkl), PDB (.pdb, .ent), mmCIF (.cif, .mmcif), XYZ (.xyz), each also gzipped (.gz), or a
-        /// scan manifest (.scan.toml); the bundled demo when none.
+        #[arg(help = files_help("Files to open"))]
         files: Vec<PathBuf>,
         /// Open a bundled demo instead of files.
         #[arg(long, value_enum)]
@@ -88,9 +87,7 @@ enum Command {
     Render(RenderArgs),
     /// Print atoms and grids of a file.
     Info {
-        /// Gaussian cube (.cube, .cub), Molden (.molden, .molden.input, .mold), Gaussian formatted
-        /// checkpoint (.fchk, .fch), AIM wavefunction (.wfn, .wfx), ORCA Molekel (.mkl), PDB (.pdb,
-        /// .ent), mmCIF (.cif, .mmcif) or XYZ (.xyz), each also gzipped (.gz).
+        #[arg(help = formats::described())]
         file: PathBuf,
         /// Machine-readable JSON instead of text.
         #[arg(long)]
@@ -367,10 +364,7 @@ enum BenchCommand {
 
 #[derive(Args)]
 struct RenderArgs {
-    /// Gaussian cube (.cube, .cub), Molden (.molden, .molden.input, .mold), Gaussian formatted
-    /// checkpoint (.fchk, .fch), AIM wavefunction (.wfn, .wfx), ORCA Molekel (.mkl), PDB (.pdb,
-    /// .ent), mmCIF (.cif, .mmcif) or XYZ (.xyz), each also gzipped (.gz); the bundled demo when
-    /// omitted.
+    #[arg(help = format!("{}; the bundled demo when omitted", formats::described()))]
     file: Option<PathBuf>,
     /// Output PNG.
     #[arg(short, long)]

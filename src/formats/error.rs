@@ -26,9 +26,7 @@ pub enum LoadError {
     Io { path: String, source: std::io::Error },
     #[error("{path}: not a text file (invalid UTF-8 at byte {offset})")]
     NotText { path: String, offset: usize },
-    #[error(
-        "{path}: unknown file type (expected .cube, .cub, .molden, .molden.input, .mold, .fchk, .fch, .wfn, .wfx, .mkl, .pdb, .ent, .cif, .mmcif or .xyz, optionally .gz)"
-    )]
+    #[error("{path}: unknown file type (expected {})", super::described())]
     UnknownFormat { path: String },
     #[error(transparent)]
     Parse(#[from] ParseError),

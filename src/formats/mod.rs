@@ -52,9 +52,7 @@ pub const MAX_LINE_BYTES: usize = 1 << 20;
 /// Blank bytes a cube may carry after the values its header declares before reading stops.
 pub const MAX_TRAILING_BYTES: usize = 64 << 10;
 
-/// Reads a file from disk, picking the reader by extension: `.cube`, `.cub`, `.molden`,
-/// `.molden.input`, `.mold`, `.fchk`, `.fch`, `.wfn`, `.wfx`, `.mkl`, `.pdb`, `.ent`, `.cif`,
-/// `.mmcif`, `.xyz`, each also gzipped (`.gz`).
+/// Reads a file from disk, picking the reader by the ending of its name ([`FORMATS`]).
 pub fn load(path: &Path) -> Result<Document, LoadError> {
     load_with(path, DEFAULT_OVERLAP)
 }
@@ -116,37 +114,48 @@ enum Reader {
     Xyz,
 }
 
-/// Every file name ending a reader takes (each also with `.gz`), and the reader.
-const READERS: [(&str, Reader); 15] = [
-    (".cube", Reader::Cube),
-    (".cub", Reader::Cube),
-    (".molden", Reader::Molden),
-    (".molden.input", Reader::Molden),
-    (".mold", Reader::Molden),
-    (".fchk", Reader::Fchk),
-    (".fch", Reader::Fchk),
-    (".wfn", Reader::Wfn),
-    (".wfx", Reader::Wfx),
-    (".mkl", Reader::Mkl),
-    (".pdb", Reader::Pdb),
-    (".ent", Reader::Pdb),
-    (".cif", Reader::Mmcif),
-    (".mmcif", Reader::Mmcif),
-    (".xyz", Reader::Xyz),
+/// A file format a reader takes: what users call it and the file name endings it has (each also
+/// with `.gz`).
+pub struct Format {
+    pub name: &'static str,
+    pub endings: &'static [&'static str],
+    reader: Reader,
+}
+
+/// Every format orbcloud reads. The command line's help, the unknown-type message and the
+/// viewer's file chooser are made from this table, so a new reader is one row here.
+pub const FORMATS: &[Format] = &[
+    Format { name: "Gaussian cube", endings: &[".cube", ".cub"], reader: Reader::Cube },
+    Format { name: "Molden", endings: &[".molden", ".molden.input", ".mold"], reader: Reader::Molden },
+    Format { name: "Gaussian formatted checkpoint", endings: &[".fchk", ".fch"], reader: Reader::Fchk },
+    Format { name: "AIM wavefunction", endings: &[".wfn"], reader: Reader::Wfn },
+    Format { name: "AIM extended wavefunction", endings: &[".wfx"], reader: Reader::Wfx },
+    Format { name: "ORCA Molekel", endings: &[".mkl"], reader: Reader::Mkl },
+    Format { name: "PDB", endings: &[".pdb", ".ent"], reader: Reader::Pdb },
+    Format { name: "mmCIF", endings: &[".cif", ".mmcif"], reader: Reader::Mmcif },
+    Format { name: "XYZ", endings: &[".xyz"], reader: Reader::Xyz },
 ];
 
 /// The file name endings [`load`] reads (each also gzipped, `.gz`).
 pub fn extensions() -> impl Iterator<Item = &'static str> {
-    READERS.iter().map(|(e, _)| *e)
+    FORMATS.iter().flat_map(|f| f.endings.iter().copied())
+}
+
+/// The formats in words: "Gaussian cube (.cube, .cub), Molden (…), … or XYZ (.xyz), each also
+/// gzipped (.gz)".
+pub fn described() -> String {
+    let each: Vec<String> = FORMATS.iter().map(|f| format!("{} ({})", f.name, f.endings.join(", "))).collect();
+    let (last, rest) = each.split_last().expect("at least one format");
+    format!("{} or {last}, each also gzipped (.gz)", rest.join(", "))
 }
 
 fn reader_for(path: &Path) -> Result<Reader, LoadError> {
     let name = path.file_name().map(|n| n.to_string_lossy().to_lowercase()).unwrap_or_default();
     let base = name.strip_suffix(".gz").unwrap_or(&name);
-    READERS
+    FORMATS
         .iter()
-        .find(|(e, _)| base.ends_with(e))
-        .map(|&(_, r)| r)
+        .find(|f| f.endings.iter().any(|e| base.ends_with(e)))
+        .map(|f| f.reader)
         .ok_or_else(|| LoadError::UnknownFormat { path: path.display().to_string() })
 }
 
