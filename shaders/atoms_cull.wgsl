@@ -3,7 +3,7 @@
 // seen last frame are rasterised first; a coarse depth pyramid (the farthest depth of 8×8-pixel
 // tiles and of 8×8-tile blocks) is built from them; every other cell whose bounds it hides is
 // skipped, the rest rasterised; after a second pyramid only the cells that may show write ids
-// (or, with packed words, are only marked seen). Seed 002's screen-size level of detail: a
+// (or, with packed words, are only marked seen). Lee et al.'s screen-size level of detail: a
 // sphere whose projected radius is at most `viewport.w` pixels is rasterised here exactly (per
 // pixel ray–sphere test, nearest wins through an atomic maximum of the inverted depth), after a
 // test that skips it when every pixel it could cover already holds something nearer (nearer

@@ -83,7 +83,7 @@ fn shade(n: vec3<f32>, view: vec3<f32>, tint: vec3<f32>, highlight: f32) -> vec3
     return u.color.rgb * tint * (0.25 + 0.75 * diffuse) + vec3<f32>(0.3 * specular + 0.06 * rim);
 }
 
-// Seed 002's points: a cell of the surface too small on screen to be worth its triangles,
+// Lee et al.'s points: a cell of the surface too small on screen to be worth its triangles,
 // drawn as a disc at the cell's centre, lit with the cell's mean normal (`lit_spread`). The
 // disc lies across that normal (a surfel: seen edge-on at a silhouette it narrows instead of
 // spilling past it, and neighbours overlap in depth as the surface does), turned towards the

@@ -50,7 +50,7 @@ struct Shaded {
 
 const MIN_N_DOT_V: f32 = 0.01;
 
-// Seed 003: I = S{a N·L + [b/(1 + c N·V)](R·V)ⁿ} + d/(1 + f|N·V|), t = exp(−g/|N·V|), with
+// Koide and Miyata: I = S{a N·L + [b/(1 + c N·V)](R·V)ⁿ} + d/(1 + f|N·V|), t = exp(−g/|N·V|), with
 // S = 0 where N·L < 0 or N·V < 0; d, f, g switch to the glow's inside another object's surface
 // (scene::translucency::Optics::shade is the CPU reference).
 fn koide(o: SurfaceOptics, n_dot_l: f32, n_dot_v: f32, r_dot_v: f32, glow: bool) -> Shaded {

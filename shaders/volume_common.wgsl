@@ -90,7 +90,7 @@ fn gaussian(x: f32) -> f32 {
     return exp(-x * x);
 }
 
-// Seed 004's shapes on the signed value s = value / max|value|, placed at the signed centre c;
+// Jang and Varetto's shapes on the signed value s = value / max|value|, placed at the signed centre c;
 // `outward` (±1) is the sign of the values the lobe colours. See scene::transfer::Shape::at.
 fn shape_factor(shape: u32, s: f32, c: f32, w_in: f32, outward: f32) -> f32 {
     let w = max(w_in, 1e-4);

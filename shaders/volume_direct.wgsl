@@ -1,4 +1,4 @@
-// Seed 004's direct mode: no grid at all; each slice fragment evaluates the orbital (and its
+// Jang and Varetto's direct mode: no grid at all; each slice fragment evaluates the orbital (and its
 // analytic gradient) from its basis functions at its own position.
 // Prepended: volume_common.wgsl, gto_common.wgsl.
 

@@ -1,4 +1,4 @@
-// Seed 000's interpolation between two key volumes A and B on one grid, θ between their
+// Naka et al.'s interpolation between two key volumes A and B on one grid, θ between their
 // angles with ratio k = u.morph_k (`volume` is A).
 //
 // exact: the two volumes sampled and mixed per sample. α-mix: the two samples' colours and

@@ -1,4 +1,4 @@
-//! Seed 004's atomic-orbital selector: single basis functions named as chemists write them and
+//! Jang and Varetto's atomic-orbital selector: single basis functions named as chemists write them and
 //! shown bare, and orbitals restricted to chosen functions, against PySCF
 //! (tests/fixtures/wavefunctions/*.ao.json, written by scripts/make_ao_fixtures.py from the
 //! Molden fixtures), read from Molden and from fchk files.

@@ -1,4 +1,4 @@
-//! Seed 000's two ways of compositing a slice between two key volumes, on lavapipe, against an
+//! Naka et al.'s two ways of compositing a slice between two key volumes, on lavapipe, against an
 //! independent CPU compositor (tests/common/cloud.rs samples each key volume along the same
 //! rays): α-mix (their eq. 5: per slice α = (1−k)α_A + kα_B and the colours mixed) and the
 //! three-pass method (their eqs. 6–7: attenuate by α_A, or α_B past the middle, then add

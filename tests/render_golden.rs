@@ -141,7 +141,7 @@ fn clipped_cloud() {
     assert_golden("clipped_cloud", &clipped);
 }
 
-/// Seed 004's pairing for nested cores: opacity grows from the empty space to each lobe's
+/// Jang and Varetto's pairing for nested cores: opacity grows from the empty space to each lobe's
 /// extreme value, lit so the nested shells show.
 #[test]
 fn nested_cores() {
@@ -153,7 +153,7 @@ fn nested_cores() {
     assert_golden("nested_cores", &img);
 }
 
-/// Seed 004's half Gaussians are drawn on the signed value, so far from the molecule (ψ ≈ 0)
+/// Jang and Varetto's half Gaussians are drawn on the signed value, so far from the molecule (ψ ≈ 0)
 /// they are clear: with the box filling the frame, the border of the picture is exactly what it
 /// is with the cloud hidden, while the lobes show.
 #[test]

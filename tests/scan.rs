@@ -89,7 +89,7 @@ fn the_skeleton_follows_theta_and_the_charge_moves_at_minus_90() {
     }
     let m = scan.geometry_at(-97.5);
     assert!((scan.coordinate.measure(&m).unwrap() - -97.5).abs() < 1e-6);
-    // Seed 000's picture at −90°: HOMO on the C=N side, LUMO on the allyl side. Partition ψ² by
+    // Naka et al.'s picture at −90°: HOMO on the C=N side, LUMO on the allyl side. Partition ψ² by
     // nearest atom on the common grid.
     let tracks = scan.track(Follow::Index).unwrap();
     let grid = scan.common_grid(orbcloud::scene::framing::ORBITAL_MARGIN, 48);
@@ -195,7 +195,7 @@ fn three_pass_stays_close_to_exact_and_equals_it_at_key_angles() {
     let camera = scene.camera();
     let size = [160, 120];
     let s = settings();
-    let render = |theta: f64, mode| scene.render(&ctx, &[0, 1], theta, mode, &camera, &s, size).unwrap();
+    let render = |value: f64, mode| scene.render(&ctx, &[0, 1], value, mode, &camera, &s, size).unwrap();
     // At a key angle k = 0: both reduce to that frame's volume.
     let (mean, max) =
         common::mean_max_difference(&render(-90.0, Interpolation::Exact), &render(-90.0, Interpolation::ThreePass));
@@ -203,15 +203,15 @@ fn three_pass_stays_close_to_exact_and_equals_it_at_key_angles() {
     assert!(mean < 1.0 && max <= 4, "at a key angle three-pass differs from exact: mean {mean}, max {max}");
     // Between: Naka et al.'s approximation; report and bound its error.
     let mut worst: f64 = 0.0;
-    for theta in [-97.5, -87.5, -45.0] {
-        let exact = render(theta, Interpolation::Exact);
-        let three = render(theta, Interpolation::ThreePass);
+    for value in [-97.5, -87.5, -45.0] {
+        let exact = render(value, Interpolation::Exact);
+        let three = render(value, Interpolation::ThreePass);
         let (mean, max) = common::mean_max_difference(&exact, &three);
-        eprintln!("θ = {theta}°: three-pass vs exact: mean {mean:.2}/255, max {max}/255");
+        eprintln!("θ = {value}°: three-pass vs exact: mean {mean:.2}/255, max {max}/255");
         worst = worst.max(mean);
         // Both must differ from the nearer key frame's picture: they interpolate.
-        let key = render(scene.scan.frames[scene.scan.nearest_frame(theta)].at, Interpolation::Exact);
-        assert!(common::mean_max_difference(&exact, &key).0 > 0.02, "θ = {theta}: exact shows only a key frame");
+        let key = render(scene.scan.frames[scene.scan.nearest_frame(value)].at, Interpolation::Exact);
+        assert!(common::mean_max_difference(&exact, &key).0 > 0.02, "θ = {value}: exact shows only a key frame");
     }
     assert!(worst < 2.0, "three-pass strays from exact by {worst}/255 on average");
 }
@@ -223,11 +223,11 @@ fn the_gpu_mix_matches_the_cpu_interpolated_grid() {
     let s = settings();
     let camera = scene.camera();
     let size = [128, 96];
-    let theta = -97.5;
+    let value = -97.5;
     for slot in 0..2 {
-        let mixed = scene.render(&ctx, &[slot], theta, Interpolation::Exact, &camera, &s, size).unwrap();
+        let mixed = scene.render(&ctx, &[slot], value, Interpolation::Exact, &camera, &s, size).unwrap();
         // The CPU's interpolated volume, uploaded alone, on the same box and scale.
-        let grid: VolumeGrid = scene.interpolated_grid(slot, theta);
+        let grid: VolumeGrid = scene.interpolated_grid(slot, value);
         let mut volume = VolumeTexture::upload_as(&ctx, &grid, wgpu::TextureFormat::R32Float).unwrap();
         let key = scene.key_volume(slot, 0);
         volume.max_abs = key.max_abs;
@@ -235,7 +235,7 @@ fn the_gpu_mix_matches_the_cpu_interpolated_grid() {
         volume.grid_box = key.grid_box;
         let mut renderer = Renderer::new(&ctx);
         let layer = renderer.main();
-        layer.set_molecule(&ctx, &scene.scan.geometry_at(theta), s.atoms);
+        layer.set_molecule(&ctx, &scene.scan.geometry_at(value), s.atoms);
         layer.set_volume_texture(&ctx, volume);
         let target = OffscreenTarget::new(&ctx.device, size);
         let mut encoder = ctx.device.create_command_encoder(&Default::default());

@@ -70,10 +70,10 @@ fn a_bending_scan_opens_from_scan_init_alone() {
     assert_eq!(scan.values(), [80.0, 90.0, 100.0, 110.0, 120.0, 130.0, 140.0, 150.0, 160.0].map(|v: f64| v));
     assert_key_frames_reproduced(scan);
     // Between key frames the molecule keeps its O-H lengths and has the angle asked for.
-    for theta in [84.0, 117.5, 151.0] {
-        let m = scan.geometry_at(theta);
+    for value in [84.0, 117.5, 151.0] {
+        let m = scan.geometry_at(value);
         let measured = scan.coordinate.measure(&m).unwrap();
-        assert!((measured - theta).abs() < 1e-6, "{theta}: {measured}");
+        assert!((measured - value).abs() < 1e-6, "{value}: {measured}");
         let oh = m.atoms[0].position.distance(m.atoms[2].position) * orbcloud::model::units::ANGSTROM_PER_BOHR;
         assert!((oh - 0.96).abs() < 1e-6, "O-H {oh}");
     }

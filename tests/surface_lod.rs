@@ -62,7 +62,7 @@ fn far_parts_become_points_within_two_levels_of_every_triangle() {
     assert_eq!(stats.total_triangles, 0, "no level of detail asked for");
     common::assert_golden("surface_ses_fragment", &full);
 
-    // Seed 002's level of detail at 3 px: some cells are points, the rest
+    // Lee et al.'s level of detail at 3 px: some cells are points, the rest
     // triangles, the picture within 2/255.
     let look = SurfaceLook { lod_px: Some(POINTS_PX), ..color.into() };
     orbcloud::layers::show_meshes(&ctx, renderer.main(), &[(mesh.clone(), look)]);

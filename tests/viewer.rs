@@ -65,7 +65,7 @@ fn starts_on_the_demo_and_changes_controls() {
     h.get_by_label("shapes").click();
     h.run_steps(2);
     assert_eq!(h.state().selected_quantity().unwrap().cloud.transfer.kind, TransferKind::Shaped);
-    // Seed 004's pairing: the left half on ψ > 0, the right half on ψ < 0.
+    // Jang and Varetto's pairing: the left half on ψ > 0, the right half on ψ < 0.
     h.get_by_label("nested cores").click();
     h.run_steps(2);
     let t = h.state().selected_quantity().unwrap().cloud.transfer;
@@ -198,21 +198,21 @@ fn open_expecting_error(h: &mut Harness<'static, OrbApp>, path: std::path::PathB
 fn the_scan_demo_opens_side_by_side_and_a_drag_twists_both_views() {
     let mut h = scan_demo();
     let scan = h.state().scan.as_ref().unwrap();
-    assert_eq!(scan.theta, -90.0, "opens at the twisted geometry");
+    assert_eq!(scan.value, -90.0, "opens at the twisted geometry");
     assert_eq!(scan.shown().len(), 2, "HOMO and LUMO side by side");
     assert!(scan.shown().iter().all(|s| s.map(|(t, _)| t) == Some(-90.0)), "{:?}", scan.shown());
     h.get_by_label("Play");
     assert!(h.query_all_by_label("dihedral").count() >= 1, "the θ slider");
 
-    // Seed 000: a horizontal drag across the (left) view turns the bond.
+    // Naka et al.: a horizontal drag across the (left) view turns the bond.
     let during = drag_right(&mut h, egui::pos2(500.0, 260.0), 90.0);
     assert_drag_detail(&mut h, &during, 2);
     h.run_steps(1);
     let scan = h.state().scan.as_ref().unwrap();
-    let theta = scan.theta;
-    assert!(theta > -85.0, "θ after dragging right: {theta}");
+    let value = scan.value;
+    assert!(value > -85.0, "θ after dragging right: {value}");
     for (slot, shown) in scan.shown().iter().enumerate() {
-        assert_eq!(shown.map(|(t, _)| t), Some(theta), "view {slot} does not show the new θ");
+        assert_eq!(shown.map(|(t, _)| t), Some(value), "view {slot} does not show the new θ");
     }
 
     // The interpolation mode switches both views.
@@ -226,7 +226,7 @@ fn the_scan_demo_opens_side_by_side_and_a_drag_twists_both_views() {
     h.run_steps(1);
     wait_for_scan(&mut h, |s| s.scene.tracks.follow == orbcloud::model::scan::Follow::Overlap);
     let scan = h.state().scan.as_ref().unwrap();
-    assert_eq!(scan.theta, theta);
+    assert_eq!(scan.value, value);
     assert_eq!(scan.mode, orbcloud::scene::Interpolation::ThreePass);
 
     // A manifest with one frame says where it is wrong, and the open scan stays.
@@ -235,7 +235,7 @@ fn the_scan_demo_opens_side_by_side_and_a_drag_twists_both_views() {
     std::fs::write(&bad, "dihedral = [2, 3, 4, 5]\n[[frame]]\nangle = 0\nfile = \"a.molden\"\n").unwrap();
     let err = open_expecting_error(&mut h, bad);
     assert!(err.contains("bad.scan.toml:"), "{err}");
-    assert_eq!(h.state().scan.as_ref().map(|s| s.theta), Some(theta), "the scan stays open");
+    assert_eq!(h.state().scan.as_ref().map(|s| s.value), Some(value), "the scan stays open");
 }
 
 #[test]
@@ -423,15 +423,15 @@ fn a_scan_shows_isosurfaces_at_theta_and_its_measured_dihedral_follows_theta() {
     assert!(app.status.ends_with('°'), "{}", app.status);
     let value_at = |app: &OrbApp| {
         let scan = app.scan.as_ref().unwrap();
-        app.measurements.list[0].value(&scan.scene.scan.geometry_at(scan.theta)).unwrap()
+        app.measurements.list[0].value(&scan.scene.scan.geometry_at(scan.value)).unwrap()
     };
     let before = value_at(app);
     // Step θ to the next key angle: the measured dihedral turns by as much.
-    let theta = app.scan.as_ref().unwrap().theta;
+    let value = app.scan.as_ref().unwrap().value;
     h.key_press(egui::Key::CloseBracket);
     h.run_steps(2);
     let app = h.state();
-    let turned = app.scan.as_ref().unwrap().theta - theta;
+    let turned = app.scan.as_ref().unwrap().value - value;
     assert!(turned > 1.0, "θ moved: {turned}");
     let change = (value_at(app) - before + 540.0).rem_euclid(360.0) - 180.0;
     assert!((change.abs() - turned).abs() < 1.0, "dihedral changed by {change:.2}°, θ by {turned:.2}°");
@@ -682,7 +682,7 @@ fn bending_scan(dir: &std::path::Path) -> Harness<'static, OrbApp> {
 fn grabbing_the_moving_hydrogen_bends_the_angle() {
     let dir = tempfile::tempdir().unwrap();
     let mut h = bending_scan(dir.path());
-    let start = h.state().scan.as_ref().unwrap().theta;
+    let start = h.state().scan.as_ref().unwrap().value;
     let screen = |h: &Harness<'static, OrbApp>, atom: usize| {
         let app = h.state();
         app.scan.as_ref().unwrap().atom_on_screen(0, atom, &app.view.camera).expect("on screen")
@@ -711,11 +711,11 @@ fn grabbing_the_moving_hydrogen_bends_the_angle() {
     }
     h.drop_at(target(10.0));
     h.run_steps(2);
-    let theta = h.state().scan.as_ref().unwrap().theta;
+    let value = h.state().scan.as_ref().unwrap().value;
     let (held, wanted) = (opening(screen(&h, 2)), opening(target(10.0)));
-    eprintln!("angle {start:.1}° → {theta:.1}°; on screen the hydrogen at {held:.1}°, the pointer at {wanted:.1}°");
+    eprintln!("angle {start:.1}° → {value:.1}°; on screen the hydrogen at {held:.1}°, the pointer at {wanted:.1}°");
     assert!((held - wanted).abs() < 1.5, "the hydrogen follows the pointer: {held} vs {wanted}");
-    assert!(theta > start + 5.0, "grabbing the hydrogen opens the angle: {start} → {theta}");
+    assert!(value > start + 5.0, "grabbing the hydrogen opens the angle: {start} → {value}");
 }
 
 /// The clipping plane is the object's, edited under its atoms: on, it leaves the atoms whole

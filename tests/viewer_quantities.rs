@@ -200,7 +200,7 @@ fn worst_difference(app: &OrbApp, want: impl Fn(glam::DVec3) -> f64) -> (f64, f6
     (worst, max)
 }
 
-/// Seed 004's atomic-orbital selector picks single basis functions: ticking O 2px alone
+/// Jang and Varetto's atomic-orbital selector picks single basis functions: ticking O 2px alone
 /// restricts the HOMO (water's lone pair) to c·χ(2px); right-clicking O 3dxy shows that bare
 /// d function as a quantity of its own.
 #[test]

@@ -294,7 +294,7 @@ impl World {
         world
     }
 
-    /// One molecule as the whole scene (a scan's skeleton at θ).
+    /// One molecule as the whole scene (a scan's skeleton at the value).
     pub fn single(molecule: Molecule) -> Self {
         Self { molecule, offsets: vec![0], docs: Vec::new() }
     }

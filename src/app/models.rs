@@ -1,5 +1,5 @@
 //! Models of a structure (an NMR ensemble's, an XYZ trajectory's frames): which one the active
-//! object shows, and playing them in turn like a scan's θ; and which of its atoms are shown
+//! object shows, and playing them in turn like a scan's the value; and which of its atoms are shown
 //! (a selection by chain, residue number and residue name).
 
 use std::sync::Arc;

@@ -300,7 +300,7 @@ fn row_text(name: &str, label: &str, sym: &str, eh: &str, ev: &str, occ: &str) -
     format!("{name:<6}{label:<7}{sym:<4}{eh:>10}{ev:>9}{occ:>5}")
 }
 
-/// Seed 004's atomic-orbital selector (its Fig. 9): tick single basis functions — 2px apart
+/// Jang and Varetto's atomic-orbital selector (its Fig. 9): tick single basis functions — 2px apart
 /// from 2py, one d component — to restrict the shown orbitals to them, or show one alone as a
 /// quantity of its own (right-click).
 fn ao_selector(ui: &mut egui::Ui, doc: &Document, wf: &Wavefunction, state: &mut ObjectState) -> Option<Pick> {

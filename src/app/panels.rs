@@ -219,7 +219,7 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
                 ));
                 cloud_editor(ui, &mut scan.settings.volume, true);
                 ui.separator();
-                // A scan's isosurfaces are cut from the orbital at θ; levels are absolute there.
+                // A scan's isosurfaces are cut from the orbital at the value; levels are absolute there.
                 ui.heading("Isosurface");
                 isosurface_editor(ui, &mut scan.settings.iso, true, None);
                 ui.separator();
@@ -278,9 +278,9 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
             }
             ui.separator();
             match &app.scan {
-                // The measured values follow θ.
+                // The measured values follow the value.
                 Some(s) => {
-                    super::measure::panel(ui, &s.scene.scan.geometry_at(s.theta), &mut app.measurements, false);
+                    super::measure::panel(ui, &s.scene.scan.geometry_at(s.value), &mut app.measurements, false);
                 }
                 None => {
                     if let Some(n) = super::measure::panel(ui, &app.world.molecule, &mut app.measurements, true) {
@@ -298,8 +298,8 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
 
             ui.separator();
             ui.collapsing("Atoms in file", |ui| {
-                // A scan's atoms where they are at θ.
-                let twisted = app.scan.as_ref().map(|s| s.scene.scan.geometry_at(s.theta));
+                // A scan's atoms where they are at the value.
+                let twisted = app.scan.as_ref().map(|s| s.scene.scan.geometry_at(s.value));
                 let molecule = twisted.as_ref().unwrap_or(&app.doc().molecule);
                 // Coordinates in columns of their own, so none is cut off by the panel's edge.
                 egui::Grid::new("atoms").striped(true).num_columns(5).show(ui, |ui| {
@@ -740,7 +740,7 @@ pub fn translucency_editor(ui: &mut egui::Ui, iso: &mut IsosurfaceSettings) -> b
         | (iso.translucent && coefficients_editor(ui, &mut iso.tuning))
 }
 
-/// Seed 003's coefficients of a translucent surface, per R, G, B, as factors on its preset.
+/// Koide and Miyata's coefficients of a translucent surface, per R, G, B, as factors on its preset.
 fn coefficients_editor(ui: &mut egui::Ui, tuning: &mut OpticsTuning) -> bool {
     let mut changed = false;
     egui::CollapsingHeader::new("coefficients").id_salt(ui.next_auto_id()).show(ui, |ui| {

@@ -66,10 +66,10 @@ impl OrbApp {
         self.picture.open = true;
     }
 
-    /// The name *Save PNG* proposes: the file and its orbital, or a scan's title and θ.
+    /// The name *Save PNG* proposes: the file and its orbital, or a scan's title and value.
     fn proposed_picture_name(&self) -> String {
         match &self.scan {
-            Some(scan) => picture_name(&scan.scene.scan.title, Some(&format!("{:.0}deg", scan.theta))),
+            Some(scan) => picture_name(&scan.scene.scan.title, Some(&format!("{:.0}deg", scan.value))),
             None => {
                 let quantity = (self.objects.get(self.active))
                     .and_then(|o| o.state.quantities.get(o.state.selected).map(|q| q.source.name(&o.doc)));
@@ -111,7 +111,7 @@ impl OrbApp {
                     }
                 }
                 let slots: Vec<usize> = (0..scan.views.len()).collect();
-                caption_views(&mut out, &scan.scene, &slots, scan.theta, size[0]);
+                caption_views(&mut out, &scan.scene, &slots, scan.value, size[0]);
                 result.map(|()| out)
             }
             // A split view: its panes side by side, as drawn.

@@ -1,5 +1,5 @@
-//! Dihedral scans in the window: HOMO and LUMO side by side with linked cameras and θ, a θ
-//! slider with the key angles as ticks, play/loop, and the orbital energies against θ.
+//! Dihedral scans in the window: HOMO and LUMO side by side with linked cameras and the coordinate's value, a
+//! slider with the key angles as ticks, play/loop, and the orbital energies against the coordinate.
 
 use super::jobs::{Pending, spawn};
 use std::path::PathBuf;
@@ -115,24 +115,24 @@ impl ScanJob {
     }
 }
 
-/// An open scan: its resident key volumes, θ, and one view per orbital.
+/// An open scan: its resident key volumes, the coordinate's value, and one view per orbital.
 pub struct ScanView {
     pub scene: Arc<ScanScene>,
-    /// Degrees, within the scan's range.
-    pub theta: f64,
+    /// The coordinate's value in its unit (degrees, Å, or a path's position), within the scan's range.
+    pub value: f64,
     pub mode: Interpolation,
     pub playing: bool,
     /// Bounce between the ends instead of stopping.
     pub looping: bool,
-    /// Animation speed, degrees per second.
+    /// Animation speed, the coordinate's units per second.
     pub speed: f64,
-    /// Primary drags twist θ (Naka et al., docs/references.md); else they orbit and only a drag on the bond twists.
+    /// Primary drags change the value (Naka et al., docs/references.md); else they orbit and only a drag on the bond twists.
     pub drag_twists: bool,
     direction: f64,
     pub(super) views: Vec<Viewport>,
     /// Where the scan came from (to open it again, following orbitals another way).
     pub source: ScanSource,
-    /// How its views draw the orbitals at θ: cloud, isosurface, atoms (the side panel edits it).
+    /// How its views draw the orbitals at the value: cloud, isosurface, atoms (the side panel edits it).
     pub settings: RenderSettings,
     /// The atom style the views were last shown with.
     styled: AtomStyle,
@@ -155,10 +155,10 @@ impl ScanView {
         let views = contexts.into_iter().map(Viewport::new).collect();
         // Open where the picture says most: the key frame nearest the middle of the range.
         let (lo, hi) = scene.scan.range();
-        let theta = scene.scan.frames[scene.scan.nearest_frame(0.5 * (lo + hi))].at;
+        let value = scene.scan.frames[scene.scan.nearest_frame(0.5 * (lo + hi))].at;
         Self {
             scene: Arc::new(scene),
-            theta,
+            value,
             mode: Interpolation::Exact,
             playing: false,
             looping: true,
@@ -174,10 +174,10 @@ impl ScanView {
         }
     }
 
-    /// Takes θ and the interaction settings of the same scan opened before (reopened to follow
+    /// Takes the value and the interaction settings of the same scan opened before (reopened to follow
     /// its orbitals another way).
     pub fn keep_interaction_of(&mut self, old: &ScanView) {
-        self.set_theta(old.theta);
+        self.set_value(old.value);
         self.mode = old.mode;
         self.looping = old.looping;
         self.speed = old.speed;
@@ -186,26 +186,26 @@ impl ScanView {
         self.diagram.window = old.diagram.window;
     }
 
-    /// Where atom `atom` of the skeleton at θ is drawn in view `view` (for tests and overlays).
+    /// Where atom `atom` of the skeleton at the value is drawn in view `view` (for tests and overlays).
     pub fn atom_on_screen(&self, view: usize, atom: usize, camera: &crate::scene::Camera) -> Option<egui::Pos2> {
-        let p = self.scene.scan.geometry_at(self.theta).atoms.get(atom)?.position.as_vec3();
+        let p = self.scene.scan.geometry_at(self.value).atoms.get(atom)?.position.as_vec3();
         self.views.get(view)?.to_screen(camera, p)
     }
 
-    /// The θ and interpolation each view last drew (None before its first frame).
+    /// The value and interpolation each view last drew (None before its first frame).
     pub fn shown(&self) -> Vec<Option<(f64, Interpolation)>> {
         self.views.iter().map(|v| v.scan_shown).collect()
     }
 
-    pub fn set_theta(&mut self, theta: f64) {
+    pub fn set_value(&mut self, value: f64) {
         let (lo, hi) = self.scene.scan.range();
-        self.theta = theta.clamp(lo, hi);
+        self.value = value.clamp(lo, hi);
     }
 
-    /// Moves θ on by `dt` seconds of animation.
+    /// Moves the value on by `dt` seconds of animation.
     fn advance(&mut self, dt: f64) {
         let (lo, hi) = self.scene.scan.range();
-        let mut t = self.theta + self.direction * self.speed * dt;
+        let mut t = self.value + self.direction * self.speed * dt;
         if t >= hi || t <= lo {
             if self.looping {
                 self.direction = -self.direction;
@@ -214,19 +214,19 @@ impl ScanView {
             }
             t = t.clamp(lo, hi);
         }
-        self.theta = t;
+        self.value = t;
     }
 
-    /// The key frame's value before (`-1`) or after (`+1`) θ.
+    /// The key frame's value before (`-1`) or after (`+1`) the value.
     fn step_key(&mut self, dir: i32) {
         let angles = self.scene.scan.values();
         let next = if dir > 0 {
-            angles.iter().copied().find(|&a| a > self.theta + 1e-6)
+            angles.iter().copied().find(|&a| a > self.value + 1e-6)
         } else {
-            angles.iter().rev().copied().find(|&a| a < self.theta - 1e-6)
+            angles.iter().rev().copied().find(|&a| a < self.value - 1e-6)
         };
         if let Some(a) = next {
-            self.theta = a;
+            self.value = a;
         }
     }
 
@@ -240,10 +240,10 @@ impl ScanView {
                 let (a, b) = (screen(i)?, screen(j)?);
                 let axis = b - a;
                 let length = axis.length();
-                (length > 2.0).then(|| self.theta * ((pointer - a).dot(axis) / (length * length)) as f64)
+                (length > 2.0).then(|| self.value * ((pointer - a).dot(axis) / (length * length)) as f64)
             }
             Coordinate::Angle([i, j, k]) => {
-                // The screen angle at the vertex from the fixed arm to the moving atom, at θ and
+                // The screen angle at the vertex from the fixed arm to the moving atom, at the value and
                 // a degree on: one Newton step on that (a plane seen at a slant turns more or
                 // less on screen than in space).
                 let opening = |m: &crate::model::Molecule, p: Option<egui::Pos2>| {
@@ -254,17 +254,17 @@ impl ScanView {
                     Some((u.x * w.y - u.y * w.x).atan2(u.x * w.x + u.y * w.y).abs().to_degrees() as f64)
                 };
                 let (here, further) =
-                    (self.scene.scan.geometry_at(self.theta), self.scene.scan.geometry_at(self.theta + 1.0));
+                    (self.scene.scan.geometry_at(self.value), self.scene.scan.geometry_at(self.value + 1.0));
                 let (now, on, wanted) =
                     (opening(&here, None)?, opening(&further, None)?, opening(&here, Some(pointer))?);
                 let slope = on - now;
-                (slope.abs() > 0.05).then(|| self.theta + (wanted - now) / slope)
+                (slope.abs() > 0.05).then(|| self.value + (wanted - now) / slope)
             }
             Coordinate::Dihedral(_) | Coordinate::Path => None,
         }
     }
 
-    /// The bond the coordinate moves about at θ (a dihedral's rotatable bond, an angle's
+    /// The bond the coordinate moves about at the value (a dihedral's rotatable bond, an angle's
     /// moving arm, a distance's bond), for grabbing it with the mouse; none for a path.
     fn bond(&self) -> Option<[glam::Vec3; 2]> {
         let (j, k) = match self.scene.scan.coordinate {
@@ -272,7 +272,7 @@ impl ScanView {
             Coordinate::Angle([_, j, k]) | Coordinate::Dihedral([_, j, k, _]) => (j, k),
             Coordinate::Path => return None,
         };
-        let m = self.scene.scan.geometry_at(self.theta);
+        let m = self.scene.scan.geometry_at(self.value);
         Some([m.atoms[j].position.as_vec3(), m.atoms[k].position.as_vec3()])
     }
 }
@@ -299,13 +299,13 @@ pub fn controls(ui: &mut egui::Ui, scan: &mut ScanView) -> Option<ScanRequest> {
             // Room for the value box and the slider's label after the rail.
             let width = (ui.available_width() - 150.0).max(160.0);
             ui.spacing_mut().slider_width = width;
-            let mut theta = scan.theta;
+            let mut value = scan.value;
             let c = scan.scene.scan.coordinate;
             let decimals = if matches!(c, crate::model::scan::Coordinate::Distance(_)) { 3 } else { 1 };
             let slider =
-                ui.add(egui::Slider::new(&mut theta, lo..=hi).suffix(c.unit()).fixed_decimals(decimals).text(c.kind()));
+                ui.add(egui::Slider::new(&mut value, lo..=hi).suffix(c.unit()).fixed_decimals(decimals).text(c.kind()));
             if slider.changed() {
-                scan.set_theta(theta);
+                scan.set_value(value);
             }
             key_ticks(ui, slider.rect, scan, width);
         });
@@ -337,9 +337,9 @@ pub fn controls(ui: &mut egui::Ui, scan: &mut ScanView) -> Option<ScanRequest> {
                 "the orbitals the correlation diagram shows; a click on a line shows it in the first view",
             );
         });
-        let asked = super::correlation::plot(ui, &mut scan.diagram, &scan.scene.scan, scan.theta);
+        let asked = super::correlation::plot(ui, &mut scan.diagram, &scan.scene.scan, scan.value);
         if let Some(value) = asked.value {
-            scan.set_theta(value);
+            scan.set_value(value);
         }
         if let Some(name) = asked.orbital {
             follow = Some(ScanRequest::Show(name));
@@ -364,10 +364,10 @@ fn key_ticks(ui: &egui::Ui, rect: egui::Rect, scan: &ScanView, width: f32) {
     }
 }
 
-/// The orbital views side by side, each labelled with its orbital and energy at θ; drags and
-/// keys change θ; both views share `view` (camera and settings).
-/// The scan's views side by side, each with its orbital at θ (cloud, isosurfaces at θ when
-/// shown, atoms), picking and measurements on the skeleton at θ. Returns what to tell the user.
+/// The orbital views side by side, each labelled with its orbital and energy at the value; drags and
+/// keys change the value; both views share `view` (camera and settings).
+/// The scan's views side by side, each with its orbital at the value (cloud, isosurfaces at the value when
+/// shown, atoms), picking and measurements on the skeleton at the value. Returns what to tell the user.
 pub fn views(
     ui: &mut egui::Ui,
     render_state: &egui_wgpu::RenderState,
@@ -420,18 +420,18 @@ pub fn views(
         .map_or(Detail::FULL, |vp| Detail::for_frame(interacting(ui.ctx(), scan.playing), vp.ctx.info.device_type, n));
     ui.columns(n, |columns| {
         for (slot, (ui, vp)) in columns.iter_mut().zip(scan.views.iter_mut()).enumerate() {
-            if vp.scan_shown != Some((scan.theta, scan.mode)) {
-                vp.show_scan(&scan.scene, slot, scan.theta, scan.mode, style);
+            if vp.scan_shown != Some((scan.value, scan.mode)) {
+                vp.show_scan(&scan.scene, slot, scan.value, scan.mode, style);
             }
             ui.horizontal(|ui| {
-                ui.strong(scan.scene.label(slot, scan.theta));
-                ui.label(RichText::new(scan.scene.coordinate_label(scan.theta)).weak());
+                ui.strong(scan.scene.label(slot, scan.value));
+                ui.label(RichText::new(scan.scene.coordinate_label(scan.value)).weak());
             });
-            // Isosurfaces of the orbital at θ, cut in the background from the two key volumes.
-            let wanted = scan.settings.iso.visible.then_some((scan.theta, scan.settings.iso));
+            // Isosurfaces of the orbital at the value, cut in the background from the two key volumes.
+            let wanted = scan.settings.iso.visible.then_some((scan.value, scan.settings.iso));
             if vp.scan_iso != wanted {
                 vp.scan_iso = wanted;
-                let (a, b, k) = scan.scene.bracket_grids(slot, scan.theta);
+                let (a, b, k) = scan.scene.bracket_grids(slot, scan.value);
                 let iso = scan.settings.iso;
                 vp.request_meshes(0, move |max_bytes| isosurfaces_within(&mix(&a, &b, k), &[iso], max_bytes));
             }
@@ -440,7 +440,7 @@ pub fn views(
                     said = Some(format!(
                         "{}isosurfaces at {}: {n} triangles",
                         note.map_or(String::new(), |n| n + "; "),
-                        scan.scene.coordinate_label(scan.theta)
+                        scan.scene.coordinate_label(scan.value)
                     ));
                 }
                 Some(Err(e)) => said = Some(e),
@@ -452,7 +452,7 @@ pub fn views(
             let twisted = vp.show_twistable(ui, render_state, view, Some(&mut scan.settings.clip), Some(twist));
             dragged += twisted.along;
             held = held.or(twisted.pointer.map(|p| (slot, p)));
-            let world = World::single(scan.scene.scan.geometry_at(scan.theta));
+            let world = World::single(scan.scene.scan.geometry_at(scan.value));
             if let Some(click) = vp.click.take() {
                 let text = measurements.click(click, &world);
                 if !text.is_empty() {
@@ -463,11 +463,11 @@ pub fn views(
         }
     });
     if dragged != 0.0 {
-        scan.set_theta(scan.theta + dragged as f64 * (hi - lo));
+        scan.set_value(scan.value + dragged as f64 * (hi - lo));
         ui.ctx().request_repaint();
     }
-    if let Some(theta) = held.and_then(|(v, p)| scan.held_value(v, p, &view.camera)) {
-        scan.set_theta(theta);
+    if let Some(value) = held.and_then(|(v, p)| scan.held_value(v, p, &view.camera)) {
+        scan.set_value(value);
         ui.ctx().request_repaint();
     }
     said

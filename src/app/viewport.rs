@@ -57,7 +57,7 @@ struct PaneTarget {
     drawn: Option<PaneDrawn>,
 }
 
-/// How a drag in a scan view twists the dihedral (Naka et al.: horizontal drag changes θ).
+/// How a drag in a scan view twists the dihedral (Naka et al.: horizontal drag changes the value).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct TwistInput {
     /// Every primary drag twists (else the view orbits, unless the drag starts on the bond).
@@ -272,9 +272,9 @@ pub struct Viewport {
     previewing: bool,
     last_full_slow: bool,
     band_rows: u32,
-    /// The scan frame shown: (θ, interpolation), for tests and redraws.
+    /// The scan frame shown: (value, interpolation), for tests and redraws.
     pub scan_shown: Option<(f64, crate::scene::Interpolation)>,
-    /// The θ and settings a scan view's isosurfaces were last asked for (`None`: hidden).
+    /// The value and settings a scan view's isosurfaces were last asked for (`None`: hidden).
     pub scan_iso: Option<(f64, IsosurfaceSettings)>,
     /// A frame with translucent surfaces was drawn and its fragment counts are not back yet.
     awaiting_fragments: bool,
@@ -981,7 +981,7 @@ impl Viewport {
         }
     }
 
-    /// Shows slot `slot` of a scan at θ (both key volumes and the twisted skeleton).
+    /// Shows slot `slot` of a scan at the value (both key volumes and the twisted skeleton).
     /// Cuts a single-layer view (a scan's) with `clip`; draws again when it moved.
     pub fn set_clip(&mut self, clip: ClipPlane) {
         let layer = self.renderer.main();
@@ -995,12 +995,12 @@ impl Viewport {
         &mut self,
         scene: &ScanScene,
         slot: usize,
-        theta: f64,
+        value: f64,
         mode: crate::scene::Interpolation,
         style: crate::scene::AtomStyle,
     ) {
-        scene.show(&self.ctx, &mut self.renderer, slot, theta, mode, style);
-        self.scan_shown = Some((theta, mode));
+        scene.show(&self.ctx, &mut self.renderer, slot, value, mode, style);
+        self.scan_shown = Some((value, mode));
         self.generation += 1;
     }
 

@@ -125,7 +125,7 @@ fn write_frames(
 }
 
 /// A scan's coordinate swept from `--from` to `--to`: every view side by side, each captioned,
-/// frame k equal to `scan render --at θk`.
+/// frame k equal to `scan render --at VALUEk`.
 fn scan_sweep(args: &MovieArgs) -> Result<(usize, f64)> {
     let file = match &args.input {
         Some(path) => load_scan(path)?,

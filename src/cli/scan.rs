@@ -361,12 +361,12 @@ pub struct KeyVolumeBench {
     /// Points along the longest side of the grid.
     #[arg(long, default_value_t = DEFAULT_SCAN_POINTS)]
     points: usize,
-    /// Frames to time per K (each at a different θ, so a different pair of volumes).
+    /// Frames to time per K (each at a different value, so a different pair of volumes).
     #[arg(long, default_value_t = 8)]
     frames: usize,
     #[arg(long, default_value = "400x300", value_parser = super::parse_size)]
     size: [u32; 2],
-    /// View-aligned slices per frame (the viewer draws 64 at most while θ is dragged).
+    /// View-aligned slices per frame (the viewer draws 64 at most while the value is dragged).
     #[arg(long, default_value_t = crate::scene::RenderSettings::default().volume.slices)]
     slices: u32,
     #[arg(long)]

@@ -29,7 +29,7 @@ pub fn orbital_geometry(doc: &Document, quantity: Quantity, points: usize) -> Op
 #[derive(Debug, Clone, PartialEq)]
 pub struct WavefunctionView {
     pub quantity: Quantity,
-    /// Seed 004's direct mode (orbitals only): evaluate per slice sample, no grid.
+    /// Jang and Varetto's direct mode (orbitals only): evaluate per slice sample, no grid.
     pub direct: bool,
     /// Points per axis of the evaluation grid.
     pub points: usize,
@@ -91,7 +91,7 @@ impl Values {
 enum Cloud {
     /// An orbital filled on the GPU, already a texture.
     Texture(VolumeTexture),
-    /// Seed 004's direct mode: the orbital evaluated per slice sample, scaled to its measured
+    /// Jang and Varetto's direct mode: the orbital evaluated per slice sample, scaled to its measured
     /// (max |ψ|, max |∇ψ|).
     Direct(CartesianExpansion, GridSpec, (f64, f64)),
     /// Values computed on the CPU (densities), uploaded when shown.

@@ -19,7 +19,7 @@
 //! cubes = ["homo_a105.cube", "lumo_a105.cube"]   # or one cube per orbital
 //! ```
 //!
-//! Older manifests name a dihedral scan `dihedral = [i, j, k, l]` with frames at `angle = θ`;
+//! Older manifests name a dihedral scan `dihedral = [i, j, k, l]` with frames at `angle = A`;
 //! they read as before.
 
 use std::path::{Path, PathBuf};

@@ -61,7 +61,7 @@ struct GpuSurface {
     optics: Option<Optics>,
     /// This frame: its index among the frame's translucent surfaces (`None`: drawn opaque).
     translucent: Option<u32>,
-    /// Seed 002's level of detail (big opaque surfaces): the octrees of the mesh and of its
+    /// Lee et al.'s level of detail (big opaque surfaces): the octrees of the mesh and of its
     /// coarser versions (their reordered indices, one after another, are the index buffer)
     /// and what this frame draws of them.
     lod: Option<Lod>,

@@ -107,7 +107,7 @@ impl Layer {
         self.volume.set_texture(ctx, Some(volume));
     }
 
-    /// Shows θ between two key volumes of a scan (Naka et al., docs/references.md), mixed (1−k):k.
+    /// Shows a value between two key volumes of a scan (Naka et al., docs/references.md), mixed (1−k):k.
     pub fn set_morph(
         &mut self,
         ctx: &GpuContext,

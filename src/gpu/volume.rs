@@ -182,13 +182,13 @@ impl VolumeTexture {
 enum Program {
     /// One 3D texture.
     Slices,
-    /// Seed 004's direct mode: the orbital from its basis functions.
+    /// Jang and Varetto's direct mode: the orbital from its basis functions.
     Direct,
     /// Two key volumes mixed per sample.
     Exact,
-    /// Seed 000's three-pass compositing, in one pass.
+    /// Naka et al.'s three-pass compositing, in one pass.
     ThreePass,
-    /// Seed 000's α-mix (the reference the three passes approximate).
+    /// Naka et al.'s α-mix (the reference the three passes approximate).
     AlphaMix,
     /// A full-screen pass of the resolve: translucent surfaces' fragments and the samples of
     /// up to [`MAX_WALKED`] clouds composited in one walk per pixel (volume_interleave.wgsl).
@@ -571,7 +571,7 @@ impl VolumePass {
         Ok(())
     }
 
-    /// Seed 004's direct mode: the slices through `geometry`'s box evaluate `expansion` per
+    /// Jang and Varetto's direct mode: the slices through `geometry`'s box evaluate `expansion` per
     /// fragment. `max_abs` scales the opacity like a grid's maximum and `max_grad` the analytic
     /// gradient (both measured: [`crate::model::gto::PreparedBasis::sampled_range`]); the grid
     /// spacing of `geometry` is the reference step of k1.
@@ -624,9 +624,17 @@ impl VolumePass {
         });
     }
 
-    /// Seed 000's interpolated frame: key volumes `a` and `b` (one grid, one scale: `a`'s box
+    /// Naka et al.'s interpolated frame: key volumes `a` and `b` (one grid, one scale: `a`'s box
     /// and `max_abs` are used) mixed (1−k):k as `mode` says.
     pub fn set_morph(&mut self, ctx: &GpuContext, mut a: VolumeTexture, b: VolumeTexture, k: f32, mode: Interpolation) {
+        // Dragging within one pair of key volumes changes only the weight: the bind groups stay.
+        let same_pair = self.volume.as_ref().is_some_and(|v| v.texture == a.texture)
+            && self.morph.as_ref().is_some_and(|m| m._partner.texture == b.texture);
+        if let Some(morph) = self.morph.as_mut().filter(|_| same_pair) {
+            morph.k = k.clamp(0.0, 1.0);
+            morph.mode = mode;
+            return;
+        }
         // A mix can show a brick where either volume can.
         a.bricks = match (&a.bricks, &b.bricks) {
             (Some(x), Some(y)) => x.union(y).map(Arc::new),

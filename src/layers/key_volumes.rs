@@ -1,6 +1,6 @@
 //! A dihedral scan on the GPU (Naka et al., docs/references.md): every key volume of the chosen orbitals evaluated on
-//! one common grid and kept resident as a 3D texture, so any θ is drawn by mixing the two key
-//! volumes around it, with the skeleton turned to θ.
+//! one common grid and kept resident as a 3D texture, so any value is drawn by mixing the two key
+//! volumes around it, with the skeleton turned to the value.
 
 use std::sync::Arc;
 
@@ -62,7 +62,7 @@ pub struct ScanScene {
     pub grid: GridSpec,
     /// `keys[slot][frame]`, phase-aligned, each with the slot's common opacity scale.
     keys: Vec<Vec<VolumeTexture>>,
-    /// The same key volumes' values (what isosurfaces at θ are mixed from).
+    /// The same key volumes' values (what isosurfaces at the value are mixed from).
     key_grids: Vec<Vec<Arc<VolumeGrid>>>,
     /// Largest |ψ| per slot over all frames: one opacity scale for the whole scan, so the
     /// cloud does not brighten or fade between frames for nothing.
@@ -165,24 +165,24 @@ impl ScanScene {
         self.keys.len()
     }
 
-    /// Puts slot `slot` at θ into `renderer`: the two key volumes around θ and the skeleton
-    /// turned to θ.
+    /// Puts slot `slot` at the value into `renderer`: the two key volumes around the value and the skeleton
+    /// turned to the value.
     pub fn show(
         &self,
         ctx: &GpuContext,
         renderer: &mut Renderer,
         slot: usize,
-        theta: f64,
+        value: f64,
         mode: Interpolation,
         style: AtomStyle,
     ) {
-        let Bracket { a, b, k } = self.scan.bracket(theta);
+        let Bracket { a, b, k } = self.scan.bracket(value);
         let keys = &self.keys[slot];
         let layer = renderer.main();
         layer.set_morph(ctx, keys[a].clone(), keys[b].clone(), k as f32, mode);
         // A clipping plane's offset is measured from the middle of what the sweep shows.
         layer.clip_centre = (0.5 * (self.visible.0 + self.visible.1)).as_vec3();
-        layer.set_molecule(ctx, &self.scan.geometry_at(theta), style);
+        layer.set_molecule(ctx, &self.scan.geometry_at(value), style);
     }
 
     /// A camera framing what the sweep shows ([`ScanScene::visible`]), looking at the first key
@@ -197,19 +197,19 @@ impl ScanScene {
         camera
     }
 
-    /// Renders `slots` at θ side by side (left to right), each `size`, into one image.
+    /// Renders `slots` at the value side by side (left to right), each `size`, into one image.
     #[allow(clippy::too_many_arguments, reason = "a side-by-side picture's inputs, as `scan render` names them")]
     pub fn render(
         &self,
         ctx: &GpuContext,
         slots: &[usize],
-        theta: f64,
+        value: f64,
         mode: Interpolation,
         camera: &Camera,
         settings: &RenderSettings,
         size: [u32; 2],
     ) -> Result<image::RgbaImage, GpuError> {
-        ScanPainter::new(ctx, size).paint(self, ctx, slots, theta, mode, camera, settings)
+        ScanPainter::new(ctx, size).paint(self, ctx, slots, value, mode, camera, settings)
     }
 
     /// A slot's key volume in one frame.
@@ -217,36 +217,36 @@ impl ScanScene {
         &self.keys[slot][frame]
     }
 
-    /// "HOMO  −0.3012 Eh  (−8.20 eV)" (after the view's caption, if any) at θ, the energy interpolated between key frames.
-    pub fn label(&self, slot: usize, theta: f64) -> String {
+    /// "HOMO  −0.3012 Eh  (−8.20 eV)" (after the view's caption, if any) at the value, the energy interpolated between key frames.
+    pub fn label(&self, slot: usize, value: f64) -> String {
         let mut name = self.scan.orbitals[slot].to_uppercase().replace('-', "−");
         if let Some(caption) = self.scan.captions.get(slot).filter(|c| !c.is_empty()) {
             name = format!("{caption}: {name}");
         }
-        match self.scan.energy_at(&self.tracks, slot, theta) {
+        match self.scan.energy_at(&self.tracks, slot, value) {
             Some(e) => format!("{name}  {e:.4} Eh  ({:.2} eV)", e * EV_PER_HARTREE).replace('-', "−"),
             None => name,
         }
     }
 
-    /// The coordinate at θ in words: "dihedral 1-2-3-4 = 45.0°", "distance 1-2 = 1.200 Å".
-    pub fn coordinate_label(&self, theta: f64) -> String {
+    /// The coordinate at the value in words: "dihedral 1-2-3-4 = 45.0°", "distance 1-2 = 1.200 Å".
+    pub fn coordinate_label(&self, value: f64) -> String {
         let c = &self.scan.coordinate;
-        format!("{} = {}", c.label(), c.value_text(theta))
+        format!("{} = {}", c.label(), c.value_text(value))
     }
 
-    /// The two key volumes' values around θ and the weight k of the second: slot `slot` at θ
+    /// The two key volumes' values around the value and the weight k of the second: slot `slot` at the value
     /// is (1−k)·a + k·b ([`mix`]).
-    pub fn bracket_grids(&self, slot: usize, theta: f64) -> (Arc<VolumeGrid>, Arc<VolumeGrid>, f32) {
-        let Bracket { a, b, k } = self.scan.bracket(theta);
+    pub fn bracket_grids(&self, slot: usize, value: f64) -> (Arc<VolumeGrid>, Arc<VolumeGrid>, f32) {
+        let Bracket { a, b, k } = self.scan.bracket(value);
         let keys = &self.key_grids[slot];
         (keys[a].clone(), keys[b].clone(), k as f32)
     }
 
-    /// The exactly interpolated volume of a slot at θ, evaluated on the CPU (for export).
-    pub fn interpolated_grid(&self, slot: usize, theta: f64) -> VolumeGrid {
-        let label = format!("{} at {theta}° (interpolated)", self.scan.orbitals[slot]);
-        self.scan.interpolated_grid(&self.tracks, slot, theta, &self.grid, label)
+    /// The exactly interpolated volume of a slot at the value, evaluated on the CPU (for export).
+    pub fn interpolated_grid(&self, slot: usize, value: f64) -> VolumeGrid {
+        let label = format!("{} at {value}° (interpolated)", self.scan.orbitals[slot]);
+        self.scan.interpolated_grid(&self.tracks, slot, value, &self.grid, label)
     }
 }
 
@@ -263,14 +263,14 @@ impl ScanPainter {
         Self { renderer: Renderer::new(ctx), target: OffscreenTarget::new(&ctx.device, size) }
     }
 
-    /// `slots` of `scene` at θ side by side (left to right), each the painter's size.
+    /// `slots` of `scene` at the value side by side (left to right), each the painter's size.
     #[allow(clippy::too_many_arguments, reason = "a side-by-side picture's inputs, as `scan render` names them")]
     pub fn paint(
         &mut self,
         scene: &ScanScene,
         ctx: &GpuContext,
         slots: &[usize],
-        theta: f64,
+        value: f64,
         mode: Interpolation,
         camera: &Camera,
         settings: &RenderSettings,
@@ -278,7 +278,7 @@ impl ScanPainter {
         let size = self.target.size;
         let mut out = image::RgbaImage::new(size[0] * slots.len() as u32, size[1]);
         for (n, &slot) in slots.iter().enumerate() {
-            scene.show(ctx, &mut self.renderer, slot, theta, mode, settings.atoms);
+            scene.show(ctx, &mut self.renderer, slot, value, mode, settings.atoms);
             self.renderer.main().clip = settings.clip;
             let mut encoder =
                 ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("scan frame") });

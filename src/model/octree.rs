@@ -1,4 +1,4 @@
-//! Seed 002's hybrid point/polygon level of detail for big surfaces: a mesh's triangles binned
+//! Lee et al.'s hybrid point/polygon level of detail for big surfaces: a mesh's triangles binned
 //! into an octree whose cells shrink to about an atom's size, empty cells dropped; per frame,
 //! cells outside the view or facing away are skipped, a cell whose projected size falls under
 //! a threshold is drawn as one point splat (its area-weighted centre and normal, sized so that

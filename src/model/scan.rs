@@ -161,8 +161,8 @@ pub struct Scan {
     pub direction: f64,
 }
 
-/// Where θ falls between the key frames: frames `a` ≤ θ ≤ `b` and the mixing ratio
-/// k = (θ − θa)/(θb − θa).
+/// Where a value x falls between the key frames: frames `a` ≤ x ≤ `b` and the mixing ratio
+/// k = (x − xa)/(xb − xa).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Bracket {
     pub a: usize,
@@ -560,10 +560,10 @@ impl Scan {
         self.frames.iter().map(|f| f.at).collect()
     }
 
-    /// The two key frames around θ (clamped to the scan's range).
-    pub fn bracket(&self, theta: f64) -> Bracket {
+    /// The two key frames around the value (clamped to the scan's range).
+    pub fn bracket(&self, value: f64) -> Bracket {
         let (lo, hi) = self.range();
-        let t = theta.clamp(lo, hi);
+        let t = value.clamp(lo, hi);
         let b = self.frames.iter().position(|f| f.at >= t).unwrap_or(self.frames.len() - 1).max(1);
         let a = b - 1;
         let (ta, tb) = (self.frames[a].at, self.frames[b].at);
@@ -576,12 +576,12 @@ impl Scan {
         shift(&self.coordinate, positions, &self.moving, self.direction, delta);
     }
 
-    /// The skeleton at θ: each bracketing frame's moving fragment moved towards θ by its share
+    /// The skeleton at the value: each bracketing frame's moving fragment moved towards the value by its share
     /// of the measured change between them (slid along the bond, bent in the angle's plane,
     /// twisted about the bond), then the two blended (1−k):k, so the result is each key frame's
     /// own geometry at its value, and a rigid motion for rigid scans. A path blends the frames.
-    pub fn geometry_at(&self, theta: f64) -> Molecule {
-        let Bracket { a, b, k } = self.bracket(theta);
+    pub fn geometry_at(&self, value: f64) -> Molecule {
+        let Bracket { a, b, k } = self.bracket(value);
         let (fa, fb) = (&self.frames[a].molecule, &self.frames[b].molecule);
         let mut pa: Vec<DVec3> = fa.atoms.iter().map(|x| x.position).collect();
         let mut pb: Vec<DVec3> = fb.atoms.iter().map(|x| x.position).collect();
@@ -593,7 +593,7 @@ impl Scan {
             self.shift(&mut pa, k * delta);
             self.shift(&mut pb, -(1.0 - k) * delta);
         }
-        // Both shapes are now at θ; a program may have written the frames in different
+        // Both shapes are now at the value; a program may have written the frames in different
         // orientations (a symmetric bend moves both arms in the standard orientation). Blend
         // them laid on each other, then carry the blend the fraction k of the way from frame a's
         // orientation to frame b's: each key frame comes back exactly as written.
@@ -614,9 +614,9 @@ impl Scan {
         Molecule { atoms, bonds: self.frames[0].molecule.bonds.clone() }
     }
 
-    /// The key frame nearest to θ.
-    pub fn nearest_frame(&self, theta: f64) -> usize {
-        let Bracket { a, b, k } = self.bracket(theta);
+    /// The key frame nearest to the value.
+    pub fn nearest_frame(&self, value: f64) -> usize {
+        let Bracket { a, b, k } = self.bracket(value);
         if k <= 0.5 { a } else { b }
     }
 
@@ -828,9 +828,9 @@ impl Scan {
         }
     }
 
-    /// The exactly interpolated volume at θ: (1−k)·ψa + k·ψb of the two bracketing key frames.
-    pub fn interpolated_values(&self, tracks: &Tracks, slot: usize, theta: f64, grid: &GridSpec) -> Vec<f32> {
-        let Bracket { a, b, k } = self.bracket(theta);
+    /// The exactly interpolated volume at the value: (1−k)·ψa + k·ψb of the two bracketing key frames.
+    pub fn interpolated_values(&self, tracks: &Tracks, slot: usize, value: f64, grid: &GridSpec) -> Vec<f32> {
+        let Bracket { a, b, k } = self.bracket(value);
         let (va, vb) = (self.key_values(tracks, slot, a, grid), self.key_values(tracks, slot, b, grid));
         let (wa, wb) = ((1.0 - k) as f32, k as f32);
         va.iter().zip(&vb).map(|(&x, &y)| wa * x + wb * y).collect()
@@ -841,11 +841,11 @@ impl Scan {
         &self,
         tracks: &Tracks,
         slot: usize,
-        theta: f64,
+        value: f64,
         grid: &GridSpec,
         label: impl Into<String>,
     ) -> VolumeGrid {
-        let values = self.interpolated_values(tracks, slot, theta, grid);
+        let values = self.interpolated_values(tracks, slot, value, grid);
         let mut g = VolumeGrid::new(label, grid.dims, grid.world_from_grid, values);
         g.kind = super::grid::ValueKind::Signed;
         g
@@ -856,9 +856,9 @@ impl Scan {
         self.orbitals.iter().position(|o| o.eq_ignore_ascii_case(name))
     }
 
-    /// A slot's orbital energy at θ (Eh), interpolated linearly between the key frames.
-    pub fn energy_at(&self, tracks: &Tracks, slot: usize, theta: f64) -> Option<f64> {
-        let Bracket { a, b, k } = self.bracket(theta);
+    /// A slot's orbital energy at the value (Eh), interpolated linearly between the key frames.
+    pub fn energy_at(&self, tracks: &Tracks, slot: usize, value: f64) -> Option<f64> {
+        let Bracket { a, b, k } = self.bracket(value);
         let (ea, eb) = (tracks.points[slot][a].energy?, tracks.points[slot][b].energy?);
         Some((1.0 - k) * ea + k * eb)
     }
@@ -934,12 +934,12 @@ mod tests {
     }
 
     #[test]
-    fn geometry_follows_theta() {
+    fn geometry_follows_the_value() {
         let scan =
             Scan::new("t".into(), Coordinate::Dihedral([0, 1, 2, 3]), vec![], frames(&[-180.0, -90.0, 0.0])).unwrap();
-        for theta in [-180.0, -150.0, -90.0, -45.0, -10.0, 0.0] {
-            let m = scan.geometry_at(theta);
-            assert!((wrap_degrees(measure(&m, [0, 1, 2, 3]) - theta)).abs() < 1e-9, "{theta}");
+        for value in [-180.0, -150.0, -90.0, -45.0, -10.0, 0.0] {
+            let m = scan.geometry_at(value);
+            assert!((wrap_degrees(measure(&m, [0, 1, 2, 3]) - value)).abs() < 1e-9, "{value}");
             // Rigid: bond lengths unchanged.
             let d = (m.atoms[3].position - m.atoms[2].position).length();
             assert!((d - (chain().atoms[3].position - chain().atoms[2].position).length()).abs() < 1e-9);
@@ -972,10 +972,10 @@ mod tests {
         let frames: Vec<KeyFrame> = [90.0, 105.0, 120.0].iter().map(|&a| key(a, water(a, 0.96))).collect();
         let scan = Scan::new("bend".into(), Coordinate::Angle([1, 0, 2]), vec![], frames.clone()).unwrap();
         assert_eq!(scan.moving, vec![2], "the side of the third atom moves");
-        for theta in [90.0, 97.0, 105.0, 111.5, 120.0] {
-            let m = scan.geometry_at(theta);
+        for value in [90.0, 97.0, 105.0, 111.5, 120.0] {
+            let m = scan.geometry_at(value);
             let measured = scan.coordinate.measure(&m).unwrap();
-            assert!((measured - theta).abs() < 1e-9, "{theta}: {measured}");
+            assert!((measured - value).abs() < 1e-9, "{value}: {measured}");
             let oh = m.atoms[0].position.distance(m.atoms[2].position) * crate::model::units::ANGSTROM_PER_BOHR;
             assert!((oh - 0.96).abs() < 1e-12, "the arm keeps its length");
         }

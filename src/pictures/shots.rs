@@ -73,28 +73,28 @@ impl ScanShots {
         Self { scene, slots, values, camera, settings, interpolation, figure, captions: true, size, painter }
     }
 
-    /// The views at value `theta`.
-    pub fn at(&mut self, ctx: &GpuContext, theta: f64) -> Result<image::RgbaImage, GpuError> {
+    /// The views at value `value`.
+    pub fn at(&mut self, ctx: &GpuContext, value: f64) -> Result<image::RgbaImage, GpuError> {
         let slots = &self.slots;
         let background = self.settings.background;
         let (scene, painter, settings) = (&self.scene, &mut self.painter, &mut self.settings);
         let mut image = self.figure.draw(background, |bg| {
             settings.background = bg;
-            painter.paint(scene, ctx, slots, theta, self.interpolation, &self.camera, settings)
+            painter.paint(scene, ctx, slots, value, self.interpolation, &self.camera, settings)
         })?;
         settings.background = background;
         if self.captions {
-            caption_views(&mut image, scene, slots, theta, self.size[0]);
+            caption_views(&mut image, scene, slots, value, self.size[0]);
         }
         Ok(image)
     }
 }
 
 /// Captions each view of a scan picture (`slots` side by side, each `width` wide) with its
-/// orbital and energy and the coordinate's value at θ, as the window labels them.
-pub fn caption_views(image: &mut image::RgbaImage, scene: &ScanScene, slots: &[usize], theta: f64, width: u32) {
+/// orbital and energy and the coordinate's value at the value, as the window labels them.
+pub fn caption_views(image: &mut image::RgbaImage, scene: &ScanScene, slots: &[usize], value: f64, width: u32) {
     for (n, &slot) in slots.iter().enumerate() {
-        let lines = [scene.label(slot, theta), scene.coordinate_label(theta)];
+        let lines = [scene.label(slot, value), scene.coordinate_label(value)];
         caption(image, n as u32 * width, width, &lines);
     }
 }

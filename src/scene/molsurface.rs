@@ -55,7 +55,7 @@ pub struct SurfaceSettings {
     pub color: [f32; 3],
     /// Translucent with Koide and Miyata's optics, in exact order with every other translucent surface.
     pub translucent: bool,
-    /// Seed 002's level of detail: parts of the surface smaller than this many pixels on screen
+    /// Lee et al.'s level of detail: parts of the surface smaller than this many pixels on screen
     /// are drawn as points (0: every triangle); the viewer scales it up while the view is
     /// dragged. Opaque surfaces only.
     pub lod_px: f32,

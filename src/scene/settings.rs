@@ -11,7 +11,7 @@ pub enum SliceMode {
     /// Planes perpendicular to the view direction, cut from the grid box each frame.
     #[default]
     ViewAligned,
-    /// Seed 000: three stacks along the grid axes; the one facing the viewer is drawn.
+    /// Naka et al.: three stacks along the grid axes; the one facing the viewer is drawn.
     AxisAligned,
 }
 
@@ -21,10 +21,10 @@ pub enum Interpolation {
     /// Both volumes sampled and mixed per sample, ψ = (1−k)ψA + kψB: the interpolated orbital.
     #[default]
     Exact,
-    /// Seed 000's real-time approximation: per slice, three blends (attenuate by A_i's
+    /// Naka et al.'s real-time approximation: per slice, three blends (attenuate by A_i's
     /// opacity, B_i's past the middle; add (1−k)A_i; add kB_i), drawn as one.
     ThreePass,
-    /// Seed 000's reference for it: per slice the two samples' colours and opacities mixed,
+    /// Naka et al.'s reference for it: per slice the two samples' colours and opacities mixed,
     /// α = (1−k)α_A + kα_B.
     AlphaMix,
 }
@@ -43,7 +43,7 @@ pub struct VolumeSettings {
     pub positive_color: [f32; 3],
     /// Linear RGB for negative ψ (or the thin end of a density ramp).
     pub negative_color: [f32; 3],
-    /// Seed 004's shaped transfer functions, gradient shading and boundary enhancement (when
+    /// Jang and Varetto's shaped transfer functions, gradient shading and boundary enhancement (when
     /// `transfer.kind` is `Shaped`; k1 and k2 apply to the power law).
     pub transfer: Transfer,
     /// The clipping plane a cloud had before the plane belonged to its object (sessions

@@ -101,7 +101,7 @@ impl GridBox {
         triangulate_convex(&mut poly, n, out);
     }
 
-    /// Seed 000's three stacks: planes of constant grid coordinate along the axis that faces the
+    /// Naka et al.'s three stacks: planes of constant grid coordinate along the axis that faces the
     /// viewer most directly, ordered back to front.
     pub fn axis_aligned(&self, count: u32, eye: Vec3, view_dir: Vec3) -> Slices {
         let v = view_dir.normalize_or(Vec3::NEG_Z);

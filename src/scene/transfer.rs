@@ -6,7 +6,7 @@
 
 use serde::{Deserialize, Serialize};
 
-/// Seed 004's five shapes, drawn as the paper draws them: on the signed value
+/// Jang and Varetto's five shapes, drawn as the paper draws them: on the signed value
 /// s = value / max|value| ∈ [−1, 1], each lobe's shape placed at s = ±centre (its sign).
 ///
 /// The halves are not mirror images of each other: a right half falls off towards larger s, a
@@ -118,10 +118,10 @@ impl Lobe {
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 pub enum TransferKind {
-    /// Seed 000: α = k1·ρ^k2.
+    /// Naka et al.: α = k1·ρ^k2.
     #[default]
     PowerLaw,
-    /// Seed 004: shaped functions of the value, per sign.
+    /// Jang and Varetto: shaped functions of the value, per sign.
     Shaped,
 }
 
@@ -155,7 +155,7 @@ impl Default for Transfer {
 }
 
 impl Transfer {
-    /// Seed 004's pairing for nested cores: the left half on ψ > 0 and the right half on ψ < 0,
+    /// Jang and Varetto's pairing for nested cores: the left half on ψ > 0 and the right half on ψ < 0,
     /// each peaked at its extreme value, so opacity grows from the empty space to the cores.
     /// The width keeps ψ = 0 under the shaders' visibility floor of 10⁻⁵ (2·e^−(1/0.28)² ≈ 6·10⁻⁶):
     /// empty space stays exactly clear.

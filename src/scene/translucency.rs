@@ -1,4 +1,4 @@
-//! Seed 003's optical model of translucent isosurfaces (Koide & Miyata), and the CPU reference
+//! Koide and Miyata's optical model of translucent isosurfaces (docs/references.md), and the CPU reference
 //! of its exact-order composition that the GPU's fragment lists are checked against.
 //!
 //! A surface fragment with outward normal N, seen along V (towards the eye) and lit from L,
@@ -35,7 +35,7 @@ pub struct Optics {
 /// Looks of translucent surfaces, each made from the surface's colour.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub enum OpticsPreset {
-    /// Seed 003's pictures: tinted glass with a soft emitting rim; overlaps glow warm.
+    /// Koide and Miyata's pictures: tinted glass with a soft emitting rim; overlaps glow warm.
     #[default]
     Koide,
     /// Clear glass: strong highlights, little emission, very transparent.
@@ -165,7 +165,7 @@ pub struct SurfaceLook {
     /// Linear RGB (of the opaque surface; a translucent one's optics were made from it).
     pub color: [f32; 3],
     pub optics: Option<Optics>,
-    /// Seed 002's level of detail for an opaque closed surface: parts that look smaller than
+    /// Lee et al.'s level of detail for an opaque closed surface: parts that look smaller than
     /// this many pixels are drawn as points ([`crate::model::octree`]); `None`: every triangle.
     pub lod_px: Option<f32>,
 }
