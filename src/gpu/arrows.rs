@@ -149,6 +149,20 @@ impl ArrowsPass {
     }
 }
 
+impl super::frame::Representation for ArrowsPass {
+    fn new(ctx: &GpuContext, _shared: &super::frame::Shared<'_>) -> Self {
+        Self::new(ctx)
+    }
+
+    fn instance(&self, ctx: &GpuContext) -> Self {
+        self.instance(ctx)
+    }
+
+    fn clear(&mut self, _ctx: &GpuContext) {
+        self.clear();
+    }
+}
+
 impl Draw for ArrowsPass {
     fn prepare(&mut self, f: &Prepare<'_>) {
         if self.arrows.is_none() {

@@ -876,6 +876,20 @@ pub fn projected_radius_px(clip_from_world: Mat4, center: Vec3, radius: f32, hei
     radius * clip_from_world.row(1).truncate().length() * 0.5 * height_px as f32 / w
 }
 
+impl super::frame::Representation for AtomsPass {
+    fn new(ctx: &GpuContext, _shared: &super::frame::Shared<'_>) -> Self {
+        Self::new(ctx)
+    }
+
+    fn instance(&self, ctx: &GpuContext) -> Self {
+        self.instance(ctx)
+    }
+
+    fn clear(&mut self, ctx: &GpuContext) {
+        self.set_molecule(ctx, &Molecule::default(), AtomStyle::Hidden, None);
+    }
+}
+
 impl Draw for AtomsPass {
     fn prepare(&mut self, f: &super::frame::Prepare<'_>) {
         if !f.later_tile {

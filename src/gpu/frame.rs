@@ -137,6 +137,29 @@ pub trait Draw {
     fn occlude(&self, _encoder: &mut wgpu::CommandEncoder, _pyramid: &wgpu::BindGroup) {}
 }
 
+/// The renderer's layouts a representation's pipelines are built against.
+pub struct Shared<'a> {
+    /// The resolve pass's group of the frame's colour and depth (what a cloud's walk reads).
+    pub scene: &'a wgpu::BindGroupLayout,
+    /// The fragment lists translucent surfaces append to.
+    pub collect: &'a wgpu::BindGroupLayout,
+    /// The fragment lists as the composite reads them.
+    pub composite: &'a wgpu::BindGroupLayout,
+    /// The depth pyramid occlusion tests read.
+    pub pyramid: &'a wgpu::BindGroupLayout,
+}
+
+/// A kind of drawing a layer holds (atoms, arrows, isosurfaces, clouds, …): made once per
+/// renderer, instanced per layer, listed in [`super::layer::Representations`].
+pub trait Representation: Draw + Sized {
+    /// The first instance, its pipelines built.
+    fn new(ctx: &super::GpuContext, shared: &Shared<'_>) -> Self;
+    /// An empty instance sharing this one's pipelines.
+    fn instance(&self, ctx: &super::GpuContext) -> Self;
+    /// Draws nothing from now on, keeping its pipelines.
+    fn clear(&mut self, ctx: &super::GpuContext);
+}
+
 /// What each representation of a layer is given every frame ([`Draw::prepare`]).
 pub struct Prepare<'a> {
     pub ctx: &'a super::GpuContext,

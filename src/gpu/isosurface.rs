@@ -568,6 +568,20 @@ impl IsosurfacePass {
     }
 }
 
+impl super::frame::Representation for IsosurfacePass {
+    fn new(ctx: &GpuContext, shared: &super::frame::Shared<'_>) -> Self {
+        Self::new(ctx, shared.collect, shared.pyramid)
+    }
+
+    fn instance(&self, _ctx: &GpuContext) -> Self {
+        self.instance()
+    }
+
+    fn clear(&mut self, _ctx: &GpuContext) {
+        self.clear();
+    }
+}
+
 impl Draw for IsosurfacePass {
     fn prepare(&mut self, f: &super::frame::Prepare<'_>) {
         let lod = (!f.later_tile).then_some((f.size, f.lod_scale));

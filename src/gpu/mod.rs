@@ -11,6 +11,7 @@ pub mod context;
 pub mod frame;
 pub mod gto;
 pub mod isosurface;
+pub mod layer;
 pub mod occlusion;
 pub mod oit;
 pub mod readback;

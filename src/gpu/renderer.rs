@@ -2,21 +2,16 @@
 
 use glam::{Mat4, Vec3};
 
-use super::arrows::ArrowsPass;
-use super::atoms::AtomsPass;
-use super::frame::{Draw, FrameTargets, ObjectView, Phase, PhaseNode, PickId, Prepare, STANDARD_FRAME};
-use super::isosurface::IsosurfacePass;
+use super::frame::{FrameTargets, ObjectView, Phase, PhaseNode, PickId, Prepare, STANDARD_FRAME, Shared};
+pub use super::layer::Layer;
+use super::layer::Representations;
 use super::occlusion::DepthPyramid;
 use super::oit::{FragmentDump, FragmentLists, FragmentStats, MAX_BANDS, Transparency};
 use super::resolve::{Lists, ResolvePass, Rows};
-use super::volume::{MAX_WALKED, VolumePass, VolumeTexture, overlapping_groups};
+use super::volume::{MAX_WALKED, VolumePass, overlapping_groups};
 use super::{GpuContext, GpuError};
-use crate::model::GridSpec;
-use crate::model::cartesian::CartesianExpansion;
-use crate::model::octree::box_corners;
-use crate::model::{Molecule, VolumeGrid};
 use crate::scene::translucency::TranslucentSurface;
-use crate::scene::{AtomColors, AtomStyle, Camera, ClipPlane, RenderSettings, VolumeSettings};
+use crate::scene::{Camera, RenderSettings, VolumeSettings};
 
 /// What one frame needs besides the long-lived GPU state.
 #[derive(Debug, Clone, Copy)]
@@ -56,109 +51,6 @@ impl<'a> FrameInput<'a> {
     }
 }
 
-/// One object of the scene on the GPU: its atoms, isosurfaces and cloud, each a long-lived
-/// instance of its pass, drawn where `world_from_object` places them. Its index in the
-/// renderer is the object number its pick ids carry.
-pub struct Layer {
-    pub atoms: AtomsPass,
-    /// Arrows (a normal mode's displacements) drawn with the atoms.
-    pub arrows: ArrowsPass,
-    pub surfaces: IsosurfacePass,
-    pub volume: VolumePass,
-    /// A rigid placement (rotation and translation).
-    pub world_from_object: Mat4,
-    /// Whether the layer is drawn at all.
-    pub visible: bool,
-    /// The molecule's bounds in the object's frame, padded by the largest atom.
-    molecule_bounds: Option<(Vec3, Vec3)>,
-    /// The object's clipping plane, its offset measured from `clip_centre` (object frame).
-    pub clip: ClipPlane,
-    pub clip_centre: Vec3,
-}
-
-impl Layer {
-    /// Shows a molecule's atoms in a style, coloured by element.
-    pub fn set_molecule(&mut self, ctx: &GpuContext, molecule: &Molecule, style: AtomStyle) {
-        self.set_atoms(ctx, molecule, style, None);
-    }
-
-    /// Shows a molecule's atoms in a style and colours (by element when `None`).
-    pub fn set_atoms(&mut self, ctx: &GpuContext, molecule: &Molecule, style: AtomStyle, colors: Option<&AtomColors>) {
-        self.atoms.set_molecule(ctx, molecule, style, colors);
-        // Pad by the largest space-filling radius so near/far planes never clip an atom.
-        self.molecule_bounds = molecule.bounds().map(|(lo, hi)| (lo.as_vec3() - 4.5, hi.as_vec3() + 4.5));
-    }
-
-    /// Shows `grid` as the layer's cloud. A grid over this device's limits is shown at every
-    /// `step`-th point instead ([`super::volume::fitting_step`]); returns the step (1: whole).
-    pub fn set_volume(&mut self, ctx: &GpuContext, grid: Option<&VolumeGrid>) -> Result<usize, GpuError> {
-        let step = grid.map_or(1, |g| {
-            super::volume::fitting_step(g.dims, super::volume::texel_bytes(ctx.volume_format), &ctx.device.limits())
-        });
-        match grid {
-            Some(g) if step > 1 => self.volume.set_volume(ctx, Some(&g.subsampled(step)))?,
-            _ => self.volume.set_volume(ctx, grid)?,
-        }
-        Ok(step)
-    }
-
-    /// Shows a volume already on the GPU (a filled GTO grid).
-    pub fn set_volume_texture(&mut self, ctx: &GpuContext, volume: VolumeTexture) {
-        self.volume.set_texture(ctx, Some(volume));
-    }
-
-    /// Shows a value between two key volumes of a scan (Naka et al., docs/references.md), mixed (1−k):k.
-    pub fn set_morph(
-        &mut self,
-        ctx: &GpuContext,
-        a: VolumeTexture,
-        b: VolumeTexture,
-        k: f32,
-        mode: crate::scene::Interpolation,
-    ) {
-        self.volume.set_morph(ctx, a, b, k, mode);
-    }
-
-    /// Shows an orbital evaluated per fragment from its basis functions (Jang and Varetto's direct mode),
-    /// its opacity and gradient scaled to `(max |ψ|, max |∇ψ|)`.
-    pub fn set_direct(
-        &mut self,
-        ctx: &GpuContext,
-        expansion: &CartesianExpansion,
-        geometry: &GridSpec,
-        scale: (f64, f64),
-    ) {
-        self.volume.set_direct(ctx, expansion, geometry, scale);
-    }
-
-    /// Empties the layer (no atoms, surfaces or cloud), keeping its pipelines.
-    pub fn clear(&mut self, ctx: &GpuContext) {
-        self.set_molecule(ctx, &Molecule::default(), AtomStyle::Hidden);
-        self.volume.set_texture(ctx, None);
-        self.surfaces.clear();
-        self.arrows.clear();
-    }
-
-    /// The world-space box around everything the layer draws.
-    fn bounds(&self) -> Option<(Vec3, Vec3)> {
-        let volume = self.volume.volume().map(|v| v.grid_box.corners().to_vec()).unwrap_or_default();
-        let atoms = self.molecule_bounds.map(|(lo, hi)| box_corners(lo, hi).to_vec()).unwrap_or_default();
-        let points: Vec<Vec3> =
-            volume.into_iter().chain(atoms).map(|p| self.world_from_object.transform_point3(p)).collect();
-        let first = *points.first()?;
-        Some(points.iter().fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p))))
-    }
-
-    /// The representations, in the order they draw within a phase.
-    fn drawers(&self) -> [&dyn Draw; 4] {
-        [&self.atoms, &self.arrows, &self.surfaces, &self.volume]
-    }
-
-    fn drawers_mut(&mut self) -> [&mut dyn Draw; 4] {
-        [&mut self.atoms, &mut self.arrows, &mut self.surfaces, &mut self.volume]
-    }
-}
-
 /// Most objects one scene draws: the object field of a [`PickId`] has 6 bits.
 pub const MAX_LAYERS: usize = 64;
 
@@ -193,17 +85,13 @@ impl Renderer {
     fn with_lists(ctx: &GpuContext, lists: FragmentLists) -> Self {
         let resolve = ResolvePass::new(ctx, &lists.composite_layout, &lists.weighted_layout);
         let pyramid = DepthPyramid::new(ctx);
-        let layer = Layer {
-            atoms: AtomsPass::new(ctx),
-            arrows: ArrowsPass::new(ctx),
-            surfaces: IsosurfacePass::new(ctx, &lists.collect_layout, &pyramid.read_layout),
-            volume: VolumePass::new(ctx, &resolve.layout, &lists.composite_layout),
-            world_from_object: Mat4::IDENTITY,
-            visible: true,
-            molecule_bounds: None,
-            clip: ClipPlane::default(),
-            clip_centre: Vec3::ZERO,
+        let shared = Shared {
+            scene: &resolve.layout,
+            collect: &lists.collect_layout,
+            composite: &lists.composite_layout,
+            pyramid: &pyramid.read_layout,
         };
+        let layer = Layer::new(Representations::new(ctx, &shared));
         Self {
             layers: vec![layer],
             resolve,
@@ -246,18 +134,7 @@ impl Renderer {
 
     /// A layer that draws nothing, sharing the first layer's pipelines.
     fn empty_layer(&self, ctx: &GpuContext) -> Layer {
-        let first = &self.layers[0];
-        Layer {
-            atoms: first.atoms.instance(ctx),
-            arrows: first.arrows.instance(ctx),
-            surfaces: first.surfaces.instance(),
-            volume: first.volume.instance(ctx),
-            world_from_object: Mat4::IDENTITY,
-            visible: true,
-            molecule_bounds: None,
-            clip: ClipPlane::default(),
-            clip_centre: Vec3::ZERO,
-        }
+        Layer::new(self.layers[0].representations.instance(ctx))
     }
 
     /// Inserts an empty layer at `n` (at the end when past it); the layers from `n` on move up
@@ -324,24 +201,9 @@ impl Renderer {
         output: &wgpu::TextureView,
         frame: &FrameInput,
     ) {
-        let resized = self.targets.as_ref().is_none_or(|(t, _)| t.size != frame.size.map(|v| v.max(1)));
-        if resized {
-            let targets = FrameTargets::new(&ctx.device, frame.size);
-            let bind = self.resolve.bind(&ctx.device, &targets.color_view);
-            self.pyramid.resize(ctx, targets.size, &targets.depth_view);
-            self.targets = Some((targets, bind));
-        }
-        let cam = frame.camera;
-        let eye = cam.eye();
-        let (light, up) = super::atoms::headlight(eye, cam.target, cam.up());
-        let world = ObjectView {
-            clip_from_object: self.clip_from_world(cam, frame.size),
-            eye,
-            view_dir: (cam.target - eye).normalize_or(Vec3::NEG_Z),
-            light,
-            up,
-        };
-        let Some((targets, resolve)) = &self.targets else { return };
+        let resized = self.ensure_targets(ctx, frame.size);
+        let world = self.world_view(frame);
+        let Some((targets, _)) = &self.targets else { return };
         // The frame's translucent surfaces, numbered across layers in drawing order.
         let translucent: Vec<TranslucentSurface> = (self.layers.iter().enumerate().filter(|(_, l)| l.visible))
             .flat_map(|(n, l)| {
@@ -353,14 +215,74 @@ impl Renderer {
         if weighted && self.lists.surfaces > 0 {
             self.lists.weighted_targets(ctx);
         }
-        let lists = (self.lists.surfaces > 0).then(|| self.lists.collect_bind()).flatten();
-        let hidden = VolumeSettings { visible: false, ..VolumeSettings::default() };
         // A later tile keeps what the first drew: only the clouds inside it are added, and the
         // fragment lists of a frame drawn in one band.
         let later_tile = frame.tile.is_some_and(|t| !t.first);
+        self.prepare_layers(ctx, &world, frame, later_tile);
+        let oit = self.lists.surfaces > 0;
+        let height = frame.size[1].max(1);
+        // Weighted blending keeps no lists: one band always.
+        let bands = if oit && !weighted { self.lists.bands.clamp(1, MAX_BANDS).min(height) } else { 1 };
+        if !weighted {
+            self.lists.bands = bands;
+        }
+        // The clouds drawn from a texture are composited in one depth order with each other and
+        // the surfaces, by a walk per pixel (one cloud alone with no surfaces: by its slices).
+        let sorted = oit && !weighted;
+        let clouds: Vec<(usize, [u32; 4])> = (self.layers.iter().enumerate())
+            .filter(|(_, l)| l.visible && l.volume.walkable())
+            .map(|(n, l)| (n, l.volume.screen_rect()))
+            .collect();
+        let plan = plan_walks(&clouds, weighted, sorted, sorted && self.lists.composite_bind().is_some());
+        for (n, layer) in self.layers.iter_mut().enumerate() {
+            layer.volume.set_walked(plan.walked.contains(&n));
+        }
+        let Some((targets, _)) = &self.targets else { return };
+        let walks: Vec<((wgpu::RenderPipeline, wgpu::BindGroup), [u32; 4])> = (plan.walks.iter())
+            .filter_map(|(g, rect)| {
+                let clouds: Vec<&VolumePass> = g.iter().map(|&n| &self.layers[n].volume).collect();
+                Some((VolumePass::walk(ctx, &clouds, &targets.depth_view, sorted)?, *rect))
+            })
+            .collect();
+        let shape = FrameShape { oit, weighted, sorted, bands, collects: oit && (bands > 1 || !later_tile) };
+        self.encode_phases(encoder, output, frame, &shape, &walks);
+    }
+
+    /// The targets at `size`, made anew when it changed (then true).
+    fn ensure_targets(&mut self, ctx: &GpuContext, size: [u32; 2]) -> bool {
+        let resized = self.targets.as_ref().is_none_or(|(t, _)| t.size != size.map(|v| v.max(1)));
+        if resized {
+            let targets = FrameTargets::new(&ctx.device, size);
+            let bind = self.resolve.bind(&ctx.device, &targets.color_view);
+            self.pyramid.resize(ctx, targets.size, &targets.depth_view);
+            self.targets = Some((targets, bind));
+        }
+        resized
+    }
+
+    /// The frame's camera seen from the world, with its headlight.
+    fn world_view(&self, frame: &FrameInput) -> ObjectView {
+        let cam = frame.camera;
+        let eye = cam.eye();
+        let (light, up) = super::atoms::headlight(eye, cam.target, cam.up());
+        ObjectView {
+            clip_from_object: self.clip_from_world(cam, frame.size),
+            eye,
+            view_dir: (cam.target - eye).normalize_or(Vec3::NEG_Z),
+            light,
+            up,
+        }
+    }
+
+    /// Gives every layer's representations the frame ([`super::frame::Draw::prepare`]), the
+    /// translucent surfaces numbered across layers in drawing order.
+    fn prepare_layers(&mut self, ctx: &GpuContext, world: &ObjectView, frame: &FrameInput, later_tile: bool) {
+        let Some((targets, _)) = &self.targets else { return };
+        let lists = (self.lists.surfaces > 0).then(|| self.lists.collect_bind()).flatten();
+        let hidden = VolumeSettings { visible: false, ..VolumeSettings::default() };
         let mut first_translucent = 0;
         for (n, layer) in self.layers.iter_mut().enumerate() {
-            let view = ObjectView::new(&world, layer.world_from_object);
+            let view = ObjectView::new(world, layer.world_from_object);
             let prepare = Prepare {
                 ctx,
                 view: &view,
@@ -382,55 +304,33 @@ impl Renderer {
                 first_translucent += layer.drawers().iter().map(|d| d.translucent_surfaces()).sum::<usize>();
             }
         }
-        let oit = self.lists.surfaces > 0;
+    }
+
+    /// Records the frame's phases: opaque passes, culling, the translucent fragments (in bands
+    /// when the lists overflow), and the resolve that composites surfaces and walked clouds.
+    fn encode_phases(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        output: &wgpu::TextureView,
+        frame: &FrameInput,
+        shape: &FrameShape,
+        walks: &[((wgpu::RenderPipeline, wgpu::BindGroup), [u32; 4])],
+    ) {
+        let Some((targets, resolve)) = &self.targets else { return };
+        let &FrameShape { oit, weighted, sorted, bands, collects } = shape;
+        let later_tile = frame.tile.is_some_and(|t| !t.first);
         let [width, height] = targets.size;
-        // Weighted blending keeps no lists: one band always.
-        let bands = if oit && !weighted { self.lists.bands.clamp(1, MAX_BANDS).min(height) } else { 1 };
-        if !weighted {
-            self.lists.bands = bands;
-        }
-        let collects = oit && (bands > 1 || !later_tile);
         if collects && !weighted {
             self.lists.begin_frame(encoder);
         }
-        // The clouds drawn from a texture are composited in one depth order with each other and
-        // the surfaces, by a walk per pixel (one cloud alone with no surfaces: by its slices).
-        let sorted = oit && !weighted;
-        let walkable: Vec<usize> = (self.layers.iter().enumerate())
-            .filter(|(_, l)| l.visible && l.volume.walkable())
-            .map(|(n, _)| n)
-            .collect();
-        // Clouds whose pixels overlap are walked together, up to MAX_WALKED (more are drawn by
-        // their slices, behind); a group apart on screen is walked on its own, in its rectangle.
-        let rects: Vec<[u32; 4]> = walkable.iter().map(|&n| self.layers[n].volume.screen_rect()).collect();
-        let groups: Vec<(Vec<usize>, [u32; 4])> = overlapping_groups(&rects)
-            .into_iter()
-            .map(|(g, rect)| (g.into_iter().map(|i| walkable[i]).take(MAX_WALKED).collect(), rect))
-            .collect();
         let lists_bind = if sorted { self.lists.composite_bind() } else { None };
-        // With surfaces, the walk reads their lists: none, no walk (the slices draw the clouds).
-        let walks_group =
-            |g: &[usize]| !weighted && (g.len() > 1 || (g.len() == 1 && sorted)) && (!sorted || lists_bind.is_some());
-        for (n, layer) in self.layers.iter_mut().enumerate() {
-            let walked = groups.iter().any(|(g, _)| g.len() > 1 && walks_group(g) && g.contains(&n));
-            layer.volume.set_walked(walked);
-        }
-        let mut walks: Vec<((wgpu::RenderPipeline, wgpu::BindGroup), [u32; 4])> = (groups.iter())
-            .filter(|(g, _)| walks_group(g))
-            .filter_map(|(g, rect)| {
-                let clouds: Vec<&VolumePass> = g.iter().map(|&n| &self.layers[n].volume).collect();
-                Some((VolumePass::walk(ctx, &clouds, &targets.depth_view, sorted)?, *rect))
-            })
-            .collect();
         // The first group's walk is the resolve of the whole frame; the others follow it in
         // their rectangles.
-        let further = walks.split_off(walks.len().min(1));
-        let walk = walks.pop().map(|(walk, _)| walk);
-        let further: Vec<(Lists, [u32; 4])> = further
-            .iter()
+        let walk = walks.first().map(|((pipeline, clouds), _)| (pipeline, clouds));
+        let further: Vec<(Lists, [u32; 4])> = (walks.iter().skip(1))
             .map(|((pipeline, clouds), rect)| (Lists::Walk(lists_bind, pipeline, clouds), *rect))
             .collect();
-        let composite = match (oit, self.lists.weighted().filter(|_| weighted), &walk) {
+        let composite = match (oit, self.lists.weighted().filter(|_| weighted), walk) {
             (true, Some(w), _) => Some(Lists::Weighted(&w.resolve_bind)),
             (_, _, Some((pipeline, clouds))) => Some(Lists::Walk(lists_bind, pipeline, clouds)),
             (false, _, _) => None,
@@ -441,15 +341,6 @@ impl Renderer {
             .tile
             .filter(|_| matches!(composite, Some(Lists::Walk(..))))
             .map(|Tile { rect: [_, y, _, h], first }| (y, h, first));
-        let resolve_rows = |rows: Option<Rows>| match (walk_rows, rows) {
-            (None, rows) => rows,
-            (Some((y, h, _)), None) => Some(Rows { start: y, count: h, first: false }),
-            (Some((y, h, _)), Some(r)) => {
-                let start = r.start.max(y);
-                let end = (r.start + r.count).min(y + h);
-                (end > start).then_some(Rows { start, count: end - start, first: false })
-            }
-        };
         for node in self.frame {
             if node.phase == Phase::Resolve && walk_rows.is_some_and(|(_, _, first)| first) {
                 self.resolve.draw(encoder, resolve, output, None, None, width);
@@ -461,7 +352,7 @@ impl Renderer {
                         self.collect(encoder, targets, frame.background, Some((start, count)));
                         self.lists.end_band(encoder, band);
                         let rows = Rows { start, count, first: band == 0 };
-                        if let Some(rows) = resolve_rows(Some(rows)) {
+                        if let Some(rows) = rows_to_resolve(walk_rows, Some(rows)) {
                             self.resolve.draw(encoder, resolve, output, composite, Some(rows), width);
                             for &(walk, rect) in &further {
                                 self.resolve.draw_walk(encoder, resolve, output, walk, rect, Some(rows));
@@ -470,7 +361,7 @@ impl Renderer {
                     }
                 }
                 Phase::Resolve => {
-                    let rows = resolve_rows(None);
+                    let rows = rows_to_resolve(walk_rows, None);
                     self.resolve.draw(encoder, resolve, output, composite, rows, width);
                     for &(walk, rect) in &further {
                         self.resolve.draw_walk(encoder, resolve, output, walk, rect, rows);
@@ -623,5 +514,103 @@ impl Renderer {
         }
         let bytes = super::readback::read_texel(&ctx.device, &ctx.queue, &targets.ids, pixel, 4)?;
         Ok(PickId::decode(u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]])))
+    }
+}
+
+/// How a frame composites what it draws, decided before any phase is recorded.
+struct FrameShape {
+    /// It has translucent surfaces.
+    oit: bool,
+    /// They are blended by weight (no lists, no walk).
+    weighted: bool,
+    /// They are kept in per-pixel lists in exact depth order.
+    sorted: bool,
+    /// The lists are filled and resolved in this many bands of rows.
+    bands: u32,
+    /// This tile fills the lists.
+    collects: bool,
+}
+
+/// Which clouds a frame walks per pixel in one depth order, and where ([`plan_walks`]).
+#[derive(Debug, PartialEq)]
+pub struct WalkPlan {
+    /// The groups walked, each its layers (at most [`MAX_WALKED`]) and screen rectangle; the
+    /// first one's walk is the frame's resolve, the others follow it in their rectangles.
+    pub walks: Vec<(Vec<usize>, [u32; 4])>,
+    /// The layers walked together with others: their slices are not drawn.
+    pub walked: Vec<usize>,
+}
+
+/// Plans a frame's walks from its walkable `clouds` (layer and screen rectangle, in layer
+/// order). Clouds whose pixels overlap are walked together, up to [`MAX_WALKED`] (more are drawn
+/// by their slices, behind); a group apart on screen is walked on its own, in its rectangle.
+/// Nothing is walked under weighted blending (`weighted`); a lone cloud is walked only to meet
+/// the surfaces' `sorted` lists, and a frame with sorted lists walks only when it can read them
+/// (`lists`).
+pub fn plan_walks(clouds: &[(usize, [u32; 4])], weighted: bool, sorted: bool, lists: bool) -> WalkPlan {
+    let rects: Vec<[u32; 4]> = clouds.iter().map(|c| c.1).collect();
+    let walks_group = |g: &[usize]| !weighted && (g.len() > 1 || (g.len() == 1 && sorted)) && (!sorted || lists);
+    let walks: Vec<(Vec<usize>, [u32; 4])> = overlapping_groups(&rects)
+        .into_iter()
+        .map(|(g, rect)| (g.into_iter().map(|i| clouds[i].0).take(MAX_WALKED).collect::<Vec<_>>(), rect))
+        .filter(|(g, _)| walks_group(g))
+        .collect();
+    let walked = walks.iter().filter(|(g, _)| g.len() > 1).flat_map(|(g, _)| g.iter().copied()).collect();
+    WalkPlan { walks, walked }
+}
+
+/// The rows a resolve draws: a band's `rows` (or the whole frame), within a walked tile's own
+/// rows when the frame is drawn in tiles (`walk_rows`: its first row, height and whether it
+/// is the first tile).
+fn rows_to_resolve(walk_rows: Option<(u32, u32, bool)>, rows: Option<Rows>) -> Option<Rows> {
+    match (walk_rows, rows) {
+        (None, rows) => rows,
+        (Some((y, h, _)), None) => Some(Rows { start: y, count: h, first: false }),
+        (Some((y, h, _)), Some(r)) => {
+            let start = r.start.max(y);
+            let end = (r.start + r.count).min(y + h);
+            (end > start).then_some(Rows { start, count: end - start, first: false })
+        }
+    }
+}
+
+#[cfg(test)]
+mod plan_tests {
+    use super::*;
+
+    #[test]
+    fn overlapping_clouds_are_walked_together_and_apart_ones_alone() {
+        // Layers 1 and 3 overlap on screen; layer 5 is apart.
+        let clouds = [(1, [0, 0, 100, 100]), (3, [50, 50, 150, 150]), (5, [300, 0, 400, 100])];
+        let plan = plan_walks(&clouds, false, false, false);
+        assert_eq!(
+            plan.walks,
+            vec![(vec![1, 3], [0, 0, 150, 150])],
+            "a lone cloud with no surfaces draws by its slices"
+        );
+        assert_eq!(plan.walked, vec![1, 3]);
+        let with_surfaces = plan_walks(&clouds, false, true, true);
+        assert_eq!(with_surfaces.walks.len(), 2, "with sorted surfaces every cloud meets them in a walk");
+        assert_eq!(with_surfaces.walked, vec![1, 3], "a lone walked cloud still draws as itself");
+        assert!(plan_walks(&clouds, false, true, false).walks.is_empty(), "unreadable lists: no walk");
+        assert!(plan_walks(&clouds, true, false, false).walks.is_empty(), "weighted blending walks nothing");
+    }
+
+    #[test]
+    fn at_most_max_walked_clouds_share_a_walk() {
+        let clouds: Vec<(usize, [u32; 4])> = (0..MAX_WALKED + 2).map(|n| (n, [0, 0, 10, 10])).collect();
+        let plan = plan_walks(&clouds, false, false, false);
+        assert_eq!(plan.walks[0].0.len(), MAX_WALKED);
+        assert!(!plan.walked.contains(&(MAX_WALKED + 1)), "the rest draw by their slices");
+    }
+
+    #[test]
+    fn a_walked_tile_resolves_only_its_rows_of_each_band() {
+        let band = Rows { start: 0, count: 100, first: true };
+        assert_eq!(rows_to_resolve(None, Some(band)), Some(band));
+        let tile = Some((40, 30, false));
+        assert_eq!(rows_to_resolve(tile, None), Some(Rows { start: 40, count: 30, first: false }));
+        assert_eq!(rows_to_resolve(tile, Some(band)), Some(Rows { start: 40, count: 30, first: false }));
+        assert_eq!(rows_to_resolve(tile, Some(Rows { start: 80, count: 20, first: false })), None);
     }
 }

@@ -978,6 +978,20 @@ const TF_GRADIENT: u32 = 2;
 const TF_SHAPED: u32 = 4;
 const TF_CLIP: u32 = 8;
 
+impl super::frame::Representation for VolumePass {
+    fn new(ctx: &GpuContext, shared: &super::frame::Shared<'_>) -> Self {
+        Self::new(ctx, shared.scene, shared.composite)
+    }
+
+    fn instance(&self, ctx: &GpuContext) -> Self {
+        self.instance(ctx)
+    }
+
+    fn clear(&mut self, ctx: &GpuContext) {
+        self.set_texture(ctx, None);
+    }
+}
+
 impl super::frame::Draw for VolumePass {
     fn prepare(&mut self, f: &super::frame::Prepare<'_>) {
         self.set_view(&f.ctx.device, &f.ctx.queue, f.view, f.cloud, f.clip, f.size);
