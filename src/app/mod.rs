@@ -15,6 +15,7 @@ mod orbitals;
 mod panels;
 pub mod panes;
 pub mod picture;
+mod progressive;
 pub mod record;
 pub mod restart;
 pub mod scan;

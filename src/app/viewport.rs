@@ -5,6 +5,7 @@ use egui::{Key, PointerButton, Sense};
 
 use super::detail::Detail;
 use super::jobs::Latest;
+use super::progressive::{Progressive, Turn};
 use super::state::{DRAG_ROTATE, KEY_ROTATE, KEY_ZOOM, ViewState};
 use crate::evaluate::meshes::{color_isosurfaces, isosurfaces_within, molecular_surface};
 use crate::evaluate::{Evaluated, WavefunctionView, evaluate_within};
@@ -12,7 +13,7 @@ use crate::gpu::context::guarded;
 use crate::gpu::frame::PickId;
 use crate::gpu::gto::GtoFillPass;
 use crate::gpu::oit::FragmentStats;
-use crate::gpu::{FrameInput, GpuContext, GpuError, OffscreenTarget, Renderer, Tile};
+use crate::gpu::{FrameInput, GpuContext, GpuError, OffscreenTarget, Renderer};
 use crate::layers::key_volumes::ScanScene;
 use crate::model::isosurface::Mesh;
 use crate::model::{Document, VolumeGrid};
@@ -23,7 +24,6 @@ use crate::scene::{
 };
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use std::sync::{Arc, Mutex};
-use std::time::{Duration, Instant};
 
 /// What a frame drew: the view, the clouds, the size, the scene's generation and the bits of
 /// the level-of-detail scale; a frame is drawn again when any of them changes.
@@ -76,29 +76,6 @@ pub struct Twist {
     pub along: f32,
     /// Where the pointer holds the grabbed atom (points, in the window).
     pub pointer: Option<egui::Pos2>,
-}
-
-/// How long one UI frame may spend drawing bands of a costly frame, and how long one band
-/// should take: inputs are answered within about 100 ms whatever the view shows.
-const FRAME_BUDGET: Duration = Duration::from_millis(80);
-/// The same while a coarse picture stands in: the window's own drawing between turns costs tens
-/// of ms on a CPU rasteriser, so longer turns finish the picture sooner.
-const REFINE_BUDGET: Duration = Duration::from_millis(250);
-const BAND_TIME: Duration = Duration::from_millis(40);
-
-/// The most bands a picture is drawn in.
-const MAX_BANDS: u32 = 32;
-
-/// A full picture slower than this gets a coarse preview at once after the next change.
-const PREVIEW_AFTER_MS: f64 = 300.0;
-/// A picture still being drawn after this shows its progress.
-const PROGRESS_AFTER: Duration = Duration::from_millis(150);
-
-/// A costly frame being drawn in bands: the first row not drawn yet, and rows per band.
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct Progress {
-    next_row: u32,
-    rows: u32,
 }
 
 /// The note for a document's data set `i` shown at every `step`-th point (`None` when whole).
@@ -233,10 +210,8 @@ pub struct Viewport {
     pub detail: Detail,
     /// The surfaces' level-of-detail scale while interacting, kept to the frame-time budget.
     pub lod_budget: super::detail::LodBudget,
-    /// When the picture being drawn was started, and how long the last complete one took (ms,
-    /// taken once).
-    picture_started: Option<Instant>,
-    picture_ms: Option<f64>,
+    /// The schedule of a costly picture drawn in bands over several frames.
+    progressive: Progressive,
     /// The state the texture currently shows; a frame is drawn only when this changes.
     drawn: Option<Drawn>,
     /// Bumped whenever the renderer's data changes.
@@ -264,14 +239,8 @@ pub struct Viewport {
     twisting: bool,
     /// Whether that drag started on the coordinate's bond: the grabbed atom follows the pointer.
     grabbed: bool,
-    /// A costly frame being drawn band by band, and how many rows the last band drew.
-    progress: Option<Progress>,
-    /// The coarse picture shown while a costly frame is drawn ([`Detail::PREVIEW`]), whether
-    /// it stands in now, and whether the last full picture took long enough to want one.
+    /// The coarse picture shown while a costly frame is drawn ([`Detail::PREVIEW`]).
     preview: Option<(OffscreenTarget, egui::TextureId)>,
-    previewing: bool,
-    last_full_slow: bool,
-    band_rows: u32,
     /// The scan frame shown: (value, interpolation), for tests and redraws.
     pub scan_shown: Option<(f64, crate::scene::Interpolation)>,
     /// The value and settings a scan view's isosurfaces were last asked for (`None`: hidden).
@@ -302,8 +271,7 @@ impl Viewport {
             shown_size: None,
             detail: Detail::FULL,
             lod_budget: Default::default(),
-            picture_started: None,
-            picture_ms: None,
+            progressive: Progressive::default(),
             drawn: None,
             generation: 0,
             parts: Vec::new(),
@@ -318,11 +286,7 @@ impl Viewport {
             twisting: false,
             grabbed: false,
             scan_shown: None,
-            progress: None,
             preview: None,
-            previewing: false,
-            last_full_slow: true,
-            band_rows: 8,
             scan_iso: None,
             awaiting_fragments: false,
             fragments: None,
@@ -639,7 +603,7 @@ impl Viewport {
 
     /// How long the last complete picture took to draw (ms), once.
     pub fn take_picture_ms(&mut self) -> Option<f64> {
-        self.picture_ms.take()
+        self.progressive.take_ms()
     }
 
     /// Object `n`'s quantity `k` on its grid, when computed from a basis (an orbital or
@@ -879,8 +843,7 @@ impl Viewport {
         self.hovered = None;
         // Panes are drawn whole each time (no bands): a banded single view left unfinished
         // when the view split is started again from its first band when it comes back.
-        self.progress = None;
-        self.previewing = false;
+        self.progressive.stop();
         if response.clicked_by(PointerButton::Primary)
             && let Some(pos) = response.interact_pointer_pos()
             && let Some(p) = rects.iter().position(|r| r.contains(pos))
@@ -1067,27 +1030,20 @@ impl Viewport {
         let key = (drawn, clouds, size, self.generation, self.detail.lod_scale.to_bits());
         let changed = self.drawn.as_ref() != Some(&key);
         if changed && self.target.is_some() {
-            self.picture_started = Some(Instant::now());
             // A costly frame (orbitals evaluated per sample, or any frame on a CPU rasteriser)
             // is drawn in bands over several UI frames, so the window answers while the
-            // picture fills in; a cheap one still takes one band.
+            // picture fills in; a cheap one still takes one band. Until then a coarse picture
+            // of the whole view may stand in, drawn at once; a frame already drawn coarse (a
+            // drag) needs none.
             let cpu = self.ctx.info.device_type == wgpu::DeviceType::Cpu;
-            self.progress =
-                (cpu || self.renderer.is_costly()).then_some(Progress { next_row: 0, rows: self.band_rows });
-            // Until then a coarse picture of the whole view stands in, drawn at once; a frame
-            // already drawn coarse (a drag) needs none.
-            self.previewing = self.progress.is_some()
-                && self.detail == Detail::FULL
-                && (self.last_full_slow || self.renderer.is_costly());
-            if self.previewing {
+            let costly = self.renderer.is_costly();
+            if self.progressive.start(cpu || costly, self.detail == Detail::FULL, costly) {
                 self.draw_preview(render_state, &key.0, shown);
             }
         }
-        // The band loop below may call for a preview: the target is borrowed through clones.
         let shown_target = self.target.as_ref().map(|(t, id)| (t.color_view.clone(), *id));
-        let mut want_preview = false;
         if let Some((color_view, id)) = &shown_target {
-            if changed || self.progress.is_some() {
+            if changed || self.progressive.drawing() {
                 let frame = FrameInput {
                     camera: &key.0.camera,
                     background: key.0.background,
@@ -1095,65 +1051,27 @@ impl Viewport {
                     size,
                     tile: None,
                 };
-                match &mut self.progress {
-                    None => {
-                        let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
-                        self.renderer.render(&self.ctx, &mut encoder, color_view, &frame);
-                        self.ctx.queue.submit([encoder.finish()]);
-                        self.picture_ms = self.picture_started.take().map(|t| t.elapsed().as_secs_f64() * 1e3);
+                if self.progressive.drawing() {
+                    let (renderer, ctx) = (&mut self.renderer, &self.ctx);
+                    let turn = self.progressive.turn(size, self.detail == Detail::FULL, |tile| {
+                        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+                        renderer.render(ctx, &mut encoder, color_view, &FrameInput { tile: Some(tile), ..frame });
+                        ctx.queue.submit([encoder.finish()]);
+                        // Waiting here keeps each frame's GPU work within the budget.
+                        let _ = ctx.device.poll(wgpu::PollType::wait_indefinitely());
+                    });
+                    if turn != Turn::Done {
+                        ui.ctx().request_repaint();
                     }
-                    Some(p) => {
-                        let start = Instant::now();
-                        // With a preview standing in the window loses nothing to longer turns.
-                        let budget = if self.previewing { REFINE_BUDGET } else { FRAME_BUDGET };
-                        while p.next_row < size[1] && start.elapsed() < budget {
-                            let rows = p.rows.min(size[1] - p.next_row);
-                            let tile = Tile { rect: [0, p.next_row, size[0], rows], first: p.next_row == 0 };
-                            let band = Instant::now();
-                            let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
-                            let frame = FrameInput { tile: Some(tile), ..frame };
-                            self.renderer.render(&self.ctx, &mut encoder, color_view, &frame);
-                            self.ctx.queue.submit([encoder.finish()]);
-                            // Waiting here keeps each frame's GPU work within the budget.
-                            let _ = self.ctx.device.poll(wgpu::PollType::wait_indefinitely());
-                            let per_row = band.elapsed().as_secs_f64() / rows as f64;
-                            p.next_row += rows;
-                            // At most twice the band before: one band measured fast (its GPU
-                            // work overlapping the last) must not turn the rest of the frame
-                            // into one band that holds the window for seconds.
-                            let most = (2 * rows).min(size[1]);
-                            // A band also costs a fixed part (the frame's set-up, every slice's
-                            // triangles): at least 1/MAX_BANDS of the rows, or bands of one row
-                            // would spend their time on it.
-                            let least = (size[1] / MAX_BANDS).clamp(1, most);
-                            p.rows = ((BAND_TIME.as_secs_f64() / per_row.max(1e-6)) as u32).clamp(least, most);
-                            // The rest will take long: a coarse picture stands in from now.
-                            let rest_ms = per_row * (size[1] - p.next_row) as f64 * 1e3;
-                            if !self.previewing && self.detail == Detail::FULL && rest_ms > PREVIEW_AFTER_MS {
-                                want_preview = true;
-                                break;
-                            }
-                        }
-                        self.band_rows = p.rows;
-                        if p.next_row >= size[1] {
-                            self.progress = None;
-                            self.picture_ms = self.picture_started.take().map(|t| t.elapsed().as_secs_f64() * 1e3);
-                            if self.detail == Detail::FULL {
-                                self.last_full_slow = self.picture_ms.is_some_and(|ms| ms > PREVIEW_AFTER_MS);
-                            }
-                        } else {
-                            ui.ctx().request_repaint();
-                        }
+                    if turn == Turn::WantPreview {
+                        self.draw_preview(render_state, &key.0, shown);
+                        self.progressive.preview_drawn();
                     }
-                }
-                if want_preview {
-                    self.previewing = true;
-                    self.draw_preview(render_state, &key.0, shown);
-                    // The preview drew through the renderer's own targets: the full picture
-                    // starts again from its first band.
-                    if let Some(p) = &mut self.progress {
-                        p.next_row = 0;
-                    }
+                } else {
+                    let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
+                    self.renderer.render(&self.ctx, &mut encoder, color_view, &frame);
+                    self.ctx.queue.submit([encoder.finish()]);
+                    self.progressive.finished_whole();
                 }
                 self.drawn = Some(key);
                 self.awaiting_fragments = self.renderer.has_translucent();
@@ -1163,11 +1081,11 @@ impl Viewport {
             }
             let uv = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
             let painter = ui.painter();
-            match (&self.preview, self.progress) {
-                (Some((_, coarse)), Some(p)) if self.previewing => {
+            match (&self.preview, self.progressive.rows_drawn()) {
+                (Some((_, coarse)), Some(rows)) if self.progressive.is_previewing() => {
                     // The coarse picture, with the rows of the full one drawn so far over it.
                     painter.image(*coarse, rect, uv, egui::Color32::WHITE);
-                    let done = p.next_row as f32 / size[1].max(1) as f32;
+                    let done = rows as f32 / size[1].max(1) as f32;
                     let top = egui::Rect::from_min_size(rect.min, egui::vec2(rect.width(), rect.height() * done));
                     painter.image(
                         *id,
@@ -1180,9 +1098,8 @@ impl Viewport {
                     painter.image(*id, rect, uv, egui::Color32::WHITE);
                 }
             }
-            let slow = self.picture_started.is_some_and(|t| t.elapsed() > PROGRESS_AFTER);
-            if let Some(p) = self.progress.filter(|_| self.previewing || slow) {
-                progress_bar(painter, rect, p.next_row as f32 / size[1].max(1) as f32);
+            if let Some(rows) = self.progressive.rows_drawn().filter(|_| self.progressive.shows_progress()) {
+                progress_bar(painter, rect, rows as f32 / size[1].max(1) as f32);
             }
         }
         self.check_fragments(ui.ctx());
@@ -1231,9 +1148,9 @@ impl Viewport {
     /// coarse preview drawn in between leaves the full-size ids from the first band on). A
     /// picture that keeps changing (a vibration playing) still reaches every row in turn.
     fn ids_ready(&self, pos: egui::Pos2) -> bool {
-        let (Some(p), Some((rect, size))) = (self.progress, self.layout) else { return true };
+        let (Some(next_row), Some((rect, size))) = (self.progressive.rows_drawn(), self.layout) else { return true };
         let row = ((pos.y - rect.min.y) / rect.height().max(1.0) * size[1] as f32).max(0.0) as u32;
-        row < p.next_row
+        row < next_row
     }
 
     /// Whether a click waits for its row of the picture to be drawn before it is picked.
@@ -1260,7 +1177,7 @@ impl Viewport {
 
     /// Whether a coarse picture stands in while the full one is drawn.
     pub fn is_previewing(&self) -> bool {
-        self.previewing && self.progress.is_some()
+        self.progressive.is_previewing()
     }
 
     /// Reads the last frame's fragment counts once they are back: a frame whose lists
@@ -1354,8 +1271,8 @@ impl Viewport {
 
     /// How much of a frame drawn in bands is done (0..1); `None` when none is under way.
     pub fn progress(&self) -> Option<f32> {
-        let p = self.progress?;
-        Some(p.next_row as f32 / self.rendered_size()?[1].max(1) as f32)
+        let rows = self.progressive.rows_drawn()?;
+        Some(rows as f32 / self.rendered_size()?[1].max(1) as f32)
     }
 
     /// The view's size on screen, pixels.

@@ -569,7 +569,7 @@ fn rows_to_resolve(walk_rows: Option<(u32, u32, bool)>, rows: Option<Rows>) -> O
         (Some((y, h, _)), Some(r)) => {
             let start = r.start.max(y);
             let end = (r.start + r.count).min(y + h);
-            (end > start).then_some(Rows { start, count: end - start, first: false })
+            (end > start).then(|| Rows { start, count: end - start, first: false })
         }
     }
 }
