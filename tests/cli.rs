@@ -702,6 +702,65 @@ fn natural_orbitals_have_their_frontier_by_occupation_and_no_energies() {
     assert!(text.contains("LUMO: MO 6 Alpha A no energy, occupation 0.045"), "{text}");
 }
 
+/// `x` as C's `% .17e` writes it, as Psi4's Molden writer does: a space for the sign of a
+/// positive number, an exponent of at least two digits with its sign.
+fn c_exponent(x: f64) -> String {
+    let s = format!("{x:.17e}");
+    let (mantissa, exponent) = s.split_once('e').unwrap();
+    let exponent: i32 = exponent.parse().unwrap();
+    let sign = if exponent < 0 { '-' } else { '+' };
+    format!("{}{mantissa}e{sign}{:02}", if x < 0.0 { "" } else { " " }, exponent.abs())
+}
+
+#[test]
+fn psi4_natural_orbitals_write_each_spin_s_occupation_as_their_energy() {
+    // Water's orbitals rewritten in the layout of Psi4's Molden writer for natural orbitals of a
+    // restricted density: `Ene=` the occupation of one spin, `Occup=` that of both.
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/fixtures/wavefunctions/h2o_cart_631gs.molden"
+    ))
+    .unwrap();
+    let (head, mo) = text.split_once("[MO]\n").unwrap();
+    let per_spin = [0.99991, 0.9965, 0.99, 0.985, 0.98, 0.0225, 0.015, 0.006];
+    let mut psi4 = format!("{head}[MO]\n");
+    let mut k = 0;
+    for line in mo.lines() {
+        let t = line.trim();
+        if t.starts_with("Sym=") {
+            let occ = per_spin.get(k).copied().unwrap_or(0.0);
+            k += 1;
+            psi4 += &format!(" Sym= A\n Ene= {}\n Spin= Alpha\n Occup= {}\n", c_exponent(occ), c_exponent(2.0 * occ));
+        } else if let (false, Some((index, value))) = (t.contains('='), t.split_once(char::is_whitespace)) {
+            let value: f64 = value.trim().parse().unwrap();
+            psi4 += &format!("{:>3} {}\n", index, c_exponent(value));
+        }
+    }
+    assert!(
+        psi4.contains(" Ene=  9.99909999999999966e-01\n Spin= Alpha\n Occup=  1.99981999999999993e+00\n"),
+        "{}",
+        &psi4[head.len()..head.len() + 300]
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("no.molden");
+    std::fs::write(&path, psi4).unwrap();
+    let out = orbcloud(&["info", path.to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains(
+            "natural orbitals: HOMO and LUMO by occupation; the file's energies are its occupations per spin (half of Occup=)"
+        ),
+        "{text}"
+    );
+    assert!(text.contains("HOMO: MO 5 Alpha A no energy, occupation 1.960"), "{text}");
+    assert!(text.contains("LUMO: MO 6 Alpha A no energy, occupation 0.045"), "{text}");
+    let out = orbcloud(&["info", path.to_str().unwrap(), "--json"]);
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let wf = &json["wavefunction"];
+    assert_eq!(wf["energies_as_occupations"], "per_spin", "{wf}");
+    assert_eq!(wf["energies_are_occupations"], true);
+}
+
 #[test]
 fn ball_and_stick_sizes_change_the_picture() {
     let file = benzene();
