@@ -189,7 +189,11 @@ type Objects = Vec<(Document, ObjectState)>;
 
 /// A session's objects (each file loaded), its camera and background.
 fn session_scene(path: &Path) -> Result<(Objects, Camera, [f32; 3])> {
-    let session = orbcloud::app::session::read(path).map_err(anyhow::Error::msg)?;
+    let read = orbcloud::app::session::read(path).map_err(anyhow::Error::msg)?;
+    for note in &read.notes {
+        eprintln!("warning: {note}");
+    }
+    let session = read.session;
     let mut scene = Vec::new();
     for mut state in session.objects {
         let Some(file) = state.path.clone() else { continue };
