@@ -195,3 +195,35 @@ file = "b.molden"
         let _ = orbcloud::formats::scan::parse_scan(Path::new("fuzz.scan.toml"), text, &mut |_| Ok(frame.clone()));
     });
 }
+
+/// Sessions, mutated: one that parses must come out of its range checks drawable, with every
+/// camera finite and nothing left for a second pass to change (fuzz/src/lib.rs checks the same).
+#[test]
+fn sessions_survive_mutations() {
+    use orbcloud::scene::{IsoLevel, ObjectState, QuantityState, RenderSettings, Session, Source};
+    let mut quantity = QuantityState::new(Source::Volume(0), &RenderSettings::default());
+    quantity.isosurfaces[0].visible = true;
+    quantity
+        .isosurfaces
+        .push(orbcloud::scene::IsosurfaceSettings { level: IsoLevel::Sigma(2.0), ..Default::default() });
+    quantity.pane = Some(1);
+    let mut object = ObjectState { path: Some("water.cube".into()), quantities: vec![quantity], ..Default::default() };
+    object.clip.enabled = true;
+    object.placement.offset = [1.0, 0.0, -2.0];
+    let mut session = Session { background: Some([0.1, 0.1, 0.1]), objects: vec![object], ..Default::default() };
+    session.panes.count = 2;
+    let seed = toml::to_string(&session).unwrap().into_bytes();
+    let opened = std::sync::atomic::AtomicUsize::new(0);
+    fuzz("session", &[seed], |data| {
+        let Ok(text) = std::str::from_utf8(data) else { return };
+        let Ok(read) = orbcloud::app::session::parse("fuzz.orbcloud.toml", text) else { return };
+        opened.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let mut session = read.session;
+        for camera in std::iter::once(session.camera).chain(session.panes.cameras) {
+            assert!(camera.clip_from_world(1.5, 10.0).is_finite() && camera.eye().is_finite(), "{camera:?}");
+        }
+        let again = session.sanitize();
+        assert!(again.is_empty(), "values still out of range: {again:?}");
+    });
+    assert!(opened.into_inner() > 0, "no mutated session opened: the check saw nothing");
+}

@@ -156,7 +156,8 @@ impl Camera {
         n.real(&format!("{key}.distance"), &mut self.distance, DISTANCE, default.distance);
         n.real(&format!("{key}.fov_y"), &mut self.fov_y, FOV_Y, default.fov_y);
         let q = self.orientation;
-        if !q.is_finite() || q.length() < 1e-6 {
+        // Components near f32::MAX overflow the length: no rotation to normalise either.
+        if !q.is_finite() || !(1e-6..=1e6).contains(&q.length()) {
             n.note(&format!("{key}.orientation"), format!("{q} is no rotation; none used"));
             self.orientation = glam::Quat::IDENTITY;
         } else {
@@ -350,7 +351,7 @@ impl VibrationState {
 impl ClipPlane {
     fn sanitize(&mut self, key: &str, n: &mut Notes) {
         let v = glam::Vec3::from(self.normal);
-        if !v.is_finite() || v.length() < 1e-6 {
+        if !v.is_finite() || !(1e-6..=1e6).contains(&v.length()) {
             let normal = ClipPlane::default().normal;
             n.note(&format!("{key}.normal"), format!("{:?} is no direction; {normal:?} used", self.normal));
             self.normal = normal;
