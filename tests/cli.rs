@@ -702,6 +702,35 @@ fn natural_orbitals_have_their_frontier_by_occupation_and_no_energies() {
     assert!(text.contains("LUMO: MO 6 Alpha A no energy, occupation 0.045"), "{text}");
 }
 
+/// Numbers out of range, NaN or infinite are refused by name before anything is read or
+/// drawn: four billion slices would otherwise be an allocation that aborts the process.
+#[test]
+fn numeric_options_out_of_range_are_refused_by_name() {
+    let file = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/wavefunctions/h2o_cart_631gs.molden");
+    let cases: &[(&[&str], &str, &str)] = &[
+        (&["render", file, "-o", "x.png", "--slices", "4000000000"], "--slices", "1..=4096"),
+        (&["render", file, "-o", "x.png", "--zoom", "nan"], "--zoom", "0.001..=1000"),
+        (&["render", file, "-o", "x.png", "--yaw", "inf"], "--yaw", "outside"),
+        (&["render", file, "-o", "x.png", "--k1=-1"], "--k1", "0..=1000"),
+        (&["render", file, "-o", "x.png", "--iso", "NaN"], "--iso", "outside"),
+        (&["render", file, "-o", "x.png", "--grid-points", "100000"], "--grid-points", "8..=512"),
+        (&["render", file, "-o", "x.png", "--ball-scale", "30"], "--ball-scale", "0.3..=3"),
+        (&["render", file, "-o", "x.png", "--clip", "0,0,0"], "--clip", "not zero"),
+        (&["render", file, "-o", "x.png", "--clip", "0,0,1,nan"], "--clip", "outside"),
+        (&["cube", file, "-o", "x.cube", "--grid", "100000"], "--grid", "8..=512"),
+        (&["cube", file, "-o", "x.cube", "--spacing", "0"], "--spacing", "0.001..=10"),
+        (&["modes", file, "--mode", "1", "-o", "x.xyz", "--frames", "0"], "--frames", "1..=100000"),
+        (&["mesh", file, "-o", "x.obj", "--iso-sigma=-2"], "--iso-sigma", "0..=1000"),
+    ];
+    for (args, option, expected) in cases {
+        let out = orbcloud(args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{args:?} ran");
+        assert_eq!(out.status.code(), Some(2), "a usage error, not a crash: {args:?}\n{stderr}");
+        assert!(stderr.contains(&format!("'{option} <")) && stderr.contains(expected), "{args:?}: {stderr}");
+    }
+}
+
 /// `x` as C's `% .17e` writes it, as Psi4's Molden writer does: a space for the sign of a
 /// positive number, an exponent of at least two digits with its sign.
 fn c_exponent(x: f64) -> String {

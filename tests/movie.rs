@@ -170,7 +170,7 @@ fn videos_need_ffmpeg_and_say_so() {
     for (args, says) in [
         (&["-o", "x.avi"][..], "unknown movie format"),
         (&["--normal-mode", "1", "-o", "x.gif"][..], "scan sweeps"),
-        (&["--frames", "0", "-o", "x.gif"][..], "--frames 0"),
+        (&["--frames", "0", "-o", "x.gif"][..], "'0' for '--frames <FRAMES>': 0 is outside 1..=100000"),
     ] {
         let out = orbcloud(&[&["movie", &asset(SCAN)][..], args].concat());
         let err = String::from_utf8_lossy(&out.stderr);

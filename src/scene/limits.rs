@@ -1,6 +1,7 @@
-//! The ranges the values a session (`*.orbcloud.toml`), a scan manifest or the command line
-//! gives must lie in, and [`Session::sanitize`], the one place a session's values are brought
-//! into them. A hand-edited or damaged session could otherwise ask for four billion slices (an
+//! The ranges the values a session (`*.orbcloud.toml`) or the command line gives must lie in
+//! (a scan manifest's frames lie in their coordinate's, `model::scan`), [`Session::sanitize`],
+//! the one place a session's values are brought into them, and [`within`], the command line's
+//! parser that refuses a number outside them. A hand-edited or damaged session could otherwise ask for four billion slices (an
 //! allocation that aborts the viewer and loses everything open), a NaN camera (a blank or
 //! garbled frame) or an isovalue no grid reaches. Out of range values are clamped and non-finite
 //! ones replaced by the default, each with a note naming the key, so a session always opens.
@@ -56,6 +57,15 @@ pub const LOD_PX: RangeInclusive<f32> = 0.0..=1000.0;
 pub const AMPLITUDE: RangeInclusive<f32> = 0.0..=10.0;
 pub const SPEED: RangeInclusive<f32> = 0.0..=100.0;
 pub const FWHM: RangeInclusive<f32> = 0.1..=10_000.0;
+/// Angles the command line turns by (degrees), its zoom factor.
+pub const ANGLE_DEG: RangeInclusive<f32> = -1e6..=1e6;
+pub const ZOOM: RangeInclusive<f32> = 1e-3..=1e3;
+/// A cube's grid spacing and the margin around the atoms, bohr.
+pub const SPACING: RangeInclusive<f64> = 1e-3..=10.0;
+pub const MARGIN: RangeInclusive<f64> = 0.0..=100.0;
+/// Frames of a movie, a mode's period or a benchmark, and a movie's frames per second.
+pub const FRAMES: RangeInclusive<usize> = 1..=100_000;
+pub const FPS: RangeInclusive<f64> = 0.1..=240.0;
 /// Quantities per object and isosurfaces per quantity: each is a layer of GPU work.
 pub const MAX_QUANTITIES: usize = 64;
 pub const MAX_ISOSURFACES: usize = 64;
@@ -360,6 +370,22 @@ impl ClipPlane {
     }
 }
 
+/// A command-line value parser (clap takes any `Fn(&str) -> Result`) for numbers in `range`.
+pub fn within<T>(range: RangeInclusive<T>) -> impl Fn(&str) -> Result<T, String> + Clone + Send + Sync + 'static
+where
+    T: std::str::FromStr + PartialOrd + Display + Copy + Send + Sync + 'static,
+    T::Err: Display,
+{
+    move |s: &str| parse_in(s, &range)
+}
+
+/// `range` in f64, for options read as f64: each bound the decimal it was written as (0.05,
+/// not 0.05000000074505806), so messages show it so.
+pub fn wide(range: RangeInclusive<f32>) -> RangeInclusive<f64> {
+    let wide = |x: f32| x.to_string().parse::<f64>().unwrap_or(f64::from(x));
+    wide(*range.start())..=wide(*range.end())
+}
+
 /// Parses a command-line number in `range`, refusing what is not a finite number or lies
 /// outside it.
 pub fn parse_in<T>(s: &str, range: &RangeInclusive<T>) -> Result<T, String>
@@ -432,5 +458,6 @@ mod tests {
         assert!(parse_in::<f32>("inf", &POSITION).is_err());
         assert!(parse_in::<f32>("-0.5", &FRACTION).is_err());
         assert!(parse_in::<f32>("x", &FRACTION).unwrap_err().contains("not a number"));
+        assert_eq!(wide(SURFACE_RESOLUTION), 0.05..=5.0);
     }
 }
