@@ -113,7 +113,7 @@ impl OrbApp {
         };
         // Out of range values were replaced; the session opens, and says which.
         if !notes.is_empty() {
-            self.error = Some(format!("values out of range were replaced:\n{}", notes.join("\n")));
+            self.error = Some(format!("{}: values out of range were replaced:\n{}", path.display(), notes.join("\n")));
         }
         let files: Vec<(PathBuf, Opening)> = session
             .objects
