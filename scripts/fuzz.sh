@@ -10,7 +10,7 @@ cd "$(dirname "$0")/.."
 execs="${1:-10000000}"
 shift || true
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(cube cube_gz molden fchk wfn wfx mkl scan_manifest pdb mmcif xyz)
+[ ${#targets[@]} -gt 0 ] || targets=(cube cube_gz molden fchk wfn wfx mkl scan_manifest session pdb mmcif xyz)
 
 command -v cargo-afl >/dev/null || cargo install cargo-afl --locked
 # Seeds: the fixtures each reader is tested with, kept small (AFL slows on big inputs).
@@ -59,6 +59,79 @@ seed wfn tests/fixtures/wfn_wfx_mkl/*.wfn
 seed wfx tests/fixtures/wfn_wfx_mkl/*.wfx
 seed mkl tests/fixtures/wfn_wfx_mkl/*.mkl
 seed scan_manifest assets/psb3/*.scan.toml tests/fixtures/*/*.scan.toml
+# A session: a camera, two panes, an object with a cloud, an isosurface and a clipping plane.
+mkdir -p fuzz/seeds/session
+cat > fuzz/seeds/session/water.orbcloud.toml <<'SESSION'
+background = [0.02, 0.02, 0.03]
+
+[camera]
+target = [0.0, 0.0, 0.0]
+yaw = 0.3
+pitch = -0.2
+distance = 20.0
+fov_y = 0.5235988
+orientation = [0.0, 0.0, 0.0, 1.0]
+
+[panes]
+count = 2
+linked = false
+
+[[objects]]
+path = "water.cube"
+selected = 0
+
+[objects.placement]
+offset = [1.0, 0.0, -2.0]
+rotation_deg = [0.0, 90.0, 0.0]
+
+[objects.clip]
+enabled = true
+normal = [0.0, 0.0, 1.0]
+offset = 0.5
+
+[[objects.quantities]]
+visible = true
+pane = 1
+
+[objects.quantities.source]
+Volume = 0
+
+[objects.quantities.cloud]
+visible = true
+mode = "ViewAligned"
+slices = 192
+k1 = 0.2
+k2 = 0.6
+positive_color = [0.9, 0.12, 0.1]
+negative_color = [0.1, 0.3, 0.95]
+
+[objects.quantities.cloud.transfer]
+kind = "PowerLaw"
+gradient_power = 0.0
+shading = false
+boundary = 0.0
+
+[objects.quantities.cloud.transfer.positive]
+shape = "Gaussian"
+center = 0.25
+width = 0.08
+opacity = 0.9
+
+[objects.quantities.cloud.transfer.negative]
+shape = "Gaussian"
+center = 0.25
+width = 0.08
+opacity = 0.9
+
+[[objects.quantities.isosurfaces]]
+visible = true
+positive_color = [0.85, 0.1, 0.08]
+negative_color = [0.08, 0.25, 0.85]
+density_color = [0.55, 0.62, 0.75]
+
+[objects.quantities.isosurfaces.level]
+Absolute = 0.05
+SESSION
 # Structures: every record kind of the fixtures but only their first 30 atoms, since AFL's
 # speed falls with the input's size (the 18 kB excerpts ran at a fifth of the speed).
 seed_short() {

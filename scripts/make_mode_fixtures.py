@@ -7,8 +7,9 @@ IR intensities from dipole derivatives along each mode by central differences), 
                                            [FR-NORM-COORD] and [INT] as Molden, ORCA and Gaussian
                                            write them
   tests/fixtures/modes/NAME.fchk           make_wavefunction_fixtures.py's fchk writer, then the
-                                           Vib-NDim, Vib-E2, Vib-Modes and Vib-AtMass records as
-                                           Gaussian writes them
+                                           Number of Normal Modes, Vib-NDim, Vib-E2, Vib-Modes and
+                                           Vib-AtMass records as Gaussian 16 writes them (Vib-NDim
+                                           holds the atom count, not the mode count)
   tests/fixtures/modes/NAME.expected.json  the frequencies (cm⁻¹, imaginary negative), IR
                                            intensities (km/mol), displacements and geometry (bohr)
 
@@ -79,7 +80,8 @@ def append_molden(path, mol, freq, modes, intensities):
 def append_fchk(path, mol, freq, modes, intensities, reduced, force):
     n = len(freq)
     f = Fchk()
-    f.int("Vib-NDim", n)
+    f.int("Number of Normal Modes", n)
+    f.int("Vib-NDim", mol.natm)
     # Frequencies, reduced masses, force constants, IR intensities, then ten more rows Gaussian
     # writes (Raman activities, depolarisations, …): zero here.
     f.reals("Vib-E2", np.concatenate([freq, reduced, force, intensities, np.zeros(10 * n)]))

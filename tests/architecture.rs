@@ -10,9 +10,9 @@ const LAYERS: &[(&str, &[&str])] = &[
     ("model", &[]),
     ("formats", &["model"]),
     ("scene", &["model"]),
-    ("sources", &["model", "formats", "scene"]),
     ("gpu", &["model", "scene"]),
     ("evaluate", &["model", "scene", "gpu"]),
+    ("sources", &["model", "formats", "scene", "evaluate"]),
     ("layers", &["model", "scene", "gpu", "evaluate"]),
     ("pictures", &["model", "scene", "gpu", "evaluate", "layers"]),
     ("app", &["model", "formats", "scene", "sources", "gpu", "evaluate", "layers", "pictures"]),
@@ -28,6 +28,7 @@ const NARROWER: &[(&str, &[&str])] = &[
     ("pictures/movie.rs", &[]),
     ("pictures/headless.rs", &["model", "scene", "gpu", "evaluate", "layers"]),
     ("sources/compute.rs", &["model", "formats"]),
+    ("sources/demo.rs", &["model", "formats", "scene"]),
     ("cli/info.rs", &["model"]),
 ];
 
@@ -37,7 +38,7 @@ const CRATE_RULES: &[(&str, &[&str])] = &[
     ("model", &["glam", "serde", "rayon", "thiserror", "bytemuck", "meshopt"]),
     ("formats", &["glam", "serde", "rayon", "thiserror", "flate2", "fast_float2", "toml", "bytemuck"]),
     ("scene", &["glam", "serde"]),
-    ("sources", &["flate2", "serde", "serde_json", "thiserror", "log", "libc"]),
+    ("sources", &["flate2", "serde", "serde_json", "thiserror", "log", "libc", "toml"]),
     ("gpu", &["glam", "thiserror", "wgpu", "bytemuck", "half", "image", "pollster", "log"]),
     ("evaluate", &["glam", "wgpu"]),
     ("evaluate/meshes.rs", &["glam"]),

@@ -702,6 +702,94 @@ fn natural_orbitals_have_their_frontier_by_occupation_and_no_energies() {
     assert!(text.contains("LUMO: MO 6 Alpha A no energy, occupation 0.045"), "{text}");
 }
 
+/// Numbers out of range, NaN or infinite are refused by name before anything is read or
+/// drawn: four billion slices would otherwise be an allocation that aborts the process.
+#[test]
+fn numeric_options_out_of_range_are_refused_by_name() {
+    let file = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/wavefunctions/h2o_cart_631gs.molden");
+    let cases: &[(&[&str], &str, &str)] = &[
+        (&["render", file, "-o", "x.png", "--slices", "4000000000"], "--slices", "1..=4096"),
+        (&["render", file, "-o", "x.png", "--zoom", "nan"], "--zoom", "0.001..=1000"),
+        (&["render", file, "-o", "x.png", "--yaw", "inf"], "--yaw", "outside"),
+        (&["render", file, "-o", "x.png", "--k1=-1"], "--k1", "0..=1000"),
+        (&["render", file, "-o", "x.png", "--iso", "NaN"], "--iso", "outside"),
+        (&["render", file, "-o", "x.png", "--grid-points", "100000"], "--grid-points", "8..=512"),
+        (&["render", file, "-o", "x.png", "--ball-scale", "30"], "--ball-scale", "0.3..=3"),
+        (&["render", file, "-o", "x.png", "--clip", "0,0,0"], "--clip", "not zero"),
+        (&["render", file, "-o", "x.png", "--clip", "0,0,1,nan"], "--clip", "outside"),
+        (&["cube", file, "-o", "x.cube", "--grid", "100000"], "--grid", "8..=512"),
+        (&["cube", file, "-o", "x.cube", "--spacing", "0"], "--spacing", "0.001..=10"),
+        (&["modes", file, "--mode", "1", "-o", "x.xyz", "--frames", "0"], "--frames", "1..=100000"),
+        (&["mesh", file, "-o", "x.obj", "--iso-sigma=-2"], "--iso-sigma", "0..=1000"),
+    ];
+    for (args, option, expected) in cases {
+        let out = orbcloud(args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{args:?} ran");
+        assert_eq!(out.status.code(), Some(2), "a usage error, not a crash: {args:?}\n{stderr}");
+        assert!(stderr.contains(&format!("'{option} <")) && stderr.contains(expected), "{args:?}: {stderr}");
+    }
+}
+
+/// `x` as C's `% .17e` writes it, as Psi4's Molden writer does: a space for the sign of a
+/// positive number, an exponent of at least two digits with its sign.
+fn c_exponent(x: f64) -> String {
+    let s = format!("{x:.17e}");
+    let (mantissa, exponent) = s.split_once('e').unwrap();
+    let exponent: i32 = exponent.parse().unwrap();
+    let sign = if exponent < 0 { '-' } else { '+' };
+    format!("{}{mantissa}e{sign}{:02}", if x < 0.0 { "" } else { " " }, exponent.abs())
+}
+
+#[test]
+fn psi4_natural_orbitals_write_each_spin_s_occupation_as_their_energy() {
+    // Water's orbitals rewritten in the layout of Psi4's Molden writer for natural orbitals of a
+    // restricted density: `Ene=` the occupation of one spin, `Occup=` that of both.
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/fixtures/wavefunctions/h2o_cart_631gs.molden"
+    ))
+    .unwrap();
+    let (head, mo) = text.split_once("[MO]\n").unwrap();
+    let per_spin = [0.99991, 0.9965, 0.99, 0.985, 0.98, 0.0225, 0.015, 0.006];
+    let mut psi4 = format!("{head}[MO]\n");
+    let mut k = 0;
+    for line in mo.lines() {
+        let t = line.trim();
+        if t.starts_with("Sym=") {
+            let occ = per_spin.get(k).copied().unwrap_or(0.0);
+            k += 1;
+            psi4 += &format!(" Sym= A\n Ene= {}\n Spin= Alpha\n Occup= {}\n", c_exponent(occ), c_exponent(2.0 * occ));
+        } else if let (false, Some((index, value))) = (t.contains('='), t.split_once(char::is_whitespace)) {
+            let value: f64 = value.trim().parse().unwrap();
+            psi4 += &format!("{:>3} {}\n", index, c_exponent(value));
+        }
+    }
+    assert!(
+        psi4.contains(" Ene=  9.99909999999999966e-01\n Spin= Alpha\n Occup=  1.99981999999999993e+00\n"),
+        "{}",
+        &psi4[head.len()..head.len() + 300]
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("no.molden");
+    std::fs::write(&path, psi4).unwrap();
+    let out = orbcloud(&["info", path.to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains(
+            "natural orbitals: HOMO and LUMO by occupation; the file's energies are its occupations per spin (half of Occup=)"
+        ),
+        "{text}"
+    );
+    assert!(text.contains("HOMO: MO 5 Alpha A no energy, occupation 1.960"), "{text}");
+    assert!(text.contains("LUMO: MO 6 Alpha A no energy, occupation 0.045"), "{text}");
+    let out = orbcloud(&["info", path.to_str().unwrap(), "--json"]);
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let wf = &json["wavefunction"];
+    assert_eq!(wf["energies_as_occupations"], "per_spin", "{wf}");
+    assert_eq!(wf["energies_are_occupations"], true);
+}
+
 #[test]
 fn ball_and_stick_sizes_change_the_picture() {
     let file = benzene();

@@ -8,6 +8,11 @@ use std::time::{Duration, Instant};
 use glam::DVec3;
 use orbcloud::model::{Atom, Document, Molecule};
 
+/// The AFL++ targets' entries, compiled here too so the test build checks them.
+#[allow(dead_code, reason = "only the session entry runs here; the readers' are called directly")]
+#[path = "../fuzz/src/lib.rs"]
+mod fuzz_targets;
+
 const FIXTURES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/wavefunctions");
 /// How long each reader is fuzzed.
 const BUDGET: Duration = Duration::from_secs(3);
@@ -194,4 +199,31 @@ file = "b.molden"
         let Ok(text) = std::str::from_utf8(data) else { return };
         let _ = orbcloud::formats::scan::parse_scan(Path::new("fuzz.scan.toml"), text, &mut |_| Ok(frame.clone()));
     });
+}
+
+/// Sessions, mutated: one that parses must come out of its range checks drawable, with every
+/// camera finite and nothing left for a second pass to change (the AFL++ target's check).
+#[test]
+fn sessions_survive_mutations() {
+    use orbcloud::scene::{IsoLevel, ObjectState, QuantityState, RenderSettings, Session, Source};
+    let mut quantity = QuantityState::new(Source::Volume(0), &RenderSettings::default());
+    quantity.isosurfaces[0].visible = true;
+    quantity
+        .isosurfaces
+        .push(orbcloud::scene::IsosurfaceSettings { level: IsoLevel::Sigma(2.0), ..Default::default() });
+    quantity.pane = Some(1);
+    let mut object = ObjectState { path: Some("water.cube".into()), quantities: vec![quantity], ..Default::default() };
+    object.clip.enabled = true;
+    object.placement.offset = [1.0, 0.0, -2.0];
+    let mut session = Session { background: Some([0.1, 0.1, 0.1]), objects: vec![object], ..Default::default() };
+    session.panes.count = 2;
+    let seed = toml::to_string(&session).unwrap().into_bytes();
+    let opened = std::sync::atomic::AtomicUsize::new(0);
+    fuzz("session", &[seed], |data| {
+        if std::str::from_utf8(data).is_ok_and(|t| orbcloud::sources::session::parse("fuzz.orbcloud.toml", t).is_ok()) {
+            opened.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        }
+        fuzz_targets::read_session(data);
+    });
+    assert!(opened.into_inner() > 0, "no mutated session opened: the check saw nothing");
 }

@@ -344,6 +344,49 @@ fn truncated_files_never_panic() {
     }
 }
 
+/// A Molden file cut inside `[MO]` (PySCF's layout: every coefficient written) is refused at
+/// its last line, saying how many coefficients or orbitals were expected; before, a partial
+/// orbital opened as if whole (benzene cut at 30 kB: 52 of its 96 coefficients).
+#[test]
+fn molden_files_cut_inside_their_orbitals_are_refused() {
+    let benzene = std::fs::read_to_string(format!("{FIXTURES}/benzene_631gs.molden")).unwrap();
+    let whole = formats::load_bytes(Path::new("whole.molden"), benzene.as_bytes()).expect("the whole file opens");
+    let n = whole.wavefunction.as_ref().unwrap().basis.n_functions();
+    let mo = benzene.find("[MO]").unwrap();
+    // Mid-line, at 30 kB, and at the end of the line before it.
+    let mid_line = &benzene[..30_000];
+    let at_line_end = &mid_line[..mid_line.rfind('\n').unwrap() + 1];
+    assert!(mo < at_line_end.len() && !at_line_end.trim_end().ends_with("Occup=    2.00000"));
+    for cut in [mid_line, at_line_end] {
+        let e = refused("cut.molden", cut.as_bytes());
+        assert_eq!(e.line, cut.lines().count(), "{e}");
+        assert!(e.expected.contains(&format!("{n} coefficients")), "{e}");
+        assert!(e.found.contains("cut short"), "{e}");
+    }
+    // Cut inside the next orbital's header: an orbital with no coefficients.
+    let header = &benzene[..benzene[mo..].find(" Ene=").map(|k| mo + k).unwrap()];
+    let header = &benzene[..benzene[header.len() + 1..].find(" Ene=").unwrap() + header.len() + 1];
+    let e = refused("cut.molden", header.as_bytes());
+    assert!(e.expected.contains("coefficient lines"), "{e}");
+    // An unrestricted file cut between two of its beta orbitals.
+    let uhf = std::fs::read_to_string(format!("{FIXTURES}/h2o_cation_uhf_631gs.molden")).unwrap();
+    let second_beta = uhf
+        .match_indices(" Sym=")
+        .map(|(k, _)| k)
+        .filter(|&k| uhf[k..].lines().nth(2).unwrap().contains("Beta"))
+        .nth(1)
+        .unwrap();
+    let e = refused("cut.molden", &uhf.as_bytes()[..second_beta]);
+    assert!(e.expected.contains("Beta orbitals, as many as the Alpha ones") && e.found.starts_with("1,"), "{e}");
+    // Whole files with trailing blank lines still open, every orbital in them.
+    for (name, text) in [("benzene.molden", &benzene), ("uhf.molden", &uhf)] {
+        let padded = format!("{text}\n\n   \n\n");
+        let doc = formats::load_bytes(Path::new(name), padded.as_bytes()).unwrap_or_else(|e| panic!("{e}"));
+        let whole = formats::load_bytes(Path::new(name), text.as_bytes()).unwrap();
+        assert_eq!(doc.wavefunction.unwrap().orbitals.len(), whole.wavefunction.unwrap().orbitals.len());
+    }
+}
+
 /// `orbcloud info` on a 4 GiB gzip bomb (a valid header, then blank space, the case read
 /// furthest): refused with a message, within 5 s and 200 MB of resident memory.
 #[test]

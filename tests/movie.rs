@@ -170,7 +170,7 @@ fn videos_need_ffmpeg_and_say_so() {
     for (args, says) in [
         (&["-o", "x.avi"][..], "unknown movie format"),
         (&["--normal-mode", "1", "-o", "x.gif"][..], "scan sweeps"),
-        (&["--frames", "0", "-o", "x.gif"][..], "--frames 0"),
+        (&["--frames", "0", "-o", "x.gif"][..], "'0' for '--frames <FRAMES>': 0 is outside 1..=100000"),
     ] {
         let out = orbcloud(&[&["movie", &asset(SCAN)][..], args].concat());
         let err = String::from_utf8_lossy(&out.stderr);
@@ -256,7 +256,7 @@ fn every_frame_of_a_movie_of_an_esp_map_carries_its_colour_bar() {
         ..Default::default()
     };
     let saved = Session { objects: vec![object], ..Default::default() };
-    orbcloud::app::session::write(&session, &saved).unwrap();
+    orbcloud::sources::session::write(&session, &saved).unwrap();
     let frames = dir.path().join("session/");
     ok(&["movie", s(&session), "--turntable", "--frames", "2", "--size", "240x180", "--lavapipe", "-o", s(&frames)]);
     assert!(bar_in_column(&png(&frames.join("frame_0001.png")), 240 - 16), "the session's movie carries the bar");

@@ -362,3 +362,41 @@ fn fchk_files_name_their_writer() {
         assert_eq!(doc.wavefunction.unwrap().normalization.program, writer, "{file}");
     }
 }
+
+/// Every real Molden file, cut before the last line of its last orbital (sections after `[MO]`
+/// cut away too), is refused at the end of what is left, naming the coefficients it expected; with blank lines added at its end it
+/// still opens whole.
+#[test]
+fn real_molden_files_cut_inside_their_last_orbital_are_refused() {
+    if common::refdata("refdata_wavefunctions::real_molden_files_cut_inside_their_last_orbital_are_refused").is_none() {
+        return;
+    }
+    let mut names: Vec<String> = std::fs::read_dir(dir())
+        .expect("read refdata dir")
+        .map(|e| e.expect("dir entry").file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".molden"))
+        .collect();
+    names.sort();
+    assert!(!names.is_empty());
+    for name in names {
+        let text = std::fs::read_to_string(dir().join(&name)).unwrap();
+        let whole = load(&dir().join(&name));
+        let n = whole.wavefunction.as_ref().unwrap().basis.n_functions();
+        // [MO] up to the next section (Molden's own files go on with others).
+        let mo = text.find("[MO]").expect("an [MO] section");
+        let mo_end = text[mo + 4..].find("\n[").map_or(text.len(), |k| mo + 4 + k + 1);
+        let body = text[..mo_end].trim_end();
+        let cut = &body[..body.rfind('\n').unwrap() + 1];
+        match formats::load_bytes(Path::new(&name), cut.as_bytes()) {
+            Ok(_) => panic!("{name} cut before its last line opened"),
+            Err(e) => {
+                let message = e.to_string();
+                assert!(message.starts_with(&format!("{name}:{}:", cut.lines().count())), "{message}");
+                assert!(message.contains(&format!("{n} coefficients")), "{message}");
+            }
+        }
+        let padded = format!("{text}\n \n\n");
+        let doc = formats::load_bytes(Path::new(&name), padded.as_bytes()).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(doc.wavefunction.unwrap().orbitals.len(), whole.wavefunction.unwrap().orbitals.len(), "{name}");
+    }
+}

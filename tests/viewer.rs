@@ -383,7 +383,7 @@ fn files_join_the_scene_are_measured_across_and_a_session_reopens_them() {
     let app = next.state();
     assert_eq!(app.view.background, [0.9, 0.9, 0.9]);
     assert_eq!(app.defaults.volume.k1, 0.55, "new files start with the last settings");
-    assert_eq!(orbcloud::app::session::read(&last).unwrap().objects.len(), 2);
+    assert_eq!(orbcloud::sources::session::read(&last).unwrap().session.objects.len(), 2);
     next.run_steps(2);
     next.get_by_label("Last session").click();
     wait_loaded(&mut next);

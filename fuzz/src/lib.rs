@@ -36,3 +36,17 @@ pub fn read_manifest(data: &[u8]) {
     let Ok(text) = std::str::from_utf8(data) else { return };
     let _ = orbcloud::formats::scan::parse_scan(Path::new("fuzz.scan.toml"), text, &mut |_| Ok(FRAME.clone()));
 }
+
+/// Parses `data` as a session. One that opens must be drawable: a second pass of the range
+/// checks finds nothing to change, and every camera projects to finite points.
+pub fn read_session(data: &[u8]) {
+    let Ok(text) = std::str::from_utf8(data) else { return };
+    let Ok(read) = orbcloud::sources::session::parse("fuzz.orbcloud.toml", text) else { return };
+    let mut session = read.session;
+    let cameras: Vec<_> = std::iter::once(session.camera).chain(session.panes.cameras).collect();
+    for camera in cameras {
+        assert!(camera.clip_from_world(1.5, 10.0).is_finite() && camera.eye().is_finite(), "{camera:?}");
+    }
+    let again = session.sanitize();
+    assert!(again.is_empty(), "values still out of range: {again:?}");
+}

@@ -7,7 +7,7 @@ use egui::{RichText, ScrollArea};
 use crate::model::Document;
 use crate::model::basis_labels::{atom_name, function_labels};
 use crate::model::orbitals::Quantity;
-use crate::model::orbitals::{Spin, Wavefunction};
+use crate::model::orbitals::{EnergiesAsOccupations, Spin, Wavefunction};
 use crate::model::units::EV_PER_HARTREE;
 use crate::scene::{Camera, ObjectState, Panes, QuantityState, RenderSettings, Source};
 
@@ -244,22 +244,25 @@ fn orbital_table(
     );
     // One monospace line per orbital: the whole row is the button, and the header above the
     // scrolled list lines up with it and stays in view.
+    let as_occupations = wf.energies_as_occupations();
     if wf.natural(spin) {
-        let energies = if wf.energies_are_occupations() { ": the file's energies are its occupations" } else { "" };
+        let energies = as_occupations.map_or(String::new(), |e| format!(": {}", e.describe()));
         ui.label(RichText::new(format!("natural orbitals, by occupation{energies}")).strong());
     }
-    ui.label(RichText::new(row_text("", "", "sym", "E / Eh", "E / eV", "occ")).monospace().strong());
+    let [eh_header, ev_header] = energy_headers(as_occupations);
+    ui.label(RichText::new(row_text("", "", "sym", eh_header, ev_header, "occ")).monospace().strong());
     ScrollArea::vertical().max_height(ui.available_height() * 0.6).show(ui, |ui| {
         for i in order {
             let o = &wf.orbitals[i];
             let number = wf.of_spin(o.spin).position(|(j, _)| j == i).map_or(0, |p| p + 1);
             let selected = shown == Some(Quantity::Orbital(i));
+            let [eh, ev] = energy_cells(o.energy, as_occupations);
             let text = row_text(
                 &format!("MO {number}"),
                 &wf.frontier_label(i, 5).unwrap_or_default(),
                 &o.symmetry,
-                &wf.energy(i).map_or("—".into(), |e| format!("{e:.5}")),
-                &wf.energy(i).map_or("—".into(), |e| format!("{:.3}", e * EV_PER_HARTREE)),
+                &eh,
+                &ev,
                 &format!("{:.2}", o.occupation),
             );
             ui.horizontal(|ui| {
@@ -292,6 +295,26 @@ fn orbital_table(
         }
     });
     pick
+}
+
+/// The headers of the orbital table's two energy columns. Energies that are occupations are
+/// labelled as what they are, not as hartree.
+fn energy_headers(as_occupations: Option<EnergiesAsOccupations>) -> [&'static str; 2] {
+    match as_occupations {
+        Some(EnergiesAsOccupations::Whole) => ["Ene=occ", ""],
+        Some(EnergiesAsOccupations::PerSpin) => ["Ene=occ/2", ""],
+        None => ["E / Eh", "E / eV"],
+    }
+}
+
+/// An orbital's cells under [`energy_headers`]: the file's value as an occupation when it is
+/// one, else hartree and eV (dashes when the file gave none).
+fn energy_cells(energy: f64, as_occupations: Option<EnergiesAsOccupations>) -> [String; 2] {
+    match as_occupations {
+        Some(_) => [format!("{energy:.5}"), String::new()],
+        None if energy.is_finite() => [format!("{energy:.5}"), format!("{:.3}", energy * EV_PER_HARTREE)],
+        None => ["—".into(), "—".into()],
+    }
 }
 
 /// One line of the orbital table, columns padded to fixed widths.
@@ -377,5 +400,15 @@ mod tests {
     fn a_core_orbitals_energies_stay_apart() {
         let row = super::row_text("MO 1", "", "", "-20.57911", "-559.986", "2.00");
         assert!(row.contains("-20.57911 ") && row.contains(" -559.986"), "{row:?}");
+    }
+
+    #[test]
+    fn energies_that_are_occupations_are_labelled_so() {
+        use super::{EnergiesAsOccupations, energy_cells, energy_headers};
+        assert_eq!(energy_headers(Some(EnergiesAsOccupations::PerSpin)), ["Ene=occ/2", ""]);
+        assert_eq!(energy_headers(None), ["E / Eh", "E / eV"]);
+        assert_eq!(energy_cells(0.98765, Some(EnergiesAsOccupations::PerSpin)), ["0.98765".to_string(), String::new()]);
+        assert_eq!(energy_cells(-0.5, None)[1], format!("{:.3}", -0.5 * crate::model::units::EV_PER_HARTREE));
+        assert_eq!(energy_cells(f64::NAN, None), ["—".to_string(), "—".to_string()]);
     }
 }

@@ -4,61 +4,8 @@
 use std::path::{Path, PathBuf};
 
 use super::{Opening, OrbApp};
-use crate::model::Document;
 use crate::scene::Session;
-use crate::scene::objects::AddedVolume;
-use crate::scene::objects::SESSION_SUFFIX;
-
-/// `path` ending in `.orbcloud.toml` (a dialog may have dropped the double suffix).
-pub fn with_suffix(path: PathBuf) -> PathBuf {
-    let name = path.to_string_lossy();
-    if name.ends_with(SESSION_SUFFIX) {
-        return path;
-    }
-    let stem = name.strip_suffix(".toml").unwrap_or(&name);
-    PathBuf::from(format!("{stem}{SESSION_SUFFIX}"))
-}
-
-/// Where the session is kept between runs: `$XDG_CONFIG_HOME/orbcloud` or `~/.config/orbcloud`.
-pub fn last_session_path() -> Option<PathBuf> {
-    let config = std::env::var_os("XDG_CONFIG_HOME")
-        .map(PathBuf::from)
-        .filter(|p| p.is_absolute())
-        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".config")))?;
-    Some(config.join("orbcloud").join(format!("last{SESSION_SUFFIX}")))
-}
-
-/// Reads a session file; the error names the file (and the line, for TOML errors).
-pub fn read(path: &Path) -> Result<Session, String> {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    toml::from_str(&text).map_err(|e| format!("{}: not an orbcloud session: {e}", path.display()))
-}
-
-/// Writes a session file.
-pub fn write(path: &Path, session: &Session) -> Result<(), String> {
-    let text = toml::to_string_pretty(session).map_err(|e| format!("{}: {e}", path.display()))?;
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-    }
-    std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display()))
-}
-
-/// Appends the data set(s) `added` names to `doc`: a joined file's, or a difference with
-/// another file made again.
-pub fn add_volume(doc: &mut Document, added: &AddedVolume) -> Result<(), String> {
-    match added {
-        AddedVolume::Joined { path } => {
-            let other = crate::formats::load(path).map_err(|e| e.to_string())?;
-            doc.join(other).map(|_| ())
-        }
-        AddedVolume::Difference { of, minus, points } => {
-            let other = crate::formats::load(minus).map_err(|e| e.to_string())?;
-            let grid = crate::evaluate::arithmetic::difference(doc, *of, *points, &other)?;
-            doc.volumes.push(grid);
-            Ok(())
-        }
-    }
-}
+pub use crate::sources::session::{Read, add_volume, last_session_path, parse, read, with_suffix, write};
 
 impl OrbApp {
     /// The scene as a session: every object read from a file (the bundled demo is left out),
@@ -87,13 +34,17 @@ impl OrbApp {
     /// with its representations and placement; the camera is the saved one. A session that
     /// cannot be read leaves the scene as it was.
     pub fn open_session(&mut self, path: &Path, ctx: &egui::Context) {
-        let session = match read(path) {
-            Ok(s) => s,
+        let (session, notes) = match read(path) {
+            Ok(read) => (read.session, read.notes),
             Err(e) => {
                 self.error = Some(e);
                 return;
             }
         };
+        // Out of range values were replaced; the session opens, and says which.
+        if !notes.is_empty() {
+            self.error = Some(format!("{}: values out of range were replaced:\n{}", path.display(), notes.join("\n")));
+        }
         let files: Vec<(PathBuf, Opening)> = session
             .objects
             .into_iter()
@@ -134,7 +85,10 @@ impl OrbApp {
     /// come from the session saved there (its last object's), and the scene is saved there when
     /// the window closes.
     pub fn keep_session_in(&mut self, path: PathBuf) {
-        if let Ok(session) = read(&path) {
+        if let Ok(Read { session, notes }) = read(&path) {
+            for note in notes {
+                log::warn!("{note}");
+            }
             if let Some(last) = session.objects.last() {
                 self.defaults = last.render_settings(last.selected, self.defaults.background);
                 // New files open without the last file's isosurfaces or hidden cloud.
@@ -164,6 +118,7 @@ impl OrbApp {
 mod tests {
     use super::*;
     use crate::model::orbitals::Quantity;
+    use crate::scene::objects::SESSION_SUFFIX;
     use crate::scene::{
         AtomLook, IsoLevel, IsosurfaceSettings, ObjectState, Placement, QuantityState, RenderSettings, Source,
     };
@@ -186,7 +141,7 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("orbcloud-session-{}", std::process::id()));
         let path = dir.join(format!("scene{SESSION_SUFFIX}"));
         write(&path, &session).unwrap();
-        assert_eq!(read(&path).unwrap(), session);
+        assert_eq!(read(&path).unwrap(), Read { session, notes: Vec::new() });
         std::fs::write(&path, "objects = 3").unwrap();
         let e = read(&path).unwrap_err();
         assert!(e.contains("scene.orbcloud.toml") && e.contains("line 1"), "{e}");
@@ -194,6 +149,74 @@ mod tests {
         assert_eq!(with_suffix("a/b.toml".into()), PathBuf::from("a/b.orbcloud.toml"));
         assert_eq!(with_suffix("b".into()), PathBuf::from("b.orbcloud.toml"));
         assert_eq!(with_suffix("b.orbcloud.toml".into()), PathBuf::from("b.orbcloud.toml"));
+    }
+
+    /// A session as written, with `edits` (line, replacement) made to its text.
+    fn edited_session(edits: &[(&str, &str)]) -> String {
+        let mut quantity = QuantityState::new(Source::Volume(0), &RenderSettings::default());
+        quantity.isosurfaces[0].visible = true;
+        let object =
+            ObjectState { path: Some("/data/water.cube".into()), quantities: vec![quantity], ..Default::default() };
+        let mut text = toml::to_string_pretty(&Session { objects: vec![object], ..Default::default() }).unwrap();
+        for (line, replacement) in edits {
+            assert!(text.contains(line), "{line} not in the session");
+            text = text.replacen(line, replacement, 1);
+        }
+        text
+    }
+
+    #[test]
+    fn absurd_sessions_open_with_their_values_in_range_and_say_which_were_not() {
+        let text = edited_session(&[
+            ("slices = 192", "slices = 4000000000"),
+            ("distance = 20.0", "distance = nan"),
+            ("fov_y = 0.5235988", "fov_y = inf"),
+            ("yaw = 0.0", "yaw = -inf"),
+            ("count = 1", "count = 99"),
+            ("k1 = 0.2", "k1 = -inf"),
+            ("Absolute = 0.05", "Absolute = nan"),
+            ("selected = 0", "selected = 12"),
+            ("grid_points = 72", "grid_points = 100000"),
+            ("ball_scale = 1.0", "ball_scale = 1e30"),
+        ]);
+        let Read { session, notes } = parse("absurd.orbcloud.toml", &text).expect("an absurd session still opens");
+        for key in [
+            "objects[0].quantities[0].cloud.slices: 4000000000 is outside 1..=4096",
+            "camera.distance: NaN is not a finite number",
+            "camera.fov_y: inf",
+            "camera.yaw: -inf",
+            "panes.count: 99",
+            "objects[0].quantities[0].cloud.k1: -inf",
+            "objects[0].quantities[0].isosurfaces[0].level.Absolute: NaN",
+            "objects[0].selected: 12",
+            "objects[0].evaluation.grid_points: 100000",
+            "objects[0].atoms.ball_scale: 1000000000000000000000000000000 is outside 0.3..=3",
+        ] {
+            let line = format!("absurd.orbcloud.toml: {key}");
+            assert!(notes.iter().any(|n| n.starts_with(&line)), "no note {line:?} in {notes:#?}");
+        }
+        assert_eq!(notes.len(), 10, "{notes:#?}");
+        let cloud = &session.objects[0].quantities[0].cloud;
+        let box_ = crate::scene::slicing::GridBox {
+            origin: glam::Vec3::ZERO,
+            edges: [glam::Vec3::X * 4.0, glam::Vec3::Y * 4.0, glam::Vec3::Z * 4.0],
+        };
+        let slices = box_.view_aligned(cloud.slices, session.camera.view_from_world().row(2).truncate());
+        assert_eq!(slices.depths.len(), 4096);
+        assert!(slices.vertices.iter().all(|v| v.is_finite()));
+        assert!(session.camera.clip_from_world(1.5, 10.0).is_finite());
+        assert!(session.camera.eye().is_finite());
+        assert_eq!(session.objects[0].quantities[0].isosurfaces[0].level, IsoLevel::Absolute(0.05));
+        // Written back, it reads without a note.
+        let again = toml::to_string_pretty(&session).unwrap();
+        assert_eq!(parse("again.orbcloud.toml", &again).unwrap(), Read { session, notes: Vec::new() });
+        // A number no field can hold is refused, naming the file and the line.
+        let e = parse("huge.orbcloud.toml", &edited_session(&[("slices = 192", "slices = 5000000000")])).unwrap_err();
+        let line = edited_session(&[]).lines().position(|l| l == "slices = 192").unwrap() + 1;
+        assert!(
+            e.starts_with("huge.orbcloud.toml: not an orbcloud session") && e.contains(&format!("line {line}")),
+            "{e}"
+        );
     }
 
     /// An object as sessions wrote it before objects held several quantities: one cloud, the

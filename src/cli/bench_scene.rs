@@ -98,8 +98,7 @@ pub fn bench(args: &SceneBench) -> Result<()> {
             objects: scene.iter().map(|(_, s)| s.clone()).collect(),
             ..Default::default()
         };
-        let text = toml::to_string(&session).context("writing the session")?;
-        std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))?;
+        crate::sources::session::write(path, &session).map_err(anyhow::Error::msg)?;
     }
     let mut renderer = Renderer::new(&ctx);
     let shown = show_scene(&ctx, &mut renderer, &scene, args.points)?;

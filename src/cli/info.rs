@@ -3,7 +3,7 @@
 use serde::Serialize;
 
 use crate::model::basis::ShellKind;
-use crate::model::orbitals::{Normalization, Spin, Wavefunction};
+use crate::model::orbitals::{EnergiesAsOccupations, Normalization, Spin, Wavefunction};
 use crate::model::units::EV_PER_HARTREE;
 use crate::model::{Document, GridStats, grid::ValueKind, units::ANGSTROM_PER_BOHR};
 
@@ -56,6 +56,8 @@ pub struct WavefunctionInfo {
     pub natural: bool,
     /// The file's "energies" are its occupations: no energies to show.
     pub energies_are_occupations: bool,
+    /// How they are: `whole` (as `Occup=`) or `per_spin` (half of it, as Psi4 writes them).
+    pub energies_as_occupations: Option<EnergiesAsOccupations>,
 }
 
 #[derive(Serialize)]
@@ -182,6 +184,7 @@ fn wavefunction_info(wf: &Wavefunction) -> WavefunctionInfo {
         orbitals: (0..wf.orbitals.len()).map(|i| orbital_info(wf, i)).collect(),
         natural: wf.natural(Spin::Alpha),
         energies_are_occupations: wf.energies_are_occupations(),
+        energies_as_occupations: wf.energies_as_occupations(),
     }
 }
 
@@ -301,7 +304,7 @@ pub fn text(doc: &Document) -> String {
             if n.residual > 1e-5 { "  ⚠ not orthonormal" } else { "" }
         );
         if w.natural {
-            let energies = if w.energies_are_occupations { "; the file's energies are its occupations" } else { "" };
+            let energies = w.energies_as_occupations.map_or(String::new(), |e| format!("; {}", e.describe()));
             let _ = writeln!(s, "natural orbitals: HOMO and LUMO by occupation{energies}");
         }
         for (name, o) in [("HOMO", &w.homo), ("LUMO", &w.lumo)] {

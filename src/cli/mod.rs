@@ -13,6 +13,7 @@ use crate::model::Document;
 use crate::model::orbitals::{OrbitalSpec, Quantity, Spin, Wavefunction};
 use crate::pictures::headless::Headless;
 use crate::scene::framing::camera_for;
+use crate::scene::limits::{self, within};
 use crate::scene::transfer::PRESETS;
 use crate::scene::{
     AtomColoring, AtomStyle, Camera, ClipPlane, RenderSettings, Shape, SliceMode, TransferKind, ViewPreset,
@@ -111,15 +112,15 @@ enum Command {
         file: PathBuf,
         #[command(flatten)]
         what: WhatArgs,
-        /// Points per axis (ignored with --spacing).
-        #[arg(long, default_value_t = 80)]
+        /// Points per axis, 8 to 512 (ignored with --spacing).
+        #[arg(long, default_value_t = 80, value_parser = within(limits::GRID_POINTS))]
         grid: usize,
-        /// Grid spacing in bohr (same on every axis).
-        #[arg(long)]
+        /// Grid spacing in bohr (same on every axis), 0.001 to 10.
+        #[arg(long, value_parser = within(limits::SPACING))]
         spacing: Option<f64>,
-        /// Space around the atoms, bohr (default: the box where the orbital decays to 1 % of
-        /// its largest value, a density to 1e-4 a.u.).
-        #[arg(long)]
+        /// Space around the atoms, bohr, 0 to 100 (default: the box where the orbital decays to
+        /// 1 % of its largest value, a density to 1e-4 a.u.).
+        #[arg(long, value_parser = within(limits::MARGIN))]
         margin: Option<f64>,
         /// Subtract the same quantity of another file on this grid: its wavefunction's, or its
         /// first data set's, resampled trilinearly (refused when the grids do not overlap).
@@ -186,8 +187,8 @@ struct WavefunctionArgs {
     /// instead of on a GPU-filled grid.
     #[arg(long)]
     direct: bool,
-    /// Points per axis of the grid orbitals are evaluated on.
-    #[arg(long, default_value_t = 72)]
+    /// Points per axis of the grid orbitals are evaluated on, 8 to 512.
+    #[arg(long, default_value_t = 72, value_parser = within(limits::GRID_POINTS))]
     grid_points: usize,
 }
 
@@ -218,7 +219,7 @@ impl WavefunctionArgs {
         let view = WavefunctionView {
             quantity: self.what.resolve(doc)?,
             direct: self.direct,
-            points: self.grid_points.clamp(8, 512),
+            points: self.grid_points,
             functions: None,
             grid,
         };
@@ -335,7 +336,7 @@ enum BenchCommand {
         #[command(flatten)]
         view: ViewArgs,
         /// Frames to time (after two warm-up frames).
-        #[arg(long, default_value_t = 10)]
+        #[arg(long, default_value_t = 10, value_parser = within(1..=100_000u32))]
         frames: u32,
         /// Use the CPU Vulkan adapter (lavapipe) even when a GPU is present.
         #[arg(long)]
@@ -467,25 +468,25 @@ struct ViewArgs {
     #[arg(long, default_value = "auto", value_parser = ViewPreset::parse)]
     view: ViewPreset,
     /// Camera rotation about the vertical axis, degrees (after `--view`).
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = within(limits::ANGLE_DEG))]
     yaw: f32,
     /// Camera elevation, degrees.
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = within(limits::ANGLE_DEG))]
     pitch: f32,
-    /// Zoom factor (> 1 comes closer).
-    #[arg(long, default_value_t = 1.0)]
+    /// Zoom factor (> 1 comes closer), 0.001 to 1000.
+    #[arg(long, default_value_t = 1.0, value_parser = within(limits::ZOOM))]
     zoom: f32,
     #[arg(long, value_enum, default_value_t = ModeArg::View)]
     mode: ModeArg,
-    /// Number of slices.
-    #[arg(long)]
+    /// Number of slices, 1 to 4096.
+    #[arg(long, value_parser = within(limits::SLICES))]
     slices: Option<u32>,
-    /// Opacity scale k1 in α = k1·ρ^k2 (default: chosen from the grid so its densest lines of
-    /// sight reach an optical depth of 2.5).
-    #[arg(long)]
+    /// Opacity scale k1 in α = k1·ρ^k2, 0 to 1000 (default: chosen from the grid so its densest
+    /// lines of sight reach an optical depth of 2.5).
+    #[arg(long, value_parser = within(limits::K1))]
     k1: Option<f32>,
-    /// Opacity exponent k2 in α = k1·ρ^k2.
-    #[arg(long)]
+    /// Opacity exponent k2 in α = k1·ρ^k2, 0 to 16.
+    #[arg(long, value_parser = within(limits::K2))]
     k2: Option<f32>,
     #[arg(long, value_enum, default_value_t = AtomsArg::BallAndStick)]
     atoms: AtomsArg,
@@ -495,13 +496,13 @@ struct ViewArgs {
     color: ColorArg,
     /// Darken atoms with depth by up to this fraction (0 to 1; the viewer opens big structures
     /// at 0.6): the front of a big structure reads from its back.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, value_parser = within(limits::FRACTION))]
     depth_cue: f32,
     /// Factor on the style's ball radii (0.3 to 3).
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, value_parser = within(limits::ATOM_SCALE))]
     ball_scale: f32,
     /// Factor on the style's stick radius (0.3 to 3).
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, value_parser = within(limits::ATOM_SCALE))]
     stick_scale: f32,
     /// Hide the volume (atoms only).
     #[arg(long)]
@@ -514,23 +515,23 @@ struct ViewArgs {
     /// nested-cores (left half on ψ > 0, right half on ψ < 0, peaked at the extremes).
     #[arg(long, value_enum, default_value_t = TfArg::Power)]
     tf: TfArg,
-    /// Shape centre (iso-value), a fraction of max|value|.
-    #[arg(long)]
+    /// Shape centre (iso-value), a fraction of max|value| (0 to 1).
+    #[arg(long, value_parser = within(limits::FRACTION))]
     tf_center: Option<f32>,
-    /// Shape width, a fraction of max|value| (the contour spacing for `sinusoidal`).
-    #[arg(long)]
+    /// Shape width, a fraction of max|value| (the contour spacing for `sinusoidal`), 0.0001 to 1.
+    #[arg(long, value_parser = within(limits::LOBE_WIDTH))]
     tf_width: Option<f32>,
-    /// Shape peak opacity per grid step.
-    #[arg(long)]
+    /// Shape peak opacity per grid step, 0 to 100.
+    #[arg(long, value_parser = within(limits::LOBE_OPACITY))]
     tf_opacity: Option<f32>,
     /// Light the cloud with the gradient as the normal.
     #[arg(long)]
     shading: bool,
     /// Boundary enhancement 0..1 (opacity rises with the gradient magnitude).
-    #[arg(long)]
+    #[arg(long, value_parser = within(limits::FRACTION))]
     boundary: Option<f32>,
-    /// 2D transfer function: opacity × (|∇|/max|∇|)^P.
-    #[arg(long)]
+    /// 2D transfer function: opacity × (|∇|/max|∇|)^P, P 0 to 16.
+    #[arg(long, value_parser = within(limits::GRADIENT_POWER))]
     gradient_power: Option<f32>,
     /// Clipping plane NX,NY,NZ[,OFFSET]: cut away what lies beyond it from the clouds,
     /// isosurfaces and molecular surface (offset in bohr from the centre of the molecule's and
@@ -568,13 +569,16 @@ fn parse_preset(s: &str) -> Result<([f32; 3], [f32; 3]), String> {
 }
 
 fn parse_clip(s: &str) -> Result<[f32; 4], String> {
-    let v: Vec<f32> =
-        s.split(',').map(|t| t.trim().parse::<f32>()).collect::<Result<_, _>>().map_err(|e| e.to_string())?;
-    match v[..] {
-        [x, y, z] => Ok([x, y, z, 0.0]),
-        [x, y, z, o] => Ok([x, y, z, o]),
-        _ => Err(format!("expected NX,NY,NZ[,OFFSET], got {s:?}")),
+    let v: Vec<f32> = s.split(',').map(|t| limits::parse_in(t, &limits::POSITION)).collect::<Result<_, _>>()?;
+    let plane = match v[..] {
+        [x, y, z] => [x, y, z, 0.0],
+        [x, y, z, o] => [x, y, z, o],
+        _ => return Err(format!("expected NX,NY,NZ[,OFFSET], got {s:?}")),
+    };
+    if plane[..3].iter().all(|&c| c == 0.0) {
+        return Err(format!("expected a normal NX,NY,NZ that is not zero, got {s:?}"));
     }
+    Ok(plane)
 }
 
 fn parse_size(s: &str) -> Result<[u32; 2], String> {
@@ -596,7 +600,7 @@ impl ViewArgs {
         s.volume.visible = !self.no_volume;
         s.volume.skip_empty = !self.full_slices;
         if let Some(n) = self.slices {
-            s.volume.slices = n.clamp(1, 4096);
+            s.volume.slices = n;
         }
         s.volume.auto_k1 = self.k1.is_none();
         if let Some(k1) = self.k1 {
@@ -630,8 +634,8 @@ impl ViewArgs {
             }
         }
         t.shading = self.shading;
-        t.boundary = self.boundary.unwrap_or(0.0).clamp(0.0, 1.0);
-        t.gradient_power = self.gradient_power.unwrap_or(0.0).max(0.0);
+        t.boundary = self.boundary.unwrap_or(0.0);
+        t.gradient_power = self.gradient_power.unwrap_or(0.0);
         if let Some([x, y, z, offset]) = self.clip {
             s.clip = ClipPlane { enabled: true, normal: [x, y, z], offset, atoms: self.clip_atoms };
         }
@@ -647,9 +651,9 @@ impl ViewArgs {
             ColorArg::BFactor => AtomColoring::BFactor,
             ColorArg::Secondary => AtomColoring::Secondary,
         };
-        s.depth_cue = self.depth_cue.clamp(0.0, 1.0);
-        s.ball_scale = self.ball_scale.clamp(0.3, 3.0);
-        s.stick_scale = self.stick_scale.clamp(0.3, 3.0);
+        s.depth_cue = self.depth_cue;
+        s.ball_scale = self.ball_scale;
+        s.stick_scale = self.stick_scale;
         s
     }
 
@@ -661,7 +665,7 @@ impl ViewArgs {
     /// `camera` turned by `--yaw` and `--pitch` and zoomed by `--zoom`.
     fn orbit(&self, mut camera: Camera) -> Camera {
         camera.orbit(self.yaw.to_radians(), self.pitch.to_radians());
-        camera.zoom(1.0 / self.zoom.max(1e-3));
+        camera.zoom(1.0 / self.zoom);
         camera
     }
 
@@ -706,7 +710,7 @@ struct BenchFrames {
     #[arg(long, default_value = "800x600", value_parser = parse_size)]
     size: [u32; 2],
     /// Frames to time (after two warm-up frames).
-    #[arg(long, default_value_t = 10)]
+    #[arg(long, default_value_t = 10, value_parser = within(1..=100_000u32))]
     frames: u32,
     /// Use the CPU Vulkan adapter (lavapipe) even when a GPU is present.
     #[arg(long)]

@@ -2,6 +2,7 @@
 //! file (for other programs), and `render --normal-mode N --phase φ` draws the displaced
 //! geometry.
 
+use crate::scene::limits::{self, within};
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -20,10 +21,10 @@ pub struct ModeArgs {
     #[arg(long)]
     pub normal_mode: Option<usize>,
     /// Where in the oscillation, degrees (90: the largest displacement one way, 270 the other).
-    #[arg(long, default_value_t = 90.0, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = 90.0, allow_hyphen_values = true, value_parser = within(limits::wide(limits::ANGLE_DEG)))]
     pub phase: f64,
-    /// The largest atom's displacement at the turning points, bohr.
-    #[arg(long, default_value_t = 0.4)]
+    /// The largest atom's displacement at the turning points, bohr (0 to 10).
+    #[arg(long, default_value_t = 0.4, value_parser = within(limits::wide(limits::AMPLITUDE)))]
     pub amplitude: f64,
     /// Draw each atom's displacement along the mode as an arrow from the file's geometry.
     #[arg(long, requires = "normal_mode")]
@@ -82,10 +83,10 @@ pub struct ModesArgs {
     #[arg(long)]
     mode: usize,
     /// Frames over one period.
-    #[arg(long, default_value_t = 20)]
+    #[arg(long, default_value_t = 20, value_parser = within(limits::FRAMES))]
     frames: usize,
-    /// The largest atom's displacement at the turning points, bohr.
-    #[arg(long, default_value_t = 0.4)]
+    /// The largest atom's displacement at the turning points, bohr (0 to 10).
+    #[arg(long, default_value_t = 0.4, value_parser = within(limits::wide(limits::AMPLITUDE)))]
     amplitude: f64,
     /// Output XYZ file (Å), one frame after another.
     #[arg(short, long)]

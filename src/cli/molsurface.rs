@@ -1,6 +1,7 @@
 //! `render`/`mesh --surface gaussian|ses` and `bench surface`: molecular surfaces from the
 //! command line.
 
+use crate::scene::limits::{self, within};
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
@@ -58,13 +59,15 @@ pub struct MolSurfaceArgs {
     #[arg(long, value_enum)]
     pub surface: Option<SurfaceArg>,
     /// Grid spacing of the molecular surface, Å (default 0.25 Å, coarser for big molecules).
-    #[arg(long)]
+    // Finer than the viewer allows is left to the surface's own check, which knows the
+    // molecule's size and says how coarse a grid fits.
+    #[arg(long, value_parser = within(1e-6..=*limits::wide(limits::SURFACE_RESOLUTION).end()))]
     pub surface_resolution: Option<f64>,
-    /// Probe radius of the solvent-excluded surface, Å.
-    #[arg(long, default_value_t = 1.4)]
+    /// Probe radius of the solvent-excluded surface, Å (0 to 10).
+    #[arg(long, default_value_t = 1.4, value_parser = within(limits::wide(limits::PROBE)))]
     pub probe: f64,
-    /// Smoothness α of the Gaussian surface (larger hugs the atoms tighter).
-    #[arg(long, default_value_t = SurfaceParams::SMOOTHNESS)]
+    /// Smoothness α of the Gaussian surface (larger hugs the atoms tighter), 0.1 to 20.
+    #[arg(long, default_value_t = SurfaceParams::SMOOTHNESS, value_parser = within(limits::wide(limits::SMOOTHNESS)))]
     pub smoothness: f64,
     /// What colours the molecular surface: one colour, or the nearest atom's element, chain,
     /// residue, B-factor or secondary structure.
@@ -72,7 +75,7 @@ pub struct MolSurfaceArgs {
     pub surface_color: SurfaceColorArg,
     /// Level of detail: parts smaller than this many pixels are drawn as points
     /// (0: every triangle).
-    #[arg(long, default_value_t = SurfaceSettings::LOD_PX)]
+    #[arg(long, default_value_t = SurfaceSettings::LOD_PX, value_parser = within(limits::LOD_PX))]
     pub lod_px: f32,
 }
 

@@ -2,6 +2,7 @@
 //! through the same renderer as `render` and `scan render`, written as PNG frames, a GIF, an
 //! animated PNG or (through ffmpeg) a video.
 
+use crate::scene::limits::{self, within};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
@@ -27,19 +28,19 @@ pub struct MovieArgs {
     #[arg(short, long)]
     output: PathBuf,
     /// Frames: over the scan's range (ends included), over a full turn, or over one period.
-    #[arg(long, default_value_t = 24)]
+    #[arg(long, default_value_t = 24, value_parser = within(limits::FRAMES))]
     frames: usize,
-    /// Frames per second.
-    #[arg(long, default_value_t = 12.0)]
+    /// Frames per second, 0.1 to 240.
+    #[arg(long, default_value_t = 12.0, value_parser = within(limits::FPS))]
     fps: f64,
     /// Turn the view a full circle about the screen's vertical axis.
     #[arg(long)]
     turntable: bool,
     /// Where a scan's sweep starts (the coordinate's unit; default: the first key frame).
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, allow_hyphen_values = true, value_parser = within(-1e9..=1e9))]
     from: Option<f64>,
     /// Where a scan's sweep ends (default: the last key frame).
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, allow_hyphen_values = true, value_parser = within(-1e9..=1e9))]
     to: Option<f64>,
     /// Sweep there and back, so the movie loops.
     #[arg(long)]
@@ -59,8 +60,8 @@ pub struct MovieArgs {
     /// One period of this normal mode (1-based, as `info` lists them), the atoms moving along it.
     #[arg(long)]
     normal_mode: Option<usize>,
-    /// The largest atom's displacement at the turning points, bohr.
-    #[arg(long, default_value_t = 0.4)]
+    /// The largest atom's displacement at the turning points, bohr (0 to 10).
+    #[arg(long, default_value_t = 0.4, value_parser = within(limits::wide(limits::AMPLITUDE)))]
     amplitude: f64,
     /// Draw each atom's displacement along the mode as an arrow.
     #[arg(long, requires = "normal_mode")]
@@ -81,9 +82,6 @@ fn is_session(path: &Path) -> bool {
 pub fn movie(args: MovieArgs) -> Result<()> {
     // Everything that can be refused is, before any frame is drawn.
     MovieFormat::of(&args.output)?.check(&args.output)?;
-    if args.frames == 0 || args.frames > 100_000 {
-        bail!("--frames {} must be 1 to 100000", args.frames);
-    }
     let scan_input = args.input.as_deref().is_none_or(is_scan);
     match (scan_input, args.turntable, args.normal_mode) {
         (true, _, Some(_)) => bail!("--normal-mode animates a file's vibration; a scan sweeps its coordinate"),
@@ -189,14 +187,19 @@ type Objects = Vec<(Document, ObjectState)>;
 
 /// A session's objects (each file loaded), its camera and background.
 fn session_scene(path: &Path) -> Result<(Objects, Camera, [f32; 3])> {
-    let session = crate::app::session::read(path).map_err(anyhow::Error::msg)?;
+    let read = crate::sources::session::read(path).map_err(anyhow::Error::msg)?;
+    for note in &read.notes {
+        eprintln!("warning: {note}");
+    }
+    let session = read.session;
     let mut scene = Vec::new();
     for mut state in session.objects {
         let Some(file) = state.path.clone() else { continue };
         let mut doc =
             crate::formats::load(&file).with_context(|| format!("{}: opening {}", path.display(), file.display()))?;
         for added in &state.added {
-            crate::app::session::add_volume(&mut doc, added).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+            crate::sources::session::add_volume(&mut doc, added)
+                .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
         }
         state.fit_to(&doc, &crate::scene::RenderSettings::default());
         scene.push((doc, state));

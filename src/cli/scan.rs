@@ -1,5 +1,6 @@
 //! `orbcloud scan …` and `orbcloud bench keyvolumes`: scans of a distance, angle, dihedral or path from the command line.
 
+use crate::scene::limits::{self, within};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -57,7 +58,7 @@ pub enum ScanCommand {
     Export {
         scan: PathBuf,
         /// The coordinate's value (degrees for a dihedral).
-        #[arg(long, alias = "angle", allow_hyphen_values = true)]
+        #[arg(long, alias = "angle", allow_hyphen_values = true, value_parser = within(-1e9..=1e9))]
         at: f64,
         /// Which of the scan's orbitals (as the manifest names them).
         #[arg(long, default_value = "homo", allow_hyphen_values = true)]
@@ -94,8 +95,8 @@ impl CoordinateArgs {
 
 #[derive(Args)]
 pub struct KeyArgs {
-    /// Points along the longest side of the common grid.
-    #[arg(long, default_value_t = DEFAULT_SCAN_POINTS)]
+    /// Points along the longest side of the common grid, 8 to 512.
+    #[arg(long, default_value_t = DEFAULT_SCAN_POINTS, value_parser = within(limits::GRID_POINTS))]
     points: usize,
     /// Follow each orbital by index (name) or by overlap (character); default: the manifest's.
     #[arg(long, value_enum)]
@@ -134,7 +135,7 @@ impl From<InterpolationArg> for Interpolation {
 pub struct ScanRenderArgs {
     scan: PathBuf,
     /// The coordinate's value (degrees for a dihedral).
-    #[arg(long, alias = "angle", allow_hyphen_values = true)]
+    #[arg(long, alias = "angle", allow_hyphen_values = true, value_parser = within(-1e9..=1e9))]
     at: f64,
     #[arg(long = "interpolation", value_enum, default_value_t = InterpolationArg::Exact)]
     interpolation: InterpolationArg,
@@ -358,16 +359,16 @@ pub struct KeyVolumeBench {
     /// Resident key volume counts to time.
     #[arg(long, value_delimiter = ',', default_value = "2,8,32,128,512")]
     counts: Vec<usize>,
-    /// Points along the longest side of the grid.
-    #[arg(long, default_value_t = DEFAULT_SCAN_POINTS)]
+    /// Points along the longest side of the grid, 8 to 512.
+    #[arg(long, default_value_t = DEFAULT_SCAN_POINTS, value_parser = within(limits::GRID_POINTS))]
     points: usize,
     /// Frames to time per K (each at a different value, so a different pair of volumes).
-    #[arg(long, default_value_t = 8)]
+    #[arg(long, default_value_t = 8, value_parser = within(limits::FRAMES))]
     frames: usize,
     #[arg(long, default_value = "400x300", value_parser = super::parse_size)]
     size: [u32; 2],
     /// View-aligned slices per frame (the viewer draws 64 at most while the value is dragged).
-    #[arg(long, default_value_t = crate::scene::RenderSettings::default().volume.slices)]
+    #[arg(long, default_value_t = crate::scene::RenderSettings::default().volume.slices, value_parser = within(limits::SLICES))]
     slices: u32,
     #[arg(long)]
     lavapipe: bool,

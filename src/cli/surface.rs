@@ -1,6 +1,7 @@
 //! `orbcloud mesh`, `render --iso/--pick` and `bench isosurface`: isosurfaces and picking from
 //! the command line.
 
+use crate::scene::limits::{self, within};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -29,10 +30,10 @@ use super::{WhatArgs, load, wavefunction_of};
 pub struct IsoArgs {
     /// Isosurface value in atomic units (ψ = ±V for an orbital, ρ = V for a density); repeat
     /// for nested surfaces.
-    #[arg(long = "iso", allow_hyphen_values = true)]
+    #[arg(long = "iso", allow_hyphen_values = true, value_parser = within(-*limits::ISOVALUE.end()..=*limits::ISOVALUE.end()))]
     pub values: Vec<f32>,
-    /// Isosurface at S standard deviations of the grid's values; repeatable.
-    #[arg(long = "iso-sigma")]
+    /// Isosurface at S standard deviations of the grid's values (0 to 1000); repeatable.
+    #[arg(long = "iso-sigma", value_parser = within(limits::SIGMA))]
     pub sigmas: Vec<f32>,
     /// Draw the isosurfaces translucent (each shining and letting light through, composited in
     /// exact depth order; where one lies inside another object's surface it glows).
@@ -53,7 +54,7 @@ pub struct IsoArgs {
     pub color_by: Option<String>,
     /// The |value| at which `--color-by` colours saturate (a.u.); by default the 98th
     /// percentile of |value| over the vertices.
-    #[arg(long, requires = "color_by")]
+    #[arg(long, requires = "color_by", value_parser = within(1e-30..=f64::from(*limits::ISOVALUE.end())))]
     pub color_range: Option<f64>,
 }
 
@@ -125,9 +126,9 @@ fn parse_tuning(s: &str) -> Result<(String, Vec<f32>), String> {
     }
     let factors: Vec<f32> = values
         .split(',')
-        .map(|v| v.trim().parse::<f32>().ok().filter(|f| f.is_finite() && *f >= 0.0))
+        .map(|v| limits::parse_in(v, &limits::OPTICS_FACTOR).ok())
         .collect::<Option<_>>()
-        .ok_or_else(|| format!("{name}: expected factors ≥ 0, got {values:?}"))?;
+        .ok_or_else(|| format!("{name}: expected factors 0 to 100, got {values:?}"))?;
     match (name, factors.len()) {
         (_, 1) | ("a" | "b" | "c" | "d" | "f" | "g" | "glow_d" | "glow_f" | "glow_g", 3) => {
             Ok((name.to_string(), factors))
@@ -314,8 +315,8 @@ pub struct GridArgs {
     volume: usize,
     #[command(flatten)]
     what: WhatArgs,
-    /// Points per axis of the grid a wavefunction is evaluated on.
-    #[arg(long, default_value_t = 80)]
+    /// Points per axis of the grid a wavefunction is evaluated on, 8 to 512.
+    #[arg(long, default_value_t = 80, value_parser = within(limits::GRID_POINTS))]
     grid_points: usize,
 }
 

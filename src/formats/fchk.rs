@@ -115,7 +115,7 @@ const NEEDED: [&str; 23] = [
     "Alpha MO coefficients",
     "Beta MO coefficients",
     "Multiplicity",
-    "Vib-NDim",
+    "Number of Normal Modes",
     "Vib-E2",
     "Vib-Modes",
 ];
@@ -545,16 +545,30 @@ impl FchkFile {
         doc
     }
 
-    /// The normal modes of a frequency job (`Vib-NDim`, `Vib-E2`, `Vib-Modes`), at `geometry`;
-    /// `None` when the file has none (Q-Chem's fchk files never do).
+    /// The normal modes of a frequency job (`Vib-E2`, `Vib-Modes`), at `geometry`; `None` when
+    /// the file has none (Q-Chem's fchk files never do). The count comes from `Vib-Modes`, one
+    /// vector of 3 × atoms values per mode: `Vib-NDim` is no mode count (Gaussian 16 writes the
+    /// atom count there).
     fn vibrations(&self, file: &str, geometry: &[DVec3]) -> Result<Option<Vibrations>, ParseError> {
-        if !self.records.contains_key("Vib-NDim") {
+        if !self.records.contains_key("Vib-Modes") {
             return Ok(None);
         }
-        let count = usize::try_from(self.int(file, "Vib-NDim")?)
-            .map_err(|_| error(file, self.line_of("Vib-NDim"), "a mode count ≥ 0", "a negative one"))?;
         let e2 = (self.reals(file, "Vib-E2", None)?, self.line_of("Vib-E2"));
         let vectors = (self.reals(file, "Vib-Modes", None)?, self.line_of("Vib-Modes"));
+        let per_mode = 3 * geometry.len();
+        if per_mode == 0 || vectors.0.len() % per_mode != 0 {
+            let expected =
+                format!("a multiple of 3 × {} atoms values in Vib-Modes (one vector per mode)", geometry.len());
+            return Err(error(file, vectors.1, expected, format!("{} values", vectors.0.len())));
+        }
+        let count = vectors.0.len() / per_mode;
+        if self.records.contains_key("Number of Normal Modes") {
+            let stated = self.int(file, "Number of Normal Modes")?;
+            if stated != count as i64 {
+                let expected = format!("{count} normal modes (the vectors in Vib-Modes)");
+                return Err(error(file, self.line_of("Number of Normal Modes"), expected, stated.to_string()));
+            }
+        }
         super::modes::from_fchk(file, count, e2, vectors, geometry).map(Some)
     }
 }
@@ -707,6 +721,39 @@ mod tests {
         let bad = reals("IRC point       1 Geometries", &[0.0; 5]);
         let e = geometries("t.fchk", &file(false, &bad)).expect_err("odd geometry");
         assert!(e.expected.contains("multiple of 3 × 2"), "{e}");
+    }
+
+    /// A frequency job's records for the two atoms of [`file`] and 3 modes: Gaussian 16 writes
+    /// `Number of Normal Modes`, the atom count in `Vib-NDim` and 14 values per mode in `Vib-E2`.
+    fn mode_records(stated: Option<i64>, ndim: i64, vectors: usize) -> String {
+        let e2: Vec<f64> = (0..14 * 3).map(|k| 100.0 * (k + 1) as f64).collect();
+        let modes: Vec<f64> = (0..vectors).map(|k| k as f64 / 10.0).collect();
+        let mut t = stated.map_or(String::new(), |n| int("Number of Normal Modes", n));
+        t += &int("Vib-NDim", ndim);
+        t += &int("Vib-NDim0", ndim);
+        t += &reals("Vib-AtMass", &[15.99491, 1.00783]);
+        t += &reals("Vib-E2", &e2);
+        t + &reals("Vib-Modes", &modes)
+    }
+
+    #[test]
+    fn mode_count_comes_from_the_vectors_not_vib_ndim() {
+        let gaussian16 = doc(&file(false, &mode_records(Some(3), 2, 18)));
+        assert!(gaussian16.problems.is_empty(), "{:?}", gaussian16.problems);
+        let gaussian09 = doc(&file(false, &mode_records(None, 3, 18)));
+        for d in [&gaussian16, &gaussian09] {
+            let v = d.vibrations.as_ref().expect("modes read");
+            assert_eq!(v.modes.len(), 3);
+            assert_eq!(v.modes[2].frequency_cm1, 300.0, "frequencies come first");
+            assert_eq!(v.modes[2].ir_intensity, Some(1200.0), "intensities after 3 × 3 values");
+            assert_eq!(v.modes[1].displacement[1], DVec3::new(0.9, 1.0, 1.1));
+        }
+        let mismatch = doc(&file(false, &mode_records(Some(4), 2, 18)));
+        assert!(mismatch.vibrations.is_none() && mismatch.wavefunction.is_some());
+        assert!(mismatch.problems[0].contains("3 normal modes"), "{:?}", mismatch.problems);
+        let ragged = doc(&file(false, &mode_records(None, 2, 17)));
+        assert!(ragged.vibrations.is_none());
+        assert!(ragged.problems[0].contains("multiple of 3 × 2 atoms"), "{:?}", ragged.problems);
     }
 
     #[test]

@@ -149,6 +149,7 @@ impl MoldenFile {
             return Err(error(file, 1, "a Molden file (a `[Molden Format]` header)", found));
         }
         let (mut seen_atoms, mut seen_gto) = (0usize, 0usize);
+        let mut mo_ends_file = false;
         let mut i = 0;
         while i < lines.len() {
             let line_no = i + 1;
@@ -196,6 +197,7 @@ impl MoldenFile {
                     }
                     out.mo_line = line_no;
                     out.orbitals = parse_mo(file, &lines, i, end)?;
+                    mo_ends_file = end == lines.len();
                 }
                 "freq" | "fr-coord" | "fr-norm-coord" | "int" => {
                     let read = out.modes.read(file, &name, line_no, &lines, (i, end));
@@ -224,7 +226,63 @@ impl MoldenFile {
         if out.mo_line == 0 {
             return Err(error(file, eof, "an [MO] section", "end of file"));
         }
+        if mo_ends_file {
+            out.check_not_cut(file, &lines, text.ends_with('\n'))?;
+        }
         Ok(out)
+    }
+
+    /// The number of basis functions `[GTO]` defines, as the file counts them.
+    fn n_file_functions(&self) -> usize {
+        self.shells
+            .iter()
+            .map(|s| match (&s.sp_coefficients, self.pure.is_pure(s.l)) {
+                (Some(_), _) => 4,
+                (None, true) => 2 * s.l as usize + 1,
+                (None, false) => (s.l as usize + 1) * (s.l as usize + 2) / 2,
+            })
+            .sum()
+    }
+
+    /// Refuses an `[MO]` section that ends the file and was cut short. Coefficients may be
+    /// sparse, so a short orbital alone proves nothing; a cut shows as the last orbital
+    /// stopping partway through indices 1, 2, 3, … while every orbital before it has all of
+    /// them (or, alone, its last line lacks its newline), or as fewer beta orbitals than a full
+    /// set of alpha ones. Otherwise the partial orbital would be shown as if whole.
+    fn check_not_cut(&self, file: &str, lines: &[&str], ends_with_newline: bool) -> Result<(), ParseError> {
+        let n = self.n_file_functions();
+        let last_line = lines.iter().rposition(|l| !l.trim().is_empty()).map_or(1, |k| k + 1);
+        let dense = |o: &MoldenOrbital, len: usize| {
+            o.coefficients.len() == len && o.coefficients.iter().enumerate().all(|(k, &(index, _))| index == k + 1)
+        };
+        if let Some((last, before)) = self.orbitals.split_last() {
+            let k = last.coefficients.len();
+            let written_in_full =
+                if before.is_empty() { !ends_with_newline } else { before.iter().all(|o| dense(o, n)) };
+            if k < n && dense(last, k) && written_in_full {
+                return Err(error(
+                    file,
+                    last_line,
+                    format!(
+                        "{n} coefficients `index value` for the orbital from line {} (one per basis function of [GTO])",
+                        last.line
+                    ),
+                    format!("{k}, then the end of the file: the file was cut short"),
+                ));
+            }
+        }
+        let count = |spin| self.orbitals.iter().filter(|o| o.spin == spin).count();
+        let (alpha, beta) = (count(Spin::Alpha), count(Spin::Beta));
+        let beta_block_last = self.orbitals.iter().skip_while(|o| o.spin == Spin::Alpha).all(|o| o.spin == Spin::Beta);
+        if beta > 0 && beta < alpha && alpha == n && beta_block_last {
+            return Err(error(
+                file,
+                last_line,
+                format!("{alpha} Beta orbitals, as many as the Alpha ones"),
+                format!("{beta}, then the end of the file: the file was cut short"),
+            ));
+        }
+        Ok(())
     }
 
     /// The writer the file names in its title or betrays by its layout, if any.
@@ -739,6 +797,39 @@ s 2 1.00
         let text = H2.replace(" Occup= 0.0\n Ene= 0.7\n Sym= 2a\n 2 -0.9\n", "");
         let wf = doc(&text).wavefunction.expect("wf");
         assert_eq!((wf.basis.n_functions(), wf.orbitals.len()), (2, 1));
+    }
+
+    #[test]
+    fn an_mo_section_cut_short_is_refused_at_the_end_of_the_file() {
+        let dense = H2.replace(" Sym= 2a\n 2 -0.9\n", " Sym= 2a\n 1 0.3\n 2 -0.9\n");
+        assert_eq!(doc(&dense).wavefunction.expect("wf").orbitals.len(), 2);
+        let cut = dense.replace(" 2 -0.9\n", "");
+        let e = err(&cut);
+        assert_eq!((e.file.as_str(), e.line), ("t.molden", cut.lines().count()), "{e}");
+        assert!(e.expected.contains("2 coefficients") && e.expected.contains("from line 25"), "{e}");
+        assert!(e.found.contains("cut short"), "{e}");
+        // One orbital, its last line without a newline: cut inside the line.
+        let alone = H2.split(" Occup= 0.0").next().unwrap().replace(" 1 0.5\n 2 0.5\n", " 1 0.5");
+        assert!(err(&alone).expected.contains("2 coefficients"));
+        // Trailing blank lines and a last line without its newline are no cut.
+        assert_eq!(doc(&format!("{dense}\n\n  \n")).wavefunction.expect("wf").orbitals.len(), 2);
+        assert_eq!(doc(dense.trim_end()).wavefunction.expect("wf").orbitals.len(), 2);
+        // Sparse coefficients (index 1 left out) are no cut either.
+        assert_eq!(doc(H2).wavefunction.expect("wf").orbitals.len(), 2);
+    }
+
+    #[test]
+    fn an_unrestricted_file_cut_among_its_beta_orbitals_is_refused() {
+        let beta = |n: usize| {
+            let alpha = " Ene= -0.6\n Spin= Alpha\n Occup= 1.0\n 1 0.5\n 2 0.5\n Ene= 0.7\n Spin= Alpha\n Occup= 0.0\n 1 0.5\n 2 -0.5\n";
+            let b = " Ene= -0.5\n Spin= Beta\n Occup= 1.0\n 1 0.5\n 2 0.5\n Ene= 0.8\n Spin= Beta\n Occup= 0.0\n 1 0.5\n 2 -0.5\n";
+            let b: Vec<&str> = b.split_inclusive('\n').collect();
+            format!("{}[MO]\n{alpha}{}", H2.split("[MO]").next().unwrap(), b[..5 * n].concat())
+        };
+        assert!(!doc(&beta(2)).wavefunction.expect("wf").restricted);
+        let e = err(&beta(1));
+        assert!(e.expected.contains("2 Beta orbitals") && e.found.contains("1,"), "{e}");
+        assert_eq!(e.line, beta(1).lines().count());
     }
 
     #[test]

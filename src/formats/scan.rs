@@ -28,7 +28,9 @@ use serde::Deserialize;
 
 use super::{LoadError, ParseError};
 pub use crate::model::scan::Follow;
-use crate::model::scan::{ANGLE_TOLERANCE, Coordinate, FrameContent, KeyFrame, Scan, best_coordinate};
+use crate::model::scan::{
+    ANGLE_TOLERANCE, Coordinate, FrameContent, KeyFrame, MAX_KEY_FRAMES, MAX_SCAN_ORBITALS, Scan, best_coordinate,
+};
 use crate::model::{Document, Molecule};
 
 #[derive(Debug, Deserialize)]
@@ -43,8 +45,8 @@ struct Manifest {
     align: Option<toml::Spanned<bool>>,
     /// The older way to name a dihedral scan.
     dihedral: Option<toml::Spanned<Vec<usize>>>,
-    #[serde(default = "default_orbitals")]
-    orbitals: Vec<String>,
+    /// The orbitals shown side by side (default: HOMO and LUMO).
+    orbitals: Option<toml::Spanned<Vec<String>>>,
     #[serde(default)]
     follow: Follow,
     /// A caption per view, e.g. ["RHF", "B3LYP"] when each view reads its own files.
@@ -173,25 +175,51 @@ pub fn parse_scan(
         )
         .into());
     }
+    if let Some(extra) = manifest.frames.get(MAX_KEY_FRAMES) {
+        let found = format!("{} frames", manifest.frames.len());
+        return Err(error(
+            &name,
+            line_of(text, extra.span().start),
+            format!("at most {MAX_KEY_FRAMES} [[frame]] entries"),
+            found,
+        )
+        .into());
+    }
+    let (orbitals, orbitals_line) = match &manifest.orbitals {
+        Some(o) => (o.get_ref().clone(), line_of(text, o.span().start)),
+        None => (default_orbitals(), 1),
+    };
+    if !(1..=MAX_SCAN_ORBITALS).contains(&orbitals.len()) {
+        let expected = format!("1 to {MAX_SCAN_ORBITALS} orbitals = [\"homo\", …]");
+        return Err(error(&name, orbitals_line, expected, format!("{} orbitals", orbitals.len())).into());
+    }
+    let range = coordinate.value_range();
     let mut frames: Vec<(usize, KeyFrame)> = Vec::with_capacity(manifest.frames.len());
     let mut first_kind: Option<bool> = None;
     for spanned in &manifest.frames {
         let line = line_of(text, spanned.span().start);
         let entry = spanned.get_ref();
         let named = |e| LoadError::Named { manifest: name.clone(), line, inner: Box::new(e) };
-        if !entry.at.is_finite() {
-            return Err(error(&name, line, "a finite value of the coordinate (at = …)", entry.at.to_string()).into());
+        if !range.contains(&entry.at) {
+            let expected = format!(
+                "a value of the {} in {}..={}{} (at = …)",
+                coordinate.kind(),
+                range.start(),
+                range.end(),
+                coordinate.unit()
+            );
+            return Err(error(&name, line, expected, format!("at = {:?}", entry.at)).into());
         }
         let single = entry.file.as_ref().map(std::slice::from_ref);
         let files =
             if entry.file.is_some() && entry.files.is_some() { None } else { single.or(entry.files.as_deref()) };
         let (molecule, content, source) = match (files, &entry.cubes) {
             (Some(files), None) if !files.is_empty() => {
-                if entry.file.is_none() && files.len() != manifest.orbitals.len() {
+                if entry.file.is_none() && files.len() != orbitals.len() {
                     return Err(error(
                         &name,
                         line,
-                        format!("one file per orbital ({})", manifest.orbitals.len()),
+                        format!("one file per orbital ({})", orbitals.len()),
                         format!("{} files", files.len()),
                     )
                     .into());
@@ -269,8 +297,8 @@ pub fn parse_scan(
     let title = manifest
         .title
         .unwrap_or_else(|| path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default());
-    let mut scan = Scan::new(title, coordinate, manifest.orbitals, frames.into_iter().map(|(_, f)| f).collect())
-        .map_err(|e| {
+    let mut scan =
+        Scan::new(title, coordinate, orbitals, frames.into_iter().map(|(_, f)| f).collect()).map_err(|e| {
             let expected = format!("a {} whose atoms can move on one side of a bond", coordinate.kind());
             error(&name, coordinate_line, expected, e.to_string())
         })?;
@@ -614,6 +642,67 @@ mod tests {
         assert_eq!(unwrap_angles(&[-60.0, 0.0, 60.0]), vec![-60.0, 0.0, 60.0]);
         let u = unwrap_angles(&[170.0, -170.0, 150.0]);
         assert_eq!(u, vec![170.0, 190.0, 150.0]);
+    }
+
+    /// The error `text` gives as a manifest whose files all load as H–O–O–H atoms, counting the
+    /// frames it loaded.
+    fn refused(text: &str) -> (ParseError, usize) {
+        let atom =
+            |z, x, y, w| crate::model::Atom { z, charge: z as f64, position: glam::DVec3::new(x, y, w), ghost: false };
+        let frame = Document {
+            molecule: Molecule::new(vec![
+                atom(1, -1.8, 1.5, 0.0),
+                atom(8, -1.4, 0.0, 0.0),
+                atom(8, 1.4, 0.0, 0.0),
+                atom(1, 1.8, 1.5, 0.5),
+            ]),
+            ..Document::default()
+        };
+        let mut loaded = 0;
+        let e = parse_scan(Path::new("m.scan.toml"), text, &mut |_| {
+            loaded += 1;
+            Ok(frame.clone())
+        });
+        match e {
+            Err(LoadError::Parse(e)) => (e, loaded),
+            Err(other) => panic!("{other}"),
+            Ok(_) => panic!("accepted:\n{text}"),
+        }
+    }
+
+    #[test]
+    fn values_and_counts_out_of_range_are_refused_at_their_line() {
+        let frames = |values: &[&str]| -> String {
+            values.iter().map(|v| format!("\n[[frame]]\nat = {v}\ncubes = [\"f.cube\"]\n")).collect()
+        };
+        let cases = [
+            ("coordinate = \"dihedral\"\natoms = [1, 2, 3, 4]\n", ["-90", "1e300"], "the dihedral in -720..=720°"),
+            ("coordinate = \"distance\"\natoms = [2, 3]\n", ["1.4", "-1.0"], "the distance in 0..=1000 Å"),
+            ("coordinate = \"angle\"\natoms = [1, 2, 3]\n", ["100", "200"], "the angle in 0..=180°"),
+            ("coordinate = \"path\"\n", ["0", "nan"], "the path in"),
+        ];
+        for (head, values, expected) in cases {
+            let text = format!("{head}{}", frames(&values));
+            let (e, _) = refused(&text);
+            let line = text.lines().position(|l| l == format!("at = {}", values[1])).unwrap();
+            assert_eq!((e.file.as_str(), e.line), ("m.scan.toml", line), "{e}");
+            let at: f64 = values[1].parse().unwrap();
+            assert!(e.expected.contains(expected) && e.found == format!("at = {at:?}"), "{e}");
+        }
+        let head = "coordinate = \"dihedral\"\natoms = [1, 2, 3, 4]\n";
+        let (e, _) = refused(&format!("{head}orbitals = []\n{}", frames(&["0", "90"])));
+        assert_eq!(e.line, 3, "{e}");
+        assert!(e.expected.contains("1 to 16 orbitals") && e.found == "0 orbitals", "{e}");
+        let many: Vec<String> = (0..17).map(|k| format!("\"homo-{k}\"")).collect();
+        let (e, _) = refused(&format!("{head}orbitals = [{}]\n{}", many.join(", "), frames(&["0", "90"])));
+        assert!(e.line == 3 && e.found == "17 orbitals", "{e}");
+        // Too many frames are refused before any file is loaded.
+        let values: Vec<String> = (0..=MAX_KEY_FRAMES).map(|k| format!("{}", k as f64 * 0.1)).collect();
+        let text = format!("{head}{}", frames(&values.iter().map(String::as_str).collect::<Vec<_>>()));
+        let (e, loaded) = refused(&text);
+        assert_eq!(loaded, 0);
+        assert_eq!(e.line, 3 + 4 * MAX_KEY_FRAMES + 1, "{e}");
+        assert!(e.expected.contains("at most 1000 [[frame]]"), "{e}");
     }
 
     #[test]

@@ -10,6 +10,26 @@ pub enum Spin {
     Beta,
 }
 
+/// What a natural-orbital file writes as its orbitals' energies.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EnergiesAsOccupations {
+    /// Each orbital's occupation, as written in `Occup=`.
+    Whole,
+    /// Each orbital's occupation per spin: half of `Occup=` (Psi4's natural orbitals).
+    PerSpin,
+}
+
+impl EnergiesAsOccupations {
+    /// What the energies are, in words.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Self::Whole => "the file's energies are its occupations",
+            Self::PerSpin => "the file's energies are its occupations per spin (half of Occup=)",
+        }
+    }
+}
+
 #[derive(Debug, Clone, PartialEq)]
 pub struct MolecularOrbital {
     /// Energy in hartree (NaN when the file gives none).
@@ -56,10 +76,27 @@ impl Wavefunction {
         self.of_spin(spin).any(|(_, o)| [0.0, 1.0, 2.0].iter().all(|&n| (o.occupation - n).abs() > 1e-3))
     }
 
-    /// Whether the file's "energies" are its occupations (natural-orbital files write them so):
-    /// then they are no energies to show.
+    /// How the file's "energies" hold its occupations, when they do (natural-orbital files write
+    /// them in place of energies): then they are no energies to show.
+    pub fn energies_as_occupations(&self) -> Option<EnergiesAsOccupations> {
+        if self.orbitals.is_empty() {
+            return None;
+        }
+        let all = |f: &dyn Fn(&MolecularOrbital) -> bool| self.orbitals.iter().all(f);
+        if all(&|o| (o.energy - o.occupation).abs() < 1e-9) {
+            return Some(EnergiesAsOccupations::Whole);
+        }
+        // Psi4 writes a restricted density's natural orbitals with `Ene=` the occupation of one
+        // spin, in [0, 1], and `Occup=` that of both.
+        let per_spin = |o: &MolecularOrbital| {
+            (-1e-9..=1.0 + 1e-9).contains(&o.energy) && (2.0 * o.energy - o.occupation).abs() < 1e-9
+        };
+        (self.restricted && all(&per_spin)).then_some(EnergiesAsOccupations::PerSpin)
+    }
+
+    /// Whether the file's "energies" are its occupations, whole or per spin.
     pub fn energies_are_occupations(&self) -> bool {
-        !self.orbitals.is_empty() && self.orbitals.iter().all(|o| (o.energy - o.occupation).abs() < 1e-9)
+        self.energies_as_occupations().is_some()
     }
 
     /// Orbital `i`'s energy (hartree), when the file gives one: not when its "energies" are
@@ -266,6 +303,17 @@ mod tests {
         assert_eq!(w.resolve(OrbitalSpec::Homo(1), Spin::Alpha), Some(4));
         assert_eq!(w.resolve(OrbitalSpec::Lumo(1), Spin::Alpha), Some(5));
         assert_eq!(w.frontier_label(4, 3).as_deref(), Some("HOMO-1"));
+        // Psi4's natural orbitals of a restricted density: Ene= is half of Occup=.
+        let halves: Vec<f64> = occ.iter().map(|o| o / 2.0).collect();
+        let psi4 = wf(&occ, &halves);
+        assert_eq!(psi4.energies_as_occupations(), Some(EnergiesAsOccupations::PerSpin));
+        assert_eq!((psi4.energy(0), psi4.homo(Spin::Alpha)), (None, Some(2)));
+        assert_eq!(w.energies_as_occupations(), Some(EnergiesAsOccupations::Whole));
+        let unrestricted = Wavefunction { restricted: false, ..psi4.clone() };
+        assert!(!unrestricted.energies_are_occupations(), "per spin only for a restricted set");
+        let mut one_off = psi4;
+        one_off.orbitals[3].energy += 1e-6;
+        assert!(!one_off.energies_are_occupations() && one_off.energy(3).is_some());
         // A Hartree–Fock set is not natural, its energies are energies.
         let hf = wf(&[2.0, 2.0, 0.0], &[-0.5, -0.3, 0.1]);
         assert!(!hf.natural(Spin::Alpha) && !hf.energies_are_occupations());

@@ -18,6 +18,12 @@ use super::overlap::cross_overlap;
 use super::superpose::superpose;
 use super::{Atom, VolumeGrid};
 
+/// The most key frames a scan holds: each is a file loaded and kept, and a volume per orbital
+/// made from it.
+pub const MAX_KEY_FRAMES: usize = 1000;
+/// The most orbitals a scan shows side by side.
+pub const MAX_SCAN_ORBITALS: usize = 16;
+
 /// Two key frames whose coordinates are closer than this (degrees, Å, path units) are at the
 /// same place.
 pub const ANGLE_TOLERANCE: f64 = 1e-3;
@@ -54,6 +60,18 @@ impl Coordinate {
             Coordinate::Angle(_) => "angle",
             Coordinate::Dihedral(_) => "dihedral",
             Coordinate::Path => "path",
+        }
+    }
+
+    /// The values a key frame may take: a distance up to 1000 Å, an angle of 0° to 180°, a
+    /// dihedral of one turn either way of ±360° (scans unwrapped past ±180° run on), any path
+    /// parameter of at most 10⁹. Beyond them a manifest is mistyped, not a scan.
+    pub fn value_range(&self) -> std::ops::RangeInclusive<f64> {
+        match self {
+            Coordinate::Distance(_) => 0.0..=1000.0,
+            Coordinate::Angle(_) => 0.0..=180.0,
+            Coordinate::Dihedral(_) => -720.0..=720.0,
+            Coordinate::Path => -1e9..=1e9,
         }
     }
 

@@ -34,7 +34,8 @@ impl Default for Camera {
     }
 }
 
-const PITCH_LIMIT: f32 = std::f32::consts::FRAC_PI_2 - 1e-3;
+/// How close to straight up or down the camera may look (radians from the horizon).
+pub const PITCH_LIMIT: f32 = std::f32::consts::FRAC_PI_2 - 1e-3;
 
 impl Camera {
     /// A camera looking at the centre of the box `lo..hi` from far enough to see all of it.

@@ -4,6 +4,7 @@ pub mod camera;
 pub mod coloring;
 pub mod detail;
 pub mod framing;
+pub mod limits;
 pub mod molsurface;
 pub mod objects;
 pub mod occupancy;

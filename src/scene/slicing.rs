@@ -75,7 +75,8 @@ impl GridBox {
         let corners = self.corners();
         let depths = corners.map(|c| c.dot(n));
         let (lo, hi) = depths.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(l, h), &d| (l.min(d), h.max(d)));
-        let count = count.max(1);
+        // Whatever asks (a session, a caller's arithmetic), the slices stay a bounded allocation.
+        let count = count.clamp(*super::limits::SLICES.start(), *super::limits::SLICES.end());
         let spacing = (hi - lo) / count as f32;
         let mut vertices = Vec::with_capacity(count as usize * 12);
         let mut starts = Vec::with_capacity(count as usize);
@@ -109,7 +110,7 @@ impl GridBox {
         let normals = [e[1].cross(e[2]), e[2].cross(e[0]), e[0].cross(e[1])].map(|c| c.normalize_or(Vec3::Z));
         let axis = (0..3).max_by(|&a, &b| normals[a].dot(v).abs().total_cmp(&normals[b].dot(v).abs())).unwrap_or(0);
         let (u, w) = ((axis + 1) % 3, (axis + 2) % 3);
-        let count = count.max(1);
+        let count = count.clamp(*super::limits::SLICES.start(), *super::limits::SLICES.end());
         let mut normal = normals[axis];
         // Orient the normal away from the eye, so "back" is the larger signed distance.
         let centre = self.origin + 0.5 * (e[0] + e[1] + e[2]);
@@ -255,6 +256,15 @@ mod tests {
         assert!((area(&s.vertices) - 10.0 * 4.0).abs() < 1e-3);
         // Back to front: looking down −z, the first slice has the smallest z.
         assert!(s.vertices[0].z < s.vertices.last().unwrap().z);
+    }
+
+    #[test]
+    fn absurd_slice_counts_stay_a_bounded_allocation() {
+        let most = *crate::scene::limits::SLICES.end() as usize;
+        let view = unit_cube().view_aligned(4_000_000_000, Vec3::NEG_Z);
+        let axis = unit_cube().axis_aligned(u32::MAX, Vec3::new(0.0, 0.0, 5.0), Vec3::NEG_Z);
+        assert_eq!((view.starts.len(), axis.starts.len()), (most, most));
+        assert_eq!(unit_cube().view_aligned(0, Vec3::NEG_Z).starts.len(), 1);
     }
 
     #[test]
