@@ -438,6 +438,46 @@ fn a_scan_shows_isosurfaces_at_theta_and_its_measured_dihedral_follows_theta() {
 }
 
 #[test]
+fn a_session_keeps_the_scan_where_it_stood_with_its_measurements() {
+    use orbcloud::scene::Interpolation;
+    let mut h = scan_demo();
+    let (lo, hi) = h.state().scan.as_ref().unwrap().scene.scan.range();
+    let atoms = h.state().scan.as_ref().unwrap().scene.scan.coordinate.atoms().to_vec();
+    let value = lo + 0.3 * (hi - lo);
+    {
+        let app = h.state_mut();
+        let scan = app.scan.as_mut().unwrap();
+        scan.set_value(value);
+        scan.mode = Interpolation::ThreePass;
+        scan.looping = false;
+        scan.settings.iso.visible = true;
+        app.measurements.list = vec![orbcloud::model::measure::Measurement::new(&atoms).unwrap()];
+    }
+    h.run_steps(2);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("scan.orbcloud.toml");
+    h.state_mut().save_session(&path);
+    let saved = orbcloud::sources::session::read(&path).unwrap().session;
+    let kept = saved.scan.as_ref().expect("the session keeps the scan");
+    assert!(kept.manifest.is_none() && (kept.value - value).abs() < 1e-9, "{kept:?}");
+
+    // Somewhere else, then the session again: the scan comes back as it stood.
+    h.state_mut().scan.as_mut().unwrap().set_value(hi);
+    h.state_mut().clear_scene();
+    h.run_steps(2);
+    assert!(h.state().scan.is_none() && h.state().measurements.list.is_empty());
+    let ctx = h.ctx.clone();
+    h.state_mut().open_session(&path, &ctx);
+    wait_for_scan(&mut h, |s| (s.value - value).abs() < 1e-9);
+    let app = h.state();
+    let scan = app.scan.as_ref().unwrap();
+    assert_eq!((scan.mode, scan.looping, scan.settings.iso.visible), (Interpolation::ThreePass, false, true));
+    assert_eq!(app.measurements.list.len(), 1, "the measurement on the scan's atoms comes back");
+    assert_eq!(app.measurements.list[0].atoms, atoms);
+    assert_eq!(app.view.camera, saved.camera, "the session's camera, not a fresh framing");
+}
+
+#[test]
 fn files_open_without_a_system_dialog_and_a_failed_file_leaves_the_demo() {
     let demo = orbcloud::sources::demo::document().unwrap();
     let dir = tempfile::tempdir().unwrap();

@@ -211,6 +211,8 @@ pub struct OrbApp {
     pub spectrum: Option<egui_plot::PlotTransform>,
     /// A session's measurements, kept until its files have loaded.
     restoring_measurements: Option<Vec<crate::model::measure::Measurement>>,
+    /// A session's scan being opened: where it stood, and its measurements.
+    restoring_scan: Option<(crate::scene::ScanState, Vec<crate::model::measure::Measurement>)>,
     /// Whether *Open…* and dropped files replace the scene instead of adding to it.
     pub open_replaces: bool,
     scroll_to_frontier: bool,
@@ -399,6 +401,7 @@ impl OrbApp {
             pending: Vec::new(),
             applied: Vec::new(),
             restoring_measurements: None,
+            restoring_scan: None,
             spectrum: None,
             open_replaces: false,
             scroll_to_frontier: false,
@@ -1106,13 +1109,15 @@ impl OrbApp {
         {
             let (name, source) = (job.name.clone(), job.source.clone());
             self.scan_job = None;
+            // A session's scan that does not open leaves nothing to restore into a later one.
+            let restoring = self.restoring_scan.take();
             match result {
                 Ok(scene) => {
                     // One device handle per view.
                     let contexts: Option<Vec<GpuContext>> = (0..scene.slots()).map(|_| self.gpu_context()).collect();
                     if let Some(contexts) = contexts {
                         let reopened = self.scan.take().filter(|old| old.source == source);
-                        if reopened.is_none() {
+                        if reopened.is_none() && restoring.is_none() {
                             self.view.camera = scene.camera();
                             // Picks number the scan's atoms now.
                             self.measurements = measure::Measurements::default();
@@ -1129,9 +1134,15 @@ impl OrbApp {
                                 scene.tracks.swaps.len()
                             );
                         }
+                        if let Some((_, measurements)) = &restoring {
+                            let atoms = scene.scan.frames.first().map_or(0, |f| f.molecule.atoms.len());
+                            self.measurements = measure::Measurements::default();
+                            self.measurements.list =
+                                measurements.iter().filter(|m| m.atoms.iter().all(|&a| a < atoms)).cloned().collect();
+                        }
                         let mut view = ScanView::new(scene, source, contexts);
-                        if let Some(old) = &reopened {
-                            view.keep_interaction_of(old);
+                        if let Some(state) = reopened.map(|old| old.state()).or(restoring.map(|(state, _)| state)) {
+                            view.restore(&state);
                         }
                         self.scan = Some(view);
                     }

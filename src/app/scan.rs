@@ -18,7 +18,7 @@ use crate::formats::scan::{ScanFile, load_scan};
 use crate::gpu::GpuContext;
 use crate::layers::key_volumes::{KeyOptions, ScanScene, ScanSceneError, mix};
 use crate::model::scan::{Coordinate, Follow};
-use crate::scene::{AtomStyle, Interpolation, RenderSettings};
+use crate::scene::{AtomStyle, Interpolation, RenderSettings, ScanState};
 
 /// Where a scan comes from.
 #[derive(Debug, Clone, PartialEq)]
@@ -174,16 +174,37 @@ impl ScanView {
         }
     }
 
-    /// Takes the value and the interaction settings of the same scan opened before (reopened to follow
-    /// its orbitals another way).
-    pub fn keep_interaction_of(&mut self, old: &ScanView) {
-        self.set_value(old.value);
-        self.mode = old.mode;
-        self.looping = old.looping;
-        self.speed = old.speed;
-        self.drag_twists = old.drag_twists;
-        self.settings = old.settings;
-        self.diagram.window = old.diagram.window;
+    /// What a session keeps of the scan: its source, the value, how it is mixed, drawn and
+    /// played, and the orbitals its views follow.
+    pub fn state(&self) -> ScanState {
+        ScanState {
+            manifest: match &self.source {
+                ScanSource::File(path) => Some(path.clone()),
+                ScanSource::Demo => None,
+            },
+            value: self.value,
+            mode: self.mode,
+            looping: self.looping,
+            speed: self.speed,
+            drag_scans: self.drag_twists,
+            settings: self.settings,
+            orbitals: self.scene.scan.orbitals.clone(),
+            follow: self.scene.tracks.follow,
+            diagram: self.diagram.window,
+        }
+    }
+
+    /// Takes the value and the interaction settings `state` holds (a session's, or the same
+    /// scan's opened before to follow its orbitals another way); the value is clamped into this
+    /// scan's range.
+    pub fn restore(&mut self, state: &ScanState) {
+        self.set_value(state.value);
+        self.mode = state.mode;
+        self.looping = state.looping;
+        self.speed = state.speed;
+        self.drag_twists = state.drag_scans;
+        self.settings = state.settings;
+        self.diagram.window = state.diagram;
     }
 
     /// Where atom `atom` of the skeleton at the value is drawn in view `view` (for tests and overlays).

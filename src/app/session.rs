@@ -9,7 +9,7 @@ pub use crate::sources::session::{Read, add_volume, last_session_path, parse, re
 
 impl OrbApp {
     /// The scene as a session: every object read from a file (the bundled demo is left out),
-    /// the camera and the background.
+    /// the open scan, the camera and the background.
     pub fn session(&mut self) -> Session {
         Session {
             camera: self.view.camera,
@@ -18,6 +18,7 @@ impl OrbApp {
             background: Some(self.view.background),
             objects: self.objects.iter().filter(|o| o.state.path.is_some()).map(|o| o.state.clone()).collect(),
             recent: self.recent.clone(),
+            scan: self.scan.as_ref().map(super::scan::ScanView::state),
         }
     }
 
@@ -50,15 +51,25 @@ impl OrbApp {
             .into_iter()
             .filter_map(|state| Some((state.path.clone()?, Opening::Restore(Box::new(state)))))
             .collect();
-        if files.is_empty() {
+        if files.is_empty() && session.scan.is_none() {
             self.error = Some(format!("{}: the session names no file", path.display()));
             return;
         }
         self.clear_scene();
         self.view.camera = session.camera;
         self.view.panes = session.panes;
-        // Measurements number the scene's atoms: they come back once every file has loaded.
-        self.restoring_measurements = Some(session.measurements);
+        match session.scan {
+            // A scan is shown instead of the objects, and its measurements number its atoms:
+            // they come back with it once its key volumes are made.
+            Some(scan) => {
+                let source = scan.manifest.clone().map_or(super::scan::ScanSource::Demo, super::scan::ScanSource::File);
+                let orbitals = (!scan.orbitals.is_empty()).then(|| scan.orbitals.clone());
+                self.open_scan_with(source, Some(scan.follow), orbitals, ctx);
+                self.restoring_scan = Some((scan, session.measurements));
+            }
+            // Measurements number the scene's atoms: they come back once every file has loaded.
+            None => self.restoring_measurements = Some(session.measurements),
+        }
         if let Some(bg) = session.background {
             self.view.background = bg;
         }

@@ -11,12 +11,14 @@ use std::ops::RangeInclusive;
 
 use super::camera::PITCH_LIMIT;
 use super::objects::MAX_PANES;
+use super::objects::ScanState;
 use super::translucency::OpticsTuning;
 use super::vibration::VibrationState;
 use super::{
     AtomLook, Camera, ClipPlane, DensityScale, Evaluation, IsoLevel, IsosurfaceSettings, ObjectState, Placement,
     QuantityState, Session, SurfaceSettings, Transfer, VolumeSettings,
 };
+use crate::model::scan::MAX_SCAN_ORBITALS;
 
 /// Slices through a cloud: beyond a few thousand they add nothing a pixel shows.
 pub const SLICES: RangeInclusive<u32> = 1..=4096;
@@ -66,6 +68,8 @@ pub const MARGIN: RangeInclusive<f64> = 0.0..=100.0;
 /// Frames of a movie, a mode's period or a benchmark, and a movie's frames per second.
 pub const FRAMES: RangeInclusive<usize> = 1..=100_000;
 pub const FPS: RangeInclusive<f64> = 0.1..=240.0;
+/// A scan's animation speed: its coordinate's units per second.
+pub const SCAN_SPEED: RangeInclusive<f32> = 1e-6..=1e6;
 /// Quantities per object and isosurfaces per quantity: each is a layer of GPU work.
 pub const MAX_QUANTITIES: usize = 64;
 pub const MAX_ISOSURFACES: usize = 64;
@@ -150,7 +154,37 @@ impl Session {
         for (k, object) in self.objects.iter_mut().enumerate() {
             object.sanitize(&format!("objects[{k}]"), &mut n);
         }
+        if let Some(scan) = &mut self.scan {
+            scan.sanitize("scan", &mut n);
+        }
         list
+    }
+}
+
+impl ScanState {
+    /// The value itself is clamped into the scan's range when the scan has opened.
+    fn sanitize(&mut self, key: &str, n: &mut Notes) {
+        if !self.value.is_finite() {
+            n.note(&format!("{key}.value"), format!("{} is not a finite number; 0 used", self.value));
+            self.value = 0.0;
+        }
+        let mut speed = self.speed as f32;
+        n.real(&format!("{key}.speed"), &mut speed, SCAN_SPEED, 30.0);
+        self.speed = f64::from(speed);
+        n.count(&format!("{key}.diagram"), &mut self.diagram, 0..=8);
+        let orbitals = self.orbitals.len();
+        if orbitals > MAX_SCAN_ORBITALS {
+            n.note(&format!("{key}.orbitals"), format!("{orbitals} orbitals; the first {MAX_SCAN_ORBITALS} kept"));
+            self.orbitals.truncate(MAX_SCAN_ORBITALS);
+        }
+        let s = &mut self.settings;
+        s.volume.sanitize(&format!("{key}.settings.volume"), n);
+        s.iso.sanitize(&format!("{key}.settings.iso"), n);
+        s.clip.sanitize(&format!("{key}.settings.clip"), n);
+        n.color(&format!("{key}.settings.background"), &mut s.background);
+        n.real(&format!("{key}.settings.depth_cue"), &mut s.depth_cue, FRACTION, 0.0);
+        n.real(&format!("{key}.settings.ball_scale"), &mut s.ball_scale, ATOM_SCALE, 1.0);
+        n.real(&format!("{key}.settings.stick_scale"), &mut s.stick_scale, ATOM_SCALE, 1.0);
     }
 }
 
@@ -422,6 +456,10 @@ mod tests {
         object.evaluation.grid_points = usize::MAX;
         object.clip.normal = [0.0; 3];
         s.objects.push(object);
+        let mut scan = ScanState { value: f64::NAN, speed: f64::INFINITY, diagram: 100, ..Default::default() };
+        scan.orbitals = vec!["homo".into(); 40];
+        scan.settings.volume.slices = 4_000_000_000;
+        s.scan = Some(scan);
         let notes = s.sanitize();
         let has = |key: &str| notes.iter().any(|n| n.starts_with(&format!("{key}: ")));
         for key in [
@@ -435,11 +473,19 @@ mod tests {
             "objects[0].selected",
             "objects[0].evaluation.grid_points",
             "objects[0].clip.normal",
+            "scan.value",
+            "scan.speed",
+            "scan.diagram",
+            "scan.orbitals",
+            "scan.settings.volume.slices",
         ] {
             assert!(has(key), "no note for {key}: {notes:#?}");
         }
-        assert_eq!(notes.len(), 10, "{notes:#?}");
+        assert_eq!(notes.len(), 15, "{notes:#?}");
         let q = &s.objects[0].quantities[0];
+        let scan = s.scan.as_ref().unwrap();
+        assert!(scan.value.is_finite() && scan.speed.is_finite() && scan.orbitals.len() == MAX_SCAN_ORBITALS);
+        assert_eq!((scan.diagram, scan.settings.volume.slices), (8, *SLICES.end()));
         assert_eq!((q.cloud.slices, s.panes.count, s.objects[0].selected), (*SLICES.end(), MAX_PANES, 0));
         assert_eq!(q.isosurfaces[0].level, IsosurfaceSettings::default().level);
         assert_eq!(s.camera.distance, Camera::default().distance);

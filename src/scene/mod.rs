@@ -21,7 +21,7 @@ pub mod view;
 pub use camera::Camera;
 pub use coloring::AtomColors;
 pub use molsurface::{SurfaceChoice, SurfaceSettings};
-pub use objects::{Changes, ObjectState, Panes, Placement, QuantityChanges, Session, changes};
+pub use objects::{Changes, ObjectState, Panes, Placement, QuantityChanges, ScanState, Session, changes};
 pub use opacity::DensityScale;
 pub use quantity::{AtomLook, ESP_MAP_DENSITY, Evaluation, QuantityState, Source};
 pub use settings::{

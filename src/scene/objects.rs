@@ -423,6 +423,51 @@ pub struct Session {
     pub objects: Vec<ObjectState>,
     /// Files opened recently, newest first (the session kept between runs).
     pub recent: Vec<std::path::PathBuf>,
+    /// The scan open in the window, shown instead of the objects.
+    pub scan: Option<ScanState>,
+}
+
+/// A scan as a session keeps it: where it comes from, where its coordinate stood, how frames
+/// between its key volumes are mixed and drawn, and which orbitals its views follow.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct ScanState {
+    /// Its manifest (`*.scan.toml`); `None`: the bundled PSB3 scan.
+    pub manifest: Option<std::path::PathBuf>,
+    /// The coordinate's value in its unit (degrees, Å, or a path's position).
+    pub value: f64,
+    pub mode: super::Interpolation,
+    /// Bounce between the ends when playing.
+    pub looping: bool,
+    /// Animation speed, the coordinate's units per second.
+    pub speed: f64,
+    /// A horizontal drag changes the value (else it orbits and only a drag on the bond does).
+    pub drag_scans: bool,
+    /// How its views draw the orbitals at the value: cloud, isosurfaces, atoms.
+    pub settings: RenderSettings,
+    /// The orbitals its views show, as manifests name them (empty: the manifest's own).
+    pub orbitals: Vec<String>,
+    /// How orbitals are followed across frames.
+    pub follow: crate::model::scan::Follow,
+    /// How many orbitals below the HOMO and above the LUMO the correlation diagram shows.
+    pub diagram: usize,
+}
+
+impl Default for ScanState {
+    fn default() -> Self {
+        Self {
+            manifest: None,
+            value: 0.0,
+            mode: super::Interpolation::default(),
+            looping: true,
+            speed: 30.0,
+            drag_scans: true,
+            settings: RenderSettings::default(),
+            orbitals: Vec::new(),
+            follow: crate::model::scan::Follow::default(),
+            diagram: 2,
+        }
+    }
 }
 
 /// What a session file is called.
