@@ -836,3 +836,33 @@ fn files_opened_together_stand_side_by_side_across_the_view() {
     h.run_steps(2);
     check(h.state());
 }
+
+#[test]
+fn the_view_gets_most_of_the_window_and_the_panels_fit_beside_it_or_close() {
+    let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fixtures/wavefunctions/h2o_cation_uhf_631gs.molden");
+    let mut h = Harness::builder()
+        .with_size([1280.0, 800.0])
+        .wgpu_setup(wgpu_setup(true))
+        .build_eframe(move |cc| OrbApp::new(cc, vec![file]));
+    wait_loaded(&mut h);
+    let view = h.state().view_rect().expect("a view");
+    assert!(view.width() > 0.5 * 1280.0, "the view is {} of 1280 px", view.width());
+    // An unrestricted file's browser holds the most: each of its controls lies whole between the
+    // view and the window's edge.
+    for label in ["ESP map", "+ electrostatic potential", "per sample (direct)", "β"] {
+        let r = h.get_by_label(label).rect();
+        assert!(r.min.x >= view.max.x - 0.5 && r.max.x <= 1280.5, "{label} at {r:?}, the view {view:?}");
+    }
+    let heading = h.get_all_by_label("Orbitals").map(|n| n.rect()).max_by(|a, b| a.min.y.total_cmp(&b.min.y)).unwrap();
+    assert!(heading.min.x >= view.max.x - 0.5, "the heading {heading:?} is cut");
+    // The top bar's toggles close both panels: the view takes the window's width.
+    for toggle in ["Scene", "Orbitals"] {
+        let top = h.get_all_by_label(toggle).min_by(|a, b| a.rect().min.y.total_cmp(&b.rect().min.y)).unwrap();
+        top.click();
+        h.run_steps(1);
+    }
+    h.run_steps(20);
+    let wide = h.state().view_rect().expect("a view");
+    assert!(wide.width() > 1200.0, "with the panels closed the view is {} px", wide.width());
+}

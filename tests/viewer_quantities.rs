@@ -96,9 +96,8 @@ fn homo_and_lumo_of_one_file_side_by_side_in_linked_panes_and_a_session_keeps_th
     let dir = tempfile::tempdir().unwrap();
     let wf = h.state().doc().wavefunction.clone().unwrap();
     let (homo, lumo) = (wf.homo(Spin::Alpha).unwrap(), wf.lumo(Spin::Alpha).unwrap());
-    // The HOMO shown with its ±ψ surfaces: the LUMO beside it is drawn the same way.
-    h.get_by_label("show ψ = ±value").click();
-    wait_loaded(&mut h);
+    // The HOMO opens with its ±ψ surfaces: the LUMO beside it is drawn the same way.
+    assert!(h.state().objects[0].state.quantities[0].isosurfaces[0].visible, "an orbital opens with its surfaces");
     h.get_by_label_contains(&format!("MO {} ", lumo + 1)).click_secondary();
     h.run_steps(2);
     h.get_by_label("show beside (a pane of its own)").click();

@@ -1205,6 +1205,7 @@ impl eframe::App for OrbApp {
                 &defaults,
                 (&mut view.panes, &view.camera),
                 &mut self.scroll_to_frontier,
+                &mut view.panels.orbitals,
             );
         }
         if let Some(o) = self.objects.get_mut(self.active).filter(|_| self.scan.is_none()) {

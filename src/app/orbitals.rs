@@ -15,7 +15,9 @@ use crate::scene::{Camera, ObjectState, Panes, QuantityState, RenderSettings, So
 pub const ORTHONORMAL_TOLERANCE: f64 = 1e-5;
 
 /// The orbital browser's width, points: a row (its + and the 41 monospace columns) fits.
-const ORBITALS_PANEL_WIDTH: f32 = 400.0;
+/// The orbital browser's width as it opens, and the widths a drag of its edge may give it.
+const ORBITALS_PANEL_WIDTH: f32 = 350.0;
+const ORBITALS_PANEL_WIDTHS: std::ops::RangeInclusive<f32> = 260.0..=640.0;
 
 /// What a click in the browser does with a wavefunction quantity.
 enum Pick {
@@ -40,104 +42,109 @@ pub fn panel(
     defaults: &RenderSettings,
     (panes, camera): (&mut Panes, &Camera),
     scroll_to_frontier: &mut bool,
+    open: &mut bool,
 ) {
     let Some(wf) = &doc.wavefunction else { return };
     let mut pick = None;
-    egui::Panel::right("orbitals").exact_size(ORBITALS_PANEL_WIDTH).show(ui, |ui| {
-        ui.heading("Orbitals");
-        let n = &wf.normalization;
-        ui.label(
-            RichText::new(format!(
-                "{} basis functions, {} orbitals · written by {} · repair: {} · |C^T S C - I| {:.1e}",
-                wf.basis.n_functions(),
-                wf.orbitals.len(),
-                n.program,
-                n.repair,
-                n.residual
-            ))
-            .small()
-            .weak(),
-        );
-        if n.residual > ORTHONORMAL_TOLERANCE {
+    egui::Panel::right("orbitals")
+        .resizable(true)
+        .default_size(ORBITALS_PANEL_WIDTH)
+        .size_range(ORBITALS_PANEL_WIDTHS)
+        .show_collapsible(ui, open, |ui| {
+            ui.heading("Orbitals");
+            let n = &wf.normalization;
             ui.label(
-                RichText::new("Warning: these orbitals are not orthonormal in this basis: the file may be wrong")
-                    .color(ui.visuals().warn_fg_color),
+                RichText::new(format!(
+                    "{} basis functions, {} orbitals · written by {} · repair: {} · |C^T S C - I| {:.1e}",
+                    wf.basis.n_functions(),
+                    wf.orbitals.len(),
+                    n.program,
+                    n.repair,
+                    n.residual
+                ))
+                .small()
+                .weak(),
             );
-        }
-        let shown = shown_quantity(state);
-        // The list is of the shown orbital's spin (a session reopened on a β orbital lists β).
-        if let Some(o) = shown.and_then(|q| match q {
-            Quantity::Orbital(i) => wf.orbitals.get(i),
-            _ => None,
-        }) {
-            state.evaluation.spin = o.spin;
-        }
-        if !wf.restricted {
-            ui.horizontal(|ui| {
-                ui.label("orbitals of spin");
-                for (spin, name) in [(Spin::Alpha, "α"), (Spin::Beta, "β")] {
-                    if ui.selectable_label(state.evaluation.spin == spin, name).clicked()
-                        && state.evaluation.spin != spin
-                    {
-                        state.evaluation.spin = spin;
-                        // The orbital shown follows: the same place relative to the frontier.
-                        if let Some(Quantity::Orbital(i)) = shown
-                            && let Some(j) = same_role(wf, i, spin)
+            if n.residual > ORTHONORMAL_TOLERANCE {
+                ui.label(
+                    RichText::new("Warning: these orbitals are not orthonormal in this basis: the file may be wrong")
+                        .color(ui.visuals().warn_fg_color),
+                );
+            }
+            let shown = shown_quantity(state);
+            // The list is of the shown orbital's spin (a session reopened on a β orbital lists β).
+            if let Some(o) = shown.and_then(|q| match q {
+                Quantity::Orbital(i) => wf.orbitals.get(i),
+                _ => None,
+            }) {
+                state.evaluation.spin = o.spin;
+            }
+            if !wf.restricted {
+                ui.horizontal(|ui| {
+                    ui.label("orbitals of spin");
+                    for (spin, name) in [(Spin::Alpha, "α"), (Spin::Beta, "β")] {
+                        if ui.selectable_label(state.evaluation.spin == spin, name).clicked()
+                            && state.evaluation.spin != spin
                         {
-                            pick = Some(Pick::Switch(Quantity::Orbital(j)));
+                            state.evaluation.spin = spin;
+                            // The orbital shown follows: the same place relative to the frontier.
+                            if let Some(Quantity::Orbital(i)) = shown
+                                && let Some(j) = same_role(wf, i, spin)
+                            {
+                                pick = Some(Pick::Switch(Quantity::Orbital(j)));
+                            }
                         }
+                    }
+                });
+            }
+            let mut densities = vec![(Quantity::Density, "total density")];
+            if !wf.restricted {
+                densities.push((Quantity::SpinDensity, "spin density"));
+            }
+            densities.push((Quantity::Potential, "electrostatic potential"));
+            ui.horizontal_wrapped(|ui| {
+                ui.label("show");
+                for &(q, name) in &densities {
+                    if ui.selectable_label(shown == Some(q), name).clicked() {
+                        pick = Some(Pick::Switch(q));
                     }
                 }
             });
-        }
-        let mut densities = vec![(Quantity::Density, "total density")];
-        if !wf.restricted {
-            densities.push((Quantity::SpinDensity, "spin density"));
-        }
-        densities.push((Quantity::Potential, "electrostatic potential"));
-        ui.horizontal(|ui| {
-            ui.label("show");
-            for &(q, name) in &densities {
-                if ui.selectable_label(shown == Some(q), name).clicked() {
-                    pick = Some(Pick::Switch(q));
-                }
-            }
-        });
-        ui.horizontal(|ui| {
+            ui.horizontal(|ui| {
             let hint = "the density surface ρ = 0.002 coloured by the electrostatic potential: red where the molecule \
                         attracts a positive charge, blue where it repels one";
             if ui.button("ESP map").on_hover_text(hint).clicked() {
                 pick = Some(Pick::EspMap);
             }
         });
-        ui.horizontal(|ui| {
-            ui.label("add");
-            for &(q, name) in &densities {
-                let hint = format!("the {name} joins what is shown (an orbital inside its density)");
-                if ui.button(format!("+ {name}")).on_hover_text(hint).clicked() {
-                    pick = Some(Pick::Add(q));
+            ui.horizontal_wrapped(|ui| {
+                ui.label("add");
+                for &(q, name) in &densities {
+                    let hint = format!("the {name} joins what is shown (an orbital inside its density)");
+                    if ui.button(format!("+ {name}")).on_hover_text(hint).clicked() {
+                        pick = Some(Pick::Add(q));
+                    }
                 }
+            });
+            ui.horizontal_wrapped(|ui| {
+                let e = &mut state.evaluation;
+                ui.label("evaluate");
+                ui.selectable_value(&mut e.direct, false, "on a GPU grid").on_hover_text(
+                    "a compute pass fills a 3D texture; the slices sample it (fast to view, switch in one pass)",
+                );
+                ui.selectable_value(&mut e.direct, true, "per sample (direct)")
+                    .on_hover_text("every slice fragment evaluates the orbital from the basis functions, no grid");
+            });
+            if let Some(p) = keyboard(ui, wf, state.evaluation.spin, shown) {
+                pick = Some(p);
+            }
+            if let Some(p) = orbital_table(ui, wf, state.evaluation.spin, shown, scroll_to_frontier) {
+                pick = Some(p);
+            }
+            if let Some(p) = ao_selector(ui, doc, wf, state) {
+                pick = Some(p);
             }
         });
-        ui.horizontal(|ui| {
-            let e = &mut state.evaluation;
-            ui.label("evaluate");
-            ui.selectable_value(&mut e.direct, false, "on a GPU grid").on_hover_text(
-                "a compute pass fills a 3D texture; the slices sample it (fast to view, switch in one pass)",
-            );
-            ui.selectable_value(&mut e.direct, true, "per sample (direct)")
-                .on_hover_text("every slice fragment evaluates the orbital from the basis functions, no grid");
-        });
-        if let Some(p) = keyboard(ui, wf, state.evaluation.spin, shown) {
-            pick = Some(p);
-        }
-        if let Some(p) = orbital_table(ui, wf, state.evaluation.spin, shown, scroll_to_frontier) {
-            pick = Some(p);
-        }
-        if let Some(p) = ao_selector(ui, doc, wf, state) {
-            pick = Some(p);
-        }
-    });
     match pick {
         Some(Pick::Switch(q)) => {
             match state.selected_quantity_mut().filter(|s| matches!(s.source, Source::Wavefunction(_))) {
@@ -250,49 +257,58 @@ fn orbital_table(
         ui.label(RichText::new(format!("natural orbitals, by occupation{energies}")).strong());
     }
     let [eh_header, ev_header] = energy_headers(as_occupations);
-    ui.label(RichText::new(row_text("", "", "sym", eh_header, ev_header, "occ")).monospace().strong());
-    ScrollArea::vertical().max_height(ui.available_height() * 0.6).show(ui, |ui| {
-        for i in order {
-            let o = &wf.orbitals[i];
-            let number = wf.of_spin(o.spin).position(|(j, _)| j == i).map_or(0, |p| p + 1);
-            let selected = shown == Some(Quantity::Orbital(i));
-            let [eh, ev] = energy_cells(o.energy, as_occupations);
-            let text = row_text(
-                &format!("MO {number}"),
-                &wf.frontier_label(i, 5).unwrap_or_default(),
-                &o.symmetry,
-                &eh,
-                &ev,
-                &format!("{:.2}", o.occupation),
-            );
-            ui.horizontal(|ui| {
-                let add = ui.small_button("+").on_hover_text("add this orbital to the object beside what it shows");
-                let row = ui.add(
-                    egui::Button::selectable(selected, RichText::new(text).monospace())
-                        .min_size(egui::vec2(ui.available_width(), 0.0)),
+    // One label on every orbital (a file without symmetry: "A" throughout) says nothing: the
+    // column is left out and the rows fit a narrower panel.
+    let symmetries = order.first().map(|&i| &wf.orbitals[i].symmetry);
+    let sym_column = order.iter().any(|&i| Some(&wf.orbitals[i].symmetry) != symmetries);
+    let sym = |s: &str| if sym_column { format!("{s:<4}") } else { String::new() };
+    // A panel narrower than the rows scrolls them sideways rather than growing past the window.
+    let height = ui.available_height() * 0.6;
+    ScrollArea::horizontal().id_salt("orbital rows").show(ui, |ui| {
+        ui.label(RichText::new(row_text("", "", &sym("sym"), eh_header, ev_header, "occ")).monospace().strong());
+        ScrollArea::vertical().max_height(height).show(ui, |ui| {
+            for i in order {
+                let o = &wf.orbitals[i];
+                let number = wf.of_spin(o.spin).position(|(j, _)| j == i).map_or(0, |p| p + 1);
+                let selected = shown == Some(Quantity::Orbital(i));
+                let [eh, ev] = energy_cells(o.energy, as_occupations);
+                let text = row_text(
+                    &format!("MO {number}"),
+                    &wf.frontier_label(i, 5).unwrap_or_default(),
+                    &sym(&o.symmetry),
+                    &eh,
+                    &ev,
+                    &format!("{:.2}", o.occupation),
                 );
-                if row.clicked() {
-                    pick = Some(Pick::Switch(Quantity::Orbital(i)));
-                }
-                row.context_menu(|ui| {
-                    if ui.button("show beside (a pane of its own)").clicked() {
-                        pick = Some(Pick::Beside(Quantity::Orbital(i)));
-                        ui.close();
+                ui.horizontal(|ui| {
+                    let add = ui.small_button("+").on_hover_text("add this orbital to the object beside what it shows");
+                    let row = ui.add(
+                        egui::Button::selectable(selected, RichText::new(text).monospace())
+                            .min_size(egui::vec2(ui.available_width(), 0.0)),
+                    );
+                    if row.clicked() {
+                        pick = Some(Pick::Switch(Quantity::Orbital(i)));
                     }
-                    if ui.button("add to this view").clicked() {
+                    row.context_menu(|ui| {
+                        if ui.button("show beside (a pane of its own)").clicked() {
+                            pick = Some(Pick::Beside(Quantity::Orbital(i)));
+                            ui.close();
+                        }
+                        if ui.button("add to this view").clicked() {
+                            pick = Some(Pick::Add(Quantity::Orbital(i)));
+                            ui.close();
+                        }
+                    });
+                    if add.clicked() {
                         pick = Some(Pick::Add(Quantity::Orbital(i)));
-                        ui.close();
+                    }
+                    if *scroll_to_frontier && Some(i) == wf.homo(spin) {
+                        row.scroll_to_me(Some(egui::Align::Center));
+                        *scroll_to_frontier = false;
                     }
                 });
-                if add.clicked() {
-                    pick = Some(Pick::Add(Quantity::Orbital(i)));
-                }
-                if *scroll_to_frontier && Some(i) == wf.homo(spin) {
-                    row.scroll_to_me(Some(egui::Align::Center));
-                    *scroll_to_frontier = false;
-                }
-            });
-        }
+            }
+        });
     });
     pick
 }
@@ -317,10 +333,11 @@ fn energy_cells(energy: f64, as_occupations: Option<EnergiesAsOccupations>) -> [
     }
 }
 
-/// One line of the orbital table, columns padded to fixed widths.
+/// One line of the orbital table, columns padded to fixed widths (`sym` comes padded, or empty
+/// when the column is left out).
 fn row_text(name: &str, label: &str, sym: &str, eh: &str, ev: &str, occ: &str) -> String {
     // Wide enough that a core orbital's energies (-20.57911, -559.986) stay apart.
-    format!("{name:<6}{label:<7}{sym:<4}{eh:>10}{ev:>9}{occ:>5}")
+    format!("{name:<6}{label:<7}{sym}{eh:>9}{ev:>9}{occ:>5}")
 }
 
 /// Jang and Varetto's atomic-orbital selector (its Fig. 9): tick single basis functions — 2px apart

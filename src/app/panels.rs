@@ -13,7 +13,9 @@ use crate::scene::{
 };
 
 /// The side panel's width, points.
-const SIDE_PANEL_WIDTH: f32 = 290.0;
+/// The scene panel's width as it opens, and the widths a drag of its edge may give it.
+const SIDE_PANEL_WIDTH: f32 = 240.0;
+const SIDE_PANEL_WIDTHS: std::ops::RangeInclusive<f32> = 220.0..=480.0;
 
 pub enum Action {
     None,
@@ -66,6 +68,13 @@ pub fn top_bar(ui: &mut egui::Ui, app: &mut OrbApp) -> Action {
                     }
                 }
             });
+            ui.separator();
+            // The view takes the room of a closed panel; a drag on a panel's edge resizes it.
+            ui.toggle_value(&mut app.view.panels.scene, "Scene").on_hover_text("show or hide the scene panel");
+            if app.scan.is_none() && app.objects.get(app.active).is_some_and(|o| o.doc.wavefunction.is_some()) {
+                ui.toggle_value(&mut app.view.panels.orbitals, "Orbitals")
+                    .on_hover_text("show or hide the orbital browser");
+            }
             ui.separator();
             let source = match &app.scan {
                 Some(s) => s.scene.scan.title.clone(),
@@ -197,9 +206,14 @@ fn status_line(ui: &mut egui::Ui, app: &OrbApp, cancel: &mut bool, dismiss: &mut
 }
 
 pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
-    // A fixed width: opening a section never makes the panel jump.
-    egui::Panel::left("controls").exact_size(SIDE_PANEL_WIDTH).show(ui, |ui| {
-        egui::ScrollArea::vertical().show(ui, |ui| {
+    // Opening a section never makes the panel jump: its width changes only by a drag on its edge.
+    let mut open = app.view.panels.scene;
+    egui::Panel::left("controls")
+        .resizable(true)
+        .default_size(SIDE_PANEL_WIDTH)
+        .size_range(SIDE_PANEL_WIDTHS)
+        .show_collapsible(ui, &mut open, |ui| {
+            egui::ScrollArea::vertical().show(ui, |ui| {
             super::scene_panel::section(ui, app);
             if app.scan.is_none() && !app.objects.is_empty() {
                 ui.separator();
@@ -333,7 +347,8 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
             };
             ui.label(RichText::new(help).small().weak());
         });
-    });
+        });
+    app.view.panels.scene = open;
 }
 
 /// *minus*: another open file whose same quantity is subtracted from this one, as a new data

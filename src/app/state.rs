@@ -17,6 +17,24 @@ pub struct ViewState {
     /// How the view is split into panes.
     #[serde(default)]
     pub panes: Panes,
+    /// Which side panels are open (the view takes the room of a closed one).
+    #[serde(skip)]
+    pub panels: SidePanels,
+}
+
+/// The side panels shown beside the view.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SidePanels {
+    /// The scene and its representations (left).
+    pub scene: bool,
+    /// The orbital browser (right).
+    pub orbitals: bool,
+}
+
+impl Default for SidePanels {
+    fn default() -> Self {
+        Self { scene: true, orbitals: true }
+    }
 }
 
 impl Default for ViewState {
@@ -26,6 +44,7 @@ impl Default for ViewState {
             background: RenderSettings::default().background,
             labels: false,
             panes: Panes::default(),
+            panels: SidePanels::default(),
         }
     }
 }

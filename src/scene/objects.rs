@@ -132,6 +132,14 @@ impl ObjectState {
         let settings = defaults.for_structure(doc.molecule.atoms.len(), chains);
         let mut state = Self { atoms: AtomLook::of(&settings), ..Self::default() };
         state.quantities.extend(first_source(doc).map(|s| QuantityState::new(s, &settings)));
+        // An orbital opens readable at once: its ± surfaces over the cloud, as chemists know
+        // orbitals from other viewers (the cloud alone reads as a faint haze at first sight).
+        for q in state.quantities.iter_mut().filter(|q| q.source.orbital().is_some()) {
+            for iso in &mut q.isosurfaces {
+                iso.visible = true;
+                iso.translucent = true;
+            }
+        }
         state.fit_to(doc, defaults);
         state
     }
