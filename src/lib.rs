@@ -18,5 +18,6 @@ pub mod layers;
 pub mod meshes;
 pub mod model;
 pub mod movie;
+pub mod plane;
 pub mod scene;
 pub mod shots;

@@ -26,6 +26,8 @@ mod modes_cli;
 mod molsurface_cli;
 #[path = "cli/movie.rs"]
 mod movie_cli;
+#[path = "cli/plane.rs"]
+mod plane_cli;
 #[path = "cli/quantities.rs"]
 mod quantities_cli;
 #[path = "cli/render.rs"]
@@ -138,6 +140,9 @@ enum Command {
         #[arg(short, long)]
         output: PathBuf,
     },
+    /// Map a quantity on a plane through the molecule (exact from the wavefunction) with
+    /// contour lines, as a PNG or SVG figure and, on request, its numbers as CSV.
+    Plane(Box<plane_cli::PlaneArgs>),
     /// Write isosurfaces (both signs of an orbital, or a density's) or a molecular surface
     /// (--surface) as OBJ, PLY or glTF.
     Mesh(surface_cli::MeshArgs),
@@ -779,6 +784,7 @@ fn dispatch(cli: Cli, later: &[quantities_cli::Later]) -> Result<()> {
         Some(Command::Cube { file, what, grid, spacing, margin, minus, output }) => {
             values_cli::cube(&file, &what, (grid, spacing, margin), minus.as_deref(), &output)
         }
+        Some(Command::Plane(args)) => plane_cli::plane(&args),
         Some(Command::Compute(args)) => compute_cli::compute(args),
         Some(Command::Scan(command)) => scan_cli::run(command),
         Some(Command::Modes(args)) => modes_cli::write_xyz(&args),
