@@ -29,7 +29,7 @@ pub use values::{PlaneMap, Sampling, evaluate};
 pub enum PlaneError {
     #[error("atom {index} does not exist: the molecule has {atoms} atoms, numbered from 1")]
     Atom { index: usize, atoms: usize },
-    #[error("{0}: no plane passes through them alone")]
+    #[error("{0}: they span no plane")]
     Collinear(String),
     #[error("the plane's normal is zero (or not a number)")]
     ZeroNormal,
