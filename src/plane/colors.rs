@@ -126,7 +126,7 @@ pub fn label(v: f64) -> String {
         return "0".into();
     }
     let a = v.abs();
-    if !(1e-2..1e4).contains(&a) {
+    if !(1e-3..1e4).contains(&a) {
         let text = format!("{v:.2e}");
         // 1.00e-3 reads as 1e-3.
         return text.replace(".00e", "e").replace("0e", "e");
@@ -169,7 +169,9 @@ mod tests {
         assert_eq!(label(0.05), "0.05");
         assert_eq!(label(-0.1234), "-0.123");
         assert_eq!(label(12.5), "12.5");
-        assert_eq!(label(0.001), "1e-3");
+        assert_eq!(label(0.001), "0.001");
+        assert_eq!(label(0.00879), "0.00879");
+        assert_eq!(label(1e-4), "1e-4");
         assert_eq!(label(2.5e-5), "2.5e-5");
         assert_eq!(label(0.0), "0");
     }
