@@ -145,7 +145,12 @@ pub fn plane(args: &PlaneArgs) -> Result<()> {
             if outside > 0 { format!("; {outside} points lie outside its grid (no value)") } else { String::new() }
         );
     }
-    let levels = args.levels.resolve(map.max_abs(), map.signed);
+    let levels = if map.vanishes() {
+        eprintln!("{}: zero on this plane but for rounding (a nodal plane): no contours", described.label);
+        Vec::new()
+    } else {
+        args.levels.resolve(map.max_abs(), map.signed)
+    };
     let caption =
         vec![format!("{} · {}", file_name(&args.file), described.label), where_text(&how, &plane, args.offset)];
     let scale = (source == Source::Wavefunction(Quantity::Potential) && args.minus.is_none())

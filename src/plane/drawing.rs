@@ -7,7 +7,7 @@ use image::{Rgba, RgbaImage};
 
 use super::colors::{ColorScale, label};
 use super::contour::contour;
-use super::values::{PlaneMap, Sampling};
+use super::values::{PlaneMap, Sampling, VANISHING};
 use crate::model::Molecule;
 use crate::model::units::{ANGSTROM_PER_BOHR, BOHR_PER_ANGSTROM};
 
@@ -85,6 +85,9 @@ impl MapPicture<'_> {
     /// The caption as drawn: the lines given, and a note when the values are interpolated.
     pub fn caption_lines(&self) -> Vec<String> {
         let mut lines = self.caption.clone();
+        if self.map.vanishes() {
+            lines.push(format!("zero on this plane: |value| < {VANISHING:e} everywhere (a nodal plane); no contours"));
+        }
         if let Sampling::Trilinear { outside } = self.map.sampling {
             let mut note =
                 "values interpolated trilinearly between the cube file's grid points (not exact)".to_string();
@@ -112,6 +115,9 @@ impl MapPicture<'_> {
     pub fn scale(&self) -> ColorScale {
         if let Some(scale) = self.scale {
             return scale;
+        }
+        if self.map.vanishes() {
+            return ColorScale::Diverging { limit: VANISHING };
         }
         let low = self.levels.iter().copied().find(|&l| l > 0.0);
         ColorScale::for_values(&self.map.values, self.map.signed, low)
@@ -153,6 +159,9 @@ impl MapPicture<'_> {
     }
 
     fn contours(&self, canvas: &mut impl Canvas, [x0, y0, w, h]: Rect) {
+        if self.map.vanishes() {
+            return;
+        }
         let n = self.map.plane.points;
         let last = (n - 1) as f64;
         for &level in self.levels {

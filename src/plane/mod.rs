@@ -22,7 +22,7 @@ pub use geometry::{Frame, MAX_POINTS, Plane, atom_position};
 pub use levels::{Levels, auto_levels};
 pub use raster::png;
 pub use svg::svg;
-pub use values::{PlaneMap, Sampling, evaluate};
+pub use values::{PlaneMap, Sampling, VANISHING, evaluate};
 
 /// Why a map cannot be made.
 #[derive(Debug, thiserror::Error)]
@@ -88,6 +88,27 @@ mod tests {
         assert_eq!(text.matches(r#"class="atom""#).count(), 3);
         assert!(text.contains(">O1<") && text.contains(">H3<") && !text.contains(">C4<"));
         assert!(text.contains("data:image/png;base64,"));
+    }
+
+    #[test]
+    fn a_nodal_plane_draws_no_contours_of_its_rounding_noise() {
+        let (molecule, mut map) = saddle();
+        let noise: Vec<f64> = (0..map.values.len()).map(|k| if k % 3 == 0 { 1e-17 } else { -1e-17 }).collect();
+        map.values = noise;
+        assert!(map.vanishes());
+        let levels = Levels::Auto.resolve(map.max_abs(), true);
+        assert!(!contour(&map.values, 81, 81, 0.0).is_empty(), "noise alone would be contoured");
+        let picture = MapPicture {
+            map: &map,
+            molecule: &molecule,
+            levels: &levels,
+            caption: vec![],
+            unit: "f".into(),
+            scale: None,
+        };
+        let text = svg(&picture);
+        assert!(!text.contains(r#"class="contour""#));
+        assert!(text.contains("nodal plane"));
     }
 
     #[test]

@@ -14,6 +14,10 @@ use crate::model::orbitals::Quantity;
 use crate::model::{Document, VolumeGrid};
 use crate::scene::Source;
 
+/// Below this magnitude everywhere (a.u.) a map holds only rounding: the plane is a nodal
+/// plane of the quantity (a π orbital in its molecule's plane), whose contours would trace noise.
+pub const VANISHING: f64 = 1e-10;
+
 /// How a map's values were found.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Sampling {
@@ -38,6 +42,11 @@ impl PlaneMap {
     /// The largest |value| on the map (NaN left out).
     pub fn max_abs(&self) -> f64 {
         self.values.iter().filter(|v| v.is_finite()).fold(0.0, |m, v| m.max(v.abs()))
+    }
+
+    /// Whether the quantity is zero on the whole plane but for rounding ([`VANISHING`]).
+    pub fn vanishes(&self) -> bool {
+        self.max_abs() < VANISHING
     }
 
     /// The map's numbers as CSV: a header, then `x,y,z,value` per point in bohr, u fastest.
