@@ -4,8 +4,8 @@
 use glam::DVec3;
 
 use super::PlaneError;
-use crate::model::Molecule;
 use crate::model::units::BOHR_PER_ANGSTROM;
+use crate::model::{GridSpec, Molecule};
 
 /// The most points along a side: 4000² values are 16 million, a minute of evaluation and
 /// 128 MB of numbers; beyond that a map is no longer a figure.
@@ -185,6 +185,16 @@ impl Plane {
         (0..self.points).flat_map(|j| (0..self.points).map(move |i| (i, j))).map(|(i, j)| self.point(i, j)).collect()
     }
 
+    /// The points as a one-layer grid whose rows run along u (the fastest index of cube
+    /// order), so the evaluator's grid paths apply: each value is still the quantity at its
+    /// point, with exponentials carried along a row by recurrence (and factorised along the
+    /// axes when the plane is a coordinate plane).
+    pub fn grid(&self) -> GridSpec {
+        let [hu, hv] = self.spacing();
+        let steps = [self.frame.normal, self.frame.v * hv, self.frame.u * hu];
+        GridSpec::new(self.point(0, 0), steps, [1, self.points, self.points])
+    }
+
     /// `p` in the map's coordinates: bohr from the centre along u and v, and from the plane.
     pub fn project(&self, p: DVec3) -> ([f64; 2], f64) {
         let d = p - self.center;
@@ -237,6 +247,12 @@ mod tests {
         let h = plane.spacing();
         assert!(((points[1] - points[0]).length() - h[0]).abs() < 1e-12);
         assert!(((points[31] - points[0]).length() - h[1]).abs() < 1e-12);
+        // The evaluator's grid holds the same points in the same order.
+        let grid = plane.grid();
+        assert_eq!(grid.len(), points.len());
+        for (n, p) in points.iter().enumerate() {
+            assert!((grid.point(0, n / 31, n % 31) - *p).length() < 1e-12);
+        }
         // The three atoms' projections lie inside the default square.
         for atom in [a, b, c] {
             let ([x, y], _) = plane.project(atom);
