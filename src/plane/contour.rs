@@ -39,8 +39,9 @@ fn segments(case: u8, centre_above: bool) -> &'static [(u8, u8)] {
 }
 
 /// The contour lines of `values` (`nx` × `ny`, x fastest) at `level`. A corner counts as above
-/// when its value exceeds the level; cells with a missing (NaN) corner have no lines.
-pub fn contour(values: &[f64], nx: usize, ny: usize, level: f64) -> Vec<Polyline> {
+/// when its value exceeds the level; cells with a missing (NaN) corner, or whose corners all
+/// have magnitudes below `floor`, have no lines.
+pub fn contour(values: &[f64], nx: usize, ny: usize, level: f64, floor: f64) -> Vec<Polyline> {
     assert_eq!(values.len(), nx * ny, "a grid of nx × ny values");
     let at = |i: usize, j: usize| values[j * nx + i];
     // Each crossing is named by its grid edge: 2·(j·nx + i) for the edge from (i,j) along x,
@@ -50,7 +51,7 @@ pub fn contour(values: &[f64], nx: usize, ny: usize, level: f64) -> Vec<Polyline
     for j in 0..ny.saturating_sub(1) {
         for i in 0..nx.saturating_sub(1) {
             let corners = [at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)];
-            if corners.iter().any(|v| v.is_nan()) {
+            if corners.iter().any(|v| v.is_nan()) || corners.iter().all(|v| v.abs() < floor) {
                 continue;
             }
             let case = corners.iter().enumerate().fold(0u8, |c, (k, &v)| c | (u8::from(v > level) << k));
@@ -130,7 +131,7 @@ mod tests {
         let (n, h, r) = (61, 0.1, 2.2);
         let coord = |k: usize| k as f64 * h - 3.0;
         let values: Vec<f64> = (0..n).flat_map(|j| (0..n).map(move |i| coord(i).powi(2) + coord(j).powi(2))).collect();
-        let lines = contour(&values, n, n, r * r);
+        let lines = contour(&values, n, n, r * r, 0.0);
         assert_eq!(lines.len(), 1, "one line");
         let line = &lines[0];
         assert!(line.closed);
@@ -157,7 +158,7 @@ mod tests {
         let grid = |bl: f64, br: f64, tr: f64, tl: f64| vec![bl, br, tl, tr];
         // Centre (1 − 1 + 2 − 1)/4 > 0: the high corners join; the low corners are cut off,
         // each by a line between its two edges.
-        let lines = contour(&grid(1.0, -1.0, 2.0, -1.0), 2, 2, 0.0);
+        let lines = contour(&grid(1.0, -1.0, 2.0, -1.0), 2, 2, 0.0, 0.0);
         assert_eq!(lines.len(), 2);
         // A line cuts a corner off when both its ends lie on the two edges that meet there.
         let cut_off = |line: &Polyline, corner: [f64; 2]| {
@@ -165,7 +166,7 @@ mod tests {
         };
         assert!(lines.iter().any(|l| cut_off(l, [1.0, 0.0])) && lines.iter().any(|l| cut_off(l, [0.0, 1.0])));
         // Centre (1 − 1.5 + 0.5 − 1)/4 < 0: the high corners are apart, each cut off.
-        let lines = contour(&grid(1.0, -1.5, 0.5, -1.0), 2, 2, 0.0);
+        let lines = contour(&grid(1.0, -1.5, 0.5, -1.0), 2, 2, 0.0, 0.0);
         assert_eq!(lines.len(), 2);
         assert!(lines.iter().any(|l| cut_off(l, [0.0, 0.0])) && lines.iter().any(|l| cut_off(l, [1.0, 1.0])));
         // The crossings are where the edges' values pass 0: bottom edge at 1/(1 + 1.5).
@@ -178,15 +179,19 @@ mod tests {
         // A plane tilted along x: one straight open line across the map at x = 2.5.
         let (nx, ny) = (6, 6);
         let mut values: Vec<f64> = (0..ny).flat_map(|_| (0..nx).map(|i| i as f64)).collect();
-        let lines = contour(&values, nx, ny, 2.5);
+        let lines = contour(&values, nx, ny, 2.5, 0.0);
         assert_eq!(lines.len(), 1);
         assert!(!lines[0].closed);
         assert_eq!(lines[0].points.len(), ny);
         assert!(lines[0].points.iter().all(|p| (p[0] - 2.5).abs() < 1e-12));
         // A missing value in the middle breaks it in two.
         values[2 * nx + 2] = f64::NAN;
-        assert_eq!(contour(&values, nx, ny, 2.5).len(), 2);
+        assert_eq!(contour(&values, nx, ny, 2.5, 0.0).len(), 2);
         // A level outside the values has no line.
-        assert!(contour(&values, nx, ny, 10.0).is_empty());
+        assert!(contour(&values, nx, ny, 10.0, 0.0).is_empty());
+        // Cells whose values all lie below the floor have none either: the line's cells hold
+        // 2 and 3, so a floor of 3.5 removes it and one of 2.5 keeps it.
+        assert!(contour(&values, nx, ny, 2.5, 3.5).is_empty());
+        assert_eq!(contour(&values, nx, ny, 2.5, 2.5).len(), 2);
     }
 }

@@ -164,14 +164,25 @@ impl MapPicture<'_> {
         }
         let n = self.map.plane.points;
         let last = (n - 1) as f64;
+        let faint = self.faint();
         for &level in self.levels {
             let stroke = Stroke { color: INK, width: if level == 0.0 { 1.6 } else { 0.9 }, dashed: level < 0.0 };
-            for line in contour(&self.map.values, n, n, level) {
+            // Where the quantity has all but vanished its sign follows the tails' last digits:
+            // the zero line there says nothing.
+            let floor = if level == 0.0 { faint } else { 0.0 };
+            for line in contour(&self.map.values, n, n, level, floor) {
                 let points: Vec<[f64; 2]> =
                     line.points.iter().map(|p| [x0 + p[0] / last * w, y0 + (1.0 - p[1] / last) * h]).collect();
                 canvas.polyline(&points, stroke, "contour");
             }
         }
+    }
+
+    /// Cells whose values all stay below this magnitude have no zero contour: a thousandth of
+    /// the smallest nonzero level (a millionth of the largest value when zero is the only level).
+    fn faint(&self) -> f64 {
+        let smallest = self.levels.iter().map(|l| l.abs()).filter(|&l| l > 0.0).fold(f64::INFINITY, f64::min);
+        if smallest.is_finite() { 1e-3 * smallest } else { 1e-6 * self.map.max_abs() }
     }
 
     /// A point in space as pixels of the plot, and its distance from the plane (bohr).

@@ -79,7 +79,7 @@ mod tests {
         let text = svg(&picture);
         assert!(text.starts_with("<svg") && text.trim_end().ends_with("</svg>"));
         let contours: Vec<&str> = text.lines().filter(|l| l.contains(r#"class="contour""#)).collect();
-        let expected: usize = levels.iter().map(|&l| contour(&map.values, 81, 81, l).len()).sum();
+        let expected: usize = levels.iter().map(|&l| contour(&map.values, 81, 81, l, 0.0).len()).sum();
         assert_eq!(contours.len(), expected);
         assert!(contours.len() > 10, "{} lines", contours.len());
         assert!(contours.iter().any(|l| l.contains("stroke-dasharray")), "negative levels dashed");
@@ -97,7 +97,7 @@ mod tests {
         map.values = noise;
         assert!(map.vanishes());
         let levels = Levels::Auto.resolve(map.max_abs(), true);
-        assert!(!contour(&map.values, 81, 81, 0.0).is_empty(), "noise alone would be contoured");
+        assert!(!contour(&map.values, 81, 81, 0.0, 0.0).is_empty(), "noise alone would be contoured");
         let picture = MapPicture {
             map: &map,
             molecule: &molecule,
