@@ -1,7 +1,7 @@
 //! orbcloud: molecular orbitals and electron densities as GPU-rendered clouds.
 //!
 //! Layers, each using only those before it (see ARCHITECTURE.md): `model` ← `formats`, `scene`
-//! ← `sources`, `gpu` ← `evaluate` ← `layers` ← `pictures` ← `app`, `cli` ← `main.rs`.
+//! ← `gpu` ← `evaluate` ← `sources`, `layers` ← `pictures` ← `plane` ← `app`, `cli` ← `main.rs`.
 
 pub mod app;
 pub mod cli;
@@ -11,5 +11,6 @@ pub mod gpu;
 pub mod layers;
 pub mod model;
 pub mod pictures;
+pub mod plane;
 pub mod scene;
 pub mod sources;

@@ -240,7 +240,7 @@ fn the_atomic_orbital_selector_picks_single_basis_functions() {
     wait_loaded(&mut h);
     let dxy = find_function(&doc.molecule, &wf.basis, "O1 3dxy").unwrap();
     assert_eq!(sources(h.state()), [Wavefunction(Quantity::BasisFunction(dxy))]);
-    assert!(h.query_by_label("O1 3dxy · cloud").is_some(), "the scene panel names it");
+    assert!(h.query_by_label_contains("O1 3dxy · cloud").is_some(), "the scene panel names it");
     let (worst, max) = worst_difference(h.state(), |p| prepared.basis_values(p)[dxy]);
     assert!(max > 0.1 && worst < 1e-5, "the bare O 3dxy: worst {worst:.2e} of {max:.3}");
     picture(&mut h, dir, "ao_bare_3dxy");
@@ -388,7 +388,8 @@ fn the_panels_follow_the_scene() {
 
     // After a scan opens, the previous file's orbital browser is gone.
     let mut h = open(vec![fixture("wavefunctions/h2o_cart_631gs.molden")]);
-    assert!(h.query_by_label("Orbitals").is_some());
+    // The browser's heading and the top bar's toggle that closes it.
+    assert_eq!(h.query_all_by_label("Orbitals").count(), 2);
     let ctx = h.ctx.clone();
     h.state_mut().open_demo(orbcloud::app::Demo::Scan, &ctx);
     let start = std::time::Instant::now();
@@ -398,7 +399,7 @@ fn the_panels_follow_the_scene() {
         h.run_steps(1);
     }
     h.run_steps(2);
-    assert!(h.query_by_label("Orbitals").is_none(), "the orbital browser left with its file");
+    assert_eq!(h.query_all_by_label("Orbitals").count(), 0, "the orbital browser left with its file");
 }
 
 #[test]

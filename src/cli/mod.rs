@@ -28,6 +28,7 @@ pub mod info;
 mod modes;
 mod molsurface;
 mod movie;
+mod plane;
 mod quantities;
 mod render;
 mod scan;
@@ -129,6 +130,9 @@ enum Command {
         #[arg(short, long)]
         output: PathBuf,
     },
+    /// Map a quantity on a plane through the molecule (exact from the wavefunction) with
+    /// contour lines, as a PNG or SVG figure and, on request, its numbers as CSV.
+    Plane(Box<plane::PlaneArgs>),
     /// Write isosurfaces (both signs of an orbital, or a density's) or a molecular surface
     /// (--surface) as OBJ, PLY or glTF.
     Mesh(surface::MeshArgs),
@@ -756,6 +760,7 @@ fn dispatch(cli: Cli, later: &[quantities::Later]) -> Result<()> {
         Some(Command::Cube { file, what, grid, spacing, margin, minus, output }) => {
             values::cube(&file, &what, (grid, spacing, margin), minus.as_deref(), &output)
         }
+        Some(Command::Plane(args)) => plane::plane(&args),
         Some(Command::Compute(args)) => compute::compute(args),
         Some(Command::Scan(command)) => scan::run(command),
         Some(Command::Modes(args)) => modes::write_xyz(&args),

@@ -104,7 +104,7 @@ pub fn cube(
 /// The quantity `what` asks for, of the file `other`, at `points` (bohr): evaluated from its
 /// wavefunction, or its first data set sampled trilinearly (0 outside its grid, with a warning;
 /// refused when no point lies inside).
-fn other_values(other: &Path, what: &WhatArgs, points: &[DVec3]) -> Result<Vec<f64>> {
+pub fn other_values(other: &Path, what: &WhatArgs, points: &[DVec3]) -> Result<Vec<f64>> {
     let doc = formats::load(other)?;
     let source = match &doc.wavefunction {
         Some(_) => Source::Wavefunction(what.resolve(&doc)?),
