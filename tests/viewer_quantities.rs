@@ -552,3 +552,64 @@ fn a_density_minus_another_files_density_joins_as_a_data_set_and_a_session_makes
     assert_eq!(app.objects[0].state, saved);
     assert_eq!(app.objects[0].doc.volumes[0].values, values, "the same difference, made again");
 }
+
+#[test]
+fn a_plane_map_beside_the_view_is_exact_follows_the_plane_and_saves_its_figure() {
+    use orbcloud::model::gto::PreparedBasis;
+    use orbcloud::model::units::BOHR_PER_ANGSTROM;
+    let mut h = open(vec![fixture("wavefunctions/benzene_631gs.fchk")]);
+    let dir = tempfile::tempdir().unwrap();
+    h.get_by_label("Plane map").click();
+    // Steps until the full map of the plane at `offset` is shown.
+    let wait = |h: &mut Harness<'static, OrbApp>, offset: f64| {
+        let start = std::time::Instant::now();
+        loop {
+            h.run_steps(1);
+            let app = h.state();
+            assert!(app.plane.error.is_none(), "{:?}", app.plane.error);
+            if let Some(made) = app.plane.made()
+                && made.map().plane.points == app.plane.points
+                && made.offset() == offset
+            {
+                break;
+            }
+            assert!(start.elapsed().as_secs() < 120, "no map at {offset} Å after two minutes");
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+    };
+    wait(&mut h, 0.0);
+    let check = |app: &OrbApp| {
+        let made = app.plane.made().unwrap();
+        let doc = &app.objects[0].doc;
+        let wf = doc.wavefunction.as_ref().unwrap();
+        let homo = Quantity::Orbital(wf.homo(Spin::Alpha).unwrap());
+        let map = made.map();
+        // Exact: the evaluator's own value at every 997th point of the map.
+        let points: Vec<_> = map.plane.points().into_iter().step_by(997).collect();
+        let expected = PreparedBasis::new(&wf.basis).quantity_at_points(wf, &doc.molecule, homo, &points);
+        let got: Vec<f64> = map.values.iter().copied().step_by(997).collect();
+        let worst = got.iter().zip(&expected).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+        assert!(worst <= 1e-9 * map.max_abs().max(1e-12), "worst {worst:e} of {}", map.max_abs());
+        // The plane lies the offset away from the ring's first three atoms.
+        let atoms: Vec<_> = doc.molecule.atoms[..3].iter().map(|a| a.position).collect();
+        let normal = (atoms[1] - atoms[0]).cross(atoms[2] - atoms[0]).normalize();
+        let distance = (map.plane.center - atoms[0]).dot(normal).abs();
+        assert!((distance - made.offset() * BOHR_PER_ANGSTROM).abs() < 1e-9, "{distance} bohr");
+        map.vanishes()
+    };
+    assert!(check(h.state()), "the π HOMO vanishes in the ring's plane");
+    // Moved half an ångström off the ring, the map follows: the π lobes.
+    h.state_mut().plane.offset = 0.5;
+    wait(&mut h, 0.5);
+    assert!(!check(h.state()), "the HOMO's lobes above the ring");
+    let svg = dir.path().join("homo.svg");
+    h.state().plane.save(&svg).unwrap();
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(
+        text.matches(r#"class="contour""#).count() > 4 && text.contains("stroke-dasharray"),
+        "contours, negative dashed"
+    );
+    let png = dir.path().join("homo.png");
+    h.state().plane.save(&png).unwrap();
+    assert!(image::open(&png).unwrap().width() > 200);
+}

@@ -14,6 +14,8 @@ pub enum Purpose {
     Open,
     SaveSession,
     SavePng,
+    /// A plane map's figure, PNG or SVG.
+    SaveMap,
 }
 
 impl Purpose {
@@ -22,6 +24,7 @@ impl Purpose {
             Purpose::Open => "Open a file",
             Purpose::SaveSession => "Save the session",
             Purpose::SavePng => "Save the picture",
+            Purpose::SaveMap => "Save the plane map",
         }
     }
 
@@ -36,6 +39,7 @@ impl Purpose {
             }
             Purpose::SaveSession => name.ends_with(crate::scene::objects::SESSION_SUFFIX),
             Purpose::SavePng => name.ends_with(".png"),
+            Purpose::SaveMap => name.ends_with(".png") || name.ends_with(".svg"),
         }
     }
 }
@@ -69,6 +73,9 @@ pub fn native(purpose: Purpose, file_name: &str) -> Native {
             .pick_file(),
         Purpose::SaveSession => dialog.add_filter("orbcloud session", &["toml"]).set_file_name(file_name).save_file(),
         Purpose::SavePng => dialog.add_filter("PNG image", &["png"]).set_file_name(file_name).save_file(),
+        Purpose::SaveMap => {
+            dialog.add_filter("PNG or SVG figure", &["png", "svg"]).set_file_name(file_name).save_file()
+        }
     };
     if chosen.is_none() && start.elapsed() < NO_DIALOG { Native::Missing } else { Native::Answered(chosen) }
 }

@@ -15,6 +15,7 @@ mod orbitals;
 mod panels;
 pub mod panes;
 pub mod picture;
+pub mod plane_pane;
 mod progressive;
 pub mod record;
 pub mod restart;
@@ -261,6 +262,8 @@ pub struct OrbApp {
     /// The *Scan* window's choices (*Scan this…* on a measurement), and the computation under
     /// way (a scan, or a structure's orbitals).
     pub scan_dialog: compute::ScanDialog,
+    /// The plane map beside the view.
+    pub plane: plane_pane::PlanePane,
     pub computing: Option<compute::ComputeRun>,
     /// The *Compute orbitals* window: the object and the level of theory.
     pub orbitals_dialog: Option<(usize, crate::sources::compute::Settings)>,
@@ -428,6 +431,10 @@ impl OrbApp {
             rehearsal: None,
             notice: None,
             scan_dialog: compute::ScanDialog::default(),
+            plane: {
+                let repaint = cc.egui_ctx.clone();
+                plane_pane::PlanePane::new(move || repaint.request_repaint())
+            },
             computing: None,
             orbitals_dialog: None,
             record: record::RecordDialog::default(),
@@ -955,6 +962,16 @@ impl OrbApp {
         playing
     }
 
+    /// The first three atoms of the last measurement of three or more atoms, when all lie in the
+    /// active object: 1-based, as the plane pane numbers them.
+    fn measured_plane_atoms(&self) -> Option<[usize; 3]> {
+        let m = self.measurements.list.iter().rev().find(|m| m.atoms.len() >= 3)?;
+        let first = *self.world.offsets.get(self.active)?;
+        let n = self.objects.get(self.active)?.doc.molecule.atoms.len();
+        let local = |a: usize| a.checked_sub(first).filter(|&i| i < n).map(|i| i + 1);
+        Some([local(m.atoms[0])?, local(m.atoms[1])?, local(m.atoms[2])?])
+    }
+
     /// Puts back a session's measurements once its files have loaded (those naming atoms the
     /// scene does not have are left out).
     fn restore_measurements(&mut self) {
@@ -992,7 +1009,8 @@ impl OrbApp {
             }
         }
         // Pictures go where the last one went; files open from where the last one came.
-        let last_saved = self.last_folder.clone().filter(|_| purpose == files::Purpose::SavePng);
+        let last_saved =
+            self.last_folder.clone().filter(|_| matches!(purpose, files::Purpose::SavePng | files::Purpose::SaveMap));
         let dir = last_saved
             .or_else(|| self.recent.first().and_then(|p| p.parent()).map(Path::to_path_buf))
             .or_else(|| std::env::current_dir().ok())
@@ -1007,6 +1025,13 @@ impl OrbApp {
             files::Purpose::Open => self.open(path, ctx),
             files::Purpose::SaveSession => self.save_session(&session::with_suffix(path)),
             files::Purpose::SavePng => self.save_png(&path),
+            files::Purpose::SaveMap => match self.plane.save(&path) {
+                Ok(()) => {
+                    self.status = format!("saved the plane map as {}", path.display());
+                    self.last_folder = path.parent().map(Path::to_path_buf);
+                }
+                Err(e) => self.error = Some(e),
+            },
         }
     }
 
@@ -1211,6 +1236,20 @@ impl eframe::App for OrbApp {
         if let Some(o) = self.objects.get_mut(self.active).filter(|_| self.scan.is_none()) {
             vibrations::panel(ui, &o.doc, &mut o.state.vibration, &mut self.spectrum);
         }
+        if self.plane.open
+            && self.scan.is_none()
+            && let Some(o) = self.objects.get(self.active)
+        {
+            let source = o.state.selected_quantity().map(|q| q.source);
+            let measured = self.measured_plane_atoms();
+            if plane_pane::panel(ui, &mut self.plane, &o.doc, source, measured) {
+                let stem =
+                    Path::new(&o.doc.source).file_stem().map_or("map".into(), |s| s.to_string_lossy().into_owned());
+                if let Some(path) = self.choose(files::Purpose::SaveMap, &format!("{stem}-plane.png")) {
+                    self.chosen(files::Purpose::SaveMap, path, &ctx);
+                }
+            }
+        }
         self.apply_changes();
         self.apply_scene_edits();
         let modes_play = self.animate_modes(ui.input(|i| i.time));
@@ -1314,6 +1353,9 @@ impl eframe::App for OrbApp {
                         }
                     }
                     measure::overlay(ui, vp, &self.view.camera, &self.world, &self.measurements, self.view.labels);
+                    if let Some(o) = self.objects.get(self.active).filter(|_| self.plane.open) {
+                        plane_pane::outline(ui, vp, &self.view.camera, &self.plane, &o.state.placement);
+                    }
                 }
                 (None, None) => {}
             }

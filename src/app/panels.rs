@@ -75,6 +75,10 @@ pub fn top_bar(ui: &mut egui::Ui, app: &mut OrbApp) -> Action {
                 ui.toggle_value(&mut app.view.panels.orbitals, "Orbitals")
                     .on_hover_text("show or hide the orbital browser");
             }
+            if app.scan.is_none() && app.objects.get(app.active).is_some_and(|o| o.doc.molecule.atoms.len() >= 3) {
+                ui.toggle_value(&mut app.plane.open, "Plane map")
+                    .on_hover_text("the selected quantity on a plane through three atoms, with contours");
+            }
             ui.separator();
             let source = match &app.scan {
                 Some(s) => s.scene.scan.title.clone(),

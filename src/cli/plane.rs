@@ -8,7 +8,7 @@ use crate::formats;
 use crate::model::Document;
 use crate::model::orbitals::Quantity;
 use crate::model::units::{ANGSTROM_PER_BOHR, BOHR_PER_ANGSTROM};
-use crate::plane::{self, ColorScale, Frame, Levels, MapPicture, Plane, PlaneMap};
+use crate::plane::{self, Frame, Levels, MapPicture, PlaneMap};
 use crate::scene::Source;
 use anyhow::{Context, Result, bail};
 use clap::Args;
@@ -152,9 +152,9 @@ pub fn plane(args: &PlaneArgs) -> Result<()> {
         args.levels.resolve(map.max_abs(), map.signed)
     };
     let caption =
-        vec![format!("{} · {}", file_name(&args.file), described.label), where_text(&how, &plane, args.offset)];
+        vec![format!("{} · {}", file_name(&args.file), described.label), plane::where_text(&how, &plane, args.offset)];
     let scale = (source == Source::Wavefunction(Quantity::Potential) && args.minus.is_none())
-        .then(|| potential_scale(&map))
+        .then(|| plane::potential_scale(&map))
         .flatten();
     let picture =
         MapPicture { map: &map, molecule: &doc.molecule, levels: &levels, caption, unit: described.unit, scale };
@@ -175,14 +175,6 @@ fn report(map: &PlaneMap, levels: &[f64], seconds: f64, args: &PlaneArgs) {
         args.output.display(),
         levels.len()
     );
-}
-
-/// A potential's colours span twice its most negative value both ways: the nuclei's potential
-/// (which grows without bound) saturates, and the negative regions, where an electrophile is
-/// drawn, keep their shades. `None` (the automatic scale) when it has no negative region.
-fn potential_scale(map: &PlaneMap) -> Option<ColorScale> {
-    let lowest = map.values.iter().copied().filter(|v| v.is_finite()).fold(0.0, f64::min);
-    (lowest < 0.0).then(|| ColorScale::Diverging { limit: -2.0 * lowest })
 }
 
 #[derive(Clone, Copy)]
@@ -230,17 +222,11 @@ fn source(args: &PlaneArgs, doc: &Document) -> Result<(Source, Described)> {
             bail!("--volume {} is out of range: the file has {} data set(s)", args.volume, doc.volumes.len());
         }
         let label = doc.volumes[args.volume].label.clone();
-        return Ok((Source::Volume(args.volume), Described { label, unit: "value".into() }));
+        return Ok((Source::Volume(args.volume), Described { label, unit: plane::unit(Source::Volume(0)).into() }));
     }
     let q = args.what.resolve(doc)?;
-    let unit = match q {
-        Quantity::Orbital(_) => "ψ (a.u.)",
-        Quantity::BasisFunction(_) => "χ (a.u.)",
-        Quantity::Density => "ρ (a.u.)",
-        Quantity::SpinDensity => "ρα − ρβ (a.u.)",
-        Quantity::Potential => "V (a.u.)",
-    };
-    Ok((Source::Wavefunction(q), Described { label: super::quantity_label(&q, doc), unit: unit.into() }))
+    let source = Source::Wavefunction(q);
+    Ok((source, Described { label: super::quantity_label(&q, doc), unit: plane::unit(source).into() }))
 }
 
 /// The plane the options name, whether the map keeps its origin at the centre, and how the
@@ -278,14 +264,6 @@ fn frame(args: &PlaneArgs, doc: &Document) -> Result<(Frame, bool, String)> {
             )
         }
     }
-}
-
-/// The caption's second line: the plane, its offset, its points and extent.
-fn where_text(how: &str, plane: &Plane, offset: f64) -> String {
-    let n = plane.points;
-    let [w, h] = plane.size.map(|s| s * ANGSTROM_PER_BOHR);
-    let offset = if offset != 0.0 { format!(", offset {offset} Å") } else { String::new() };
-    format!("{how}{offset} · {n}×{n} points over {w:.2} × {h:.2} Å")
 }
 
 /// The last part of a path, for captions.

@@ -6,6 +6,7 @@
 //! contours; contour.rs: marching squares; colors.rs: colour scales; drawing.rs: the figure
 //! laid out on a canvas, which raster.rs (PNG) and svg.rs (SVG) draw.
 
+mod caption;
 mod colors;
 mod contour;
 mod drawing;
@@ -15,6 +16,7 @@ mod raster;
 mod svg;
 mod values;
 
+pub use caption::{potential_scale, unit, where_text};
 pub use colors::ColorScale;
 pub use contour::{Polyline, contour};
 pub use drawing::{MapPicture, NEAR_PLANE};
