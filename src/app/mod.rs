@@ -1242,7 +1242,14 @@ impl eframe::App for OrbApp {
         {
             let source = o.state.selected_quantity().map(|q| q.source);
             let measured = self.measured_plane_atoms();
-            if plane_pane::panel(ui, &mut self.plane, &o.doc, source, measured) {
+            // The view's plane in the object's own frame: through the camera's target, facing it.
+            let object_from_world = o.state.placement.world_from_object().inverse().as_dmat4();
+            let camera = &self.view.camera;
+            let facing = plane_pane::Through::Facing {
+                origin: object_from_world.transform_point3(camera.target.as_dvec3()),
+                normal: object_from_world.transform_vector3((camera.eye() - camera.target).as_dvec3()),
+            };
+            if plane_pane::panel(ui, &mut self.plane, (&o.doc, source), measured, facing) {
                 let stem =
                     Path::new(&o.doc.source).file_stem().map_or("map".into(), |s| s.to_string_lossy().into_owned());
                 if let Some(path) = self.choose(files::Purpose::SaveMap, &format!("{stem}-plane.png")) {

@@ -12,6 +12,8 @@ use egui::{Color32, RichText, Stroke};
 
 use super::jobs::Latest;
 use super::viewport::Viewport;
+use glam::DVec3;
+
 use crate::model::Document;
 use crate::model::units::BOHR_PER_ANGSTROM;
 use crate::plane::{self, ColorScale, Frame, Levels, MapPicture, PlaneMap};
@@ -24,13 +26,21 @@ const POINT_CHOICES: [usize; 4] = [100, 200, 300, 500];
 /// How far the plane may be moved from the atoms (Å).
 const MAX_OFFSET: f64 = 10.0;
 
-/// What a map is of: a document's quantity on the plane through three of its atoms (1-based),
-/// moved `offset` Å along the plane's normal, at `points` per side.
+/// Which plane: through three atoms (1-based), or by a point and a normal (bohr, the object's
+/// frame: the plane the view faced when asked).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Through {
+    Atoms([usize; 3]),
+    Facing { origin: DVec3, normal: DVec3 },
+}
+
+/// What a map is of: a document's quantity on a plane moved `offset` Å along its normal, at
+/// `points` per side.
 #[derive(Clone)]
 struct Asked {
     doc: Arc<Document>,
     source: Source,
-    atoms: [usize; 3],
+    through: Through,
     offset: f64,
     points: usize,
 }
@@ -38,8 +48,8 @@ struct Asked {
 impl PartialEq for Asked {
     fn eq(&self, other: &Self) -> bool {
         Arc::ptr_eq(&self.doc, &other.doc)
-            && (self.source, self.atoms, self.offset.to_bits(), self.points)
-                == (other.source, other.atoms, other.offset.to_bits(), other.points)
+            && (self.source, self.through, self.offset.to_bits(), self.points)
+                == (other.source, other.through, other.offset.to_bits(), other.points)
     }
 }
 
@@ -80,8 +90,8 @@ impl Made {
 /// The pane's state: the plane asked for and the map shown.
 pub struct PlanePane {
     pub open: bool,
-    /// The atoms the plane passes through (1-based, of the active object).
-    pub atoms: [usize; 3],
+    /// The plane (of the active object).
+    pub through: Through,
     /// Along the plane's normal, Å.
     pub offset: f64,
     pub points: usize,
@@ -97,7 +107,7 @@ impl PlanePane {
     pub fn new(repaint: impl Fn() + Send + Sync + 'static) -> Self {
         Self {
             open: false,
-            atoms: [1, 2, 3],
+            through: Through::Atoms([1, 2, 3]),
             offset: 0.0,
             points: 200,
             jobs: Latest::new("making the plane map", repaint),
@@ -120,7 +130,7 @@ impl PlanePane {
     /// Asks for the map of `doc`'s `source` on the current plane when it is not the one shown
     /// or coming: a coarse map first, then (when it arrives) the full one.
     fn ask(&mut self, doc: &Arc<Document>, source: Source) {
-        let full = Asked { doc: doc.clone(), source, atoms: self.atoms, offset: self.offset, points: self.points };
+        let full = Asked { doc: doc.clone(), source, through: self.through, offset: self.offset, points: self.points };
         let coarse = Asked { points: COARSE_POINTS.min(self.points), ..full.clone() };
         let shown = self.shown.as_ref().map(|(m, _)| &m.asked);
         if shown == Some(&full) || self.asked.as_ref() == Some(&full) {
@@ -165,16 +175,19 @@ impl PlanePane {
 fn make(asked: Asked) -> Result<Made, String> {
     let doc = &asked.doc;
     let m = &doc.molecule;
-    let frame = Frame::through_atoms(m, asked.atoms).map_err(|e| e.to_string())?;
+    let name = |i: usize| m.atoms.get(i - 1).map_or(String::new(), |a| format!("{}{i}", a.element().symbol));
+    let (frame, keep_origin, how) = match asked.through {
+        Through::Atoms(atoms) => {
+            let [a, b, c] = atoms;
+            (Frame::through_atoms(m, atoms), false, format!("plane through {} {} {}", name(a), name(b), name(c)))
+        }
+        Through::Facing { origin, normal } => (Frame::from_normal(origin, normal), true, "the view's plane".into()),
+    };
     let plane = frame
-        .offset(asked.offset * BOHR_PER_ANGSTROM)
-        .rectangle(m, None, asked.points, false)
+        .and_then(|f| f.offset(asked.offset * BOHR_PER_ANGSTROM).rectangle(m, None, asked.points, keep_origin))
         .map_err(|e| e.to_string())?;
     let map = plane::evaluate(doc, asked.source, &plane).map_err(|e| e.to_string())?;
     let levels = if map.vanishes() { Vec::new() } else { Levels::Auto.resolve(map.max_abs(), map.signed) };
-    let name = |i: usize| m.atoms.get(i - 1).map_or(String::new(), |a| format!("{}{i}", a.element().symbol));
-    let [a, b, c] = asked.atoms;
-    let how = format!("plane through {} {} {}", name(a), name(b), name(c));
     let file = Path::new(&doc.source).file_name().map_or(doc.source.clone(), |n| n.to_string_lossy().into_owned());
     let caption = vec![format!("{file} · {}", asked.source.name(doc)), plane::where_text(&how, &plane, asked.offset)];
     let scale = matches!(asked.source, Source::Wavefunction(crate::model::orbitals::Quantity::Potential))
@@ -191,13 +204,14 @@ fn make(asked: Asked) -> Result<Made, String> {
 
 /// The pane beside the view: the plane's controls and its map. `doc` and `source` are the
 /// active object's and its selected quantity's; `measured` the atoms of the last measurement
-/// (1-based, of this object). Returns whether *Save map* was pressed.
+/// (1-based, of this object); `facing` the plane the view faces (its target and line of
+/// sight, in the object's frame). Returns whether *Save map* was pressed.
 pub fn panel(
     ui: &mut egui::Ui,
     pane: &mut PlanePane,
-    doc: &Arc<Document>,
-    source: Option<Source>,
+    (doc, source): (&Arc<Document>, Option<Source>),
     measured: Option<[usize; 3]>,
+    facing: Through,
 ) -> bool {
     pane.poll(ui.ctx());
     let mut save = false;
@@ -219,8 +233,16 @@ pub fn panel(
             ui.label(RichText::new(source.name(doc)).strong());
             ui.horizontal_wrapped(|ui| {
                 ui.label("through atoms");
-                for a in &mut pane.atoms {
-                    ui.add(egui::DragValue::new(a).range(1..=n));
+                let mut atoms = match pane.through {
+                    Through::Atoms(atoms) => atoms,
+                    Through::Facing { .. } => [1, 2, 3],
+                };
+                let mut changed = false;
+                for a in &mut atoms {
+                    changed |= ui.add(egui::DragValue::new(a).range(1..=n)).changed();
+                }
+                if changed || matches!(pane.through, Through::Atoms(_)) {
+                    pane.through = Through::Atoms(atoms);
                 }
                 if let Some(atoms) = measured
                     && ui
@@ -228,7 +250,14 @@ pub fn panel(
                         .on_hover_text("the plane through the last angle or dihedral measured")
                         .clicked()
                 {
-                    pane.atoms = atoms;
+                    pane.through = Through::Atoms(atoms);
+                }
+                if ui
+                    .selectable_label(matches!(pane.through, Through::Facing { .. }), "the view's plane")
+                    .on_hover_text("the plane through the view's centre facing the viewer, as the view is now")
+                    .clicked()
+                {
+                    pane.through = facing;
                 }
             });
             ui.horizontal_wrapped(|ui| {
