@@ -613,3 +613,27 @@ fn a_plane_map_beside_the_view_is_exact_follows_the_plane_and_saves_its_figure()
     h.state().plane.save(&png).unwrap();
     assert!(image::open(&png).unwrap().width() > 200);
 }
+
+#[test]
+fn an_esp_map_is_framed_beside_its_colour_bar() {
+    let mut h = open(vec![fixture("wavefunctions/benzene_631gs.fchk")]);
+    h.get_by_label("ESP map").click();
+    wait_loaded(&mut h);
+    let app = h.state();
+    let view = app.view_rect().expect("a view");
+    let free = view.right() - orbcloud::app::legend::BAR_ROOM;
+    // The ρ = 0.002 surface reaches about 3.8 bohr past the nuclei: every atom's reach towards
+    // the bar stays left of it, and the surface is not shrunk to a corner.
+    let (right, _) = app.view.camera.screen_axes();
+    let reach: Vec<egui::Pos2> = app
+        .world()
+        .molecule
+        .atoms
+        .iter()
+        .map(|a| app.point_on_screen(a.position.as_vec3() + right * 3.8).unwrap())
+        .collect();
+    let rightmost = reach.iter().map(|p| p.x).fold(f32::MIN, f32::max);
+    assert!(rightmost < free, "the surface reaches x = {rightmost}, the bar starts at {free}");
+    let leftmost = reach.iter().map(|p| p.x).fold(f32::MAX, f32::min);
+    assert!(rightmost - leftmost > 0.3 * (free - view.left()), "framed to fill the free part: {leftmost}..{rightmost}");
+}

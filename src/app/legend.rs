@@ -6,6 +6,10 @@ use egui::{Color32, Pos2, Rect, vec2};
 
 use crate::scene::coloring::ValueMap;
 
+/// How much of the view's width (points, from its right edge) the bar and its labels take:
+/// what a map framed beside it leaves free.
+pub const BAR_ROOM: f32 = 130.0;
+
 /// Draws `map`'s bar at the right edge of `rect`, titled with the quantity `name`.
 pub fn value_bar(ui: &mut egui::Ui, rect: Rect, map: &ValueMap, name: &str) {
     let painter = ui.painter_at(rect);

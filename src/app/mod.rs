@@ -7,7 +7,7 @@ mod difference;
 pub mod files;
 pub mod jobs;
 mod joining;
-mod legend;
+pub mod legend;
 mod loader;
 pub mod measure;
 pub mod models;
@@ -508,6 +508,11 @@ impl OrbApp {
         self.viewport.as_ref()?.to_screen(&self.view.camera, position)
     }
 
+    /// Where a point of the scene (bohr) is drawn in the single-file view.
+    pub fn point_on_screen(&self, p: glam::Vec3) -> Option<egui::Pos2> {
+        self.viewport.as_ref()?.to_screen(&self.view.camera, p)
+    }
+
     /// Where the 3-D view lies in the window (as last laid out).
     pub fn view_rect(&self) -> Option<egui::Rect> {
         self.viewport.as_ref()?.rect()
@@ -794,6 +799,32 @@ impl OrbApp {
     pub fn reframe(&mut self) {
         let framed = self.framing_camera();
         (self.view.camera.target, self.view.camera.distance) = (framed.target, framed.distance);
+    }
+
+    /// Frames the active object's ρ = 0.002 surface (its atoms padded by the surface's reach)
+    /// in the part of the view its colour bar leaves free, looking as the view does.
+    fn frame_beside_bar(&mut self) {
+        // The 0.002 a.u. density surface lies about a van der Waals radius beyond the nuclei.
+        const REACH: f32 = 3.8;
+        let (Some(o), Some(vp)) = (self.objects.get(self.active), &self.viewport) else { return };
+        let (Some(rect), Some(aspect)) = (vp.rect(), vp.aspect()) else { return };
+        let m = o.state.placement.world_from_object();
+        let atoms: Vec<glam::Vec3> =
+            o.doc.molecule.atoms.iter().map(|a| m.transform_point3(a.position.as_vec3())).collect();
+        let Some((lo, hi)) = atoms.iter().fold(None, |b: Option<(glam::Vec3, glam::Vec3)>, &p| {
+            Some(b.map_or((p, p), |(lo, hi)| (lo.min(p), hi.max(p))))
+        }) else {
+            return;
+        };
+        let camera = &mut self.view.camera;
+        camera.target = 0.5 * (lo + hi);
+        camera.distance = 0.0;
+        let free = ((rect.width() - legend::BAR_ROOM) / rect.width().max(1.0)).clamp(0.3, 1.0);
+        camera.fit_points(atoms.iter().copied(), aspect * free, REACH);
+        // The framed scene's centre moves to the middle of the free part, left of the bar.
+        let (right, _) = camera.screen_axes();
+        let world_per_point = 2.0 * camera.distance * (0.5 * camera.fov_y).tan() / rect.height().max(1.0);
+        camera.target += right * (0.5 * legend::BAR_ROOM * world_per_point);
     }
 
     /// A camera that frames every object where it is placed, looking at the first one as a new
@@ -1223,7 +1254,7 @@ impl eframe::App for OrbApp {
         // A scan shows its own orbitals; the browser belongs to the scene's objects.
         if let Some(o) = self.objects.get_mut(self.active).filter(|_| self.scan.is_none()) {
             let view = &mut self.view;
-            orbitals::panel(
+            let esp_map = orbitals::panel(
                 ui,
                 &o.doc,
                 &mut o.state,
@@ -1232,6 +1263,9 @@ impl eframe::App for OrbApp {
                 &mut self.scroll_to_frontier,
                 &mut view.panels.orbitals,
             );
+            if esp_map {
+                self.frame_beside_bar();
+            }
         }
         if let Some(o) = self.objects.get_mut(self.active).filter(|_| self.scan.is_none()) {
             vibrations::panel(ui, &o.doc, &mut o.state.vibration, &mut self.spectrum);

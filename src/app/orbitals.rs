@@ -34,7 +34,8 @@ enum Pick {
 
 /// The orbital browser of the object `state` describes: it edits `state` in place (the
 /// selected quantity's orbital or density, the spin listed, how orbitals are evaluated).
-/// `scroll_to_frontier` brings the HOMO's row into view once (after a file opens).
+/// `scroll_to_frontier` brings the HOMO's row into view once (after a file opens). Returns
+/// whether an ESP map was added (the view frames it beside its colour bar).
 pub fn panel(
     ui: &mut egui::Ui,
     doc: &Document,
@@ -43,8 +44,8 @@ pub fn panel(
     (panes, camera): (&mut Panes, &Camera),
     scroll_to_frontier: &mut bool,
     open: &mut bool,
-) {
-    let Some(wf) = &doc.wavefunction else { return };
+) -> bool {
+    let Some(wf) = &doc.wavefunction else { return false };
     let mut pick = None;
     egui::Panel::right("orbitals")
         .resizable(true)
@@ -145,6 +146,7 @@ pub fn panel(
                 pick = Some(p);
             }
         });
+    let mut esp_map = false;
     match pick {
         Some(Pick::Switch(q)) => {
             match state.selected_quantity_mut().filter(|s| matches!(s.source, Source::Wavefunction(_))) {
@@ -154,6 +156,7 @@ pub fn panel(
         }
         Some(Pick::Add(q)) => add(state, q, defaults),
         Some(Pick::EspMap) => {
+            esp_map = true;
             let map = QuantityState::esp_map(
                 Source::Wavefunction(Quantity::Density),
                 Source::Wavefunction(Quantity::Potential),
@@ -182,6 +185,7 @@ pub fn panel(
         }
         None => {}
     }
+    esp_map
 }
 
 /// Adds `q` to the object as a new quantity, selected.
