@@ -252,6 +252,26 @@ pub fn wavefunction_document(
     }
 }
 
+/// Orbitals as a program's log prints them, to `decimals` places: normalised like every file's
+/// and measured, but not repaired: a residual of the print's size is no writer's quirk, and a
+/// repair chosen by rounding noise would change good orbitals. The precision is recorded with
+/// the residual so that it is reported, not hidden.
+pub fn check_printed(wf: Wavefunction, program: &str, overlap: Option<OverlapFn>, decimals: u32) -> Wavefunction {
+    let mut wf = wf;
+    normalize_contractions(&mut wf);
+    let (repair, residual) = match overlap {
+        Some(overlap) => ("none", residual(&wf.orbitals, &overlap(&wf.basis))),
+        None => ("unchecked", f64::NAN),
+    };
+    wf.normalization = Normalization {
+        program: program.to_string(),
+        repair: repair.into(),
+        residual,
+        printed_decimals: Some(decimals),
+    };
+    wf
+}
+
 /// Checks the orbitals of a freshly read wavefunction and undoes a known writer quirk when the
 /// check fails (see the module documentation). `program` is the writer the file names, if any.
 /// Without an overlap function nothing is checked: the file is kept as read, residual NaN.
@@ -260,7 +280,8 @@ pub fn check_and_repair(wf: Wavefunction, program: Option<&str>, overlap: Option
     let Some(overlap) = overlap else {
         let mut wf = wf;
         normalize_contractions(&mut wf);
-        wf.normalization = Normalization { program: named, repair: "unchecked".into(), residual: f64::NAN };
+        wf.normalization =
+            Normalization { program: named, repair: "unchecked".into(), residual: f64::NAN, printed_decimals: None };
         return wf;
     };
     let measure = |wf: &Wavefunction| {
@@ -294,12 +315,14 @@ pub fn check_and_repair(wf: Wavefunction, program: Option<&str>, overlap: Option
                 program: repair.program().to_string(),
                 repair: repair.describe().to_string(),
                 residual: r,
+                printed_decimals: None,
             };
             fixed
         }
         None => {
             let mut wf = as_read;
-            wf.normalization = Normalization { program: named, repair: "none".into(), residual: raw };
+            wf.normalization =
+                Normalization { program: named, repair: "none".into(), residual: raw, printed_decimals: None };
             wf
         }
     }
