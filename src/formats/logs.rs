@@ -40,6 +40,9 @@ pub const BANNERS: &str =
 
 /// Parses a program's log into a document, the program told by its banner.
 pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Document, ParseError> {
+    if text.trim().is_empty() {
+        return Err(error(file, 1, BANNERS, "an empty file"));
+    }
     match program(text) {
         Some(Program::Gaussian) => gaussian_log::parse(file, text, overlap),
         Some(Program::Orca) => Err(error(
