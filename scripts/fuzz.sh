@@ -58,7 +58,7 @@ seed fchk tests/fixtures/wavefunctions/h2o_cart_631gs.fchk tests/fixtures/wavefu
 seed wfn tests/fixtures/wfn_wfx_mkl/*.wfn
 seed wfx tests/fixtures/wfn_wfx_mkl/*.wfx
 seed mkl tests/fixtures/wfn_wfx_mkl/*.mkl
-seed gaussian_log tests/fixtures/logs/*.log
+seed gaussian_log tests/fixtures/logs/*.log tests/fixtures/logs/*.out
 seed scan_manifest assets/psb3/*.scan.toml tests/fixtures/*/*.scan.toml
 # A session: a camera, two panes, an object with a cloud, an isosurface and a clipping plane.
 mkdir -p fuzz/seeds/session

@@ -171,6 +171,7 @@ fn aim_and_mkl_readers_survive_mutated_fixtures() {
 fn the_log_reader_survives_mutated_fixtures() {
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/logs");
     fuzz("log", &files_in(dir, "log"), read("fuzz.log"));
+    fuzz("out", &files_in(dir, "out"), read("fuzz.out"));
 }
 
 #[test]

@@ -12,6 +12,7 @@ const FIXTURES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/wave
 /// AIM `.wfn`/`.wfx` and ORCA `.mkl` fixtures.
 const AIM: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/wfn_wfx_mkl");
 const LOG: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/logs/h2_sto3g.log");
+const ORCA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/logs/h2_orca.out");
 
 /// A 2×2×3 bohr grid with one oxygen atom (line 7) and its 12 values (lines 8–9).
 fn cube(atom: &str, axes: [&str; 3], origin: &str) -> String {
@@ -347,7 +348,9 @@ fn truncated_files_never_panic() {
     let aim = |name: &str| std::fs::read_to_string(format!("{AIM}/{name}")).unwrap();
     let (wfn, wfx, mkl) = (aim("oh_rohf.wfn"), aim("oh_rohf.wfx"), aim("oh_rohf.mkl"));
     let log = std::fs::read_to_string(LOG).unwrap();
+    let orca = std::fs::read_to_string(ORCA).unwrap();
     for (name, text) in [
+        ("t.out", &orca),
         ("t.cube", &cube),
         ("t.molden", &molden),
         ("t.fchk", &fchk),
@@ -513,4 +516,19 @@ fn gaussian_logs_with_lying_counts_are_refused_at_their_line() {
     let e = refused("gamess.out", b" GAMESS VERSION = 30 SEP 2017 (R1)\n EXECUTION OF GAMESS BEGUN\n");
     assert!(e.expected.contains("Entering Gaussian System") && e.expected.contains("O   R   C   A"), "{e}");
     assert_eq!(e.line, 1);
+}
+
+/// An ORCA output whose shell claims 10¹¹ primitives, or whose orbital rows name the wrong atom,
+/// is refused at its line.
+#[test]
+fn orca_outputs_with_lying_counts_are_refused_at_their_line() {
+    let orca = std::fs::read_to_string(ORCA).unwrap();
+    assert!(formats::load_bytes(Path::new("h2.out"), orca.as_bytes()).is_ok());
+    let bad = orca.replacen(" S 3 ", " S 99999999999 ", 1);
+    let e = refused("count.out", bad.as_bytes());
+    assert!(e.expected.contains("primitive"), "{e}");
+    let bad = orca.replacen("  1H   1s", "  0H   1s", 1);
+    let e = refused("atom.out", bad.as_bytes());
+    assert_eq!(e.line, bad.lines().position(|l| l.starts_with("  0H") && l.contains('-')).unwrap() + 1, "{e}");
+    assert!(e.expected.contains("function of atom 1"), "{e}");
 }

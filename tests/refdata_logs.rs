@@ -1,7 +1,8 @@
 //! The program logs of ../shared/refdata/real-world/logs (Gaussian 09 runs of divinylbenzene,
 //! see its MANIFEST.md): the single point's orbitals agree with its fchk twin's within what 5
 //! printed decimals allow, the optimisation opens as frames with their energies, the frequency
-//! job's modes are the log's; other programs' outputs are refused naming what was looked for.
+//! job's modes are the log's; ORCA 6's single point opens with its printed orbitals; other
+//! programs' outputs are refused naming what was looked for.
 
 use std::path::{Path, PathBuf};
 
@@ -153,4 +154,40 @@ fn other_programs_outputs_are_refused_naming_the_banners() {
         let e = formats::load(&dir.join(name)).expect_err(name).to_string();
         assert!(e.contains(name) && e.contains("Entering Gaussian System") && e.contains("O   R   C   A"), "{e}");
     }
+}
+
+#[test]
+fn the_orca_single_point_opens_with_its_printed_orbitals() {
+    let Some(dir) = logs("refdata_logs::the_orca_single_point_opens_with_its_printed_orbitals") else { return };
+    let path = dir.join("basicORCA6.0_dvb_sp_dft.out");
+    let doc = load(&path);
+    let text = std::fs::read_to_string(&path).unwrap();
+    // The ORBITAL ENERGIES table, read here on its own: `NO OCC E(Eh) E(eV) Irrep`.
+    let table: Vec<(f64, f64)> = text
+        .lines()
+        .skip_while(|l| l.trim() != "ORBITAL ENERGIES")
+        .skip(4)
+        .map_while(|l| {
+            let t: Vec<&str> = l.split_whitespace().collect();
+            (t.len() >= 4).then(|| (t[1].parse().ok(), t[2].parse().ok())).and_then(|(o, e)| Some((o?, e?)))
+        })
+        .collect();
+    let wf = doc.wavefunction.as_ref().expect("orbitals");
+    assert_eq!(doc.molecule.atoms.len(), 20);
+    assert_eq!(wf.basis.n_functions(), 60);
+    // The table lists the occupied orbitals and the first virtual ones; the blocks print all.
+    assert_eq!(wf.orbitals.len(), 60);
+    assert!(table.len() > 35, "{} rows in ORBITAL ENERGIES", table.len());
+    for (k, (o, (occupation, energy))) in wf.orbitals.iter().zip(&table).enumerate() {
+        assert_eq!(o.occupation, *occupation, "orbital {k}");
+        assert!((o.energy - energy).abs() <= 1e-5, "orbital {k}: {} and {energy}", o.energy);
+    }
+    let electrons: f64 = wf.orbitals.iter().map(|o| o.occupation).sum();
+    assert_eq!(electrons, 70.0);
+    let n = &wf.normalization;
+    eprintln!("ORCA sp: max |CᵀSC − I| = {:.2e}", n.residual);
+    assert_eq!((n.program.as_str(), n.repair.as_str(), n.printed_decimals), ("ORCA", "none", Some(6)));
+    // Orthonormal to the print's precision only with the p functions taken as z, x, y.
+    assert!(n.residual > 0.0 && n.residual < n.expected_residual(), "{n:?}");
+    assert!(doc.title.contains("b3lyp"), "{}", doc.title);
 }

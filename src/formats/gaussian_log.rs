@@ -34,7 +34,7 @@
 
 use glam::DVec3;
 
-use super::logs::{LogLines, decimals, error, trailing_numbers};
+use super::logs::{Geometry as Orientation, LogLines, decimals, error, frames, trailing_numbers, trajectory};
 use super::text::parse_real;
 use super::wavefunction::{OverlapFn, check_printed, to_model_order};
 use super::{MAX_Z, ParseError};
@@ -52,14 +52,6 @@ pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Docum
     let log = LogLines::new(file, text);
     let scan = Scan::read(&log)?;
     scan.into_document(&log, overlap)
-}
-
-/// One orientation table: its header's 0-based line, atomic numbers and positions (bohr).
-#[derive(Debug, Clone)]
-struct Orientation {
-    line: usize,
-    z: Vec<u32>,
-    positions: Vec<DVec3>,
 }
 
 /// A `gfinput` shell as printed: its atom (1-based), type letters, exponents and coefficient
@@ -174,23 +166,9 @@ impl Scan {
         if self.standard.is_empty() { &self.input } else { &self.standard }
     }
 
-    /// The frames: each orientation with the first energy printed after it (before the next),
-    /// those printed again at an unchanged geometry without a new energy left out.
+    /// The frames: each orientation with its `SCF Done` energy.
     fn frames(&self) -> Vec<(&Orientation, Option<f64>)> {
-        let all = self.orientations();
-        let mut out: Vec<(&Orientation, Option<f64>)> = Vec::new();
-        for (k, o) in all.iter().enumerate() {
-            let end = all.get(k + 1).map_or(usize::MAX, |n| n.line);
-            let energy = self.energies.iter().find(|(l, _)| *l > o.line && *l < end).map(|e| e.1);
-            if energy.is_none()
-                && let Some((last, _)) = out.last()
-                && same_geometry(last, o)
-            {
-                continue;
-            }
-            out.push((o, energy));
-        }
-        out
+        frames(self.orientations(), &self.energies)
     }
 
     fn into_document(self, log: &LogLines, overlap: Option<OverlapFn>) -> Result<Document, ParseError> {
@@ -457,10 +435,6 @@ fn shell_l(letters: &str) -> Option<u32> {
         return None;
     }
     SHELL_LETTERS.find(c).map(|l| l as u32).filter(|&l| l <= MAX_L)
-}
-
-fn same_geometry(a: &Orientation, b: &Orientation) -> bool {
-    a.z == b.z && a.positions.iter().zip(&b.positions).all(|(p, q)| p.distance(*q) < 1e-5)
 }
 
 /// The route section: from its `#` line up to the dashes, lines joined as Gaussian wrapped them.
@@ -829,29 +803,6 @@ fn vibrations(
         geometry: geometry.positions.clone(),
         geometry_from: format!("the orientation at line {}", geometry.line + 1),
     })
-}
-
-/// The document of a log without orbitals: every frame as a model, its energy kept with it.
-fn trajectory(file: &str, title: &str, frames: &[(&Orientation, Option<f64>)]) -> Document {
-    let z: Vec<u8> = frames.first().map(|f| f.0.z.iter().map(|&z| z as u8).collect()).unwrap_or_default();
-    let named: Vec<(String, Vec<DVec3>)> = frames
-        .iter()
-        .enumerate()
-        .map(|(k, (o, e))| {
-            let name = match e {
-                Some(e) => format!("step {}: E = {e:.9} Eh (line {})", k + 1, o.line + 1),
-                None => format!("step {} (line {})", k + 1, o.line + 1),
-            };
-            (name, o.positions.clone())
-        })
-        .collect();
-    let mut doc = super::structure::trajectory(file, title, &z, &named);
-    if let Some(view) = doc.structure.as_mut() {
-        for (model, (_, e)) in view.structure.models.iter_mut().zip(frames) {
-            model.energy = *e;
-        }
-    }
-    doc
 }
 
 #[cfg(test)]

@@ -5,9 +5,11 @@
 //! What the readers of logs share: the lines with their numbers, numbers in fixed-width
 //! columns, and the errors they raise.
 
+use glam::DVec3;
+
 use super::text::{excerpt, parse_real};
 use super::wavefunction::OverlapFn;
-use super::{ParseError, gaussian_log};
+use super::{ParseError, gaussian_log, orca_log};
 use crate::model::Document;
 
 /// Lines of the file's top in which the program's banner is looked for: a job scheduler may
@@ -45,12 +47,7 @@ pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Docum
     }
     match program(text) {
         Some(Program::Gaussian) => gaussian_log::parse(file, text, overlap),
-        Some(Program::Orca) => Err(error(
-            file,
-            1,
-            "a Gaussian log (ORCA's output is recognised but not read yet)",
-            "ORCA's banner \"O   R   C   A\"",
-        )),
+        Some(Program::Orca) => orca_log::parse(file, text, overlap),
         None => Err(error(
             file,
             1,
@@ -106,6 +103,60 @@ pub(crate) fn trailing_numbers(line: &str, count: usize, width: usize) -> Option
     let values: Option<Vec<f64>> = tokens[first..].iter().map(|t| parse_real(t)).collect();
     let head_len = tokens[first..].first().map_or(line.len(), |t| t.as_ptr() as usize - line.as_ptr() as usize);
     Some((values?, &line[..head_len]))
+}
+
+/// One geometry a log prints: its header's 0-based line, atomic numbers and positions (bohr).
+#[derive(Debug, Clone)]
+pub(crate) struct Geometry {
+    pub line: usize,
+    pub z: Vec<u32>,
+    pub positions: Vec<DVec3>,
+}
+
+fn same_geometry(a: &Geometry, b: &Geometry) -> bool {
+    a.z == b.z && a.positions.iter().zip(&b.positions).all(|(p, q)| p.distance(*q) < 1e-5)
+}
+
+/// The frames of a series (an optimisation's, a scan's, an IRC's steps): each geometry with the
+/// first energy printed after it and before the next; a geometry printed again unchanged without
+/// a new energy (the converged one, printed once more at the end) is no new frame.
+pub(crate) fn frames<'a>(all: &'a [Geometry], energies: &[(usize, f64)]) -> Vec<(&'a Geometry, Option<f64>)> {
+    let mut out: Vec<(&Geometry, Option<f64>)> = Vec::new();
+    for (k, g) in all.iter().enumerate() {
+        let end = all.get(k + 1).map_or(usize::MAX, |n| n.line);
+        let energy = energies.iter().find(|(l, _)| *l > g.line && *l < end).map(|e| e.1);
+        if energy.is_none()
+            && let Some((last, _)) = out.last()
+            && same_geometry(last, g)
+        {
+            continue;
+        }
+        out.push((g, energy));
+    }
+    out
+}
+
+/// The document of a log without orbitals: every frame as a model, its energy kept with it.
+pub(crate) fn trajectory(file: &str, title: &str, frames: &[(&Geometry, Option<f64>)]) -> Document {
+    let z: Vec<u8> = frames.first().map(|f| f.0.z.iter().map(|&z| z as u8).collect()).unwrap_or_default();
+    let named: Vec<(String, Vec<DVec3>)> = frames
+        .iter()
+        .enumerate()
+        .map(|(k, (g, e))| {
+            let name = match e {
+                Some(e) => format!("step {}: E = {e:.9} Eh (line {})", k + 1, g.line + 1),
+                None => format!("step {} (line {})", k + 1, g.line + 1),
+            };
+            (name, g.positions.clone())
+        })
+        .collect();
+    let mut doc = super::structure::trajectory(file, title, &z, &named);
+    if let Some(view) = doc.structure.as_mut() {
+        for (model, (_, e)) in view.structure.models.iter_mut().zip(frames) {
+            model.energy = *e;
+        }
+    }
+    doc
 }
 
 /// Digits after the decimal point of a printed number ("-0.02805" → 5).

@@ -13,6 +13,7 @@ pub mod mkl;
 pub mod mmcif;
 pub mod modes;
 pub mod molden;
+pub mod orca_log;
 pub mod pdb;
 mod primitives;
 pub mod scan;
