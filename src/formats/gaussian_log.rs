@@ -23,9 +23,10 @@
 //!   Harmonic frequencies (cm**-1), IR intensities (KM/Mole), …  normal modes, 3 a block, or 5
 //!                                                             with `freq=hpmodes` (`---`)
 //! ```
-//! Each orientation followed by an `SCF Done` energy is a frame (an optimisation's, a scan's, an
-//! IRC's steps): an orientation printed again without a new energy (the converged geometry
-//! after "Optimization completed") is no new frame. The orbitals belong to the last orientation
+//! Each orientation followed by an `SCF Done` energy is a frame (an optimisation's, an IRC's
+//! steps): an orientation printed again without a new energy (the converged geometry after
+//! "Optimization completed") is no new frame; a relaxed scan (several "Optimization completed")
+//! keeps one frame per point, its converged geometry. The orbitals belong to the last orientation
 //! printed before them. Within a shell Gaussian orders functions as its fchk files do
 //! ([`super::fchk::gaussian_cartesian_order`], pure m = 0, +1, −1, …); the AO labels of the
 //! orbital rows (`3D 0` or `3XX`) say whether each shell is pure or cartesian, and must agree
@@ -99,6 +100,8 @@ struct Scan {
     cartesian: Option<(bool, bool, usize)>,
     sections: Vec<MoSection>,
     electrons: Option<(usize, usize)>,
+    /// Lines of "Optimization completed": several make a relaxed scan.
+    completed: Vec<usize>,
     modes: Option<(usize, Vec<NormalMode>)>,
 }
 
@@ -141,6 +144,8 @@ impl Scan {
                 s.sections.push(section);
                 i = next;
                 continue;
+            } else if t.starts_with("Optimization completed") {
+                s.completed.push(i);
             } else if t.contains("alpha electrons") && t.contains("beta electrons") {
                 let n: Vec<usize> = t.split_whitespace().filter_map(|w| w.parse().ok()).collect();
                 if let [a, b] = n[..] {
@@ -167,8 +172,23 @@ impl Scan {
     }
 
     /// The frames: each orientation with its `SCF Done` energy.
+    /// A relaxed scan (`opt=modredundant`, one "Optimization completed" per point) keeps the
+    /// converged geometry of each point, the last before its "Optimization completed"; any other
+    /// series keeps every step.
     fn frames(&self) -> Vec<(&Orientation, Option<f64>)> {
-        frames(self.orientations(), &self.energies)
+        let all = frames(self.orientations(), &self.energies);
+        if self.completed.len() < 2 {
+            return all;
+        }
+        let mut points: Vec<(&Orientation, Option<f64>)> = Vec::new();
+        for &c in &self.completed {
+            if let Some(&f) = all.iter().rev().find(|f| f.0.line < c)
+                && points.last().is_none_or(|p| p.0.line != f.0.line)
+            {
+                points.push(f);
+            }
+        }
+        points
     }
 
     fn into_document(self, log: &LogLines, overlap: Option<OverlapFn>) -> Result<Document, ParseError> {

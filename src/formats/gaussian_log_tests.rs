@@ -446,3 +446,28 @@ fn normal_modes_are_read_from_either_layout_hpmodes_first() {
     let d = both.vibrations.as_ref().unwrap().modes[1].displacement[1].x;
     assert!((d * 100.0 - (d * 100.0).round()).abs() > 1e-6, "{d}");
 }
+
+#[test]
+fn a_relaxed_scan_keeps_the_converged_geometry_of_each_point() {
+    let mut text = format!("{HEADER}{}", route("opt=modredundant"));
+    // Two points of two optimisation steps each; each point ends with its converged geometry.
+    let mut k = 0;
+    for point in 0..2 {
+        for step in 0..2 {
+            let scale = 1.0 + 0.01 * (2 * point + step) as f64;
+            text += &orientation_table("Standard orientation:", scale);
+            text += &format!(" SCF Done:  E(RB3LYP) =  -76.0{k}0000000     A.U. after    9 cycles\n");
+            k += 1;
+        }
+        text += " Optimization completed.\n    -- Stationary point found.\n";
+        text += &orientation_table("Standard orientation:", 1.0 + 0.01 * (2 * point + 1) as f64);
+    }
+    let doc = read(&text).unwrap_or_else(|e| panic!("{e}"));
+    let s = &doc.structure.as_ref().expect("frames").structure;
+    let energies: Vec<Option<f64>> = s.models.iter().map(|m| m.energy).collect();
+    assert_eq!(energies, vec![Some(-76.01), Some(-76.03)], "{:?}", s.models);
+    // Without a second "Optimization completed" every step is a frame.
+    let one = text.replacen(" Optimization completed.", " Optimization stopped.", 1);
+    let doc = read(&one).unwrap();
+    assert_eq!(doc.structure.as_ref().unwrap().structure.models.len(), 4);
+}
