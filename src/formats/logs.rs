@@ -118,16 +118,17 @@ fn same_geometry(a: &Geometry, b: &Geometry) -> bool {
 }
 
 /// The frames of a series (an optimisation's, a scan's, an IRC's steps): each geometry with the
-/// first energy printed after it and before the next; a geometry printed again unchanged without
-/// a new energy (the converged one, printed once more at the end) is no new frame.
+/// first energy printed after it and before the next; a geometry printed again unchanged, without
+/// an energy or with the same one (the converged one, printed or evaluated once more at the end),
+/// is no new frame.
 pub(crate) fn frames<'a>(all: &'a [Geometry], energies: &[(usize, f64)]) -> Vec<(&'a Geometry, Option<f64>)> {
     let mut out: Vec<(&Geometry, Option<f64>)> = Vec::new();
     for (k, g) in all.iter().enumerate() {
         let end = all.get(k + 1).map_or(usize::MAX, |n| n.line);
         let energy = energies.iter().find(|(l, _)| *l > g.line && *l < end).map(|e| e.1);
-        if energy.is_none()
-            && let Some((last, _)) = out.last()
+        if let Some((last, last_energy)) = out.last()
             && same_geometry(last, g)
+            && (energy.is_none() || energy == *last_energy)
         {
             continue;
         }
@@ -169,6 +170,16 @@ pub(crate) fn decimals(token: &str) -> Option<u32> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_geometry_repeated_without_a_new_energy_is_no_new_frame() {
+        let g = |line, x| Geometry { line, z: vec![1], positions: vec![DVec3::new(x, 0.0, 0.0)] };
+        let all = [g(0, 0.0), g(10, 0.5), g(20, 0.5), g(30, 0.5), g(40, 0.5)];
+        // Energies after lines 0, 10 and 20 (the same value twice), then 40 (a new one).
+        let energies = [(5, -1.0), (15, -1.5), (25, -1.5), (45, -1.6)];
+        let kept: Vec<(usize, Option<f64>)> = frames(&all, &energies).iter().map(|(g, e)| (g.line, *e)).collect();
+        assert_eq!(kept, vec![(0, Some(-1.0)), (10, Some(-1.5)), (40, Some(-1.6))]);
+    }
 
     #[test]
     fn programs_are_told_by_their_banner() {
