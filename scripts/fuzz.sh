@@ -10,7 +10,7 @@ cd "$(dirname "$0")/.."
 execs="${1:-10000000}"
 shift || true
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(cube cube_gz molden fchk wfn wfx mkl scan_manifest session pdb mmcif xyz)
+[ ${#targets[@]} -gt 0 ] || targets=(cube cube_gz molden fchk wfn wfx mkl scan_manifest session pdb mmcif xyz gaussian_log)
 
 command -v cargo-afl >/dev/null || cargo install cargo-afl --locked
 # Seeds: the fixtures each reader is tested with, kept small (AFL slows on big inputs).
@@ -58,6 +58,7 @@ seed fchk tests/fixtures/wavefunctions/h2o_cart_631gs.fchk tests/fixtures/wavefu
 seed wfn tests/fixtures/wfn_wfx_mkl/*.wfn
 seed wfx tests/fixtures/wfn_wfx_mkl/*.wfx
 seed mkl tests/fixtures/wfn_wfx_mkl/*.mkl
+seed gaussian_log tests/fixtures/logs/*.log tests/fixtures/logs/*.out
 seed scan_manifest assets/psb3/*.scan.toml tests/fixtures/*/*.scan.toml
 # A session: a camera, two panes, an object with a cloud, an isosurface and a clipping plane.
 mkdir -p fuzz/seeds/session

@@ -168,6 +168,13 @@ fn aim_and_mkl_readers_survive_mutated_fixtures() {
 }
 
 #[test]
+fn the_log_reader_survives_mutated_fixtures() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/logs");
+    fuzz("log", &files_in(dir, "log"), read("fuzz.log"));
+    fuzz("out", &files_in(dir, "out"), read("fuzz.out"));
+}
+
+#[test]
 fn scan_manifests_survive_mutations() {
     let atom = |z, x, y, w| Atom { z, charge: z as f64, position: DVec3::new(x, y, w), ghost: false };
     let frame = Document {

@@ -11,6 +11,8 @@ use orbcloud::formats::{self, LoadError, MAX_LINE_BYTES, MAX_TRAILING_BYTES, Par
 const FIXTURES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/wavefunctions");
 /// AIM `.wfn`/`.wfx` and ORCA `.mkl` fixtures.
 const AIM: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/wfn_wfx_mkl");
+const LOG: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/logs/h2_sto3g.log");
+const ORCA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/logs/h2_orca.out");
 
 /// A 2×2×3 bohr grid with one oxygen atom (line 7) and its 12 values (lines 8–9).
 fn cube(atom: &str, axes: [&str; 3], origin: &str) -> String {
@@ -302,9 +304,22 @@ fn empty_binary_and_endless_files_are_refused_in_every_format() {
         })
         .collect();
     let long_line = vec![b'7'; 3 * MAX_LINE_BYTES];
-    for ext in
-        ["cube", "molden", "fchk", "wfn", "wfx", "mkl", "cube.gz", "molden.gz", "fchk.gz", "wfn.gz", "wfx.gz", "mkl.gz"]
-    {
+    for ext in [
+        "cube",
+        "molden",
+        "fchk",
+        "wfn",
+        "wfx",
+        "mkl",
+        "log",
+        "cube.gz",
+        "molden.gz",
+        "fchk.gz",
+        "wfn.gz",
+        "wfx.gz",
+        "mkl.gz",
+        "out.gz",
+    ] {
         let name = format!("hostile.{ext}");
         let e = refused(&name, b"");
         assert!(e.found.contains("empty file"), "{name}: {e}");
@@ -332,9 +347,18 @@ fn truncated_files_never_panic() {
     let fchk = std::fs::read_to_string(format!("{FIXTURES}/h2o_cart_631gs.fchk")).unwrap();
     let aim = |name: &str| std::fs::read_to_string(format!("{AIM}/{name}")).unwrap();
     let (wfn, wfx, mkl) = (aim("oh_rohf.wfn"), aim("oh_rohf.wfx"), aim("oh_rohf.mkl"));
-    for (name, text) in
-        [("t.cube", &cube), ("t.molden", &molden), ("t.fchk", &fchk), ("t.wfn", &wfn), ("t.wfx", &wfx), ("t.mkl", &mkl)]
-    {
+    let log = std::fs::read_to_string(LOG).unwrap();
+    let orca = std::fs::read_to_string(ORCA).unwrap();
+    for (name, text) in [
+        ("t.out", &orca),
+        ("t.cube", &cube),
+        ("t.molden", &molden),
+        ("t.fchk", &fchk),
+        ("t.wfn", &wfn),
+        ("t.wfx", &wfx),
+        ("t.mkl", &mkl),
+        ("t.log", &log),
+    ] {
         let step = (text.len() / 97).max(1);
         for cut in (0..text.len()).step_by(step) {
             if let Ok(cut_text) = std::str::from_utf8(&text.as_bytes()[..cut]) {
@@ -462,4 +486,49 @@ fn fuzzing_findings_stay_fixed() {
         let err = formats::load_bytes(Path::new(name), text.as_bytes()).expect_err("no atoms to show");
         assert!(err.to_string().contains(name), "{err}");
     }
+}
+
+/// A Gaussian log whose counts lie: a shell of 10¹¹ primitives, an orbital block whose rows stop,
+/// an orientation without its closing dashes. Each is refused at its line, nothing is allocated
+/// from a count, and a log of another program is refused naming what was looked for.
+#[test]
+fn gaussian_logs_with_lying_counts_are_refused_at_their_line() {
+    let log = std::fs::read_to_string(LOG).unwrap();
+    assert!(formats::load_bytes(Path::new("h2.log"), log.as_bytes()).is_ok());
+    let line_of = |text: &str, needle: &str| text.lines().position(|l| l.contains(needle)).unwrap() + 1;
+
+    let bad = log.replacen(" S   3 1.00", " S   99999999999 1.00", 1);
+    let start = Instant::now();
+    let e = refused("count.log", bad.as_bytes());
+    assert!(start.elapsed() < Duration::from_secs(2));
+    assert!(e.expected.contains("primitive"), "{e}");
+
+    let bad = log.replacen("   2 2   H  1S          0.54884  -1.21245\n", "", 1);
+    let e = refused("rows.log", bad.as_bytes());
+    assert_eq!(e.line, line_of(&bad, "Molecular Orbital Coefficients:"), "{e}");
+    assert!(e.expected.contains("2 rows of coefficients (the basis set's functions)"), "{e}");
+
+    let cut = &log[..log.find(" Standard basis").unwrap()];
+    let bad = cut.trim_end().rsplit_once('\n').unwrap().0.to_string() + "\n";
+    let e = refused("cut.log", bad.as_bytes());
+    assert!(e.expected.contains("dashes that close the orientation table"), "{e}");
+
+    let e = refused("gamess.out", b" GAMESS VERSION = 30 SEP 2017 (R1)\n EXECUTION OF GAMESS BEGUN\n");
+    assert!(e.expected.contains("Entering Gaussian System") && e.expected.contains("O   R   C   A"), "{e}");
+    assert_eq!(e.line, 1);
+}
+
+/// An ORCA output whose shell claims 10¹¹ primitives, or whose orbital rows name the wrong atom,
+/// is refused at its line.
+#[test]
+fn orca_outputs_with_lying_counts_are_refused_at_their_line() {
+    let orca = std::fs::read_to_string(ORCA).unwrap();
+    assert!(formats::load_bytes(Path::new("h2.out"), orca.as_bytes()).is_ok());
+    let bad = orca.replacen(" S 3 ", " S 99999999999 ", 1);
+    let e = refused("count.out", bad.as_bytes());
+    assert!(e.expected.contains("primitive"), "{e}");
+    let bad = orca.replacen("  1H   1s", "  0H   1s", 1);
+    let e = refused("atom.out", bad.as_bytes());
+    assert_eq!(e.line, bad.lines().position(|l| l.starts_with("  0H") && l.contains('-')).unwrap() + 1, "{e}");
+    assert!(e.expected.contains("function of atom 1"), "{e}");
 }

@@ -64,7 +64,7 @@ pub fn native(purpose: Purpose, file_name: &str) -> Native {
     let chosen = match purpose {
         Purpose::Open => dialog
             .add_filter(
-                "Cube, Molden, fchk, wfn, wfx, MKL, PDB, mmCIF, XYZ, scan, session",
+                "Cube, Molden, fchk, wfn, wfx, MKL, PDB, mmCIF, XYZ, Gaussian/ORCA log, scan, session",
                 &crate::formats::extensions()
                     .filter_map(|e| e.rsplit('.').next())
                     .chain(["toml", "gz"])

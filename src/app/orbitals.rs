@@ -56,17 +56,18 @@ pub fn panel(
             let n = &wf.normalization;
             ui.label(
                 RichText::new(format!(
-                    "{} basis functions, {} orbitals · written by {} · repair: {} · |C^T S C - I| {:.1e}",
+                    "{} basis functions, {} orbitals · written by {} · repair: {} · |C^T S C - I| {:.1e}{}",
                     wf.basis.n_functions(),
                     wf.orbitals.len(),
                     n.program,
                     n.repair,
-                    n.residual
+                    n.residual,
+                    n.precision_note().map_or(String::new(), |p| format!(" · {p}"))
                 ))
                 .small()
                 .weak(),
             );
-            if n.residual > ORTHONORMAL_TOLERANCE {
+            if n.residual > ORTHONORMAL_TOLERANCE.max(n.expected_residual()) {
                 ui.label(
                     RichText::new("Warning: these orbitals are not orthonormal in this basis: the file may be wrong")
                         .color(ui.visuals().warn_fg_color),

@@ -66,6 +66,8 @@ pub struct ModelInfo {
     pub number: i32,
     pub atoms: usize,
     pub title: String,
+    /// The frame's energy (hartree), where the file gives one (a program log's steps).
+    pub energy_hartree: Option<f64>,
 }
 
 #[derive(Serialize)]
@@ -129,7 +131,12 @@ fn structure_info(view: &crate::model::StructureView) -> StructureInfo {
         models: s
             .models
             .iter()
-            .map(|m| ModelInfo { number: m.number, atoms: len(&m.atoms), title: m.title.clone() })
+            .map(|m| ModelInfo {
+                number: m.number,
+                atoms: len(&m.atoms),
+                title: m.title.clone(),
+                energy_hartree: m.energy,
+            })
             .collect(),
         chains: s
             .chains
@@ -248,6 +255,14 @@ pub fn text(doc: &Document) -> String {
             st.all_atoms
         );
     }
+    if let Some(st) = &info.structure
+        && st.models.iter().any(|m| m.energy_hartree.is_some())
+    {
+        for m in &st.models {
+            let e = m.energy_hartree.map_or("no energy".to_string(), |e| format!("E = {e:.9} Eh"));
+            let _ = writeln!(s, "  frame {:>3}: {e}", m.number);
+        }
+    }
     for a in &info.atoms {
         let p = a.position_bohr;
         let ang = p.map(|v| v * ANGSTROM_PER_BOHR);
@@ -297,11 +312,12 @@ pub fn text(doc: &Document) -> String {
         );
         let _ = writeln!(
             s,
-            "written by {}; repair: {}; max |CᵀSC − I| = {:.2e}{}",
+            "written by {}; repair: {}; max |CᵀSC − I| = {:.2e}{}{}",
             n.program,
             n.repair,
             n.residual,
-            if n.residual > 1e-5 { "  ⚠ not orthonormal" } else { "" }
+            n.precision_note().map_or(String::new(), |p| format!("; {p}")),
+            if n.residual > n.expected_residual() { "  ⚠ not orthonormal" } else { "" }
         );
         if w.natural {
             let energies = w.energies_as_occupations.map_or(String::new(), |e| format!("; {}", e.describe()));

@@ -6,11 +6,14 @@ pub mod cube;
 pub mod cube_write;
 mod error;
 pub mod fchk;
+pub mod gaussian_log;
+pub mod logs;
 pub mod mesh_write;
 pub mod mkl;
 pub mod mmcif;
 pub mod modes;
 pub mod molden;
+pub mod orca_log;
 pub mod pdb;
 mod primitives;
 pub mod scan;
@@ -90,6 +93,7 @@ fn parse_text(name: &str, reader: Reader, text: Bounded, overlap: Option<Overlap
         Reader::Pdb => pdb::parse(name, &text.text),
         Reader::Mmcif => mmcif::parse(name, &text.text),
         Reader::Xyz => xyz::parse(name, &text.text),
+        Reader::Log => logs::parse(name, &text.text, overlap),
     };
     // When reading stopped early the parser names the first fault in what was read, if it
     // sees one; otherwise the reason reading stopped is the error.
@@ -112,6 +116,7 @@ enum Reader {
     Pdb,
     Mmcif,
     Xyz,
+    Log,
 }
 
 /// A file format a reader takes: what users call it and the file name endings it has (each also
@@ -134,6 +139,7 @@ pub const FORMATS: &[Format] = &[
     Format { name: "PDB", endings: &[".pdb", ".ent"], reader: Reader::Pdb },
     Format { name: "mmCIF", endings: &[".cif", ".mmcif"], reader: Reader::Mmcif },
     Format { name: "XYZ", endings: &[".xyz"], reader: Reader::Xyz },
+    Format { name: "Gaussian or ORCA output", endings: &[".log", ".out"], reader: Reader::Log },
 ];
 
 /// The file name endings [`load`] reads (each also gzipped, `.gz`).

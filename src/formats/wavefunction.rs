@@ -113,10 +113,9 @@ impl Repair {
                             *c *= extra / cartesian_norm(a, p);
                         }
                     }
-                    if self == Repair::Orca && pure && (3..=5).contains(&l) {
-                        // m = ±3 and ±4 sit after 0, ±1, ±2: positions 5..9 in the shell (h±5 keep
-                        // their sign).
-                        for f in &mut row_factor[first + 5..first + (2 * l as usize + 1).min(9)] {
+                    if self == Repair::Orca && pure {
+                        let flipped = orca_flipped(l);
+                        for f in &mut row_factor[first + flipped.start..first + flipped.end] {
                             *f = -1.0;
                         }
                     }
@@ -157,6 +156,13 @@ impl Repair {
         }
         out
     }
+}
+
+/// The functions of a pure shell of `l` whose sign ORCA writes opposite to the real solid
+/// harmonics' (the m = ±3 and ±4 of f, g and h, which sit after 0, ±1, ±2: positions 5..9 in
+/// the shell; h±5 keep their sign), in its Molden files and its printed orbitals alike.
+pub(crate) fn orca_flipped(l: u32) -> std::ops::Range<usize> {
+    if (3..=5).contains(&l) { 5..(2 * l as usize + 1).min(9) } else { 0..0 }
 }
 
 /// Norm of the contraction Σ cᵢ gᵢ of normalised primitives of angular momentum `l` (the same
@@ -252,6 +258,33 @@ pub fn wavefunction_document(
     }
 }
 
+/// Orbitals as a program's log prints them, to `decimals` places: measured, but not repaired: a
+/// residual of the print's size is no writer's quirk, and a repair chosen by rounding noise would
+/// change good orbitals. The precision is recorded with the residual so that it is reported, not
+/// hidden. The programs compute with unit-normalised contractions and print the orbitals over
+/// them, whatever scale the basis they echo has: each contraction is scaled to unit norm and the
+/// orbital coefficients are kept as printed.
+pub fn check_printed(wf: Wavefunction, program: &str, overlap: Option<OverlapFn>, decimals: u32) -> Wavefunction {
+    let mut wf = wf;
+    for shell in &mut wf.basis.shells {
+        let n = contraction_norm(shell.l, &shell.exponents, &shell.coefficients);
+        if n > 0.0 && n.is_finite() {
+            shell.coefficients.iter_mut().for_each(|c| *c /= n);
+        }
+    }
+    let (repair, residual) = match overlap {
+        Some(overlap) => ("none", residual(&wf.orbitals, &overlap(&wf.basis))),
+        None => ("unchecked", f64::NAN),
+    };
+    wf.normalization = Normalization {
+        program: program.to_string(),
+        repair: repair.into(),
+        residual,
+        printed_decimals: Some(decimals),
+    };
+    wf
+}
+
 /// Checks the orbitals of a freshly read wavefunction and undoes a known writer quirk when the
 /// check fails (see the module documentation). `program` is the writer the file names, if any.
 /// Without an overlap function nothing is checked: the file is kept as read, residual NaN.
@@ -260,7 +293,8 @@ pub fn check_and_repair(wf: Wavefunction, program: Option<&str>, overlap: Option
     let Some(overlap) = overlap else {
         let mut wf = wf;
         normalize_contractions(&mut wf);
-        wf.normalization = Normalization { program: named, repair: "unchecked".into(), residual: f64::NAN };
+        wf.normalization =
+            Normalization { program: named, repair: "unchecked".into(), residual: f64::NAN, printed_decimals: None };
         return wf;
     };
     let measure = |wf: &Wavefunction| {
@@ -294,12 +328,14 @@ pub fn check_and_repair(wf: Wavefunction, program: Option<&str>, overlap: Option
                 program: repair.program().to_string(),
                 repair: repair.describe().to_string(),
                 residual: r,
+                printed_decimals: None,
             };
             fixed
         }
         None => {
             let mut wf = as_read;
-            wf.normalization = Normalization { program: named, repair: "none".into(), residual: raw };
+            wf.normalization =
+                Normalization { program: named, repair: "none".into(), residual: raw, printed_decimals: None };
             wf
         }
     }

@@ -52,6 +52,24 @@ pub struct Normalization {
     pub repair: String,
     /// max |CᵀSC − I| over the orbitals after the repair.
     pub residual: f64,
+    /// Decimals the coefficients were printed to, when they come from a program's log (Gaussian
+    /// prints 5, ORCA 6): the residual is then of the print's size and no repair is looked for.
+    pub printed_decimals: Option<u32>,
+}
+
+impl Normalization {
+    /// Where the coefficients come from, when that limits their precision: "coefficients
+    /// printed to 5 decimals (a log)".
+    pub fn precision_note(&self) -> Option<String> {
+        self.printed_decimals.map(|d| format!("coefficients printed to {d} decimals (a log)"))
+    }
+
+    /// The residual the coefficients' precision accounts for: 1e-5 for files that write them in
+    /// full, 100 units of the last printed decimal for a log (rounding errors of every
+    /// coefficient of an orbital add up in CᵀSC).
+    pub fn expected_residual(&self) -> f64 {
+        self.printed_decimals.map_or(1e-5, |d| 100.0 * 10f64.powi(-(d.min(16) as i32)))
+    }
 }
 
 #[derive(Debug, Clone, PartialEq, Default)]

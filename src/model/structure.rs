@@ -94,6 +94,8 @@ pub struct StructureModel {
     pub atoms: Range<u32>,
     /// A frame's own title (an XYZ comment line), if any.
     pub title: String,
+    /// The frame's energy in hartree, where the file gives one (a program log's steps).
+    pub energy: Option<f64>,
 }
 
 /// Per-atom annotations of every model, in file order.
@@ -168,7 +170,7 @@ impl Structure {
     /// Starts a model (MODEL n, an XYZ frame); atoms pushed before any model form model 1.
     pub fn begin_model(&mut self, number: i32, title: String) {
         let at = self.z.len() as u32;
-        self.models.push(StructureModel { number, atoms: at..at, title });
+        self.models.push(StructureModel { number, atoms: at..at, title, energy: None });
     }
 
     /// Appends an atom to the last model; a new chain or residue starts where the record's

@@ -1,0 +1,404 @@
+//! ORCA outputs (GUIDE §10): what an ORCA job prints, read into the model.
+//!
+//! ```text
+//! CARTESIAN COORDINATES (A.U.)                                 bohr, one table per geometry
+//!   NO LB      ZA    FRAG     MASS         X           Y           Z
+//!    0 C     6.0000    0    12.011   -2.674441    0.435056    0.000000
+//! BASIS SET IN INPUT FORMAT                                    `print[p_basis] 2`
+//!  NewGTO C                                                    per element
+//!  S 3                                                         shell, primitives
+//!    1      71.6168370000      0.1543289700                    exponent, coefficient
+//!   end;
+//! FINAL SINGLE POINT ENERGY      -382.055108392562
+//! MOLECULAR ORBITALS (RHF, ROHF)                               `print[p_mos] 1`; 6 a block
+//!                       0         1                            orbitals, from 0 (again from 0:
+//!                  -10.01641 -10.01636                         the beta ones), energies,
+//!                    2.00000   2.00000                         occupations
+//!                   --------  --------
+//!   0C   1s         0.699236  0.699232                         atom (from 0), function
+//! ```
+//! ORCA writes p functions z, x, y and pure functions m = 0, +1, −1, … (orbcloud's order), the
+//! f±3, g±3, g±4, h±3, h±4 functions with the opposite sign (as in its Molden files:
+//! [`super::wavefunction::orca_flipped`]); its printed contraction coefficients are for
+//! normalised primitives, as input. Coefficients are printed to 6 decimals: the residual is
+//! measured and reported as such, no repair is tried on it. Each coordinate table followed by a
+//! `FINAL SINGLE POINT ENERGY` is a frame.
+
+use std::collections::HashMap;
+
+use glam::DVec3;
+
+use super::logs::{Geometry, LogLines, decimals, error, frames, trailing_numbers, trajectory};
+use super::structure::element_of;
+use super::text::parse_real;
+use super::wavefunction::{OverlapFn, check_printed, orca_flipped};
+use super::{MAX_Z, ParseError};
+use crate::model::basis::{Basis, MAX_L, Shell, ShellKind};
+use crate::model::orbitals::{MolecularOrbital, Spin, Wavefunction};
+use crate::model::{Atom, Document, Molecule};
+
+/// The keywords that make ORCA print the basis set and the orbitals.
+pub const ORBITAL_KEYWORDS: &str = "%output print[p_basis] 2 print[p_mos] 1 end";
+
+/// Parses an ORCA output, checking its orbitals (if printed) with `overlap`.
+pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Document, ParseError> {
+    let log = LogLines::new(file, text);
+    let mut geometries = Vec::new();
+    let mut energies = Vec::new();
+    let mut basis: Option<(usize, HashMap<String, Vec<PrintedShell>>)> = None;
+    let mut orbitals: Option<MoSection> = None;
+    let mut title = String::new();
+    let mut i = 0;
+    while i < log.lines.len() {
+        let t = log.lines[i].trim();
+        if title.is_empty() && t.starts_with("|  1>") {
+            title = t.trim_start_matches("|  1>").trim().to_string();
+        }
+        if t == "CARTESIAN COORDINATES (A.U.)" {
+            let (g, next) = coordinates(&log, i)?;
+            geometries.push(g);
+            i = next;
+            continue;
+        } else if t.starts_with("FINAL SINGLE POINT ENERGY") {
+            let e = t.split_whitespace().last().and_then(parse_real);
+            energies.push((i, e.ok_or_else(|| log.error_at(i, "an energy after `FINAL SINGLE POINT ENERGY`"))?));
+        } else if t == "BASIS SET IN INPUT FORMAT" {
+            let (b, next) = input_basis(&log, i)?;
+            basis = Some((i, b));
+            i = next;
+            continue;
+        } else if t.starts_with("MOLECULAR ORBITALS") {
+            let (section, next) = mo_section(&log, i)?;
+            orbitals = Some(section);
+            i = next;
+            continue;
+        }
+        i += 1;
+    }
+    let frames = frames(&geometries, &energies);
+    let Some(last) = frames.last().map(|f| f.0) else {
+        return Err(error(file, log.lines.len().max(1), "a `CARTESIAN COORDINATES (A.U.)` table", "none in the file"));
+    };
+    for (g, _) in &frames {
+        if g.z != last.z {
+            return Err(log.error_at(
+                g.line,
+                format!("the same {} atoms in every geometry (as at line {})", last.z.len(), last.line + 1),
+            ));
+        }
+    }
+    let title = if title.is_empty() { file.to_string() } else { title };
+    let why = match (&orbitals, &basis) {
+        (Some(section), Some((_, basis))) => {
+            let geometry = geometries.iter().rev().find(|g| g.line < section.line).unwrap_or(last);
+            let mut doc = wavefunction_document(&log, geometry, basis, section, overlap)?;
+            if frames.len() > 1 {
+                doc.problems.push(format!(
+                    "{file}: its {} geometries are not shown: the orbitals open at the one they belong to (line {})",
+                    frames.len(),
+                    geometry.line + 1
+                ));
+            }
+            doc.title = title;
+            return Ok(doc);
+        }
+        (None, None) => format!("the output prints neither the basis set nor the orbitals (add `{ORBITAL_KEYWORDS}`)"),
+        (None, Some(_)) => "the output prints the basis set but not the orbitals (add `print[p_mos] 1`)".to_string(),
+        (Some(_), None) => "the output prints the orbitals but not the basis set (add `print[p_basis] 2`)".to_string(),
+    };
+    let mut doc = trajectory(file, &title, &frames);
+    doc.problems.push(format!("{file}: no orbitals to draw: {why}"));
+    Ok(doc)
+}
+
+#[derive(Debug, Clone)]
+struct PrintedShell {
+    l: u32,
+    exponents: Vec<f64>,
+    coefficients: Vec<f64>,
+}
+
+#[derive(Debug, Clone, Default)]
+struct MoSection {
+    line: usize,
+    /// Each row's line, atom (from 0) and function label ("1s", "2pz", "3dz2").
+    rows: Vec<(usize, usize, String)>,
+    /// Energy, occupation, spin, coefficients in the file's order.
+    orbitals: Vec<(f64, f64, Spin, Vec<f64>)>,
+    decimals: u32,
+}
+
+/// A `CARTESIAN COORDINATES (A.U.)` table at line `header`; returns it and the line after it.
+fn coordinates(log: &LogLines, header: usize) -> Result<(Geometry, usize), ParseError> {
+    let mut i = header + 1;
+    while log.get(i, "the coordinate table")?.trim().starts_with("---") {
+        i += 1;
+    }
+    if !log.get(i, "the heading `NO LB ZA FRAG MASS X Y Z`")?.trim_start().starts_with("NO") {
+        return Err(log.error_at(i, "the heading `NO LB ZA FRAG MASS X Y Z`"));
+    }
+    i += 1;
+    let mut g = Geometry { line: header, z: Vec::new(), positions: Vec::new() };
+    while let Some(l) = log.lines.get(i).filter(|l| !l.trim().is_empty()) {
+        let t: Vec<&str> = l.split_whitespace().collect();
+        let row = "an atom row `NO LB ZA FRAG MASS X Y Z` (bohr)";
+        if t.len() != 8 {
+            return Err(log.error_at(i, row));
+        }
+        let symbol = t[1].trim_end_matches(|c: char| !c.is_ascii_alphabetic());
+        let z = element_of(symbol)
+            .map(u32::from)
+            .filter(|&z| z <= MAX_Z)
+            .ok_or_else(|| log.error_at(i, "an element symbol in the LB column"))?;
+        let xyz: Option<Vec<f64>> = t[5..].iter().map(|v| parse_real(v)).collect();
+        let xyz = xyz.ok_or_else(|| log.error_at(i, row))?;
+        g.z.push(z);
+        g.positions.push(DVec3::new(xyz[0], xyz[1], xyz[2]));
+        i += 1;
+    }
+    if g.z.is_empty() {
+        return Err(log.error_at(i, "at least one atom row in the coordinate table"));
+    }
+    Ok((g, i))
+}
+
+/// `BASIS SET IN INPUT FORMAT` at line `header`: per element `NewGTO X`, shells, `end;`.
+fn input_basis(log: &LogLines, header: usize) -> Result<(HashMap<String, Vec<PrintedShell>>, usize), ParseError> {
+    let mut out: HashMap<String, Vec<PrintedShell>> = HashMap::new();
+    let mut i = header + 1;
+    while let Some(l) = log.lines.get(i) {
+        let t = l.trim();
+        if t.is_empty() || t.starts_with('#') || (t.starts_with("---") && i == header + 1) {
+            i += 1;
+            continue;
+        }
+        let Some(element) = t.strip_prefix("NewGTO") else { break };
+        let element = element.trim().trim_matches('"').to_ascii_lowercase();
+        let mut shells = Vec::new();
+        i += 1;
+        loop {
+            let l = log.get(i, "a shell `S 3` or `end;`")?;
+            let t: Vec<&str> = l.split_whitespace().collect();
+            if t.first() == Some(&"end;") {
+                i += 1;
+                break;
+            }
+            let shell = "a shell `S|P|D|F|G|H  primitives` or `end;`";
+            let l_of =
+                t.first().and_then(|s| "SPDFGH".find(s.to_ascii_uppercase().as_str())).filter(|_| t[0].len() == 1);
+            let l_of = l_of.map(|l| l as u32).filter(|&l| l <= MAX_L).ok_or_else(|| log.error_at(i, shell))?;
+            let count: usize =
+                t.get(1).and_then(|n| n.parse().ok()).filter(|&n| n > 0).ok_or_else(|| log.error_at(i, shell))?;
+            let mut p = PrintedShell { l: l_of, exponents: Vec::new(), coefficients: Vec::new() };
+            for _ in 0..count {
+                i += 1;
+                let expected = "a primitive `k  exponent  coefficient`";
+                let v: Option<Vec<f64>> = log.get(i, expected)?.split_whitespace().map(parse_real).collect();
+                let v = v.filter(|v| v.len() == 3 && v[1] > 0.0).ok_or_else(|| log.error_at(i, expected))?;
+                p.exponents.push(v[1]);
+                p.coefficients.push(v[2]);
+            }
+            shells.push(p);
+            i += 1;
+        }
+        out.insert(element, shells);
+    }
+    if out.is_empty() {
+        return Err(log.error_at(i, "`NewGTO ELEMENT` opening the basis set"));
+    }
+    Ok((out, i))
+}
+
+/// A block's header: the orbitals' numbers (from 0), one after another.
+fn column_numbers(line: &str) -> Option<Vec<usize>> {
+    let n: Option<Vec<usize>> = line.split_whitespace().map(|t| t.parse().ok()).collect();
+    n.filter(|n| !n.is_empty() && n.windows(2).all(|w| w[1] == w[0] + 1))
+}
+
+/// Width of ORCA's orbital columns.
+const COLUMN: usize = 10;
+
+/// `MOLECULAR ORBITALS` at line `header`: blocks of up to 6 orbitals; numbering from 0 again
+/// starts the beta orbitals.
+fn mo_section(log: &LogLines, header: usize) -> Result<(MoSection, usize), ParseError> {
+    let mut section = MoSection { line: header, ..Default::default() };
+    let mut i = header + 1;
+    while log.lines.get(i).is_some_and(|l| l.trim().starts_with("---")) {
+        i += 1;
+    }
+    let mut spin = Spin::Alpha;
+    let mut first_decimals = None;
+    let mut in_spin = 0;
+    while let Some(numbers) = log.lines.get(i).and_then(|l| column_numbers(l)) {
+        let block = i;
+        let k = numbers.len();
+        if numbers[0] == 0 && in_spin > 0 {
+            if spin == Spin::Beta {
+                break;
+            }
+            spin = Spin::Beta;
+            in_spin = 0;
+        } else if numbers[0] != in_spin {
+            break;
+        }
+        let numbers_of = |i: usize, what: &str| -> Result<Vec<f64>, ParseError> {
+            let l = log.get(i, what)?;
+            let v: Option<Vec<f64>> = l.split_whitespace().map(parse_real).collect();
+            v.filter(|v| v.len() == k).ok_or_else(|| log.error_at(i, format!("{k} {what}")))
+        };
+        let energies = numbers_of(i + 1, "orbital energies")?;
+        let occupations = numbers_of(i + 2, "occupations")?;
+        if !log.get(i + 3, "a line of dashes")?.trim().starts_with("---") {
+            return Err(log.error_at(i + 3, "a line of dashes under the occupations"));
+        }
+        i += 4;
+        let rows_before = section.rows.len();
+        let first_block = section.orbitals.is_empty();
+        let mut columns: Vec<Vec<f64>> = vec![Vec::new(); k];
+        let mut row = 0;
+        while let Some(l) = log.lines.get(i) {
+            let Some((values, head)) = trailing_numbers(l, k, COLUMN) else { break };
+            let head: Vec<&str> = head.split_whitespace().collect();
+            let [atom, label] = head[..] else { break };
+            let digits = atom.chars().take_while(char::is_ascii_digit).count();
+            let Ok(atom) = atom[..digits].parse::<usize>() else { break };
+            if first_decimals.is_none() {
+                first_decimals = l.split_whitespace().last().and_then(decimals);
+            }
+            if first_block {
+                section.rows.push((i, atom, label.to_ascii_lowercase()));
+            } else if section.rows.get(row).is_none_or(|r| r.1 != atom || r.2 != label.to_ascii_lowercase()) {
+                return Err(log.error_at(i, format!("row {} as in the first block (line {})", row + 1, header + 1)));
+            }
+            for (c, v) in values.into_iter().enumerate() {
+                columns[c].push(v);
+            }
+            row += 1;
+            i += 1;
+        }
+        if row == 0 || (!first_block && row != rows_before) {
+            let want = if first_block { "one or more".to_string() } else { rows_before.to_string() };
+            return Err(log.error_at(
+                i,
+                format!(
+                    "{want} rows of coefficients for orbitals {}–{} (block at line {})",
+                    numbers[0],
+                    numbers[k - 1],
+                    block + 1
+                ),
+            ));
+        }
+        for (c, coefficients) in columns.into_iter().enumerate() {
+            section.orbitals.push((energies[c], occupations[c], spin, coefficients));
+        }
+        in_spin += k;
+    }
+    if section.orbitals.is_empty() {
+        return Err(log.error_at(i, "a block of orbitals: their numbers `0 1 2 3 4 5`"));
+    }
+    section.decimals = first_decimals.unwrap_or(6);
+    Ok((section, i))
+}
+
+/// Letters of shells by l, as ORCA names its functions.
+const LETTERS: &str = "spdfgh";
+
+fn wavefunction_document(
+    log: &LogLines,
+    geometry: &Geometry,
+    printed: &HashMap<String, Vec<PrintedShell>>,
+    section: &MoSection,
+    overlap: Option<OverlapFn>,
+) -> Result<Document, ParseError> {
+    let atoms: Vec<Atom> = geometry
+        .z
+        .iter()
+        .zip(&geometry.positions)
+        .map(|(&z, &position)| Atom { z, charge: z as f64, position, ghost: z == 0 })
+        .collect();
+    let mut shells = Vec::new();
+    // For each printed row, its function in the model's order, and its sign.
+    let mut file_to_model = Vec::new();
+    let mut signs = Vec::new();
+    for (a, atom) in atoms.iter().enumerate() {
+        let symbol = atom.element().symbol.to_ascii_lowercase();
+        let Some(element) = printed.get(&symbol) else {
+            return Err(log.error_at(
+                geometry.line,
+                format!("a basis set for {} (atom {a}) in the printed basis", atom.element().symbol),
+            ));
+        };
+        for p in element {
+            let kind = if p.l < 2 { ShellKind::Cartesian } else { ShellKind::Pure };
+            let shell = Shell {
+                atom: a,
+                center: atom.position,
+                l: p.l,
+                kind,
+                exponents: p.exponents.clone(),
+                coefficients: p.coefficients.clone(),
+            };
+            let first = file_to_model.len();
+            let n = shell.n_functions();
+            if p.l == 1 {
+                // z, x, y → x, y, z.
+                file_to_model.extend([first + 2, first, first + 1]);
+            } else {
+                file_to_model.extend(first..first + n);
+            }
+            let flipped = if kind == ShellKind::Pure { orca_flipped(p.l) } else { 0..0 };
+            signs.extend((0..n).map(|k| if flipped.contains(&k) { -1.0 } else { 1.0 }));
+            // Each row names the atom and the shell's letter.
+            for k in 0..n {
+                let Some((line, row_atom, label)) = section.rows.get(first + k) else {
+                    return Err(log.error_at(
+                        section.line,
+                        format!("{} rows of coefficients or more (the printed basis set's functions)", first + k + 1),
+                    ));
+                };
+                let letter = label.trim_start_matches(|c: char| c.is_ascii_digit()).chars().next();
+                if *row_atom != a || letter != LETTERS.chars().nth(p.l as usize) {
+                    let letter = LETTERS.chars().nth(p.l as usize).unwrap_or('?');
+                    return Err(
+                        log.error_at(*line, format!("a {letter} function of atom {a}, as the printed basis set says"))
+                    );
+                }
+            }
+            shells.push(shell);
+        }
+    }
+    let n = file_to_model.len();
+    if section.rows.len() != n {
+        return Err(log.error_at(section.line, format!("{n} rows of coefficients (the printed basis set's functions)")));
+    }
+    let restricted = section.orbitals.iter().all(|o| o.2 == Spin::Alpha);
+    let orbitals = section
+        .orbitals
+        .iter()
+        .map(|(energy, occupation, spin, c)| {
+            let mut coefficients = vec![0.0; n];
+            for (k, &v) in c.iter().enumerate() {
+                coefficients[file_to_model[k]] = v * signs[k];
+            }
+            MolecularOrbital {
+                energy: *energy,
+                occupation: *occupation,
+                spin: *spin,
+                symmetry: String::new(),
+                coefficients,
+            }
+        })
+        .collect();
+    let wf = Wavefunction { basis: Basis { shells }, orbitals, restricted, normalization: Default::default() };
+    Ok(Document {
+        source: log.file.to_string(),
+        title: log.file.to_string(),
+        molecule: Molecule::new(atoms),
+        wavefunction: Some(check_printed(wf, "ORCA", overlap, section.decimals)),
+        ..Default::default()
+    })
+}
+
+#[cfg(test)]
+#[path = "orca_log_tests.rs"]
+mod tests;

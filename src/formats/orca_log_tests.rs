@@ -1,0 +1,234 @@
+//! Outputs written here in ORCA 6's layout (checked against its own): orthonormal orbitals over
+//! s, p, d and f shells, printed in ORCA's order and signs to 6 decimals, and read back.
+
+use super::super::ref_overlap::reference_overlap;
+use super::*;
+use crate::model::gto::PreparedBasis;
+
+/// Water (bohr): O with s, s, p, d and f shells, H with s.
+const ATOMS: [(&str, [f64; 3]); 3] = [("O", [0.0, 0.0, 0.22]), ("H", [0.0, 1.43, -0.89]), ("H", [0.0, -1.43, -0.89])];
+
+fn element_shells(symbol: &str) -> Vec<PrintedShell> {
+    let s = |l, e: &[f64], c: &[f64]| PrintedShell { l, exponents: e.to_vec(), coefficients: c.to_vec() };
+    match symbol {
+        "O" => vec![
+            s(0, &[130.7, 23.81, 6.444], &[0.1543, 0.5353, 0.4446]),
+            s(0, &[5.033, 1.170], &[-0.0999, 0.3995]),
+            s(1, &[5.033, 1.170], &[0.1559, 0.6077]),
+            s(2, &[1.2], &[1.0]),
+            s(3, &[0.9], &[1.0]),
+        ],
+        _ => vec![s(0, &[3.425, 0.6239], &[0.4, 0.7])],
+    }
+}
+
+fn model_basis() -> Basis {
+    let mut shells = Vec::new();
+    for (atom, (symbol, p)) in ATOMS.iter().enumerate() {
+        for ps in element_shells(symbol) {
+            let kind = if ps.l >= 2 { ShellKind::Pure } else { ShellKind::Cartesian };
+            shells.push(Shell {
+                atom,
+                center: DVec3::from_array(*p),
+                l: ps.l,
+                kind,
+                exponents: ps.exponents,
+                coefficients: ps.coefficients,
+            });
+        }
+    }
+    Basis { shells }
+}
+
+/// Orthonormal orbitals (Gram–Schmidt in the overlap) over the normalised `basis`.
+fn orbitals(basis: &Basis, seed: f64) -> Vec<Vec<f64>> {
+    let wf = Wavefunction { basis: normalized(basis), ..Default::default() };
+    let s = reference_overlap(&wf.basis);
+    let n = wf.basis.n_functions();
+    let dot =
+        |a: &[f64], b: &[f64]| -> f64 { (0..n).map(|i| (0..n).map(|j| a[i] * s[i * n + j] * b[j]).sum::<f64>()).sum() };
+    let mut cols: Vec<Vec<f64>> = Vec::new();
+    for k in 0..n {
+        let mut v: Vec<f64> =
+            (0..n).map(|i| if i == k { 1.0 } else { 0.2 * ((i * 5 + k) as f64 + seed).cos() }).collect();
+        for c in &cols {
+            let p = dot(&v, c);
+            v.iter_mut().zip(c).for_each(|(x, y)| *x -= p * y);
+        }
+        let norm = dot(&v, &v).sqrt();
+        v.iter_mut().for_each(|x| *x /= norm);
+        cols.push(v);
+    }
+    cols
+}
+
+/// ORCA's function labels of a shell and, for each, the model's function and sign.
+fn rows_of(l: u32, n: u32) -> Vec<(String, usize, f64)> {
+    let names: Vec<String> = match l {
+        0 => vec!["s".into()],
+        1 => vec!["pz".into(), "px".into(), "py".into()],
+        2 => ["dz2", "dxz", "dyz", "dx2y2", "dxy"].iter().map(ToString::to_string).collect(),
+        _ => {
+            let mut v = vec![format!("{}0", LETTERS.chars().nth(l as usize).unwrap())];
+            for m in 1..=l {
+                v.push(format!("{}+{m}", LETTERS.chars().nth(l as usize).unwrap()));
+                v.push(format!("{}-{m}", LETTERS.chars().nth(l as usize).unwrap()));
+            }
+            v
+        }
+    };
+    let flipped = orca_flipped(l);
+    names
+        .into_iter()
+        .enumerate()
+        .map(|(k, name)| {
+            let model = if l == 1 { [2, 0, 1][k] } else { k };
+            (format!("{n}{name}"), model, if l >= 2 && flipped.contains(&k) { -1.0 } else { 1.0 })
+        })
+        .collect()
+}
+
+/// An output with the coordinates, the basis and the orbitals (alpha, then beta when given).
+fn output(alpha: &[Vec<f64>], beta: Option<&[Vec<f64>]>) -> String {
+    let mut t = "                                 *****************\n                                 * O   R   C   A *\n                                 *****************\n".to_string();
+    t += "|  1> ! uks hf def2-svp\n\n----------------------------\nCARTESIAN COORDINATES (A.U.)\n----------------------------\n";
+    t += "  NO LB      ZA    FRAG     MASS         X           Y           Z\n";
+    for (k, (symbol, p)) in ATOMS.iter().enumerate() {
+        let (za, mass) = if *symbol == "O" { (8.0, 15.999) } else { (1.0, 1.008) };
+        t += &format!("{k:>4} {symbol:<2} {za:>9.4}{:>5}{mass:>11.3}{:>12.6}{:>12.6}{:>12.6}\n", 0, p[0], p[1], p[2]);
+    }
+    t += "\n-------------------------\nBASIS SET IN INPUT FORMAT\n-------------------------\n\n";
+    for symbol in ["H", "O"] {
+        t += &format!(" # Basis set for element : {symbol} \n NewGTO {symbol} \n");
+        for s in element_shells(symbol) {
+            t += &format!(
+                " {} {} \n",
+                LETTERS.chars().nth(s.l as usize).unwrap().to_ascii_uppercase(),
+                s.exponents.len()
+            );
+            for (k, (e, c)) in s.exponents.iter().zip(&s.coefficients).enumerate() {
+                t += &format!("  {:>2} {e:>18.10} {c:>16.10}\n", k + 1);
+            }
+        }
+        t += "  end;\n\n";
+    }
+    t += "FINAL SINGLE POINT ENERGY       -76.012345678901\n\n";
+    // Rows: (atom, label, model index, sign).
+    let basis = model_basis();
+    let offsets = basis.shell_offsets();
+    let mut rows = Vec::new();
+    for (s, first) in basis.shells.iter().zip(offsets) {
+        for (label, k, sign) in rows_of(s.l, s.l + 1) {
+            rows.push((s.atom, label, first + k, sign));
+        }
+    }
+    t += "------------------\nMOLECULAR ORBITALS\n------------------\n";
+    for set in std::iter::once(alpha).chain(beta) {
+        for (b, block) in set.chunks(6).enumerate() {
+            t += &format!("{:>16}{}\n", "", (0..block.len()).map(|c| format!("{:>10}", b * 6 + c)).collect::<String>());
+            t += &format!(
+                "{:>16}{}\n",
+                "",
+                (0..block.len()).map(|c| format!("{:>10.5}", -1.0 + 0.1 * (b * 6 + c) as f64)).collect::<String>()
+            );
+            let occupied = if beta.is_some() { 1.0 } else { 2.0 };
+            t += &format!(
+                "{:>16}{}\n",
+                "",
+                (0..block.len())
+                    .map(|c| format!("{:>10.5}", if b * 6 + c < 5 { occupied } else { 0.0 }))
+                    .collect::<String>()
+            );
+            t += &format!("{:>16}{}\n", "", (0..block.len()).map(|_| "  --------").collect::<String>());
+            for (atom, label, k, sign) in &rows {
+                let head = format!("{:>3}{:<2}  {label:<6}", atom, ATOMS[*atom].0);
+                let values: String = block.iter().map(|o| format!("{:>10.6}", sign * o[*k])).collect();
+                t += &format!("{head:<16}{values}\n");
+            }
+        }
+    }
+    t + "\n------------------------\nMULLIKEN POPULATION ANALYSIS\n"
+}
+
+/// `basis` with every contraction scaled to unit norm (the orbitals are over those).
+fn normalized(basis: &Basis) -> Basis {
+    let mut b = basis.clone();
+    for s in &mut b.shells {
+        let n = crate::formats::wavefunction::contraction_norm(s.l, &s.exponents, &s.coefficients);
+        s.coefficients.iter_mut().for_each(|c| *c /= n);
+    }
+    b
+}
+
+fn values(basis: &Basis, orbitals: &[&[f64]]) -> Vec<f64> {
+    let mut wf = Wavefunction { basis: normalized(basis), ..Default::default() };
+    wf.orbitals = orbitals
+        .iter()
+        .map(|c| MolecularOrbital {
+            energy: 0.0,
+            occupation: 0.0,
+            spin: Spin::Alpha,
+            symmetry: String::new(),
+            coefficients: c.to_vec(),
+        })
+        .collect();
+    let pb = PreparedBasis::new(&wf.basis);
+    let points: Vec<DVec3> =
+        (0..12).map(|k| DVec3::new((k as f64).sin(), (1.7 * k as f64).cos(), 0.2 * k as f64 - 1.0) * 1.5).collect();
+    wf.orbitals
+        .iter()
+        .flat_map(|o| points.iter().map(|&p| pb.orbital_value(&o.coefficients, p)).collect::<Vec<_>>())
+        .collect()
+}
+
+fn read(text: &str) -> Result<Document, ParseError> {
+    parse("t.out", text, Some(&reference_overlap))
+}
+
+#[test]
+fn orbitals_over_d_and_f_shells_read_back_in_orcas_order_and_signs() {
+    let basis = model_basis();
+    let (alpha, beta) = (orbitals(&basis, 0.4), orbitals(&basis, 2.1));
+    for unrestricted in [false, true] {
+        let text = output(&alpha, unrestricted.then_some(&beta[..]));
+        let doc = read(&text).unwrap_or_else(|e| panic!("{e}"));
+        let wf = doc.wavefunction.as_ref().expect("orbitals");
+        assert_eq!(wf.basis.n_functions(), 1 + 1 + 3 + 5 + 7 + 2);
+        assert_eq!(wf.restricted, !unrestricted);
+        let n = &wf.normalization;
+        assert_eq!((n.program.as_str(), n.repair.as_str(), n.printed_decimals), ("ORCA", "none", Some(6)));
+        assert!(n.residual < n.expected_residual(), "{n:?}");
+        for (spin, want) in [(Spin::Alpha, &alpha), (Spin::Beta, &beta)] {
+            let got: Vec<&[f64]> = wf.of_spin(spin).map(|(_, o)| o.coefficients.as_slice()).collect();
+            if spin == Spin::Beta && !unrestricted {
+                assert!(got.is_empty());
+                continue;
+            }
+            let want: Vec<&[f64]> = want.iter().map(Vec::as_slice).collect();
+            let (a, b) = (values(&wf.basis, &got), values(&basis, &want));
+            let scale = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let worst = a.iter().zip(&b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+            assert!(worst < 1e-5 * scale, "{spin:?}: values differ by {worst:e} of {scale:e}");
+        }
+        assert_eq!(doc.title, "! uks hf def2-svp");
+    }
+}
+
+#[test]
+fn a_cut_orbital_block_and_a_missing_basis_are_reported() {
+    let basis = model_basis();
+    let text = output(&orbitals(&basis, 0.4), None);
+    let lines: Vec<&str> = text.lines().collect();
+    let block = lines.iter().position(|l| column_numbers(l).is_some_and(|n| n[0] == 6)).unwrap();
+    let cut = block + 4 + 9;
+    let e = read(&(lines[..cut].join("\n") + "\n\nMULLIKEN\n")).unwrap_err();
+    assert_eq!((e.file.as_str(), e.line), ("t.out", cut + 1), "{e}");
+    assert!(e.expected.contains("19 rows of coefficients for orbitals 6–11"), "{e}");
+
+    let start = text.find("-------------------------\nBASIS SET").unwrap();
+    let end = text.find("FINAL SINGLE POINT").unwrap();
+    let doc = read(&format!("{}{}", &text[..start], &text[end..])).unwrap();
+    assert!(doc.wavefunction.is_none());
+    assert_eq!(doc.structure.as_ref().unwrap().structure.models[0].energy, Some(-76.012345678901));
+    assert!(doc.problems.iter().any(|p| p.contains("print[p_basis] 2")), "{:?}", doc.problems);
+}
