@@ -680,18 +680,7 @@ fn mo_section(log: &LogLines, header: usize, spin: Option<Spin>) -> Result<(MoSe
             row += 1;
             i += 1;
         }
-        if row == 0 || (rows_before > 0 && row != rows_before) {
-            let want = if rows_before > 0 { rows_before.to_string() } else { "one or more".to_string() };
-            return Err(log.error_at(
-                i,
-                format!(
-                    "{want} rows of coefficients for orbitals {}–{} (block at line {})",
-                    numbers[0],
-                    numbers[k - 1],
-                    block + 1
-                ),
-            ));
-        }
+        log.block_rows(i, row, (rows_before > 0).then_some(rows_before), (numbers[0], numbers[k - 1]), block)?;
         for (c, coefficients) in columns.into_iter().enumerate() {
             section.orbitals.push(PrintedOrbital {
                 energy: energies[c],

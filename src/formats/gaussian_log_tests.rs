@@ -63,23 +63,10 @@ fn model_basis(pure: bool) -> Basis {
 fn orbitals(basis: &Basis, seed: f64) -> Vec<Vec<f64>> {
     let mut wf = Wavefunction { basis: basis.clone(), ..Default::default() };
     normalize_contractions(&mut wf);
-    let s = reference_overlap(&wf.basis);
-    let n = wf.basis.n_functions();
-    let dot =
-        |a: &[f64], b: &[f64]| -> f64 { (0..n).map(|i| (0..n).map(|j| a[i] * s[i * n + j] * b[j]).sum::<f64>()).sum() };
-    let mut cols: Vec<Vec<f64>> = Vec::new();
-    for k in 0..n {
-        let mut v: Vec<f64> =
-            (0..n).map(|i| if i == k { 1.0 } else { 0.2 * ((i * 7 + k) as f64 + seed).sin() }).collect();
-        for c in &cols {
-            let p = dot(&v, c);
-            v.iter_mut().zip(c).for_each(|(x, y)| *x -= p * y);
-        }
-        let norm = dot(&v, &v).sqrt();
-        v.iter_mut().for_each(|x| *x /= norm);
-        cols.push(v);
-    }
-    cols
+    super::super::orthonormal_orbitals(
+        &wf.basis,
+        |i, k| if i == k { 1.0 } else { 0.2 * ((i * 7 + k) as f64 + seed).sin() },
+    )
 }
 
 /// Gaussian's AO labels of a shell, in its order.

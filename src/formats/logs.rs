@@ -82,6 +82,27 @@ impl<'a> LogLines<'a> {
         let found = self.lines.get(i).map_or_else(|| "end of file".to_string(), |l| excerpt(l));
         error(self.file, (i + 1).min(self.lines.len().max(1)), expected, found)
     }
+
+    /// Checks that an orbital block (orbitals `first`–`last`, its header at line index
+    /// `block`) read `rows` rows of coefficients, as many as the first block when `before` is
+    /// its count; the error names line index `i`, where the block stopped.
+    pub fn block_rows(
+        &self,
+        i: usize,
+        rows: usize,
+        before: Option<usize>,
+        (first, last): (impl std::fmt::Display, impl std::fmt::Display),
+        block: usize,
+    ) -> Result<(), ParseError> {
+        if rows > 0 && before.is_none_or(|n| rows == n) {
+            return Ok(());
+        }
+        let want = before.map_or_else(|| "one or more".to_string(), |n| n.to_string());
+        Err(self.error_at(
+            i,
+            format!("{want} rows of coefficients for orbitals {first}–{last} (block at line {})", block + 1),
+        ))
+    }
 }
 
 /// The last `count` numbers of `line`, printed in fields `width` characters wide (Fortran's

@@ -34,6 +34,29 @@ mod ref_overlap;
 #[cfg(test)]
 use crate::model::basis::{Basis, ShellKind};
 
+/// Orbitals orthonormal in the reference overlap of `basis` (contractions already normalised),
+/// by Gram–Schmidt from `start(i, k)` (coefficient `i` of orbital `k`): the readers' tests write
+/// them in each program's layout and check them back.
+#[cfg(test)]
+fn orthonormal_orbitals(basis: &Basis, start: impl Fn(usize, usize) -> f64) -> Vec<Vec<f64>> {
+    let s = ref_overlap::reference_overlap(basis);
+    let n = basis.n_functions();
+    let dot =
+        |a: &[f64], b: &[f64]| -> f64 { (0..n).map(|i| (0..n).map(|j| a[i] * s[i * n + j] * b[j]).sum::<f64>()).sum() };
+    let mut cols: Vec<Vec<f64>> = Vec::new();
+    for k in 0..n {
+        let mut v: Vec<f64> = (0..n).map(|i| start(i, k)).collect();
+        for c in &cols {
+            let p = dot(&v, c);
+            v.iter_mut().zip(c).for_each(|(x, y)| *x -= p * y);
+        }
+        let norm = dot(&v, &v).sqrt();
+        v.iter_mut().for_each(|x| *x /= norm);
+        cols.push(v);
+    }
+    cols
+}
+
 use std::path::Path;
 
 use crate::model::Document;

@@ -276,18 +276,7 @@ fn mo_section(log: &LogLines, header: usize) -> Result<(MoSection, usize), Parse
             row += 1;
             i += 1;
         }
-        if row == 0 || (!first_block && row != rows_before) {
-            let want = if first_block { "one or more".to_string() } else { rows_before.to_string() };
-            return Err(log.error_at(
-                i,
-                format!(
-                    "{want} rows of coefficients for orbitals {}–{} (block at line {})",
-                    numbers[0],
-                    numbers[k - 1],
-                    block + 1
-                ),
-            ));
-        }
+        log.block_rows(i, row, (!first_block).then_some(rows_before), (numbers[0], numbers[k - 1]), block)?;
         for (c, coefficients) in columns.into_iter().enumerate() {
             section.orbitals.push((energies[c], occupations[c], spin, coefficients));
         }

@@ -42,24 +42,9 @@ fn model_basis() -> Basis {
 
 /// Orthonormal orbitals (Gram–Schmidt in the overlap) over the normalised `basis`.
 fn orbitals(basis: &Basis, seed: f64) -> Vec<Vec<f64>> {
-    let wf = Wavefunction { basis: normalized(basis), ..Default::default() };
-    let s = reference_overlap(&wf.basis);
-    let n = wf.basis.n_functions();
-    let dot =
-        |a: &[f64], b: &[f64]| -> f64 { (0..n).map(|i| (0..n).map(|j| a[i] * s[i * n + j] * b[j]).sum::<f64>()).sum() };
-    let mut cols: Vec<Vec<f64>> = Vec::new();
-    for k in 0..n {
-        let mut v: Vec<f64> =
-            (0..n).map(|i| if i == k { 1.0 } else { 0.2 * ((i * 5 + k) as f64 + seed).cos() }).collect();
-        for c in &cols {
-            let p = dot(&v, c);
-            v.iter_mut().zip(c).for_each(|(x, y)| *x -= p * y);
-        }
-        let norm = dot(&v, &v).sqrt();
-        v.iter_mut().for_each(|x| *x /= norm);
-        cols.push(v);
-    }
-    cols
+    super::super::orthonormal_orbitals(&normalized(basis), |i, k| {
+        if i == k { 1.0 } else { 0.2 * ((i * 5 + k) as f64 + seed).cos() }
+    })
 }
 
 /// ORCA's function labels of a shell and, for each, the model's function and sign.

@@ -445,22 +445,7 @@ mod repair_tests {
         }
         let mut wf = Wavefunction { basis: Basis { shells }, restricted: true, ..Default::default() };
         normalize_contractions(&mut wf);
-        let s = reference_overlap(&wf.basis);
-        let n = wf.basis.n_functions();
-        let dot = |a: &[f64], b: &[f64]| -> f64 {
-            (0..n).map(|i| (0..n).map(|j| a[i] * s[i * n + j] * b[j]).sum::<f64>()).sum()
-        };
-        let mut cols: Vec<Vec<f64>> = Vec::new();
-        for k in 0..n {
-            let mut v: Vec<f64> = (0..n).map(|i| if i == k { 1.0 } else { 0.1 }).collect();
-            for c in &cols {
-                let p = dot(&v, c);
-                v.iter_mut().zip(c).for_each(|(x, y)| *x -= p * y);
-            }
-            let norm = dot(&v, &v).sqrt();
-            v.iter_mut().for_each(|x| *x /= norm);
-            cols.push(v);
-        }
+        let cols = super::super::orthonormal_orbitals(&wf.basis, |i, k| if i == k { 1.0 } else { 0.1 });
         wf.orbitals = cols
             .into_iter()
             .enumerate()
