@@ -637,3 +637,31 @@ fn an_esp_map_is_framed_beside_its_colour_bar() {
     let leftmost = reach.iter().map(|p| p.x).fold(f32::MAX, f32::min);
     assert!(rightmost - leftmost > 0.3 * (free - view.left()), "framed to fill the free part: {leftmost}..{rightmost}");
 }
+
+#[test]
+fn panes_show_the_molecule_across_their_width_and_reset_view_refits_them() {
+    let mut h = open(vec![fixture("wavefunctions/benzene_631gs.molden")]);
+    let lumo = h.state().doc().wavefunction.as_ref().unwrap().lumo(Spin::Alpha).unwrap();
+    h.get_by_label_contains(&format!("MO {} ", lumo + 1)).click_secondary();
+    h.run_steps(2);
+    h.get_by_label("show beside (a pane of its own)").click();
+    wait_loaded(&mut h);
+    // How much of the first pane's width the atoms span.
+    let span = |app: &OrbApp| {
+        let pane = app.view_rect().expect("a pane");
+        let xs: Vec<f32> =
+            (0..app.world().molecule.atoms.len()).map(|a| app.atom_on_screen(a).expect("on screen").x).collect();
+        let (lo, hi) = xs.iter().fold((f32::MAX, f32::MIN), |(lo, hi), &x| (lo.min(x), hi.max(x)));
+        assert!(lo > pane.left() && hi < pane.right(), "the molecule inside its pane: {lo}..{hi} in {pane:?}");
+        (hi - lo) / pane.width()
+    };
+    assert_eq!(h.state().view.panes.count, 2);
+    let framed = span(h.state());
+    assert!(framed > 0.5, "the atoms span {framed:.2} of the pane's width");
+    h.state_mut().view.camera.distance *= 3.0;
+    h.run_steps(2);
+    assert!(span(h.state()) < 0.5 * framed, "zoomed out");
+    h.get_by_label("Reset view").click();
+    h.run_steps(3);
+    assert!((span(h.state()) - framed).abs() < 0.05, "Reset view frames the panes again: {}", span(h.state()));
+}

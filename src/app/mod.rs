@@ -801,6 +801,30 @@ impl OrbApp {
         (self.view.camera.target, self.view.camera.distance) = (framed.target, framed.distance);
     }
 
+    /// Frames the scene's atoms (with room for the orbitals around them) to fill the width of
+    /// each pane of a split view, which is narrower than tall: the single view's framing fits
+    /// only their height. Each pane's camera is the view's, stood back by the pane's narrowness
+    /// ([`viewport`]'s `fit_width`), so the distance set here is what that leaves exact.
+    fn frame_panes(&mut self) {
+        const ROOM: f32 = 3.0;
+        let count = self.view.panes.count;
+        let Some(rect) = self.viewport.as_ref().and_then(Viewport::rect).filter(|_| count > 1) else { return };
+        let aspect = rect.width() / count as f32 / rect.height().max(1.0);
+        let atoms: Vec<glam::Vec3> = self.world.molecule.atoms.iter().map(|a| a.position.as_vec3()).collect();
+        let Some((lo, hi)) = atoms.iter().fold(None, |b: Option<(glam::Vec3, glam::Vec3)>, &p| {
+            Some(b.map_or((p, p), |(lo, hi)| (lo.min(p), hi.max(p))))
+        }) else {
+            return;
+        };
+        let camera = &mut self.view.camera;
+        camera.target = 0.5 * (lo + hi);
+        camera.distance = 0.0;
+        camera.fit_points(atoms, aspect, ROOM);
+        if aspect < 1.0 {
+            camera.distance *= aspect.max(0.2);
+        }
+    }
+
     /// Frames the active object's ρ = 0.002 surface (its atoms padded by the surface's reach)
     /// in the part of the view its colour bar leaves free, looking as the view does.
     fn frame_beside_bar(&mut self) {
@@ -1254,7 +1278,7 @@ impl eframe::App for OrbApp {
         // A scan shows its own orbitals; the browser belongs to the scene's objects.
         if let Some(o) = self.objects.get_mut(self.active).filter(|_| self.scan.is_none()) {
             let view = &mut self.view;
-            let esp_map = orbitals::panel(
+            let reframe = orbitals::panel(
                 ui,
                 &o.doc,
                 &mut o.state,
@@ -1263,8 +1287,10 @@ impl eframe::App for OrbApp {
                 &mut self.scroll_to_frontier,
                 &mut view.panels.orbitals,
             );
-            if esp_map {
-                self.frame_beside_bar();
+            match reframe {
+                orbitals::Reframe::BesideBar => self.frame_beside_bar(),
+                orbitals::Reframe::Panes => self.frame_panes(),
+                orbitals::Reframe::None => {}
             }
         }
         if let Some(o) = self.objects.get_mut(self.active).filter(|_| self.scan.is_none()) {
@@ -1320,6 +1346,9 @@ impl eframe::App for OrbApp {
                 self.view.camera = match &self.scan {
                     Some(scan) => scan.scene.camera(),
                     None => self.scene_camera(),
+                };
+                if self.scan.is_none() {
+                    self.frame_panes();
                 }
             }
             panels::Action::None => {}

@@ -32,10 +32,20 @@ enum Pick {
     EspMap,
 }
 
+/// How the view frames what a pick in the browser changed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Reframe {
+    None,
+    /// An ESP map: beside its colour bar.
+    BesideBar,
+    /// A pane was added: the molecule fills each pane's width.
+    Panes,
+}
+
 /// The orbital browser of the object `state` describes: it edits `state` in place (the
 /// selected quantity's orbital or density, the spin listed, how orbitals are evaluated).
 /// `scroll_to_frontier` brings the HOMO's row into view once (after a file opens). Returns
-/// whether an ESP map was added (the view frames it beside its colour bar).
+/// how the view should frame what the pick changed.
 pub fn panel(
     ui: &mut egui::Ui,
     doc: &Document,
@@ -44,8 +54,8 @@ pub fn panel(
     (panes, camera): (&mut Panes, &Camera),
     scroll_to_frontier: &mut bool,
     open: &mut bool,
-) -> bool {
-    let Some(wf) = &doc.wavefunction else { return false };
+) -> Reframe {
+    let Some(wf) = &doc.wavefunction else { return Reframe::None };
     let mut pick = None;
     egui::Panel::right("orbitals")
         .resizable(true)
@@ -147,7 +157,7 @@ pub fn panel(
                 pick = Some(p);
             }
         });
-    let mut esp_map = false;
+    let mut reframe = Reframe::None;
     match pick {
         Some(Pick::Switch(q)) => {
             match state.selected_quantity_mut().filter(|s| matches!(s.source, Source::Wavefunction(_))) {
@@ -157,7 +167,7 @@ pub fn panel(
         }
         Some(Pick::Add(q)) => add(state, q, defaults),
         Some(Pick::EspMap) => {
-            esp_map = true;
+            reframe = Reframe::BesideBar;
             let map = QuantityState::esp_map(
                 Source::Wavefunction(Quantity::Density),
                 Source::Wavefunction(Quantity::Potential),
@@ -169,6 +179,7 @@ pub fn panel(
             state.selected = state.quantities.len() - 1;
         }
         Some(Pick::Beside(q)) => {
+            reframe = Reframe::Panes;
             if panes.count == 1 {
                 // What was shown stays in the first pane; the new one goes beside it.
                 state.quantities.iter_mut().filter(|q| q.pane.is_none()).for_each(|q| q.pane = Some(0));
@@ -186,7 +197,7 @@ pub fn panel(
         }
         None => {}
     }
-    esp_map
+    reframe
 }
 
 /// Adds `q` to the object as a new quantity, selected.
