@@ -866,3 +866,24 @@ fn the_view_gets_most_of_the_window_and_the_panels_fit_beside_it_or_close() {
     let wide = h.state().view_rect().expect("a view");
     assert!(wide.width() > 1200.0, "with the panels closed the view is {} px", wide.width());
 }
+
+#[test]
+fn the_demo_shows_its_molecule_at_once_while_its_key_volumes_are_made() {
+    let mut h = Harness::builder()
+        .with_size([1280.0, 800.0])
+        .wgpu_setup(wgpu_setup(true))
+        .build_eframe(|cc| OrbApp::new(cc, Vec::new()));
+    let start = std::time::Instant::now();
+    while !h.state().shows_scan_skeleton() {
+        assert!(h.state().scan.is_none(), "the scan opened before its first frame was shown");
+        assert!(start.elapsed().as_secs() < 60, "no molecule after a minute");
+        std::thread::sleep(std::time::Duration::from_millis(10));
+        h.run_steps(1);
+    }
+    h.run_steps(2);
+    assert!(h.query_by_label_contains("its first frame is shown while").is_some(), "the status says what is prepared");
+    // The molecule is drawn: its atoms lie in the view.
+    let view = h.state().view_rect().expect("a view");
+    assert!(view.width() > 600.0);
+    wait_for_scan(&mut h, |_| true);
+}

@@ -508,6 +508,11 @@ impl OrbApp {
         self.viewport.as_ref()?.to_screen(&self.view.camera, position)
     }
 
+    /// Whether a scan being prepared shows its first frame (no scan or file open yet).
+    pub fn shows_scan_skeleton(&self) -> bool {
+        self.scan.is_none() && self.scan_job.as_ref().is_some_and(|j| j.skeleton_shown)
+    }
+
     /// Where a point of the scene (bohr) is drawn in the single-file view.
     pub fn point_on_screen(&self, p: glam::Vec3) -> Option<egui::Pos2> {
         self.viewport.as_ref()?.to_screen(&self.view.camera, p)
@@ -1380,6 +1385,16 @@ impl eframe::App for OrbApp {
                     }
                 }
                 (None, Some(vp)) => {
+                    // A scan being prepared in an empty window: its first frame at once, framed.
+                    if let Some(job) = self.scan_job.as_mut().filter(|j| !j.skeleton_shown && self.objects.is_empty())
+                        && let Some(molecule) = job.skeleton()
+                    {
+                        vp.show_molecule(&molecule, self.defaults.atoms);
+                        if let Some((lo, hi)) = molecule.bounds() {
+                            self.view.camera = crate::scene::Camera::framing(lo.as_vec3(), hi.as_vec3());
+                        }
+                        job.skeleton_shown = true;
+                    }
                     // A mode playing redraws every frame, as a drag does.
                     let interacting = detail::interacting(ui.ctx(), modes_play);
                     vp.detail = detail::Detail::for_frame(interacting, vp.ctx.info.device_type, 1);

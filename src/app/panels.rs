@@ -160,6 +160,10 @@ fn status_line(ui: &mut egui::Ui, app: &OrbApp, cancel: &mut bool, dismiss: &mut
                 }
                 return;
             }
+            if app.objects.is_empty() && app.scan_job.is_some() {
+                ui.label("its first frame is shown while the orbitals of every key frame are evaluated on the GPU");
+                return;
+            }
             let m = &app.doc().molecule;
             ui.label(format!("{} atoms ({}), {} bonds", m.atoms.len(), m.formula(), m.bonds.len()));
             let shown = app.shown_atoms();

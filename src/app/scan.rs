@@ -37,6 +37,10 @@ pub struct ScanJob {
     total: Arc<AtomicUsize>,
     cancel: Arc<AtomicBool>,
     result: Pending<Result<ScanScene, ScanFailure>>,
+    /// The first key frame's molecule once the manifest is read: the window shows it while
+    /// the key volumes are made, and whether it does already.
+    skeleton: Arc<std::sync::Mutex<Option<crate::model::Molecule>>>,
+    pub skeleton_shown: bool,
 }
 
 /// Why a scan did not open.
@@ -68,6 +72,8 @@ impl ScanJob {
         let (done, total, cancel) =
             (Arc::new(AtomicUsize::new(0)), Arc::new(AtomicUsize::new(0)), Arc::new(AtomicBool::new(false)));
         let (d, t, c) = (done.clone(), total.clone(), cancel.clone());
+        let skeleton = Arc::new(std::sync::Mutex::new(None));
+        let first = skeleton.clone();
         let job_source = source.clone();
         let repaint = Arc::new(repaint);
         let progress = repaint.clone();
@@ -78,6 +84,10 @@ impl ScanJob {
                     ScanSource::Demo => crate::sources::demo::scan(),
                 }
                 .map_err(|e| ScanFailure::Other(e.to_string()))?;
+                if let Some(frame) = file.scan.frames.first() {
+                    *first.lock().unwrap_or_else(std::sync::PoisonError::into_inner) = Some(frame.molecule.clone());
+                    progress();
+                }
                 if let Some(names) = orbitals {
                     file.scan.orbitals = names;
                     file.scan.check_orbitals().map_err(|e| ScanFailure::Other(e.to_string()))?;
@@ -98,7 +108,12 @@ impl ScanJob {
             run()
         };
         let result = spawn(&format!("opening the scan {name}"), work, move || repaint());
-        Self { name, source: job_source, done, total, cancel, result }
+        Self { name, source: job_source, done, total, cancel, result, skeleton, skeleton_shown: false }
+    }
+
+    /// The first key frame's molecule, once the manifest has been read.
+    pub fn skeleton(&self) -> Option<crate::model::Molecule> {
+        self.skeleton.lock().unwrap_or_else(std::sync::PoisonError::into_inner).clone()
     }
 
     /// Key volumes made so far, of how many.

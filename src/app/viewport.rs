@@ -944,6 +944,13 @@ impl Viewport {
         }
     }
 
+    /// Shows `molecule` alone in the first layer (a scan's first frame while its key volumes
+    /// are made).
+    pub fn show_molecule(&mut self, molecule: &crate::model::Molecule, style: crate::scene::AtomStyle) {
+        self.renderer.main().set_molecule(&self.ctx, molecule, style);
+        self.generation += 1;
+    }
+
     /// Shows slot `slot` of a scan at the value (both key volumes and the twisted skeleton).
     /// Cuts a single-layer view (a scan's) with `clip`; draws again when it moved.
     pub fn set_clip(&mut self, clip: ClipPlane) {
