@@ -72,14 +72,25 @@ pub fn plot(ui: &mut egui::Ui, view: &mut DiagramView, scan: &Scan, value: f64) 
     };
     let mut clicked = None;
     let mut scrub = None;
+    let ev = |e: f64| e * EV_PER_HARTREE;
+    let extents: Vec<(f64, f64)> = (diagram.lines.iter())
+        .map(|l| l.points.iter().fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(ev(p.1)), b.max(ev(p.1)))))
+        .collect();
+    let (y_lo, y_hi) = y_range(&extents);
+    let pad = 0.06 * (y_hi - y_lo).max(1e-3);
+    // Each line's name at its right end, moved apart where lines meet (degenerate orbitals),
+    // within the plot; a line above it is named at its top edge.
+    let ends: Vec<f64> = diagram.lines.iter().map(|l| l.points.last().map_or(0.0, |p| ev(p.1)).min(y_hi)).collect();
+    let labels = spread_labels(&ends, 0.07 * (y_hi - y_lo + 2.0 * pad));
     Plot::new("correlation diagram")
         .x_axis_label(x_label)
         .y_axis_label("orbital energy (eV)")
         .allow_scroll(false)
         .allow_drag(false)
         .allow_zoom(false)
-        // Room after the last frame for the lines' names.
-        .include_x(hi + 0.15 * (hi - lo))
+        // The data's span only, with room after the last frame for the lines' names.
+        .default_x_bounds(lo, hi + 0.18 * (hi - lo).max(1e-9))
+        .default_y_bounds(y_lo - pad, y_hi + pad)
         .show(ui, |plot| {
             for line in &diagram.lines {
                 let points: Vec<[f64; 2]> = line.points.iter().map(|&(x, e, _)| [x, e * EV_PER_HARTREE]).collect();
@@ -101,13 +112,17 @@ pub fn plot(ui: &mut egui::Ui, view: &mut DiagramView, scan: &Scan, value: f64) 
                             .color(Color32::from_rgb(250, 210, 80)),
                     );
                 }
-                if let Some(&[x, y]) = points.last() {
-                    plot.text(
-                        Text::new(line.label.clone(), PlotPoint::new(x, y), format!(" {}", line.label))
-                            .anchor(egui::Align2::LEFT_CENTER)
-                            .color(color),
-                    );
-                }
+            }
+            for (k, line) in diagram.lines.iter().enumerate() {
+                let color =
+                    if line.occupied { Color32::from_rgb(90, 150, 255) } else { Color32::from_rgb(255, 120, 90) };
+                let above = extents[k].0 > y_hi;
+                let name = if above { format!(" {} ↑", line.label) } else { format!(" {}", line.label) };
+                plot.text(
+                    Text::new(line.label.clone(), PlotPoint::new(hi, labels[k]), name)
+                        .anchor(egui::Align2::LEFT_CENTER)
+                        .color(color),
+                );
             }
             plot.vline(VLine::new(c.kind(), value));
             let response = plot.response();
@@ -127,4 +142,52 @@ pub fn plot(ui: &mut egui::Ui, view: &mut DiagramView, scan: &Scan, value: f64) 
             }
         });
     Asked { orbital: clicked, value: scrub.map(|x| x.clamp(lo, hi)) }
+}
+
+/// The energies a diagram shows (eV), from each line's lowest and highest: all of them, but
+/// for a line wholly far above the rest (more than the rest span above the next one), which would
+/// squeeze the others into a band of the plot: it runs off the top, named there.
+fn y_range(extents: &[(f64, f64)]) -> (f64, f64) {
+    let lo = extents.iter().map(|e| e.0).fold(f64::MAX, f64::min);
+    let mut by_top = extents.to_vec();
+    by_top.sort_by(|a, b| a.1.total_cmp(&b.1));
+    let hi = match by_top[..] {
+        // The highest line lies wholly above the next by more than the rest span.
+        [.., (_, second), (bottom, _)] if extents.len() >= 3 && bottom - second > second - lo => second,
+        [.., (_, top)] => top,
+        [] => return (0.0, 1.0),
+    };
+    if hi > lo { (lo, hi) } else { (lo - 0.5, lo + 0.5) }
+}
+
+/// Heights for labels wanted at `ys`, each at least `gap` from the next (in the same order as
+/// `ys`): labels of lines that end together are stacked around where they end.
+fn spread_labels(ys: &[f64], gap: f64) -> Vec<f64> {
+    let mut order: Vec<usize> = (0..ys.len()).collect();
+    order.sort_by(|&a, &b| ys[a].total_cmp(&ys[b]));
+    let mut placed = ys.to_vec();
+    for w in 1..order.len() {
+        let (below, here) = (order[w - 1], order[w]);
+        placed[here] = placed[here].max(placed[below] + gap);
+    }
+    // Centred on the group's own heights: the stack does not only grow upwards.
+    let shift = (ys.iter().sum::<f64>() - placed.iter().sum::<f64>()) / ys.len().max(1) as f64;
+    placed.iter().map(|p| p + shift.min(0.0)).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn degenerate_lines_get_labels_apart_and_an_outlier_does_not_squeeze_the_plot() {
+        let placed = spread_labels(&[-5.0, -5.0, -3.0], 0.5);
+        assert!((placed[1] - placed[0]).abs() >= 0.5 - 1e-9, "{placed:?}");
+        assert!(placed[2] - placed[0].max(placed[1]) >= 0.5 - 1e-9);
+        assert!(placed.iter().all(|p| (p - -4.3).abs() < 1.5), "near where the lines end: {placed:?}");
+        // Three lines within 2 eV and one 20 eV above: the plot spans the three.
+        let (lo, hi) = y_range(&[(-6.0, -5.0), (-5.5, -4.5), (-4.2, -4.0), (14.0, 16.0)]);
+        assert_eq!((lo, hi), (-6.0, -4.0));
+        assert_eq!(y_range(&[(-6.0, -5.0), (-5.5, -4.5), (-4.2, -1.0)]), (-6.0, -1.0), "no outlier: all");
+    }
 }

@@ -20,8 +20,9 @@ pub struct Line {
     pub occupied: bool,
     /// (the coordinate's value, energy in Eh, the orbital's index in that frame's file) per frame.
     pub points: Vec<(f64, f64, usize)>,
-    /// Frames at which the orbital followed holds another place in the energy order than in
-    /// the frame before (it crossed another orbital).
+    /// Frames at which the orbital followed crossed another line of the diagram: their order
+    /// in energy differs from the frame before (a crossing with an orbital the diagram does
+    /// not draw is not marked: it would have no partner to see).
     pub crossings: Vec<usize>,
 }
 
@@ -101,21 +102,35 @@ pub fn correlation(scan: &Scan, below: usize, above: usize) -> Option<Diagram> {
                 taken.push(j);
                 next_current[l] = j;
             }
-            // Each orbital's place in its frame's energy order, once per frame.
-            let (before, after) = (prev.by_energy(spin), next.by_energy(spin));
-            let rank = |order: &[usize], i: usize| order.iter().position(|&j| j == i);
             for (l, line) in lines.iter_mut().enumerate() {
                 let j = next_current[l];
-                if rank(&before, current[l]) != rank(&after, j) {
-                    line.crossings.push(f);
-                }
                 line.points.push((scan.frames[f].at, next.orbitals[j].energy, j));
             }
             current = next_current;
         }
+        mark_crossings(&mut lines);
         diagram.lines.extend(lines);
     }
     Some(diagram)
+}
+
+/// Marks, on each line, the frames where it crossed another of `lines`: the sign of their
+/// energy difference changed from the frame before.
+fn mark_crossings(lines: &mut [Line]) {
+    let frames = lines.iter().map(|l| l.points.len()).min().unwrap_or(0);
+    let energy = |lines: &[Line], l: usize, f: usize| lines[l].points[f].1;
+    for l in 0..lines.len() {
+        let crossed: Vec<usize> = (1..frames)
+            .filter(|&f| {
+                (0..lines.len()).filter(|&m| m != l).any(|m| {
+                    let before = energy(lines, l, f - 1) - energy(lines, m, f - 1);
+                    let after = energy(lines, l, f) - energy(lines, m, f);
+                    before * after < 0.0
+                })
+            })
+            .collect();
+        lines[l].crossings = crossed;
+    }
 }
 
 impl Diagram {
@@ -137,5 +152,31 @@ impl Diagram {
             out.push('\n');
         }
         out
+    }
+}
+
+#[cfg(test)]
+mod crossing_tests {
+    use super::*;
+
+    fn line(label: &str, energies: &[f64]) -> Line {
+        Line {
+            label: label.into(),
+            spin: Spin::Alpha,
+            occupied: true,
+            points: energies.iter().enumerate().map(|(f, &e)| (f as f64, e, 0)).collect(),
+            crossings: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn only_crossings_between_drawn_lines_are_marked_on_both() {
+        // a and b cross between frames 1 and 2; c stays above both (it may cross orbitals the
+        // diagram does not draw, which leaves no mark).
+        let mut lines = [line("a", &[-0.5, -0.4, -0.2]), line("b", &[-0.3, -0.35, -0.45]), line("c", &[0.1, 0.2, 0.3])];
+        mark_crossings(&mut lines);
+        assert_eq!(lines[0].crossings, [2]);
+        assert_eq!(lines[1].crossings, [2], "the partner carries the mark too");
+        assert!(lines[2].crossings.is_empty());
     }
 }
