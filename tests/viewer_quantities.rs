@@ -413,6 +413,8 @@ fn a_normal_mode_animates_with_arrows_and_a_click_on_its_band_picks_it() {
     h.get_by_label_contains("1117.82i").click();
     h.run_steps(3);
     assert_eq!(h.state().objects[0].state.vibration.mode, Some(0));
+    h.run_steps(1);
+    assert!(h.query_by_label_contains("mode 1: 1117.8i cm-1").is_some(), "named, imaginary");
     wait_loaded(&mut h);
     let a = picture(&mut h, dir.path(), "a");
     for _ in 0..10 {
@@ -429,6 +431,8 @@ fn a_normal_mode_animates_with_arrows_and_a_click_on_its_band_picks_it() {
     click_at(&mut h, band, false);
     h.run_steps(2);
     assert_eq!(h.state().objects[0].state.vibration.mode, Some(1), "the band's mode");
+    h.run_steps(2);
+    assert!(h.query_by_label_contains("mode 2: 1852.0 cm-1").is_some(), "the mode shown is named");
 
     // The session keeps the mode and its settings; "none" puts the atoms back.
     h.state_mut().objects[0].state.vibration.amplitude = 0.7;

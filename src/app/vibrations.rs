@@ -50,13 +50,26 @@ fn controls(ui: &mut egui::Ui, modes: &Vibrations, v: &mut VibrationState) {
         }
         ui.checkbox(&mut v.arrows, "arrows");
     });
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         ui.spacing_mut().slider_width = 70.0;
         ui.add(Slider::new(&mut v.amplitude, 0.05..=1.5).text("bohr"))
             .on_hover_text("the largest atom's displacement at the turning points");
         ui.add(Slider::new(&mut v.speed, 0.1..=3.0).text("per s")).on_hover_text("oscillations per second");
     });
+    // The mode shown, named: what plays in the view.
+    if let Some((k, m)) = v.mode.and_then(|k| modes.modes.get(k).map(|m| (k, m))) {
+        let intensity = m.ir_intensity.map_or(String::new(), |i| format!(", {i:.1} km/mol"));
+        let name = match m.is_imaginary() {
+            true => format!("mode {}: {:.1}i cm-1{intensity} (imaginary: along the reaction)", k + 1, -m.frequency_cm1),
+            false => format!("mode {}: {:.1} cm-1{intensity}", k + 1, m.frequency_cm1),
+        };
+        ui.label(RichText::new(name).strong());
+    }
     ui.label(RichText::new(format!("{:>4} {:>11} {:>9}", "mode", "cm-1", "km/mol")).monospace().strong());
+    // The list scrolls to the mode shown whenever it changes (a click on the spectrum picks
+    // one the list may not show).
+    let scrolled_id = ui.scope_id().with("modes scrolled to");
+    let scrolled_to = ui.data(|d| d.get_temp::<Option<usize>>(scrolled_id)).flatten();
     ScrollArea::vertical().id_salt("modes").show(ui, |ui| {
         for (k, m) in modes.modes.iter().enumerate() {
             let frequency = match m.is_imaginary() {
@@ -70,11 +83,16 @@ fn controls(ui: &mut egui::Ui, modes: &Vibrations, v: &mut VibrationState) {
             }
             let button =
                 egui::Button::selectable(v.mode == Some(k), row).min_size(egui::vec2(ui.available_width(), 0.0));
-            if ui.add(button).clicked() {
+            let response = ui.add(button);
+            if response.clicked() {
                 v.mode = Some(k);
+            }
+            if v.mode == Some(k) && scrolled_to != Some(k) {
+                response.scroll_to_me(Some(egui::Align::Center));
             }
         }
     });
+    ui.data_mut(|d| d.insert_temp(scrolled_id, v.mode));
 }
 
 /// The IR spectrum with its bands broadened as `v` says and a stick per mode; a click picks the
