@@ -306,6 +306,9 @@ fn quantity_label(q: &Quantity, doc: &Document) -> String {
         Quantity::Density => "total electron density".into(),
         Quantity::SpinDensity => "spin density".into(),
         Quantity::Potential => "electrostatic potential (a.u.)".into(),
+        Quantity::ReducedGradient => "reduced density gradient".into(),
+        Quantity::SignLambda2Rho => "sign(lambda2)*rho (a.u.)".into(),
+        Quantity::DensityLaplacian => "Laplacian of the electron density (a.u.)".into(),
         Quantity::BasisFunction(k) => {
             let name = crate::model::basis_labels::function_name(&doc.molecule, &wf.basis, *k);
             format!("basis function {}", name.unwrap_or_default())

@@ -24,6 +24,7 @@ pub mod gto;
 pub mod isosurface;
 pub mod measure;
 pub mod molecule;
+pub mod nci;
 pub mod neighbours;
 pub mod octree;
 pub mod orbitals;
