@@ -29,6 +29,7 @@ pub mod neighbours;
 pub mod octree;
 pub mod orbitals;
 pub mod overlap;
+pub mod promolecular;
 pub mod rigid;
 pub mod scan;
 mod separable;
