@@ -5,8 +5,12 @@ Hydrogen's density is the exact e^{−2r}/π. Every other neutral atom He–Cm (
 computed all-electron by PySCF's spherically averaged Hartree–Fock
 (`scf.atom_hf.AtomSphAverageRHF`: the electrons of open shells spread evenly over their m
 components, so the density is spherical), in def2-QZVPP for He–Kr and ANO-RCC (PySCF's "ano",
-all-electron, the largest range of elements PySCF has without pseudopotentials) for Rb–Cm. Non-relativistic: for the heaviest elements the core is a little
-too diffuse, which the valence tail (what promolecular NCI looks at) hardly feels.
+all-electron, the largest range of elements PySCF has without pseudopotentials) for Rb–Cm.
+Non-relativistic throughout: ANO-RCC is contracted for a scalar-relativistic Hamiltonian, so
+from Rb on the energies lie well above the non-relativistic Hartree–Fock limit (Xe by about
+260 hartree) and the cores are only roughly right; the valence tails, where NCI regions lie,
+feel it much less. An energy above the previous element's is reported as a warning (the SCF
+ended in a wrong configuration).
 
 The density is tabulated as ln ρ at radii spaced evenly in ln r (what the model interpolates
 with a natural cubic spline in ln r, so ρ, ρ′ and ρ″ are smooth), then shifted so that the
@@ -95,6 +99,7 @@ def main():
         "# per element a line `Z energy_hartree basis`, then ln(rho / (e/bohr^3)) at each radius",
         f"radii {R_MIN} {R_MAX} {N_RADII}",
     ]
+    previous = 0.0
     for z in range(1, MAX_Z + 1):
         t = time.time()
         path = cache and os.path.join(cache, f"{z}.npz")
@@ -108,6 +113,9 @@ def main():
         log_rho = np.log(np.maximum(rho, 1e-300))
         log_rho += np.log(z / spline_integral(log_rho))
         assert abs(spline_integral(log_rho) - z) < 1e-6 * z
+        if z > 1 and e > previous:
+            print(f"warning: Z={z} E={e:.6f} lies above Z={z - 1}'s {previous:.6f}", flush=True)
+        previous = e
         lines.append(f"{z} {e:.8f} {basis}")
         values = [f"{v:.6f}" for v in log_rho]
         lines += [" ".join(values[i : i + 12]) for i in range(0, len(values), 12)]

@@ -1,7 +1,7 @@
 //! Promolecular densities: sums of spherical neutral atoms, what NCI uses where a
 //! wavefunction is out of reach (proteins, ligands in pockets). The atoms' radial densities
 //! come from `assets/atomic_densities.txt`, made by `scripts/make_atomic_densities.py`
-//! (spherically averaged all-electron Hartree–Fock atoms, H–Cm): ln ρ tabulated at radii evenly
+//! (spherically averaged all-electron Hartree–Fock atoms, H–Er): ln ρ tabulated at radii evenly
 //! spaced in ln r, interpolated by a natural cubic spline in ln r (so ρ, ρ′ and ρ″ are smooth
 //! and analytic), constant inside the first radius and falling exponentially beyond the last.
 //! Atoms are found near a batch of points through cells as wide as the largest reach.
