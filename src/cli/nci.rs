@@ -94,16 +94,21 @@ pub fn nci(args: &NciArgs) -> Result<()> {
     let atoms: Vec<_> = docs.iter().flat_map(|d| d.molecule.atoms.iter().cloned()).collect();
     let molecule = Molecule::new(atoms);
     let (lo, hi) = molecule.bounds().context("no atoms")?;
-    let spec = GridSpec::spaced(lo - DVec3::splat(margin), hi + DVec3::splat(margin), step);
-    let points = spec.dims.iter().map(|&d| d as u64).product::<u64>();
-    if points > limits::NCI_POINTS {
+    let (lo, hi) = (lo - DVec3::splat(margin), hi + DVec3::splat(margin));
+    // Counted in floating point first: far-flung atoms must not overflow the count.
+    let sides = ((hi - lo) / step).ceil().max(DVec3::ONE) + DVec3::ONE;
+    let points = sides.x * sides.y * sides.z;
+    if points.is_nan() || points > limits::NCI_POINTS as f64 {
         bail!(
-            "a {:?} grid ({points} points) is more than nci holds ({}): a larger --step (now {:.4} Å) or a smaller --margin makes it fit",
-            spec.dims,
+            "a {:.0}×{:.0}×{:.0} grid ({points:.3e} points) is more than nci holds ({}): a larger --step (now {:.4} Å) or a smaller --margin makes it fit",
+            sides.x,
+            sides.y,
+            sides.z,
             limits::NCI_POINTS,
             step * ANGSTROM_PER_BOHR
         );
     }
+    let spec = GridSpec::spaced(lo, hi, step);
     let settings = NciSettings {
         density_cut: args.cut.unwrap_or(if args.promolecular {
             nci::PROMOLECULAR_DENSITY_CUT
