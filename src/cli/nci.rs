@@ -27,7 +27,7 @@ pub struct NciArgs {
     /// with --promolecular any file with atoms (XYZ, PDB, mmCIF, cube, a wavefunction's atoms).
     #[arg(required = true)]
     files: Vec<PathBuf>,
-    /// Sums of spherical atoms instead of the files' wavefunctions (elements H–Er).
+    /// Sums of spherical atoms instead of the files' wavefunctions (elements H–Cm).
     #[arg(long)]
     promolecular: bool,
     /// Grid step in Å, 0.001 to 10 (default 0.1 bohr, NCIPLOT's: 0.0529 Å).

@@ -1,7 +1,7 @@
 //! Promolecular densities: sums of spherical neutral atoms, what NCI uses where a
 //! wavefunction is out of reach (proteins, ligands in pockets). The atoms' radial densities
 //! come from `assets/atomic_densities.txt`, made by `scripts/make_atomic_densities.py`
-//! (spherically averaged all-electron Hartree–Fock atoms, H–Er): ln ρ tabulated at radii evenly
+//! (spherically averaged all-electron Hartree–Fock atoms, H–Cm): ln ρ tabulated at radii evenly
 //! spaced in ln r, interpolated by a natural cubic spline in ln r (so ρ, ρ′ and ρ″ are smooth
 //! and analytic), constant inside the first radius and falling exponentially beyond the last.
 //! Atoms are found near a batch of points through cells as wide as the largest reach.
@@ -286,7 +286,7 @@ mod tests {
     #[test]
     fn the_table_covers_hydrogen_to_its_last_element_without_gaps() {
         let (last, complete) = covered();
-        assert!(last >= 68, "H–Er at least, got up to Z = {last}");
+        assert!(last >= 96, "H–Cm, got up to Z = {last}");
         assert!(complete, "every element up to Z = {last}");
     }
 
@@ -351,7 +351,7 @@ mod tests {
             (1, [1.8, 0.0, 0.3]),
             (1, [-0.5, 1.7, 0.0]),
             (6, [0.4, -2.9, 1.1]),
-            (53, [3.9, 2.1, -1.0]),
+            (79, [3.9, 2.1, -1.0]),
         ];
         let molecule = Molecule::new(
             atoms
