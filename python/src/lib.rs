@@ -70,7 +70,8 @@ impl PyDocument {
     }
 
     /// The quantity `kind` names: "orbital" (`index` into all orbitals), "density",
-    /// "spin_density", "basis_function" (`index` of the function).
+    /// "spin_density", "esp", "reduced_gradient", "sign_lambda2_rho", "density_laplacian",
+    /// "basis_function" (`index` of the function).
     fn quantity(&self, kind: &str, index: usize) -> PyResult<Quantity> {
         let wf = self.wavefunction()?;
         let q = match kind {
@@ -79,6 +80,9 @@ impl PyDocument {
             "density" => Quantity::Density,
             "spin_density" => Quantity::SpinDensity,
             "esp" => Quantity::Potential,
+            "reduced_gradient" => Quantity::ReducedGradient,
+            "sign_lambda2_rho" => Quantity::SignLambda2Rho,
+            "density_laplacian" => Quantity::DensityLaplacian,
             _ => return Err(PyValueError::new_err(format!("no {kind} {index} in {}", self.doc.source))),
         };
         Ok(q)
@@ -273,6 +277,9 @@ impl PyDocument {
             Quantity::SpinDensity => "spin density".into(),
             Quantity::Potential => "electrostatic potential (a.u.)".into(),
             Quantity::BasisFunction(k) => format!("basis function {k}"),
+            Quantity::ReducedGradient => "reduced density gradient".into(),
+            Quantity::SignLambda2Rho => "sign(lambda2)*rho (a.u.)".into(),
+            Quantity::DensityLaplacian => "Laplacian of the electron density (a.u.)".into(),
         };
         let id = match q {
             Quantity::Orbital(i) => wf.of_spin(wf.orbitals[i].spin).position(|(j, _)| j == i).map_or(0, |p| p + 1),

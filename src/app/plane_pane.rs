@@ -190,9 +190,7 @@ fn make(asked: Asked) -> Result<Made, String> {
     let levels = if map.vanishes() { Vec::new() } else { Levels::Auto.resolve(map.max_abs(), map.signed) };
     let file = Path::new(&doc.source).file_name().map_or(doc.source.clone(), |n| n.to_string_lossy().into_owned());
     let caption = vec![format!("{file} · {}", asked.source.name(doc)), plane::where_text(&how, &plane, asked.offset)];
-    let scale = matches!(asked.source, Source::Wavefunction(crate::model::orbitals::Quantity::Potential))
-        .then(|| plane::potential_scale(&map))
-        .flatten();
+    let scale = plane::scale_for(asked.source, &map);
     let unit = plane::unit(asked.source).to_string();
     let picture =
         MapPicture { map: &map, molecule: m, levels: &levels, caption: caption.clone(), unit: unit.clone(), scale };

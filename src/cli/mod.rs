@@ -28,6 +28,7 @@ pub mod info;
 mod modes;
 mod molsurface;
 mod movie;
+mod nci;
 mod plane;
 mod quantities;
 mod render;
@@ -133,6 +134,9 @@ enum Command {
     /// Map a quantity on a plane through the molecule (exact from the wavefunction) with
     /// contour lines, as a PNG or SVG figure and, on request, its numbers as CSV.
     Plane(Box<plane::PlaneArgs>),
+    /// Non-covalent interactions as NCIPLOT writes them: PREFIX-dens.cube (100·sign(λ₂)ρ) and
+    /// PREFIX-grad.cube (the reduced density gradient) of files whose densities add.
+    Nci(nci::NciArgs),
     /// Write isosurfaces (both signs of an orbital, or a density's) or a molecular surface
     /// (--surface) as OBJ, PLY or glTF.
     Mesh(surface::MeshArgs),
@@ -170,6 +174,15 @@ struct WhatArgs {
     /// The electrostatic potential of the nuclei and electrons (a.u.) instead of an orbital.
     #[arg(long, conflicts_with_all = ["density", "spin_density", "basis_function"])]
     esp: bool,
+    /// The reduced density gradient s = |∇ρ| / (2(3π²)^{1/3} ρ^{4/3}) instead of an orbital.
+    #[arg(long, conflicts_with_all = ["density", "spin_density", "esp", "basis_function", "sign_lambda2_rho", "laplacian"])]
+    rdg: bool,
+    /// sign(λ₂)·ρ (λ₂ the middle eigenvalue of the density's Hessian, a.u.) instead of an orbital.
+    #[arg(long, conflicts_with_all = ["density", "spin_density", "esp", "basis_function", "laplacian"])]
+    sign_lambda2_rho: bool,
+    /// The Laplacian of the total density ∇²ρ (a.u.) instead of an orbital.
+    #[arg(long, conflicts_with_all = ["density", "spin_density", "esp", "basis_function"])]
+    laplacian: bool,
     /// A bare basis function (atomic orbital) instead of an orbital, named as the viewer's
     /// atomic-orbital selector names it: "C3 2pz", "O1 3dz2", "O1 3dxy", "H2 3dxx".
     #[arg(long, conflicts_with_all = ["density", "spin_density"])]
@@ -205,11 +218,18 @@ impl WavefunctionArgs {
             // A quantity only a wavefunction has, asked of atoms alone, is an error, not a
             // picture of the atoms.
             let w = &self.what;
-            let asked = [(w.density, "--density"), (w.spin_density, "--spin-density"), (w.esp, "--esp")]
-                .into_iter()
-                .find(|(on, _)| *on)
-                .map(|(_, flag)| flag)
-                .or(w.basis_function.as_ref().map(|_| "--basis-function"));
+            let asked = [
+                (w.density, "--density"),
+                (w.spin_density, "--spin-density"),
+                (w.esp, "--esp"),
+                (w.rdg, "--rdg"),
+                (w.sign_lambda2_rho, "--sign-lambda2-rho"),
+                (w.laplacian, "--laplacian"),
+            ]
+            .into_iter()
+            .find(|(on, _)| *on)
+            .map(|(_, flag)| flag)
+            .or(w.basis_function.as_ref().map(|_| "--basis-function"));
             if let Some(flag) = asked {
                 bail!(
                     "{}: {flag} needs a wavefunction (Molden, fchk, wfn, wfx or MKL), and this file has none: `orbcloud compute {}` computes one with PySCF",
@@ -246,6 +266,15 @@ impl WhatArgs {
         if self.density {
             return Ok(Quantity::Density);
         }
+        if self.rdg {
+            return Ok(Quantity::ReducedGradient);
+        }
+        if self.sign_lambda2_rho {
+            return Ok(Quantity::SignLambda2Rho);
+        }
+        if self.laplacian {
+            return Ok(Quantity::DensityLaplacian);
+        }
         if self.esp {
             return Ok(Quantity::Potential);
         }
@@ -269,6 +298,15 @@ impl WhatArgs {
         }
         if self.density {
             return "density".into();
+        }
+        if self.rdg {
+            return "rdg".into();
+        }
+        if self.sign_lambda2_rho {
+            return "sign_lambda2_rho".into();
+        }
+        if self.laplacian {
+            return "laplacian".into();
         }
         if self.esp {
             return "esp".into();
@@ -297,6 +335,9 @@ impl WhatArgs {
         match self.short_name().as_str() {
             "density" => "--density".into(),
             "esp" => "--esp".into(),
+            "rdg" => "--rdg".into(),
+            "sign_lambda2_rho" => "--sign-lambda2-rho".into(),
+            "laplacian" => "--laplacian".into(),
             "spin_density" => "--spin-density".into(),
             name => format!("--orbital {name}"),
         }
@@ -310,6 +351,9 @@ fn quantity_label(q: &Quantity, doc: &Document) -> String {
         Quantity::Density => "total electron density".into(),
         Quantity::SpinDensity => "spin density".into(),
         Quantity::Potential => "electrostatic potential (a.u.)".into(),
+        Quantity::ReducedGradient => "reduced density gradient".into(),
+        Quantity::SignLambda2Rho => "sign(lambda2)*rho (a.u.)".into(),
+        Quantity::DensityLaplacian => "Laplacian of the electron density (a.u.)".into(),
         Quantity::BasisFunction(k) => {
             let name = crate::model::basis_labels::function_name(&doc.molecule, &wf.basis, *k);
             format!("basis function {}", name.unwrap_or_default())
@@ -762,6 +806,7 @@ fn dispatch(cli: Cli, later: &[quantities::Later]) -> Result<()> {
         }
         Some(Command::Plane(args)) => plane::plane(&args),
         Some(Command::Compute(args)) => compute::compute(args),
+        Some(Command::Nci(args)) => nci::nci(&args),
         Some(Command::Scan(command)) => scan::run(command),
         Some(Command::Modes(args)) => modes::write_xyz(&args),
         Some(Command::Movie(args)) => movie::movie(*args),

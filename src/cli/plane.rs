@@ -6,7 +6,6 @@ use std::time::Instant;
 
 use crate::formats;
 use crate::model::Document;
-use crate::model::orbitals::Quantity;
 use crate::model::units::{ANGSTROM_PER_BOHR, BOHR_PER_ANGSTROM};
 use crate::plane::{self, Frame, Levels, MapPicture, PlaneMap};
 use crate::scene::Source;
@@ -30,13 +29,6 @@ pub struct PlaneArgs {
     /// wavefunction's at each point, or its first data set's, interpolated trilinearly.
     #[arg(long, value_name = "FILE")]
     minus: Option<PathBuf>,
-    /// The Laplacian of the density (not available: it needs the density's second derivatives).
-    #[arg(long)]
-    laplacian: bool,
-    /// The NCI quantities, reduced density gradient and sign(λ₂)ρ (not available: they need the
-    /// density's second derivatives).
-    #[arg(long)]
-    nci: bool,
     /// The plane through three atoms A,B,C (counted from 1): u along A→B, v towards C.
     #[arg(long, value_name = "A,B,C", value_parser = parse_indices::<3>)]
     through: Option<[usize; 3]>,
@@ -113,12 +105,6 @@ struct Described {
 }
 
 pub fn plane(args: &PlaneArgs) -> Result<()> {
-    if args.laplacian || args.nci {
-        let what = if args.laplacian { "the Laplacian of the density" } else { "NCI (s and sign(λ₂)ρ)" };
-        bail!(
-            "{what} needs the density's Hessian, which orbcloud does not evaluate yet; a plane map can show an orbital, --density, --spin-density, --esp, a --basis-function or a --minus difference"
-        );
-    }
     let format = Format::of(&args.output)?;
     let doc = formats::load(&args.file)?;
     let (source, mut described) = source(args, &doc)?;
@@ -153,9 +139,7 @@ pub fn plane(args: &PlaneArgs) -> Result<()> {
     };
     let caption =
         vec![format!("{} · {}", file_name(&args.file), described.label), plane::where_text(&how, &plane, args.offset)];
-    let scale = (source == Source::Wavefunction(Quantity::Potential) && args.minus.is_none())
-        .then(|| plane::potential_scale(&map))
-        .flatten();
+    let scale = args.minus.is_none().then(|| plane::scale_for(source, &map)).flatten();
     let picture =
         MapPicture { map: &map, molecule: &doc.molecule, levels: &levels, caption, unit: described.unit, scale };
     write_figure(&picture, format, &args.output)?;

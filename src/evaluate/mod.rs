@@ -116,7 +116,14 @@ pub fn evaluate_wavefunction(
     let combination = match view.quantity {
         Quantity::Orbital(i) => Some(restricted(&wf.orbitals[i].coefficients, view.functions.as_deref())),
         Quantity::BasisFunction(k) => Some(prepared.unit_coefficients(k)),
-        Quantity::Density | Quantity::SpinDensity | Quantity::Potential => None,
+        // Densities, the potential and the quantities of the density's derivatives are
+        // evaluated on the CPU.
+        Quantity::Density
+        | Quantity::SpinDensity
+        | Quantity::Potential
+        | Quantity::ReducedGradient
+        | Quantity::SignLambda2Rho
+        | Quantity::DensityLaplacian => None,
     };
     match combination {
         Some(coefficients) => {

@@ -1,7 +1,8 @@
 //! A wavefunction's quantities on points and grids: orbitals, densities, the spin density and the
 //! electrostatic potential, each sent to the evaluator that serves it best (the axis-separated
 //! sums of [`super::separable`] on axis-aligned grids, row by row otherwise, [`super::esp`] for
-//! the potential). The evaluators build on [`PreparedBasis`]; this layer above them chooses.
+//! the potential, [`super::nci`] for the quantities of the density's first and second
+//! derivatives). The evaluators build on [`PreparedBasis`]; this layer above them chooses.
 
 use glam::DVec3;
 use rayon::prelude::*;
@@ -9,6 +10,7 @@ use rayon::prelude::*;
 use super::esp::Potential;
 use super::gto::{GridSpec, PreparedBasis, spin_weight};
 use super::molecule::Molecule;
+use super::nci::{self, WavefunctionDensity};
 use super::orbitals::{Quantity, Wavefunction};
 use super::separable;
 
@@ -54,6 +56,10 @@ impl PreparedBasis {
         if quantity == Quantity::Potential {
             return Potential::new(molecule, wf).at_points(points);
         }
+        if quantity.from_density_derivatives() {
+            let source = WavefunctionDensity { basis: self.clone(), wavefunction: wf };
+            return nci::quantity_at_points(&source, quantity, points);
+        }
         points.par_chunks(1024).flat_map_iter(|chunk| self.quantity_at(wf, quantity, chunk)).collect()
     }
 
@@ -72,6 +78,14 @@ impl PreparedBasis {
             Quantity::BasisFunction(k) => self.eval_grid(&self.unit_coefficients(k), grid),
             Quantity::Density => self.density_grid(wf, grid),
             Quantity::SpinDensity => self.spin_density_grid(wf, grid),
+            Quantity::ReducedGradient | Quantity::SignLambda2Rho | Quantity::DensityLaplacian => {
+                let points: Vec<DVec3> = (0..grid.dims[0])
+                    .flat_map(|i| (0..grid.dims[1]).flat_map(move |j| (0..grid.dims[2]).map(move |k| (i, j, k))))
+                    .map(|(i, j, k)| grid.point(i, j, k))
+                    .collect();
+                let source = WavefunctionDensity { basis: self.clone(), wavefunction: wf };
+                nci::quantity_at_points(&source, quantity, &points)
+            }
         }
     }
 

@@ -101,6 +101,10 @@ pub fn quantity_box(wf: &Wavefunction, molecule: &Molecule, quantity: Quantity) 
         // The potential never decays (a charged molecule's goes as 1/r): it is shown in the
         // density's box, where the surfaces it colours lie.
         Quantity::Potential => return quantity_box(wf, molecule, Quantity::Density),
+        // s, sign(λ₂)ρ and ∇²ρ matter where the density does: the density's box.
+        Quantity::ReducedGradient | Quantity::SignLambda2Rho | Quantity::DensityLaplacian => {
+            return quantity_box(wf, molecule, Quantity::Density);
+        }
     };
     Some(decay_box(lo, hi, START_REACH, decay, |spec| prepared.quantity_grid(wf, molecule, quantity, spec)))
 }

@@ -313,6 +313,106 @@ impl PreparedBasis {
         }
     }
 
+    /// Values, gradients and second derivatives of one shell's functions at `d` = point −
+    /// centre: per function `[v, ∂x, ∂y, ∂z, ∂xx, ∂xy, ∂xz, ∂yy, ∂yz, ∂zz]` in
+    /// `out[..n_functions]`; `cart` is scratch for the cartesian components. With the radial
+    /// part R(r²) = Σ c_j exp(−α_j r²) and a monomial M,
+    /// ∂a∂b(M R) = (∂a∂b M) R + (∂a M x_b + ∂b M x_a) R₁ + M (x_a x_b R₂ + δ_ab R₁),
+    /// with R₁ = Σ −2α_j c_j e_j and R₂ = Σ 4α_j² c_j e_j.
+    pub(super) fn shell_second_derivatives(
+        &self,
+        shell: &PreparedShell,
+        d: DVec3,
+        out: &mut [[f64; 10]],
+        cart: &mut Vec<[f64; 10]>,
+    ) {
+        let n = shell.n_functions as usize;
+        let r2 = d.length_squared();
+        if r2 > shell.cutoff * shell.cutoff {
+            out[..n].fill([0.0; 10]);
+            return;
+        }
+        let l = shell.l as usize;
+        let (mut rad, mut rad1, mut rad2) = (0.0, 0.0, 0.0);
+        for j in shell.primitives() {
+            if r2 <= self.primitive_cutoffs2[j] {
+                let alpha = self.exponents[j];
+                let e = self.coefficients[j] * (-alpha * r2).exp();
+                rad += e;
+                rad1 -= 2.0 * alpha * e;
+                rad2 += 4.0 * alpha * alpha * e;
+            }
+        }
+        let mut pw = [[1.0f64; 8]; 3];
+        for axis in 0..3 {
+            for k in 1..=l {
+                pw[axis][k] = pw[axis][k - 1] * d[axis];
+            }
+        }
+        // ∂^da/∂x^da … of x^a y^b z^c.
+        let derivative = |e: [u32; 3], order: [u32; 3]| -> f64 {
+            let mut v = 1.0;
+            for axis in 0..3 {
+                let (p, k) = (e[axis], order[axis]);
+                if k > p {
+                    return 0.0;
+                }
+                for m in 0..k {
+                    v *= (p - m) as f64;
+                }
+                v *= pw[axis][(p - k) as usize];
+            }
+            v
+        };
+        const UNIT: [[u32; 3]; 3] = [[1, 0, 0], [0, 1, 0], [0, 0, 1]];
+        const PAIRS: [(usize, usize); 6] = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
+        cart.clear();
+        for (p, f) in self.powers[l].iter().zip(&self.component_factors[l]) {
+            let m = derivative(*p, [0; 3]);
+            let dm: [f64; 3] = std::array::from_fn(|a| derivative(*p, UNIT[a]));
+            let mut c = [0.0; 10];
+            c[0] = m * rad;
+            for a in 0..3 {
+                c[1 + a] = dm[a] * rad + m * d[a] * rad1;
+            }
+            for (k, &(a, b)) in PAIRS.iter().enumerate() {
+                let order = [UNIT[a][0] + UNIT[b][0], UNIT[a][1] + UNIT[b][1], UNIT[a][2] + UNIT[b][2]];
+                let delta = if a == b { rad1 } else { 0.0 };
+                c[4 + k] = derivative(*p, order) * rad
+                    + (dm[a] * d[b] + dm[b] * d[a]) * rad1
+                    + m * (d[a] * d[b] * rad2 + delta);
+            }
+            cart.push(c.map(|v| v * f));
+        }
+        if shell.pure {
+            let t = &self.pure_matrices[l];
+            let nc = cart.len();
+            for (k, o) in out[..n].iter_mut().enumerate() {
+                *o = [0.0; 10];
+                for (w, c) in t[k * nc..(k + 1) * nc].iter().zip(cart.iter()) {
+                    if *w != 0.0 {
+                        for (o, c) in o.iter_mut().zip(c) {
+                            *o += w * c;
+                        }
+                    }
+                }
+            }
+        } else {
+            out[..n].copy_from_slice(cart);
+        }
+    }
+
+    /// Every basis function's `[v, ∂x, ∂y, ∂z, ∂xx, ∂xy, ∂xz, ∂yy, ∂yz, ∂zz]` at `point`
+    /// (bohr), in the basis's order.
+    pub fn basis_second_derivatives(&self, point: DVec3) -> Vec<[f64; 10]> {
+        let mut out = vec![[0.0; 10]; self.n_functions];
+        let mut cart = Vec::new();
+        for s in &self.shells {
+            self.shell_second_derivatives(s, point - s.center(), &mut out[s.functions()], &mut cart);
+        }
+        out
+    }
+
     /// All basis-function values at `point` (bohr), in the basis's order.
     pub fn basis_values(&self, point: DVec3) -> Vec<f64> {
         let mut out = vec![0.0; self.n_functions];
@@ -361,7 +461,8 @@ impl PreparedBasis {
 
     /// An orbital, a bare basis function, the total density or the spin density of `wf` at each
     /// of `points` (what [`Self::orbital_value`], [`Self::density`]… give), one scratch for all;
-    /// NaN for the potential, which needs the nuclei ([`Self::quantity_at_points`]).
+    /// NaN for the potential, which needs the nuclei, and for the quantities of the density's
+    /// derivatives ([`Self::quantity_at_points`] serves both).
     pub(super) fn quantity_at(&self, wf: &Wavefunction, quantity: Quantity, points: &[DVec3]) -> Vec<f64> {
         let mut values = vec![0.0; self.n_functions];
         let (mut c, mut cg) = (Vec::new(), Vec::new());
@@ -376,7 +477,10 @@ impl PreparedBasis {
                     Quantity::BasisFunction(k) => values[k],
                     Quantity::Density => density_of(wf, &values),
                     Quantity::SpinDensity => spin_density_of(wf, &values),
-                    Quantity::Potential => f64::NAN,
+                    Quantity::Potential
+                    | Quantity::ReducedGradient
+                    | Quantity::SignLambda2Rho
+                    | Quantity::DensityLaplacian => f64::NAN,
                 }
             })
             .collect()
@@ -1001,6 +1105,41 @@ pub(crate) mod tests {
     }
 
     #[test]
+    fn second_derivatives_match_finite_differences_of_the_gradients() {
+        // Up to h, pure and cartesian, on three centres, with and without cutoffs.
+        for threshold in [DEFAULT_THRESHOLD, 0.0] {
+            let pb = PreparedBasis::with_threshold(&test_basis(), threshold);
+            let h = 1e-5;
+            let mut checked = 0;
+            for p in points(25, 11, 2.0) {
+                let all = pb.basis_second_derivatives(p);
+                let (v, g) = pb.basis_values_and_gradients(p);
+                for f in 0..v.len() {
+                    assert!((all[f][0] - v[f]).abs() < 1e-14 * (1.0 + v[f].abs()), "value of {f}");
+                    for a in 0..3 {
+                        assert!((all[f][1 + a] - g[f][a]).abs() < 1e-13 * (1.0 + g[f][a].abs()), "∂{a} of {f}");
+                    }
+                }
+                for (k, (a, b)) in [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)].into_iter().enumerate() {
+                    let mut e = DVec3::ZERO;
+                    e[b] = h;
+                    let (gp, gm) = (pb.basis_values_and_gradients(p + e).1, pb.basis_values_and_gradients(p - e).1);
+                    for f in 0..v.len() {
+                        let fd = (gp[f][a] - gm[f][a]) / (2.0 * h);
+                        let got = all[f][4 + k];
+                        assert!(
+                            (fd - got).abs() < 1e-6 * (1.0 + fd.abs()),
+                            "function {f} ∂{a}∂{b} at {p}: {fd} vs {got}"
+                        );
+                        checked += (fd.abs() > 1e-3) as usize;
+                    }
+                }
+            }
+            assert!(checked > 1000, "most second derivatives are not negligible: {checked}");
+        }
+    }
+
+    #[test]
     fn grid_equals_point_evaluation() {
         let pb = PreparedBasis::new(&test_basis());
         let c = pseudo_random(pb.n_functions(), 11);
@@ -1114,7 +1253,7 @@ pub(crate) mod tests {
                 Quantity::BasisFunction(k) => pb.basis_values(p)[k],
                 Quantity::Density => pb.density(&wf, p),
                 Quantity::SpinDensity => pb.spin_density(&wf, p),
-                Quantity::Potential => f64::NAN,
+                _ => f64::NAN,
             };
             for (v, &p) in pb.quantity_at(&wf, q, &scattered).iter().zip(&scattered) {
                 assert_eq!(*v, at(p), "{q:?} at {p}");

@@ -185,6 +185,20 @@ pub enum Quantity {
     BasisFunction(usize),
     /// The electrostatic potential of the nuclei and the electrons (a.u.).
     Potential,
+    /// The reduced density gradient s = |∇ρ| / (2(3π²)^{1/3} ρ^{4/3}) (NCI).
+    ReducedGradient,
+    /// sign(λ₂)·ρ, λ₂ the middle eigenvalue of the density's Hessian (NCI, a.u.).
+    SignLambda2Rho,
+    /// ∇²ρ, the Laplacian of the total density (a.u.).
+    DensityLaplacian,
+}
+
+impl Quantity {
+    /// Whether the quantity is made of the total density's first and second derivatives
+    /// (evaluated by [`super::nci`]).
+    pub fn from_density_derivatives(self) -> bool {
+        matches!(self, Self::ReducedGradient | Self::SignLambda2Rho | Self::DensityLaplacian)
+    }
 }
 
 /// Which orbital a user means: `homo`, `lumo`, `homo-2`, `lumo+1`, or a 1-based index into the

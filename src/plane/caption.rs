@@ -14,6 +14,9 @@ pub fn unit(source: Source) -> &'static str {
         Source::Wavefunction(Quantity::Density) => "ρ (a.u.)",
         Source::Wavefunction(Quantity::SpinDensity) => "ρα − ρβ (a.u.)",
         Source::Wavefunction(Quantity::Potential) => "V (a.u.)",
+        Source::Wavefunction(Quantity::DensityLaplacian) => "Laplacian of ρ (a.u.)",
+        Source::Wavefunction(Quantity::ReducedGradient) => "s",
+        Source::Wavefunction(Quantity::SignLambda2Rho) => "sign(λ₂)ρ (a.u.)",
         _ => "value",
     }
 }
@@ -32,4 +35,20 @@ pub fn where_text(how: &str, plane: &Plane, offset: f64) -> String {
 pub fn potential_scale(map: &PlaneMap) -> Option<ColorScale> {
     let lowest = map.values.iter().copied().filter(|v| v.is_finite()).fold(0.0, f64::min);
     (lowest < 0.0).then(|| ColorScale::Diverging { limit: -2.0 * lowest })
+}
+
+/// The colour scale `source`'s map needs when the automatic one would wash it out: a
+/// potential's ([`potential_scale`]), or a Laplacian's, whose values at the nuclei exceed the
+/// valence shells' by orders of magnitude (it saturates at the 98th percentile of |value|).
+pub fn scale_for(source: Source, map: &PlaneMap) -> Option<ColorScale> {
+    match source {
+        Source::Wavefunction(Quantity::Potential) => potential_scale(map),
+        Source::Wavefunction(Quantity::DensityLaplacian) => {
+            let mut magnitudes: Vec<f64> = map.values.iter().filter(|v| v.is_finite()).map(|v| v.abs()).collect();
+            magnitudes.sort_by(f64::total_cmp);
+            let limit = *magnitudes.get(magnitudes.len() * 98 / 100)?;
+            (limit > 0.0).then_some(ColorScale::Diverging { limit })
+        }
+        _ => None,
+    }
 }

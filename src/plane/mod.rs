@@ -16,7 +16,7 @@ mod raster;
 mod svg;
 mod values;
 
-pub use caption::{potential_scale, unit, where_text};
+pub use caption::{potential_scale, scale_for, unit, where_text};
 pub use colors::ColorScale;
 pub use contour::{Polyline, contour};
 pub use drawing::{MapPicture, NEAR_PLANE};

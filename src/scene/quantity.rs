@@ -28,6 +28,7 @@ impl Source {
                 Quantity::Orbital(i) => i < wf.orbitals.len(),
                 Quantity::BasisFunction(k) => k < wf.basis.n_functions(),
                 Quantity::Density | Quantity::Potential => true,
+                Quantity::ReducedGradient | Quantity::SignLambda2Rho | Quantity::DensityLaplacian => true,
                 Quantity::SpinDensity => !wf.restricted,
             }),
         }
@@ -63,6 +64,9 @@ impl Source {
             Source::Wavefunction(Quantity::Density) => "total density".into(),
             Source::Wavefunction(Quantity::SpinDensity) => "spin density".into(),
             Source::Wavefunction(Quantity::Potential) => "electrostatic potential".into(),
+            Source::Wavefunction(Quantity::ReducedGradient) => "reduced density gradient".into(),
+            Source::Wavefunction(Quantity::SignLambda2Rho) => "sign(λ₂)ρ".into(),
+            Source::Wavefunction(Quantity::DensityLaplacian) => "density Laplacian".into(),
             Source::Wavefunction(Quantity::Orbital(i)) => match &doc.wavefunction {
                 Some(wf) => orbital_name(wf, i),
                 None => format!("MO {}", i + 1),

@@ -1,0 +1,416 @@
+//! Non-covalent interactions (Johnson et al., JACS 132, 6498 (2010); NCIPLOT 4: Boto et al.,
+//! JCTC 16, 4150 (2020)): the density with its gradient and Hessian at points, from a
+//! wavefunction (analytic second derivatives of the basis functions) or from a promolecule
+//! ([`super::promolecular`]); from them the reduced density gradient
+//! s = |∇ρ| / (2(3π²)^{1/3} ρ^{4/3}), λ₂ (the Hessian's middle eigenvalue) and sign(λ₂)ρ, and
+//! NCIPLOT's two grids (`-dens`: 100·sign(λ₂)ρ, `-grad`: s) for fragments whose densities add.
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use super::eigen::symmetric_eigen;
+use super::grid::GridSpec;
+use super::gto::PreparedBasis;
+use super::orbitals::{Quantity, Wavefunction};
+
+/// What NCIPLOT's cubes hold where a point is cut (ρ above the cut, or an intermolecular
+/// point that one fragment owns): both `-dens` and `-grad` say 100, beyond any isosurface.
+pub const CUT_VALUE: f32 = 100.0;
+
+/// The density cut of a wavefunction's density (NCIPLOT's default for SCF densities).
+pub const WAVEFUNCTION_DENSITY_CUT: f64 = 0.05;
+
+/// The density cut of a promolecular density (NCIPLOT's).
+pub const PROMOLECULAR_DENSITY_CUT: f64 = 0.07;
+
+/// NCIPLOT's intermolecular rule: a point belongs to the interaction between fragments when no
+/// fragment holds more than this share of its density.
+pub const INTERMOLECULAR_SHARE: f64 = 0.95;
+
+/// 2(3π²)^{1/3}: s = |∇ρ| / (this · ρ^{4/3}).
+pub fn rdg_factor() -> f64 {
+    2.0 * (3.0 * std::f64::consts::PI * std::f64::consts::PI).cbrt()
+}
+
+/// ρ, ∇ρ and the Hessian of ρ at a point (a.u.).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct DensityDerivatives {
+    pub rho: f64,
+    pub gradient: DVec3,
+    pub hessian: [[f64; 3]; 3],
+}
+
+impl DensityDerivatives {
+    /// The sum of two densities (fragments' densities add, and so do their derivatives).
+    pub fn add(&mut self, other: &Self) {
+        self.rho += other.rho;
+        self.gradient += other.gradient;
+        for (row, o) in self.hessian.iter_mut().zip(&other.hessian) {
+            for (h, o) in row.iter_mut().zip(o) {
+                *h += o;
+            }
+        }
+    }
+
+    /// The reduced density gradient s; infinite where ρ ≤ 0 (s grows without bound as ρ → 0).
+    pub fn reduced_gradient(&self) -> f64 {
+        if self.rho <= 0.0 {
+            return f64::INFINITY;
+        }
+        self.gradient.length() / (rdg_factor() * self.rho.powf(4.0 / 3.0))
+    }
+
+    /// The Hessian's eigenvalues, ascending.
+    pub fn eigenvalues(&self) -> [f64; 3] {
+        let (mut e, _) = symmetric_eigen(self.hessian, 50);
+        e.sort_by(f64::total_cmp);
+        e
+    }
+
+    /// λ₂, the middle eigenvalue of the Hessian.
+    pub fn lambda2(&self) -> f64 {
+        self.eigenvalues()[1]
+    }
+
+    /// sign(λ₂)·ρ: negative in bonding regions (hydrogen bonds), positive in steric clashes.
+    pub fn sign_lambda2_rho(&self) -> f64 {
+        if self.lambda2() < 0.0 { -self.rho } else { self.rho }
+    }
+
+    /// ∇²ρ, the Hessian's trace.
+    pub fn laplacian(&self) -> f64 {
+        self.hessian[0][0] + self.hessian[1][1] + self.hessian[2][2]
+    }
+
+    /// The quantity among those made of ρ's derivatives (NaN for any other).
+    pub fn quantity(&self, quantity: Quantity) -> f64 {
+        match quantity {
+            Quantity::ReducedGradient => self.reduced_gradient(),
+            Quantity::SignLambda2Rho => self.sign_lambda2_rho(),
+            Quantity::DensityLaplacian => self.laplacian(),
+            Quantity::Density => self.rho,
+            _ => f64::NAN,
+        }
+    }
+}
+
+/// A density whose value and first and second derivatives can be had at points.
+pub trait DensitySource: Sync {
+    /// ρ and its derivatives at each of `points` (bohr), written to `out` (as long as `points`).
+    /// Callers pass nearby points together (a grid row): sources screen their centres once
+    /// per call.
+    fn derivatives_at(&self, points: &[DVec3], out: &mut [DensityDerivatives]);
+}
+
+/// A wavefunction's total density as a [`DensitySource`].
+pub struct WavefunctionDensity<'a> {
+    pub basis: PreparedBasis,
+    pub wavefunction: &'a Wavefunction,
+}
+
+impl<'a> WavefunctionDensity<'a> {
+    pub fn new(wavefunction: &'a Wavefunction) -> Self {
+        Self { basis: PreparedBasis::new(&wavefunction.basis), wavefunction }
+    }
+}
+
+impl DensitySource for WavefunctionDensity<'_> {
+    fn derivatives_at(&self, points: &[DVec3], out: &mut [DensityDerivatives]) {
+        self.basis.density_derivatives_into(self.wavefunction, points, out);
+    }
+}
+
+impl PreparedBasis {
+    /// ρ, ∇ρ and the Hessian of `wf`'s total density at each of `points`:
+    /// ∂a∂bρ = 2 Σ_i n_i (ψ_i ∂a∂bψ_i + ∂aψ_i ∂bψ_i), the orbitals' derivatives from the basis
+    /// functions' analytic ones (only the shells within their cutoff of the point).
+    pub fn density_derivatives(&self, wf: &Wavefunction, points: &[DVec3]) -> Vec<DensityDerivatives> {
+        let mut out = vec![DensityDerivatives::default(); points.len()];
+        self.density_derivatives_into(wf, points, &mut out);
+        out
+    }
+
+    fn density_derivatives_into(&self, wf: &Wavefunction, points: &[DVec3], out: &mut [DensityDerivatives]) {
+        let occupied: Vec<(&[f64], f64)> = (wf.orbitals.iter())
+            .filter(|o| o.occupation != 0.0)
+            .map(|o| (o.coefficients.as_slice(), o.occupation))
+            .collect();
+        let mut phi = vec![[0.0; 10]; self.n_functions()];
+        let mut cart = Vec::new();
+        let mut active: Vec<usize> = Vec::new();
+        // Shells that can reach any of the points: the rest are never looked at.
+        let (lo, hi) = bounds(points);
+        let (centre, half) = ((lo + hi) * 0.5, (hi - lo).length() * 0.5);
+        let near: Vec<usize> = (0..self.shells.len())
+            .filter(|&s| self.shells[s].center().distance(centre) <= self.shells[s].cutoff + half)
+            .collect();
+        for (p, o) in points.iter().zip(out.iter_mut()) {
+            active.clear();
+            for &si in &near {
+                let s = &self.shells[si];
+                let d = *p - s.center();
+                if d.length_squared() <= s.cutoff * s.cutoff {
+                    self.shell_second_derivatives(s, d, &mut phi[s.functions()], &mut cart);
+                    active.extend(s.functions());
+                }
+            }
+            let mut rho = 0.0;
+            let mut g = [0.0; 3];
+            let mut h = [0.0; 6];
+            for &(c, n) in &occupied {
+                let mut psi = [0.0; 10];
+                for &k in &active {
+                    let ck = c.get(k).copied().unwrap_or(0.0);
+                    if ck != 0.0 {
+                        for (a, b) in psi.iter_mut().zip(&phi[k]) {
+                            *a += ck * b;
+                        }
+                    }
+                }
+                rho += n * psi[0] * psi[0];
+                for a in 0..3 {
+                    g[a] += 2.0 * n * psi[0] * psi[1 + a];
+                }
+                for (k, (a, b)) in PAIRS.into_iter().enumerate() {
+                    h[k] += 2.0 * n * (psi[0] * psi[4 + k] + psi[1 + a] * psi[1 + b]);
+                }
+            }
+            *o = DensityDerivatives { rho, gradient: DVec3::from_array(g), hessian: symmetric(h) };
+        }
+    }
+}
+
+/// The six independent components' (row, column): xx, xy, xz, yy, yz, zz.
+const PAIRS: [(usize, usize); 6] = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
+
+fn symmetric(h: [f64; 6]) -> [[f64; 3]; 3] {
+    [[h[0], h[1], h[2]], [h[1], h[3], h[4]], [h[2], h[4], h[5]]]
+}
+
+/// The box of `points` (a point box at the origin when there are none).
+pub(super) fn bounds(points: &[DVec3]) -> (DVec3, DVec3) {
+    match points.first() {
+        None => (DVec3::ZERO, DVec3::ZERO),
+        Some(&first) => points.iter().fold((first, first), |(lo, hi), p| (lo.min(*p), hi.max(*p))),
+    }
+}
+
+/// The quantities of ρ's derivatives at `points` for one source, in parallel.
+pub fn quantity_at_points(source: &dyn DensitySource, quantity: Quantity, points: &[DVec3]) -> Vec<f64> {
+    points
+        .par_chunks(256)
+        .flat_map_iter(|chunk| {
+            let mut d = vec![DensityDerivatives::default(); chunk.len()];
+            source.derivatives_at(chunk, &mut d);
+            d.into_iter().map(move |d| d.quantity(quantity))
+        })
+        .collect()
+}
+
+/// How NCIPLOT's grids are made.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NciSettings {
+    /// Points whose total ρ is above this are cut.
+    pub density_cut: f64,
+    /// With several fragments, the largest share of a point's density one fragment may hold
+    /// for the point to be kept (`None`: every point is kept).
+    pub intermolecular: Option<f64>,
+}
+
+/// NCIPLOT's two grids, cube order: `dens` holds 100·sign(λ₂)ρ, `grad` holds s, both
+/// [`CUT_VALUE`] at the points cut.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NciGrids {
+    pub dens: Vec<f32>,
+    pub grad: Vec<f32>,
+    /// Points not cut.
+    pub kept: usize,
+}
+
+/// [`NciGrids`] of the fragments' summed density on `grid`, x-slabs in parallel, a row of
+/// points at a time.
+pub fn nci_grid(fragments: &[&dyn DensitySource], grid: &GridSpec, settings: NciSettings) -> NciGrids {
+    let [_, ny, nz] = grid.dims;
+    let slab = ny * nz;
+    let mut dens = vec![CUT_VALUE; grid.len()];
+    let mut grad = vec![CUT_VALUE; grid.len()];
+    if grid.is_empty() {
+        return NciGrids { dens, grad, kept: 0 };
+    }
+    let kept: usize = dens
+        .par_chunks_mut(slab)
+        .zip(grad.par_chunks_mut(slab))
+        .enumerate()
+        .map(|(ix, (dens, grad))| {
+            let mut points = Vec::with_capacity(nz);
+            let mut total = vec![DensityDerivatives::default(); nz];
+            let mut part = vec![DensityDerivatives::default(); nz];
+            let mut largest = vec![0.0f64; nz];
+            let mut kept = 0;
+            for iy in 0..ny {
+                points.clear();
+                points.extend((0..nz).map(|iz| grid.point(ix, iy, iz)));
+                total.fill(DensityDerivatives::default());
+                largest.fill(0.0);
+                for f in fragments {
+                    f.derivatives_at(&points, &mut part);
+                    for ((t, p), l) in total.iter_mut().zip(&part).zip(largest.iter_mut()) {
+                        t.add(p);
+                        *l = l.max(p.rho);
+                    }
+                }
+                for (iz, (t, l)) in total.iter().zip(&largest).enumerate() {
+                    let own = settings.intermolecular.is_some_and(|share| *l > share * t.rho);
+                    if t.rho > settings.density_cut || own || t.rho.is_nan() || t.rho <= 0.0 {
+                        continue;
+                    }
+                    let s = t.reduced_gradient();
+                    let k = iy * nz + iz;
+                    dens[k] = (100.0 * t.sign_lambda2_rho()) as f32;
+                    grad[k] = if s.is_finite() { s.min(CUT_VALUE as f64) as f32 } else { CUT_VALUE };
+                    kept += 1;
+                }
+            }
+            kept
+        })
+        .sum();
+    NciGrids { dens, grad, kept }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::basis::{Basis, Shell, ShellKind};
+    use crate::model::orbitals::{MolecularOrbital, Spin};
+
+    /// Two centres with s, p, d (pure) and f (cartesian) shells, two occupied orbitals.
+    fn wavefunction() -> Wavefunction {
+        let shell = |center: DVec3, l: u32, kind: ShellKind| Shell {
+            atom: 0,
+            center,
+            l,
+            kind,
+            exponents: vec![3.0, 0.8, 0.25],
+            coefficients: vec![0.2, 0.5, 0.5],
+        };
+        let (a, b) = (DVec3::ZERO, DVec3::new(2.2, 0.4, -0.3));
+        let basis = Basis {
+            shells: vec![
+                shell(a, 0, ShellKind::Pure),
+                shell(a, 1, ShellKind::Pure),
+                shell(b, 0, ShellKind::Pure),
+                shell(b, 2, ShellKind::Pure),
+                shell(a, 3, ShellKind::Cartesian),
+            ],
+        };
+        let n = basis.n_functions();
+        let orbital = |seed: u64, occupation: f64| MolecularOrbital {
+            energy: -0.5,
+            occupation,
+            spin: Spin::Alpha,
+            symmetry: String::new(),
+            coefficients: crate::model::gto::tests::pseudo_random(n, seed),
+        };
+        Wavefunction { basis, orbitals: vec![orbital(1, 2.0), orbital(2, 1.5)], restricted: true, ..Default::default() }
+    }
+
+    #[test]
+    fn density_derivatives_match_finite_differences() {
+        let wf = wavefunction();
+        let pb = PreparedBasis::new(&wf.basis);
+        let points: Vec<DVec3> = (0..40)
+            .map(|i| {
+                let t = i as f64 * 0.37;
+                DVec3::new(1.1 * t.sin() + 0.8, 1.3 * (1.7 * t).cos(), 0.9 * (0.6 * t).sin())
+            })
+            .collect();
+        let d = pb.density_derivatives(&wf, &points);
+        let h = 1e-4;
+        for (p, d) in points.iter().zip(&d) {
+            assert!((d.rho - pb.density(&wf, *p)).abs() < 1e-13 * (1.0 + d.rho));
+            for a in 0..3 {
+                let mut e = DVec3::ZERO;
+                e[a] = h;
+                let (dp, dm) = (pb.density_derivatives(&wf, &[*p + e])[0], pb.density_derivatives(&wf, &[*p - e])[0]);
+                let fd = (dp.rho - dm.rho) / (2.0 * h);
+                assert!(
+                    (fd - d.gradient[a]).abs() < 1e-6 * (1.0 + fd.abs()),
+                    "∂{a}ρ at {p}: {fd} vs {}",
+                    d.gradient[a]
+                );
+                for b in 0..3 {
+                    let fd = (dp.gradient[b] - dm.gradient[b]) / (2.0 * h);
+                    let got = d.hessian[a][b];
+                    assert!((fd - got).abs() < 1e-6 * (1.0 + fd.abs()), "∂{a}∂{b}ρ at {p}: {fd} vs {got}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn reduced_gradient_and_lambda2_follow_their_definitions() {
+        // A hydrogen-like density e^{-2r}/π: s = (1/(3π²)^{1/3}) ρ^{-1/3} exactly, and the
+        // Hessian's eigenvalues are ρ″ = 4ρ (radial) and ρ′/r = −2ρ/r (twice).
+        let r: f64 = 1.7;
+        let rho = (-2.0 * r).exp() / std::f64::consts::PI;
+        let x = DVec3::new(r, 0.0, 0.0);
+        let d = DensityDerivatives {
+            rho,
+            gradient: -2.0 * rho * x / r,
+            hessian: [[4.0 * rho, 0.0, 0.0], [0.0, -2.0 * rho / r, 0.0], [0.0, 0.0, -2.0 * rho / r]],
+        };
+        let want = 2.0 * rho / (rdg_factor() * rho.powf(4.0 / 3.0));
+        assert!((d.reduced_gradient() - want).abs() < 1e-12 * want);
+        assert!((d.lambda2() + 2.0 * rho / r).abs() < 1e-14);
+        assert_eq!(d.sign_lambda2_rho(), -rho);
+        assert!((d.laplacian() - (4.0 - 4.0 / r) * rho).abs() < 1e-15);
+        let turned = DensityDerivatives { hessian: [[1.0, 2.0, 0.0], [2.0, -3.0, 0.5], [0.0, 0.5, 0.2]], ..d };
+        let e = turned.eigenvalues();
+        assert!(e[0] < e[1] && e[1] < e[2]);
+        assert!((e.iter().sum::<f64>() - turned.laplacian()).abs() < 1e-12);
+        assert_eq!(DensityDerivatives::default().reduced_gradient(), f64::INFINITY);
+    }
+
+    #[test]
+    fn nci_grid_cuts_dense_points_and_fragments_add() {
+        let wf = wavefunction();
+        let source = WavefunctionDensity::new(&wf);
+        let grid = GridSpec::cube(DVec3::splat(-2.0), DVec3::new(4.0, 2.0, 2.0), 9);
+        let settings = NciSettings { density_cut: 0.05, intermolecular: None };
+        let one = nci_grid(&[&source], &grid, settings);
+        let two = nci_grid(&[&source, &source], &grid, settings);
+        let mut cut = 0;
+        for i in 0..grid.dims[0] {
+            for j in 0..grid.dims[1] {
+                for k in 0..grid.dims[2] {
+                    let at = (i * grid.dims[1] + j) * grid.dims[2] + k;
+                    let d = pb_point(&source, grid.point(i, j, k));
+                    if d.rho > 0.05 {
+                        assert_eq!((one.dens[at], one.grad[at]), (CUT_VALUE, CUT_VALUE));
+                        cut += 1;
+                    } else {
+                        assert!((one.dens[at] as f64 - 100.0 * d.sign_lambda2_rho()).abs() < 1e-5);
+                        assert!((one.grad[at] as f64 - d.reduced_gradient().min(100.0)).abs() < 1e-4);
+                    }
+                    // Twice the density: s scales by 2^{-1/3}.
+                    if 2.0 * d.rho <= 0.05 && d.reduced_gradient() < 50.0 {
+                        let want = d.reduced_gradient() * 2f64.powf(-1.0 / 3.0);
+                        assert!((two.grad[at] as f64 - want).abs() < 1e-4 * (1.0 + want));
+                    }
+                }
+            }
+        }
+        assert!(cut > 0 && one.kept > 0 && one.kept + cut == grid.len());
+        // One fragment twice holds half of every point: kept at a share of 0.95, cut at 0.4.
+        let inter =
+            |share| nci_grid(&[&source, &source], &grid, NciSettings { intermolecular: Some(share), ..settings });
+        assert_eq!(inter(0.95).kept, two.kept);
+        assert_eq!(inter(0.4).kept, 0);
+    }
+
+    fn pb_point(source: &WavefunctionDensity, p: DVec3) -> DensityDerivatives {
+        let mut d = [DensityDerivatives::default()];
+        source.derivatives_at(&[p], &mut d);
+        d[0]
+    }
+}
