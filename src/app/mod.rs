@@ -1022,6 +1022,54 @@ impl OrbApp {
         playing
     }
 
+    /// The panels of the active object beside and below the view: its orbital browser, its
+    /// normal modes and the plane map (a scan shows its own controls instead).
+    fn object_panels(&mut self, ui: &mut egui::Ui, ctx: &egui::Context) {
+        let defaults = self.defaults;
+        // A scan shows its own orbitals; the browser belongs to the scene's objects.
+        if let Some(o) = self.objects.get_mut(self.active).filter(|_| self.scan.is_none()) {
+            let view = &mut self.view;
+            let reframe = orbitals::panel(
+                ui,
+                &o.doc,
+                &mut o.state,
+                &defaults,
+                (&mut view.panes, &view.camera),
+                &mut self.scroll_to_frontier,
+                &mut view.panels.orbitals,
+            );
+            match reframe {
+                orbitals::Reframe::BesideBar => self.frame_beside_bar(),
+                orbitals::Reframe::Panes => self.frame_panes(),
+                orbitals::Reframe::None => {}
+            }
+        }
+        if let Some(o) = self.objects.get_mut(self.active).filter(|_| self.scan.is_none()) {
+            vibrations::panel(ui, &o.doc, &mut o.state.vibration, &mut self.spectrum);
+        }
+        if self.plane.open
+            && self.scan.is_none()
+            && let Some(o) = self.objects.get(self.active)
+        {
+            let source = o.state.selected_quantity().map(|q| q.source);
+            let measured = self.measured_plane_atoms();
+            // The view's plane in the object's own frame: through the camera's target, facing it.
+            let object_from_world = o.state.placement.world_from_object().inverse().as_dmat4();
+            let camera = &self.view.camera;
+            let facing = plane_pane::Through::Facing {
+                origin: object_from_world.transform_point3(camera.target.as_dvec3()),
+                normal: object_from_world.transform_vector3((camera.eye() - camera.target).as_dvec3()),
+            };
+            if plane_pane::panel(ui, &mut self.plane, (&o.doc, source), measured, facing) {
+                let stem =
+                    Path::new(&o.doc.source).file_stem().map_or("map".into(), |s| s.to_string_lossy().into_owned());
+                if let Some(path) = self.choose(files::Purpose::SaveMap, &format!("{stem}-plane.png")) {
+                    self.chosen(files::Purpose::SaveMap, path, ctx);
+                }
+            }
+        }
+    }
+
     /// The first three atoms of the last measurement of three or more atoms, when all lie in the
     /// active object: 1-based, as the plane pane numbers them.
     fn measured_plane_atoms(&self) -> Option<[usize; 3]> {
@@ -1279,49 +1327,7 @@ impl eframe::App for OrbApp {
         self.compute_windows(&ctx);
         picture::picture_window(&ctx, self);
         panels::side_panel(ui, self);
-        let defaults = self.defaults;
-        // A scan shows its own orbitals; the browser belongs to the scene's objects.
-        if let Some(o) = self.objects.get_mut(self.active).filter(|_| self.scan.is_none()) {
-            let view = &mut self.view;
-            let reframe = orbitals::panel(
-                ui,
-                &o.doc,
-                &mut o.state,
-                &defaults,
-                (&mut view.panes, &view.camera),
-                &mut self.scroll_to_frontier,
-                &mut view.panels.orbitals,
-            );
-            match reframe {
-                orbitals::Reframe::BesideBar => self.frame_beside_bar(),
-                orbitals::Reframe::Panes => self.frame_panes(),
-                orbitals::Reframe::None => {}
-            }
-        }
-        if let Some(o) = self.objects.get_mut(self.active).filter(|_| self.scan.is_none()) {
-            vibrations::panel(ui, &o.doc, &mut o.state.vibration, &mut self.spectrum);
-        }
-        if self.plane.open
-            && self.scan.is_none()
-            && let Some(o) = self.objects.get(self.active)
-        {
-            let source = o.state.selected_quantity().map(|q| q.source);
-            let measured = self.measured_plane_atoms();
-            // The view's plane in the object's own frame: through the camera's target, facing it.
-            let object_from_world = o.state.placement.world_from_object().inverse().as_dmat4();
-            let camera = &self.view.camera;
-            let facing = plane_pane::Through::Facing {
-                origin: object_from_world.transform_point3(camera.target.as_dvec3()),
-                normal: object_from_world.transform_vector3((camera.eye() - camera.target).as_dvec3()),
-            };
-            if plane_pane::panel(ui, &mut self.plane, (&o.doc, source), measured, facing) {
-                let stem =
-                    Path::new(&o.doc.source).file_stem().map_or("map".into(), |s| s.to_string_lossy().into_owned());
-                if let Some(path) = self.choose(files::Purpose::SaveMap, &format!("{stem}-plane.png")) {
-                    self.chosen(files::Purpose::SaveMap, path, &ctx);
-                }
-            }
-        }
+        self.object_panels(ui, &ctx);
         self.apply_changes();
         self.apply_scene_edits();
         let modes_play = self.animate_modes(ui.input(|i| i.time));

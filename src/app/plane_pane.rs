@@ -43,13 +43,14 @@ struct Asked {
     through: Through,
     offset: f64,
     points: usize,
+    gradient_lines: bool,
 }
 
 impl PartialEq for Asked {
     fn eq(&self, other: &Self) -> bool {
         Arc::ptr_eq(&self.doc, &other.doc)
-            && (self.source, self.through, self.offset.to_bits(), self.points)
-                == (other.source, other.through, other.offset.to_bits(), other.points)
+            && (self.source, self.through, self.offset.to_bits(), self.points, self.gradient_lines)
+                == (other.source, other.through, other.offset.to_bits(), other.points, other.gradient_lines)
     }
 }
 
@@ -83,6 +84,8 @@ impl Made {
             caption: self.caption.clone(),
             unit: self.unit.clone(),
             scale: self.scale,
+            gradient_lines: self.asked.gradient_lines,
+            bohr: false,
         }
     }
 }
@@ -95,6 +98,8 @@ pub struct PlanePane {
     /// Along the plane's normal, Å.
     pub offset: f64,
     pub points: usize,
+    /// Gradient lines from the atoms near the plane.
+    pub gradient_lines: bool,
     jobs: Latest<Result<Made, String>>,
     /// The map shown, and its texture.
     shown: Option<(Made, egui::TextureHandle)>,
@@ -110,6 +115,7 @@ impl PlanePane {
             through: Through::Atoms([1, 2, 3]),
             offset: 0.0,
             points: 200,
+            gradient_lines: false,
             jobs: Latest::new("making the plane map", repaint),
             shown: None,
             asked: None,
@@ -130,7 +136,14 @@ impl PlanePane {
     /// Asks for the map of `doc`'s `source` on the current plane when it is not the one shown
     /// or coming: a coarse map first, then (when it arrives) the full one.
     fn ask(&mut self, doc: &Arc<Document>, source: Source) {
-        let full = Asked { doc: doc.clone(), source, through: self.through, offset: self.offset, points: self.points };
+        let full = Asked {
+            doc: doc.clone(),
+            source,
+            through: self.through,
+            offset: self.offset,
+            points: self.points,
+            gradient_lines: self.gradient_lines,
+        };
         let coarse = Asked { points: COARSE_POINTS.min(self.points), ..full.clone() };
         let shown = self.shown.as_ref().map(|(m, _)| &m.asked);
         if shown == Some(&full) || self.asked.as_ref() == Some(&full) {
@@ -192,8 +205,16 @@ fn make(asked: Asked) -> Result<Made, String> {
     let caption = vec![format!("{file} · {}", asked.source.name(doc)), plane::where_text(&how, &plane, asked.offset)];
     let scale = plane::scale_for(asked.source, &map);
     let unit = plane::unit(asked.source).to_string();
-    let picture =
-        MapPicture { map: &map, molecule: m, levels: &levels, caption: caption.clone(), unit: unit.clone(), scale };
+    let picture = MapPicture {
+        map: &map,
+        molecule: m,
+        levels: &levels,
+        caption: caption.clone(),
+        unit: unit.clone(),
+        scale,
+        gradient_lines: asked.gradient_lines,
+        bohr: false,
+    };
     let image = plane::png(&picture);
     let figure =
         egui::ColorImage::from_rgba_unmultiplied([image.width() as usize, image.height() as usize], image.as_raw());
@@ -272,6 +293,8 @@ pub fn panel(
                 for p in POINT_CHOICES {
                     ui.selectable_value(&mut pane.points, p, p.to_string());
                 }
+                ui.checkbox(&mut pane.gradient_lines, "gradient lines")
+                    .on_hover_text("paths down the quantity's gradient from the atoms in the plane");
             });
             pane.ask(doc, source);
             if let Some(e) = &pane.error {

@@ -136,6 +136,11 @@ pub fn quantity_choices(doc: &Document) -> Vec<(Source, String)> {
             choices.push((Source::Wavefunction(Quantity::SpinDensity), "spin density".into()));
         }
         choices.push((Source::Wavefunction(Quantity::Potential), "electrostatic potential".into()));
+        // From the density's second derivatives: shell structure, and the NCI quantities.
+        for q in [Quantity::DensityLaplacian, Quantity::ReducedGradient, Quantity::SignLambda2Rho] {
+            let source = Source::Wavefunction(q);
+            choices.push((source, source.name(doc)));
+        }
     }
     choices
 }

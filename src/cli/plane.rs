@@ -29,6 +29,13 @@ pub struct PlaneArgs {
     /// wavefunction's at each point, or its first data set's, interpolated trilinearly.
     #[arg(long, value_name = "FILE")]
     minus: Option<PathBuf>,
+    /// Draw gradient lines from the atoms near the plane over the contours (for the density,
+    /// the paths that outline each atom's basin).
+    #[arg(long)]
+    gradient_lines: bool,
+    /// Label the axes in bohr (ångström by default).
+    #[arg(long)]
+    bohr: bool,
     /// The plane through three atoms A,B,C (counted from 1): u along A→B, v towards C.
     #[arg(long, value_name = "A,B,C", value_parser = parse_indices::<3>)]
     through: Option<[usize; 3]>,
@@ -140,8 +147,16 @@ pub fn plane(args: &PlaneArgs) -> Result<()> {
     let caption =
         vec![format!("{} · {}", file_name(&args.file), described.label), plane::where_text(&how, &plane, args.offset)];
     let scale = args.minus.is_none().then(|| plane::scale_for(source, &map)).flatten();
-    let picture =
-        MapPicture { map: &map, molecule: &doc.molecule, levels: &levels, caption, unit: described.unit, scale };
+    let picture = MapPicture {
+        map: &map,
+        molecule: &doc.molecule,
+        levels: &levels,
+        caption,
+        unit: described.unit,
+        scale,
+        gradient_lines: args.gradient_lines,
+        bohr: args.bohr,
+    };
     write_figure(&picture, format, &args.output)?;
     if let Some(path) = &args.values {
         std::fs::write(path, map.csv()).with_context(|| format!("writing {}", path.display()))?;

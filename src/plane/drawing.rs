@@ -70,6 +70,10 @@ pub struct MapPicture<'a> {
     pub unit: String,
     /// The colour scale, when not the one the values suggest ([`ColorScale::for_values`]).
     pub scale: Option<ColorScale>,
+    /// Gradient lines from the atoms near the plane over the contours.
+    pub gradient_lines: bool,
+    /// The axes in bohr (else ångström).
+    pub bohr: bool,
 }
 
 /// Where the parts of a figure go.
@@ -134,6 +138,9 @@ impl MapPicture<'_> {
         let scale = self.scale();
         canvas.raster(layout.plot, &self.fill(&scale, [w as u32, h as u32]));
         self.contours(canvas, layout.plot);
+        if self.gradient_lines {
+            self.gradient(canvas, layout.plot);
+        }
         self.atoms(canvas, layout.plot);
         canvas.rect(layout.plot, None, Some(INK));
         self.axes(canvas, layout.plot);
@@ -175,6 +182,29 @@ impl MapPicture<'_> {
                     line.points.iter().map(|p| [x0 + p[0] / last * w, y0 + (1.0 - p[1] / last) * h]).collect();
                 canvas.polyline(&points, stroke, "contour");
             }
+        }
+    }
+
+    /// Gradient lines from the atoms within [`NEAR_PLANE`] of the plane, thin and grey.
+    fn gradient(&self, canvas: &mut impl Canvas, plot: Rect) {
+        if self.map.vanishes() {
+            return;
+        }
+        let n = self.map.plane.points;
+        let last = (n - 1) as f64;
+        let [x0, y0, w, h] = plot;
+        let centres: Vec<[f64; 2]> = (self.molecule.atoms.iter())
+            .filter_map(|a| {
+                let ([u, v], d) = self.map.plane.project(a.position);
+                let [su, sv] = self.map.plane.size;
+                (d.abs() <= NEAR_PLANE).then_some([(u / su + 0.5) * last, (v / sv + 0.5) * last])
+            })
+            .collect();
+        let stroke = Stroke { color: FAINT, width: 0.7, dashed: false };
+        for line in super::gradient::gradient_lines(&self.map.values, n, &centres) {
+            let points: Vec<[f64; 2]> =
+                line.iter().map(|p| [x0 + p[0] / last * w, y0 + (1.0 - p[1] / last) * h]).collect();
+            canvas.polyline(&points, stroke, "gradient");
         }
     }
 
@@ -233,7 +263,8 @@ impl MapPicture<'_> {
     }
 
     fn axes(&self, canvas: &mut impl Canvas, [x0, y0, w, h]: Rect) {
-        let [su, sv] = self.map.plane.size.map(|s| s * ANGSTROM_PER_BOHR);
+        let (per_bohr, unit) = if self.bohr { (1.0, "bohr") } else { (ANGSTROM_PER_BOHR, "Å") };
+        let [su, sv] = self.map.plane.size.map(|s| s * per_bohr);
         let step = nice_step(su.max(sv) / 6.0);
         let stroke = Stroke { color: INK, width: 1.0, dashed: false };
         for value in ticks(su * 0.5, step) {
@@ -246,8 +277,8 @@ impl MapPicture<'_> {
             canvas.polyline(&[[x0, y], [x0 - 5.0, y]], stroke, "axis");
             canvas.text([x0 - 9.0, y], TEXT - 1.0, Anchor::End, INK, &label(value));
         }
-        canvas.text([x0 + 0.5 * w, y0 + h + 42.0], TEXT, Anchor::Middle, INK, "u (Å)");
-        canvas.text([x0 - 66.0, y0 + 0.5 * h], TEXT, Anchor::Middle, INK, "v (Å)");
+        canvas.text([x0 + 0.5 * w, y0 + h + 42.0], TEXT, Anchor::Middle, INK, &format!("u ({unit})"));
+        canvas.text([x0 - 66.0, y0 + 0.5 * h], TEXT, Anchor::Middle, INK, &format!("v ({unit})"));
     }
 
     fn color_bar(&self, canvas: &mut impl Canvas, scale: &ColorScale, [x, y, w, h]: Rect) {

@@ -11,6 +11,7 @@ mod colors;
 mod contour;
 mod drawing;
 mod geometry;
+mod gradient;
 mod levels;
 mod raster;
 mod svg;
@@ -21,6 +22,7 @@ pub use colors::ColorScale;
 pub use contour::{Polyline, contour};
 pub use drawing::{MapPicture, NEAR_PLANE};
 pub use geometry::{Frame, MAX_POINTS, Plane, atom_position};
+pub use gradient::gradient_lines;
 pub use levels::{Levels, auto_levels};
 pub use raster::png;
 pub use svg::svg;
@@ -77,6 +79,8 @@ mod tests {
             caption: vec!["x·y".into()],
             unit: "f".into(),
             scale: None,
+            gradient_lines: false,
+            bohr: false,
         };
         let text = svg(&picture);
         assert!(text.starts_with("<svg") && text.trim_end().ends_with("</svg>"));
@@ -107,6 +111,8 @@ mod tests {
             caption: vec![],
             unit: "f".into(),
             scale: None,
+            gradient_lines: false,
+            bohr: false,
         };
         let text = svg(&picture);
         assert!(!text.contains(r#"class="contour""#));
@@ -124,6 +130,8 @@ mod tests {
             caption: vec!["x·y".into()],
             unit: "f".into(),
             scale: None,
+            gradient_lines: false,
+            bohr: false,
         };
         let img = png(&picture);
         let layout = picture.layout();
