@@ -153,8 +153,6 @@ fn bad_planes_fail_with_a_message() {
         (&["--origin", "0,0,0", "--normal", "0,0,0"][..], "normal is zero"),
         (&["--through", "1,2,3", "--points", "4001"][..], "4001 points per side"),
         (&["--through", "1,2,3", "--extent=0"][..], "positive side"),
-        (&["--through", "1,2,3", "--laplacian"][..], "needs the density's Hessian"),
-        (&["--through", "1,2,3", "--nci"][..], "needs the density's Hessian"),
         (&["--bond", "1,2", "--toward", "0,0,0"][..], "runs along the bond"),
         (&[][..], "which plane?"),
     ] {
@@ -208,4 +206,55 @@ fn a_cube_file_is_interpolated_and_says_so() {
     let worst = smooth.iter().map(|(e, c)| (e - c).abs() / 0.05).fold(0.0, f64::max);
     assert!(worst < 0.1, "interpolation error {worst} of 0.05");
     assert!(smooth.iter().any(|(e, c)| e != c));
+}
+
+/// The Laplacian and the NCI quantities on a plane are what `eval` gives at the same points
+/// (itself checked against PySCF's second derivatives in tests/nci_pyscf.rs), and gradient
+/// lines reach the SVG.
+#[test]
+fn second_derivative_quantities_map_as_eval_gives_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let water = fixture("h2o_cart_631gs.molden");
+    for flag in ["--laplacian", "--rdg", "--sign-lambda2-rho"] {
+        let (csv, csv_s) = path(dir.path(), "map.csv");
+        let (svg, svg_s) = path(dir.path(), "map.svg");
+        let o = orbcloud(&[
+            "plane",
+            &water,
+            flag,
+            "--through",
+            "1,2,3",
+            "--offset",
+            "0.2",
+            "--points",
+            "12",
+            "--gradient-lines",
+            "--bohr",
+            "-o",
+            &svg_s,
+            "--values",
+            &csv_s,
+        ]);
+        assert!(o.status.success(), "{flag}: {}", String::from_utf8_lossy(&o.stderr));
+        let map = read_csv(&csv);
+        let points: String = map.iter().map(|(p, _)| format!("{} {} {}\n", p.x, p.y, p.z)).collect();
+        let (pts, pts_s) = path(dir.path(), "points.txt");
+        std::fs::write(&pts, points).unwrap();
+        let o = orbcloud(&["eval", &water, flag, "--points", &pts_s]);
+        assert!(o.status.success(), "{flag}: {}", String::from_utf8_lossy(&o.stderr));
+        let eval: Vec<f64> = String::from_utf8_lossy(&o.stdout)
+            .lines()
+            .filter(|l| !l.starts_with('#') && !l.trim().is_empty())
+            .filter_map(|l| l.split_whitespace().nth(3)?.parse().ok())
+            .collect();
+        assert_eq!(eval.len(), map.len(), "{flag}");
+        let largest = map.iter().map(|(_, v)| v.abs()).fold(0.0, f64::max);
+        let worst = map.iter().zip(&eval).map(|((_, a), b)| (a - b).abs()).fold(0.0, f64::max);
+        assert!(worst <= 1e-9 * largest.max(1.0), "{flag}: worst {worst:e} of {largest:e}");
+        let text = std::fs::read_to_string(&svg).unwrap();
+        assert!(text.contains("u (bohr)"), "{flag}: axes in bohr");
+        if flag == "--laplacian" {
+            assert!(text.contains(r#"class="gradient""#), "gradient lines drawn");
+        }
+    }
 }

@@ -237,8 +237,10 @@ fn the_correlation_diagram_follows_each_orbital_by_character() {
             assert_eq!(symmetry(f, p.2), first, "{} at frame {f} (orbital {})", l.label, p.2 + 1);
         }
     }
-    let crossing = diagram.lines.iter().find(|l| !l.crossings.is_empty()).expect("a crossing among the virtuals");
-    let f = crossing.crossings[0];
+    // An orbital whose character moves to another orbital number between two frames.
+    let (crossing, f) = (diagram.lines.iter())
+        .find_map(|l| (1..l.points.len()).find(|&f| l.points[f].2 != l.points[f - 1].2).map(|f| (l, f)))
+        .expect("a character swap among the virtuals");
     let (before, after) = (crossing.points[f - 1].2, crossing.points[f].2);
     assert_ne!(before, after, "{} continues into another orbital number", crossing.label);
     assert_ne!(symmetry(f, before), symmetry(f - 1, before), "by number, the character would change");

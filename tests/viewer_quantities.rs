@@ -602,7 +602,28 @@ fn a_plane_map_beside_the_view_is_exact_follows_the_plane_and_saves_its_figure()
         map.vanishes()
     };
     assert!(check(h.state()), "the π HOMO vanishes in the ring's plane");
-    // Moved half an ångström off the ring, the map follows: the π lobes.
+    // Moved half an ångström off the ring, in the view (Alt + wheel, 0.1 Å a notch), the map
+    // follows: the π lobes. The camera stays where it was.
+    let view = h.state().view_rect().unwrap();
+    let distance = h.state().view.camera.distance;
+    h.hover_at(view.center());
+    h.event(egui::Event::ModifiersChanged(egui::Modifiers::ALT));
+    for _ in 0..5 {
+        h.event(egui::Event::MouseWheel {
+            unit: egui::MouseWheelUnit::Line,
+            delta: egui::vec2(0.0, 1.0),
+            phase: egui::TouchPhase::Move,
+            source: egui::MouseWheelSource::Unknown,
+            modifiers: egui::Modifiers::ALT,
+        });
+        h.run_steps(1);
+    }
+    // The wheel's smoothed remainder is spent while Alt is still held.
+    h.run_steps(20);
+    h.event(egui::Event::ModifiersChanged(egui::Modifiers::NONE));
+    h.run_steps(1);
+    assert!((h.state().plane.offset - 0.5).abs() < 1e-9, "offset {}", h.state().plane.offset);
+    assert_eq!(h.state().view.camera.distance, distance, "Alt + wheel moves the plane, not the camera");
     h.state_mut().plane.offset = 0.5;
     wait(&mut h, 0.5);
     assert!(!check(h.state()), "the HOMO's lobes above the ring");

@@ -1396,7 +1396,8 @@ impl eframe::App for OrbApp {
                         && let Some(molecule) = job.skeleton()
                     {
                         vp.show_molecule(&molecule, self.defaults.atoms);
-                        if let Some((lo, hi)) = molecule.bounds() {
+                        // A session's scan keeps the session's camera.
+                        if let Some((lo, hi)) = molecule.bounds().filter(|_| self.restoring_scan.is_none()) {
                             self.view.camera = crate::scene::Camera::framing(lo.as_vec3(), hi.as_vec3());
                         }
                         job.skeleton_shown = true;
@@ -1446,6 +1447,23 @@ impl eframe::App for OrbApp {
                     measure::overlay(ui, vp, &self.view.camera, &self.world, &self.measurements, self.view.labels);
                     if let Some(o) = self.objects.get(self.active).filter(|_| self.plane.open) {
                         plane_pane::outline(ui, vp, &self.view.camera, &self.plane, &o.state.placement);
+                        // Alt + wheel over the view moves the plane along its normal, 0.1 Å a notch.
+                        let notches: Vec<f32> = ui.input(|i| {
+                            (i.raw.events.iter())
+                                .filter_map(|e| match e {
+                                    egui::Event::MouseWheel { delta, modifiers, .. } if modifiers.alt => {
+                                        Some(delta.y + delta.x)
+                                    }
+                                    _ => None,
+                                })
+                                .filter(|d| *d != 0.0)
+                                .collect()
+                        });
+                        if vp.rect().is_some_and(|r| ui.rect_contains_pointer(r)) {
+                            for d in notches {
+                                self.plane.nudge(f64::from(d.signum()) * 0.1);
+                            }
+                        }
                     }
                 }
                 (None, None) => {}

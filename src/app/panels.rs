@@ -351,6 +351,9 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
                     "drag: rotate (from the bond: {}) · right/middle drag: pan · wheel: zoom · Space: play",
                     super::scan::drag_words(&s.scene.scan.coordinate)
                 ),
+                None if app.plane.open => {
+                    "drag: rotate · right/middle drag: pan · wheel: zoom · Alt + wheel: move the plane".into()
+                }
                 None => "drag: rotate · right/middle drag: pan · wheel: zoom · arrows, +/−: keys".into(),
             };
             ui.label(RichText::new(help).small().weak());

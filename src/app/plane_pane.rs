@@ -123,6 +123,11 @@ impl PlanePane {
         }
     }
 
+    /// Moves the plane `angstrom` along its normal, within the offsets the pane allows.
+    pub fn nudge(&mut self, angstrom: f64) {
+        self.offset = (self.offset + angstrom).clamp(-MAX_OFFSET, MAX_OFFSET);
+    }
+
     /// The map shown, once one is made.
     pub fn made(&self) -> Option<&Made> {
         self.shown.as_ref().map(|(m, _)| m)

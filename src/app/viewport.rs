@@ -1343,7 +1343,8 @@ fn handle_input(ui: &egui::Ui, response: &egui::Response, view: &mut ViewState, 
         let h = response.rect.height().max(1.0);
         cam.pan(d.x / h, d.y / h);
     }
-    if response.hovered() {
+    // The wheel zooms; with Alt it is the plane map's (which moves its plane).
+    if response.hovered() && !ui.input(|i| i.modifiers.alt) {
         let scroll = ui.input(|i| i.smooth_scroll_delta.y);
         if scroll != 0.0 {
             cam.zoom((-scroll * 0.002).exp());
