@@ -816,15 +816,8 @@ impl OrbApp {
         let Some(rect) = self.viewport.as_ref().and_then(Viewport::rect).filter(|_| count > 1) else { return };
         let aspect = rect.width() / count as f32 / rect.height().max(1.0);
         let atoms: Vec<glam::Vec3> = self.world.molecule.atoms.iter().map(|a| a.position.as_vec3()).collect();
-        let Some((lo, hi)) = atoms.iter().fold(None, |b: Option<(glam::Vec3, glam::Vec3)>, &p| {
-            Some(b.map_or((p, p), |(lo, hi)| (lo.min(p), hi.max(p))))
-        }) else {
-            return;
-        };
         let camera = &mut self.view.camera;
-        camera.target = 0.5 * (lo + hi);
-        camera.distance = 0.0;
-        camera.fit_points(atoms, aspect, ROOM);
+        camera.fit_exactly(&atoms, aspect, ROOM);
         if aspect < 1.0 {
             camera.distance *= aspect.max(0.2);
         }
@@ -840,16 +833,9 @@ impl OrbApp {
         let m = o.state.placement.world_from_object();
         let atoms: Vec<glam::Vec3> =
             o.doc.molecule.atoms.iter().map(|a| m.transform_point3(a.position.as_vec3())).collect();
-        let Some((lo, hi)) = atoms.iter().fold(None, |b: Option<(glam::Vec3, glam::Vec3)>, &p| {
-            Some(b.map_or((p, p), |(lo, hi)| (lo.min(p), hi.max(p))))
-        }) else {
-            return;
-        };
         let camera = &mut self.view.camera;
-        camera.target = 0.5 * (lo + hi);
-        camera.distance = 0.0;
         let free = ((rect.width() - legend::BAR_ROOM) / rect.width().max(1.0)).clamp(0.3, 1.0);
-        camera.fit_points(atoms.iter().copied(), aspect * free, REACH);
+        camera.fit_exactly(&atoms, aspect * free, REACH);
         // The framed scene's centre moves to the middle of the free part, left of the bar.
         let (right, _) = camera.screen_axes();
         let world_per_point = 2.0 * camera.distance * (0.5 * camera.fov_y).tan() / rect.height().max(1.0);

@@ -69,6 +69,16 @@ impl Camera {
         }
     }
 
+    /// Looks at the middle of `points` from as close as keeps them all `margin` inside a view
+    /// of width/height `aspect`, in the direction it looks now (nothing changes for no points).
+    pub fn fit_exactly(&mut self, points: &[Vec3], aspect: f32, margin: f32) {
+        let Some(&first) = points.first() else { return };
+        let (lo, hi) = points.iter().fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+        self.target = 0.5 * (lo + hi);
+        self.distance = 0.0;
+        self.fit_points(points.iter().copied(), aspect, margin);
+    }
+
     /// Unit vector from the target towards the eye.
     pub fn backward(&self) -> Vec3 {
         let (sy, cy) = self.yaw.sin_cos();
