@@ -1,7 +1,13 @@
 // Arrows as impostors (a normal mode's displacements): each arrow's box is rasterised, and each
 // fragment meets its eye ray with the arrow's shaft (a cylinder closed at its foot) and head (a
-// cone on a disc), writing the true depth and the lit colour. model::arrow::Arrow::hit is the
-// CPU reference of `hit_arrow`.
+// cone on a disc), writing the lit colour and a depth in front of everything else.
+// model::arrow::Arrow::hit is the CPU reference of `hit_arrow`.
+
+// An arrow's depth is its true depth scaled into [0, IN_FRONT): arrows still hide one another
+// in their true order, but nothing else hides them. They are what a chemist playing a mode
+// looks at, and a cloud or a translucent surface around the molecule would otherwise veil them
+// (clouds stop and translucent fragments are dropped at the opaque depth).
+const IN_FRONT: f32 = 1e-3;
 
 struct ArrowUniforms {
     clip_from_object: mat4x4<f32>,
@@ -146,6 +152,6 @@ fn fs_main(in: VertexOut) -> FragOut {
     out.color = vec4<f32>(u.color.rgb * (0.25 + 0.75 * diffuse) + vec3<f32>(0.35 * specular), 1.0);
     // An arrow is an annotation: nothing to pick.
     out.id = 0u;
-    out.depth = clip.z / clip.w;
+    out.depth = IN_FRONT * clip.z / clip.w;
     return out;
 }

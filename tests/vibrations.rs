@@ -205,6 +205,45 @@ fn a_modes_arrows_match_their_golden_image() {
     assert!(!bad.status.success(), "--arrows needs a mode");
 }
 
+/// Pixels of the arrows' yellow in `img`: red and green high, blue low.
+fn arrow_pixels(img: &image::RgbaImage) -> usize {
+    img.pixels().filter(|p| p[0] > 170 && p[1] > 120 && p[2] < 90 && p[0].abs_diff(p[1]) < 90).count()
+}
+
+#[test]
+fn a_modes_arrows_are_seen_through_the_cloud_and_the_translucent_surfaces() {
+    let dir = tempfile::tempdir().unwrap();
+    let water = fixture("water_rhf_631g.fchk");
+    let draw = |name: &str, extra: &[&str]| {
+        let png = dir.path().join(name);
+        let mut args = vec![
+            "render",
+            water.to_str().unwrap(),
+            "--lavapipe",
+            "--size",
+            "240x180",
+            "--view",
+            "x",
+            "--normal-mode",
+            "1",
+            "--phase",
+            "0",
+            "--arrows",
+            "-o",
+            png.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let out = orbcloud(&args);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        image::open(&png).unwrap().to_rgba8()
+    };
+    let bare = arrow_pixels(&draw("bare.png", &["--no-volume"]));
+    let veiled = arrow_pixels(&draw("veiled.png", &["--iso", "0.05", "--translucent"]));
+    eprintln!("arrow pixels: {bare} over the atoms alone, {veiled} inside the HOMO's cloud and surfaces");
+    assert!(bare > 100, "the arrows are drawn: {bare} pixels");
+    assert!(veiled * 10 >= bare * 9, "the cloud and the surfaces hide the arrows: {veiled} of {bare} pixels");
+}
+
 #[test]
 fn arrow_impostors_cover_what_the_cpu_ray_cast_covers() {
     use glam::{DVec3, Vec3, Vec4};

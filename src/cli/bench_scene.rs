@@ -85,6 +85,14 @@ fn scene_bounds(scene: &[(crate::model::Document, ObjectState)]) -> Option<(glam
         .reduce(|(l, h), (a, b)| (l.min(a), h.max(b)))
 }
 
+/// What of the scene a timed picture draws.
+#[derive(Clone, Copy, PartialEq)]
+enum Part {
+    Whole,
+    Clouds,
+    Surfaces,
+}
+
 /// Rows of one band of a picture drawn band by band.
 const BAND_ROWS: u32 = 32;
 
@@ -102,6 +110,17 @@ pub fn bench(args: &SceneBench) -> Result<()> {
     }
     let mut renderer = Renderer::new(&ctx);
     let shown = show_scene(&ctx, &mut renderer, &scene, args.points)?;
+    // The same scene without its surfaces, to tell the clouds' share of the time from theirs.
+    let bare: Vec<_> = scene
+        .iter()
+        .map(|(doc, state)| {
+            let mut state = state.clone();
+            state.quantities.iter_mut().flat_map(|q| &mut q.isosurfaces).for_each(|iso| iso.visible = false);
+            (doc, state)
+        })
+        .collect();
+    let mut clouds_renderer = Renderer::new(&ctx);
+    show_scene(&ctx, &mut clouds_renderer, &bare, args.points)?;
     let camera = Camera::framing(lo, hi);
     let size = args.bench.size;
     let quantities: usize = scene.iter().map(|(_, s)| s.quantities.len()).sum();
@@ -117,18 +136,22 @@ pub fn bench(args: &SceneBench) -> Result<()> {
     // picture done, and the picture.
     // `band`: drawn as the window draws a slow picture, in tiles of that many rows, each
     // waited for.
-    let mut picture = |detail: Detail, f: u32, band: Option<u32>| -> Result<(f64, image::RgbaImage)> {
+    // `part`: the whole scene, its surfaces alone or its clouds alone.
+    let mut part_picture = |part: Part, detail: Detail, f: u32, band: Option<u32>| -> Result<(f64, image::RgbaImage)> {
         let mut cam = camera;
         cam.orbit(0.05 * f as f32, 0.02 * f as f32);
         let size = detail.render_size(size);
-        let clouds: Vec<_> = shown.clouds.iter().map(|&c| detail.cloud(c)).collect();
+        let clouds: Vec<_> = (shown.clouds.iter())
+            .map(|&c| crate::scene::VolumeSettings { visible: c.visible && part != Part::Surfaces, ..detail.cloud(c) })
+            .collect();
+        let renderer = if part == Part::Clouds { &mut clouds_renderer } else { &mut renderer };
         let target = OffscreenTarget::new(&ctx.device, size);
         renderer.set_lod_scale(detail.lod_scale);
         let start = Instant::now();
         let frame = FrameInput { camera: &cam, background: [0.02, 0.02, 0.03], clouds: &clouds, size, tile: None };
         match band {
             None => {
-                draw_exact(&ctx, &mut renderer, &target.color_view, &frame);
+                draw_exact(&ctx, renderer, &target.color_view, &frame);
             }
             Some(rows) => {
                 for y in (0..size[1]).step_by(rows.max(1) as usize) {
@@ -144,6 +167,7 @@ pub fn bench(args: &SceneBench) -> Result<()> {
         let ms = start.elapsed().as_secs_f64() * 1e3;
         Ok((ms, target.read_rgba(&ctx.device, &ctx.queue)?))
     };
+    let mut picture = |detail, f, band| part_picture(Part::Whole, detail, f, band);
     // Warm up: every pipeline built once, at both sizes.
     picture(Detail::PREVIEW, 0, None)?;
     picture(Detail::FULL, 0, None)?;
@@ -171,6 +195,13 @@ pub fn bench(args: &SceneBench) -> Result<()> {
     );
     println!("full picture: {:.0} ms after a change (the preview's time included)", median(fulls));
     println!("full picture in bands of {BAND_ROWS} rows, as the window draws it: {:.0} ms", median(banded));
+    let parts = [Part::Clouds, Part::Surfaces].map(|part| {
+        let times: Result<Vec<f64>> =
+            (1..=args.bench.frames.max(1)).map(|f| Ok(part_picture(part, Detail::FULL, f, None)?.0)).collect();
+        times.map(median)
+    });
+    let [clouds_ms, surfaces_ms] = parts;
+    println!("of which: the clouds alone {:.0} ms, the surfaces alone {:.0} ms", clouds_ms?, surfaces_ms?);
     if let (Some(dir), Some((preview, full))) = (&args.images, last) {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
         for (name, img) in [("preview", preview), ("full", full)] {

@@ -19,14 +19,14 @@ pub struct Arrow {
 
 /// How long the longest arrow of a mode is for each bohr of amplitude: longer than the motion,
 /// to be seen.
-pub const ARROW_LENGTH_PER_AMPLITUDE: f64 = 5.0;
+pub const ARROW_LENGTH_PER_AMPLITUDE: f64 = 6.0;
 
 impl Arrow {
     /// An arrow from `from` along `vector`, its shaft and head sized for atoms a bohr or two
     /// apart.
     pub fn along(from: DVec3, vector: DVec3) -> Self {
         let length = vector.length();
-        Self { from, to: from + vector, shaft_radius: 0.09, head_radius: 0.22, head_length: (0.4 * length).min(0.6) }
+        Self { from, to: from + vector, shaft_radius: 0.13, head_radius: 0.3, head_length: (0.4 * length).min(0.7) }
     }
 
     /// The nearest point where the ray `origin + t·dir` (`dir` of unit length) meets the arrow, in
