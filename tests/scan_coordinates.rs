@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use orbcloud::formats::scan::{ScanFile, init, load_scan, parse_scan};
-use orbcloud::model::scan::{Coordinate, Follow, Scan};
+use orbcloud::model::scan::{Coordinate, Follow, PathMeasure, Scan};
 
 fn fixture(dir: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/scans").join(dir)
@@ -111,9 +111,9 @@ fn a_bond_length_scan_and_a_path() {
 
     // The angle and a bond together: no single coordinate explains it, so a path.
     let made = init(&fixture("water_path"), None).unwrap();
-    assert_eq!(made.coordinate, Coordinate::Path);
+    assert_eq!(made.coordinate, Coordinate::Path(PathMeasure::ArcLength));
     let path = load_scan(&fixture("water_path").join("water_path.scan.toml")).unwrap();
-    assert_eq!(path.scan.coordinate, Coordinate::Path);
+    assert_eq!(path.scan.coordinate, Coordinate::Path(PathMeasure::Frame));
     assert_eq!(path.scan.moving.len(), 3, "every atom moves");
     assert_key_frames_reproduced(&path.scan);
 }
@@ -139,6 +139,8 @@ fn manifests_name_their_coordinate_and_errors_their_line() {
         (format!("coordinate = \"path\"\natoms = [1, 2]\n{frames}"), 2, "no atoms for a path"),
         (format!("coordinate = \"angle\"\natoms = [2, 1, 3]\nalign = true\n{frames}"), 3, "align only for a path"),
         (format!("atoms = [1, 2]\n{frames}"), 1, "no coordinate"),
+        (format!("coordinate = \"angle\"\natoms = [2, 1, 3]\nmeasure = \"arc length\"\n{frames}"), 1, "measure only for a path"),
+        (format!("coordinate = \"path\"\nmeasure = \"arc\"\n{frames}"), 2, "\"mass-weighted arc length\""),
     ] {
         let e = parse(&text).unwrap_err().to_string();
         assert!(e.contains(&format!("t.scan.toml:{line}:")) && e.contains(says), "{text}\n→ {e}");
@@ -163,6 +165,21 @@ fn the_command_line_takes_any_coordinate() {
     let out = orbcloud(&["scan", "init", dir.to_str().unwrap(), "--distance", "1,2", "--dry-run"]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success() && err.contains("a distance different from"), "{err}");
+    // A path is measured by the length travelled (Å), or mass-weighted, as IRCs are; the
+    // manifest says so and reads back with its unit.
+    let path = fixture("water_path");
+    for (flags, unit, measure) in
+        [(&["--path"][..], "Å", "arc length"), (&["--path", "--mass-weighted"][..], "amu½·Å", "mass-weighted arc length")]
+    {
+        let mut args = vec!["scan", "init", path.to_str().unwrap(), "--dry-run"];
+        args.extend_from_slice(flags);
+        let out = orbcloud(&args);
+        let (err, text) = (String::from_utf8_lossy(&out.stderr), String::from_utf8_lossy(&out.stdout));
+        assert!(out.status.success() && err.contains(&format!("path; 4 frames from 0.000 {unit} to ")), "{err}");
+        assert!(text.contains(&format!("measure = \"{measure}\"")) && text.contains("at = 0.0000"), "{text}");
+        let last: f64 = text.rsplit("at = ").next().unwrap().lines().next().unwrap().parse().unwrap();
+        assert!(last > 0.05, "the path is {last} {unit} long");
+    }
 
     // A manifest on disk, rendered and exported at a value between key frames.
     let tmp = tempfile::tempdir().unwrap();
@@ -318,12 +335,12 @@ fn a_multi_frame_xyz_beside_the_files_orders_a_path() {
         }
     }
     std::fs::write(tmp.path().join("irc.xyz"), &xyz).unwrap();
-    let made = init(tmp.path(), Some(Coordinate::Path)).unwrap();
+    let made = init(tmp.path(), Some(Coordinate::Path(PathMeasure::ArcLength))).unwrap();
     let order: Vec<&str> = made.frames.iter().map(|(f, _)| f.as_str()).collect();
     assert_eq!(order, names, "the XYZ file's order, not the names'");
     // Without it, the names' order.
     std::fs::remove_file(tmp.path().join("irc.xyz")).unwrap();
-    let made = init(tmp.path(), Some(Coordinate::Path)).unwrap();
+    let made = init(tmp.path(), Some(Coordinate::Path(PathMeasure::ArcLength))).unwrap();
     let order: Vec<&str> = made.frames.iter().map(|(f, _)| f.as_str()).collect();
     assert_eq!(order, ["a.molden.gz", "b.molden.gz", "c.molden.gz", "d.molden.gz"]);
 }
@@ -341,7 +358,7 @@ fn an_unrestricted_diagram_has_alpha_and_beta_lines() {
         molecule: doc.molecule.clone(),
         content: FrameContent::Wavefunctions(vec![wf.clone()]),
     };
-    let scan = Scan::new("uhf".into(), Coordinate::Path, vec!["homo".into()], vec![frame(0.0), frame(1.0)]).unwrap();
+    let scan = Scan::new("uhf".into(), Coordinate::Path(PathMeasure::ArcLength), vec!["homo".into()], vec![frame(0.0), frame(1.0)]).unwrap();
     let diagram = correlation(&scan, 1, 1).unwrap();
     let labels: Vec<&str> = diagram.lines.iter().map(|l| l.label.as_str()).collect();
     assert_eq!(labels, ["HOMO−1 α", "HOMO α", "LUMO α", "LUMO+1 α", "HOMO−1 β", "HOMO β", "LUMO β", "LUMO+1 β"]);

@@ -11,7 +11,7 @@ use std::sync::mpsc;
 
 use crate::formats::scan::Computed;
 use crate::model::Document;
-use crate::model::scan::Coordinate;
+use crate::model::scan::{Coordinate, PathMeasure};
 use crate::sources::compute::{self, Event, FrameJob, Held, Job, Settings};
 
 /// The choices of the *Scan* window: plain data.
@@ -40,7 +40,7 @@ impl Default for ScanDialog {
         Self {
             open: false,
             object: 0,
-            coordinate: Coordinate::Path,
+            coordinate: Coordinate::Path(PathMeasure::ArcLength),
             now: 0.0,
             from: 0.0,
             to: 0.0,

@@ -1,4 +1,4 @@
-//! Dihedral scans in the window: HOMO and LUMO side by side with linked cameras and the coordinate's value, a
+//! Scans in the window: HOMO and LUMO side by side with linked cameras and the coordinate's value, a
 //! slider with the key angles as ticks, play/loop, and the orbital energies against the coordinate.
 
 use super::jobs::{Pending, spawn};
@@ -296,7 +296,7 @@ impl ScanView {
                 let slope = on - now;
                 (slope.abs() > 0.05).then(|| self.value + (wanted - now) / slope)
             }
-            Coordinate::Dihedral(_) | Coordinate::Path => None,
+            Coordinate::Dihedral(_) | Coordinate::Path(_) => None,
         }
     }
 
@@ -306,7 +306,7 @@ impl ScanView {
         let (j, k) = match self.scene.scan.coordinate {
             Coordinate::Distance([i, j]) => (i, j),
             Coordinate::Angle([_, j, k]) | Coordinate::Dihedral([_, j, k, _]) => (j, k),
-            Coordinate::Path => return None,
+            Coordinate::Path(_) => return None,
         };
         let m = self.scene.scan.geometry_at(self.value);
         Some([m.atoms[j].position.as_vec3(), m.atoms[k].position.as_vec3()])
@@ -437,7 +437,7 @@ pub fn views(
     }
     // The bond's position matters only where a press may start a drag that grabs it.
     let grab = !scan.drag_twists && ui.input(|i| i.pointer.primary_down());
-    let direct = !matches!(scan.scene.scan.coordinate, Coordinate::Dihedral(_) | Coordinate::Path);
+    let direct = !matches!(scan.scene.scan.coordinate, Coordinate::Dihedral(_) | Coordinate::Path(_));
     let bond = (grab || (direct && ui.input(|i| i.pointer.primary_down()))).then(|| scan.bond()).flatten();
     let twist = TwistInput { drag_twists: scan.drag_twists, bond, direct };
     let (lo, hi) = scan.scene.scan.range();
@@ -523,6 +523,6 @@ pub fn drag_words(coordinate: &crate::model::scan::Coordinate) -> &'static str {
         Coordinate::Dihedral(_) => "twist the dihedral",
         Coordinate::Angle(_) => "bend the angle",
         Coordinate::Distance(_) => "stretch the bond",
-        Coordinate::Path => "move along the path",
+        Coordinate::Path(_) => "move along the path",
     }
 }

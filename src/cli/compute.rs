@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
 use crate::formats::scan::Computed;
-use crate::model::scan::Coordinate;
+use crate::model::scan::{Coordinate, PathMeasure};
 use crate::model::{Document, Molecule};
 use crate::sources::compute::{self, Event, FrameJob, Held, Job, Settings};
 use anyhow::{Context, Result, bail};
@@ -201,11 +201,11 @@ fn scan_frames(args: &ScanComputeArgs, doc: &Document) -> Result<(Coordinate, Ve
                 models.len()
             );
         }
-        let c = Coordinate::Path;
-        let frames = models
-            .into_iter()
-            .enumerate()
-            .map(|(i, m)| FrameJob::new(compute::frame_file(&stem, &c, i as f64), i as f64, &m))
+        // Files named by frame number, frames placed by the length travelled along the path.
+        let c = Coordinate::Path(PathMeasure::ArcLength);
+        let lengths = crate::model::scan::path_values(&models, PathMeasure::ArcLength);
+        let frames = (models.iter().zip(lengths).enumerate())
+            .map(|(i, (m, at))| FrameJob::new(compute::frame_file(&stem, &c, i as f64), at, m))
             .collect();
         return Ok((c, frames, 0));
     }

@@ -10,7 +10,7 @@ use crate::gpu::volume::{VolumeTexture, residency_budget, texel_bytes};
 use crate::gpu::{GpuContext, OffscreenTarget, Renderer};
 use crate::layers::key_volumes::{DEFAULT_SCAN_POINTS, KeyOptions, ScanScene};
 use crate::model::VolumeGrid;
-use crate::model::scan::{Coordinate, Scan};
+use crate::model::scan::{Coordinate, PathMeasure, Scan};
 use crate::pictures::shots::ScanShots;
 use crate::scene::Interpolation;
 use anyhow::{Context, Result, bail};
@@ -32,9 +32,13 @@ pub enum ScanCommand {
         /// frames best, or a path.
         #[command(flatten)]
         coordinate: CoordinateArgs,
-        /// The frames as a path, in the order of their file names.
+        /// The frames as a path, in the order of their file names (or of a multi-frame XYZ file
+        /// beside them), measured by the length travelled in Å as IRCs measure it.
         #[arg(long, group = "coordinate")]
         path: bool,
+        /// A path's length with each atom's displacement weighted by √(mass), amu½·Å.
+        #[arg(long, requires = "path")]
+        mass_weighted: bool,
         /// Print the manifest instead of writing it.
         #[arg(long)]
         dry_run: bool,
@@ -228,8 +232,9 @@ fn check_angle(scan: &Scan, at: f64) -> Result<()> {
 pub fn run(command: ScanCommand) -> Result<()> {
     match command {
         ScanCommand::Compute(args) => super::compute::scan_compute(*args),
-        ScanCommand::Init { dir, coordinate, path, dry_run } => {
-            let chosen = coordinate.coordinate().or(path.then_some(Coordinate::Path));
+        ScanCommand::Init { dir, coordinate, path, mass_weighted, dry_run } => {
+            let measure = if mass_weighted { PathMeasure::MassWeighted } else { PathMeasure::ArcLength };
+            let chosen = coordinate.coordinate().or(path.then_some(Coordinate::Path(measure)));
             let made = init(&dir, chosen)?;
             let c = made.coordinate;
             let (lo, hi) = (made.frames[0].1, made.frames[made.frames.len() - 1].1);

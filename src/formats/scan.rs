@@ -29,7 +29,8 @@ use serde::Deserialize;
 use super::{LoadError, ParseError};
 pub use crate::model::scan::Follow;
 use crate::model::scan::{
-    ANGLE_TOLERANCE, Coordinate, FrameContent, KeyFrame, MAX_KEY_FRAMES, MAX_SCAN_ORBITALS, Scan, best_coordinate,
+    ANGLE_TOLERANCE, Coordinate, FrameContent, KeyFrame, MAX_KEY_FRAMES, MAX_SCAN_ORBITALS, PathMeasure, Scan,
+    best_coordinate, path_values,
 };
 use crate::model::{Document, Molecule};
 
@@ -43,6 +44,9 @@ struct Manifest {
     atoms: Option<toml::Spanned<Vec<usize>>>,
     /// A path's frames rotated onto each other.
     align: Option<toml::Spanned<bool>>,
+    /// What a path's values count: "frame" (the default), "arc length" or "mass-weighted arc
+    /// length".
+    measure: Option<toml::Spanned<String>>,
     /// The older way to name a dihedral scan.
     dihedral: Option<toml::Spanned<Vec<usize>>>,
     /// The orbitals shown side by side (default: HOMO and LUMO).
@@ -347,6 +351,20 @@ fn coordinate_of(name: &str, text: &str, m: &Manifest) -> Result<(Coordinate, us
     {
         return Err(error(name, line_at(align.span()), "align only for a path", format!("align with a {kind}")));
     }
+    let measure = match &m.measure {
+        None => PathMeasure::Frame,
+        Some(_) if kind != "path" => {
+            return Err(error(name, kind_line, "measure only for a path", format!("measure with a {kind}")));
+        }
+        Some(v) => PathMeasure::from_name(v.get_ref()).ok_or_else(|| {
+            error(
+                name,
+                line_at(v.span()),
+                "measure = \"frame\", \"arc length\" or \"mass-weighted arc length\"",
+                format!("{:?}", v.get_ref()),
+            )
+        })?,
+    };
     let (list, line) = atoms.unwrap_or((Vec::new(), kind_line));
     if list.len() != wanted || list.contains(&0) {
         let expected = match wanted {
@@ -360,7 +378,7 @@ fn coordinate_of(name: &str, text: &str, m: &Manifest) -> Result<(Coordinate, us
         2 => Coordinate::Distance([a[0], a[1]]),
         3 => Coordinate::Angle([a[0], a[1], a[2]]),
         4 => Coordinate::Dihedral([a[0], a[1], a[2], a[3]]),
-        _ => Coordinate::Path,
+        _ => Coordinate::Path(measure),
     };
     Ok((coordinate, line))
 }
@@ -511,11 +529,18 @@ pub fn init(dir: &Path, coordinate: Option<Coordinate>) -> Result<ScanInit, Load
     };
     let values: Vec<f64> = match coordinate {
         // A path's frames in the order a multi-frame XYZ file beside them gives (each file at
-        // the frame of the path it matches), or of their names; one unit apart.
-        Coordinate::Path => match path_order(dir, &molecules)? {
-            Some(order) => order,
-            None => (0..molecules.len()).map(|i| i as f64).collect(),
-        },
+        // the frame of the path it matches), or of their names; then measured along it.
+        Coordinate::Path(measure) => {
+            let order = path_order(dir, &molecules)?.unwrap_or_else(|| (0..molecules.len()).map(|i| i as f64).collect());
+            let mut in_order: Vec<usize> = (0..molecules.len()).collect();
+            in_order.sort_by(|&a, &b| order[a].total_cmp(&order[b]));
+            let along = path_values(&in_order.iter().map(|&i| molecules[i].clone()).collect::<Vec<_>>(), measure);
+            let mut values = vec![0.0; molecules.len()];
+            for (&file, value) in in_order.iter().zip(along) {
+                values[file] = value;
+            }
+            values
+        }
         Coordinate::Dihedral(_) => {
             unwrap_angles(&molecules.iter().filter_map(|m| coordinate.measure(m)).collect::<Vec<_>>())
         }
@@ -554,6 +579,9 @@ pub fn manifest_text(
     if !coordinate.atoms().is_empty() {
         let atoms: Vec<String> = coordinate.atoms().iter().map(|i| (i + 1).to_string()).collect();
         text.push_str(&format!("atoms = [{}]\n", atoms.join(", ")));
+    }
+    if let Coordinate::Path(measure @ (PathMeasure::ArcLength | PathMeasure::MassWeighted)) = coordinate {
+        text.push_str(&format!("measure = \"{}\"\n", measure.name()));
     }
     text.push_str("orbitals = [\"homo\", \"lumo\"]\n");
     for (file, value) in frames {

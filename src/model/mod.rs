@@ -14,6 +14,7 @@ pub mod cartesian;
 pub mod correlation;
 pub mod document;
 pub mod eigen;
+mod atomic_masses;
 mod element_table;
 pub mod elements;
 pub mod esp;

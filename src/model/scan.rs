@@ -38,8 +38,73 @@ pub enum Coordinate {
     /// The torsion i–j–k–l about the j–k bond (degrees): the side of k turns about the bond.
     Dihedral([usize; 4]),
     /// Frames in order with no single internal coordinate (an IRC, a relaxed scan, a morph):
-    /// every atom moves, blended between frames.
-    Path,
+    /// every atom moves, blended between frames. Its value is measured as the [`PathMeasure`]
+    /// says.
+    Path(PathMeasure),
+}
+
+/// What a path's value counts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum PathMeasure {
+    /// The frame's number (manifests written before paths had a length).
+    #[default]
+    Frame,
+    /// The length travelled from the first frame, Å: each step the root of the sum of the atoms'
+    /// squared displacements once the frame is laid on the one before it.
+    ArcLength,
+    /// The same with each displacement weighted by √(atomic mass), amu^½·Å: the reaction
+    /// coordinate IRCs print (in bohr there).
+    MassWeighted,
+}
+
+impl PathMeasure {
+    /// As manifests write it: "frame", "arc length", "mass-weighted arc length".
+    pub fn name(self) -> &'static str {
+        match self {
+            PathMeasure::Frame => "frame",
+            PathMeasure::ArcLength => "arc length",
+            PathMeasure::MassWeighted => "mass-weighted arc length",
+        }
+    }
+
+    /// The measure a manifest names.
+    pub fn from_name(name: &str) -> Option<Self> {
+        [PathMeasure::Frame, PathMeasure::ArcLength, PathMeasure::MassWeighted].into_iter().find(|m| m.name() == name)
+    }
+}
+
+/// Where each of `molecules` (frames in path order, the same atoms) lies along the path, as
+/// `measure` counts: 0 at the first frame. Each frame is laid on the one before it (the rigid
+/// motion that fits it best), so a program writing each geometry in its own orientation adds no
+/// length.
+pub fn path_values(molecules: &[Molecule], measure: PathMeasure) -> Vec<f64> {
+    if measure == PathMeasure::Frame {
+        return (0..molecules.len()).map(|i| i as f64).collect();
+    }
+    let mut values = Vec::with_capacity(molecules.len());
+    let mut travelled = 0.0;
+    for (k, m) in molecules.iter().enumerate() {
+        if k > 0 {
+            let before: Vec<DVec3> = molecules[k - 1].atoms.iter().map(|a| a.position).collect();
+            let here: Vec<DVec3> = m.atoms.iter().map(|a| a.position).collect();
+            let (rotation, shift) = superpose(&here, &before);
+            let squared: f64 = (m.atoms.iter().zip(here.iter().zip(&before)))
+                .map(|(atom, (p, q))| {
+                    let weight = match measure {
+                        PathMeasure::MassWeighted => super::atomic_masses::ATOMIC_MASSES
+                            .get(atom.z as usize)
+                            .copied()
+                            .unwrap_or(0.0),
+                        _ => 1.0,
+                    };
+                    weight * (rotation * *p + shift).distance_squared(*q)
+                })
+                .sum();
+            travelled += squared.sqrt() * super::units::ANGSTROM_PER_BOHR;
+        }
+        values.push(travelled);
+    }
+    values
 }
 
 impl Coordinate {
@@ -49,7 +114,7 @@ impl Coordinate {
             Coordinate::Distance(a) => a,
             Coordinate::Angle(a) => a,
             Coordinate::Dihedral(a) => a,
-            Coordinate::Path => &[],
+            Coordinate::Path(_) => &[],
         }
     }
 
@@ -59,7 +124,7 @@ impl Coordinate {
             Coordinate::Distance(_) => "distance",
             Coordinate::Angle(_) => "angle",
             Coordinate::Dihedral(_) => "dihedral",
-            Coordinate::Path => "path",
+            Coordinate::Path(_) => "path",
         }
     }
 
@@ -71,16 +136,17 @@ impl Coordinate {
             Coordinate::Distance(_) => 0.0..=1000.0,
             Coordinate::Angle(_) => 0.0..=180.0,
             Coordinate::Dihedral(_) => -720.0..=720.0,
-            Coordinate::Path => -1e9..=1e9,
+            Coordinate::Path(_) => -1e9..=1e9,
         }
     }
 
-    /// The unit values are given in: "Å", "°", or none for a path.
+    /// The unit values are given in: "Å", "°", a path's length's, or none for a path's frames.
     pub fn unit(&self) -> &'static str {
         match self {
-            Coordinate::Distance(_) => " Å",
+            Coordinate::Distance(_) | Coordinate::Path(PathMeasure::ArcLength) => " Å",
             Coordinate::Angle(_) | Coordinate::Dihedral(_) => "°",
-            Coordinate::Path => "",
+            Coordinate::Path(PathMeasure::MassWeighted) => " amu½·Å",
+            Coordinate::Path(PathMeasure::Frame) => "",
         }
     }
 
@@ -90,11 +156,13 @@ impl Coordinate {
         if atoms.is_empty() { self.kind().into() } else { format!("{} {}", self.kind(), atoms.join("-")) }
     }
 
-    /// `value` with its unit: "104.5°", "1.20 Å", "3.00".
+    /// `value` with its unit: "104.5°", "1.200 Å", frame "3.00".
     pub fn value_text(&self, value: f64) -> String {
         match self {
-            Coordinate::Distance(_) => format!("{value:.3} Å"),
-            Coordinate::Path => format!("{value:.2}"),
+            Coordinate::Distance(_) | Coordinate::Path(PathMeasure::ArcLength | PathMeasure::MassWeighted) => {
+                format!("{value:.3}{}", self.unit())
+            }
+            Coordinate::Path(PathMeasure::Frame) => format!("{value:.2}"),
             _ => format!("{value:.1}°"),
         }
     }
@@ -106,7 +174,7 @@ impl Coordinate {
             Coordinate::Distance([i, j]) => Some(p(i).distance(p(j)) * super::units::ANGSTROM_PER_BOHR),
             Coordinate::Angle([i, j, k]) => Some(super::measure::angle(p(i), p(j), p(k))),
             Coordinate::Dihedral(d) => Some(measure(molecule, d)),
-            Coordinate::Path => None,
+            Coordinate::Path(_) => None,
         }
     }
 }
@@ -340,7 +408,7 @@ pub fn moving_atoms(molecule: &Molecule, coordinate: &Coordinate) -> Result<(Vec
         Coordinate::Angle([_, j, k]) | Coordinate::Dihedral([_, j, k, _]) => {
             Ok((moving_fragment(molecule, j, k)?, 1.0))
         }
-        Coordinate::Path => Ok(((0..molecule.atoms.len()).collect(), 1.0)),
+        Coordinate::Path(_) => Ok(((0..molecule.atoms.len()).collect(), 1.0)),
     }
 }
 
@@ -351,7 +419,7 @@ fn shift(coordinate: &Coordinate, positions: &mut [DVec3], moving: &[usize], dir
         Coordinate::Distance(d) => stretch(positions, moving, d, direction * delta),
         Coordinate::Angle(a) => bend(positions, moving, a, delta),
         Coordinate::Dihedral([_, j, k, _]) => twist(positions, moving, j, k, delta),
-        Coordinate::Path => {}
+        Coordinate::Path(_) => {}
     }
 }
 
@@ -452,7 +520,7 @@ pub fn unexplained(molecules: &[Molecule], coordinate: &Coordinate) -> Option<f6
             Coordinate::Distance(d) => stretch(&mut predicted, &moving, d, direction * delta),
             Coordinate::Angle(a) => bend(&mut predicted, &moving, a, delta),
             Coordinate::Dihedral([_, j, k, _]) => twist(&mut predicted, &moving, j, k, delta),
-            Coordinate::Path => return None,
+            Coordinate::Path(_) => return None,
         }
         let actual: Vec<DVec3> = m.atoms.iter().map(|a| a.position).collect();
         sum += distance_change(&predicted, &actual).powi(2);
@@ -513,7 +581,7 @@ pub fn best_coordinate(molecules: &[Molecule]) -> Option<Coordinate> {
     }
     match best {
         Some((c, left, _)) if left <= PATH_THRESHOLD => Some(c),
-        _ => Some(Coordinate::Path),
+        _ => Some(Coordinate::Path(PathMeasure::ArcLength)),
     }
 }
 
@@ -985,6 +1053,39 @@ mod tests {
     }
 
     #[test]
+    fn a_path_is_measured_by_the_length_travelled_whatever_each_frame_s_orientation() {
+        // A symmetric stretch, 0.96 → 1.06 → 1.16 Å: the best fit only centres the frames, so
+        // each step is √Σ|Δₐ − Δ̄|² (Δ̄ the mean displacement) and the steps are equal.
+        let frames: Vec<Molecule> = [0.96, 1.06, 1.16].iter().map(|&r| water(104.5, r)).collect();
+        let p = |m: &Molecule| m.atoms.iter().map(|a| a.position).collect::<Vec<_>>();
+        let (a, b) = (p(&frames[0]), p(&frames[1]));
+        let d: Vec<DVec3> = a.iter().zip(&b).map(|(x, y)| *y - *x).collect();
+        let mean = d.iter().copied().sum::<DVec3>() / 3.0;
+        let masses = [15.999, 1.008, 1.008];
+        let step = |w: &[f64]| {
+            d.iter().zip(w).map(|(v, w)| w * (*v - mean).length_squared()).sum::<f64>().sqrt()
+                * crate::model::units::ANGSTROM_PER_BOHR
+        };
+        let plain = path_values(&frames, PathMeasure::ArcLength);
+        assert!((plain[1] - step(&[1.0; 3])).abs() < 1e-9 && (plain[2] - 2.0 * plain[1]).abs() < 1e-9, "{plain:?}");
+        let weighted = path_values(&frames, PathMeasure::MassWeighted);
+        assert!((weighted[1] - step(&masses)).abs() < 1e-6, "{weighted:?} vs {}", step(&masses));
+        // Each frame written in its own orientation and place: the same lengths.
+        let mut turned = frames.clone();
+        for (k, m) in turned.iter_mut().enumerate() {
+            let r = DQuat::from_rotation_y(0.7 * k as f64) * DQuat::from_rotation_x(0.3);
+            for atom in &mut m.atoms {
+                atom.position = r * atom.position + DVec3::new(1.5, -2.0, 0.5 * k as f64);
+            }
+        }
+        let again = path_values(&turned, PathMeasure::ArcLength);
+        assert!(again.iter().zip(&plain).all(|(x, y)| (x - y).abs() < 1e-8), "{again:?} vs {plain:?}");
+        assert_eq!(path_values(&frames, PathMeasure::Frame), vec![0.0, 1.0, 2.0]);
+        let c = Coordinate::Path(PathMeasure::ArcLength);
+        assert_eq!((c.value_text(0.1234), c.unit()), ("0.123 Å".to_string(), " Å"));
+    }
+
+    #[test]
     fn bending_and_stretching_reproduce_key_frames_and_move_one_side() {
         // An angle scan: H2 turns in the plane about O; key frames reproduced exactly.
         let frames: Vec<KeyFrame> = [90.0, 105.0, 120.0].iter().map(|&a| key(a, water(a, 0.96))).collect();
@@ -1041,7 +1142,7 @@ mod tests {
         assert_eq!(best_coordinate(&twists), Some(Coordinate::Dihedral([0, 1, 2, 3])));
         // Bending and stretching at once: no single coordinate explains it, a path does.
         let both: Vec<Molecule> = [(95.0, 0.9), (110.0, 1.1), (125.0, 1.3)].iter().map(|&(a, r)| water(a, r)).collect();
-        assert_eq!(best_coordinate(&both), Some(Coordinate::Path));
+        assert_eq!(best_coordinate(&both), Some(Coordinate::Path(PathMeasure::ArcLength)));
         assert_eq!(best_coordinate(&[water(100.0, 1.0), water(100.0, 1.0)]), None, "nothing changes");
     }
 
@@ -1049,7 +1150,7 @@ mod tests {
     fn a_path_blends_every_atom() {
         let (a, b) = (water(95.0, 0.9), water(125.0, 1.3));
         let scan =
-            Scan::new("path".into(), Coordinate::Path, vec![], vec![key(0.0, a.clone()), key(1.0, b.clone())]).unwrap();
+            Scan::new("path".into(), Coordinate::Path(PathMeasure::Frame), vec![], vec![key(0.0, a.clone()), key(1.0, b.clone())]).unwrap();
         assert_eq!(scan.moving, vec![0, 1, 2]);
         let mid = scan.geometry_at(0.5);
         for i in 0..3 {

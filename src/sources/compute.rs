@@ -376,7 +376,7 @@ pub fn stem(path: &Path) -> String {
 pub fn frame_file(stem: &str, coordinate: &Coordinate, value: f64) -> String {
     let v = match coordinate {
         Coordinate::Distance(_) => format!("{value:.3}"),
-        Coordinate::Path => format!("{:04}", value.round() as i64),
+        Coordinate::Path(_) => format!("{:04}", value.round() as i64),
         _ => format!("{value:.2}"),
     };
     format!("{stem}_{}{}.molden", coordinate.kind(), v.replace('-', "m"))
