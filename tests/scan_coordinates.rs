@@ -139,7 +139,11 @@ fn manifests_name_their_coordinate_and_errors_their_line() {
         (format!("coordinate = \"path\"\natoms = [1, 2]\n{frames}"), 2, "no atoms for a path"),
         (format!("coordinate = \"angle\"\natoms = [2, 1, 3]\nalign = true\n{frames}"), 3, "align only for a path"),
         (format!("atoms = [1, 2]\n{frames}"), 1, "no coordinate"),
-        (format!("coordinate = \"angle\"\natoms = [2, 1, 3]\nmeasure = \"arc length\"\n{frames}"), 1, "measure only for a path"),
+        (
+            format!("coordinate = \"angle\"\natoms = [2, 1, 3]\nmeasure = \"arc length\"\n{frames}"),
+            1,
+            "measure only for a path",
+        ),
         (format!("coordinate = \"path\"\nmeasure = \"arc\"\n{frames}"), 2, "\"mass-weighted arc length\""),
     ] {
         let e = parse(&text).unwrap_err().to_string();
@@ -168,9 +172,10 @@ fn the_command_line_takes_any_coordinate() {
     // A path is measured by the length travelled (Å), or mass-weighted, as IRCs are; the
     // manifest says so and reads back with its unit.
     let path = fixture("water_path");
-    for (flags, unit, measure) in
-        [(&["--path"][..], "Å", "arc length"), (&["--path", "--mass-weighted"][..], "amu½·Å", "mass-weighted arc length")]
-    {
+    for (flags, unit, measure) in [
+        (&["--path"][..], "Å", "arc length"),
+        (&["--path", "--mass-weighted"][..], "amu½·Å", "mass-weighted arc length"),
+    ] {
         let mut args = vec!["scan", "init", path.to_str().unwrap(), "--dry-run"];
         args.extend_from_slice(flags);
         let out = orbcloud(&args);
@@ -358,7 +363,13 @@ fn an_unrestricted_diagram_has_alpha_and_beta_lines() {
         molecule: doc.molecule.clone(),
         content: FrameContent::Wavefunctions(vec![wf.clone()]),
     };
-    let scan = Scan::new("uhf".into(), Coordinate::Path(PathMeasure::ArcLength), vec!["homo".into()], vec![frame(0.0), frame(1.0)]).unwrap();
+    let scan = Scan::new(
+        "uhf".into(),
+        Coordinate::Path(PathMeasure::ArcLength),
+        vec!["homo".into()],
+        vec![frame(0.0), frame(1.0)],
+    )
+    .unwrap();
     let diagram = correlation(&scan, 1, 1).unwrap();
     let labels: Vec<&str> = diagram.lines.iter().map(|l| l.label.as_str()).collect();
     assert_eq!(labels, ["HOMO−1 α", "HOMO α", "LUMO α", "LUMO+1 α", "HOMO−1 β", "HOMO β", "LUMO β", "LUMO+1 β"]);

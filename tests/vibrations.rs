@@ -301,3 +301,40 @@ fn arrow_impostors_cover_what_the_cpu_ray_cast_covers() {
     assert!(covered > 500, "{covered} pixels");
     assert!(differ * 100 <= covered * 3, "{differ} of {covered} pixels differ");
 }
+
+#[test]
+fn atoms_moved_in_place_draw_as_atoms_uploaded_anew() {
+    use orbcloud::gpu::{FrameInput, OffscreenTarget, Renderer};
+    use orbcloud::scene::{AtomStyle, Camera, VolumeSettings};
+    let ctx = common::lavapipe();
+    let doc = orbcloud::formats::load(&fixture("water_rhf_631g.fchk")).unwrap();
+    let mut moved = doc.molecule.clone();
+    for (k, atom) in moved.atoms.iter_mut().enumerate() {
+        atom.position += glam::DVec3::new(0.3 * k as f64, -0.2, 0.1 * k as f64);
+    }
+    let size = [160u32, 120];
+    let camera = Camera::framing(glam::Vec3::splat(-3.0), glam::Vec3::splat(3.0));
+    let hidden = [VolumeSettings { visible: false, ..Default::default() }];
+    let draw = |renderer: &mut Renderer| {
+        let target = OffscreenTarget::new(&ctx.device, size);
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        let frame = FrameInput { camera: &camera, background: [0.0; 3], clouds: &hidden, size, tile: None };
+        renderer.render(&ctx, &mut encoder, &target.color_view, &frame);
+        ctx.queue.submit([encoder.finish()]);
+        target.read_rgba(&ctx.device, &ctx.queue).unwrap()
+    };
+    let mut in_place = Renderer::new(&ctx);
+    in_place.main().set_atoms(&ctx, &doc.molecule, AtomStyle::BallAndStick, None);
+    let before = draw(&mut in_place);
+    assert!(in_place.main().move_atoms(&ctx, &moved), "the same atoms and bonds move in place");
+    let after = draw(&mut in_place);
+    let mut anew = Renderer::new(&ctx);
+    anew.main().set_atoms(&ctx, &moved, AtomStyle::BallAndStick, None);
+    let reference = draw(&mut anew);
+    assert!(common::mean_difference(&before, &after) > 0.5, "the atoms moved");
+    assert_eq!(after, reference, "moved in place, the picture is the one of the atoms uploaded anew");
+    let mut fewer = moved.clone();
+    fewer.atoms.pop();
+    fewer.bonds.retain(|b| b.a < 2 && b.b < 2);
+    assert!(!in_place.main().move_atoms(&ctx, &fewer), "other atoms are uploaded anew");
+}

@@ -705,11 +705,15 @@ impl Viewport {
         for (atom, p) in molecule.atoms.iter_mut().zip(positions) {
             atom.position = p;
         }
-        let look = crate::layers::atom_look(doc, &state.atoms, &state.selection);
         let layer = self.renderer.layer_mut(&self.ctx, l);
-        layer.atoms.sizes = crate::layers::sizes(&state.atoms);
-        layer.set_atoms(&self.ctx, &molecule, state.atoms.style, Some(&look));
-        layer.atoms.depth_cue = state.atoms.depth_cue;
+        // Each frame of the animation moves the atoms in place; only the first uploads them.
+        if self.slots[l].displaced.is_none() || !layer.move_atoms(&self.ctx, &molecule) {
+            let look = crate::layers::atom_look(doc, &state.atoms, &state.selection);
+            let layer = self.renderer.layer_mut(&self.ctx, l);
+            layer.atoms.sizes = crate::layers::sizes(&state.atoms);
+            layer.set_atoms(&self.ctx, &molecule, state.atoms.style, Some(&look));
+            layer.atoms.depth_cue = state.atoms.depth_cue;
+        }
         self.slots[l].displaced = Some(key);
         self.generation += 1;
         true

@@ -531,7 +531,8 @@ pub fn init(dir: &Path, coordinate: Option<Coordinate>) -> Result<ScanInit, Load
         // A path's frames in the order a multi-frame XYZ file beside them gives (each file at
         // the frame of the path it matches), or of their names; then measured along it.
         Coordinate::Path(measure) => {
-            let order = path_order(dir, &molecules)?.unwrap_or_else(|| (0..molecules.len()).map(|i| i as f64).collect());
+            let order =
+                path_order(dir, &molecules)?.unwrap_or_else(|| (0..molecules.len()).map(|i| i as f64).collect());
             let mut in_order: Vec<usize> = (0..molecules.len()).collect();
             in_order.sort_by(|&a, &b| order[a].total_cmp(&order[b]));
             let along = path_values(&in_order.iter().map(|&i| molecules[i].clone()).collect::<Vec<_>>(), measure);

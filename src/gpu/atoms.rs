@@ -271,8 +271,7 @@ impl AtomData {
                 a.z.min(127) | flags << 8 | color << 16
             })
             .collect();
-        let positions: Vec<[f32; 4]> =
-            molecule.atoms.iter().map(|a| a.position.as_vec3().extend(0.0).to_array()).collect();
+        let positions = positions_of(molecule);
         Self {
             cells: Cells::new(&positions),
             positions,
@@ -288,6 +287,11 @@ impl AtomData {
             + self.cells.len() * 4
             + self.bonds.len() * (8 + 4)
     }
+}
+
+/// Each atom's position as the shaders read it: xyz bohr, w unused.
+fn positions_of(molecule: &Molecule) -> Vec<[f32; 4]> {
+    molecule.atoms.iter().map(|a| a.position.as_vec3().extend(0.0).to_array()).collect()
 }
 
 /// The style's radius per atomic number (bohr, times `sizes.ball`), then the palette (linear RGB).
@@ -662,6 +666,31 @@ impl AtomsPass {
             attr_words: data.attrs,
             group,
         });
+    }
+
+    /// Moves the uploaded atoms to `molecule`'s positions (the same atoms and bonds, as a
+    /// vibration or a scan moves them), writing the positions and the culling cells in place;
+    /// false, leaving everything as it was, when the atoms, the bonds or the cells' layout differ
+    /// (then [`Self::set_molecule`] uploads anew). A frame of an animation thus makes no new
+    /// buffers or bind groups.
+    pub fn move_atoms(&mut self, ctx: &GpuContext, molecule: &Molecule) -> bool {
+        let Some(d) = &mut self.data else { return false };
+        let same_bonds = d.bond_count as usize == molecule.bonds.len();
+        if d.atoms as usize != molecule.atoms.len() || !same_bonds {
+            return false;
+        }
+        let positions = positions_of(molecule);
+        let cells = Cells::new(&positions);
+        if cells.data.len() != d.cells.data.len() || cells.len() != d.cells.len() {
+            return false;
+        }
+        ctx.queue.write_buffer(&d.positions, 0, bytemuck::cast_slice(&positions));
+        if !cells.data.is_empty() {
+            ctx.queue.write_buffer(&d.cell_data, 0, bytemuck::cast_slice(&cells.data));
+        }
+        d.cells = cells;
+        d.bounds = molecule.bounds().map_or([Vec3::ZERO; 2], |(lo, hi)| [lo.as_vec3(), hi.as_vec3()]);
+        true
     }
 
     /// Restyles, recolours and reselects: rewrites the attributes' palette and hidden bits and

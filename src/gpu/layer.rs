@@ -112,8 +112,17 @@ impl Layer {
     /// Shows a molecule's atoms in a style and colours (by element when `None`).
     pub fn set_atoms(&mut self, ctx: &GpuContext, molecule: &Molecule, style: AtomStyle, colors: Option<&AtomColors>) {
         self.atoms.set_molecule(ctx, molecule, style, colors);
-        // Pad by the largest space-filling radius so near/far planes never clip an atom.
-        self.molecule_bounds = molecule.bounds().map(|(lo, hi)| (lo.as_vec3() - 4.5, hi.as_vec3() + 4.5));
+        self.molecule_bounds = padded_bounds(molecule);
+    }
+
+    /// Moves the layer's atoms to `molecule`'s positions in place when only they changed (the
+    /// same atoms and bonds); false when they must be uploaded anew with [`Self::set_atoms`].
+    pub fn move_atoms(&mut self, ctx: &GpuContext, molecule: &Molecule) -> bool {
+        let moved = self.atoms.move_atoms(ctx, molecule);
+        if moved {
+            self.molecule_bounds = padded_bounds(molecule);
+        }
+        moved
     }
 
     /// Shows `grid` as the layer's cloud. A grid over this device's limits is shown at every
@@ -173,4 +182,10 @@ impl Layer {
         let first = *points.first()?;
         Some(points.iter().fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p))))
     }
+}
+
+/// `molecule`'s box padded by the largest space-filling radius, so that the near and far planes
+/// never clip an atom.
+fn padded_bounds(molecule: &Molecule) -> Option<(Vec3, Vec3)> {
+    molecule.bounds().map(|(lo, hi)| (lo.as_vec3() - 4.5, hi.as_vec3() + 4.5))
 }

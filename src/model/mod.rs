@@ -5,6 +5,7 @@
 
 pub mod arrow;
 pub mod atom;
+mod atomic_masses;
 pub mod basis;
 pub mod basis_labels;
 pub mod bonds;
@@ -14,7 +15,6 @@ pub mod cartesian;
 pub mod correlation;
 pub mod document;
 pub mod eigen;
-mod atomic_masses;
 mod element_table;
 pub mod elements;
 pub mod esp;

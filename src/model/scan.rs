@@ -91,10 +91,9 @@ pub fn path_values(molecules: &[Molecule], measure: PathMeasure) -> Vec<f64> {
             let squared: f64 = (m.atoms.iter().zip(here.iter().zip(&before)))
                 .map(|(atom, (p, q))| {
                     let weight = match measure {
-                        PathMeasure::MassWeighted => super::atomic_masses::ATOMIC_MASSES
-                            .get(atom.z as usize)
-                            .copied()
-                            .unwrap_or(0.0),
+                        PathMeasure::MassWeighted => {
+                            super::atomic_masses::ATOMIC_MASSES.get(atom.z as usize).copied().unwrap_or(0.0)
+                        }
                         _ => 1.0,
                     };
                     weight * (rotation * *p + shift).distance_squared(*q)
@@ -1149,8 +1148,13 @@ mod tests {
     #[test]
     fn a_path_blends_every_atom() {
         let (a, b) = (water(95.0, 0.9), water(125.0, 1.3));
-        let scan =
-            Scan::new("path".into(), Coordinate::Path(PathMeasure::Frame), vec![], vec![key(0.0, a.clone()), key(1.0, b.clone())]).unwrap();
+        let scan = Scan::new(
+            "path".into(),
+            Coordinate::Path(PathMeasure::Frame),
+            vec![],
+            vec![key(0.0, a.clone()), key(1.0, b.clone())],
+        )
+        .unwrap();
         assert_eq!(scan.moving, vec![0, 1, 2]);
         let mid = scan.geometry_at(0.5);
         for i in 0..3 {
