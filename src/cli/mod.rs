@@ -354,6 +354,10 @@ fn quantity_label(q: &Quantity, doc: &Document) -> String {
         Quantity::ReducedGradient => "reduced density gradient".into(),
         Quantity::SignLambda2Rho => "sign(lambda2)*rho (a.u.)".into(),
         Quantity::DensityLaplacian => "Laplacian of the electron density (a.u.)".into(),
+        Quantity::DifferenceDensity => format!("difference density (state {} minus ground)", state_of(wf)),
+        Quantity::Attachment => format!("attachment density (state {})", state_of(wf)),
+        Quantity::Detachment => format!("detachment density (state {})", state_of(wf)),
+        Quantity::ExcitedDensity => format!("excited-state density (state {})", state_of(wf)),
         Quantity::BasisFunction(k) => {
             let name = crate::model::basis_labels::function_name(&doc.molecule, &wf.basis, *k);
             format!("basis function {}", name.unwrap_or_default())
@@ -364,6 +368,11 @@ fn quantity_label(q: &Quantity, doc: &Document) -> String {
             format!("MO {n} ({:?}) E={:.6} Eh occ={:.3} {}", o.spin, o.energy, o.occupation, o.symmetry)
         }
     }
+}
+
+/// The excited state whose density `wf` holds, in words ("1", "?" when none).
+fn state_of(wf: &Wavefunction) -> String {
+    wf.excited.as_ref().map_or_else(|| "?".to_string(), |e| e.state.to_string())
 }
 
 fn wavefunction_of(doc: &Document) -> Result<&Wavefunction> {

@@ -336,7 +336,13 @@ impl Scan {
             }
         }
         let digits = sections.iter().map(|s| s.decimals).min().unwrap_or(5);
-        let wf = Wavefunction { basis, orbitals, restricted: !unrestricted, normalization: Default::default() };
+        let wf = Wavefunction {
+            basis,
+            orbitals,
+            restricted: !unrestricted,
+            normalization: Default::default(),
+            excited: None,
+        };
         Ok(Document {
             source: file.to_string(),
             title: file.to_string(),

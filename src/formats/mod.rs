@@ -6,6 +6,7 @@ pub mod cube;
 pub mod cube_write;
 mod error;
 pub mod fchk;
+mod fchk_excited;
 pub mod gaussian_log;
 pub mod logs;
 pub mod mesh_write;

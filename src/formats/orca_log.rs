@@ -378,7 +378,13 @@ fn wavefunction_document(
             }
         })
         .collect();
-    let wf = Wavefunction { basis: Basis { shells }, orbitals, restricted, normalization: Default::default() };
+    let wf = Wavefunction {
+        basis: Basis { shells },
+        orbitals,
+        restricted,
+        normalization: Default::default(),
+        excited: None,
+    };
     Ok(Document {
         source: log.file.to_string(),
         title: log.file.to_string(),

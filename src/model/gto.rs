@@ -477,6 +477,12 @@ impl PreparedBasis {
                     Quantity::BasisFunction(k) => values[k],
                     Quantity::Density => density_of(wf, &values),
                     Quantity::SpinDensity => spin_density_of(wf, &values),
+                    Quantity::DifferenceDensity
+                    | Quantity::Attachment
+                    | Quantity::Detachment
+                    | Quantity::ExcitedDensity => (super::evaluation::state_sets(wf, quantity).iter())
+                        .map(|(c, w)| w * dot(c, &values).powi(2))
+                        .sum(),
                     Quantity::Potential
                     | Quantity::ReducedGradient
                     | Quantity::SignLambda2Rho
@@ -1216,7 +1222,7 @@ pub(crate) mod tests {
                 orbital(4, 0.0, Spin::Beta),
             ],
             restricted: false,
-            normalization: Default::default(),
+            ..Default::default()
         };
         let grid = GridSpec::new(
             DVec3::splat(-3.0),

@@ -1,0 +1,146 @@
+//! Excited states of ../shared/refdata/real-world/logs (divinylbenzene's TD-DFT in Gaussian 09,
+//! ORCA 6 and Q-Chem 5.1, and CO's Gaussian TD checkpoint; see its MANIFEST.md): the states
+//! each file lists, and the difference, attachment and detachment densities of the Gaussian TD
+//! fchk files, whose electrons moved the two densities share on the grid as in the trace.
+
+use std::path::{Path, PathBuf};
+
+use glam::DVec3;
+use orbcloud::formats;
+use orbcloud::model::Document;
+use orbcloud::model::excited_density::StatePart;
+use orbcloud::model::gto::PreparedBasis;
+use orbcloud::model::orbitals::Quantity;
+
+mod common;
+
+fn logs(test: &str) -> Option<PathBuf> {
+    common::refdata(test).map(|d| d.join("logs"))
+}
+
+fn load(path: &Path) -> Document {
+    formats::load(path).unwrap_or_else(|e| panic!("{e}"))
+}
+
+#[test]
+fn td_fchk_files_hold_their_states_and_one_excited_density() {
+    let Some(dir) = logs("excited_states::td_fchk_files_hold_their_states_and_one_excited_density") else { return };
+    // The grid's integrals: a 0.2 bohr grid sums STO-3G's smooth valence densities almost
+    // exactly, but CO's 6-311++G(d,p) detachment density peaks at 1.2 a.u. on the nuclei
+    // (functions 0.01 bohr wide) and its attachment reaches past the grid's 6 bohr margin
+    // through the diffuse functions: there the grid is good to 1 %, the trace is exact.
+    for (name, count, grid_error) in
+        [("basicGaussian09_dvb_td.fchk", 5, 1e-4), ("basicGaussian09_CO_TD_delta.fchk", 24, 1e-2)]
+    {
+        let doc = load(&dir.join(name));
+        assert!(doc.problems.is_empty(), "{name}: {:?}", doc.problems);
+        let states = doc.excited.as_ref().expect("states");
+        assert_eq!(states.states.len(), count, "{name}");
+        assert_eq!(states.density_of, Some(1), "{name}");
+        let wf = doc.wavefunction.as_ref().expect("orbitals");
+        let excited = wf.excited.as_ref().expect("an excited density");
+        let moved = excited.electrons_moved();
+        let detached = excited.electrons_detached();
+        eprintln!("{name}: electrons moved {moved:.6}, detached {detached:.6}");
+        // tr(ΔP S) = 0: the excitation keeps the electron count.
+        assert!((moved - detached).abs() < 1e-6, "{name}: {moved} vs {detached}");
+        assert!(moved > 0.5 && moved < 2.0, "{name}: {moved}");
+        let prepared = PreparedBasis::new(&wf.basis);
+        let g = excited.grid_descriptors(&prepared, &doc.molecule).expect("atoms");
+        eprintln!("{name}: {g:?}");
+        for (what, integral) in [("attachment", g.attachment_integral), ("detachment", g.detachment_integral)] {
+            let error = (integral - moved).abs() / moved;
+            assert!(error < grid_error, "{name}: {what} integrates to {integral}, trace {moved}");
+        }
+        assert!(!excited.sets(StatePart::Attachment).is_empty());
+    }
+}
+
+#[test]
+fn centroids_from_dipole_integrals_agree_with_the_grid() {
+    let Some(dir) = logs("excited_states::centroids_from_dipole_integrals_agree_with_the_grid") else { return };
+    let doc = load(&dir.join("basicGaussian09_dvb_td.fchk"));
+    let wf = doc.wavefunction.as_ref().expect("orbitals");
+    let d = wf.excited.as_ref().expect("density").descriptors(&wf.basis, &doc.molecule).expect("atoms");
+    eprintln!("{d:?}");
+    for (exact, grid) in [
+        (d.attachment_centroid_bohr, d.grid.attachment_centroid),
+        (d.detachment_centroid_bohr, d.grid.detachment_centroid),
+    ] {
+        for k in 0..3 {
+            assert!((exact[k] - grid[k]).abs() < 1e-3, "{exact:?} vs {grid:?}");
+        }
+    }
+}
+
+/// What scripts/excited_reference.py computes from an fchk file with numpy and PySCF alone.
+#[derive(serde::Deserialize)]
+struct Reference {
+    points: Vec<[f64; 3]>,
+    rho_excited: Vec<f64>,
+    difference: Vec<f64>,
+    attachment: Vec<f64>,
+    detachment: Vec<f64>,
+    electrons_moved: f64,
+    electrons_detached: f64,
+    trace_delta_s: f64,
+    attachment_centroid: [f64; 3],
+    detachment_centroid: [f64; 3],
+}
+
+fn reference(fchk: &Path) -> Reference {
+    let python = orbcloud::sources::compute::python();
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/excited_reference.py");
+    let out = std::process::Command::new(&python)
+        .arg(&script)
+        .arg(fchk)
+        .output()
+        .unwrap_or_else(|e| panic!("running `{python}`: {e} (scripts/test sets ORBCLOUD_PYTHON)"));
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    serde_json::from_slice(&out.stdout).expect("the script's JSON")
+}
+
+/// The four densities of both Gaussian TD checkpoints at 340 points agree with PySCF's
+/// evaluation of the file's own matrices (its own Löwdin diagonalisation for attachment and
+/// detachment) within 1e-6 of the largest value, and so do the electrons moved and centroids.
+#[test]
+fn state_densities_equal_an_independent_evaluation() {
+    let Some(dir) = logs("excited_states::state_densities_equal_an_independent_evaluation") else { return };
+    for name in ["basicGaussian09_dvb_td.fchk", "basicGaussian09_CO_TD_delta.fchk"] {
+        let path = dir.join(name);
+        let r = reference(&path);
+        let doc = load(&path);
+        let wf = doc.wavefunction.as_ref().expect("orbitals");
+        let excited = wf.excited.as_ref().expect("an excited density");
+        let points: Vec<DVec3> = r.points.iter().map(|p| DVec3::from_array(*p)).collect();
+        let prepared = PreparedBasis::new(&wf.basis);
+        for (quantity, expected) in [
+            (Quantity::DifferenceDensity, &r.difference),
+            (Quantity::Attachment, &r.attachment),
+            (Quantity::Detachment, &r.detachment),
+            (Quantity::ExcitedDensity, &r.rho_excited),
+        ] {
+            let got = prepared.quantity_at_points(wf, &doc.molecule, quantity, &points);
+            let scale = expected.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let worst = got.iter().zip(expected).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+            eprintln!("{name} {quantity:?}: max |orbcloud − PySCF| = {worst:.2e} (max |value| {scale:.3e})");
+            assert!(worst <= 1e-6 * scale, "{name} {quantity:?}: {worst:e} over {scale:e}");
+        }
+        eprintln!(
+            "{name}: electrons moved {:.9} (PySCF {:.9}), tr(ΔP S) = {:.1e}",
+            excited.electrons_moved(),
+            r.electrons_moved,
+            r.trace_delta_s
+        );
+        assert!((excited.electrons_moved() - r.electrons_moved).abs() < 1e-8);
+        assert!((excited.electrons_detached() - r.electrons_detached).abs() < 1e-8);
+        let d = excited.descriptors(&wf.basis, &doc.molecule).expect("atoms");
+        for (ours, theirs) in
+            [(d.attachment_centroid_bohr, r.attachment_centroid), (d.detachment_centroid_bohr, r.detachment_centroid)]
+        {
+            for k in 0..3 {
+                assert!((ours[k] - theirs[k]).abs() < 1e-6, "{name}: centroid {ours:?} vs PySCF {theirs:?}");
+            }
+        }
+    }
+}
