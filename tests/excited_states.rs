@@ -144,3 +144,91 @@ fn state_densities_equal_an_independent_evaluation() {
         }
     }
 }
+
+/// (number, eV, f) of a state, for comparing with the printed tables.
+fn summary(s: &orbcloud::model::excited::ExcitedState) -> (usize, f64, Option<f64>) {
+    (s.number, s.energy_ev, s.oscillator_strength)
+}
+
+/// The TD tables of the three dvb logs: the state count, the first and last states' energies
+/// and oscillator strengths as printed, their spin, and the main transition in Gaussian's
+/// numbering (ORCA's orbitals count from 0, Q-Chem's virtuals after the 35 occupied).
+#[test]
+fn td_logs_list_their_states_as_printed() {
+    let Some(dir) = logs("excited_states::td_logs_list_their_states_as_printed") else { return };
+    let cases = [
+        (
+            "basicGaussian09_dvb_td.out",
+            5,
+            (1, 5.6287, Some(0.0018)),
+            (5, 7.0797, Some(0.1551)),
+            ("Singlet", "A"),
+            (34, 36, 0.52587),
+        ),
+        (
+            "basicORCA6.0_dvb_td.out",
+            10,
+            (1, 5.352154, Some(0.005038390)),
+            (10, 5.298129, Some(0.0)),
+            ("Singlet", "Bu"),
+            (34, 36, 0.75002079),
+        ),
+        (
+            "basicQChem5.1_dvb_td.out",
+            10,
+            (1, 3.6052, Some(0.0)),
+            (10, 7.5567, Some(0.0)),
+            ("Triplet", ""),
+            (35, 36, 0.9266),
+        ),
+    ];
+    for (name, count, first, last, (spin, symmetry), main) in cases {
+        let doc = load(&dir.join(name));
+        assert_eq!(doc.molecule.atoms.len(), 20, "{name}");
+        let states = doc.excited.as_ref().unwrap_or_else(|| panic!("{name}: no states"));
+        assert_eq!(states.states.len(), count, "{name}");
+        let (a, b) = (states.states.first().unwrap(), states.states.last().unwrap());
+        assert_eq!((summary(a), summary(b)), (first, last), "{name}");
+        assert_eq!((a.spin.as_str(), a.symmetry.as_str()), (spin, symmetry), "{name}");
+        let t = a.main_transitions(1)[0];
+        assert_eq!((t.from, t.to, t.coefficient), main, "{name}");
+        assert!((a.wavelength_nm() - 1239.841984 / first.1).abs() < 1e-9);
+    }
+    // The strongest states, as each program prints them.
+    let strongest = |name: &str| {
+        let doc = load(&dir.join(name));
+        let s = doc.excited.unwrap().states;
+        let f = |x: &orbcloud::model::excited::ExcitedState| x.oscillator_strength.unwrap_or(-1.0);
+        let best = s.iter().max_by(|x, y| f(x).total_cmp(&f(y))).unwrap();
+        (best.number, best.oscillator_strength)
+    };
+    assert_eq!(strongest("basicGaussian09_dvb_td.out"), (2, Some(0.5880)));
+    assert_eq!(strongest("basicORCA6.0_dvb_td.out"), (2, Some(1.170940055)));
+    assert_eq!(strongest("basicQChem5.1_dvb_td.out"), (7, Some(0.9407714761)));
+}
+
+/// The fchk's states: ΔE from `ETran state values` and `SCF Energy`, f = ⅔ ΔE |μ|², equal to
+/// the twin log's printed values: the energies within their last digit; f within 3e-4 of its
+/// value besides, since the fchk's transition dipoles differ from the log's in the fourth digit
+/// (state 2: |μ|² = 3.9585 from the fchk, 3.9588 printed, f 0.58790 and 0.5880).
+#[test]
+fn the_td_fchk_states_match_the_logs_print() {
+    let Some(dir) = logs("excited_states::the_td_fchk_states_match_the_logs_print") else { return };
+    let fchk = load(&dir.join("basicGaussian09_dvb_td.fchk")).excited.expect("states");
+    let log = load(&dir.join("basicGaussian09_dvb_td.out")).excited.expect("states");
+    assert_eq!(fchk.states.len(), log.states.len());
+    for (f, l) in fchk.states.iter().zip(&log.states) {
+        eprintln!(
+            "state {}: fchk {:.5} eV f={:.5}, log {} eV f={:?}",
+            f.number,
+            f.energy_ev,
+            f.oscillator_strength.unwrap(),
+            l.energy_ev,
+            l.oscillator_strength
+        );
+        assert!((f.energy_ev - l.energy_ev).abs() < 1e-4, "{f:?} vs {l:?}");
+        let (ff, lf) = (f.oscillator_strength.unwrap(), l.oscillator_strength.unwrap());
+        assert!((ff - lf).abs() <= 0.5e-4 + 3e-4 * lf, "{f:?} vs {l:?}");
+        assert_eq!(f.spin, l.spin);
+    }
+}

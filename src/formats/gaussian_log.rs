@@ -52,7 +52,9 @@ pub const ORBITAL_KEYWORDS: &str = "pop=full gfinput";
 pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Document, ParseError> {
     let log = LogLines::new(file, text);
     let scan = Scan::read(&log)?;
-    scan.into_document(&log, overlap)
+    let mut doc = scan.into_document(&log, overlap)?;
+    doc.excited = super::excited_logs::gaussian(&log)?;
+    Ok(doc)
 }
 
 /// A `gfinput` shell as printed: its atom (1-based), type letters, exponents and coefficient
