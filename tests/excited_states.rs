@@ -232,3 +232,98 @@ fn the_td_fchk_states_match_the_logs_print() {
         assert_eq!(f.spin, l.spin);
     }
 }
+
+fn orbcloud(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_orbcloud")).args(args).output().expect("run orbcloud")
+}
+
+/// `info --json` lists the TD fchk's states and its density's electrons moved, centroids'
+/// distance and overlap; the text lists the states too.
+#[test]
+fn info_lists_states_and_the_electrons_moved() {
+    let Some(dir) = logs("excited_states::info_lists_states_and_the_electrons_moved") else { return };
+    let path = dir.join("basicGaussian09_dvb_td.fchk");
+    let out = orbcloud(&["info", "--json", path.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let x = &json["excited_states"];
+    let states = x["states"].as_array().expect("states");
+    assert_eq!(states.len(), 5);
+    assert!((states[0]["energy_ev"].as_f64().unwrap() - 5.6287).abs() < 1e-4, "{}", states[0]);
+    assert!((states[0]["wavelength_nm"].as_f64().unwrap() - 220.27).abs() < 0.01);
+    assert_eq!(states[1]["spin"], "Singlet");
+    let d = &x["density"];
+    let doc = load(&path);
+    let wf = doc.wavefunction.as_ref().unwrap();
+    let moved = wf.excited.as_ref().unwrap().electrons_moved();
+    assert_eq!(d["state"], 1);
+    assert!((d["electrons_moved"].as_f64().unwrap() - moved).abs() < 1e-12, "{d}");
+    let distance = d["centroid_distance_bohr"].as_f64().unwrap();
+    let overlap = d["grid"]["overlap"].as_f64().unwrap();
+    assert!(distance > 0.1 && distance < 1.0 && overlap > 0.5 && overlap < 1.0, "{d}");
+
+    let log = dir.join("basicGaussian09_dvb_td.out");
+    let out = orbcloud(&["info", log.to_str().unwrap()]);
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.contains("5 excited states") && text.contains("220.27 nm"), "{text}");
+    assert!(text.contains("35 -> 36 0.67354"), "state 2's main transition: {text}");
+}
+
+/// `cube --attachment` writes the attachment density (positive, its electrons those moved);
+/// `eval --difference-density` prints the library's values; files without an excited density
+/// are refused naming the file, and a state the file has no density of is refused naming it.
+#[test]
+fn cube_and_eval_of_state_densities_and_refusals() {
+    let Some(dir) = logs("excited_states::cube_and_eval_of_state_densities_and_refusals") else { return };
+    let td = dir.join("basicGaussian09_dvb_td.fchk");
+    let tmp = tempfile::tempdir().unwrap();
+    let cube = tmp.path().join("attachment.cube");
+    let out =
+        orbcloud(&["cube", td.to_str().unwrap(), "--attachment", "--spacing", "0.25", "-o", cube.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let grid = &load(&cube).volumes[0];
+    let electrons: f64 = grid.values.iter().map(|&v| f64::from(v)).sum::<f64>() * grid.voxel_volume();
+    eprintln!("attachment cube: {:?}, {electrons:.5} electrons", grid.dims);
+    assert!(grid.stats.min >= 0.0, "{:?}", grid.stats);
+    assert!((electrons - 1.00113).abs() < 2e-3, "{electrons}");
+
+    let points = tmp.path().join("points.txt");
+    std::fs::write(&points, "0 0 0\n1.5 -0.5 0.3\n-2.6 0.4 0.2\n").unwrap();
+    let out = orbcloud(&["eval", td.to_str().unwrap(), "--difference-density", "--points", points.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let got: Vec<f64> = String::from_utf8(out.stdout)
+        .unwrap()
+        .lines()
+        .map(|l| l.split_whitespace().nth(3).unwrap().parse().unwrap())
+        .collect();
+    let doc = load(&td);
+    let wf = doc.wavefunction.as_ref().unwrap();
+    let at = [DVec3::ZERO, DVec3::new(1.5, -0.5, 0.3), DVec3::new(-2.6, 0.4, 0.2)];
+    let want = PreparedBasis::new(&wf.basis).quantity_at_points(wf, &doc.molecule, Quantity::DifferenceDensity, &at);
+    for (g, w) in got.iter().zip(&want) {
+        assert!((g - w).abs() <= 1e-12 + 1e-9 * w.abs(), "{got:?} vs {want:?}");
+    }
+
+    let refused = |args: &[&str], wanted: &[&str]| {
+        let out = orbcloud(args);
+        let e = String::from_utf8_lossy(&out.stderr).to_string();
+        assert!(!out.status.success() && wanted.iter().all(|w| e.contains(w)), "{args:?}: {e}");
+    };
+    let sp = dir.join("basicGaussian09_dvb_sp.fchk");
+    let out_cube = tmp.path().join("no.cube");
+    refused(
+        &["cube", sp.to_str().unwrap(), "--attachment", "-o", out_cube.to_str().unwrap()],
+        &["basicGaussian09_dvb_sp.fchk", "--attachment needs an excited state's density"],
+    );
+    assert!(!out_cube.exists());
+    refused(
+        &["eval", td.to_str().unwrap(), "--detachment", "--state", "2", "--points", points.to_str().unwrap()],
+        &["basicGaussian09_dvb_td.fchk", "--state 2", "state 1 only"],
+    );
+    let orca = dir.join("basicORCA6.0_dvb_td.out");
+    refused(
+        &["eval", orca.to_str().unwrap(), "--difference-density", "--points", points.to_str().unwrap()],
+        &["basicORCA6.0_dvb_td.out"],
+    );
+    refused(&["cube", td.to_str().unwrap(), "--attachment", "--density", "-o", "x.cube"], &["cannot be used with"]);
+}

@@ -187,7 +187,40 @@ struct WhatArgs {
     /// atomic-orbital selector names it: "C3 2pz", "O1 3dz2", "O1 3dxy", "H2 3dxx".
     #[arg(long, conflicts_with_all = ["density", "spin_density"])]
     basis_function: Option<String>,
+    /// The difference density ρ_exc − ρ_gs of the file's excited state (a Gaussian TD fchk).
+    #[arg(long, conflicts_with_all = &EXCITED_CONFLICTS[..7])]
+    difference_density: bool,
+    /// The attachment density of the file's excited state: where the excitation's electrons go
+    /// (the positive eigenvalues of the difference density matrix, Head-Gordon 1995).
+    #[arg(long, conflicts_with_all = &EXCITED_CONFLICTS[..8])]
+    attachment: bool,
+    /// The detachment density: where the excitation's electrons come from.
+    #[arg(long, conflicts_with_all = &EXCITED_CONFLICTS[..9])]
+    detachment: bool,
+    /// The excited state's own density.
+    #[arg(long, conflicts_with_all = &EXCITED_CONFLICTS[..10])]
+    excited_density: bool,
+    /// The excited state (numbered as the program numbers them) whose density the options
+    /// above show; a Gaussian TD fchk holds one state's density, and another is refused.
+    #[arg(long, value_name = "N", value_parser = within(1..=100_000usize))]
+    state: Option<usize>,
 }
+
+/// What an excited state's densities exclude: every other quantity. Each of the four conflicts
+/// with what comes before its own name (clap makes conflicts mutual, and refuses an option that
+/// conflicts with itself), so they take the first 7, 8, 9 and 10 names.
+const EXCITED_CONFLICTS: [&str; 10] = [
+    "density",
+    "spin_density",
+    "esp",
+    "rdg",
+    "sign_lambda2_rho",
+    "laplacian",
+    "basis_function",
+    "difference_density",
+    "attachment",
+    "detachment",
+];
 
 #[derive(Clone, Copy, ValueEnum)]
 enum SpinArg {
@@ -225,6 +258,10 @@ impl WavefunctionArgs {
                 (w.rdg, "--rdg"),
                 (w.sign_lambda2_rho, "--sign-lambda2-rho"),
                 (w.laplacian, "--laplacian"),
+                (w.difference_density, "--difference-density"),
+                (w.attachment, "--attachment"),
+                (w.detachment, "--detachment"),
+                (w.excited_density, "--excited-density"),
             ]
             .into_iter()
             .find(|(on, _)| *on)
@@ -254,8 +291,47 @@ impl WavefunctionArgs {
 }
 
 impl WhatArgs {
+    /// The excited-state quantity asked for, with its option's name.
+    fn state_quantity(&self) -> Option<(Quantity, &'static str)> {
+        [
+            (self.difference_density, Quantity::DifferenceDensity, "--difference-density"),
+            (self.attachment, Quantity::Attachment, "--attachment"),
+            (self.detachment, Quantity::Detachment, "--detachment"),
+            (self.excited_density, Quantity::ExcitedDensity, "--excited-density"),
+        ]
+        .into_iter()
+        .find(|(on, ..)| *on)
+        .map(|(_, q, flag)| (q, flag))
+    }
+
     fn resolve(&self, doc: &Document) -> Result<Quantity> {
         let wf = wavefunction_of(doc)?;
+        if let Some((quantity, flag)) = self.state_quantity() {
+            let Some(excited) = &wf.excited else {
+                let listed = doc.excited.as_ref().map_or(String::new(), |s| {
+                    format!(" (it lists {} excited states, but no excited state's density)", s.states.len())
+                });
+                bail!(
+                    "{}: {flag} needs an excited state's density (a Gaussian TD fchk's `Total CI Rho(1) Density`), and this file has none{listed}",
+                    doc.source
+                );
+            };
+            if let Some(n) = self.state
+                && n != excited.state
+            {
+                bail!(
+                    "{}: --state {n}: the file holds the density of state {} only (a Gaussian TD fchk keeps the state its job chose with root=)",
+                    doc.source,
+                    excited.state
+                );
+            }
+            return Ok(quantity);
+        }
+        if let Some(n) = self.state {
+            bail!(
+                "--state {n} picks the excited state of --difference-density, --attachment, --detachment or --excited-density; none is asked for"
+            );
+        }
         if let Some(name) = &self.basis_function {
             return crate::model::basis_labels::find_function(&doc.molecule, &wf.basis, name)
                 .map(Quantity::BasisFunction)
@@ -299,6 +375,9 @@ impl WhatArgs {
         if self.density {
             return "density".into();
         }
+        if let Some((_, flag)) = self.state_quantity() {
+            return flag.trim_start_matches("--").replace('-', "_");
+        }
         if self.rdg {
             return "rdg".into();
         }
@@ -339,6 +418,9 @@ impl WhatArgs {
             "sign_lambda2_rho" => "--sign-lambda2-rho".into(),
             "laplacian" => "--laplacian".into(),
             "spin_density" => "--spin-density".into(),
+            "difference_density" | "attachment" | "detachment" | "excited_density" => {
+                format!("--{}", self.short_name().replace('_', "-"))
+            }
             name => format!("--orbital {name}"),
         }
     }
