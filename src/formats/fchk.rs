@@ -546,12 +546,20 @@ impl FchkFile {
         let positions: Vec<DVec3> = atoms.iter().map(|a| a.position).collect();
         let mut doc = wavefunction_document(source, &self.title, atoms, wf, Some(self.writer()), overlap);
         // A TD job's states and the excited state's density: a malformed record leaves them out.
-        match self.excited_states(file) {
-            Ok(states) => doc.excited = states,
-            Err(e) => doc.problems.push(format!("excited states left out: {e}")),
-        }
-        if let Some(wf) = doc.wavefunction.as_mut() {
-            let state = doc.excited.as_ref().and_then(|s| s.density_of).unwrap_or(1);
+        // Without `ETran` records the density is taken as state 1's (Gaussian's default root);
+        // with records that disagree its state is unknown, and it is left out too.
+        let state = match self.excited_states(file) {
+            Ok(states) => {
+                let state = states.as_ref().map_or(Some(1), |s| s.density_of);
+                doc.excited = states;
+                state
+            }
+            Err(e) => {
+                doc.problems.push(format!("excited states (and their density) left out: {e}"));
+                None
+            }
+        };
+        if let (Some(wf), Some(state)) = (doc.wavefunction.as_mut(), state) {
             match self.excited_density(file, &file_to_model, wf, state) {
                 Ok(density) => wf.excited = density.map(std::sync::Arc::new),
                 Err(e) => doc.problems.push(format!("excited-state density left out: {e}")),

@@ -103,34 +103,31 @@ impl FchkFile {
     }
 
     /// The state the excited density belongs to: the one `ETran scalars` names (its fifth
-    /// value), which the `CIS Energy` record must match; `None` without an excited density.
+    /// value) when its energy is the `CIS Energy` record's, else the first state whose energy
+    /// is; `None` without an excited density. A file whose `CIS Energy` is no state's is refused.
     fn density_state(&self, file: &str, scalars: &[i64], states: &[ExcitedState]) -> Result<Option<usize>, ParseError> {
         if !EXCITED_DENSITIES.iter().any(|l| self.records.contains_key(*l)) {
             return Ok(None);
         }
         let named = scalars.get(4).and_then(|&s| usize::try_from(s).ok()).filter(|&s| s >= 1 && s <= states.len());
-        let Some(state) = named else {
-            return Err(error(
-                file,
-                self.line_of("ETran scalars"),
-                format!("the state of the excited density (value 5, 1..={})", states.len()),
-                format!("{:?}", scalars.get(4)),
-            ));
-        };
-        if self.records.contains_key("CIS Energy") {
-            let cis = self.real(file, "CIS Energy")?;
-            let printed = states[state - 1].total_energy_hartree.unwrap_or(f64::NAN);
-            // ETran prints 9 significant digits: 1e-6 Eh on a few hundred hartree.
-            if (cis - printed).abs() > 1e-5 * cis.abs().max(1.0) {
-                return Err(error(
-                    file,
-                    self.line_of("CIS Energy"),
-                    format!("the energy of state {state} ({printed:.6} Eh, ETran state values)"),
-                    format!("{cis:.6}"),
-                ));
-            }
+        if !self.records.contains_key("CIS Energy") {
+            return Ok(Some(named.unwrap_or(1)));
         }
-        Ok(Some(state))
+        let cis = self.real(file, "CIS Energy")?;
+        // ETran prints 9 significant digits: 1e-6 Eh on a few hundred hartree.
+        let matches = |k: usize| {
+            let e = states[k - 1].total_energy_hartree.unwrap_or(f64::NAN);
+            (cis - e).abs() <= 1e-5 * cis.abs().max(1.0)
+        };
+        match named.filter(|&k| matches(k)).or_else(|| (1..=states.len()).find(|&k| matches(k))) {
+            Some(k) => Ok(Some(k)),
+            None => Err(error(
+                file,
+                self.line_of("CIS Energy"),
+                "the energy of a state of `ETran state values`",
+                format!("{cis:.6} Eh"),
+            )),
+        }
     }
 
     /// The excited state's density and the ground state's, in the model's function order
@@ -188,5 +185,107 @@ impl FchkFile {
         ExcitedDensity::new(state, label, &wf.basis, ground, excited)
             .map(Some)
             .map_err(|e| error(file, self.line_of(label), "a density matrix over the basis", e))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::model::Document;
+
+    fn reals(label: &str, v: &[f64]) -> String {
+        let mut s = format!("{label:<43}R   N={:>12}\n", v.len());
+        for row in v.chunks(5) {
+            s.extend(row.iter().map(|x| format!("{x:>16.8E}")));
+            s.push('\n');
+        }
+        s
+    }
+
+    fn ints(label: &str, v: &[i64]) -> String {
+        let mut s = format!("{label:<43}I   N={:>12}\n", v.len());
+        for row in v.chunks(6) {
+            s.extend(row.iter().map(|x| format!("{x:>12}")));
+            s.push('\n');
+        }
+        s
+    }
+
+    fn scalar(label: &str, v: &str) -> String {
+        format!("{label:<43}{v}\n")
+    }
+
+    /// H₂ in one s function per atom, the ground state's bonding orbital doubly occupied, the
+    /// excited state's density one electron in each of bonding and antibonding; two states,
+    /// the first a singlet with μ = (0, 0, 0.8) 0.5 Eh up. `cis` and `ground` replace the
+    /// `CIS Energy` and the ground density's off-diagonal element.
+    fn h2(cis: f64, ground_offdiagonal: Option<f64>) -> Document {
+        let s12 = (-0.5f64 * 1.4 * 1.4).exp();
+        let b = 1.0 / (2.0 + 2.0 * s12).sqrt();
+        let a = 1.0 / (2.0 - 2.0 * s12).sqrt();
+        let mut t =
+            String::from("h2 td\nSP        RTD-HF                                                      minimal\n");
+        t += &scalar("Number of atoms", "I                2");
+        t += &scalar("Number of alpha electrons", "I                1");
+        t += &scalar("Number of beta electrons", "I                1");
+        t += &scalar("Number of basis functions", "I                2");
+        t += &ints("Atomic numbers", &[1, 1]);
+        t += &reals("Current cartesian coordinates", &[0.0, 0.0, 0.0, 0.0, 0.0, 1.4]);
+        t += &ints("Shell types", &[0, 0]);
+        t += &ints("Number of primitives per shell", &[1, 1]);
+        t += &ints("Shell to atom map", &[1, 2]);
+        t += &reals("Primitive exponents", &[1.0, 1.0]);
+        t += &reals("Contraction coefficients", &[1.0, 1.0]);
+        t += &scalar("SCF Energy", "R     -1.000000000000000E+00");
+        t += &scalar("CIS Energy", &format!("R     {cis:.15E}"));
+        t += &reals("Alpha Orbital Energies", &[-0.5, 0.3]);
+        t += &reals("Alpha MO coefficients", &[b, b, a, -a]);
+        let g = 2.0 * b * b;
+        t += &reals("Total SCF Density", &[g, ground_offdiagonal.unwrap_or(g), g]);
+        t += &reals("Total CI Rho(1) Density", &[b * b + a * a, b * b - a * a, b * b + a * a]);
+        let mut scalars = vec![0i64; 20];
+        scalars[..5].copy_from_slice(&[2, 16, 1, 10, 1]);
+        t += &ints("ETran scalars", &scalars);
+        t += &ints("ETran spin", &[0, 2]);
+        t += &ints("ETran sym", &[0, 0]);
+        let mut values = vec![0.0; 32];
+        values[0] = -0.5;
+        values[3] = 0.8;
+        values[16] = -0.4;
+        t += &reals("ETran state values", &values);
+        super::super::fchk::parse("h2.fchk", &t, None).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    #[test]
+    fn states_and_the_density_of_a_td_checkpoint() {
+        let doc = h2(-0.5, None);
+        assert!(doc.problems.is_empty(), "{:?}", doc.problems);
+        let states = doc.excited.as_ref().expect("states");
+        assert_eq!((states.states.len(), states.density_of), (2, Some(1)));
+        let first = &states.states[0];
+        assert!((first.energy_ev - 0.5 * crate::model::units::EV_PER_HARTREE).abs() < 1e-9);
+        assert!((first.oscillator_strength.unwrap() - 2.0 / 3.0 * 0.5 * 0.64).abs() < 1e-12);
+        assert_eq!((first.spin.as_str(), states.states[1].spin.as_str()), ("Singlet", "Triplet"));
+        let excited = doc.wavefunction.as_ref().unwrap().excited.as_ref().expect("density");
+        assert!((excited.electrons_moved() - 1.0).abs() < 1e-7, "{}", excited.electrons_moved());
+        assert_eq!(excited.source, "Total CI Rho(1) Density");
+    }
+
+    #[test]
+    fn records_that_disagree_leave_the_states_or_the_density_out() {
+        // A CIS energy that is no state's: the states are left out, saying so; the orbitals open.
+        let doc = h2(-0.45, None);
+        assert!(doc.excited.is_none() && doc.wavefunction.as_ref().is_some_and(|wf| wf.excited.is_none()));
+        assert!(
+            doc.problems[0].contains("excited states (and their density) left out")
+                && doc.problems[0].contains("-0.450000"),
+            "{:?}",
+            doc.problems
+        );
+        // A ground density that is not the orbitals': the functions' order or normalisation is
+        // not theirs, so the excited density is left out.
+        let doc = h2(-0.5, Some(0.0));
+        assert!(doc.excited.is_some());
+        assert!(doc.wavefunction.as_ref().unwrap().excited.is_none());
+        assert!(doc.problems[0].contains("the ground-state density the orbitals make"), "{:?}", doc.problems);
     }
 }

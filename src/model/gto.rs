@@ -466,6 +466,8 @@ impl PreparedBasis {
     pub(super) fn quantity_at(&self, wf: &Wavefunction, quantity: Quantity, points: &[DVec3]) -> Vec<f64> {
         let mut values = vec![0.0; self.n_functions];
         let (mut c, mut cg) = (Vec::new(), Vec::new());
+        // An excited state's density: its natural orbitals with their weights.
+        let state = super::evaluation::state_sets(wf, quantity);
         points
             .iter()
             .map(|&p| {
@@ -480,9 +482,7 @@ impl PreparedBasis {
                     Quantity::DifferenceDensity
                     | Quantity::Attachment
                     | Quantity::Detachment
-                    | Quantity::ExcitedDensity => (super::evaluation::state_sets(wf, quantity).iter())
-                        .map(|(c, w)| w * dot(c, &values).powi(2))
-                        .sum(),
+                    | Quantity::ExcitedDensity => state.iter().map(|(c, w)| w * dot(c, &values).powi(2)).sum(),
                     Quantity::Potential
                     | Quantity::ReducedGradient
                     | Quantity::SignLambda2Rho
