@@ -1,6 +1,7 @@
 //! Q-Chem outputs: the geometries (`Standard Nuclear Orientation (Angstroms)`, one per step) as
 //! frames, and the excited states of a TDDFT, TDA or CIS job ([`super::excited_logs::qchem`]).
-//! Q-Chem prints neither the basis nor the orbitals by default, so a log opens as its atoms.
+//! Q-Chem prints neither the basis nor the orbitals by default (and this reader reads neither), so a
+//! log opens as its atoms; the job's fchk file holds the orbitals.
 
 use glam::DVec3;
 
@@ -49,7 +50,7 @@ pub fn parse(file: &str, text: &str) -> Result<Document, ParseError> {
     }
     let mut doc = trajectory(file, file, &frames);
     doc.problems.push(format!(
-        "{file}: no orbitals to draw: Q-Chem prints neither the basis set nor the orbitals here (its fchk file holds them)"
+        "{file}: no orbitals to draw: a Q-Chem output is read for its geometries and excited states only (the job's fchk file, `GUI=2`, holds the orbitals)"
     ));
     if let Some(occupied) = electrons {
         doc.excited = super::excited_logs::qchem(&log, occupied)?;
