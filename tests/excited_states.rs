@@ -324,7 +324,7 @@ fn cube_and_eval_of_state_densities_and_refusals() {
     let orca = dir.join("basicORCA6.0_dvb_td.out");
     refused(
         &["eval", orca.to_str().unwrap(), "--difference-density", "--points", points.to_str().unwrap()],
-        &["basicORCA6.0_dvb_td.out"],
+        &["basicORCA6.0_dvb_td.out", "needs an excited state's density", "it lists 10 excited states"],
     );
     refused(&["cube", td.to_str().unwrap(), "--attachment", "--density", "-o", "x.cube"], &["cannot be used with"]);
 }

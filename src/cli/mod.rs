@@ -267,6 +267,9 @@ impl WavefunctionArgs {
             .find(|(on, _)| *on)
             .map(|(_, flag)| flag)
             .or(w.basis_function.as_ref().map(|_| "--basis-function"));
+            if let Some((_, flag)) = w.state_quantity() {
+                return Err(no_state_density(doc, flag));
+            }
             if let Some(flag) = asked {
                 bail!(
                     "{}: {flag} needs a wavefunction (Molden, fchk, wfn, wfx or MKL), and this file has none: `orbcloud compute {}` computes one with PySCF",
@@ -305,17 +308,9 @@ impl WhatArgs {
     }
 
     fn resolve(&self, doc: &Document) -> Result<Quantity> {
-        let wf = wavefunction_of(doc)?;
         if let Some((quantity, flag)) = self.state_quantity() {
-            let Some(excited) = &wf.excited else {
-                let listed = doc.excited.as_ref().map_or(String::new(), |s| {
-                    format!(" (it lists {} excited states, but no excited state's density)", s.states.len())
-                });
-                bail!(
-                    "{}: {flag} needs an excited state's density (a Gaussian TD fchk's `Total CI Rho(1) Density`), and this file has none{listed}",
-                    doc.source
-                );
-            };
+            let excited = doc.wavefunction.as_ref().and_then(|wf| wf.excited.as_ref());
+            let Some(excited) = excited else { return Err(no_state_density(doc, flag)) };
             if let Some(n) = self.state
                 && n != excited.state
             {
@@ -327,6 +322,7 @@ impl WhatArgs {
             }
             return Ok(quantity);
         }
+        let wf = wavefunction_of(doc)?;
         if let Some(n) = self.state {
             bail!(
                 "--state {n} picks the excited state of --difference-density, --attachment, --detachment or --excited-density; none is asked for"
@@ -450,6 +446,17 @@ fn quantity_label(q: &Quantity, doc: &Document) -> String {
             format!("MO {n} ({:?}) E={:.6} Eh occ={:.3} {}", o.spin, o.energy, o.occupation, o.symmetry)
         }
     }
+}
+
+/// The refusal of an excited state's density (`flag`) by a file that holds none.
+fn no_state_density(doc: &Document, flag: &str) -> anyhow::Error {
+    let listed = doc.excited.as_ref().map_or(String::new(), |s| {
+        format!(" (it lists {} excited states, but no excited state's density)", s.states.len())
+    });
+    anyhow::anyhow!(
+        "{}: {flag} needs an excited state's density (a Gaussian TD fchk's `Total CI Rho(1) Density`), and this file has none{listed}",
+        doc.source
+    )
 }
 
 /// The excited state whose density `wf` holds, in words ("1", "?" when none).

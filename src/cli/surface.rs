@@ -324,6 +324,9 @@ impl GridArgs {
     /// A cube file's volume, or the orbital or density of a Molden/fchk file evaluated on the
     /// CPU over the box the viewer uses.
     pub fn grid(&self, doc: &Document) -> Result<VolumeGrid> {
+        if let (None, Some((_, flag))) = (&doc.wavefunction, self.what.state_quantity()) {
+            return Err(super::no_state_density(doc, flag));
+        }
         if doc.wavefunction.is_none() {
             return doc.volumes.get(self.volume).cloned().with_context(|| {
                 format!("{}: no volume {} (the file has {})", doc.source, self.volume, doc.volumes.len())

@@ -304,6 +304,62 @@ fn qchem_transition(line: &str, (alpha, beta): (usize, usize)) -> Option<Transit
 mod tests {
     use super::*;
 
+    /// ORCA 5 prints no `Sym:`/`Mult` on its state lines and numbers the spectrum's rows by
+    /// state, energies in cm⁻¹: the multiplicity comes from the block's heading, f from the row.
+    #[test]
+    fn orca_5_states_and_spectrum() {
+        let text = "\
+------------------------------------
+TD-DFT/TDA EXCITED STATES (SINGLETS)
+------------------------------------
+
+the weight of the individual excitations are printed if larger than 1.0e-02
+
+STATE  1:  E=   0.196688 au      5.352 eV    43168.0 cm**-1 <S**2> =   0.000000
+    33a ->  35a  :     0.562531 (c=  0.75002079)
+
+STATE  2:  E=   0.210622 au      5.731 eV    46226.2 cm**-1 <S**2> =   0.000000
+    34a ->  35a  :     0.934296
+
+-----------------------------------------------------------------------------
+         ABSORPTION SPECTRUM VIA TRANSITION ELECTRIC DIPOLE MOMENTS
+-----------------------------------------------------------------------------
+State   Energy    Wavelength  fosc         T2        TX        TY        TZ
+        (cm-1)      (nm)                 (au**2)    (au)      (au)      (au)
+-----------------------------------------------------------------------------
+   1   43168.0    231.7   0.005038390   0.03842   0.16288   0.10906   0.00000
+   2   46226.2    216.3   1.170940055   8.33915   2.88656   0.08326  -0.00000
+
+";
+        let s = orca(&LogLines::new("o.out", text)).unwrap().expect("states");
+        assert_eq!(s.method, "TD-DFT/TDA");
+        let f: Vec<Option<f64>> = s.states.iter().map(|s| s.oscillator_strength).collect();
+        assert_eq!(f, vec![Some(0.005038390), Some(1.170940055)]);
+        assert!((s.states[0].energy_ev - 0.196688 * EV_PER_HARTREE).abs() < 1e-12);
+        assert_eq!((s.states[1].spin.as_str(), s.states[1].symmetry.as_str()), ("Singlet", ""));
+        // Without `(c= …)` the coefficient is the weight's square root.
+        assert!((s.states[1].transitions[0].coefficient - 0.934296f64.sqrt()).abs() < 1e-12);
+    }
+
+    /// An unrestricted Gaussian state: ⟨S²⟩'s label for the spin, A and B orbitals.
+    #[test]
+    fn gaussian_unrestricted_states() {
+        let text = " Excited State   1:  3.010-A      2.1000 eV  590.40 nm  f=0.0100  <S**2>=2.015
+      10A -> 11A        0.70000
+      10B -> 11B       -0.20000
+
+ Excited State   2:  3.020-B      2.5000 eV  495.94 nm  f=0.0000  <S**2>=2.020
+      9A -> 11A        0.90000
+";
+        let s = gaussian(&LogLines::new("g.log", text)).unwrap().expect("states");
+        assert_eq!(s.states.len(), 2);
+        let a = &s.states[0];
+        assert_eq!((a.spin.as_str(), a.symmetry.as_str(), a.s_squared), ("3.010", "A", Some(2.015)));
+        let spins: Vec<&str> = a.transitions.iter().map(|t| t.spin.as_str()).collect();
+        assert_eq!(spins, ["alpha", "beta"]);
+        assert_eq!((s.states[1].energy_ev, s.states[1].oscillator_strength), (2.5, Some(0.0)));
+    }
+
     #[test]
     fn transition_lines_of_each_program() {
         let g = gaussian_transition("      35 <- 37        -0.01172").unwrap();
