@@ -146,6 +146,10 @@ pub(crate) fn orca(log: &LogLines) -> Result<Option<ExcitedStates>, ParseError> 
             }
             i += 1;
         }
+        // ORCA writes `a` for alpha and for restricted orbitals alike: beta ones tell.
+        if state.transitions.iter().any(|t| t.spin == "beta") {
+            state.transitions.iter_mut().filter(|t| t.spin.is_empty()).for_each(|t| t.spin = "alpha".into());
+        }
         states.push(state);
     }
     if states.is_empty() {
@@ -201,9 +205,10 @@ fn orca_spectrum(log: &LogLines, header: usize, states: &mut [ExcitedState]) -> 
             let (root, rest) = target.split_once('-').ok_or_else(|| log.error_at(i, row))?;
             let root: usize = root.parse().map_err(|_| log.error_at(i, row))?;
             let mult = match rest.chars().next() {
-                Some('1') => "Singlet",
-                Some('3') => "Triplet",
-                _ => "",
+                Some('1') => "Singlet".to_string(),
+                Some('3') => "Triplet".to_string(),
+                Some(d) => format!("multiplicity {d}"),
+                None => String::new(),
             };
             let k = (states.iter().enumerate())
                 .filter(|(_, s)| s.spin == mult)

@@ -53,7 +53,11 @@ pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Docum
     let log = LogLines::new(file, text);
     let scan = Scan::read(&log)?;
     let mut doc = scan.into_document(&log, overlap)?;
-    doc.excited = super::excited_logs::gaussian(&log)?;
+    // A malformed table leaves the states out, not the file.
+    match super::excited_logs::gaussian(&log) {
+        Ok(states) => doc.excited = states,
+        Err(e) => doc.problems.push(format!("excited states left out: {e}")),
+    }
     Ok(doc)
 }
 

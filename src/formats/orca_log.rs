@@ -44,7 +44,11 @@ pub const ORBITAL_KEYWORDS: &str = "%output print[p_basis] 2 print[p_mos] 1 end"
 pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Document, ParseError> {
     let log = LogLines::new(file, text);
     let mut doc = read(&log, overlap)?;
-    doc.excited = super::excited_logs::orca(&log)?;
+    // A malformed table leaves the states out, not the file.
+    match super::excited_logs::orca(&log) {
+        Ok(states) => doc.excited = states,
+        Err(e) => doc.problems.push(format!("excited states left out: {e}")),
+    }
     Ok(doc)
 }
 

@@ -53,7 +53,11 @@ pub fn parse(file: &str, text: &str) -> Result<Document, ParseError> {
         "{file}: no orbitals to draw: a Q-Chem output is read for its geometries and excited states only (the job's fchk file, `GUI=2`, holds the orbitals)"
     ));
     if let Some(occupied) = electrons {
-        doc.excited = super::excited_logs::qchem(&log, occupied)?;
+        // A malformed table leaves the states out, not the file.
+        match super::excited_logs::qchem(&log, occupied) {
+            Ok(states) => doc.excited = states,
+            Err(e) => doc.problems.push(format!("excited states left out: {e}")),
+        }
     }
     Ok(doc)
 }
