@@ -86,7 +86,7 @@ fn load(name: &str) -> (Fixture, Wavefunction) {
             })
             .collect(),
         restricted: fx.restricted,
-        normalization: Default::default(),
+        ..Default::default()
     };
     assert_eq!(fx.name, name);
     assert_eq!(wf.basis.n_functions(), fx.n_ao, "{name}");

@@ -145,15 +145,18 @@ fn the_frequency_log_has_its_54_modes() {
 #[test]
 fn other_programs_outputs_are_refused_naming_the_banners() {
     let Some(dir) = logs("refdata_logs::other_programs_outputs_are_refused_naming_the_banners") else { return };
-    for name in [
-        "basicGAMESS-US2017_dvb_sp.out",
-        "basicNWChem6.5_dvb_sp_hf.out",
-        "basicPsi4-1.3.1_dvb_sp_rhf.out",
-        "basicQChem5.1_dvb_sp.out",
-    ] {
+    for name in ["basicGAMESS-US2017_dvb_sp.out", "basicNWChem6.5_dvb_sp_hf.out", "basicPsi4-1.3.1_dvb_sp_rhf.out"] {
         let e = formats::load(&dir.join(name)).expect_err(name).to_string();
         assert!(e.contains(name) && e.contains("Entering Gaussian System") && e.contains("O   R   C   A"), "{e}");
     }
+    // Q-Chem's outputs open as their atoms (and a TD job's states), saying there are no orbitals.
+    let qchem = load(&dir.join("basicQChem5.1_dvb_sp.out"));
+    assert_eq!(qchem.molecule.atoms.len(), 20);
+    assert!(
+        qchem.wavefunction.is_none() && qchem.problems.iter().any(|p| p.contains("no orbitals")),
+        "{:?}",
+        qchem.problems
+    );
 }
 
 #[test]

@@ -280,6 +280,10 @@ impl PyDocument {
             Quantity::ReducedGradient => "reduced density gradient".into(),
             Quantity::SignLambda2Rho => "sign(lambda2)*rho (a.u.)".into(),
             Quantity::DensityLaplacian => "Laplacian of the electron density (a.u.)".into(),
+            // An excited state's densities: the package does not ask for them yet.
+            Quantity::DifferenceDensity | Quantity::Attachment | Quantity::Detachment | Quantity::ExcitedDensity => {
+                format!("{q:?}")
+            }
         };
         let id = match q {
             Quantity::Orbital(i) => wf.of_spin(wf.orbitals[i].spin).position(|(j, _)| j == i).map_or(0, |p| p + 1),

@@ -3,6 +3,8 @@
 use serde::Serialize;
 
 use crate::model::basis::ShellKind;
+use crate::model::excited::Transition;
+use crate::model::excited_density::Descriptors;
 use crate::model::orbitals::{EnergiesAsOccupations, Normalization, Spin, Wavefunction};
 use crate::model::units::EV_PER_HARTREE;
 use crate::model::{Document, GridStats, grid::ValueKind, units::ANGSTROM_PER_BOHR};
@@ -118,8 +120,66 @@ pub struct DocumentInfo {
     pub modes: Vec<crate::model::vibrations::NormalMode>,
     /// Where the modes' geometry comes from, when there are modes.
     pub modes_geometry: Option<String>,
+    /// Excited states the file lists, and what its excited state's density says.
+    pub excited_states: Option<ExcitedInfo>,
     /// Parts of the file left out, each saying where and why.
     pub problems: Vec<String>,
+}
+
+#[derive(Serialize)]
+pub struct StateInfo {
+    pub number: usize,
+    pub energy_ev: f64,
+    pub wavelength_nm: f64,
+    pub oscillator_strength: Option<f64>,
+    pub spin: String,
+    pub symmetry: String,
+    pub s_squared: Option<f64>,
+    pub total_energy_hartree: Option<f64>,
+    /// The largest transitions (at most 5), orbitals numbered from 1 within their spin.
+    pub main_transitions: Vec<Transition>,
+}
+
+#[derive(Serialize)]
+pub struct ExcitedInfo {
+    pub program: String,
+    pub method: String,
+    pub states: Vec<StateInfo>,
+    /// The state whose density the file holds, and what its attachment and detachment
+    /// densities say: `electrons_moved`, their centroids and distance (exact, from dipole
+    /// integrals), their overlap and integrals on a grid.
+    pub density: Option<Descriptors>,
+    /// Where that density comes from ("Total CI Rho(1) Density").
+    pub density_source: Option<String>,
+}
+
+fn excited_info(doc: &Document) -> Option<ExcitedInfo> {
+    let wf = doc.wavefunction.as_ref();
+    let density = wf.and_then(|wf| Some((wf, wf.excited.as_ref()?)));
+    if doc.excited.is_none() && density.is_none() {
+        return None;
+    }
+    let listed = doc.excited.clone().unwrap_or_default();
+    let states = (listed.states.iter())
+        .map(|s| StateInfo {
+            number: s.number,
+            energy_ev: s.energy_ev,
+            wavelength_nm: s.wavelength_nm(),
+            oscillator_strength: s.oscillator_strength,
+            spin: s.spin.clone(),
+            symmetry: s.symmetry.clone(),
+            s_squared: s.s_squared,
+            total_energy_hartree: s.total_energy_hartree,
+            main_transitions: s.main_transitions(5).into_iter().cloned().collect(),
+        })
+        .collect();
+    Some(ExcitedInfo {
+        program: listed.program,
+        method: listed.method,
+        states,
+        density: density.and_then(|(wf, e)| e.descriptors(&wf.basis, &doc.molecule)),
+        density_source: density.map(|(_, e)| e.source.clone()),
+    })
 }
 
 fn structure_info(view: &crate::model::StructureView) -> StructureInfo {
@@ -234,6 +294,7 @@ pub fn describe(doc: &Document) -> DocumentInfo {
         structure: doc.structure.as_ref().map(structure_info),
         modes: doc.vibrations.as_ref().map(|v| v.modes.clone()).unwrap_or_default(),
         modes_geometry: doc.vibrations.as_ref().map(|v| v.geometry_from.clone()),
+        excited_states: excited_info(doc),
         problems: doc.problems.clone(),
     }
 }
@@ -358,8 +419,57 @@ pub fn text(doc: &Document) -> String {
     } else if info.wavefunction.as_ref().is_some_and(|w| w.normalization.program == "Q-Chem") {
         let _ = writeln!(s, "no normal modes: Q-Chem's fchk files carry none");
     }
+    if let Some(x) = &info.excited_states {
+        excited_text(&mut s, x);
+    }
     for p in &info.problems {
         let _ = writeln!(s, "⚠ {p}");
     }
     s
+}
+
+/// The states as a table, their main transitions, and the density's descriptors.
+fn excited_text(s: &mut String, x: &ExcitedInfo) {
+    use std::fmt::Write;
+    let method = if x.method.is_empty() { String::new() } else { format!(" ({})", x.method) };
+    let _ = writeln!(s, "{} excited states{method} from {}:", x.states.len(), x.program);
+    for st in &x.states {
+        let f = st.oscillator_strength.map_or("—".to_string(), |f| format!("{f:.4}"));
+        let label =
+            [st.spin.as_str(), st.symmetry.as_str()].iter().filter(|w| !w.is_empty()).copied().collect::<Vec<_>>();
+        let transitions: Vec<String> = st.main_transitions.iter().take(3).map(ToString::to_string).collect();
+        let _ = writeln!(
+            s,
+            "  state {:>3} {:>9.4} eV {:>8.2} nm  f = {f:>7}  {:<12} {}",
+            st.number,
+            st.energy_ev,
+            st.wavelength_nm,
+            label.join(" "),
+            transitions.join(", ")
+        );
+    }
+    if let Some(d) = &x.density {
+        let g = &d.grid;
+        let _ = writeln!(
+            s,
+            "state {} density ({}): {:.4} electrons moved (detachment {:.4}); attachment and detachment centroids {:.3} bohr apart ({:.3} Å), overlap {:.3}",
+            d.state,
+            x.density_source.as_deref().unwrap_or(""),
+            d.electrons_moved,
+            d.electrons_detached,
+            d.centroid_distance_bohr,
+            d.centroid_distance_bohr * ANGSTROM_PER_BOHR,
+            g.overlap
+        );
+        let _ = writeln!(
+            s,
+            "  on a {}×{}×{} grid ({} bohr): attachment {:.4}, detachment {:.4} electrons",
+            g.grid_points[0],
+            g.grid_points[1],
+            g.grid_points[2],
+            g.spacing_bohr,
+            g.attachment_integral,
+            g.detachment_integral
+        );
+    }
 }

@@ -187,7 +187,40 @@ struct WhatArgs {
     /// atomic-orbital selector names it: "C3 2pz", "O1 3dz2", "O1 3dxy", "H2 3dxx".
     #[arg(long, conflicts_with_all = ["density", "spin_density"])]
     basis_function: Option<String>,
+    /// The difference density ρ_exc − ρ_gs of the file's excited state (a Gaussian TD fchk).
+    #[arg(long, conflicts_with_all = &EXCITED_CONFLICTS[..7])]
+    difference_density: bool,
+    /// The attachment density of the file's excited state: where the excitation's electrons go
+    /// (the positive eigenvalues of the difference density matrix, Head-Gordon 1995).
+    #[arg(long, conflicts_with_all = &EXCITED_CONFLICTS[..8])]
+    attachment: bool,
+    /// The detachment density: where the excitation's electrons come from.
+    #[arg(long, conflicts_with_all = &EXCITED_CONFLICTS[..9])]
+    detachment: bool,
+    /// The excited state's own density.
+    #[arg(long, conflicts_with_all = &EXCITED_CONFLICTS[..10])]
+    excited_density: bool,
+    /// The excited state (numbered as the program numbers them) whose density the options
+    /// above show; a Gaussian TD fchk holds one state's density, and another is refused.
+    #[arg(long, value_name = "N", value_parser = within(1..=100_000usize))]
+    state: Option<usize>,
 }
+
+/// What an excited state's densities exclude: every other quantity. Each of the four conflicts
+/// with what comes before its own name (clap makes conflicts mutual, and refuses an option that
+/// conflicts with itself), so they take the first 7, 8, 9 and 10 names.
+const EXCITED_CONFLICTS: [&str; 10] = [
+    "density",
+    "spin_density",
+    "esp",
+    "rdg",
+    "sign_lambda2_rho",
+    "laplacian",
+    "basis_function",
+    "difference_density",
+    "attachment",
+    "detachment",
+];
 
 #[derive(Clone, Copy, ValueEnum)]
 enum SpinArg {
@@ -225,11 +258,18 @@ impl WavefunctionArgs {
                 (w.rdg, "--rdg"),
                 (w.sign_lambda2_rho, "--sign-lambda2-rho"),
                 (w.laplacian, "--laplacian"),
+                (w.difference_density, "--difference-density"),
+                (w.attachment, "--attachment"),
+                (w.detachment, "--detachment"),
+                (w.excited_density, "--excited-density"),
             ]
             .into_iter()
             .find(|(on, _)| *on)
             .map(|(_, flag)| flag)
             .or(w.basis_function.as_ref().map(|_| "--basis-function"));
+            if let Some((_, flag)) = w.state_quantity() {
+                return Err(no_state_density(doc, flag));
+            }
             if let Some(flag) = asked {
                 bail!(
                     "{}: {flag} needs a wavefunction (Molden, fchk, wfn, wfx or MKL), and this file has none: `orbcloud compute {}` computes one with PySCF",
@@ -254,8 +294,40 @@ impl WavefunctionArgs {
 }
 
 impl WhatArgs {
+    /// The excited-state quantity asked for, with its option's name.
+    fn state_quantity(&self) -> Option<(Quantity, &'static str)> {
+        [
+            (self.difference_density, Quantity::DifferenceDensity, "--difference-density"),
+            (self.attachment, Quantity::Attachment, "--attachment"),
+            (self.detachment, Quantity::Detachment, "--detachment"),
+            (self.excited_density, Quantity::ExcitedDensity, "--excited-density"),
+        ]
+        .into_iter()
+        .find(|(on, ..)| *on)
+        .map(|(_, q, flag)| (q, flag))
+    }
+
     fn resolve(&self, doc: &Document) -> Result<Quantity> {
+        if let Some((quantity, flag)) = self.state_quantity() {
+            let excited = doc.wavefunction.as_ref().and_then(|wf| wf.excited.as_ref());
+            let Some(excited) = excited else { return Err(no_state_density(doc, flag)) };
+            if let Some(n) = self.state
+                && n != excited.state
+            {
+                bail!(
+                    "{}: --state {n}: the file holds the density of state {} only (a Gaussian TD fchk keeps the state its job chose with root=)",
+                    doc.source,
+                    excited.state
+                );
+            }
+            return Ok(quantity);
+        }
         let wf = wavefunction_of(doc)?;
+        if let Some(n) = self.state {
+            bail!(
+                "--state {n} picks the excited state of --difference-density, --attachment, --detachment or --excited-density; none is asked for"
+            );
+        }
         if let Some(name) = &self.basis_function {
             return crate::model::basis_labels::find_function(&doc.molecule, &wf.basis, name)
                 .map(Quantity::BasisFunction)
@@ -299,6 +371,9 @@ impl WhatArgs {
         if self.density {
             return "density".into();
         }
+        if let Some((_, flag)) = self.state_quantity() {
+            return flag.trim_start_matches("--").replace('-', "_");
+        }
         if self.rdg {
             return "rdg".into();
         }
@@ -339,6 +414,9 @@ impl WhatArgs {
             "sign_lambda2_rho" => "--sign-lambda2-rho".into(),
             "laplacian" => "--laplacian".into(),
             "spin_density" => "--spin-density".into(),
+            "difference_density" | "attachment" | "detachment" | "excited_density" => {
+                format!("--{}", self.short_name().replace('_', "-"))
+            }
             name => format!("--orbital {name}"),
         }
     }
@@ -354,6 +432,10 @@ fn quantity_label(q: &Quantity, doc: &Document) -> String {
         Quantity::ReducedGradient => "reduced density gradient".into(),
         Quantity::SignLambda2Rho => "sign(lambda2)*rho (a.u.)".into(),
         Quantity::DensityLaplacian => "Laplacian of the electron density (a.u.)".into(),
+        Quantity::DifferenceDensity => format!("difference density (state {} minus ground)", state_of(wf)),
+        Quantity::Attachment => format!("attachment density (state {})", state_of(wf)),
+        Quantity::Detachment => format!("detachment density (state {})", state_of(wf)),
+        Quantity::ExcitedDensity => format!("excited-state density (state {})", state_of(wf)),
         Quantity::BasisFunction(k) => {
             let name = crate::model::basis_labels::function_name(&doc.molecule, &wf.basis, *k);
             format!("basis function {}", name.unwrap_or_default())
@@ -364,6 +446,22 @@ fn quantity_label(q: &Quantity, doc: &Document) -> String {
             format!("MO {n} ({:?}) E={:.6} Eh occ={:.3} {}", o.spin, o.energy, o.occupation, o.symmetry)
         }
     }
+}
+
+/// The refusal of an excited state's density (`flag`) by a file that holds none.
+fn no_state_density(doc: &Document, flag: &str) -> anyhow::Error {
+    let listed = doc.excited.as_ref().map_or(String::new(), |s| {
+        format!(" (it lists {} excited states, but no excited state's density)", s.states.len())
+    });
+    anyhow::anyhow!(
+        "{}: {flag} needs an excited state's density (a Gaussian TD fchk's `Total CI Rho(1) Density`), and this file has none{listed}",
+        doc.source
+    )
+}
+
+/// The excited state whose density `wf` holds, in words ("1", "?" when none).
+fn state_of(wf: &Wavefunction) -> String {
+    wf.excited.as_ref().map_or_else(|| "?".to_string(), |e| e.state.to_string())
 }
 
 fn wavefunction_of(doc: &Document) -> Result<&Wavefunction> {

@@ -324,6 +324,9 @@ impl GridArgs {
     /// A cube file's volume, or the orbital or density of a Molden/fchk file evaluated on the
     /// CPU over the box the viewer uses.
     pub fn grid(&self, doc: &Document) -> Result<VolumeGrid> {
+        if let (None, Some((_, flag))) = (&doc.wavefunction, self.what.state_quantity()) {
+            return Err(super::no_state_density(doc, flag));
+        }
         if doc.wavefunction.is_none() {
             return doc.volumes.get(self.volume).cloned().with_context(|| {
                 format!("{}: no volume {} (the file has {})", doc.source, self.volume, doc.volumes.len())
@@ -376,8 +379,10 @@ pub fn mesh(args: &MeshArgs, later: &[MeshArgs]) -> Result<()> {
         let mut names = Vec::new();
         for q in std::iter::once(args).chain(later) {
             let grid = GridArgs { grid_points: args.grid.grid_points, ..q.grid.clone() }.grid(&doc)?;
-            // With several quantities, each surface is named after its quantity.
+            // With several quantities, each surface is named after its quantity; an excited
+            // state's difference density is signed, yet no orbital (`difference_density_plus`).
             let stem = match (later.is_empty(), doc.wavefunction.is_some()) {
+                (true, _) if q.grid.what.state_quantity().is_some() => Some(q.grid.what.short_name()),
                 (true, _) => None,
                 (false, true) => Some(q.grid.what.short_name()),
                 (false, false) => Some(file_name(&grid.label)),

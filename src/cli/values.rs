@@ -30,8 +30,8 @@ pub fn info(file: &Path, json: bool) -> Result<()> {
 /// With `minus`, that file's same quantity is subtracted ([`other_values`]).
 pub fn eval(file: &Path, what: &WhatArgs, points: &Path, minus: Option<&Path>) -> Result<()> {
     let doc = formats::load(file)?;
-    let wf = wavefunction_of(&doc)?;
     let q = what.resolve(&doc)?;
+    let wf = wavefunction_of(&doc)?;
     let prepared = PreparedBasis::new(&wf.basis);
     let points = read_points(points)?;
     let mut values = prepared.quantity_at_points(wf, &doc.molecule, q, &points);
@@ -58,8 +58,8 @@ pub fn cube(
     output: &Path,
 ) -> Result<()> {
     let doc = formats::load(file)?;
-    let wf = wavefunction_of(&doc)?;
     let q = what.resolve(&doc)?;
+    let wf = wavefunction_of(&doc)?;
     let (lo, hi) = match margin {
         Some(m) => doc.molecule.bounds().map(|(lo, hi)| (lo - DVec3::splat(m), hi + DVec3::splat(m))),
         None => crate::model::extent::quantity_box(wf, &doc.molecule, q),

@@ -14,7 +14,10 @@ use crate::scene::Source;
 /// of its wavefunction, else its first data set. Orbitals have none (their phases and order
 /// differ from file to file).
 pub fn counterpart(doc: &Document, source: Source, other: &Document) -> Option<Source> {
-    let density_like = |q: Quantity| matches!(q, Quantity::Density | Quantity::SpinDensity | Quantity::Potential);
+    // An excited state's densities too: another TD file's are their counterpart.
+    let density_like = |q: Quantity| {
+        matches!(q, Quantity::Density | Quantity::SpinDensity | Quantity::Potential) || q.state_part().is_some()
+    };
     let own = match source {
         Source::Wavefunction(q) if density_like(q) => Some(q),
         Source::Wavefunction(_) => return None,

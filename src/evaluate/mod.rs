@@ -123,7 +123,11 @@ pub fn evaluate_wavefunction(
         | Quantity::Potential
         | Quantity::ReducedGradient
         | Quantity::SignLambda2Rho
-        | Quantity::DensityLaplacian => None,
+        | Quantity::DensityLaplacian
+        | Quantity::DifferenceDensity
+        | Quantity::Attachment
+        | Quantity::Detachment
+        | Quantity::ExcitedDensity => None,
     };
     match combination {
         Some(coefficients) => {

@@ -94,7 +94,7 @@ impl FchkFile {
 }
 
 /// The records [`FchkFile::parse`] keeps.
-const NEEDED: [&str; 23] = [
+const NEEDED: [&str; 32] = [
     "Number of atoms",
     "Number of electrons",
     "Number of alpha electrons",
@@ -118,6 +118,16 @@ const NEEDED: [&str; 23] = [
     "Number of Normal Modes",
     "Vib-E2",
     "Vib-Modes",
+    // A TD job's (see `fchk_excited`).
+    "SCF Energy",
+    "CIS Energy",
+    "Total SCF Density",
+    "Total CI Density",
+    "Total CI Rho(1) Density",
+    "ETran scalars",
+    "ETran spin",
+    "ETran sym",
+    "ETran state values",
 ];
 
 fn error(file: &str, line: usize, expected: impl Into<String>, found: impl Into<String>) -> ParseError {
@@ -300,11 +310,11 @@ impl FchkFile {
         Ok(out)
     }
 
-    fn missing(&self, file: &str, label: &str) -> ParseError {
+    pub(super) fn missing(&self, file: &str, label: &str) -> ParseError {
         error(file, self.n_lines.max(1), format!("a record \"{label}\""), "end of file")
     }
 
-    fn int(&self, file: &str, label: &str) -> Result<i64, ParseError> {
+    pub(super) fn int(&self, file: &str, label: &str) -> Result<i64, ParseError> {
         match self.records.get(label) {
             Some((_, Value::Int(v))) => Ok(*v),
             Some((line, _)) => Err(error(file, *line, format!("\"{label}\" as one integer"), "an array")),
@@ -312,8 +322,17 @@ impl FchkFile {
         }
     }
 
+    /// A scalar real record.
+    pub(super) fn real(&self, file: &str, label: &str) -> Result<f64, ParseError> {
+        match self.records.get(label) {
+            Some((_, Value::Real(v))) => Ok(*v),
+            Some((line, _)) => Err(error(file, *line, format!("\"{label}\" as one real"), "another type")),
+            None => Err(self.missing(file, label)),
+        }
+    }
+
     /// An array record, required to have `len` values when given.
-    fn ints(&self, file: &str, label: &str, len: Option<usize>) -> Result<&[i64], ParseError> {
+    pub(super) fn ints(&self, file: &str, label: &str, len: Option<usize>) -> Result<&[i64], ParseError> {
         match self.records.get(label) {
             Some((line, Value::Ints(v))) => {
                 check_len(file, *line, label, v.len(), len)?;
@@ -324,7 +343,7 @@ impl FchkFile {
         }
     }
 
-    fn reals(&self, file: &str, label: &str, len: Option<usize>) -> Result<&[f64], ParseError> {
+    pub(super) fn reals(&self, file: &str, label: &str, len: Option<usize>) -> Result<&[f64], ParseError> {
         match self.records.get(label) {
             Some((line, Value::Reals(v))) => {
                 check_len(file, *line, label, v.len(), len)?;
@@ -335,7 +354,7 @@ impl FchkFile {
         }
     }
 
-    fn line_of(&self, label: &str) -> usize {
+    pub(super) fn line_of(&self, label: &str) -> usize {
         self.records.get(label).map_or(self.n_lines.max(1), |r| r.0)
     }
 
@@ -517,9 +536,35 @@ impl FchkFile {
                 });
             }
         }
-        let wf = Wavefunction { basis, orbitals, restricted: !unrestricted, normalization: Default::default() };
+        let wf = Wavefunction {
+            basis,
+            orbitals,
+            restricted: !unrestricted,
+            normalization: Default::default(),
+            excited: None,
+        };
         let positions: Vec<DVec3> = atoms.iter().map(|a| a.position).collect();
         let mut doc = wavefunction_document(source, &self.title, atoms, wf, Some(self.writer()), overlap);
+        // A TD job's states and the excited state's density: a malformed record leaves them out.
+        // Without `ETran` records the density is taken as state 1's (Gaussian's default root);
+        // with records that disagree its state is unknown, and it is left out too.
+        let state = match self.excited_states(file) {
+            Ok(states) => {
+                let state = states.as_ref().map_or(Some(1), |s| s.density_of);
+                doc.excited = states;
+                state
+            }
+            Err(e) => {
+                doc.problems.push(format!("excited states (and their density) left out: {e}"));
+                None
+            }
+        };
+        if let (Some(wf), Some(state)) = (doc.wavefunction.as_mut(), state) {
+            match self.excited_density(file, &file_to_model, wf, state) {
+                Ok(density) => wf.excited = density.map(std::sync::Arc::new),
+                Err(e) => doc.problems.push(format!("excited-state density left out: {e}")),
+            }
+        }
         // A malformed mode record leaves the modes out; the orbitals open all the same.
         match self.vibrations(file, &positions) {
             Ok(modes) => doc.vibrations = modes,

@@ -52,7 +52,13 @@ pub const ORBITAL_KEYWORDS: &str = "pop=full gfinput";
 pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Document, ParseError> {
     let log = LogLines::new(file, text);
     let scan = Scan::read(&log)?;
-    scan.into_document(&log, overlap)
+    let mut doc = scan.into_document(&log, overlap)?;
+    // A malformed table leaves the states out, not the file.
+    match super::excited_logs::gaussian(&log) {
+        Ok(states) => doc.excited = states,
+        Err(e) => doc.problems.push(format!("excited states left out: {e}")),
+    }
+    Ok(doc)
 }
 
 /// A `gfinput` shell as printed: its atom (1-based), type letters, exponents and coefficient
@@ -336,7 +342,13 @@ impl Scan {
             }
         }
         let digits = sections.iter().map(|s| s.decimals).min().unwrap_or(5);
-        let wf = Wavefunction { basis, orbitals, restricted: !unrestricted, normalization: Default::default() };
+        let wf = Wavefunction {
+            basis,
+            orbitals,
+            restricted: !unrestricted,
+            normalization: Default::default(),
+            excited: None,
+        };
         Ok(Document {
             source: file.to_string(),
             title: file.to_string(),

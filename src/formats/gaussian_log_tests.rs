@@ -458,3 +458,28 @@ fn a_relaxed_scan_keeps_the_converged_geometry_of_each_point() {
     let doc = read(&one).unwrap();
     assert_eq!(doc.structure.as_ref().unwrap().structure.models.len(), 4);
 }
+
+#[test]
+fn a_td_table_opens_with_the_log_and_a_malformed_one_is_left_out() {
+    let mut text = format!("{HEADER}{}", route("td(nstates=2)"));
+    text += &orientation_table("Standard orientation:", 1.0);
+    text += " Excitation energies and oscillator strengths:\n\n";
+    text += " Excited State   1:      Singlet-B2     7.1234 eV  174.05 nm  f=0.0312  <S**2>=0.000\n";
+    text += "       5 ->  6         0.70123\n\n";
+    text += " Excited State   2:      Triplet-A1     8.0000 eV  154.98 nm  f=0.0000  <S**2>=2.000\n";
+    text += "       4 ->  6         0.69000\n";
+    let doc = read(&text).unwrap_or_else(|e| panic!("{e}"));
+    let states = doc.excited.as_ref().expect("states");
+    assert_eq!(states.states.len(), 2);
+    assert_eq!((states.states[0].symmetry.as_str(), states.states[1].spin.as_str()), ("B2", "Triplet"));
+    assert_eq!(states.states[1].transitions[0].from, 4);
+    // An energy that is no number: the states are left out, saying where; the atoms open.
+    let broken = text.replace("8.0000 eV", "8.00x0 eV");
+    let doc = read(&broken).unwrap_or_else(|e| panic!("{e}"));
+    assert!(doc.excited.is_none() && doc.molecule.atoms.len() == ATOMS.len());
+    assert!(
+        doc.problems.iter().any(|p| p.contains("excited states left out") && p.contains(":")),
+        "{:?}",
+        doc.problems
+    );
+}

@@ -1,6 +1,7 @@
 //! Program logs (`.log`, `.out`): many programs write files with these endings, so the program
 //! is told from the text, not the name. Gaussian prints "Entering Gaussian System" and its
-//! copyright ("Gaussian, Inc.") at the top; ORCA its banner "O   R   C   A".
+//! copyright ("Gaussian, Inc.") at the top; ORCA its banner "O   R   C   A"; Q-Chem "Welcome to
+//! Q-Chem" and "Q-Chem, Inc.".
 //!
 //! What the readers of logs share: the lines with their numbers, numbers in fixed-width
 //! columns, and the errors they raise.
@@ -9,7 +10,7 @@ use glam::DVec3;
 
 use super::text::{excerpt, parse_real};
 use super::wavefunction::OverlapFn;
-use super::{ParseError, gaussian_log, orca_log};
+use super::{ParseError, gaussian_log, orca_log, qchem_log};
 use crate::model::Document;
 
 /// Lines of the file's top in which the program's banner is looked for: a job scheduler may
@@ -21,6 +22,7 @@ const BANNER_LINES: usize = 500;
 pub enum Program {
     Gaussian,
     Orca,
+    QChem,
 }
 
 /// The program that wrote `text`, from its banner.
@@ -32,13 +34,15 @@ pub fn program(text: &str) -> Option<Program> {
         if line.contains("O   R   C   A") {
             return Some(Program::Orca);
         }
+        if line.contains("Welcome to Q-Chem") || line.contains("Q-Chem, Inc.") {
+            return Some(Program::QChem);
+        }
     }
     None
 }
 
 /// What the banner check looks for, in words.
-pub const BANNERS: &str =
-    "a Gaussian log (\"Entering Gaussian System\" or \"Gaussian, Inc.\") or an ORCA output (\"O   R   C   A\")";
+pub const BANNERS: &str = "a Gaussian log (\"Entering Gaussian System\" or \"Gaussian, Inc.\"), an ORCA output (\"O   R   C   A\") or a Q-Chem output (\"Welcome to Q-Chem\")";
 
 /// Parses a program's log into a document, the program told by its banner.
 pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Document, ParseError> {
@@ -48,6 +52,7 @@ pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Docum
     match program(text) {
         Some(Program::Gaussian) => gaussian_log::parse(file, text, overlap),
         Some(Program::Orca) => orca_log::parse(file, text, overlap),
+        Some(Program::QChem) => qchem_log::parse(file, text),
         None => Err(error(
             file,
             1,

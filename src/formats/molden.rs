@@ -397,7 +397,7 @@ impl MoldenFile {
         }
         orbitals.sort_by_key(|o| o.spin == Spin::Beta);
         let restricted = !orbitals.iter().any(|o| o.spin == Spin::Beta);
-        let wf = Wavefunction { basis, orbitals, restricted, normalization: Default::default() };
+        let wf = Wavefunction { basis, orbitals, restricted, normalization: Default::default(), excited: None };
         let positions: Vec<DVec3> = atoms.iter().map(|a| a.position).collect();
         let program = self.program();
         let mut doc = wavefunction_document(source, &self.title, atoms, wf, program, overlap);

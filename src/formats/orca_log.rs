@@ -43,6 +43,18 @@ pub const ORBITAL_KEYWORDS: &str = "%output print[p_basis] 2 print[p_mos] 1 end"
 /// Parses an ORCA output, checking its orbitals (if printed) with `overlap`.
 pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Document, ParseError> {
     let log = LogLines::new(file, text);
+    let mut doc = read(&log, overlap)?;
+    // A malformed table leaves the states out, not the file.
+    match super::excited_logs::orca(&log) {
+        Ok(states) => doc.excited = states,
+        Err(e) => doc.problems.push(format!("excited states left out: {e}")),
+    }
+    Ok(doc)
+}
+
+/// The document of the log's geometries and, if printed, its basis and orbitals.
+fn read(log: &LogLines, overlap: Option<OverlapFn>) -> Result<Document, ParseError> {
+    let file = log.file;
     let mut geometries = Vec::new();
     let mut energies = Vec::new();
     let mut basis: Option<(usize, HashMap<String, Vec<PrintedShell>>)> = None;
@@ -55,7 +67,7 @@ pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Docum
             title = t.trim_start_matches("|  1>").trim().to_string();
         }
         if t == "CARTESIAN COORDINATES (A.U.)" {
-            let (g, next) = coordinates(&log, i)?;
+            let (g, next) = coordinates(log, i)?;
             geometries.push(g);
             i = next;
             continue;
@@ -63,12 +75,12 @@ pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Docum
             let e = t.split_whitespace().last().and_then(parse_real);
             energies.push((i, e.ok_or_else(|| log.error_at(i, "an energy after `FINAL SINGLE POINT ENERGY`"))?));
         } else if t == "BASIS SET IN INPUT FORMAT" {
-            let (b, next) = input_basis(&log, i)?;
+            let (b, next) = input_basis(log, i)?;
             basis = Some((i, b));
             i = next;
             continue;
         } else if t.starts_with("MOLECULAR ORBITALS") {
-            let (section, next) = mo_section(&log, i)?;
+            let (section, next) = mo_section(log, i)?;
             orbitals = Some(section);
             i = next;
             continue;
@@ -91,7 +103,7 @@ pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Docum
     let why = match (&orbitals, &basis) {
         (Some(section), Some((_, basis))) => {
             let geometry = geometries.iter().rev().find(|g| g.line < section.line).unwrap_or(last);
-            let mut doc = wavefunction_document(&log, geometry, basis, section, overlap)?;
+            let mut doc = wavefunction_document(log, geometry, basis, section, overlap)?;
             if frames.len() > 1 {
                 doc.problems.push(format!(
                     "{file}: its {} geometries are not shown: the orbitals open at the one they belong to (line {})",
@@ -378,7 +390,13 @@ fn wavefunction_document(
             }
         })
         .collect();
-    let wf = Wavefunction { basis: Basis { shells }, orbitals, restricted, normalization: Default::default() };
+    let wf = Wavefunction {
+        basis: Basis { shells },
+        orbitals,
+        restricted,
+        normalization: Default::default(),
+        excited: None,
+    };
     Ok(Document {
         source: log.file.to_string(),
         title: log.file.to_string(),

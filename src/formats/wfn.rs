@@ -121,7 +121,13 @@ pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Docum
         lines.error("spin codes 1 and 3 (restricted) or 1 and 2 (unrestricted) after $MOSPIN", &found)
     })?;
     orbitals.sort_by_key(|o| o.spin == Spin::Beta);
-    let wf = Wavefunction { basis: primitives.basis, orbitals, restricted, normalization: Default::default() };
+    let wf = Wavefunction {
+        basis: primitives.basis,
+        orbitals,
+        restricted,
+        normalization: Default::default(),
+        excited: None,
+    };
     let mut doc = wavefunction_document(file, &title, atoms, wf, program_named_in(&title), overlap);
     if let Some(note) = inferred {
         doc.problems.push(format!("{file}: {note}"));

@@ -267,7 +267,13 @@ impl<'a> WfxFile<'a> {
             })
             .collect();
         orbitals.sort_by_key(|o| o.spin == Spin::Beta);
-        let wf = Wavefunction { basis: primitives.basis, orbitals, restricted, normalization: Default::default() };
+        let wf = Wavefunction {
+            basis: primitives.basis,
+            orbitals,
+            restricted,
+            normalization: Default::default(),
+            excited: None,
+        };
         let mut doc = wavefunction_document(file, &title, atoms, wf, program_named_in(&title), overlap);
         if let Some(edf) = self.sections.get(&key(EDF)) {
             let core =

@@ -1,5 +1,6 @@
 //! What one opened file gives the viewer: a molecule and zero or more volumes.
 
+use super::excited::ExcitedStates;
 use super::vibrations::Vibrations;
 use super::{Molecule, StructureView, VolumeGrid, Wavefunction};
 
@@ -18,6 +19,9 @@ pub struct Document {
     pub structure: Option<StructureView>,
     /// Normal modes of vibration (Molden `[FREQ]`…, fchk `Vib-Modes`).
     pub vibrations: Option<Vibrations>,
+    /// Excited states the file lists (a TD job's log or fchk); their densities, where the file
+    /// holds one, are the wavefunction's ([`Wavefunction::excited`]).
+    pub excited: Option<ExcitedStates>,
     /// Parts of the file that could not be read while the rest opened, each saying where and
     /// what was expected (a malformed mode section).
     pub problems: Vec<String>,

@@ -44,6 +44,12 @@ impl PreparedBasis {
         self.grid_sum(&sets, true, grid)
     }
 
+    /// Σ w ψ² of orbitals with weights (any sign) on a grid: a density given by its natural
+    /// orbitals, such as an excited state's ([`super::excited_density`]).
+    pub fn weighted_density_grid(&self, sets: &[(&[f64], f64)], grid: &GridSpec) -> Vec<f64> {
+        self.grid_sum(sets, true, grid)
+    }
+
     /// `quantity` at each of `points` (bohr), in parallel: what `eval` prints and what colours a
     /// surface by a wavefunction's quantity.
     pub fn quantity_at_points(
@@ -78,6 +84,9 @@ impl PreparedBasis {
             Quantity::BasisFunction(k) => self.eval_grid(&self.unit_coefficients(k), grid),
             Quantity::Density => self.density_grid(wf, grid),
             Quantity::SpinDensity => self.spin_density_grid(wf, grid),
+            Quantity::DifferenceDensity | Quantity::Attachment | Quantity::Detachment | Quantity::ExcitedDensity => {
+                self.grid_sum(&state_sets(wf, quantity), true, grid)
+            }
             Quantity::ReducedGradient | Quantity::SignLambda2Rho | Quantity::DensityLaplacian => {
                 let points: Vec<DVec3> = (0..grid.dims[0])
                     .flat_map(|i| (0..grid.dims[1]).flat_map(move |j| (0..grid.dims[2]).map(move |k| (i, j, k))))
@@ -122,5 +131,14 @@ impl PreparedBasis {
             return separable::grid_sum(self, sets, square, grid);
         }
         self.grid_sum_rows(sets, square, grid)
+    }
+}
+
+/// The orbitals and weights of an excited-state quantity of `wf` (none when `wf` holds no
+/// excited state, or `quantity` is no such quantity: its values are then 0).
+pub(super) fn state_sets(wf: &Wavefunction, quantity: Quantity) -> Vec<(&[f64], f64)> {
+    match (&wf.excited, quantity.state_part()) {
+        (Some(excited), Some(part)) => excited.sets(part),
+        _ => Vec::new(),
     }
 }

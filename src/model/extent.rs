@@ -97,7 +97,12 @@ pub fn quantity_box(wf: &Wavefunction, molecule: &Molecule, quantity: Quantity) 
     let prepared = PreparedBasis::new(&wf.basis);
     let decay = match quantity {
         Quantity::Orbital(_) | Quantity::BasisFunction(_) => Decay::Relative(FACE_FRACTION),
-        Quantity::Density | Quantity::SpinDensity => Decay::Absolute(DENSITY_FACE),
+        Quantity::Density
+        | Quantity::SpinDensity
+        | Quantity::DifferenceDensity
+        | Quantity::Attachment
+        | Quantity::Detachment
+        | Quantity::ExcitedDensity => Decay::Absolute(DENSITY_FACE),
         // The potential never decays (a charged molecule's goes as 1/r): it is shown in the
         // density's box, where the surfaces it colours lie.
         Quantity::Potential => return quantity_box(wf, molecule, Quantity::Density),

@@ -466,6 +466,8 @@ impl PreparedBasis {
     pub(super) fn quantity_at(&self, wf: &Wavefunction, quantity: Quantity, points: &[DVec3]) -> Vec<f64> {
         let mut values = vec![0.0; self.n_functions];
         let (mut c, mut cg) = (Vec::new(), Vec::new());
+        // An excited state's density: its natural orbitals with their weights.
+        let state = super::evaluation::state_sets(wf, quantity);
         points
             .iter()
             .map(|&p| {
@@ -477,6 +479,10 @@ impl PreparedBasis {
                     Quantity::BasisFunction(k) => values[k],
                     Quantity::Density => density_of(wf, &values),
                     Quantity::SpinDensity => spin_density_of(wf, &values),
+                    Quantity::DifferenceDensity
+                    | Quantity::Attachment
+                    | Quantity::Detachment
+                    | Quantity::ExcitedDensity => state.iter().map(|(c, w)| w * dot(c, &values).powi(2)).sum(),
                     Quantity::Potential
                     | Quantity::ReducedGradient
                     | Quantity::SignLambda2Rho
@@ -1216,7 +1222,7 @@ pub(crate) mod tests {
                 orbital(4, 0.0, Spin::Beta),
             ],
             restricted: false,
-            normalization: Default::default(),
+            ..Default::default()
         };
         let grid = GridSpec::new(
             DVec3::splat(-3.0),

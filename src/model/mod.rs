@@ -19,6 +19,8 @@ mod element_table;
 pub mod elements;
 pub mod esp;
 mod evaluation;
+pub mod excited;
+pub mod excited_density;
 pub mod extent;
 pub mod grid;
 pub mod gto;

@@ -3,6 +3,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::basis::Basis;
+use super::excited_density::{ExcitedDensity, StatePart};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Spin {
@@ -80,6 +81,9 @@ pub struct Wavefunction {
     /// True when alpha and beta share spatial orbitals.
     pub restricted: bool,
     pub normalization: Normalization,
+    /// An excited state's density beside the ground state's, when the file holds one (a
+    /// Gaussian TD fchk): shared, since it is large and never edited.
+    pub excited: Option<std::sync::Arc<ExcitedDensity>>,
 }
 
 impl Wavefunction {
@@ -191,6 +195,16 @@ pub enum Quantity {
     SignLambda2Rho,
     /// ∇²ρ, the Laplacian of the total density (a.u.).
     DensityLaplacian,
+    /// ρ_exc − ρ_gs: the excited state's density minus the ground state's (an excited-state
+    /// file's, [`Wavefunction::excited`]).
+    DifferenceDensity,
+    /// Where an excitation's electrons go: the positive part of the difference density's
+    /// natural orbitals (Head-Gordon's attachment density).
+    Attachment,
+    /// Where they come from: the negative part, as a positive density (the detachment density).
+    Detachment,
+    /// The excited state's own density.
+    ExcitedDensity,
 }
 
 impl Quantity {
@@ -198,6 +212,17 @@ impl Quantity {
     /// (evaluated by [`super::nci`]).
     pub fn from_density_derivatives(self) -> bool {
         matches!(self, Self::ReducedGradient | Self::SignLambda2Rho | Self::DensityLaplacian)
+    }
+
+    /// Which of an excited state's densities the quantity is, if it is one.
+    pub fn state_part(self) -> Option<StatePart> {
+        match self {
+            Self::DifferenceDensity => Some(StatePart::Difference),
+            Self::Attachment => Some(StatePart::Attachment),
+            Self::Detachment => Some(StatePart::Detachment),
+            Self::ExcitedDensity => Some(StatePart::Excited),
+            _ => None,
+        }
     }
 }
 

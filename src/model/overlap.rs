@@ -40,7 +40,21 @@ fn overlap_1d(la: usize, lb: usize, xpa: f64, xpb: f64, p: f64) -> [[f64; 8]; 8]
 /// Block of S between shell `a` of basis `ba` and shell `b` of basis `bb`, row-major
 /// n_functions(a) × n_functions(b).
 fn shell_pair(ba: &PreparedBasis, a: &PreparedShell, bb: &PreparedBasis, b: &PreparedShell) -> Vec<f64> {
+    shell_pair_moment(ba, a, bb, b, None)
+}
+
+/// [`shell_pair`] of the operator 1 (`axis` `None`) or of the coordinate x, y or z (`axis`
+/// 0, 1, 2; origin at 0): x χ_b = (x − B_x) χ_b + B_x χ_b raises b's power along the axis,
+/// which the one-dimensional recurrence already holds one step further.
+fn shell_pair_moment(
+    ba: &PreparedBasis,
+    a: &PreparedShell,
+    bb: &PreparedBasis,
+    b: &PreparedShell,
+    axis: Option<usize>,
+) -> Vec<f64> {
     let (la, lb) = (a.l as usize, b.l as usize);
+    let raised = |d: usize| lb + usize::from(axis == Some(d));
     let (pa, pbw) = (&ba.powers[la], &bb.powers[lb]);
     let (fa, fb) = (&ba.component_factors[la], &bb.component_factors[lb]);
     let (na, nb) = (pa.len(), pbw.len());
@@ -60,15 +74,18 @@ fn shell_pair(ba: &PreparedBasis, a: &PreparedShell, bb: &PreparedBasis, b: &Pre
             let pc = (alpha * a.center() + beta * b.center()) / p;
             let xpa = pc - a.center();
             let xpb = pc - b.center();
-            let sx = overlap_1d(la, lb, xpa.x, xpb.x, p);
-            let sy = overlap_1d(la, lb, xpa.y, xpb.y, p);
-            let sz = overlap_1d(la, lb, xpa.z, xpb.z, p);
+            let sx = overlap_1d(la, raised(0), xpa.x, xpb.x, p);
+            let sy = overlap_1d(la, raised(1), xpa.y, xpb.y, p);
+            let sz = overlap_1d(la, raised(2), xpa.z, xpb.z, p);
+            let centre = b.center().to_array();
+            let factor = |d: usize, s: &[[f64; 8]; 8], i: usize, j: usize| match axis {
+                Some(m) if m == d => s[i][j + 1] + centre[d] * s[i][j],
+                _ => s[i][j],
+            };
             for (u, pu) in pa.iter().enumerate() {
                 for (v, pv) in pbw.iter().enumerate() {
-                    cart[u * nb + v] += pref
-                        * sx[pu[0] as usize][pv[0] as usize]
-                        * sy[pu[1] as usize][pv[1] as usize]
-                        * sz[pu[2] as usize][pv[2] as usize];
+                    let [(i0, j0), (i1, j1), (i2, j2)] = [0, 1, 2].map(|d| (pu[d] as usize, pv[d] as usize));
+                    cart[u * nb + v] += pref * factor(0, &sx, i0, j0) * factor(1, &sy, i1, j1) * factor(2, &sz, i2, j2);
                 }
             }
         }
@@ -118,16 +135,30 @@ pub fn overlap_matrix(basis: &Basis) -> Vec<f64> {
     PreparedBasis::with_threshold(basis, 0.0).overlap_matrix()
 }
 
+/// The first-moment (dipole) matrices ⟨χ_μ|x|χ_ν⟩, ⟨χ_μ|y|χ_ν⟩, ⟨χ_μ|z|χ_ν⟩ of `basis`
+/// (origin at 0, bohr), each row-major n × n: tr(P X) is a density's ∫ x ρ.
+pub fn moment_matrices(basis: &Basis) -> [Vec<f64>; 3] {
+    let prepared = PreparedBasis::with_threshold(basis, 0.0);
+    [0, 1, 2].map(|axis| prepared.symmetric_matrix(Some(axis)))
+}
+
 impl PreparedBasis {
     /// The overlap matrix of the prepared functions, row-major n × n.
     pub fn overlap_matrix(&self) -> Vec<f64> {
+        self.symmetric_matrix(None)
+    }
+
+    /// The matrix of 1 or of a coordinate (see [`shell_pair_moment`]) over the prepared
+    /// functions, row-major n × n; both operators are symmetric, so one triangle of shell
+    /// pairs is computed.
+    fn symmetric_matrix(&self, axis: Option<usize>) -> Vec<f64> {
         let n = self.n_functions();
         let blocks: Vec<(usize, usize, Vec<f64>)> = (0..self.shells.len())
             .into_par_iter()
             .flat_map_iter(|ia| {
                 (0..=ia).map(move |ib| {
                     let (a, b) = (&self.shells[ia], &self.shells[ib]);
-                    (ia, ib, shell_pair(self, a, self, b))
+                    (ia, ib, shell_pair_moment(self, a, self, b, axis))
                 })
             })
             .collect();

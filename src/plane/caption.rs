@@ -17,6 +17,10 @@ pub fn unit(source: Source) -> &'static str {
         Source::Wavefunction(Quantity::DensityLaplacian) => "Laplacian of ρ (a.u.)",
         Source::Wavefunction(Quantity::ReducedGradient) => "s",
         Source::Wavefunction(Quantity::SignLambda2Rho) => "sign(λ₂)ρ (a.u.)",
+        Source::Wavefunction(Quantity::DifferenceDensity) => "ρ_exc − ρ_gs (a.u.)",
+        Source::Wavefunction(Quantity::Attachment) => "attachment ρ (a.u.)",
+        Source::Wavefunction(Quantity::Detachment) => "detachment ρ (a.u.)",
+        Source::Wavefunction(Quantity::ExcitedDensity) => "ρ_exc (a.u.)",
         _ => "value",
     }
 }

@@ -30,6 +30,10 @@ impl Source {
                 Quantity::Density | Quantity::Potential => true,
                 Quantity::ReducedGradient | Quantity::SignLambda2Rho | Quantity::DensityLaplacian => true,
                 Quantity::SpinDensity => !wf.restricted,
+                Quantity::DifferenceDensity
+                | Quantity::Attachment
+                | Quantity::Detachment
+                | Quantity::ExcitedDensity => wf.excited.is_some(),
             }),
         }
     }
@@ -67,6 +71,10 @@ impl Source {
             Source::Wavefunction(Quantity::ReducedGradient) => "reduced density gradient".into(),
             Source::Wavefunction(Quantity::SignLambda2Rho) => "sign(λ₂)ρ".into(),
             Source::Wavefunction(Quantity::DensityLaplacian) => "density Laplacian".into(),
+            Source::Wavefunction(Quantity::DifferenceDensity) => "difference density".into(),
+            Source::Wavefunction(Quantity::Attachment) => "attachment density".into(),
+            Source::Wavefunction(Quantity::Detachment) => "detachment density".into(),
+            Source::Wavefunction(Quantity::ExcitedDensity) => "excited-state density".into(),
             Source::Wavefunction(Quantity::Orbital(i)) => match &doc.wavefunction {
                 Some(wf) => orbital_name(wf, i),
                 None => format!("MO {}", i + 1),

@@ -1,0 +1,330 @@
+//! Excited states of ../shared/refdata/real-world/logs (divinylbenzene's TD-DFT in Gaussian 09,
+//! ORCA 6 and Q-Chem 5.1, and CO's Gaussian TD checkpoint; see its MANIFEST.md): the states
+//! each file lists, and the difference, attachment and detachment densities of the Gaussian TD
+//! fchk files, whose electrons moved the two densities share on the grid as in the trace.
+
+use std::path::{Path, PathBuf};
+
+use glam::DVec3;
+use orbcloud::formats;
+use orbcloud::model::Document;
+use orbcloud::model::excited_density::StatePart;
+use orbcloud::model::gto::PreparedBasis;
+use orbcloud::model::orbitals::Quantity;
+
+mod common;
+
+fn logs(test: &str) -> Option<PathBuf> {
+    common::refdata(test).map(|d| d.join("logs"))
+}
+
+fn load(path: &Path) -> Document {
+    formats::load(path).unwrap_or_else(|e| panic!("{e}"))
+}
+
+#[test]
+fn td_fchk_files_hold_their_states_and_one_excited_density() {
+    let Some(dir) = logs("excited_states::td_fchk_files_hold_their_states_and_one_excited_density") else { return };
+    // The grid's integrals: a 0.2 bohr grid sums STO-3G's smooth valence densities almost
+    // exactly, but CO's 6-311++G(d,p) detachment density peaks at 1.2 a.u. on the nuclei
+    // (functions 0.01 bohr wide) and its attachment reaches past the grid's 6 bohr margin
+    // through the diffuse functions: there the grid is good to 1 %, the trace is exact.
+    for (name, count, grid_error) in
+        [("basicGaussian09_dvb_td.fchk", 5, 1e-4), ("basicGaussian09_CO_TD_delta.fchk", 24, 1e-2)]
+    {
+        let doc = load(&dir.join(name));
+        assert!(doc.problems.is_empty(), "{name}: {:?}", doc.problems);
+        let states = doc.excited.as_ref().expect("states");
+        assert_eq!(states.states.len(), count, "{name}");
+        assert_eq!(states.density_of, Some(1), "{name}");
+        let wf = doc.wavefunction.as_ref().expect("orbitals");
+        let excited = wf.excited.as_ref().expect("an excited density");
+        let moved = excited.electrons_moved();
+        let detached = excited.electrons_detached();
+        eprintln!("{name}: electrons moved {moved:.6}, detached {detached:.6}");
+        // tr(ΔP S) = 0: the excitation keeps the electron count.
+        assert!((moved - detached).abs() < 1e-6, "{name}: {moved} vs {detached}");
+        assert!(moved > 0.5 && moved < 2.0, "{name}: {moved}");
+        let prepared = PreparedBasis::new(&wf.basis);
+        let g = excited.grid_descriptors(&prepared, &doc.molecule).expect("atoms");
+        eprintln!("{name}: {g:?}");
+        for (what, integral) in [("attachment", g.attachment_integral), ("detachment", g.detachment_integral)] {
+            let error = (integral - moved).abs() / moved;
+            assert!(error < grid_error, "{name}: {what} integrates to {integral}, trace {moved}");
+        }
+        assert!(!excited.sets(StatePart::Attachment).is_empty());
+    }
+}
+
+#[test]
+fn centroids_from_dipole_integrals_agree_with_the_grid() {
+    let Some(dir) = logs("excited_states::centroids_from_dipole_integrals_agree_with_the_grid") else { return };
+    let doc = load(&dir.join("basicGaussian09_dvb_td.fchk"));
+    let wf = doc.wavefunction.as_ref().expect("orbitals");
+    let d = wf.excited.as_ref().expect("density").descriptors(&wf.basis, &doc.molecule).expect("atoms");
+    eprintln!("{d:?}");
+    for (exact, grid) in [
+        (d.attachment_centroid_bohr, d.grid.attachment_centroid),
+        (d.detachment_centroid_bohr, d.grid.detachment_centroid),
+    ] {
+        for k in 0..3 {
+            assert!((exact[k] - grid[k]).abs() < 1e-3, "{exact:?} vs {grid:?}");
+        }
+    }
+}
+
+/// What scripts/excited_reference.py computes from an fchk file with numpy and PySCF alone.
+#[derive(serde::Deserialize)]
+struct Reference {
+    points: Vec<[f64; 3]>,
+    rho_excited: Vec<f64>,
+    difference: Vec<f64>,
+    attachment: Vec<f64>,
+    detachment: Vec<f64>,
+    electrons_moved: f64,
+    electrons_detached: f64,
+    trace_delta_s: f64,
+    attachment_centroid: [f64; 3],
+    detachment_centroid: [f64; 3],
+}
+
+fn reference(fchk: &Path) -> Reference {
+    let python = orbcloud::sources::compute::python();
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/excited_reference.py");
+    let out = std::process::Command::new(&python)
+        .arg(&script)
+        .arg(fchk)
+        .output()
+        .unwrap_or_else(|e| panic!("running `{python}`: {e} (scripts/test sets ORBCLOUD_PYTHON)"));
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    serde_json::from_slice(&out.stdout).expect("the script's JSON")
+}
+
+/// The four densities of both Gaussian TD checkpoints at 340 points agree with PySCF's
+/// evaluation of the file's own matrices (its own Löwdin diagonalisation for attachment and
+/// detachment) within 1e-6 of the largest value, and so do the electrons moved and centroids.
+#[test]
+fn state_densities_equal_an_independent_evaluation() {
+    let Some(dir) = logs("excited_states::state_densities_equal_an_independent_evaluation") else { return };
+    for name in ["basicGaussian09_dvb_td.fchk", "basicGaussian09_CO_TD_delta.fchk"] {
+        let path = dir.join(name);
+        let r = reference(&path);
+        let doc = load(&path);
+        let wf = doc.wavefunction.as_ref().expect("orbitals");
+        let excited = wf.excited.as_ref().expect("an excited density");
+        let points: Vec<DVec3> = r.points.iter().map(|p| DVec3::from_array(*p)).collect();
+        let prepared = PreparedBasis::new(&wf.basis);
+        for (quantity, expected) in [
+            (Quantity::DifferenceDensity, &r.difference),
+            (Quantity::Attachment, &r.attachment),
+            (Quantity::Detachment, &r.detachment),
+            (Quantity::ExcitedDensity, &r.rho_excited),
+        ] {
+            let got = prepared.quantity_at_points(wf, &doc.molecule, quantity, &points);
+            let scale = expected.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let worst = got.iter().zip(expected).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+            eprintln!("{name} {quantity:?}: max |orbcloud − PySCF| = {worst:.2e} (max |value| {scale:.3e})");
+            assert!(worst <= 1e-6 * scale, "{name} {quantity:?}: {worst:e} over {scale:e}");
+        }
+        eprintln!(
+            "{name}: electrons moved {:.9} (PySCF {:.9}), tr(ΔP S) = {:.1e}",
+            excited.electrons_moved(),
+            r.electrons_moved,
+            r.trace_delta_s
+        );
+        assert!((excited.electrons_moved() - r.electrons_moved).abs() < 1e-8);
+        assert!((excited.electrons_detached() - r.electrons_detached).abs() < 1e-8);
+        let moments = orbcloud::model::overlap::moment_matrices(&wf.basis);
+        for (ours, theirs) in [
+            (excited.centroid(StatePart::Attachment, &moments).to_array(), r.attachment_centroid),
+            (excited.centroid(StatePart::Detachment, &moments).to_array(), r.detachment_centroid),
+        ] {
+            for k in 0..3 {
+                assert!((ours[k] - theirs[k]).abs() < 1e-6, "{name}: centroid {ours:?} vs PySCF {theirs:?}");
+            }
+        }
+    }
+}
+
+/// (number, eV, f) of a state, for comparing with the printed tables.
+fn summary(s: &orbcloud::model::excited::ExcitedState) -> (usize, f64, Option<f64>) {
+    (s.number, s.energy_ev, s.oscillator_strength)
+}
+
+/// The TD tables of the three dvb logs: the state count, the first and last states' energies
+/// and oscillator strengths as printed, their spin, and the main transition in Gaussian's
+/// numbering (ORCA's orbitals count from 0, Q-Chem's virtuals after the 35 occupied).
+#[test]
+fn td_logs_list_their_states_as_printed() {
+    let Some(dir) = logs("excited_states::td_logs_list_their_states_as_printed") else { return };
+    let cases = [
+        (
+            "basicGaussian09_dvb_td.out",
+            5,
+            (1, 5.6287, Some(0.0018)),
+            (5, 7.0797, Some(0.1551)),
+            ("Singlet", "A"),
+            (34, 36, 0.52587),
+        ),
+        (
+            "basicORCA6.0_dvb_td.out",
+            10,
+            (1, 5.352154, Some(0.005038390)),
+            (10, 5.298129, Some(0.0)),
+            ("Singlet", "Bu"),
+            (34, 36, 0.75002079),
+        ),
+        (
+            "basicQChem5.1_dvb_td.out",
+            10,
+            (1, 3.6052, Some(0.0)),
+            (10, 7.5567, Some(0.0)),
+            ("Triplet", ""),
+            (35, 36, 0.9266),
+        ),
+    ];
+    for (name, count, first, last, (spin, symmetry), main) in cases {
+        let doc = load(&dir.join(name));
+        assert_eq!(doc.molecule.atoms.len(), 20, "{name}");
+        let states = doc.excited.as_ref().unwrap_or_else(|| panic!("{name}: no states"));
+        assert_eq!(states.states.len(), count, "{name}");
+        let (a, b) = (states.states.first().unwrap(), states.states.last().unwrap());
+        assert_eq!((summary(a), summary(b)), (first, last), "{name}");
+        assert_eq!((a.spin.as_str(), a.symmetry.as_str()), (spin, symmetry), "{name}");
+        let t = a.main_transitions(1)[0];
+        assert_eq!((t.from, t.to, t.coefficient), main, "{name}");
+        assert!((a.wavelength_nm() - 1239.841984 / first.1).abs() < 1e-9);
+    }
+    // The strongest states, as each program prints them.
+    let strongest = |name: &str| {
+        let doc = load(&dir.join(name));
+        let s = doc.excited.unwrap().states;
+        let f = |x: &orbcloud::model::excited::ExcitedState| x.oscillator_strength.unwrap_or(-1.0);
+        let best = s.iter().max_by(|x, y| f(x).total_cmp(&f(y))).unwrap();
+        (best.number, best.oscillator_strength)
+    };
+    assert_eq!(strongest("basicGaussian09_dvb_td.out"), (2, Some(0.5880)));
+    assert_eq!(strongest("basicORCA6.0_dvb_td.out"), (2, Some(1.170940055)));
+    assert_eq!(strongest("basicQChem5.1_dvb_td.out"), (7, Some(0.9407714761)));
+}
+
+/// The fchk's states: ΔE from `ETran state values` and `SCF Energy`, f = ⅔ ΔE |μ|², equal to
+/// the twin log's printed values: the energies within their last digit; f within 3e-4 of its
+/// value besides, since the fchk's transition dipoles differ from the log's in the fourth digit
+/// (state 2: |μ|² = 3.9585 from the fchk, 3.9588 printed, f 0.58790 and 0.5880).
+#[test]
+fn the_td_fchk_states_match_the_logs_print() {
+    let Some(dir) = logs("excited_states::the_td_fchk_states_match_the_logs_print") else { return };
+    let fchk = load(&dir.join("basicGaussian09_dvb_td.fchk")).excited.expect("states");
+    let log = load(&dir.join("basicGaussian09_dvb_td.out")).excited.expect("states");
+    assert_eq!(fchk.states.len(), log.states.len());
+    for (f, l) in fchk.states.iter().zip(&log.states) {
+        eprintln!(
+            "state {}: fchk {:.5} eV f={:.5}, log {} eV f={:?}",
+            f.number,
+            f.energy_ev,
+            f.oscillator_strength.unwrap(),
+            l.energy_ev,
+            l.oscillator_strength
+        );
+        assert!((f.energy_ev - l.energy_ev).abs() < 1e-4, "{f:?} vs {l:?}");
+        let (ff, lf) = (f.oscillator_strength.unwrap(), l.oscillator_strength.unwrap());
+        assert!((ff - lf).abs() <= 0.5e-4 + 3e-4 * lf, "{f:?} vs {l:?}");
+        assert_eq!(f.spin, l.spin);
+    }
+}
+
+fn orbcloud(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_orbcloud")).args(args).output().expect("run orbcloud")
+}
+
+/// `info --json` lists the TD fchk's states and its density's electrons moved, centroids'
+/// distance and overlap; the text lists the states too.
+#[test]
+fn info_lists_states_and_the_electrons_moved() {
+    let Some(dir) = logs("excited_states::info_lists_states_and_the_electrons_moved") else { return };
+    let path = dir.join("basicGaussian09_dvb_td.fchk");
+    let out = orbcloud(&["info", "--json", path.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let x = &json["excited_states"];
+    let states = x["states"].as_array().expect("states");
+    assert_eq!(states.len(), 5);
+    assert!((states[0]["energy_ev"].as_f64().unwrap() - 5.6287).abs() < 1e-4, "{}", states[0]);
+    assert!((states[0]["wavelength_nm"].as_f64().unwrap() - 220.27).abs() < 0.01);
+    assert_eq!(states[1]["spin"], "Singlet");
+    let d = &x["density"];
+    let doc = load(&path);
+    let wf = doc.wavefunction.as_ref().unwrap();
+    let moved = wf.excited.as_ref().unwrap().electrons_moved();
+    assert_eq!(d["state"], 1);
+    assert!((d["electrons_moved"].as_f64().unwrap() - moved).abs() < 1e-12, "{d}");
+    let distance = d["centroid_distance_bohr"].as_f64().unwrap();
+    let overlap = d["grid"]["overlap"].as_f64().unwrap();
+    assert!(distance > 0.1 && distance < 1.0 && overlap > 0.5 && overlap < 1.0, "{d}");
+
+    let log = dir.join("basicGaussian09_dvb_td.out");
+    let out = orbcloud(&["info", log.to_str().unwrap()]);
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.contains("5 excited states") && text.contains("220.27 nm"), "{text}");
+    assert!(text.contains("35 -> 36 0.67354"), "state 2's main transition: {text}");
+}
+
+/// `cube --attachment` writes the attachment density (positive, its electrons those moved);
+/// `eval --difference-density` prints the library's values; files without an excited density
+/// are refused naming the file, and a state the file has no density of is refused naming it.
+#[test]
+fn cube_and_eval_of_state_densities_and_refusals() {
+    let Some(dir) = logs("excited_states::cube_and_eval_of_state_densities_and_refusals") else { return };
+    let td = dir.join("basicGaussian09_dvb_td.fchk");
+    let tmp = tempfile::tempdir().unwrap();
+    let cube = tmp.path().join("attachment.cube");
+    let out =
+        orbcloud(&["cube", td.to_str().unwrap(), "--attachment", "--spacing", "0.25", "-o", cube.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let grid = &load(&cube).volumes[0];
+    let electrons: f64 = grid.values.iter().map(|&v| f64::from(v)).sum::<f64>() * grid.voxel_volume();
+    eprintln!("attachment cube: {:?}, {electrons:.5} electrons", grid.dims);
+    assert!(grid.stats.min >= 0.0, "{:?}", grid.stats);
+    assert!((electrons - 1.00113).abs() < 2e-3, "{electrons}");
+
+    let points = tmp.path().join("points.txt");
+    std::fs::write(&points, "0 0 0\n1.5 -0.5 0.3\n-2.6 0.4 0.2\n").unwrap();
+    let out = orbcloud(&["eval", td.to_str().unwrap(), "--difference-density", "--points", points.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let got: Vec<f64> = String::from_utf8(out.stdout)
+        .unwrap()
+        .lines()
+        .map(|l| l.split_whitespace().nth(3).unwrap().parse().unwrap())
+        .collect();
+    let doc = load(&td);
+    let wf = doc.wavefunction.as_ref().unwrap();
+    let at = [DVec3::ZERO, DVec3::new(1.5, -0.5, 0.3), DVec3::new(-2.6, 0.4, 0.2)];
+    let want = PreparedBasis::new(&wf.basis).quantity_at_points(wf, &doc.molecule, Quantity::DifferenceDensity, &at);
+    for (g, w) in got.iter().zip(&want) {
+        assert!((g - w).abs() <= 1e-12 + 1e-9 * w.abs(), "{got:?} vs {want:?}");
+    }
+
+    let refused = |args: &[&str], wanted: &[&str]| {
+        let out = orbcloud(args);
+        let e = String::from_utf8_lossy(&out.stderr).to_string();
+        assert!(!out.status.success() && wanted.iter().all(|w| e.contains(w)), "{args:?}: {e}");
+    };
+    let sp = dir.join("basicGaussian09_dvb_sp.fchk");
+    let out_cube = tmp.path().join("no.cube");
+    refused(
+        &["cube", sp.to_str().unwrap(), "--attachment", "-o", out_cube.to_str().unwrap()],
+        &["basicGaussian09_dvb_sp.fchk", "--attachment needs an excited state's density"],
+    );
+    assert!(!out_cube.exists());
+    refused(
+        &["eval", td.to_str().unwrap(), "--detachment", "--state", "2", "--points", points.to_str().unwrap()],
+        &["basicGaussian09_dvb_td.fchk", "--state 2", "state 1 only"],
+    );
+    let orca = dir.join("basicORCA6.0_dvb_td.out");
+    refused(
+        &["eval", orca.to_str().unwrap(), "--difference-density", "--points", points.to_str().unwrap()],
+        &["basicORCA6.0_dvb_td.out", "needs an excited state's density", "it lists 10 excited states"],
+    );
+    refused(&["cube", td.to_str().unwrap(), "--attachment", "--density", "-o", "x.cube"], &["cannot be used with"]);
+}
