@@ -690,3 +690,36 @@ fn panes_show_the_molecule_across_their_width_and_reset_view_refits_them() {
     h.run_steps(3);
     assert!((span(h.state()) - framed).abs() < 0.05, "Reset view frames the panes again: {}", span(h.state()));
 }
+
+#[test]
+fn a_td_checkpoint_lists_its_states_and_a_click_on_a_band_picks_one_its_density_shown_in_two_colours() {
+    let Some(corpus) = common::refdata("excited states in the window") else { return };
+    let td = corpus.join("logs/basicGaussian09_dvb_td.fchk");
+    let mut h = open(vec![td]);
+    wait_loaded(&mut h);
+    assert!(h.query_by_label("Excited states").is_some(), "the states panel");
+    assert!(h.query_by_label_contains("5 states from Gaussian").is_some(), "what the list holds");
+    // The bright state 2 (f 0.588, 6.062 eV): a click on its band picks it. The file holds
+    // state 1's density only, so nothing else changes.
+    let transform = h.state().uv_vis.expect("the spectrum is drawn");
+    click_at(&mut h, transform.position_from_point(&egui_plot::PlotPoint::new(6.07, 0.3)), false);
+    h.run_steps(2);
+    assert_eq!(h.state().objects[0].state.excited.state, Some(1), "the band's state");
+    assert!(h.query_by_label_contains("state 2: 6.062 eV, 204.5 nm").is_some(), "the state picked is named");
+    // State 1 from the list: its difference density, two-coloured (gain red, loss blue).
+    h.get_by_label_contains("5.629").click();
+    h.run_steps(3);
+    wait_loaded(&mut h);
+    let o = &h.state().objects[0].state;
+    let shown = o.selected_quantity().map(|q| q.source);
+    assert_eq!(shown, Some(Source::Wavefunction(Quantity::DifferenceDensity)), "{shown:?}");
+    let dir = tempfile::tempdir().unwrap();
+    let (red, blue) = red_and_blue(&picture(&mut h, dir.path(), "difference"));
+    assert!(red > 200 && blue > 200, "gain and loss both drawn: {red} red, {blue} blue pixels");
+    h.get_by_label("attachment").click();
+    h.run_steps(3);
+    wait_loaded(&mut h);
+    let shown = h.state().objects[0].state.selected_quantity().map(|q| q.source);
+    assert_eq!(shown, Some(Source::Wavefunction(Quantity::Attachment)));
+    assert!(h.query_by_label_contains("1.001 electrons move").is_some(), "the electrons moved");
+}

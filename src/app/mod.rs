@@ -4,6 +4,7 @@ pub mod compute;
 mod correlation;
 pub mod detail;
 mod difference;
+mod excited;
 pub mod files;
 pub mod jobs;
 mod joining;
@@ -210,6 +211,8 @@ pub struct OrbApp {
     /// Where the IR spectrum was last drawn (tests click its peaks); its x is the negated
     /// wavenumber (wavenumbers fall from left to right).
     pub spectrum: Option<egui_plot::PlotTransform>,
+    /// Where the UV-vis spectrum was last drawn (tests click its bands); its x is eV.
+    pub uv_vis: Option<egui_plot::PlotTransform>,
     /// A session's measurements, kept until its files have loaded.
     restoring_measurements: Option<Vec<crate::model::measure::Measurement>>,
     /// A session's scan being opened: where it stood, and its measurements.
@@ -406,6 +409,7 @@ impl OrbApp {
             restoring_measurements: None,
             restoring_scan: None,
             spectrum: None,
+            uv_vis: None,
             open_replaces: false,
             scroll_to_frontier: false,
             viewport,
@@ -1032,6 +1036,16 @@ impl OrbApp {
         }
         if let Some(o) = self.objects.get_mut(self.active).filter(|_| self.scan.is_none()) {
             vibrations::panel(ui, &o.doc, &mut o.state.vibration, &mut self.spectrum);
+        }
+        if let Some(o) = self.objects.get_mut(self.active).filter(|_| self.scan.is_none()) {
+            let picks = excited::panel(ui, &o.doc, &mut o.state.excited, &mut self.uv_vis);
+            let view = &mut self.view;
+            let reframes: Vec<_> = (picks.into_iter())
+                .map(|p| orbitals::apply(p, &mut o.state, &defaults, (&mut view.panes, &view.camera)))
+                .collect();
+            if reframes.contains(&orbitals::Reframe::Panes) {
+                self.frame_panes();
+            }
         }
         if self.plane.open
             && self.scan.is_none()

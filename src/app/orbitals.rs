@@ -9,7 +9,11 @@ use crate::model::basis_labels::{atom_name, function_labels};
 use crate::model::orbitals::Quantity;
 use crate::model::orbitals::{EnergiesAsOccupations, Spin, Wavefunction};
 use crate::model::units::EV_PER_HARTREE;
-use crate::scene::{Camera, ObjectState, Panes, QuantityState, RenderSettings, Source};
+use crate::scene::{Camera, IsoLevel, ObjectState, Panes, QuantityState, RenderSettings, Source};
+
+/// The level (a.u.) of an excited state's difference, attachment or detachment density surfaces
+/// as they open.
+const STATE_DENSITY_LEVEL: f32 = 0.002;
 
 /// Residual of CᵀSC − I above which the orbitals are flagged as not orthonormal.
 pub const ORTHONORMAL_TOLERANCE: f64 = 1e-5;
@@ -19,8 +23,8 @@ pub const ORTHONORMAL_TOLERANCE: f64 = 1e-5;
 const ORBITALS_PANEL_WIDTH: f32 = 350.0;
 const ORBITALS_PANEL_WIDTHS: std::ops::RangeInclusive<f32> = 260.0..=640.0;
 
-/// What a click in the browser does with a wavefunction quantity.
-enum Pick {
+/// What a click in the browser (or the excited states' list) does with a wavefunction quantity.
+pub(crate) enum Pick {
     /// The selected quantity shows it instead (or the object's first, when it has none).
     Switch(Quantity),
     /// It joins the object as another quantity, selected.
@@ -157,16 +161,33 @@ pub fn panel(
                 pick = Some(p);
             }
         });
+    pick.map_or(Reframe::None, |p| apply(p, state, defaults, (panes, camera)))
+}
+
+/// Does what `pick` asks of the object `state` describes; returns how the view should frame it.
+pub(crate) fn apply(
+    pick: Pick,
+    state: &mut ObjectState,
+    defaults: &RenderSettings,
+    (panes, camera): (&mut Panes, &Camera),
+) -> Reframe {
     let mut reframe = Reframe::None;
     match pick {
-        Some(Pick::Switch(q)) => {
+        Pick::Switch(q) => {
             match state.selected_quantity_mut().filter(|s| matches!(s.source, Source::Wavefunction(_))) {
                 Some(selected) => selected.source = Source::Wavefunction(q),
                 None => add(state, q, defaults),
             }
+            // An excited state's densities are small beside an orbital's values: their
+            // surfaces at the level chemists draw them, which an orbital's level would miss.
+            if q.state_part().is_some()
+                && let Some(selected) = state.selected_quantity_mut()
+            {
+                selected.isosurfaces.iter_mut().for_each(|iso| iso.level = IsoLevel::Absolute(STATE_DENSITY_LEVEL));
+            }
         }
-        Some(Pick::Add(q)) => add(state, q, defaults),
-        Some(Pick::EspMap) => {
+        Pick::Add(q) => add(state, q, defaults),
+        Pick::EspMap => {
             reframe = Reframe::BesideBar;
             let map = QuantityState::esp_map(
                 Source::Wavefunction(Quantity::Density),
@@ -178,7 +199,7 @@ pub fn panel(
             state.quantities.push(map);
             state.selected = state.quantities.len() - 1;
         }
-        Some(Pick::Beside(q)) => {
+        Pick::Beside(q) => {
             reframe = Reframe::Panes;
             if panes.count == 1 {
                 // What was shown stays in the first pane; the new one goes beside it.
@@ -195,7 +216,6 @@ pub fn panel(
             state.quantities.push(beside);
             state.selected = state.quantities.len() - 1;
         }
-        None => {}
     }
     reframe
 }

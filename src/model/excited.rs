@@ -3,6 +3,7 @@
 
 use serde::Serialize;
 
+use super::spectrum::{self, Line};
 use super::units::EV_PER_HARTREE;
 
 /// hc in eV·nm: a photon of E eV has a wavelength of `EV_NM / E` nm (CODATA 2018).
@@ -55,6 +56,33 @@ pub struct Transition {
     pub spin: String,
     /// A de-excitation (Gaussian's `<-`: the Y part of TD-DFT).
     pub deexcitation: bool,
+}
+
+impl ExcitedStates {
+    /// Each state's line in a UV-vis spectrum (energy eV, oscillator strength); none for a state
+    /// without a strength.
+    pub fn lines(&self) -> Vec<Option<Line>> {
+        (self.states.iter()).map(|s| Some(Line { position: s.energy_ev, height: s.oscillator_strength? })).collect()
+    }
+
+    /// The UV-vis spectrum from `from` to `to` eV in `points` steps: each state's oscillator
+    /// strength broadened to a Gaussian of full width `fwhm` eV at half maximum.
+    pub fn uv_vis(&self, range: (f64, f64), points: usize, fwhm: f64) -> Vec<[f64; 2]> {
+        let lines: Vec<Line> = self.lines().into_iter().flatten().collect();
+        spectrum::broadened(&lines, range, points, fwhm, false)
+    }
+
+    /// The state (index into `states`) whose band is highest at `energy_ev` in [`Self::uv_vis`]
+    /// (a click on the spectrum); else the nearest state within `tolerance` eV (dark states
+    /// have no band).
+    pub fn band_at(&self, energy_ev: f64, fwhm: f64, tolerance: f64) -> Option<usize> {
+        spectrum::tallest_at(&self.lines(), energy_ev, fwhm, false, tolerance).or_else(|| {
+            (self.states.iter().enumerate())
+                .filter(|(_, s)| (s.energy_ev - energy_ev).abs() <= tolerance)
+                .min_by(|a, b| (a.1.energy_ev - energy_ev).abs().total_cmp(&(b.1.energy_ev - energy_ev).abs()))
+                .map(|(k, _)| k)
+        })
+    }
 }
 
 impl ExcitedState {

@@ -38,6 +38,7 @@ pub mod scan;
 mod separable;
 pub mod simplify;
 pub mod solid_harmonics;
+pub mod spectrum;
 pub mod structure;
 pub mod superpose;
 pub mod surface;

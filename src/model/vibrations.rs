@@ -3,6 +3,8 @@
 //! to; a mode's displaced geometry and the IR spectrum they make.
 
 use glam::DVec3;
+
+use super::spectrum;
 use serde::Serialize;
 
 /// One normal mode.
@@ -63,45 +65,29 @@ impl Vibrations {
     }
 
     /// The mode whose band is highest at wavenumber `x` in the spectrum broadened as
-    /// [`Self::ir_spectrum`] says: the band under a click, so a click on a tall band picks it,
-    /// not a weak neighbour a little nearer. Without intensities (or where no band rises), the
-    /// nearest real mode within `tolerance` cm⁻¹.
+    /// [`Self::ir_spectrum`] says ([`spectrum::tallest_at`]). Without intensities (or where no
+    /// band rises), the nearest real mode within `tolerance` cm⁻¹.
     pub fn band_at(&self, x: f64, fwhm: f64, lorentzian: bool, tolerance: f64) -> Option<usize> {
-        let shape = band_shape(fwhm, lorentzian);
-        let tallest = (self.modes.iter().enumerate())
-            .filter(|(_, m)| !m.is_imaginary() && (m.frequency_cm1 - x).abs() <= tolerance.max(2.0 * fwhm))
-            .filter_map(|(k, m)| Some((k, m.ir_intensity? * shape(x - m.frequency_cm1))))
-            .filter(|&(_, height)| height > 0.0)
-            // The first of equal bands (a degenerate pair): as the list orders them.
-            .reduce(|best, c| if c.1 > best.1 { c } else { best });
-        tallest.map(|(k, _)| k).or_else(|| self.mode_at(x, tolerance))
+        spectrum::tallest_at(&self.lines(), x, fwhm, lorentzian, tolerance).or_else(|| self.mode_at(x, tolerance))
     }
 
     /// The IR spectrum from `from` to `to` cm⁻¹ in `points` steps: every mode with an intensity
     /// broadened to a Lorentzian (or a Gaussian) of full width `fwhm` cm⁻¹ at half maximum and
     /// peak height its intensity. Imaginary modes are left out.
-    pub fn ir_spectrum(&self, (from, to): (f64, f64), points: usize, fwhm: f64, lorentzian: bool) -> Vec<[f64; 2]> {
-        let shape = band_shape(fwhm, lorentzian);
-        let peaks: Vec<(f64, f64)> = (self.modes.iter())
-            .filter(|m| !m.is_imaginary())
-            .filter_map(|m| Some((m.frequency_cm1, m.ir_intensity?)))
-            .collect();
-        (0..points.max(2))
-            .map(|k| {
-                let x = from + (to - from) * k as f64 / (points.max(2) - 1) as f64;
-                [x, peaks.iter().map(|&(f, i)| i * shape(x - f)).sum()]
+    pub fn ir_spectrum(&self, range: (f64, f64), points: usize, fwhm: f64, lorentzian: bool) -> Vec<[f64; 2]> {
+        let lines: Vec<spectrum::Line> = self.lines().into_iter().flatten().collect();
+        spectrum::broadened(&lines, range, points, fwhm, lorentzian)
+    }
+
+    /// Each mode's line (wavenumber, intensity); none for an imaginary mode or one without an
+    /// intensity.
+    fn lines(&self) -> Vec<Option<spectrum::Line>> {
+        (self.modes.iter())
+            .map(|m| {
+                let height = m.ir_intensity.filter(|_| !m.is_imaginary())?;
+                Some(spectrum::Line { position: m.frequency_cm1, height })
             })
             .collect()
-    }
-}
-
-/// A band's shape, 1 at its centre: a Lorentzian or a Gaussian of full width `fwhm` at half
-/// maximum, of the distance from the centre.
-fn band_shape(fwhm: f64, lorentzian: bool) -> impl Fn(f64) -> f64 {
-    let half = (fwhm * 0.5).max(1e-6);
-    move |dx: f64| match lorentzian {
-        true => half * half / (dx * dx + half * half),
-        false => (-std::f64::consts::LN_2 * (dx / half).powi(2)).exp(),
     }
 }
 

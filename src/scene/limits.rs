@@ -10,6 +10,7 @@ use std::fmt::Display;
 use std::ops::RangeInclusive;
 
 use super::camera::PITCH_LIMIT;
+use super::excited_view::ExcitedView;
 use super::objects::MAX_PANES;
 use super::objects::ScanState;
 use super::translucency::OpticsTuning;
@@ -59,6 +60,8 @@ pub const LOD_PX: RangeInclusive<f32> = 0.0..=1000.0;
 pub const AMPLITUDE: RangeInclusive<f32> = 0.0..=10.0;
 pub const SPEED: RangeInclusive<f32> = 0.0..=100.0;
 pub const FWHM: RangeInclusive<f32> = 0.1..=10_000.0;
+/// A UV-vis band's full width at half maximum, eV.
+pub const FWHM_EV: RangeInclusive<f32> = 0.01..=5.0;
 /// Angles the command line turns by (degrees), its zoom factor.
 pub const ANGLE_DEG: RangeInclusive<f32> = -1e6..=1e6;
 pub const ZOOM: RangeInclusive<f32> = 1e-3..=1e3;
@@ -236,6 +239,8 @@ impl ObjectState {
         self.evaluation.sanitize(&format!("{key}.evaluation"), n);
         self.surface.sanitize(&format!("{key}.surface"), n);
         self.vibration.sanitize(&format!("{key}.vibration"), n);
+        let default = ExcitedView::default();
+        n.real(&format!("{key}.excited.fwhm_ev"), &mut self.excited.fwhm_ev, FWHM_EV, default.fwhm_ev);
         self.clip.sanitize(&format!("{key}.clip"), n);
     }
 }

@@ -3,6 +3,7 @@
 pub mod camera;
 pub mod coloring;
 pub mod detail;
+pub mod excited_view;
 pub mod framing;
 pub mod limits;
 pub mod molsurface;

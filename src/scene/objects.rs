@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 use crate::model::Document;
 use crate::model::orbitals::Quantity;
 
+use super::excited_view::ExcitedView;
 use super::quantity::{AtomLook, Evaluation, QuantityState, Source, first_source};
 use super::vibration::VibrationState;
 use super::{Camera, ClipPlane, IsosurfaceSettings, RenderSettings, SurfaceChoice, SurfaceSettings};
@@ -88,6 +89,8 @@ pub struct ObjectState {
     pub surface: SurfaceSettings,
     /// The normal mode shown, how it moves, its arrows and the IR spectrum's broadening.
     pub vibration: VibrationState,
+    /// The excited state picked and the UV-vis spectrum's broadening and axis.
+    pub excited: ExcitedView,
     /// The clipping plane that cuts all its representations (its atoms when asked), in the
     /// object's frame, its offset from the centre of the object's bounds
     /// ([`crate::model::Document::bounds`]).
@@ -119,6 +122,7 @@ impl Default for ObjectState {
             selection: String::new(),
             surface: SurfaceSettings::default(),
             vibration: VibrationState::default(),
+            excited: ExcitedView::default(),
             clip: ClipPlane::default(),
         }
     }
@@ -338,6 +342,7 @@ struct StoredObject {
     selection: String,
     surface: SurfaceSettings,
     vibration: VibrationState,
+    excited: ExcitedView,
     clip: Option<ClipPlane>,
     settings: Option<RenderSettings>,
     isosurfaces: Vec<IsosurfaceSettings>,
@@ -374,6 +379,7 @@ impl From<StoredObject> for ObjectState {
             selection: s.selection,
             surface: s.surface,
             vibration: s.vibration,
+            excited: s.excited,
             clip: clip.unwrap_or_default(),
         }
     }
