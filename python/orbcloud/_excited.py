@@ -79,6 +79,25 @@ class Amplitudes:
             self.strengths = np.asarray(td.oscillator_strength(), dtype=float)
         except Exception:  # an oscillator strength is a courtesy; older PySCF may lack it
             self.strengths = None
+        self.symmetries = self._symmetries(td) if self.restricted else [""] * len(self.xy)
+
+    def _symmetries(self, td) -> list[str]:
+        """Each state's irreducible representation as PySCF's ``analyze`` names it, where the
+        molecule has symmetry on ("" otherwise, and "???" for a state that mixes irreps)."""
+        mol = self.mol
+        if not getattr(mol, "symmetry", False):
+            return [""] * len(self.xy)
+        try:  # a courtesy, through PySCF's own (private) helper
+            from pyscf import symm
+            from pyscf.scf import hf_symm
+            from pyscf.tdscf.rhf import _analyze_wfnsym
+
+            c_occ, c_vir, o, v = self.spaces[0]
+            orbsym = np.asarray(hf_symm.get_orbsym(mol, np.asarray(td._scf.mo_coeff)))
+            x_sym = symm.direct_prod(orbsym[o], orbsym[v], mol.groupname)
+            return [str(_analyze_wfnsym(td, x_sym, xs[0])) for xs, _ in self.xy]
+        except Exception:
+            return [""] * len(self.xy)
 
     def _per_spin(self, a) -> list:
         """A restricted amplitude as a one-spin list, an unrestricted pair as a list (PySCF's
@@ -113,7 +132,7 @@ class Amplitudes:
             spin = ("Singlet" if self.singlet else "Triplet") if self.restricted else ""
             f = None if self.strengths is None else float(self.strengths[k])
             e = float(self.energies[k])
-            out.append((k + 1, e * nist.HARTREE2EV, self.e_tot + e, f, spin, "", None, transitions))
+            out.append((k + 1, e * nist.HARTREE2EV, self.e_tot + e, f, spin, self.symmetries[k], None, transitions))
         return out
 
     def nto(self, state: int):

@@ -232,6 +232,25 @@ def test_unrestricted_tda():
         assert abs(attached - detached) < 1e-9 and 0.99 < attached <= 1 + 1e-12
 
 
+def test_symmetry_labels_and_frozen_core():
+    mol = gto.M(atom=WATER, basis="6-31g", symmetry=True, verbose=0)
+    mf = scf.RHF(mol).run()
+    td = tdscf.TDA(mf).run(nstates=3)
+    doc = orbcloud.from_pyscf(td)
+    assert [s.symmetry for s in doc.states] == ["B1", "A2", "A1"]
+    for state in (1, 2, 3):
+        weights, _ = reference_nto(td, state)
+        assert np.abs(doc.nto(state).weights - weights[: len(doc.nto(state).weights)]).max() < TOLERANCE
+    td = tdscf.TDA(mf)
+    td.frozen = 1
+    td.run(nstates=2)
+    doc = orbcloud.from_pyscf(td)
+    assert doc.states[0].transitions[0].from_orbital == 5  # numbered among all orbitals
+    weights, _ = reference_nto(td, 1)
+    assert np.abs(doc.nto(1).weights - weights[: len(doc.nto(1).weights)]).max() < TOLERANCE
+    assert abs(doc.state(1).electrons_moved[0] - 1) < 1e-9
+
+
 def test_document_made_after_get_nto_is_the_same():
     # get_nto rescales X to 1 in place; the document's amplitudes are rescaled back.
     mol = gto.M(atom=WATER, basis="sto-3g", verbose=0)
