@@ -7,8 +7,9 @@ orbcloud's Rust library (the same readers, evaluator and renderer as the ``orbcl
 >>> orbcloud.render(doc, orbital="lumo", iso=0.05)  # an RGBA image, shown inline by IPython
 
 Positions are in bohr, energies in hartree. An ``orbital`` is ``"homo"``, ``"lumo"``,
-``"homo-N"``, ``"lumo+N"`` or an ``int``: a 0-based index among the orbitals of that spin, as
-PySCF numbers the columns of ``mo_coeff``.
+``"homo-N"``, ``"lumo+N"``, an ``int``: a 0-based index among the orbitals of that spin, as
+PySCF numbers the columns of ``mo_coeff``, or an orbital's label where it is unique
+(``"hole 1"``, ``"particle 1"`` of natural transition orbitals).
 """
 
 from __future__ import annotations
@@ -26,10 +27,12 @@ from ._image import Image
 
 __all__ = [
     "Document",
+    "ExcitedState",
     "Image",
     "LoadError",
     "Orbital",
     "Scan",
+    "Transition",
     "compute",
     "from_pyscf",
     "load",
@@ -76,6 +79,55 @@ class Orbital(NamedTuple):
     """Symmetry label as written ("" when none)."""
 
 
+class Transition(NamedTuple):
+    """One orbital-to-orbital contribution to an excited state."""
+
+    from_orbital: int
+    """1-based number of the orbital the electron leaves, among the orbitals of its spin (as
+    the program prints it)."""
+    to_orbital: int
+    coefficient: float
+    """The amplitude as the program prints it (PySCF, Gaussian: X or Y, ½ = Σ X² for a
+    restricted state)."""
+    spin: str
+    """``"alpha"`` or ``"beta"`` in unrestricted calculations, ``""`` otherwise."""
+    deexcitation: bool
+    """A de-excitation (Y of TDHF/TDDFT)."""
+
+
+class ExcitedState(NamedTuple):
+    """An excited state as the program lists it (or PySCF computed it)."""
+
+    number: int
+    """1-based, as the program numbers it (``td.e[number - 1]``, ``get_nto(state=number)``)."""
+    energy_ev: float
+    """Excitation energy, eV."""
+    wavelength_nm: float
+    total_energy: float | None
+    """The state's total energy, hartree, where known."""
+    oscillator_strength: float | None
+    """Length gauge, where known."""
+    spin: str
+    """``"Singlet"``, ``"Triplet"``, … (``""`` when not known)."""
+    symmetry: str
+    s_squared: float | None
+    transitions: list[Transition]
+    """The main transitions, largest |coefficient| first."""
+
+
+_EXCITED_QUANTITIES = {
+    "difference density": "difference_density",
+    "attachment": "attachment",
+    "detachment": "detachment",
+    "excited density": "excited_density",
+}
+
+
+def _quantity_name(quantity: str) -> str:
+    """``"difference density"``, ``"difference_density"``, ``"Difference-Density"`` alike."""
+    return " ".join(str(quantity).lower().replace("_", " ").replace("-", " ").split())
+
+
 class Grid(NamedTuple):
     values: np.ndarray
     """nx × ny × nz values, x slowest (cube order)."""
@@ -101,11 +153,20 @@ class Document:
     """What orbcloud read from a file (or was given by :func:`from_pyscf`): atoms, data sets and
     the wavefunction, with its orbitals evaluated and rendered by the Rust library."""
 
-    def __init__(self, native: _native.Document, path: str | None = None, pyscf=None):
+    def __init__(self, native: _native.Document, path: str | None = None, pyscf=None, excited=None, weights=None, state=None):
         self._native = native
         self.path = path
         """The file it was read from (``None`` for :func:`from_pyscf`)."""
         self._pyscf = pyscf
+        self._excited = excited
+        self._states: dict[int, Document] = {}
+        self.weights = weights
+        """Natural transition orbitals' weights, descending, summing to 1 (an array, or the
+        alpha and beta arrays of an unrestricted state), for :meth:`nto`'s documents; ``None``
+        for other documents."""
+        self.state_number = state
+        """The excited state this document's orbitals (:meth:`nto`) or densities
+        (:meth:`state`) belong to; ``None`` for others."""
 
     def __repr__(self) -> str:
         n = len(self.atoms.numbers)
@@ -153,6 +214,95 @@ class Document:
         return np.array([o.occupation for o in self.orbitals if o.spin == spin])
 
     @property
+    def states(self) -> list[ExcitedState]:
+        """The excited states the document lists (a TD calculation from :func:`from_pyscf`, a
+        Gaussian, ORCA or Q-Chem log, a Gaussian TD fchk); empty when it lists none."""
+        listed = self._native.states()
+        if listed is None:
+            return []
+        return [
+            ExcitedState(number, ev, nm, total, f, spin, symmetry, s2, [Transition(*t) for t in transitions])
+            for number, ev, nm, total, f, spin, symmetry, s2, transitions in listed[3]
+        ]
+
+    @property
+    def excitation_method(self) -> str | None:
+        """The excited states' program and method ("PySCF", "TDA (HF)"), ``None`` without states."""
+        listed = self._native.states()
+        return None if listed is None else f"{listed[0]} {listed[1]}".strip()
+
+    @property
+    def density_state(self) -> int | None:
+        """The excited state whose density this document holds (:meth:`state`, a Gaussian TD
+        fchk's), if any."""
+        return self._native.density_state
+
+    @property
+    def electrons_moved(self) -> tuple[float, float] | None:
+        """The integrals of the held excited state's attachment and detachment densities (the
+        electrons the excitation moves), if it holds one."""
+        return self._native.electrons_moved()
+
+    def state(self, number: int) -> Document:
+        """This document holding excited state ``number``'s density (1-based, as PySCF's
+        ``td.e`` and ``get_nto`` number them): its difference, attachment, detachment and
+        excited densities are then ``evaluate``'s, ``grid``'s and ``render``'s quantities. For a
+        TD calculation from :func:`from_pyscf`, the unrelaxed density from the amplitudes (see
+        ``orbcloud._excited``); a file's own excited state's density otherwise."""
+        if self._excited is None:
+            if self.density_state is not None and number == self.density_state:
+                return self
+            held = f"only state {self.density_state}'s" if self.density_state is not None else "no excited state's density"
+            raise ValueError(f"{self.source}: state {number}'s density is not known (the document holds {held})")
+        if number not in self._states:
+            from ._pyscf import to_orbcloud_matrix
+
+            amplitudes = self._excited
+            index = amplitudes._index(number)
+            mol = amplitudes.mol
+            ground = to_orbcloud_matrix(mol, amplitudes.ground)
+            excited = to_orbcloud_matrix(mol, amplitudes.ground + amplitudes.difference(number))
+            source = f"{amplitudes.method} state {index + 1}: unrelaxed, from PySCF's amplitudes"
+            native = self._native.with_state_density(index + 1, source, ground, excited)
+            self._states[number] = Document(native, pyscf=self._pyscf, excited=amplitudes, state=index + 1)
+        return self._states[number]
+
+    def nto(self, state: int = 1) -> Document:
+        """Excited state ``state``'s natural transition orbitals (1-based, as PySCF's
+        ``td.get_nto(state=...)``) as a document of their own: orbitals ``"hole 1"``,
+        ``"particle 1"``, ``"hole 2"``, … (their labels, which ``evaluate``, ``render`` and the
+        widget take), ``weights`` descending and summing to 1, equal to ``get_nto``'s (X alone,
+        renormalised). Each orbital's sign is ``get_nto``'s: its largest coefficient over the
+        molecular orbitals positive. NTOs have no orbital energies (NaN); their occupations are
+        the weights, as ORCA's and Q-Chem's NTO Molden files write them."""
+        if self._excited is None:
+            raise ValueError(f"{self.source}: natural transition orbitals need a TD calculation's amplitudes (from_pyscf(td))")
+        from ._pyscf import document_parts
+
+        amplitudes = self._excited
+        number = amplitudes._index(state) + 1
+        sets = amplitudes.nto(number)
+        mol = amplitudes.mol
+        labels = [label for _, _, _, names in sets for label in names]
+        if amplitudes.restricted:
+            weights, c, occupations, _ = sets[0]
+            parts, keep = document_parts(mol, c, occupations, np.full(len(occupations), np.nan), labels=labels)
+        else:
+            c = tuple(c for _, c, _, _ in sets)
+            occupations = tuple(o for _, _, o, _ in sets)
+            energies = tuple(np.full(len(o), np.nan) for o in occupations)
+            parts, keep = document_parts(mol, c, occupations, energies, labels=labels)
+            weights = (sets[0][0], sets[1][0])
+        parts["source"] = f"PySCF {amplitudes.method} state {number}: natural transition orbitals"
+        return Document(_native.from_parts(**parts), pyscf=keep, weights=weights, state=number)
+
+    def info(self, json: bool = False) -> str:
+        """What ``orbcloud info`` prints of the document (``json=True``: its ``--json`` form):
+        atoms, orbitals, excited states and, for a document holding an excited state's
+        density, what its attachment and detachment densities say."""
+        return self._native.info(bool(json))
+
+    @property
     def writer(self) -> str | None:
         """The program that wrote the file, as the reader recognised it ("ORCA", "PySCF", …)."""
         n = self._native.normalization()
@@ -195,7 +345,30 @@ class Document:
             if orbital < 0:
                 raise ValueError(f"orbital {orbital}: indices count from 0")
             return self._native.resolve(str(int(orbital) + 1), spin)
-        return self._native.resolve(str(orbital), spin)
+        try:
+            return self._native.resolve(str(orbital), spin)
+        except ValueError:
+            # An orbital's label, where it names one orbital of that spin ("hole 1").
+            wanted = " ".join(str(orbital).lower().split())
+            named = [i for i, o in enumerate(self._native.orbitals()) if o[2] == spin and " ".join(o[3].lower().split()) == wanted]
+            if len(named) == 1:
+                return named[0]
+            raise
+
+    def _excited_target(self, quantity, state) -> tuple[Document, str | None]:
+        """The document that evaluates ``quantity`` of ``state``, and the native name of an
+        excited state's quantity (``None`` for the others)."""
+        name = None if quantity is None else _quantity_name(quantity)
+        kind = _EXCITED_QUANTITIES.get(name) if name is not None else None
+        if name is not None and kind is None and name not in ("orbital", "density", "spin density"):
+            raise ValueError(f"quantity {quantity!r}: one of orbital, density, spin density, {', '.join(_EXCITED_QUANTITIES)}")
+        if state is not None:
+            if kind is None:
+                raise ValueError(f"state={state} picks the excited state of a quantity among {', '.join(_EXCITED_QUANTITIES)}")
+            return self.state(int(state)), kind
+        if kind is not None and self.density_state is None:
+            raise ValueError(f"quantity {quantity!r} needs state=k (the excited state whose density it is)")
+        return self, kind
 
     @staticmethod
     def _points(points) -> np.ndarray:
@@ -206,9 +379,19 @@ class Document:
             raise ValueError(f"points must have shape (n, 3), got {p.shape}")
         return p
 
-    def evaluate(self, points, orbital: str | int = "homo", spin: str = "alpha") -> np.ndarray:
-        """ψ at ``points`` (n × 3, bohr): one value per point."""
-        return self._native.values(self._points(points), "orbital", self._flat_index(orbital, spin))
+    def evaluate(self, points, orbital: str | int = "homo", spin: str = "alpha", quantity: str | None = None, state: int | None = None) -> np.ndarray:
+        """ψ at ``points`` (n × 3, bohr): one value per point. ``quantity`` instead of an orbital:
+        ``"density"``, ``"spin density"``, or an excited state's ``"difference density"``
+        (ρ_exc − ρ_gs), ``"attachment"``, ``"detachment"``, ``"excited density"`` of ``state``
+        (1-based; see :meth:`state`)."""
+        target, kind = self._excited_target(quantity, state)
+        p = self._points(points)
+        if kind is not None:
+            return target._native.values(p, kind, 0)
+        name = None if quantity is None else _quantity_name(quantity)
+        if name in ("density", "spin density"):
+            return self.density(p, spin_density=name == "spin density")
+        return self._native.values(p, "orbital", self._flat_index(orbital, spin))
 
     def density(self, points, spin_density: bool = False) -> np.ndarray:
         """The total electron density (or the spin density ρα − ρβ) at ``points`` (n × 3, bohr)."""
@@ -225,22 +408,30 @@ class Document:
         atomic units (hartree per elementary charge), as ``orbcloud eval --esp`` gives it."""
         return self._native.values(self._points(points), "esp", 0)
 
-    def _quantity(self, orbital, spin, density) -> tuple[str, int]:
+    def _quantity(self, orbital, spin, density, quantity=None, state=None) -> tuple[_native.Document, str, int]:
+        if quantity is not None or state is not None:
+            target, kind = self._excited_target(quantity, state)
+            if kind is not None:
+                return target._native, kind, 0
+            density = {"density": True, "spin density": "spin"}.get(_quantity_name(quantity), density)
         if density in (True, "total"):
-            return "density", 0
+            return self._native, "density", 0
         if density == "spin":
-            return "spin_density", 0
-        return "orbital", self._flat_index(orbital, spin)
+            return self._native, "spin_density", 0
+        return self._native, "orbital", self._flat_index(orbital, spin)
 
-    def grid(self, orbital: str | int = "homo", spin: str = "alpha", points: int = 80, density: bool | str = False) -> Grid:
-        """An orbital (or ``density=True`` / ``"spin"``) on a grid of ``points`` per side over the
-        box where it decays, as ``orbcloud cube`` makes it."""
-        values, matrix = self._native.grid(*self._quantity(orbital, spin, density), int(points))
+    def grid(self, orbital: str | int = "homo", spin: str = "alpha", points: int = 80, density: bool | str = False, quantity: str | None = None, state: int | None = None) -> Grid:
+        """An orbital (or ``density=True`` / ``"spin"``, or :meth:`evaluate`'s ``quantity`` of
+        ``state``) on a grid of ``points`` per side over the box where it decays, as ``orbcloud
+        cube`` makes it."""
+        native, kind, index = self._quantity(orbital, spin, density, quantity, state)
+        values, matrix = native.grid(kind, index, int(points))
         return Grid(values, matrix)
 
-    def write_cube(self, path: PathLike, orbital: str | int = "homo", spin: str = "alpha", points: int = 80, density: bool | str = False) -> None:
+    def write_cube(self, path: PathLike, orbital: str | int = "homo", spin: str = "alpha", points: int = 80, density: bool | str = False, quantity: str | None = None, state: int | None = None) -> None:
         """Writes :meth:`grid`'s values as a Gaussian cube file."""
-        self._native.write_cube(os.fspath(path), *self._quantity(orbital, spin, density), int(points))
+        native, kind, index = self._quantity(orbital, spin, density, quantity, state)
+        native.write_cube(os.fspath(path), kind, index, int(points))
 
     def render(self, **options) -> Image:
         """:func:`orbcloud.render` of this document."""
@@ -292,9 +483,24 @@ def load_scan(path: PathLike) -> Scan:
 def from_pyscf(mf_or_mol, mo_coeff=None, mo_occ=None, mo_energy=None) -> Document:
     """A document straight from PySCF: a mean-field object (``from_pyscf(mf)``) or a molecule with
     its orbitals (``from_pyscf(mol, mo_coeff, mo_occ, mo_energy)``). Restricted, restricted
-    open-shell and unrestricted orbitals; cartesian or pure basis sets up to h functions."""
+    open-shell and unrestricted orbitals; cartesian or pure basis sets up to h functions.
+
+    A TD calculation that has run (``tddft.TDA(mf).run()``, ``TDHF``, ``TDDFT``, restricted or
+    unrestricted) gives its ground state's document with the excited states: :attr:`Document.states`,
+    :meth:`Document.state` (their densities), :meth:`Document.nto` (natural transition orbitals).
+    Make it before calling PySCF's ``get_nto``, which rescales ``td.xy`` in place."""
     from ._pyscf import document_parts
 
+    if mo_coeff is None:
+        from ._excited import is_td
+
+        if is_td(mf_or_mol):
+            from ._excited import Amplitudes
+
+            amplitudes = Amplitudes(mf_or_mol)
+            parts, keep = document_parts(mf_or_mol._scf)
+            native = _native.from_parts(**parts).with_states("PySCF", amplitudes.method, amplitudes.states())
+            return Document(native, pyscf=keep, excited=amplitudes)
     parts, keep = document_parts(mf_or_mol, mo_coeff, mo_occ, mo_energy)
     return Document(_native.from_parts(**parts), pyscf=keep)
 
@@ -334,13 +540,32 @@ def render(doc_or_path: Document | PathLike | None = None, size: tuple[int, int]
     RGBA image (height × width × 4, uint8) that IPython shows inline. Options are the command's,
     with underscores: ``orbital="lumo"``, ``iso=0.05``, ``view="z"``, ``yaw=30``,
     ``no_volume=True``, ``colors="red-white"``, ``lavapipe=True``; see :func:`_words`."""
-    words = _words({"size": size, **options})
     native = None
     if isinstance(doc_or_path, Document):
+        doc_or_path, options = _resolved(doc_or_path, options)
         native = doc_or_path._native
-    elif doc_or_path is not None:
+    words = _words({"size": size, **options})
+    if native is None and doc_or_path is not None:
         words.insert(0, os.fspath(doc_or_path))
     return Image.of(_native.render(native, words))
+
+
+def _resolved(doc: Document, options: dict) -> tuple[Document, dict]:
+    """The document and options the command draws: an orbital named by its label (``"hole
+    1"``) as its number, and for a TD calculation's ``state=k`` the document holding that
+    state's density (``attachment=True, state=2``)."""
+    options = dict(options)
+    orbital = options.get("orbital")
+    if isinstance(orbital, str):
+        spin = options.get("spin") or "alpha"
+        try:
+            doc._native.resolve(orbital, spin)
+        except ValueError:
+            options["orbital"] = doc.orbital_index(orbital, spin)
+    state = options.get("state")
+    if state is not None and doc._excited is not None:
+        doc = doc.state(int(state))
+    return doc, options
 
 
 def _viewable_path(doc: Document) -> str:

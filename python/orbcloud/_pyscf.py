@@ -21,29 +21,21 @@ def _pure_order(l: int) -> list[int]:
 
 
 def _spin_sets(mo_coeff, mo_occ, mo_energy):
-    """[(coefficients, occupations, energies, spin)]; unrestricted when two sets are given."""
-    c = np.asarray(mo_coeff)
-    if np.iscomplexobj(c):
+    """[(coefficients, occupations, energies, spin)]; unrestricted when two sets are given (of
+    equal or, as a tuple, unequal numbers of orbitals)."""
+    pair = isinstance(mo_coeff, (tuple, list)) and len(mo_coeff) == 2
+    if any(np.iscomplexobj(c) for c in (mo_coeff if pair else [mo_coeff])):
         raise ValueError("complex orbitals (GHF, complex RHF) are not supported")
-    if c.ndim == 3 or (isinstance(mo_coeff, (tuple, list)) and len(mo_coeff) == 2):
+    if pair or np.asarray(mo_coeff).ndim == 3:
         occ = mo_occ if mo_occ is not None else [None, None]
         ene = mo_energy if mo_energy is not None else [None, None]
         return [(np.asarray(mo_coeff[s]), occ[s], ene[s], spin) for s, spin in enumerate(("alpha", "beta"))], False
-    return [(c, mo_occ, mo_energy, "alpha")], True
+    return [(np.asarray(mo_coeff), mo_occ, mo_energy, "alpha")], True
 
 
-def document_parts(mf_or_mol, mo_coeff=None, mo_occ=None, mo_energy=None):
-    """The arguments of ``_native.from_parts``, and what :func:`write_molden` needs later."""
-    if mo_coeff is None:
-        mf = mf_or_mol
-        mol = getattr(mf, "mol", None)
-        if mol is None or getattr(mf, "mo_coeff", None) is None:
-            raise ValueError("from_pyscf takes a mean-field object that has run, or (mol, mo_coeff, mo_occ, mo_energy)")
-        mo_coeff, mo_occ, mo_energy = mf.mo_coeff, mf.mo_occ, mf.mo_energy
-    else:
-        mol = mf_or_mol
-    from pyscf.data.elements import charge as atomic_number
-
+def basis_map(mol):
+    """orbcloud's shells of ``mol``, for each of orbcloud's functions the PySCF function it is
+    (``ao_of``), and the norms √S_kk of PySCF's functions."""
     # Shells, and for each of orbcloud's functions the PySCF function it is.
     shells, ao_of = [], []
     offset = 0
@@ -62,6 +54,33 @@ def document_parts(mf_or_mol, mo_coeff=None, mo_occ=None, mo_energy=None):
         raise ValueError(f"counted {offset} basis functions, PySCF has {mol.nao_nr()}")
     ao_of = np.asarray(ao_of)
     norms = np.sqrt(mol.intor_symmetric("int1e_ovlp").diagonal())
+    return shells, ao_of, norms
+
+
+def to_orbcloud_matrix(mol, matrix, basis=None) -> np.ndarray:
+    """A matrix over PySCF's basis functions (a density matrix, n_ao × n_ao) over orbcloud's:
+    its rows and columns reordered and scaled as the orbitals' coefficients are."""
+    _, ao_of, norms = basis if basis is not None else basis_map(mol)
+    m = np.asarray(matrix, dtype=float)
+    scale = norms[ao_of]
+    return np.ascontiguousarray(m[np.ix_(ao_of, ao_of)] * scale[:, None] * scale[None, :])
+
+
+def document_parts(mf_or_mol, mo_coeff=None, mo_occ=None, mo_energy=None, labels=None):
+    """The arguments of ``_native.from_parts``, and what :func:`write_molden` needs later;
+    ``labels`` names the orbitals (by default their symmetry labels, if any)."""
+    if mo_coeff is None:
+        mf = mf_or_mol
+        mol = getattr(mf, "mol", None)
+        if mol is None or getattr(mf, "mo_coeff", None) is None:
+            raise ValueError("from_pyscf takes a mean-field object that has run, or (mol, mo_coeff, mo_occ, mo_energy)")
+        mo_coeff, mo_occ, mo_energy = mf.mo_coeff, mf.mo_occ, mf.mo_energy
+    else:
+        mol = mf_or_mol
+    from pyscf.data.elements import charge as atomic_number
+
+    shells, ao_of, norms = basis_map(mol)
+    offset = len(ao_of)
 
     sets, restricted = _spin_sets(mo_coeff, mo_occ, mo_energy)
     coefficients, energies, occupations, spins = [], [], [], []
@@ -74,7 +93,7 @@ def document_parts(mf_or_mol, mo_coeff=None, mo_occ=None, mo_energy=None):
         energies.append(np.full(n, np.nan) if ene is None else np.asarray(ene, dtype=float))
         occupations.append(np.zeros(n) if occ is None else np.asarray(occ, dtype=float))
         spins += [spin] * n
-    labels = _labels(mol, sets)
+    labels = _labels(mol, sets) if labels is None else [str(n) for n in labels]
     z = [int(atomic_number(mol.atom_pure_symbol(i))) if not _ghost(mol, i) else 0 for i in range(mol.natm)]
     parts = dict(
         source=f"PySCF ({mol.natm} atoms, {offset} basis functions)",

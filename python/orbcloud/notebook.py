@@ -11,7 +11,7 @@ from typing import Sequence
 import ipywidgets as widgets
 from jupyter_rfb import RemoteFrameBuffer
 
-from . import Document, Scan, _native, _words, load
+from . import Document, Scan, _native, _resolved, _words, load
 
 # Radians per pixel dragged, and the wheel's zoom per unit of scroll: the desktop viewer's.
 DRAG_ROTATE = 0.008
@@ -35,7 +35,7 @@ class Canvas(RemoteFrameBuffer):
     @property
     def words(self) -> list[str]:
         """The options of ``orbcloud render`` the scene is drawn with."""
-        return _words({"size": self.size, **self.options})
+        return _words({"size": self.size, **_resolved(self.doc, self.options)[1]})
 
     def show(self, doc: Document | None = None, **options) -> None:
         """Shows another document or other options (merged into the current ones; ``None``
@@ -46,7 +46,7 @@ class Canvas(RemoteFrameBuffer):
         current.update(options)
         self.options = {k: v for k, v in current.items() if v is not None}
         camera = self.scene.camera if self.scene is not None else None
-        self.scene = _native.Scene(self.doc._native, self.words)
+        self.scene = _native.Scene(_resolved(self.doc, self.options)[0]._native, self.words)
         if camera is not None:
             self.scene.camera = camera
         self.request_draw()
@@ -74,10 +74,19 @@ class Canvas(RemoteFrameBuffer):
         return self.scene.draw()
 
 
+# Pairs of natural transition orbitals the widget lists.
+NTO_PAIRS = 4
+
+
 def _orbital_choices(doc: Document) -> list[tuple[str, str]]:
-    """(label, ``--orbital``/``--density`` word) for the orbitals around the frontier and the density."""
+    """(label, ``--orbital``/``--density`` word) for the orbitals around the frontier and the
+    density; for natural transition orbitals (:meth:`Document.nto`), the main pairs."""
     choices = []
     orbitals = [o for o in doc.orbitals if o.spin == "alpha"]
+    if orbitals and doc.weights is not None:
+        for i, o in enumerate(orbitals[: 2 * NTO_PAIRS]):
+            choices.append((f"{o.label} (weight {o.occupation:.3f})", str(i + 1)))
+        return choices
     if orbitals:
         homo = doc.orbital_index("homo")
         for i in range(max(0, homo - 3), min(len(orbitals), homo + 5)):
@@ -92,7 +101,7 @@ def _orbital_choices(doc: Document) -> list[tuple[str, str]]:
 class Viewer(widgets.VBox):
     """:class:`Canvas` with its controls; a list of documents (a scan's frames) adds a slider."""
 
-    def __init__(self, doc_or_docs, size=(600, 450), orbital: str | int = "homo", iso: float = 0.05, style: str = "isosurfaces", **options):
+    def __init__(self, doc_or_docs, size=(600, 450), orbital: str | int | None = None, iso: float = 0.05, style: str = "isosurfaces", **options):
         self.labels = None
         if isinstance(doc_or_docs, Scan):
             docs: Sequence[Document] = doc_or_docs.frames
@@ -109,6 +118,8 @@ class Viewer(widgets.VBox):
         doc = docs[0]
         choices = _orbital_choices(doc)
         start = None
+        if orbital is None:
+            orbital = "hole 1" if doc.weights is not None else "homo"
         if choices:
             index = orbital if isinstance(orbital, int) else doc.orbital_index(orbital)
             start = str(index + 1)

@@ -9,6 +9,8 @@ use numpy::ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2};
 use orbcloud::formats::{self, LoadError, cube_write};
 use orbcloud::model::basis::{Basis, Shell, ShellKind};
+use orbcloud::model::excited::{ExcitedState, ExcitedStates, Transition};
+use orbcloud::model::excited_density::ExcitedDensity;
 use orbcloud::model::gto::PreparedBasis;
 use orbcloud::model::orbitals::{MolecularOrbital, OrbitalSpec, Quantity, Spin, Wavefunction};
 use orbcloud::model::scan::FrameContent;
@@ -83,6 +85,21 @@ impl PyDocument {
             "reduced_gradient" => Quantity::ReducedGradient,
             "sign_lambda2_rho" => Quantity::SignLambda2Rho,
             "density_laplacian" => Quantity::DensityLaplacian,
+            "difference_density" | "attachment" | "detachment" | "excited_density" => {
+                if wf.excited.is_none() {
+                    return Err(PyValueError::new_err(format!(
+                        "{}: the {} needs an excited state's density, and this document holds none",
+                        self.doc.source,
+                        kind.replace('_', " ")
+                    )));
+                }
+                match kind {
+                    "difference_density" => Quantity::DifferenceDensity,
+                    "attachment" => Quantity::Attachment,
+                    "detachment" => Quantity::Detachment,
+                    _ => Quantity::ExcitedDensity,
+                }
+            }
             _ => return Err(PyValueError::new_err(format!("no {kind} {index} in {}", self.doc.source))),
         };
         Ok(q)
@@ -97,6 +114,23 @@ type GridArrays<'py> = (Bound<'py, PyArray3<f64>>, Bound<'py, PyArray2<f64>>);
 type ScanFrame = (f64, String, PyDocument);
 /// A shell: atom index, l, pure, exponents, coefficients of normalised primitives.
 type ShellParts = (usize, u32, bool, Vec<f64>, Vec<f64>);
+/// A transition: from, to (1-based orbital numbers within their spin), coefficient, spin
+/// ("alpha", "beta" or ""), whether it is a de-excitation.
+type TransitionParts = (usize, usize, f64, String, bool);
+/// An excited state: number (1-based), energy (eV), total energy (hartree), oscillator
+/// strength, spin, symmetry, ⟨S²⟩, transitions.
+type StateParts = (usize, f64, Option<f64>, Option<f64>, String, String, Option<f64>, Vec<TransitionParts>);
+/// A state as Python reads it: [`StateParts`] with its wavelength (nm) after the energy.
+type StateRow = (usize, f64, f64, Option<f64>, Option<f64>, String, String, Option<f64>, Vec<TransitionParts>);
+
+/// A square matrix of `n` rows as a row-major vector.
+fn square(m: &PyReadonlyArray2<'_, f64>, n: usize, what: &str) -> PyResult<Vec<f64>> {
+    let a = m.as_array();
+    if a.nrows() != n || a.ncols() != n {
+        return Err(PyValueError::new_err(format!("{what} has shape {:?}; expected ({n}, {n})", a.shape())));
+    }
+    Ok(a.iter().copied().collect())
+}
 
 fn spin_of(spin: &str) -> PyResult<Spin> {
     match spin {
@@ -261,6 +295,114 @@ impl PyDocument {
         Ok((values.into_pyarray(py), matrix.into_pyarray(py)))
     }
 
+    /// The excited states the document lists: (program, method, the state whose density it
+    /// holds, states), `None` when it lists none.
+    fn states(&self) -> Option<(String, String, Option<usize>, Vec<StateRow>)> {
+        let x = self.doc.excited.as_ref()?;
+        let states = (x.states.iter())
+            .map(|s| {
+                let transitions = (s.transitions.iter())
+                    .map(|t| (t.from, t.to, t.coefficient, t.spin.clone(), t.deexcitation))
+                    .collect();
+                (
+                    s.number,
+                    s.energy_ev,
+                    s.wavelength_nm(),
+                    s.total_energy_hartree,
+                    s.oscillator_strength,
+                    s.spin.clone(),
+                    s.symmetry.clone(),
+                    s.s_squared,
+                    transitions,
+                )
+            })
+            .collect();
+        let density_of = self.density_state();
+        Some((x.program.clone(), x.method.clone(), density_of, states))
+    }
+
+    /// The excited state whose density the document holds (1-based), if any.
+    #[getter]
+    fn density_state(&self) -> Option<usize> {
+        Some(self.doc.wavefunction.as_ref()?.excited.as_ref()?.state)
+    }
+
+    /// The electrons the held excited state's density moves: the attachment's and the
+    /// detachment's integrals (Σ λ over λ > 0, −Σ λ over λ < 0).
+    fn electrons_moved(&self) -> Option<(f64, f64)> {
+        let e = self.doc.wavefunction.as_ref()?.excited.as_ref()?;
+        Some((e.electrons_moved(), e.electrons_detached()))
+    }
+
+    /// This document with the excited states `states` listed, as a program's (`program`,
+    /// `method`) would be.
+    fn with_states(&self, program: String, method: String, states: Vec<StateParts>) -> PyDocument {
+        let states = states
+            .into_iter()
+            .map(|(number, energy_ev, total, f, spin, symmetry, s_squared, transitions)| ExcitedState {
+                number,
+                energy_ev,
+                total_energy_hartree: total,
+                oscillator_strength: f,
+                spin,
+                symmetry,
+                s_squared,
+                transitions: transitions
+                    .into_iter()
+                    .map(|(from, to, coefficient, spin, deexcitation)| Transition {
+                        from,
+                        to,
+                        coefficient,
+                        spin,
+                        deexcitation,
+                    })
+                    .collect(),
+            })
+            .collect();
+        let mut doc = self.doc.clone();
+        let density_of = self.density_state();
+        doc.excited = Some(ExcitedStates { program, method, states, density_of });
+        PyDocument::new(doc)
+    }
+
+    /// This document holding excited state `state`'s density: the ground state's and the
+    /// excited state's total density matrices (n_basis × n_basis, over orbcloud's functions in
+    /// its order), their difference diagonalised as Head-Gordon's attachment and detachment.
+    fn with_state_density(
+        &self,
+        py: Python<'_>,
+        state: usize,
+        source: String,
+        ground: PyReadonlyArray2<'_, f64>,
+        excited: PyReadonlyArray2<'_, f64>,
+    ) -> PyResult<PyDocument> {
+        let wf = self.wavefunction()?;
+        let n = wf.basis.n_functions();
+        let (ground, excited) = (square(&ground, n, "ground")?, square(&excited, n, "excited")?);
+        let density = py
+            .detach(|| ExcitedDensity::new(state, &source, &wf.basis, ground, excited))
+            .map_err(PyValueError::new_err)?;
+        let mut doc = self.doc.clone();
+        if let Some(wf) = doc.wavefunction.as_mut() {
+            wf.excited = Some(std::sync::Arc::new(density));
+        }
+        if let Some(x) = doc.excited.as_mut() {
+            x.density_of = Some(state);
+        }
+        Ok(PyDocument::new(doc))
+    }
+
+    /// What `orbcloud info` prints of the document, or its `--json` form.
+    fn info(&self, py: Python<'_>, json: bool) -> PyResult<String> {
+        py.detach(|| {
+            if json {
+                serde_json::to_string_pretty(&cli::info::describe(&self.doc)).map_err(runtime)
+            } else {
+                Ok(cli::info::text(&self.doc))
+            }
+        })
+    }
+
     /// Writes a quantity on a grid of `points` per side as a Gaussian cube file.
     fn write_cube(&self, py: Python<'_>, path: PathBuf, kind: &str, index: usize, points: usize) -> PyResult<()> {
         let q = self.quantity(kind, index)?;
@@ -280,9 +422,15 @@ impl PyDocument {
             Quantity::ReducedGradient => "reduced density gradient".into(),
             Quantity::SignLambda2Rho => "sign(lambda2)*rho (a.u.)".into(),
             Quantity::DensityLaplacian => "Laplacian of the electron density (a.u.)".into(),
-            // An excited state's densities: the package does not ask for them yet.
             Quantity::DifferenceDensity | Quantity::Attachment | Quantity::Detachment | Quantity::ExcitedDensity => {
-                format!("{q:?}")
+                let state = wf.excited.as_ref().map_or(0, |e| e.state);
+                let what = match q {
+                    Quantity::DifferenceDensity => "difference density",
+                    Quantity::Attachment => "attachment density",
+                    Quantity::Detachment => "detachment density",
+                    _ => "excited-state density",
+                };
+                format!("{what} (state {state})")
             }
         };
         let id = match q {

@@ -93,3 +93,18 @@ def test_scan_manifest_gives_the_slider():
     assert viewer.frame.max == 3 and viewer.frame_label.value == "path = 0.00"
     viewer.frame.value = 3
     assert viewer.frame_label.value == "path = 3.00"
+
+
+def test_natural_transition_orbitals_in_the_menu():
+    from pyscf import gto, scf, tdscf
+
+    mol = gto.M(atom="O 0 0 0.117; H 0 0.757 -0.467; H 0 -0.757 -0.467", basis="sto-3g", verbose=0)
+    nto = orbcloud.from_pyscf(tdscf.TDA(scf.RHF(mol).run()).run(nstates=1)).nto(1)
+    viewer = orbcloud.widget(nto, size=(96, 72), lavapipe=True)
+    labels = [label for label, _ in viewer.orbital.options]
+    assert labels[0].startswith("hole 1 (weight") and labels[1].startswith("particle 1")
+    assert viewer.orbital.value == "1"  # hole 1 first
+    hole = np.asarray(viewer.canvas.get_frame()).copy()
+    viewer.orbital.value = viewer.orbital.options[1][1]
+    assert "--orbital" in viewer.canvas.words and "2" in viewer.canvas.words
+    assert np.abs(np.asarray(viewer.canvas.get_frame()).astype(int) - hole).sum() > 0
