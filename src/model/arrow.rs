@@ -147,7 +147,7 @@ mod tests {
         let arrows = mode_arrows(&v, 0, 0.5).expect("the mode is there");
         assert!(mode_arrows(&v, 1, 0.5).is_none());
         assert_eq!(arrows.len(), 2, "the atom that hardly moves has none");
-        assert_eq!((arrows[0].from, arrows[0].to), (DVec3::ZERO, DVec3::Z * 2.5), "5 × 0.5 bohr");
-        assert_eq!(arrows[1].to, DVec3::new(0.0, 3.0 - 1.25, 0.0), "half as long");
+        assert_eq!((arrows[0].from, arrows[0].to), (DVec3::ZERO, DVec3::Z * 3.0), "6 × 0.5 bohr");
+        assert_eq!(arrows[1].to, DVec3::new(0.0, 3.0 - 1.5, 0.0), "half as long");
     }
 }
