@@ -224,7 +224,7 @@ fn scan_export_writes_the_interpolated_orbital_and_render_writes_both_views() {
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(!out.status.success() && err.contains(says), "{args:?}: {err}");
         assert!(!err.contains("key volumes"), "{args:?}: checked only after building: {err}");
-        assert!(start.elapsed().as_secs_f64() < 3.0, "{args:?} took {:?}", start.elapsed());
+        assert!(start.elapsed().as_secs_f64() < 15.0, "{args:?} took {:?}", start.elapsed());
     }
 }
 
@@ -374,7 +374,7 @@ fn render_views_along_presets_and_refuses_bad_ones_before_any_gpu_work() {
         let out = orbcloud(&["render", "--view", view, "--lavapipe", "-o", "/dev/null"]);
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(!out.status.success() && err.contains(says), "--view {view}: {err}");
-        assert!(start.elapsed().as_secs_f64() < 5.0, "--view {view} took {:?}", start.elapsed());
+        assert!(start.elapsed().as_secs_f64() < 15.0, "--view {view} took {:?}", start.elapsed());
     }
 }
 

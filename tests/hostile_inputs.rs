@@ -500,7 +500,7 @@ fn gaussian_logs_with_lying_counts_are_refused_at_their_line() {
     let bad = log.replacen(" S   3 1.00", " S   99999999999 1.00", 1);
     let start = Instant::now();
     let e = refused("count.log", bad.as_bytes());
-    assert!(start.elapsed() < Duration::from_secs(2));
+    assert!(start.elapsed() < Duration::from_secs(10));
     assert!(e.expected.contains("primitive"), "{e}");
 
     let bad = log.replacen("   2 2   H  1S          0.54884  -1.21245\n", "", 1);

@@ -544,7 +544,7 @@ fn direct_mode_draws_in_bands_and_the_window_keeps_answering() {
     wait_loaded(&mut h);
     assert!(h.state().objects[0].state.evaluation.direct);
     // 96 basis functions per sample: the frame is drawn band by band, each UI frame short.
-    let (mut steps, mut slowest, mut seen) = (0, 0.0f64, Vec::new());
+    let (mut steps, mut slowest, mut total, mut seen) = (0, 0.0f64, 0.0f64, Vec::new());
     h.run_steps(1);
     // The coarse picture stands in at once while the full one fills in.
     assert!(h.state().frame_progress().is_some() && h.state().previewing(), "a preview while the frame is drawn");
@@ -553,6 +553,7 @@ fn direct_mode_draws_in_bands_and_the_window_keeps_answering() {
         let t = std::time::Instant::now();
         h.run_steps(1);
         slowest = slowest.max(t.elapsed().as_secs_f64());
+        total += t.elapsed().as_secs_f64();
         steps += 1;
         assert!(steps < 3000, "the frame never finished");
         if steps == 3 {
@@ -568,7 +569,9 @@ fn direct_mode_draws_in_bands_and_the_window_keeps_answering() {
     // After the restart at step 3 the picture fills in band by band.
     let after = &seen[4.min(seen.len())..];
     assert!(after.len() >= 2 && after.windows(2).all(|w| w[1] >= w[0]), "the picture fills in: {seen:?}");
-    assert!(slowest < 1.5, "a UI frame took {slowest:.2} s");
+    // Relative to the whole picture's time, not a wall-clock figure: a busy machine slows both
+    // alike, and a frame drawn whole in one UI frame would take all of it.
+    assert!(slowest < 0.25 * total, "a UI frame took {slowest:.2} s of the picture's {total:.2} s");
     assert!(!h.state().previewing(), "the full picture replaced the preview");
 }
 
