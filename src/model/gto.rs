@@ -369,6 +369,7 @@ impl PreparedBasis {
     /// part R(r²) = Σ c_j exp(−α_j r²) and a monomial M,
     /// ∂a∂b(M R) = (∂a∂b M) R + (∂a M x_b + ∂b M x_a) R₁ + M (x_a x_b R₂ + δ_ab R₁),
     /// with R₁ = Σ −2α_j c_j e_j and R₂ = Σ 4α_j² c_j e_j.
+    #[inline(always)]
     pub(super) fn shell_second_derivatives(
         &self,
         shell: &PreparedShell,
