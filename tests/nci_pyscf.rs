@@ -205,7 +205,9 @@ fn nci_cubes_follow_nciplot_conventions_for_one_file_two_fragments_and_promolecu
                         (dv - 100.0 * e.sign_lambda2_rho()).abs() < 1e-4 * (1.0 + dv.abs()),
                         "dens at {point}: {dv}"
                     );
-                    let s = e.reduced_gradient().min(100.0);
+                    // Above s = 1 (NCIPLOT's RDG cutoff) the -grad cube holds 100.
+                    let s = e.reduced_gradient();
+                    let s = if s > 1.0 { 100.0 } else { s };
                     assert!((gv - s).abs() < 1e-4 * (1.0 + s), "grad at {point}: {gv} vs {s}");
                     kept += 1;
                 }

@@ -7,7 +7,6 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use glam::DVec3;
 
 use crate::formats::{self, cube_write};
 use crate::model::nci::{self, DensitySource, NciSettings, WavefunctionDensity};
@@ -15,11 +14,6 @@ use crate::model::promolecular::Promolecule;
 use crate::model::units::{ANGSTROM_PER_BOHR, BOHR_PER_ANGSTROM};
 use crate::model::{Document, GridSpec, Molecule, VolumeGrid};
 use crate::scene::limits::{self, within};
-
-/// NCIPLOT's grid step, bohr.
-const DEFAULT_STEP_BOHR: f64 = 0.1;
-/// Space around the atoms, bohr (what the box adds on each side unless --margin says).
-const DEFAULT_MARGIN_BOHR: f64 = 2.0;
 
 #[derive(Args)]
 pub struct NciArgs {
@@ -30,16 +24,24 @@ pub struct NciArgs {
     /// Sums of spherical atoms instead of the files' wavefunctions (elements H–Cm).
     #[arg(long)]
     promolecular: bool,
-    /// Grid step in Å, 0.001 to 10 (default 0.1 bohr, NCIPLOT's: 0.0529 Å).
+    /// Grid step in Å, 0.001 to 10 (default 0.1 Å, NCIPLOT's).
     #[arg(long, value_parser = within(limits::SPACING))]
     step: Option<f64>,
-    /// Space around the atoms in Å, 0 to 100 (default 2 bohr: 1.058 Å).
+    /// Space around the atoms in Å, 0 to 100 (default 0.75 Å, NCIPLOT's).
     #[arg(long, value_parser = within(limits::MARGIN))]
     margin: Option<f64>,
+    /// Take the grid (origin, step vectors and point counts) from this cube file, e.g. one
+    /// NCIPLOT wrote, instead of building a box around the atoms.
+    #[arg(long, value_name = "CUBE", conflicts_with_all = ["step", "margin"])]
+    grid_like: Option<PathBuf>,
     /// Points whose density is above this (a.u.) are cut: 1e-6 to 10 (default 0.05 for
     /// wavefunctions, 0.07 promolecular).
     #[arg(long, value_parser = within(limits::DENSITY_CUT))]
     cut: Option<f64>,
+    /// The -grad cube holds 100 where s is above this (default 1, NCIPLOT's RDG cutoff; 100
+    /// keeps every s).
+    #[arg(long, value_name = "S", value_parser = within(limits::RDG_CUT))]
+    rdg_cut: Option<f64>,
     /// Keep only the points between fragments: those where no file holds more than 95 % of
     /// the density (needs two files or more).
     #[arg(long)]
@@ -51,14 +53,14 @@ pub struct NciArgs {
 
 /// One fragment's density, kept alive beside the document it came from.
 enum Fragment<'a> {
-    Wavefunction(WavefunctionDensity<'a>),
+    Wavefunction(Box<WavefunctionDensity<'a>>),
     Promolecular(Promolecule),
 }
 
 impl Fragment<'_> {
     fn source(&self) -> &dyn DensitySource {
         match self {
-            Fragment::Wavefunction(w) => w,
+            Fragment::Wavefunction(w) => w.as_ref(),
             Fragment::Promolecular(p) => p,
         }
     }
@@ -80,7 +82,7 @@ pub fn nci(args: &NciArgs) -> Result<()> {
             )
         } else {
             match &doc.wavefunction {
-                Some(wf) => Fragment::Wavefunction(WavefunctionDensity::new(wf)),
+                Some(wf) => Fragment::Wavefunction(Box::new(WavefunctionDensity::new(wf))),
                 None => bail!(
                     "{}: no wavefunction (Molden, fchk, wfn, wfx or MKL) for nci: --promolecular sums spherical atoms instead",
                     file.display()
@@ -89,32 +91,35 @@ pub fn nci(args: &NciArgs) -> Result<()> {
         };
         fragments.push(fragment);
     }
-    let step = args.step.map_or(DEFAULT_STEP_BOHR, |s| s * BOHR_PER_ANGSTROM);
-    let margin = args.margin.map_or(DEFAULT_MARGIN_BOHR, |m| m * BOHR_PER_ANGSTROM);
     let atoms: Vec<_> = docs.iter().flat_map(|d| d.molecule.atoms.iter().cloned()).collect();
     let molecule = Molecule::new(atoms);
-    let (lo, hi) = molecule.bounds().context("no atoms")?;
-    let (lo, hi) = (lo - DVec3::splat(margin), hi + DVec3::splat(margin));
-    // Counted in floating point first: far-flung atoms must not overflow the count.
-    let sides = ((hi - lo) / step).ceil().max(DVec3::ONE) + DVec3::ONE;
-    let points = sides.x * sides.y * sides.z;
-    if points.is_nan() || points > limits::NCI_POINTS as f64 {
+    let spec = match &args.grid_like {
+        Some(cube) => grid_of(cube)?,
+        None => {
+            let (lo, hi) = molecule.bounds().context("no atoms")?;
+            let step = args.step.unwrap_or(nci::NCIPLOT_STEP_ANGSTROM) * BOHR_PER_ANGSTROM;
+            let margin = args.margin.unwrap_or(nci::NCIPLOT_MARGIN_ANGSTROM) * BOHR_PER_ANGSTROM;
+            nci::nciplot_grid(lo, hi, margin, step)
+        }
+    };
+    let step = spec.step(0).length();
+    // Counted in floating point: far-flung atoms must not overflow the count.
+    let points: f64 = spec.dims.iter().map(|&n| n as f64).product();
+    if points > limits::NCI_POINTS as f64 {
+        let [nx, ny, nz] = spec.dims;
         bail!(
-            "a {:.0}×{:.0}×{:.0} grid ({points:.3e} points) is more than nci holds ({}): a larger --step (now {:.4} Å) or a smaller --margin makes it fit",
-            sides.x,
-            sides.y,
-            sides.z,
+            "a {nx}×{ny}×{nz} grid ({points:.3e} points) is more than nci holds ({}): a larger --step (now {:.4} Å) or a smaller --margin makes it fit",
             limits::NCI_POINTS,
             step * ANGSTROM_PER_BOHR
         );
     }
-    let spec = GridSpec::spaced(lo, hi, step);
     let settings = NciSettings {
         density_cut: args.cut.unwrap_or(if args.promolecular {
             nci::PROMOLECULAR_DENSITY_CUT
         } else {
             nci::WAVEFUNCTION_DENSITY_CUT
         }),
+        rdg_cut: args.rdg_cut.unwrap_or(nci::NCIPLOT_RDG_CUT),
         intermolecular: args.intermolecular.then_some(nci::INTERMOLECULAR_SHARE),
     };
     let sources: Vec<&dyn DensitySource> = fragments.iter().map(Fragment::source).collect();
@@ -150,6 +155,13 @@ pub fn nci(args: &NciArgs) -> Result<()> {
         if args.intermolecular { ", between fragments" } else { "" },
     );
     Ok(())
+}
+
+/// The grid of the first volume of the cube file `path`.
+fn grid_of(path: &Path) -> Result<GridSpec> {
+    let doc = formats::load(path).with_context(|| format!("reading the grid of {}", path.display()))?;
+    let grid = doc.volumes.first().with_context(|| format!("{}: no grid in it", path.display()))?;
+    Ok(GridSpec { dims: grid.dims, world_from_grid: grid.world_from_grid })
 }
 
 /// `prefix` with `suffix` appended to its file name (`out/dimer` → `out/dimer-dens.cube`).

@@ -63,7 +63,7 @@ impl PreparedBasis {
             return Potential::new(molecule, wf).at_points(points);
         }
         if quantity.from_density_derivatives() {
-            let source = WavefunctionDensity { basis: self.clone(), wavefunction: wf };
+            let source = WavefunctionDensity::with_basis(self.clone(), wf);
             return nci::quantity_at_points(&source, quantity, points);
         }
         points.par_chunks(1024).flat_map_iter(|chunk| self.quantity_at(wf, quantity, chunk)).collect()
@@ -92,7 +92,7 @@ impl PreparedBasis {
                     .flat_map(|i| (0..grid.dims[1]).flat_map(move |j| (0..grid.dims[2]).map(move |k| (i, j, k))))
                     .map(|(i, j, k)| grid.point(i, j, k))
                     .collect();
-                let source = WavefunctionDensity { basis: self.clone(), wavefunction: wf };
+                let source = WavefunctionDensity::with_basis(self.clone(), wf);
                 nci::quantity_at_points(&source, quantity, &points)
             }
         }

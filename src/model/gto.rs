@@ -235,6 +235,56 @@ impl PreparedBasis {
         self.n_functions
     }
 
+    /// A basis with one shell per group: group g's function k is Σ f · (function k of shell s)
+    /// over its (s, f), the shells' primitives side by side with f folded into their
+    /// coefficients (each primitive keeps its cutoff, so the same terms are dropped as in the
+    /// shells it came from). The shells of a group share centre, l and kind.
+    ///
+    /// Panics when a group is empty or mixes centres, l or kinds.
+    pub fn merged(&self, groups: &[Vec<(usize, f64)>]) -> Self {
+        let mut out = Self {
+            shells: Vec::with_capacity(groups.len()),
+            exponents: Vec::new(),
+            coefficients: Vec::new(),
+            primitive_cutoffs2: Vec::new(),
+            powers: self.powers.clone(),
+            component_factors: self.component_factors.clone(),
+            pure_matrices: self.pure_matrices.clone(),
+            threshold: self.threshold,
+            n_functions: 0,
+            n_cartesians: 0,
+        };
+        for group in groups {
+            let first = &self.shells[group[0].0];
+            let first_primitive = out.exponents.len() as u32;
+            let mut cutoff: f64 = 0.0;
+            for &(s, f) in group {
+                let shell = &self.shells[s];
+                assert!(
+                    shell.center == first.center && shell.l == first.l && shell.pure == first.pure,
+                    "merged shells share centre, l and kind"
+                );
+                cutoff = cutoff.max(shell.cutoff);
+                for j in shell.primitives() {
+                    out.exponents.push(self.exponents[j]);
+                    out.coefficients.push(self.coefficients[j] * f);
+                    out.primitive_cutoffs2.push(self.primitive_cutoffs2[j]);
+                }
+            }
+            out.shells.push(PreparedShell {
+                first_function: out.n_functions as u32,
+                first_cartesian: out.n_cartesians as u32,
+                first_primitive,
+                n_primitives: out.exponents.len() as u32 - first_primitive,
+                cutoff,
+                ..*first
+            });
+            out.n_functions += first.n_functions as usize;
+            out.n_cartesians += n_cartesian(first.l);
+        }
+        out
+    }
+
     /// Radial part Σ c_j exp(−α_j r²) and, when `with_derivative`, Σ −2α_j c_j exp(−α_j r²).
     fn radial(&self, shell: &PreparedShell, r2: f64) -> (f64, f64) {
         let (mut v, mut dv) = (0.0, 0.0);
@@ -319,6 +369,7 @@ impl PreparedBasis {
     /// part R(r²) = Σ c_j exp(−α_j r²) and a monomial M,
     /// ∂a∂b(M R) = (∂a∂b M) R + (∂a M x_b + ∂b M x_a) R₁ + M (x_a x_b R₂ + δ_ab R₁),
     /// with R₁ = Σ −2α_j c_j e_j and R₂ = Σ 4α_j² c_j e_j.
+    #[inline(always)]
     pub(super) fn shell_second_derivatives(
         &self,
         shell: &PreparedShell,
@@ -343,44 +394,38 @@ impl PreparedBasis {
                 rad2 += 4.0 * alpha * alpha * e;
             }
         }
-        let mut pw = [[1.0f64; 8]; 3];
+        // Per axis and power p: x^p, p x^(p−1) and p(p−1) x^(p−2).
+        let mut pw = [[[0.0f64; 3]; 8]; 3];
         for axis in 0..3 {
-            for k in 1..=l {
-                pw[axis][k] = pw[axis][k - 1] * d[axis];
+            let x = d[axis];
+            pw[axis][0] = [1.0, 0.0, 0.0];
+            for p in 1..=l {
+                let [v, d1, _] = pw[axis][p - 1];
+                pw[axis][p] = [v * x, p as f64 * v, p as f64 * d1];
             }
         }
-        // ∂^da/∂x^da … of x^a y^b z^c.
-        let derivative = |e: [u32; 3], order: [u32; 3]| -> f64 {
-            let mut v = 1.0;
-            for axis in 0..3 {
-                let (p, k) = (e[axis], order[axis]);
-                if k > p {
-                    return 0.0;
-                }
-                for m in 0..k {
-                    v *= (p - m) as f64;
-                }
-                v *= pw[axis][(p - k) as usize];
-            }
-            v
-        };
-        const UNIT: [[u32; 3]; 3] = [[1, 0, 0], [0, 1, 0], [0, 0, 1]];
         const PAIRS: [(usize, usize); 6] = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
         cart.clear();
         for (p, f) in self.powers[l].iter().zip(&self.component_factors[l]) {
-            let m = derivative(*p, [0; 3]);
-            let dm: [f64; 3] = std::array::from_fn(|a| derivative(*p, UNIT[a]));
+            let [x, y, z] = [pw[0][p[0] as usize], pw[1][p[1] as usize], pw[2][p[2] as usize]];
+            let m = x[0] * y[0] * z[0];
+            let dm = [x[1] * y[0] * z[0], x[0] * y[1] * z[0], x[0] * y[0] * z[1]];
+            let ddm = [
+                x[2] * y[0] * z[0],
+                x[1] * y[1] * z[0],
+                x[1] * y[0] * z[1],
+                x[0] * y[2] * z[0],
+                x[0] * y[1] * z[1],
+                x[0] * y[0] * z[2],
+            ];
             let mut c = [0.0; 10];
             c[0] = m * rad;
             for a in 0..3 {
                 c[1 + a] = dm[a] * rad + m * d[a] * rad1;
             }
             for (k, &(a, b)) in PAIRS.iter().enumerate() {
-                let order = [UNIT[a][0] + UNIT[b][0], UNIT[a][1] + UNIT[b][1], UNIT[a][2] + UNIT[b][2]];
                 let delta = if a == b { rad1 } else { 0.0 };
-                c[4 + k] = derivative(*p, order) * rad
-                    + (dm[a] * d[b] + dm[b] * d[a]) * rad1
-                    + m * (d[a] * d[b] * rad2 + delta);
+                c[4 + k] = ddm[k] * rad + (dm[a] * d[b] + dm[b] * d[a]) * rad1 + m * (d[a] * d[b] * rad2 + delta);
             }
             cart.push(c.map(|v| v * f));
         }

@@ -5,6 +5,8 @@
 //! s = |∇ρ| / (2(3π²)^{1/3} ρ^{4/3}), λ₂ (the Hessian's middle eigenvalue) and sign(λ₂)ρ, and
 //! NCIPLOT's two grids (`-dens`: 100·sign(λ₂)ρ, `-grad`: s) for fragments whose densities add.
 
+use std::collections::HashMap;
+
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -104,20 +106,103 @@ pub trait DensitySource: Sync {
 
 /// A wavefunction's total density as a [`DensitySource`].
 pub struct WavefunctionDensity<'a> {
+    /// The wavefunction's basis as it is.
     pub basis: PreparedBasis,
     pub wavefunction: &'a Wavefunction,
+    /// What the density is evaluated over: the basis contracted for the occupied orbitals
+    /// ([`occupied_contraction`]).
+    contracted: PreparedBasis,
+    /// Per function of `contracted`, its coefficient in each occupied orbital.
+    coefficients: Vec<f64>,
+    occupations: Vec<f64>,
 }
 
 impl<'a> WavefunctionDensity<'a> {
     pub fn new(wavefunction: &'a Wavefunction) -> Self {
-        Self { basis: PreparedBasis::new(&wavefunction.basis), wavefunction }
+        Self::with_basis(PreparedBasis::new(&wavefunction.basis), wavefunction)
+    }
+
+    /// With `basis` already prepared for `wavefunction`'s basis.
+    pub fn with_basis(basis: PreparedBasis, wavefunction: &'a Wavefunction) -> Self {
+        let (coefficients, occupations) = occupied_matrix(&basis, wavefunction);
+        let (contracted, coefficients) = occupied_contraction(&basis, &coefficients, occupations.len());
+        Self { basis, wavefunction, contracted, coefficients, occupations }
+    }
+
+    /// Basis functions the density is evaluated over (at most the basis's).
+    pub fn contracted_functions(&self) -> usize {
+        self.contracted.n_functions()
     }
 }
 
 impl DensitySource for WavefunctionDensity<'_> {
     fn derivatives_at(&self, points: &[DVec3], out: &mut [DensityDerivatives]) {
-        self.basis.density_derivatives_into(self.wavefunction, points, out);
+        self.contracted.occupied_derivatives_into(&self.coefficients, &self.occupations, points, out);
     }
+}
+
+/// Two shells' coefficient blocks are taken as proportional when they differ by no more than
+/// this fraction of the larger block's largest coefficient after scaling: far below the 8–10
+/// digits wavefunction files print.
+pub const PROPORTIONAL: f64 = 1e-7;
+
+/// `wf`'s occupied orbitals as a function-major matrix (row k: function k's coefficient in
+/// each occupied orbital) and their occupations.
+fn occupied_matrix(basis: &PreparedBasis, wf: &Wavefunction) -> (Vec<f64>, Vec<f64>) {
+    let occupied: Vec<_> = wf.orbitals.iter().filter(|o| o.occupation != 0.0).collect();
+    let n = occupied.len();
+    let mut matrix = vec![0.0; basis.n_functions() * n];
+    for (o, orbital) in occupied.iter().enumerate() {
+        for (k, &c) in orbital.coefficients.iter().enumerate().take(basis.n_functions()) {
+            matrix[k * n + o] = c;
+        }
+    }
+    (matrix, occupied.iter().map(|o| o.occupation).collect())
+}
+
+/// The basis contracted for the occupied orbitals, and their coefficients over it: shells of
+/// one centre, l and kind whose coefficient blocks (every function in every occupied orbital)
+/// are proportional become one function set, Σ f_s χ_s with the block of the first shell
+/// (within [`PROPORTIONAL`]), and shells no occupied orbital uses are left out. AIM files
+/// (.wfn, .wfx) write each contraction's primitives as functions of their own whose
+/// coefficients are the contraction's times the primitive's: this contracts them again, the
+/// density unchanged (to the files' digits) at a third of the cost or less.
+pub fn occupied_contraction(
+    basis: &PreparedBasis,
+    coefficients: &[f64],
+    n_occupied: usize,
+) -> (PreparedBasis, Vec<f64>) {
+    let n = n_occupied;
+    let block = |s: usize| {
+        let shell = &basis.shells[s];
+        &coefficients[shell.first_function as usize * n..(shell.first_function + shell.n_functions) as usize * n]
+    };
+    let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+    let mut groups: Vec<Vec<(usize, f64)>> = Vec::new();
+    let mut by_kind: HashMap<([u64; 3], u32, bool), Vec<usize>> = HashMap::new();
+    for (s, shell) in basis.shells.iter().enumerate() {
+        let b = block(s);
+        let largest = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        if largest == 0.0 || !largest.is_finite() {
+            continue;
+        }
+        let candidates = by_kind.entry((shell.center.map(f64::to_bits), shell.l, shell.pure)).or_default();
+        let found = candidates.iter().find_map(|&g| {
+            let a = block(groups[g][0].0);
+            let f = dot(b, a) / dot(a, a);
+            let tolerance = PROPORTIONAL * largest;
+            (b.iter().zip(a).all(|(x, y)| (x - f * y).abs() <= tolerance)).then_some((g, f))
+        });
+        match found {
+            Some((g, f)) => groups[g].push((s, f)),
+            None => {
+                candidates.push(groups.len());
+                groups.push(vec![(s, 1.0)]);
+            }
+        }
+    }
+    let matrix = groups.iter().flat_map(|g| block(g[0].0).iter().copied()).collect();
+    (basis.merged(&groups), matrix)
 }
 
 impl PreparedBasis {
@@ -126,16 +211,55 @@ impl PreparedBasis {
     /// functions' analytic ones (only the shells within their cutoff of the point).
     pub fn density_derivatives(&self, wf: &Wavefunction, points: &[DVec3]) -> Vec<DensityDerivatives> {
         let mut out = vec![DensityDerivatives::default(); points.len()];
-        self.density_derivatives_into(wf, points, &mut out);
+        let (coefficients, occupations) = occupied_matrix(self, wf);
+        self.occupied_derivatives_into(&coefficients, &occupations, points, &mut out);
         out
     }
 
-    fn density_derivatives_into(&self, wf: &Wavefunction, points: &[DVec3], out: &mut [DensityDerivatives]) {
-        let occupied: Vec<(&[f64], f64)> = (wf.orbitals.iter())
-            .filter(|o| o.occupation != 0.0)
-            .map(|o| (o.coefficients.as_slice(), o.occupation))
-            .collect();
+    /// [`Self::density_derivatives`] of orbitals given as a function-major matrix
+    /// (`coefficients[k · n + i]`: function k in orbital i, n = `occupations.len()`).
+    fn occupied_derivatives_into(
+        &self,
+        coefficients: &[f64],
+        occupations: &[f64],
+        points: &[DVec3],
+        out: &mut [DensityDerivatives],
+    ) {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
+            // SAFETY: the CPU has the features the function is compiled for.
+            unsafe { self.occupied_derivatives_avx2(coefficients, occupations, points, out) };
+            return;
+        }
+        self.occupied_derivatives_kernel(coefficients, occupations, points, out);
+    }
+
+    /// [`Self::occupied_derivatives_kernel`] compiled for AVX2 and FMA (the same sums, fused:
+    /// last-digit differences only).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    fn occupied_derivatives_avx2(
+        &self,
+        coefficients: &[f64],
+        occupations: &[f64],
+        points: &[DVec3],
+        out: &mut [DensityDerivatives],
+    ) {
+        self.occupied_derivatives_kernel(coefficients, occupations, points, out);
+    }
+
+    #[inline(always)]
+    fn occupied_derivatives_kernel(
+        &self,
+        coefficients: &[f64],
+        occupations: &[f64],
+        points: &[DVec3],
+        out: &mut [DensityDerivatives],
+    ) {
+        let n = occupations.len();
         let mut phi = vec![[0.0; 10]; self.n_functions()];
+        // Component-major: psi[t · n + i] is component t of orbital i.
+        let mut psi = vec![0.0; 10 * n];
         let mut cart = Vec::new();
         let mut active: Vec<usize> = Vec::new();
         // Shells that can reach any of the points: the rest are never looked at.
@@ -154,27 +278,25 @@ impl PreparedBasis {
                     active.extend(s.functions());
                 }
             }
-            let mut rho = 0.0;
-            let mut g = [0.0; 3];
-            let mut h = [0.0; 6];
-            for &(c, n) in &occupied {
-                let mut psi = [0.0; 10];
-                for &k in &active {
-                    let ck = c.get(k).copied().unwrap_or(0.0);
-                    if ck != 0.0 {
-                        for (a, b) in psi.iter_mut().zip(&phi[k]) {
-                            *a += ck * b;
-                        }
+            psi.fill(0.0);
+            for &k in &active {
+                let row = &coefficients[k * n..(k + 1) * n];
+                for (t, &v) in phi[k].iter().enumerate() {
+                    for (p, c) in psi[t * n..(t + 1) * n].iter_mut().zip(row) {
+                        *p += v * c;
                     }
                 }
-                rho += n * psi[0] * psi[0];
-                for a in 0..3 {
-                    g[a] += 2.0 * n * psi[0] * psi[1 + a];
-                }
-                for (k, (a, b)) in PAIRS.into_iter().enumerate() {
-                    h[k] += 2.0 * n * (psi[0] * psi[4 + k] + psi[1 + a] * psi[1 + b]);
-                }
             }
+            let c = |t: usize| &psi[t * n..(t + 1) * n];
+            let dot =
+                |a: &[f64], b: &[f64]| -> f64 { a.iter().zip(b).zip(occupations).map(|((x, y), w)| w * x * y).sum() };
+            let v = c(0);
+            let rho = dot(v, v);
+            let g: [f64; 3] = std::array::from_fn(|a| 2.0 * dot(v, c(1 + a)));
+            let h: [f64; 6] = std::array::from_fn(|k| {
+                let (a, b) = PAIRS[k];
+                2.0 * (dot(v, c(4 + k)) + dot(c(1 + a), c(1 + b)))
+            });
             *o = DensityDerivatives { rho, gradient: DVec3::from_array(g), hessian: symmetric(h) };
         }
     }
@@ -207,11 +329,35 @@ pub fn quantity_at_points(source: &dyn DensitySource, quantity: Quantity, points
         .collect()
 }
 
+/// NCIPLOT's RDG cutoff (its `dimcut`, CUTOFFS' second number): its `-grad` cube holds 100
+/// where s is above it.
+pub const NCIPLOT_RDG_CUT: f64 = 1.0;
+
+/// NCIPLOT's default grid step, Å (its `xinc`: 0.1 Å; FINE 0.05, ULTRAFINE 0.025, COARSE 0.15).
+pub const NCIPLOT_STEP_ANGSTROM: f64 = 0.1;
+
+/// NCIPLOT's default space around the atoms, Å (its `rthres`; COARSE without INTERMOLECULAR
+/// uses 0.5).
+pub const NCIPLOT_MARGIN_ANGSTROM: f64 = 0.75;
+
+/// NCIPLOT's automatic grid over atoms whose box is `lo..hi` (bohr): from `lo − margin`,
+/// `step` apart, ⌈(hi − lo + 2·margin)/step⌉ points per axis (its `nstep`), so the last point
+/// may stop short of `hi + margin`. At least one point per axis; counts beyond `usize` saturate
+/// (callers check the product before allocating).
+pub fn nciplot_grid(lo: DVec3, hi: DVec3, margin: f64, step: f64) -> GridSpec {
+    let (lo, hi) = (lo - DVec3::splat(margin), hi + DVec3::splat(margin));
+    let dims = ((hi - lo) / step).ceil().to_array().map(|n| if n >= 1.0 { n as usize } else { 1 });
+    GridSpec::new(lo, [DVec3::X * step, DVec3::Y * step, DVec3::Z * step], dims)
+}
+
 /// How NCIPLOT's grids are made.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct NciSettings {
     /// Points whose total ρ is above this are cut.
     pub density_cut: f64,
+    /// The `-grad` grid holds [`CUT_VALUE`] where s is above this (NCIPLOT's RDG cutoff,
+    /// [`NCIPLOT_RDG_CUT`]; [`CUT_VALUE`] keeps every s, capped at 100).
+    pub rdg_cut: f64,
     /// With several fragments, the largest share of a point's density one fragment may hold
     /// for the point to be kept (`None`: every point is kept).
     pub intermolecular: Option<f64>,
@@ -267,7 +413,8 @@ pub fn nci_grid(fragments: &[&dyn DensitySource], grid: &GridSpec, settings: Nci
                     let s = t.reduced_gradient();
                     let k = iy * nz + iz;
                     dens[k] = (100.0 * t.sign_lambda2_rho()) as f32;
-                    grad[k] = if s.is_finite() { s.min(CUT_VALUE as f64) as f32 } else { CUT_VALUE };
+                    grad[k] =
+                        if s.is_finite() && s <= settings.rdg_cut { s.min(CUT_VALUE as f64) as f32 } else { CUT_VALUE };
                     kept += 1;
                 }
             }
@@ -376,7 +523,7 @@ mod tests {
         let wf = wavefunction();
         let source = WavefunctionDensity::new(&wf);
         let grid = GridSpec::cube(DVec3::splat(-2.0), DVec3::new(4.0, 2.0, 2.0), 9);
-        let settings = NciSettings { density_cut: 0.05, intermolecular: None };
+        let settings = NciSettings { density_cut: 0.05, rdg_cut: CUT_VALUE as f64, intermolecular: None };
         let one = nci_grid(&[&source], &grid, settings);
         let two = nci_grid(&[&source, &source], &grid, settings);
         let mut cut = 0;
@@ -406,6 +553,79 @@ mod tests {
             |share| nci_grid(&[&source, &source], &grid, NciSettings { intermolecular: Some(share), ..settings });
         assert_eq!(inter(0.95).kept, two.kept);
         assert_eq!(inter(0.4).kept, 0);
+    }
+
+    #[test]
+    fn primitives_written_apart_are_contracted_again_and_give_the_same_density() {
+        // The test wavefunction as an AIM file writes it: each contraction's primitives as
+        // one-primitive shells, the orbitals' coefficients spread over them in proportion.
+        let wf = wavefunction();
+        let whole = PreparedBasis::new(&wf.basis);
+        let mut shells = Vec::new();
+        let mut orbitals: Vec<Vec<f64>> = vec![Vec::new(); wf.orbitals.len()];
+        let offsets = wf.basis.shell_offsets();
+        for (s, shell) in wf.basis.shells.iter().enumerate() {
+            let prepared = &whole.shells[s];
+            for j in prepared.primitives() {
+                shells.push(Shell { exponents: vec![whole.exponents[j]], coefficients: vec![1.0], ..shell.clone() });
+                // The lone primitive normalised to 1: its share of the contraction.
+                let lone = PreparedBasis::new(&Basis { shells: vec![shells.last().unwrap().clone()] });
+                let share = whole.coefficients[j] / lone.coefficients[0];
+                for (o, orbital) in orbitals.iter_mut().zip(&wf.orbitals) {
+                    let n = shell.n_functions();
+                    o.extend(orbital.coefficients[offsets[s]..offsets[s] + n].iter().map(|c| c * share));
+                }
+            }
+        }
+        let split = Wavefunction {
+            basis: Basis { shells },
+            orbitals: (wf.orbitals.iter().zip(orbitals))
+                .map(|(o, c)| MolecularOrbital { coefficients: c, ..o.clone() })
+                .collect(),
+            ..wf.clone()
+        };
+        // An orbital with nothing in it is no reason to keep a function.
+        let mut with_empty = split.clone();
+        with_empty.orbitals.push(MolecularOrbital { occupation: 0.0, ..with_empty.orbitals[0].clone() });
+        let (a, b) = (WavefunctionDensity::new(&wf), WavefunctionDensity::new(&with_empty));
+        assert_eq!(b.basis.n_functions(), 3 * a.basis.n_functions());
+        assert_eq!(b.contracted_functions(), a.basis.n_functions());
+        let points: Vec<DVec3> = (0..30).map(|i| DVec3::new(0.1 * i as f64 - 1.0, 0.3, 0.05 * i as f64)).collect();
+        let (mut x, mut y) = (vec![DensityDerivatives::default(); 30], vec![DensityDerivatives::default(); 30]);
+        a.derivatives_at(&points, &mut x);
+        b.derivatives_at(&points, &mut y);
+        let direct = b.basis.density_derivatives(&split, &points);
+        for ((x, y), z) in x.iter().zip(&y).zip(&direct) {
+            for (u, v) in [(x, y), (x, z)] {
+                assert!((u.rho - v.rho).abs() < 1e-12 * (1.0 + u.rho));
+                assert!((u.gradient - v.gradient).length() < 1e-11);
+                for (r, q) in u.hessian.iter().flatten().zip(v.hessian.iter().flatten()) {
+                    assert!((r - q).abs() < 1e-10, "{r} vs {q}");
+                }
+            }
+        }
+        // Blocks that are not proportional stay apart: a generic wavefunction keeps every shell.
+        assert_eq!(a.contracted_functions(), a.basis.n_functions());
+    }
+
+    #[test]
+    fn nciplot_grid_counts_steps_as_nciplot_does() {
+        // NCIPLOT 4.2's header for its benzene + ethene test (two .wfn files) at its default
+        // step: origin −6.060647 −5.717942 −1.380388, 65 × 61 × 51 points 0.188973 bohr
+        // apart, from atoms spanning these corners (bohr).
+        let step = NCIPLOT_STEP_ANGSTROM * crate::model::units::BOHR_PER_ANGSTROM;
+        let margin = NCIPLOT_MARGIN_ANGSTROM * crate::model::units::BOHR_PER_ANGSTROM;
+        let lo = DVec3::new(-4.64335224, -4.3006473, 0.03690653);
+        let hi = DVec3::new(4.64333871, 4.30064909, 6.67217064);
+        let grid = nciplot_grid(lo, hi, margin, step);
+        assert_eq!(grid.dims, [65, 61, 51]);
+        assert!((grid.origin() - DVec3::new(-6.060647, -5.717942, -1.380388)).length() < 2e-6);
+        assert!((grid.step(0) - DVec3::X * 0.188973).length() < 1e-6);
+        assert_eq!(grid.step(1), DVec3::Y * step);
+        // An exact multiple of the step gives that many points, no extra one beyond; a flat
+        // box still has one point.
+        let exact = nciplot_grid(DVec3::ZERO, DVec3::new(1.0, 0.5, 0.0), 0.0, 0.25);
+        assert_eq!(exact.dims, [4, 2, 1]);
     }
 
     fn pb_point(source: &WavefunctionDensity, p: DVec3) -> DensityDerivatives {

@@ -70,6 +70,8 @@ pub const SPACING: RangeInclusive<f64> = 1e-3..=10.0;
 pub const MARGIN: RangeInclusive<f64> = 0.0..=100.0;
 /// The density above which `nci` cuts points (a.u.).
 pub const DENSITY_CUT: RangeInclusive<f64> = 1e-6..=10.0;
+/// The RDG cutoff of `nci`'s -grad cube.
+pub const RDG_CUT: RangeInclusive<f64> = 1e-3..=100.0;
 /// The most points an `nci` grid may have: its two cubes are held in memory as f32.
 pub const NCI_POINTS: u64 = 1 << 27;
 /// Frames of a movie, a mode's period or a benchmark, and a movie's frames per second.
