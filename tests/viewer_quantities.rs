@@ -723,3 +723,31 @@ fn a_td_checkpoint_lists_its_states_and_a_click_on_a_band_picks_one_its_density_
     assert_eq!(shown, Some(Source::Wavefunction(Quantity::Attachment)));
     assert!(h.query_by_label_contains("1.001 electrons move").is_some(), "the electrons moved");
 }
+
+/// Pixels of `img` that are an NCI surface's blue-green (attraction): green and blue above red.
+fn blue_green(img: &image::RgbaImage) -> usize {
+    img.pixels().filter(|p| p[1] as i32 > p[0] as i32 + 40 && p[2] as i32 > p[0] as i32 + 40).count()
+}
+
+#[test]
+fn a_water_dimer_s_nci_surface_shows_its_hydrogen_bond_in_blue_green() {
+    let mut h = open(vec![fixture("nci/water_dimer_631gs.molden")]);
+    wait_loaded(&mut h);
+    let dir = tempfile::tempdir().unwrap();
+    let before = blue_green(&picture(&mut h, dir.path(), "homo"));
+    // A coarser grid than the window's: the density's Hessian at every point is the cost.
+    h.state_mut().objects[0].state.evaluation.grid_points = 48;
+    h.get_by_label("NCI surface").click();
+    h.run_steps(3);
+    wait_loaded(&mut h);
+    let o = &h.state().objects[0].state;
+    let q = o.selected_quantity().expect("the NCI surface is selected");
+    assert_eq!(q.source, Source::Wavefunction(Quantity::NciGradient));
+    let iso = q.isosurfaces[0];
+    assert_eq!((iso.color_by, iso.color_range), (Some(Wavefunction(Quantity::SignLambda2Rho)), Some(0.05)));
+    assert!(o.quantities.iter().filter(|q| q.visible).count() == 1, "it takes the view");
+    let shown = picture(&mut h, dir.path(), "nci");
+    let disc = blue_green(&shown);
+    eprintln!("blue-green pixels: {before} with the HOMO, {disc} with the NCI surface");
+    assert!(disc > 30 && disc > 5 * before.max(1), "the hydrogen bond's disc: {disc} pixels (HOMO: {before})");
+}

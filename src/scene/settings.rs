@@ -204,6 +204,9 @@ pub struct IsosurfaceSettings {
     /// |value| over the vertices) when `None`.
     #[serde(default)]
     pub color_range: Option<f32>,
+    /// The map those colours are taken from.
+    #[serde(default)]
+    pub color_scheme: super::coloring::ColorScheme,
 }
 
 impl Default for IsosurfaceSettings {
@@ -220,6 +223,7 @@ impl Default for IsosurfaceSettings {
             tuning: Default::default(),
             color_by: None,
             color_range: None,
+            color_scheme: Default::default(),
         }
     }
 }
