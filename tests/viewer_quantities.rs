@@ -750,4 +750,38 @@ fn a_water_dimer_s_nci_surface_shows_its_hydrogen_bond_in_blue_green() {
     let disc = blue_green(&shown);
     eprintln!("blue-green pixels: {before} with the HOMO, {disc} with the NCI surface");
     assert!(disc > 30 && disc > 5 * before.max(1), "the hydrogen bond's disc: {disc} pixels (HOMO: {before})");
+
+    // The NCI plot below the view: the hydrogen bond is the spike of low s at sign(λ₂)ρ ≈ −0.02.
+    let start = std::time::Instant::now();
+    while h.state().nci_plot.points.is_empty() {
+        assert!(start.elapsed().as_secs() < 300, "no NCI plot: {:?}", h.state().nci_plot.error);
+        std::thread::sleep(std::time::Duration::from_millis(50));
+        h.run_steps(1);
+    }
+    h.run_steps(2);
+    let points = h.state().nci_plot.points.clone();
+    let lowest = |range: std::ops::Range<f64>| {
+        points.iter().filter(|p| range.contains(&p[0])).map(|p| p[1]).fold(f64::INFINITY, f64::min)
+    };
+    let (bond, positive) = (lowest(-0.04..-0.01), lowest(0.01..0.04));
+    assert!(
+        bond < 0.6 && positive > bond + 0.2,
+        "lowest s: {bond:.2} at the hydrogen bond, {positive:.2} on the positive side"
+    );
+    // A drag across the spike keeps the disc's colours; across the empty positive side, the
+    // disc turns grey.
+    let transform = h.state().nci_plot.transform.expect("the plot is drawn");
+    let at = |x: f64| transform.position_from_point(&egui_plot::PlotPoint::new(x, 1.0));
+    let window_of = |h: &mut Harness<'static, OrbApp>, from: f64, to: f64| {
+        drag(h, at(from), at(to).x - at(from).x);
+        wait_loaded(h);
+        let iso = h.state().objects[0].state.selected_quantity().unwrap().isosurfaces[0];
+        iso.color_window.expect("a drag sets the colour window")
+    };
+    let [lo, hi] = window_of(&mut h, -0.04, -0.01);
+    assert!((lo + 0.04).abs() < 0.004 && (hi + 0.01).abs() < 0.004, "[{lo}, {hi}]");
+    let lit = blue_green(&picture(&mut h, dir.path(), "lit"));
+    window_of(&mut h, 0.01, 0.04);
+    let unlit = blue_green(&picture(&mut h, dir.path(), "unlit"));
+    assert!(lit * 10 > disc * 8 && unlit * 10 < disc, "the disc {disc} px, lit {lit}, grey {unlit}");
 }

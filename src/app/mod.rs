@@ -12,6 +12,7 @@ pub mod legend;
 mod loader;
 pub mod measure;
 pub mod models;
+pub mod nci_plot;
 mod orbitals;
 mod panels;
 pub mod panes;
@@ -267,6 +268,8 @@ pub struct OrbApp {
     pub scan_dialog: compute::ScanDialog,
     /// The plane map beside the view.
     pub plane: plane_pane::PlanePane,
+    /// The NCI plot below the view, while an NCI surface is the selected quantity.
+    pub nci_plot: nci_plot::NciPlot,
     pub computing: Option<compute::ComputeRun>,
     /// The *Compute orbitals* window: the object and the level of theory.
     pub orbitals_dialog: Option<(usize, crate::sources::compute::Settings)>,
@@ -438,6 +441,10 @@ impl OrbApp {
             plane: {
                 let repaint = cc.egui_ctx.clone();
                 plane_pane::PlanePane::new(move || repaint.request_repaint())
+            },
+            nci_plot: {
+                let repaint = cc.egui_ctx.clone();
+                nci_plot::NciPlot::new(move || repaint.request_repaint())
             },
             computing: None,
             orbitals_dialog: None,
@@ -1036,6 +1043,9 @@ impl OrbApp {
         }
         if let Some(o) = self.objects.get_mut(self.active).filter(|_| self.scan.is_none()) {
             vibrations::panel(ui, &o.doc, &mut o.state.vibration, &mut self.spectrum);
+        }
+        if let Some(o) = self.objects.get_mut(self.active).filter(|_| self.scan.is_none()) {
+            self.nci_plot.panel(ui, &o.doc, o.state.selected_quantity_mut());
         }
         if let Some(o) = self.objects.get_mut(self.active).filter(|_| self.scan.is_none()) {
             let picks = excited::panel(ui, &o.doc, &mut o.state.excited, &mut self.uv_vis);

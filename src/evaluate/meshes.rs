@@ -42,7 +42,7 @@ pub fn color_isosurfaces(
     let asking: Vec<(usize, Source)> =
         owners.zip(0..meshes.len()).filter_map(|(level, k)| level.color_by.map(|s| (k, s))).collect();
     let last = (levels.iter().rev().filter(|l| l.visible))
-        .find_map(|l| l.color_by.map(|s| (s, l.color_range, l.color_scheme)))?;
+        .find_map(|l| l.color_by.map(|s| (s, l.color_range, l.color_scheme, l.color_window)))?;
     // Each quantity evaluated once, over the vertices of every mesh it colours.
     let mut per_mesh: Vec<Option<Vec<Option<f64>>>> = vec![None; meshes.len()];
     let mut sources: Vec<Source> = asking.iter().map(|&(_, s)| s).collect();
@@ -57,8 +57,20 @@ pub fn color_isosurfaces(
     let (mut colored, values): (Vec<&mut Mesh>, Vec<Vec<Option<f64>>>) =
         meshes.iter_mut().zip(per_mesh).filter_map(|((m, _), v)| Some((m, v?))).unzip();
     let map = color_meshes(&mut colored, &values, last.1.map(f64::from), last.2);
+    if let Some([lo, hi]) = last.3 {
+        for (mesh, v) in colored.iter_mut().zip(&values) {
+            for (c, v) in mesh.colors.iter_mut().zip(v) {
+                if v.is_none_or(|v| v < f64::from(lo) || v > f64::from(hi)) {
+                    *c = OUTSIDE_WINDOW;
+                }
+            }
+        }
+    }
     Some((map, color_name(doc, last.0)))
 }
+
+/// The grey of a coloured surface's vertices outside its colour window.
+const OUTSIDE_WINDOW: [f32; 3] = [0.3, 0.3, 0.3];
 
 /// How a colour bar names `source`: "ESP" for an electrostatic potential (the wavefunction's or a
 /// data set that says it is one), else its name, cut to fit the bar.

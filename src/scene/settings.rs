@@ -207,6 +207,10 @@ pub struct IsosurfaceSettings {
     /// The map those colours are taken from.
     #[serde(default)]
     pub color_scheme: super::coloring::ColorScheme,
+    /// Only the vertices whose colouring value lies in this range keep their colours; the rest
+    /// are grey (an NCI plot's brushed spike lit on its surface).
+    #[serde(default)]
+    pub color_window: Option<[f32; 2]>,
 }
 
 impl Default for IsosurfaceSettings {
@@ -224,6 +228,7 @@ impl Default for IsosurfaceSettings {
             color_by: None,
             color_range: None,
             color_scheme: Default::default(),
+            color_window: None,
         }
     }
 }
