@@ -778,6 +778,24 @@ fn a_water_dimer_s_nci_surface_shows_its_hydrogen_bond_in_blue_green() {
         let iso = h.state().objects[0].state.selected_quantity().unwrap().isosurfaces[0];
         iso.color_window.expect("a drag sets the colour window")
     };
+    // The pointer on the disc (between the donor's H and the acceptor's O) marks its point on
+    // the plot, at the hydrogen bond's sign(λ₂)ρ.
+    let atoms = &h.state().objects[0].doc.molecule.atoms;
+    let (donor_h, acceptor) = (atoms[2].position.as_vec3(), atoms[3].position.as_vec3());
+    let (from, to) = (h.state().on_screen(donor_h).unwrap(), h.state().on_screen(acceptor).unwrap());
+    // Along the bond on screen until the pointer rests on the disc (seen nearly edge on).
+    for k in 0..=40 {
+        h.hover_at(from + (to - from) * (0.1 + 0.8 * k as f32 / 40.0));
+        h.run_steps(2);
+        if h.state().nci_plot.hovered.is_some() {
+            break;
+        }
+    }
+    assert!(h.state().nci_plot.hovered.is_some(), "no point of the disc marked under the pointer");
+    let [x, s] = h.state().nci_plot.hovered.unwrap();
+    assert!((-0.04..-0.01).contains(&x) && s < 1.0, "the disc's point: sign(λ₂)ρ {x:.4}, s {s:.2}");
+    h.hover_at(egui::pos2(5.0, 400.0));
+    h.run_steps(2);
     let [lo, hi] = window_of(&mut h, -0.04, -0.01);
     assert!((lo + 0.04).abs() < 0.004 && (hi + 0.01).abs() < 0.004, "[{lo}, {hi}]");
     let lit = blue_green(&picture(&mut h, dir.path(), "lit"));

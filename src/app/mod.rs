@@ -728,6 +728,11 @@ impl OrbApp {
         self.scan_job = Some(ScanJob::start(gpu, source, options, follow, orbitals, move || ctx.request_repaint()));
     }
 
+    /// Where world point `p` (bohr) lies in the window, in the last frame's view.
+    pub fn on_screen(&self, p: glam::Vec3) -> Option<egui::Pos2> {
+        self.viewport.as_ref()?.to_screen(&self.view.camera, p)
+    }
+
     /// Whether a file, a scan or a job of the scene is still being worked on.
     pub fn is_loading(&self) -> bool {
         self.job.is_some()
@@ -1045,6 +1050,15 @@ impl OrbApp {
             vibrations::panel(ui, &o.doc, &mut o.state.vibration, &mut self.spectrum);
         }
         if let Some(o) = self.objects.get_mut(self.active).filter(|_| self.scan.is_none()) {
+            // The surface's point under the pointer, in the object's own frame, marked on the plot.
+            let active = self.active as u32;
+            let nci = crate::scene::Source::Wavefunction(crate::model::orbitals::Quantity::NciGradient);
+            let shows_nci = o.state.selected_quantity().is_some_and(|q| q.source == nci);
+            let hovered = (self.viewport.as_ref().filter(|_| shows_nci))
+                .and_then(|vp| vp.hovered_surface_point(&self.view.camera))
+                .filter(|&(object, _)| object == active)
+                .map(|(_, p)| o.state.placement.world_from_object().inverse().transform_point3(p));
+            self.nci_plot.hover(&o.doc, hovered);
             self.nci_plot.panel(ui, &o.doc, o.state.selected_quantity_mut());
         }
         if let Some(o) = self.objects.get_mut(self.active).filter(|_| self.scan.is_none()) {

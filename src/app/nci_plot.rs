@@ -13,7 +13,7 @@ use crate::model::Document;
 use crate::model::GridSpec;
 use crate::model::extent::quantity_box;
 use crate::model::gto::PreparedBasis;
-use crate::model::nci::{self, NciSettings, WAVEFUNCTION_DENSITY_CUT, WavefunctionDensity};
+use crate::model::nci::{self, DensitySource, NciSettings, WAVEFUNCTION_DENSITY_CUT, WavefunctionDensity};
 use crate::model::orbitals::Quantity;
 use crate::scene::{IsoLevel, QuantityState, Source};
 
@@ -39,6 +39,10 @@ pub struct NciPlot {
     drag_from: Option<f64>,
     /// Where the plot was last drawn (tests drag across it).
     pub transform: Option<PlotTransform>,
+    /// (sign(λ₂)ρ, s) at the surface's point under the pointer, marked on the plot.
+    pub hovered: Option<[f64; 2]>,
+    /// The point it was evaluated at (object frame, bohr).
+    hovered_at: Option<glam::Vec3>,
     pub error: Option<String>,
 }
 
@@ -50,8 +54,24 @@ impl NciPlot {
             points: Vec::new(),
             drag_from: None,
             transform: None,
+            hovered: None,
+            hovered_at: None,
             error: None,
         }
+    }
+
+    /// Marks on the plot the point `at` (bohr, in `doc`'s own frame) of the surface under the
+    /// pointer, or nothing.
+    pub fn hover(&mut self, doc: &Document, at: Option<glam::Vec3>) {
+        if at == self.hovered_at {
+            return;
+        }
+        self.hovered_at = at;
+        self.hovered = at.zip(doc.wavefunction.as_ref()).map(|(p, wf)| {
+            let mut d = [nci::DensityDerivatives::default()];
+            nci::WavefunctionDensity::new(wf).derivatives_at(&[p.as_dvec3()], &mut d);
+            [d[0].sign_lambda2_rho(), d[0].reduced_gradient()]
+        });
     }
 
     /// Whether its points are being made.
@@ -90,6 +110,7 @@ impl NciPlot {
             };
             let points = self.points.clone();
             let window = iso.color_window;
+            let hovered = self.hovered;
             let response = Plot::new("nci plot")
                 .x_axis_label("sign(λ₂)ρ (a.u.)")
                 .y_axis_label("s")
@@ -105,6 +126,10 @@ impl NciPlot {
                     plot.points(Points::new("points", PlotPoints::new(points)).radius(1.0));
                     if let Some(level) = level {
                         plot.hline(HLine::new("surface", level));
+                    }
+                    if let Some(p) = hovered.filter(|p| p[0].abs() <= SIGN_RHO_SPAN && p[1] <= TOP_S) {
+                        let mark = Points::new("under the pointer", vec![p]).radius(5.0).color(egui::Color32::YELLOW);
+                        plot.points(mark);
                     }
                     if let Some([lo, hi]) = window {
                         plot.vline(VLine::new("from", f64::from(lo)));
