@@ -723,3 +723,83 @@ fn a_td_checkpoint_lists_its_states_and_a_click_on_a_band_picks_one_its_density_
     assert_eq!(shown, Some(Source::Wavefunction(Quantity::Attachment)));
     assert!(h.query_by_label_contains("1.001 electrons move").is_some(), "the electrons moved");
 }
+
+/// Pixels of `img` that are an NCI surface's blue-green (attraction): green and blue above red.
+fn blue_green(img: &image::RgbaImage) -> usize {
+    img.pixels().filter(|p| p[1] as i32 > p[0] as i32 + 40 && p[2] as i32 > p[0] as i32 + 40).count()
+}
+
+#[test]
+fn a_water_dimer_s_nci_surface_shows_its_hydrogen_bond_in_blue_green() {
+    let mut h = open(vec![fixture("nci/water_dimer_631gs.molden")]);
+    wait_loaded(&mut h);
+    let dir = tempfile::tempdir().unwrap();
+    let before = blue_green(&picture(&mut h, dir.path(), "homo"));
+    // A coarser grid than the window's: the density's Hessian at every point is the cost.
+    h.state_mut().objects[0].state.evaluation.grid_points = 48;
+    h.get_by_label("NCI surface").click();
+    h.run_steps(3);
+    wait_loaded(&mut h);
+    let o = &h.state().objects[0].state;
+    let q = o.selected_quantity().expect("the NCI surface is selected");
+    assert_eq!(q.source, Source::Wavefunction(Quantity::NciGradient));
+    let iso = q.isosurfaces[0];
+    assert_eq!((iso.color_by, iso.color_range), (Some(Wavefunction(Quantity::SignLambda2Rho)), Some(0.05)));
+    assert!(o.quantities.iter().filter(|q| q.visible).count() == 1, "it takes the view");
+    let shown = picture(&mut h, dir.path(), "nci");
+    let disc = blue_green(&shown);
+    eprintln!("blue-green pixels: {before} with the HOMO, {disc} with the NCI surface");
+    assert!(disc > 30 && disc > 5 * before.max(1), "the hydrogen bond's disc: {disc} pixels (HOMO: {before})");
+
+    // The NCI plot below the view: the hydrogen bond is the spike of low s at sign(λ₂)ρ ≈ −0.02.
+    let start = std::time::Instant::now();
+    while h.state().nci_plot.points.is_empty() {
+        assert!(start.elapsed().as_secs() < 300, "no NCI plot: {:?}", h.state().nci_plot.error);
+        std::thread::sleep(std::time::Duration::from_millis(50));
+        h.run_steps(1);
+    }
+    h.run_steps(2);
+    let points = h.state().nci_plot.points.clone();
+    let lowest = |range: std::ops::Range<f64>| {
+        points.iter().filter(|p| range.contains(&p[0])).map(|p| p[1]).fold(f64::INFINITY, f64::min)
+    };
+    let (bond, positive) = (lowest(-0.04..-0.01), lowest(0.01..0.04));
+    assert!(
+        bond < 0.6 && positive > bond + 0.2,
+        "lowest s: {bond:.2} at the hydrogen bond, {positive:.2} on the positive side"
+    );
+    // A drag across the spike keeps the disc's colours; across the empty positive side, the
+    // disc turns grey.
+    let transform = h.state().nci_plot.transform.expect("the plot is drawn");
+    let at = |x: f64| transform.position_from_point(&egui_plot::PlotPoint::new(x, 1.0));
+    let window_of = |h: &mut Harness<'static, OrbApp>, from: f64, to: f64| {
+        drag(h, at(from), at(to).x - at(from).x);
+        wait_loaded(h);
+        let iso = h.state().objects[0].state.selected_quantity().unwrap().isosurfaces[0];
+        iso.color_window.expect("a drag sets the colour window")
+    };
+    // The pointer on the disc (between the donor's H and the acceptor's O) marks its point on
+    // the plot, at the hydrogen bond's sign(λ₂)ρ.
+    let atoms = &h.state().objects[0].doc.molecule.atoms;
+    let (donor_h, acceptor) = (atoms[2].position.as_vec3(), atoms[3].position.as_vec3());
+    let (from, to) = (h.state().on_screen(donor_h).unwrap(), h.state().on_screen(acceptor).unwrap());
+    // Along the bond on screen until the pointer rests on the disc (seen nearly edge on).
+    for k in 0..=40 {
+        h.hover_at(from + (to - from) * (0.1 + 0.8 * k as f32 / 40.0));
+        h.run_steps(2);
+        if h.state().nci_plot.hovered.is_some() {
+            break;
+        }
+    }
+    assert!(h.state().nci_plot.hovered.is_some(), "no point of the disc marked under the pointer");
+    let [x, s] = h.state().nci_plot.hovered.unwrap();
+    assert!((-0.04..-0.01).contains(&x) && s < 1.0, "the disc's point: sign(λ₂)ρ {x:.4}, s {s:.2}");
+    h.hover_at(egui::pos2(5.0, 400.0));
+    h.run_steps(2);
+    let [lo, hi] = window_of(&mut h, -0.04, -0.01);
+    assert!((lo + 0.04).abs() < 0.004 && (hi + 0.01).abs() < 0.004, "[{lo}, {hi}]");
+    let lit = blue_green(&picture(&mut h, dir.path(), "lit"));
+    window_of(&mut h, 0.01, 0.04);
+    let unlit = blue_green(&picture(&mut h, dir.path(), "unlit"));
+    assert!(lit * 10 > disc * 8 && unlit * 10 < disc, "the disc {disc} px, lit {lit}, grey {unlit}");
+}

@@ -420,6 +420,7 @@ impl PyDocument {
             Quantity::Potential => "electrostatic potential (a.u.)".into(),
             Quantity::BasisFunction(k) => format!("basis function {k}"),
             Quantity::ReducedGradient => "reduced density gradient".into(),
+            Quantity::NciGradient => "NCI reduced density gradient".into(),
             Quantity::SignLambda2Rho => "sign(lambda2)*rho (a.u.)".into(),
             Quantity::DensityLaplacian => "Laplacian of the electron density (a.u.)".into(),
             Quantity::DifferenceDensity | Quantity::Attachment | Quantity::Detachment | Quantity::ExcitedDensity => {

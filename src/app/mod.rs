@@ -12,6 +12,7 @@ pub mod legend;
 mod loader;
 pub mod measure;
 pub mod models;
+pub mod nci_plot;
 mod orbitals;
 mod panels;
 pub mod panes;
@@ -267,6 +268,8 @@ pub struct OrbApp {
     pub scan_dialog: compute::ScanDialog,
     /// The plane map beside the view.
     pub plane: plane_pane::PlanePane,
+    /// The NCI plot below the view, while an NCI surface is the selected quantity.
+    pub nci_plot: nci_plot::NciPlot,
     pub computing: Option<compute::ComputeRun>,
     /// The *Compute orbitals* window: the object and the level of theory.
     pub orbitals_dialog: Option<(usize, crate::sources::compute::Settings)>,
@@ -438,6 +441,10 @@ impl OrbApp {
             plane: {
                 let repaint = cc.egui_ctx.clone();
                 plane_pane::PlanePane::new(move || repaint.request_repaint())
+            },
+            nci_plot: {
+                let repaint = cc.egui_ctx.clone();
+                nci_plot::NciPlot::new(move || repaint.request_repaint())
             },
             computing: None,
             orbitals_dialog: None,
@@ -719,6 +726,11 @@ impl OrbApp {
             ..Default::default()
         };
         self.scan_job = Some(ScanJob::start(gpu, source, options, follow, orbitals, move || ctx.request_repaint()));
+    }
+
+    /// Where world point `p` (bohr) lies in the window, in the last frame's view.
+    pub fn on_screen(&self, p: glam::Vec3) -> Option<egui::Pos2> {
+        self.viewport.as_ref()?.to_screen(&self.view.camera, p)
     }
 
     /// Whether a file, a scan or a job of the scene is still being worked on.
@@ -1036,6 +1048,18 @@ impl OrbApp {
         }
         if let Some(o) = self.objects.get_mut(self.active).filter(|_| self.scan.is_none()) {
             vibrations::panel(ui, &o.doc, &mut o.state.vibration, &mut self.spectrum);
+        }
+        if let Some(o) = self.objects.get_mut(self.active).filter(|_| self.scan.is_none()) {
+            // The surface's point under the pointer, in the object's own frame, marked on the plot.
+            let active = self.active as u32;
+            let nci = crate::scene::Source::Wavefunction(crate::model::orbitals::Quantity::NciGradient);
+            let shows_nci = o.state.selected_quantity().is_some_and(|q| q.source == nci);
+            let hovered = (self.viewport.as_ref().filter(|_| shows_nci))
+                .and_then(|vp| vp.hovered_surface_point(&self.view.camera))
+                .filter(|&(object, _)| object == active)
+                .map(|(_, p)| o.state.placement.world_from_object().inverse().transform_point3(p));
+            self.nci_plot.hover(&o.doc, hovered);
+            self.nci_plot.panel(ui, &o.doc, o.state.selected_quantity_mut());
         }
         if let Some(o) = self.objects.get_mut(self.active).filter(|_| self.scan.is_none()) {
             let picks = excited::panel(ui, &o.doc, &mut o.state.excited, &mut self.uv_vis);

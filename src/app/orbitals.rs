@@ -34,6 +34,9 @@ pub(crate) enum Pick {
     /// The density surface ρ = 0.002 coloured by the electrostatic potential joins the object
     /// and is what it shows.
     EspMap,
+    /// The NCI surface (s = 0.5 where ρ < 0.05, coloured by sign(λ₂)ρ) joins the object and is
+    /// what it shows.
+    NciSurface,
 }
 
 /// How the view frames what a pick in the browser changed.
@@ -132,6 +135,12 @@ pub fn panel(
             if ui.button("ESP map").on_hover_text(hint).clicked() {
                 pick = Some(Pick::EspMap);
             }
+            let hint = "non-covalent interactions: where the reduced density gradient s is low between atoms \
+                        (s = 0.5, ρ < 0.05), coloured by sign(λ₂)ρ: blue hydrogen bonds, green van der Waals \
+                        contacts, red steric clashes";
+            if ui.button("NCI surface").on_hover_text(hint).clicked() {
+                pick = Some(Pick::NciSurface);
+            }
         });
             ui.horizontal_wrapped(|ui| {
                 ui.label("add");
@@ -194,10 +203,11 @@ pub(crate) fn apply(
                 Source::Wavefunction(Quantity::Potential),
                 defaults,
             );
-            // It takes the view; what was shown stays listed, hidden, a tick away.
-            state.quantities.iter_mut().for_each(|q| q.visible = false);
-            state.quantities.push(map);
-            state.selected = state.quantities.len() - 1;
+            take_view(state, map);
+        }
+        Pick::NciSurface => {
+            reframe = Reframe::BesideBar;
+            take_view(state, QuantityState::nci_surface(defaults));
         }
         Pick::Beside(q) => {
             reframe = Reframe::Panes;
@@ -218,6 +228,14 @@ pub(crate) fn apply(
         }
     }
     reframe
+}
+
+/// Adds `quantity` to the object as what it shows: what was shown stays listed, hidden, a tick
+/// away.
+fn take_view(state: &mut ObjectState, quantity: QuantityState) {
+    state.quantities.iter_mut().for_each(|q| q.visible = false);
+    state.quantities.push(quantity);
+    state.selected = state.quantities.len() - 1;
 }
 
 /// Adds `q` to the object as a new quantity, selected.

@@ -4,6 +4,7 @@ use egui::{ComboBox, RichText, Slider};
 
 use super::Demo;
 use super::OrbApp;
+use crate::model::orbitals::Quantity;
 use crate::model::units::ANGSTROM_PER_BOHR;
 use crate::scene::transfer::{Lobe, PRESETS};
 use crate::scene::translucency::OpticsTuning;
@@ -243,7 +244,8 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
                 ui.separator();
                 // A scan's isosurfaces are cut from the orbital at the value; levels are absolute there.
                 ui.heading("Isosurface");
-                isosurface_editor(ui, &mut scan.settings.iso, true, None);
+                let levels = LevelsOf { signed: true, sigma: None, gradient: false };
+                isosurface_editor(ui, &mut scan.settings.iso, levels);
                 ui.separator();
                 ui.heading("Atoms");
                 let s = &mut scan.settings;
@@ -263,7 +265,12 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
                         subtract = minus_choice(ui, &subtractable);
                         // Isosurfaces first: for orbitals the most used, and never below the fold.
                         let colors = super::scene_panel::quantity_choices(&doc);
-                        isosurfaces_editor(ui, &mut q.isosurfaces, (grid_signed, grid_sigma), &colors);
+                        let gradient = matches!(
+                            q.source,
+                            Source::Wavefunction(Quantity::ReducedGradient | Quantity::NciGradient)
+                        );
+                        let levels = LevelsOf { signed: grid_signed, sigma: grid_sigma, gradient };
+                        isosurfaces_editor(ui, &mut q.isosurfaces, levels, &colors);
                         ui.separator();
                         ui.heading("Cloud");
                         cloud_editor(ui, &mut q.cloud, grid_signed);
@@ -451,11 +458,21 @@ fn cloud_editor(ui: &mut egui::Ui, vs: &mut crate::scene::VolumeSettings, signed
     transfer_editor(ui, &mut vs.transfer, signed);
 }
 
+/// What an isosurface's level is a level of: a signed field's (ψ = ±v), a density's (ρ = v) or
+/// a reduced density gradient's (s = v, levels around 0.5, not a density's around 0.002);
+/// `sigma`: the grid's standard deviation, where levels may be given in it.
+#[derive(Clone, Copy)]
+struct LevelsOf {
+    signed: bool,
+    sigma: Option<f64>,
+    gradient: bool,
+}
+
 /// Every isosurface of a quantity, each with its own controls, and *+ isosurface*.
 fn isosurfaces_editor(
     ui: &mut egui::Ui,
     list: &mut Vec<IsosurfaceSettings>,
-    (signed, sigma): (bool, Option<f64>),
+    levels: LevelsOf,
     colors: &[(Source, String)],
 ) {
     ui.heading("Isosurfaces");
@@ -463,7 +480,7 @@ fn isosurfaces_editor(
     for (k, iso) in list.iter_mut().enumerate() {
         ui.push_id(k, |ui| {
             egui::Frame::group(ui.style()).show(ui, |ui| {
-                isosurface_editor(ui, iso, signed, sigma);
+                isosurface_editor(ui, iso, levels);
                 color_by_editor(ui, iso, colors);
                 if ui.small_button("remove").on_hover_text("remove this isosurface").clicked() {
                     remove = Some(k);
@@ -670,8 +687,14 @@ fn clip_editor(ui: &mut egui::Ui, clip: &mut ClipPlane) {
 }
 
 /// Isosurface controls: shown or not, the value (absolute, or in σ of a cube's grid), colours.
-fn isosurface_editor(ui: &mut egui::Ui, iso: &mut IsosurfaceSettings, signed: bool, sigma: Option<f64>) {
-    ui.checkbox(&mut iso.visible, if signed { "show ψ = ±value" } else { "show ρ = value" });
+fn isosurface_editor(ui: &mut egui::Ui, iso: &mut IsosurfaceSettings, levels: LevelsOf) {
+    let LevelsOf { signed, sigma, gradient } = levels;
+    let what = match (signed, gradient) {
+        (_, true) => "show s = value",
+        (true, false) => "show ψ = ±value",
+        (false, false) => "show ρ = value",
+    };
+    ui.checkbox(&mut iso.visible, what);
     ui.horizontal(|ui| {
         let absolute = matches!(iso.level, IsoLevel::Absolute(_));
         if ui.selectable_label(absolute, "atomic units").clicked() && !absolute {
@@ -685,6 +708,10 @@ fn isosurface_editor(ui: &mut egui::Ui, iso: &mut IsosurfaceSettings, signed: bo
         }
     });
     match &mut iso.level {
+        IsoLevel::Absolute(v) if gradient => {
+            ui.add(Slider::new(v, 0.05..=2.0).text("value"))
+                .on_hover_text("s is dimensionless: NCI surfaces are drawn at 0.3 to 0.6");
+        }
         IsoLevel::Absolute(v) => {
             ui.add(Slider::new(v, 1e-4..=0.5).logarithmic(true).text("value (a.u.)"));
         }

@@ -1245,6 +1245,20 @@ impl Viewport {
         Ok(picked.map(|id| self.object_of(id)))
     }
 
+    /// The world point (bohr) of the opaque surface under the pointer when it rests on one
+    /// (an isosurface, not an atom): where the NCI plot marks the surface's point.
+    pub fn hovered_surface_point(&self, camera: &crate::scene::Camera) -> Option<(u32, glam::Vec3)> {
+        let Some(PickId::Surface { object, .. }) = self.hovered else { return None };
+        let (pos, (rect, size)) = (self.hovered_at?, self.layout?);
+        let rel = (pos - rect.min) / rect.size();
+        let pixel = [(rel.x * size[0] as f32) as u32, (rel.y * size[1] as f32) as u32];
+        let depth = self.renderer.depth_at(&self.ctx, pixel).ok()??;
+        let camera = if self.pane_layout.is_empty() { *camera } else { fit_width(*camera, size) };
+        let world_from_clip = self.renderer.clip_from_world(&camera, size).inverse();
+        let p = world_from_clip * glam::Vec4::new(rel.x * 2.0 - 1.0, 1.0 - rel.y * 2.0, depth, 1.0);
+        Some((object, p.truncate() / p.w))
+    }
+
     /// How many more layers the scene can take (each object one for its atoms and one per
     /// quantity).
     pub fn room(&self) -> usize {

@@ -1,6 +1,7 @@
 //! `orbcloud mesh`, `render --iso/--pick` and `bench isosurface`: isosurfaces and picking from
 //! the command line.
 
+use crate::scene::coloring::ColorScheme;
 use crate::scene::limits::{self, within};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -112,7 +113,8 @@ impl IsoArgs {
     /// Colours `meshes` by `source` of `doc` ([`Self::color_source`]), one map for all of them.
     pub fn color(&self, doc: &Document, source: Source, meshes: &mut [(Mesh, SurfaceLook)]) -> Colored {
         let values = values_on(doc, source, &meshes.iter().map(|(m, _)| m).collect::<Vec<_>>());
-        let map = color_meshes(&mut meshes.iter_mut().map(|(m, _)| m).collect::<Vec<_>>(), &values, self.color_range);
+        let mut colored: Vec<&mut Mesh> = meshes.iter_mut().map(|(m, _)| m).collect();
+        let map = color_meshes(&mut colored, &values, self.color_range, ColorScheme::RedWhiteBlue);
         let name = color_name(doc, source);
         Colored { map, name, values }
     }

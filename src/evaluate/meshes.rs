@@ -9,8 +9,8 @@ use crate::model::isosurface::{self, Level, Mesh};
 use crate::model::surface::{self, Sphere, SurfaceError};
 use crate::model::units::ANGSTROM_PER_BOHR;
 use crate::model::{Document, VolumeGrid};
-use crate::scene::coloring::ValueMap;
 use crate::scene::coloring::atom_colors;
+use crate::scene::coloring::{ColorScheme, ValueMap};
 use crate::scene::quantity::Source;
 use crate::scene::selection::shown_atoms;
 use crate::scene::translucency::SurfaceLook;
@@ -41,7 +41,8 @@ pub fn color_isosurfaces(
     let owners = levels.iter().filter(|l| l.visible).flat_map(|l| std::iter::repeat_n(l, per_level));
     let asking: Vec<(usize, Source)> =
         owners.zip(0..meshes.len()).filter_map(|(level, k)| level.color_by.map(|s| (k, s))).collect();
-    let last = levels.iter().rev().filter(|l| l.visible).find_map(|l| l.color_by.map(|s| (s, l.color_range)))?;
+    let last = (levels.iter().rev().filter(|l| l.visible))
+        .find_map(|l| l.color_by.map(|s| (s, l.color_range, l.color_scheme, l.color_window)))?;
     // Each quantity evaluated once, over the vertices of every mesh it colours.
     let mut per_mesh: Vec<Option<Vec<Option<f64>>>> = vec![None; meshes.len()];
     let mut sources: Vec<Source> = asking.iter().map(|&(_, s)| s).collect();
@@ -55,9 +56,21 @@ pub fn color_isosurfaces(
     }
     let (mut colored, values): (Vec<&mut Mesh>, Vec<Vec<Option<f64>>>) =
         meshes.iter_mut().zip(per_mesh).filter_map(|((m, _), v)| Some((m, v?))).unzip();
-    let map = color_meshes(&mut colored, &values, last.1.map(f64::from));
+    let map = color_meshes(&mut colored, &values, last.1.map(f64::from), last.2);
+    if let Some([lo, hi]) = last.3 {
+        for (mesh, v) in colored.iter_mut().zip(&values) {
+            for (c, v) in mesh.colors.iter_mut().zip(v) {
+                if v.is_none_or(|v| v < f64::from(lo) || v > f64::from(hi)) {
+                    *c = OUTSIDE_WINDOW;
+                }
+            }
+        }
+    }
     Some((map, color_name(doc, last.0)))
 }
+
+/// The grey of a coloured surface's vertices outside its colour window.
+const OUTSIDE_WINDOW: [f32; 3] = [0.3, 0.3, 0.3];
 
 /// How a colour bar names `source`: "ESP" for an electrostatic potential (the wavefunction's or a
 /// data set that says it is one), else its name, cut to fit the bar.
@@ -83,11 +96,16 @@ pub fn values_on(doc: &Document, source: Source, meshes: &[&Mesh]) -> Vec<Vec<Op
 
 /// Colours each mesh by its `values` on one diverging map ([`color_values`]: `range`, or robust
 /// over all of them); returns the map.
-pub fn color_meshes(meshes: &mut [&mut Mesh], values: &[Vec<Option<f64>>], range: Option<f64>) -> ValueMap {
+pub fn color_meshes(
+    meshes: &mut [&mut Mesh],
+    values: &[Vec<Option<f64>>],
+    range: Option<f64>,
+    scheme: ColorScheme,
+) -> ValueMap {
     let all: Vec<Option<f64>> = values.iter().flatten().copied().collect();
-    let (_, map) = color_values(&all, range);
+    let (_, map) = color_values(&all, range, scheme);
     for (mesh, v) in meshes.iter_mut().zip(values) {
-        mesh.colors = color_values(v, Some(map.range)).0;
+        mesh.colors = color_values(v, Some(map.range), scheme).0;
     }
     map
 }
@@ -215,13 +233,13 @@ pub fn values_at(doc: &Document, source: Source, points: &[glam::Vec3]) -> Vec<O
 /// Linear RGB for each value on a diverging map ([`ValueMap`]) of range `range`, or when that
 /// is `None` the 98th percentile of |value| (robust to a few points near a nucleus); grey where
 /// there is no value. Returns the map too.
-pub fn color_values(values: &[Option<f64>], range: Option<f64>) -> (Vec<[f32; 3]>, ValueMap) {
+pub fn color_values(values: &[Option<f64>], range: Option<f64>, scheme: ColorScheme) -> (Vec<[f32; 3]>, ValueMap) {
     let range = range.filter(|r| *r > 0.0).unwrap_or_else(|| {
         let mut magnitudes: Vec<f64> = values.iter().flatten().map(|v| v.abs()).collect();
         magnitudes.sort_by(f64::total_cmp);
         magnitudes.get(magnitudes.len() * 98 / 100).copied().unwrap_or(0.0)
     });
-    let map = ValueMap { range: range.max(1e-30) };
+    let map = ValueMap { range: range.max(1e-30), scheme };
     let colors = values.iter().map(|v| v.map_or([0.5; 3], |v| map.color(v))).collect();
     (colors, map)
 }
@@ -229,5 +247,5 @@ pub fn color_values(values: &[Option<f64>], range: Option<f64>) -> (Vec<[f32; 3]
 /// Linear RGB for `grid`'s value at each point on a diverging map ([`color_values`], range
 /// automatic). Returns the map too.
 pub fn color_by_values(points: &[glam::Vec3], grid: &VolumeGrid) -> (Vec<[f32; 3]>, ValueMap) {
-    color_values(&sample_grid(points, grid), None)
+    color_values(&sample_grid(points, grid), None, ColorScheme::RedWhiteBlue)
 }

@@ -122,6 +122,7 @@ pub fn evaluate_wavefunction(
         | Quantity::SpinDensity
         | Quantity::Potential
         | Quantity::ReducedGradient
+        | Quantity::NciGradient
         | Quantity::SignLambda2Rho
         | Quantity::DensityLaplacian
         | Quantity::DifferenceDensity

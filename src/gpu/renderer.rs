@@ -515,6 +515,20 @@ impl Renderer {
         let bytes = super::readback::read_texel(&ctx.device, &ctx.queue, &targets.ids, pixel, 4)?;
         Ok(PickId::decode(u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]])))
     }
+
+    /// The opaque depth the last frame drew at `pixel` (0 near; `None` where nothing was
+    /// drawn). A depth texture is copied whole (WebGPU copies no part of one): a hover's
+    /// question, not a frame's.
+    pub fn depth_at(&self, ctx: &GpuContext, pixel: [u32; 2]) -> Result<Option<f32>, GpuError> {
+        let Some((targets, _)) = &self.targets else { return Ok(None) };
+        if pixel[0] >= targets.size[0] || pixel[1] >= targets.size[1] {
+            return Ok(None);
+        }
+        let bytes = super::readback::read_texture(&ctx.device, &ctx.queue, &targets.depth, 4)?;
+        let at = (pixel[1] * targets.size[0] + pixel[0]) as usize * 4;
+        let depth = bytes.get(at..at + 4).map_or(1.0, |b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]));
+        Ok((depth < 1.0).then_some(depth))
+    }
 }
 
 /// How a frame composites what it draws, decided before any phase is recorded.

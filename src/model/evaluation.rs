@@ -87,7 +87,10 @@ impl PreparedBasis {
             Quantity::DifferenceDensity | Quantity::Attachment | Quantity::Detachment | Quantity::ExcitedDensity => {
                 self.grid_sum(&state_sets(wf, quantity), true, grid)
             }
-            Quantity::ReducedGradient | Quantity::SignLambda2Rho | Quantity::DensityLaplacian => {
+            Quantity::ReducedGradient
+            | Quantity::NciGradient
+            | Quantity::SignLambda2Rho
+            | Quantity::DensityLaplacian => {
                 let points: Vec<DVec3> = (0..grid.dims[0])
                     .flat_map(|i| (0..grid.dims[1]).flat_map(move |j| (0..grid.dims[2]).map(move |k| (i, j, k))))
                     .map(|(i, j, k)| grid.point(i, j, k))

@@ -530,6 +530,7 @@ impl PreparedBasis {
                     | Quantity::ExcitedDensity => state.iter().map(|(c, w)| w * dot(c, &values).powi(2)).sum(),
                     Quantity::Potential
                     | Quantity::ReducedGradient
+                    | Quantity::NciGradient
                     | Quantity::SignLambda2Rho
                     | Quantity::DensityLaplacian => f64::NAN,
                 }

@@ -88,6 +88,10 @@ impl DensityDerivatives {
     pub fn quantity(&self, quantity: Quantity) -> f64 {
         match quantity {
             Quantity::ReducedGradient => self.reduced_gradient(),
+            Quantity::NciGradient => match self.rho > WAVEFUNCTION_DENSITY_CUT {
+                true => CUT_VALUE as f64,
+                false => self.reduced_gradient().min(CUT_VALUE as f64),
+            },
             Quantity::SignLambda2Rho => self.sign_lambda2_rho(),
             Quantity::DensityLaplacian => self.laplacian(),
             Quantity::Density => self.rho,

@@ -191,6 +191,10 @@ pub enum Quantity {
     Potential,
     /// The reduced density gradient s = |∇ρ| / (2(3π²)^{1/3} ρ^{4/3}) (NCI).
     ReducedGradient,
+    /// The reduced density gradient where ρ is at most NCIPLOT's cut for a wavefunction's
+    /// density (0.05 a.u.), and 100 where it is above: what NCI surfaces (s = 0.5) are cut from,
+    /// so that the small s near the nuclei draws nothing.
+    NciGradient,
     /// sign(λ₂)·ρ, λ₂ the middle eigenvalue of the density's Hessian (NCI, a.u.).
     SignLambda2Rho,
     /// ∇²ρ, the Laplacian of the total density (a.u.).
@@ -211,7 +215,7 @@ impl Quantity {
     /// Whether the quantity is made of the total density's first and second derivatives
     /// (evaluated by [`super::nci`]).
     pub fn from_density_derivatives(self) -> bool {
-        matches!(self, Self::ReducedGradient | Self::SignLambda2Rho | Self::DensityLaplacian)
+        matches!(self, Self::ReducedGradient | Self::NciGradient | Self::SignLambda2Rho | Self::DensityLaplacian)
     }
 
     /// Which of an excited state's densities the quantity is, if it is one.

@@ -68,7 +68,11 @@ pub fn evaluate(doc: &Document, source: Source, plane: &Plane) -> Result<PlaneMa
     let (values, sampling, signed) = match (source, &doc.wavefunction) {
         (Source::Wavefunction(q), Some(wf)) => {
             let values = PreparedBasis::new(&wf.basis).quantity_grid(wf, &doc.molecule, q, &plane.grid());
-            (values, Sampling::Exact, !matches!(q, Quantity::Density | Quantity::ReducedGradient))
+            (
+                values,
+                Sampling::Exact,
+                !matches!(q, Quantity::Density | Quantity::ReducedGradient | Quantity::NciGradient),
+            )
         }
         (Source::Volume(i), _) if i < doc.volumes.len() => {
             let grid = &doc.volumes[i];

@@ -17,18 +17,36 @@ pub struct AtomColors {
 }
 
 /// An sRGB colour as linear RGB.
-/// A diverging map of values symmetric about zero: −range red, zero white, +range blue (the
-/// convention of electrostatic potentials on surfaces), what a surface coloured by a volume and
-/// its colour bar both use.
+/// A map of values symmetric about zero, what a surface coloured by a volume and its colour bar
+/// both use: diverging as the `scheme` says.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ValueMap {
     /// The |value| at which the colours saturate.
     pub range: f64,
+    pub scheme: ColorScheme,
+}
+
+/// How a [`ValueMap`] colours.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+pub enum ColorScheme {
+    /// −range red, zero white, +range blue: the convention of electrostatic potentials on
+    /// surfaces.
+    #[default]
+    RedWhiteBlue,
+    /// −range blue, zero green, +range red: NCI surfaces coloured by sign(λ₂)ρ as NCIPLOT's VMD
+    /// scripts colour them (blue attraction, green van der Waals, red repulsion).
+    BlueGreenRed,
 }
 
 impl ValueMap {
     const NEGATIVE: [f32; 3] = [0.85, 0.08, 0.06];
     const POSITIVE: [f32; 3] = [0.06, 0.2, 0.85];
+    const NCI: [[f32; 3]; 3] = [[0.0, 0.1, 0.9], [0.05, 0.75, 0.1], [0.9, 0.05, 0.03]];
+
+    /// The red-white-blue map saturating at `range`.
+    pub fn diverging(range: f64) -> Self {
+        Self { range, scheme: ColorScheme::RedWhiteBlue }
+    }
 
     /// Linear RGB of `value`.
     pub fn color(&self, value: f64) -> [f32; 3] {
@@ -50,8 +68,18 @@ impl ValueMap {
 
     /// Linear RGB at `t` in −1..1 of the range.
     pub fn at(&self, t: f32) -> [f32; 3] {
-        let end = if t < 0.0 { Self::NEGATIVE } else { Self::POSITIVE };
-        std::array::from_fn(|k| 1.0 + (end[k] - 1.0) * t.abs().min(1.0))
+        let f = t.abs().min(1.0);
+        match self.scheme {
+            ColorScheme::RedWhiteBlue => {
+                let end = if t < 0.0 { Self::NEGATIVE } else { Self::POSITIVE };
+                std::array::from_fn(|k| 1.0 + (end[k] - 1.0) * f)
+            }
+            ColorScheme::BlueGreenRed => {
+                let [blue, green, red] = Self::NCI;
+                let end = if t < 0.0 { blue } else { red };
+                std::array::from_fn(|k| green[k] + (end[k] - green[k]) * f)
+            }
+        }
     }
 }
 

@@ -28,7 +28,10 @@ impl Source {
                 Quantity::Orbital(i) => i < wf.orbitals.len(),
                 Quantity::BasisFunction(k) => k < wf.basis.n_functions(),
                 Quantity::Density | Quantity::Potential => true,
-                Quantity::ReducedGradient | Quantity::SignLambda2Rho | Quantity::DensityLaplacian => true,
+                Quantity::ReducedGradient
+                | Quantity::NciGradient
+                | Quantity::SignLambda2Rho
+                | Quantity::DensityLaplacian => true,
                 Quantity::SpinDensity => !wf.restricted,
                 Quantity::DifferenceDensity
                 | Quantity::Attachment
@@ -69,6 +72,7 @@ impl Source {
             Source::Wavefunction(Quantity::SpinDensity) => "spin density".into(),
             Source::Wavefunction(Quantity::Potential) => "electrostatic potential".into(),
             Source::Wavefunction(Quantity::ReducedGradient) => "reduced density gradient".into(),
+            Source::Wavefunction(Quantity::NciGradient) => "NCI (s where ρ ≤ 0.05)".into(),
             Source::Wavefunction(Quantity::SignLambda2Rho) => "sign(λ₂)ρ".into(),
             Source::Wavefunction(Quantity::DensityLaplacian) => "density Laplacian".into(),
             Source::Wavefunction(Quantity::DifferenceDensity) => "difference density".into(),
@@ -182,7 +186,33 @@ impl QuantityState {
         }];
         map
     }
+
+    /// An *NCI surface* (Johnson et al., 2010): the reduced density gradient's surface s =
+    /// [`NCI_LEVEL`] where ρ is below NCIPLOT's cut, coloured by sign(λ₂)ρ from −[`NCI_RANGE`]
+    /// (blue, attraction) through green to +[`NCI_RANGE`] (red, repulsion), opaque, without a
+    /// cloud.
+    pub fn nci_surface(defaults: &RenderSettings) -> Self {
+        let mut nci = Self::new(Source::Wavefunction(Quantity::NciGradient), defaults);
+        nci.cloud.visible = false;
+        nci.isosurfaces = vec![IsosurfaceSettings {
+            visible: true,
+            level: super::IsoLevel::Absolute(NCI_LEVEL),
+            translucent: false,
+            color_by: Some(Source::Wavefunction(Quantity::SignLambda2Rho)),
+            color_range: Some(NCI_RANGE),
+            color_scheme: super::coloring::ColorScheme::BlueGreenRed,
+            ..Default::default()
+        }];
+        nci
+    }
 }
+
+/// The reduced density gradient an NCI surface of a wavefunction's density is drawn at
+/// (NCIPLOT's default for SCF densities).
+pub const NCI_LEVEL: f32 = 0.5;
+
+/// The |sign(λ₂)ρ| (a.u.) where an NCI surface's colours saturate (NCIPLOT's −0.05…0.05).
+pub const NCI_RANGE: f32 = 0.05;
 
 /// How an object's atoms are drawn.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

@@ -204,6 +204,13 @@ pub struct IsosurfaceSettings {
     /// |value| over the vertices) when `None`.
     #[serde(default)]
     pub color_range: Option<f32>,
+    /// The map those colours are taken from.
+    #[serde(default)]
+    pub color_scheme: super::coloring::ColorScheme,
+    /// Only the vertices whose colouring value lies in this range keep their colours; the rest
+    /// are grey (an NCI plot's brushed spike lit on its surface).
+    #[serde(default)]
+    pub color_window: Option<[f32; 2]>,
 }
 
 impl Default for IsosurfaceSettings {
@@ -220,6 +227,8 @@ impl Default for IsosurfaceSettings {
             tuning: Default::default(),
             color_by: None,
             color_range: None,
+            color_scheme: Default::default(),
+            color_window: None,
         }
     }
 }
