@@ -12,7 +12,6 @@ use super::jobs::Latest;
 use crate::model::Document;
 use crate::model::GridSpec;
 use crate::model::extent::quantity_box;
-use crate::model::gto::PreparedBasis;
 use crate::model::nci::{self, DensitySource, NciSettings, WAVEFUNCTION_DENSITY_CUT, WavefunctionDensity};
 use crate::model::orbitals::Quantity;
 use crate::scene::{IsoLevel, QuantityState, Source};
@@ -179,8 +178,10 @@ pub fn plot_points(doc: &Document) -> Result<Vec<[f64; 2]>, String> {
     let wf = doc.wavefunction.as_ref().ok_or("an NCI plot needs a wavefunction")?;
     let (lo, hi) = quantity_box(wf, &doc.molecule, Quantity::Density).ok_or("the molecule has no atoms")?;
     let grid = GridSpec::cubic_voxels(lo, hi, PLOT_POINTS);
-    let density = WavefunctionDensity { basis: PreparedBasis::new(&wf.basis), wavefunction: wf };
-    let settings = NciSettings { density_cut: WAVEFUNCTION_DENSITY_CUT, intermolecular: None };
+    let density = WavefunctionDensity::new(wf);
+    // Every s kept (the plot's own top cuts it): NCIPLOT's s > 1 cut is for its cubes.
+    let settings =
+        NciSettings { density_cut: WAVEFUNCTION_DENSITY_CUT, rdg_cut: nci::CUT_VALUE as f64, intermolecular: None };
     let grids = nci::nci_grid(&[&density], &grid, settings);
     Ok((grids.dens.iter().zip(&grids.grad))
         .filter(|&(&d, &s)| d != nci::CUT_VALUE && f64::from(s) < TOP_S)
