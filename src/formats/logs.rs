@@ -1,7 +1,8 @@
 //! Program logs (`.log`, `.out`): many programs write files with these endings, so the program
 //! is told from the text, not the name. Gaussian prints "Entering Gaussian System" and its
 //! copyright ("Gaussian, Inc.") at the top; ORCA its banner "O   R   C   A"; Q-Chem "Welcome to
-//! Q-Chem" and "Q-Chem, Inc.".
+//! Q-Chem" and "Q-Chem, Inc."; GAMESS-US "GAMESS VERSION"; NWChem "Northwest Computational
+//! Chemistry Package"; Psi4 "Psi4: An Open-Source Ab Initio Electronic Structure Package".
 //!
 //! What the readers of logs share: the lines with their numbers, numbers in fixed-width
 //! columns, and the errors they raise.
@@ -10,7 +11,7 @@ use glam::DVec3;
 
 use super::text::{excerpt, parse_real};
 use super::wavefunction::OverlapFn;
-use super::{ParseError, gaussian_log, orca_log, qchem_log};
+use super::{ParseError, gamess_log, gaussian_log, nwchem_log, orca_log, psi4_log, qchem_log};
 use crate::model::Document;
 
 /// Lines of the file's top in which the program's banner is looked for: a job scheduler may
@@ -23,6 +24,9 @@ pub enum Program {
     Gaussian,
     Orca,
     QChem,
+    Gamess,
+    NwChem,
+    Psi4,
 }
 
 /// The program that wrote `text`, from its banner.
@@ -37,12 +41,21 @@ pub fn program(text: &str) -> Option<Program> {
         if line.contains("Welcome to Q-Chem") || line.contains("Q-Chem, Inc.") {
             return Some(Program::QChem);
         }
+        if line.contains("GAMESS VERSION =") {
+            return Some(Program::Gamess);
+        }
+        if line.contains("Northwest Computational Chemistry Package") {
+            return Some(Program::NwChem);
+        }
+        if line.contains("Psi4: An Open-Source Ab Initio Electronic Structure Package") {
+            return Some(Program::Psi4);
+        }
     }
     None
 }
 
 /// What the banner check looks for, in words.
-pub const BANNERS: &str = "a Gaussian log (\"Entering Gaussian System\" or \"Gaussian, Inc.\"), an ORCA output (\"O   R   C   A\") or a Q-Chem output (\"Welcome to Q-Chem\")";
+pub const BANNERS: &str = "a Gaussian log (\"Entering Gaussian System\" or \"Gaussian, Inc.\"), an ORCA output (\"O   R   C   A\"), a Q-Chem output (\"Welcome to Q-Chem\"), a GAMESS-US output (\"GAMESS VERSION =\"), an NWChem output (\"Northwest Computational Chemistry Package\") or a Psi4 output (\"Psi4: An Open-Source Ab Initio Electronic Structure Package\")";
 
 /// Parses a program's log into a document, the program told by its banner.
 pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Document, ParseError> {
@@ -52,12 +65,15 @@ pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Docum
     match program(text) {
         Some(Program::Gaussian) => gaussian_log::parse(file, text, overlap),
         Some(Program::Orca) => orca_log::parse(file, text, overlap),
-        Some(Program::QChem) => qchem_log::parse(file, text),
+        Some(Program::QChem) => qchem_log::parse(file, text, overlap),
+        Some(Program::Gamess) => gamess_log::parse(file, text, overlap),
+        Some(Program::NwChem) => nwchem_log::parse(file, text, overlap),
+        Some(Program::Psi4) => psi4_log::parse(file, text, overlap),
         None => Err(error(
             file,
             1,
             BANNERS,
-            format!("neither banner in the first {BANNER_LINES} lines (another program's output?)"),
+            format!("no banner in the first {BANNER_LINES} lines (another program's output?)"),
         )),
     }
 }
@@ -211,7 +227,10 @@ mod tests {
     fn programs_are_told_by_their_banner() {
         assert_eq!(program(" Entering Gaussian System, Link 0=g16\n"), Some(Program::Gaussian));
         assert_eq!(program("\n  * O   R   C   A *\n"), Some(Program::Orca));
-        assert_eq!(program(" GAMESS VERSION = 30 SEP 2017\n"), None);
+        assert_eq!(program(" *  GAMESS VERSION = 30 SEP 2017 (R1)  *\n"), Some(Program::Gamess));
+        assert_eq!(program(" Northwest Computational Chemistry Package (NWChem) 6.5\n"), Some(Program::NwChem));
+        assert_eq!(program("  Psi4: An Open-Source Ab Initio Electronic Structure Package\n"), Some(Program::Psi4));
+        assert_eq!(program(" Molpro calculation\n"), None);
         let e = parse("x.out", " NWChem Input Module\n", None).unwrap_err();
         assert_eq!(e.line, 1);
         assert!(e.expected.contains("Entering Gaussian System") && e.expected.contains("O   R   C   A"), "{e}");
