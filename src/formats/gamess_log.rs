@@ -263,6 +263,14 @@ fn atom_shells(
     for (a, name) in names.iter().enumerate() {
         let labels: Vec<&str> =
             section.rows.iter().skip(row).take_while(|r| r.atom == a).map(|r| r.label.as_str()).collect();
+        if labels.is_empty() {
+            // The rows stop (or skip to a later atom) before this atom's functions.
+            let at = section
+                .rows
+                .get(row)
+                .map_or_else(|| section.rows.last().map_or(section.line, |r| r.line + 1), |r| r.line);
+            return Err(log.error_at(at, format!("rows of coefficients for atom {} ({name})", a + 1)));
+        }
         let fits = |shells: &[PrintedShell]| {
             let mut k = 0;
             for s in shells {

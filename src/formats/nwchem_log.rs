@@ -297,7 +297,7 @@ fn ao_basis(log: &LogLines, header: usize) -> Result<(HashMap<String, Vec<Printe
             let kind = tokens.get(1).map(|k| k.to_ascii_uppercase()).unwrap_or_default();
             let two = kind == "L" || kind == "SP";
             let known = two || (kind.len() == 1 && "SPDFGH".find(kind.as_str()).is_some_and(|l| l as u32 <= MAX_L));
-            let v: Option<Vec<f64>> = tokens[2..].iter().map(|x| parse_real(x)).collect();
+            let v: Option<Vec<f64>> = tokens.get(2..).unwrap_or_default().iter().map(|x| parse_real(x)).collect();
             let want = if two { 3 } else { 2 };
             let v = v.filter(|v| known && v.len() == want && v[0] > 0.0).ok_or_else(|| log.error_at(i, row))?;
             if open.as_ref().is_some_and(|o| o.number != tokens[0] || o.kind != kind) {

@@ -202,14 +202,17 @@ pub(crate) fn document(
         let at = section.rows.get(n).map_or(section.line, |r| r.line);
         return Err(log.error_at(at, format!("{n} rows of coefficients (the printed basis set's functions)")));
     }
+    if section.orbitals.iter().any(|o| o.coefficients.len() != n) {
+        return Err(log.error_at(section.line, format!("{n} coefficients in every orbital")));
+    }
     let restricted = section.orbitals.iter().all(|o| o.spin == Spin::Alpha);
     let orbitals = section
         .orbitals
         .iter()
         .map(|o| {
             let mut coefficients = vec![0.0; n];
-            for (k, &v) in o.coefficients.iter().enumerate() {
-                coefficients[file_to_model[k]] = v;
+            for (&v, &k) in o.coefficients.iter().zip(&file_to_model) {
+                coefficients[k] = v;
             }
             MolecularOrbital {
                 energy: o.energy,

@@ -366,3 +366,59 @@ fn coefficients(log: &LogLines, header: usize) -> Result<(Section, usize), Parse
     section.decimals = first_decimals.unwrap_or(5);
     Ok((section, i))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::ref_overlap::reference_overlap;
+    use super::*;
+
+    const H2: &str = include_str!("../../tests/fixtures/logs/h2_qchem.out");
+
+    fn read(text: &str) -> Result<Document, ParseError> {
+        parse("h2.out", text, Some(&reference_overlap))
+    }
+
+    #[test]
+    fn the_printed_basis_and_orbitals_open_with_occupations_from_the_electrons() {
+        let doc = read(H2).unwrap();
+        let wf = doc.wavefunction.as_ref().expect("orbitals");
+        assert_eq!((wf.basis.shells.len(), wf.orbitals.len()), (2, 2));
+        assert_eq!([wf.orbitals[0].occupation, wf.orbitals[1].occupation], [2.0, 0.0]);
+        assert_eq!([wf.orbitals[0].energy, wf.orbitals[1].energy], [-0.579, 0.671]);
+        let n = &wf.normalization;
+        assert_eq!((n.program.as_str(), n.printed_decimals), ("Q-Chem", Some(5)));
+        assert!(n.residual < n.expected_residual(), "{n:?}");
+    }
+
+    #[test]
+    fn labels_name_cartesian_functions_by_their_letters() {
+        assert_eq!(function_of("s", 0), Some((ShellKind::Cartesian, 0)));
+        assert_eq!(function_of("pz", 1), Some((ShellKind::Cartesian, 2)));
+        assert_eq!(function_of("dyy", 2), Some((ShellKind::Cartesian, 3)));
+        assert_eq!(function_of("dxz", 2), Some((ShellKind::Cartesian, 2)));
+        assert_eq!(function_of("px", 2), None);
+    }
+
+    #[test]
+    fn an_orbital_block_cut_short_is_refused_at_its_line() {
+        let end = H2.find("   2  H 2   s").unwrap();
+        let e = read(&H2[..end]).unwrap_err();
+        assert!(e.expected.contains("rows of coefficients"), "{e}");
+        assert!(e.to_string().starts_with("h2.out:"), "{e}");
+        let bad = H2.replacen("   2  H 2   s", "   2  H 3   s", 1);
+        let e = read(&bad).unwrap_err();
+        assert_eq!(e.line, bad.lines().position(|l| l.starts_with("   2  H 3   s")).unwrap() + 1, "{e}");
+        assert!(e.expected.contains("an atom of the orientation"), "{e}");
+        let bad = H2.replacen("****\n$end", "****\nH    0\nS    3    1.000000\n   3.4E+00    1.5E-01 \n", 1);
+        let e = read(&bad).unwrap_err();
+        assert!(e.expected.contains("primitive"), "{e}");
+    }
+
+    #[test]
+    fn without_printed_orbitals_the_atoms_open_naming_the_keywords() {
+        let cut = &H2[..H2.find("                        RESTRICTED (RHF)").unwrap()];
+        let doc = read(cut).unwrap();
+        assert!(doc.wavefunction.is_none());
+        assert!(doc.problems.iter().any(|p| p.contains("print_orbitals = true")), "{:?}", doc.problems);
+    }
+}
