@@ -35,6 +35,7 @@ use crate::model::Document;
 use crate::model::basis::{MAX_L, ShellKind};
 use crate::model::elements::atomic_number;
 use crate::model::orbitals::Spin;
+use crate::model::units::BOHR_PER_ANGSTROM;
 
 /// Width of GAMESS's coefficient columns (`F11.6`).
 const COLUMN: usize = 11;
@@ -51,7 +52,7 @@ pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Docum
     let mut i = 0;
     while i < log.lines.len() {
         let t = log.lines[i].trim();
-        if t.starts_with("ATOM") && t.contains("COORDINATES (BOHR)") {
+        if (t.starts_with("ATOM") && t.contains("COORDINATES (BOHR)")) || t == "COORDINATES OF ALL ATOMS ARE (ANGS)" {
             let (g, n, next) = coordinates(&log, i)?;
             geometries.push(g);
             names.push(n);
@@ -67,10 +68,18 @@ pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Docum
             basis = Some(b);
             i = next;
             continue;
-        } else if let Some(rest) = t.strip_prefix("NUMBER OF OCCUPIED ORBITALS (ALPHA)") {
-            occupied.0 = rest.trim_start_matches([' ', '=']).trim().parse::<usize>().ok();
-        } else if let Some(rest) = t.strip_prefix("NUMBER OF OCCUPIED ORBITALS (BETA )") {
-            occupied.1 = rest.trim_start_matches([' ', '=']).trim().parse::<usize>().ok();
+        } else if t.starts_with("NUMBER OF OCCUPIED ORBITALS (ALPHA)")
+            || t.starts_with("NUMBER OF OCCUPIED ORBITALS (BETA )")
+        {
+            // With core potentials a second line says how many are kept: the later line wins.
+            let n = t.rsplit('=').next().and_then(|v| v.trim().parse::<usize>().ok());
+            if n.is_some() {
+                if t.contains("(ALPHA)") {
+                    occupied.0 = n;
+                } else {
+                    occupied.1 = n;
+                }
+            }
         } else if (t == "EIGENVECTORS" || t == "MOLECULAR ORBITALS")
             && log.lines.get(i + 1).is_some_and(|l| l.trim().starts_with("---"))
         {
@@ -140,19 +149,27 @@ fn function_of(label: &str, l: u32) -> Option<(ShellKind, usize)> {
     cartesian_index(label, l).map(|i| (ShellKind::Cartesian, i))
 }
 
-/// `ATOM ATOMIC COORDINATES (BOHR)` at `header`: the heading's second line, then rows
-/// `name charge x y z` until a blank line. Returns the geometry, the atoms' names, the next line.
+/// `ATOM ATOMIC COORDINATES (BOHR)` at `header` (the heading's second line follows) or, at each
+/// step of an optimisation, `COORDINATES OF ALL ATOMS ARE (ANGS)` (a heading `ATOM CHARGE X Y Z`
+/// and dashes follow): rows `name charge x y z` until a blank line. Returns the geometry (bohr),
+/// the atoms' names and the next line.
 fn coordinates(log: &LogLines, header: usize) -> Result<(Geometry, Vec<String>, usize), ParseError> {
-    let heading = "the heading's second line `CHARGE X Y Z`";
-    if !log.get(header + 1, heading)?.trim_start().starts_with("CHARGE") {
+    let angstrom = log.lines[header].contains("(ANGS)");
+    let heading = if angstrom { "the heading `ATOM CHARGE X Y Z`" } else { "the heading's second line `CHARGE X Y Z`" };
+    let want = if angstrom { "ATOM" } else { "CHARGE" };
+    if !log.get(header + 1, heading)?.trim_start().starts_with(want) {
         return Err(log.error_at(header + 1, heading));
     }
     let mut i = header + 2;
+    if angstrom && log.get(i, "a line of dashes")?.trim_start().starts_with("---") {
+        i += 1;
+    }
+    let scale = if angstrom { BOHR_PER_ANGSTROM } else { 1.0 };
     let mut g = Geometry { line: header, z: Vec::new(), positions: Vec::new() };
     let mut names = Vec::new();
     while let Some(l) = log.lines.get(i).filter(|l| !l.trim().is_empty()) {
         let t: Vec<&str> = l.split_whitespace().collect();
-        let row = "an atom row `name charge x y z` (bohr)";
+        let row = "an atom row `name charge x y z`";
         let v: Option<Vec<f64>> =
             t.get(1..).filter(|v| v.len() == 4).and_then(|v| v.iter().map(|x| parse_real(x)).collect());
         let v = v.ok_or_else(|| log.error_at(i, row))?;
@@ -165,7 +182,7 @@ fn coordinates(log: &LogLines, header: usize) -> Result<(Geometry, Vec<String>, 
             atomic_number(&letters).or_else(|| atomic_number(&letters[..letters.len().min(1)])).unwrap_or(0)
         };
         g.z.push(z);
-        g.positions.push(DVec3::new(v[1], v[2], v[3]));
+        g.positions.push(DVec3::new(v[1], v[2], v[3]) * scale);
         names.push(t[0].to_ascii_uppercase());
         i += 1;
     }
@@ -339,16 +356,8 @@ fn eigenvectors(log: &LogLines, header: usize) -> Result<(Section, usize), Parse
         let mut row = 0;
         while let Some(l) = log.lines.get(i) {
             let Some((values, head)) = trailing_numbers(l, k, COLUMN) else { break };
-            let tokens: Vec<&str> = head.split_whitespace().collect();
-            let Some((label, rest)) = tokens.split_last() else { break };
-            let Some(atom) = rest.get(1..).and_then(|r| {
-                let joined: String = r.concat();
-                let digits: String = joined.chars().rev().take_while(char::is_ascii_digit).collect();
-                digits.chars().rev().collect::<String>().parse::<usize>().ok()
-            }) else {
-                break;
-            };
-            if rest.first().and_then(|n| n.parse::<usize>().ok()) != Some(row + 1) || atom == 0 {
+            let Some((number, atom, label)) = row_head(head) else { break };
+            if number != row + 1 || atom == 0 {
                 break;
             }
             if first_decimals.is_none() {
@@ -383,6 +392,20 @@ fn eigenvectors(log: &LogLines, header: usize) -> Result<(Section, usize), Parse
     }
     section.decimals = first_decimals.unwrap_or(6);
     Ok((section, i))
+}
+
+/// A row's head `   56  C  1 XXXX` (`C  1XXXX` when the label fills its field): the function's
+/// number, the atom's (from 1) and the function's label.
+fn row_head(head: &str) -> Option<(usize, usize, &str)> {
+    let head = head.trim_end();
+    let label_at = head.trim_end_matches(|c: char| c.is_ascii_alphabetic()).len();
+    let label = &head[label_at..];
+    let rest = head[..label_at].trim_end();
+    let digits_at = rest.trim_end_matches(|c: char| c.is_ascii_digit()).len();
+    let atom = rest[digits_at..].parse().ok()?;
+    let mut tokens = rest[..digits_at].split_whitespace();
+    let number = tokens.next()?.parse().ok()?;
+    (!label.is_empty() && tokens.count() == 1).then_some((number, atom, label))
 }
 
 /// A block's header: the orbitals' numbers (from 1), one after another.

@@ -60,3 +60,11 @@ fn without_printed_orbitals_the_atoms_open_naming_the_keyword() {
     assert_eq!(doc.molecule.atoms.len(), 2);
     assert!(doc.problems.iter().any(|p| p.contains("NPRINT")), "{:?}", doc.problems);
 }
+
+#[test]
+fn row_heads_split_where_the_label_fills_its_field() {
+    assert_eq!(row_head("    1  C  1  S  "), Some((1, 1, "S")));
+    assert_eq!(row_head("   56  C  1XXXX"), Some((56, 1, "XXXX")));
+    assert_eq!(row_head("  120  CL 12 XYZ"), Some((120, 12, "XYZ")));
+    assert_eq!(row_head("  NUMBER OF"), None);
+}

@@ -162,17 +162,23 @@ fn same_geometry(a: &Geometry, b: &Geometry) -> bool {
 /// The frames of a series (an optimisation's, a scan's, an IRC's steps): each geometry with the
 /// first energy printed after it and before the next; a geometry printed again unchanged, without
 /// an energy or with the same one (the converged one, printed or evaluated once more at the end),
-/// is no new frame.
+/// is no new frame, nor is one printed first without its energy and then again with it.
 pub(crate) fn frames<'a>(all: &'a [Geometry], energies: &[(usize, f64)]) -> Vec<(&'a Geometry, Option<f64>)> {
     let mut out: Vec<(&Geometry, Option<f64>)> = Vec::new();
     for (k, g) in all.iter().enumerate() {
         let end = all.get(k + 1).map_or(usize::MAX, |n| n.line);
         let energy = energies.iter().find(|(l, _)| *l > g.line && *l < end).map(|e| e.1);
-        if let Some((last, last_energy)) = out.last()
+        if let Some((last, last_energy)) = out.last_mut()
             && same_geometry(last, g)
-            && (energy.is_none() || energy == *last_energy)
         {
-            continue;
+            if energy.is_none() || energy == *last_energy {
+                continue;
+            }
+            if last_energy.is_none() {
+                // Printed first without its energy (an optimiser's next step, the input echo).
+                *last_energy = energy;
+                continue;
+            }
         }
         out.push((g, energy));
     }
@@ -221,6 +227,11 @@ mod tests {
         let energies = [(5, -1.0), (15, -1.5), (25, -1.5), (45, -1.6)];
         let kept: Vec<(usize, Option<f64>)> = frames(&all, &energies).iter().map(|(g, e)| (g.line, *e)).collect();
         assert_eq!(kept, vec![(0, Some(-1.0)), (10, Some(-1.5)), (40, Some(-1.6))]);
+        // An optimiser's next geometry, printed again by the SCF that gives its energy.
+        let all = [g(0, 0.0), g(10, 0.5), g(20, 0.5)];
+        let energies = [(5, -1.0), (25, -1.5)];
+        let kept: Vec<(usize, Option<f64>)> = frames(&all, &energies).iter().map(|(g, e)| (g.line, *e)).collect();
+        assert_eq!(kept, vec![(0, Some(-1.0)), (10, Some(-1.5))]);
     }
 
     #[test]

@@ -156,20 +156,20 @@ fn function_of(label: &str, l: u32, spherical: bool) -> Option<(ShellKind, usize
     spherical.then_some((ShellKind::Pure, pure_index(m)))
 }
 
-/// `Geometry (in Angstrom|Bohr)` at `header`: a blank line, the heading `Center X Y Z Mass`,
-/// dashes, rows `label x y z mass`. Returns the geometry (bohr), the labels and the next line.
+/// `Geometry (in Angstrom|Bohr)` at `header`: a blank line, the heading `Center X Y Z Mass` and
+/// dashes (when printed), rows `label x y z [mass]`. Returns the geometry (bohr), the labels and the next line.
 fn coordinates(log: &LogLines, header: usize) -> Result<(Geometry, Vec<String>, usize), ParseError> {
     let scale = if log.lines[header].contains("Angstrom") { BOHR_PER_ANGSTROM } else { 1.0 };
     let mut i = header + 1;
     while log.get(i, "the heading `Center X Y Z Mass`")?.trim().is_empty() {
         i += 1;
     }
-    if !log.lines[i].trim_start().starts_with("Center") {
-        return Err(log.error_at(i, "the heading `Center X Y Z Mass`"));
-    }
-    i += 1;
-    if log.get(i, "a line of dashes")?.trim().starts_with("---") {
+    // The heading and its dashes (absent from an optimisation's "Structure for next step").
+    if log.lines[i].trim_start().starts_with("Center") {
         i += 1;
+        if log.get(i, "a line of dashes")?.trim().starts_with("---") {
+            i += 1;
+        }
     }
     let mut g = Geometry { line: header, z: Vec::new(), positions: Vec::new() };
     let mut labels = Vec::new();

@@ -26,7 +26,7 @@ use glam::DVec3;
 
 use super::gamess_log::column_numbers;
 use super::logs::{Geometry, LogLines, decimals, frames, trailing_numbers, trajectory};
-use super::printed::{self, Orbital, PrintedShell, Row, Section, aufbau, cartesian_index};
+use super::printed::{self, Orbital, PrintedShell, Row, Section, aufbau, cartesian_index, pure_index};
 use super::text::parse_real;
 use super::wavefunction::OverlapFn;
 use super::{MAX_Z, ParseError};
@@ -227,14 +227,19 @@ fn orientation(log: &LogLines, header: usize) -> Result<(Geometry, usize), Parse
     Ok((g, i))
 }
 
-/// A row's function label (`s`, `px`, `dxy`, `fxyz`): cartesian, by its letters.
+/// A row's function label: `s`, `px`, cartesian `dxy`, `fxyz` by their letters, pure `d 1` …
+/// `d 5` (read `d1`) in Q-Chem's order m = −l … +l.
 fn function_of(label: &str, l: u32) -> Option<(ShellKind, usize)> {
     let label = label.to_ascii_lowercase();
     let rest = label.strip_prefix(printed::letter(l))?;
     if l == 0 {
         return rest.is_empty().then_some((ShellKind::Cartesian, 0));
     }
-    cartesian_index(rest, l).map(|i| (ShellKind::Cartesian, i))
+    if let Some(i) = cartesian_index(rest, l) {
+        return Some((ShellKind::Cartesian, i));
+    }
+    let k: usize = rest.parse().ok()?;
+    (l >= 2 && (1..=2 * l as usize + 1).contains(&k)).then(|| (ShellKind::Pure, pure_index(k as i32 - 1 - l as i32)))
 }
 
 /// `Basis set in general basis input format:` at `header`: dashes, `$basis`, per atom in order
@@ -331,9 +336,15 @@ fn coefficients(log: &LogLines, header: usize) -> Result<(Section, usize), Parse
             if t.first().and_then(|n| n.parse::<usize>().ok()) != Some(row + 1) || t.len() < 3 {
                 break;
             }
-            // `C 1 px`, `C 12 dxy` or `C12 dxy`: the element, its count, the function.
-            let name: String = t[1..t.len() - 1].concat().to_ascii_uppercase();
-            let label = format!("{name} {}", t[t.len() - 1]);
+            // `C 1 px`, `C 12 dxy`, `C12 dxy`, `C  d 1` (a pure function, the element's only
+            // atom): the element and its count, then the function from its lower-case letter.
+            let function = t[2..].iter().position(|w| w.starts_with(|c: char| c.is_ascii_lowercase())).map(|k| k + 2);
+            let Some(function) = function else { break };
+            let mut name: String = t[1..function].concat().to_ascii_uppercase();
+            if !name.ends_with(|c: char| c.is_ascii_digit()) {
+                name.push('1');
+            }
+            let label = format!("{name} {}", t[function..].concat());
             if first_decimals.is_none() {
                 first_decimals = l.split_whitespace().last().and_then(decimals);
             }
@@ -397,6 +408,11 @@ mod tests {
         assert_eq!(function_of("dyy", 2), Some((ShellKind::Cartesian, 3)));
         assert_eq!(function_of("dxz", 2), Some((ShellKind::Cartesian, 2)));
         assert_eq!(function_of("px", 2), None);
+        // Pure `d 1` … `d 5`: m = −2 … +2.
+        assert_eq!(function_of("d1", 2), Some((ShellKind::Pure, 4)));
+        assert_eq!(function_of("d3", 2), Some((ShellKind::Pure, 0)));
+        assert_eq!(function_of("f7", 3), Some((ShellKind::Pure, 5)));
+        assert_eq!(function_of("d6", 2), None);
     }
 
     #[test]
