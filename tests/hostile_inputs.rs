@@ -353,8 +353,10 @@ fn truncated_files_never_panic() {
     let log = std::fs::read_to_string(LOG).unwrap();
     let orca = std::fs::read_to_string(ORCA).unwrap();
     let [gamess, nwchem, psi4, qchem] = NEW_LOGS.map(|name| std::fs::read_to_string(format!("{LOGS}/{name}")).unwrap());
+    let orca_freq = std::fs::read_to_string(format!("{LOGS}/h2o_orca_freq.out")).unwrap();
     for (name, text) in [
         ("t.out", &orca),
+        ("t.out", &orca_freq),
         ("t.out", &gamess),
         ("t.out", &nwchem),
         ("t.out", &psi4),
