@@ -22,8 +22,8 @@
 //! z). Energies and occupations come from the orbital analysis (`Vector  n  Occ=… E=…`); an
 //! orbital it leaves out gets its occupation from the closed and open shells and no energy.
 //! Coefficients are printed to 5 decimals and the basis' contraction coefficients to 6: the
-//! residual is measured and reported, never repaired. Only a restricted (RHF, ROHF, RKS) job's
-//! orbitals are read.
+//! residual is measured and reported, never repaired. An unrestricted job prints its alpha
+//! vectors (`global array: alpha evecs…`), then its beta ones, each with its own analysis.
 
 use std::collections::HashMap;
 
@@ -55,10 +55,12 @@ pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Docum
     let mut energies = Vec::new();
     let mut basis: Option<(bool, HashMap<String, Vec<PrintedShell>>)> = None;
     let mut vectors: Option<Vectors> = None;
-    // From the orbital analysis: number → (occupation, energy, symmetry).
-    let mut analysis: HashMap<usize, (f64, f64, String)> = HashMap::new();
-    let mut unrestricted = None;
+    // From the orbital analyses, alpha (or restricted) then beta: number → (occupation, energy,
+    // symmetry).
+    let mut analysis: [HashMap<usize, (f64, f64, String)>; 2] = Default::default();
+    let mut spin = 0;
     let mut shells_count = (None, None);
+    let mut electrons = (None, None);
     let mut i = 0;
     while i < log.lines.len() {
         let t = log.lines[i].trim();
@@ -78,16 +80,22 @@ pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Docum
             basis = Some((cartesian, b));
             i = next;
             continue;
-        } else if t.contains("Final Alpha Molecular Orbital Analysis")
-            || t.contains("Final Beta Molecular Orbital Analysis")
+        } else if t.ends_with("Final Molecular Orbital Analysis")
+            || t.ends_with("Final Alpha Molecular Orbital Analysis")
         {
-            unrestricted = Some(i);
-        } else if t.ends_with("Final Molecular Orbital Analysis") {
-            analysis.clear();
+            spin = 0;
+            analysis = Default::default();
+        } else if t.ends_with("Final Beta Molecular Orbital Analysis") {
+            spin = 1;
+            analysis[1].clear();
         } else if let Some(rest) = t.strip_prefix("Vector") {
             if let Some((n, entry)) = analysis_line(rest) {
-                analysis.insert(n, entry);
+                analysis[spin].insert(n, entry);
             }
+        } else if let Some(rest) = t.strip_prefix("Alpha electrons :") {
+            electrons.0 = rest.trim().parse::<usize>().ok();
+        } else if let Some(rest) = t.strip_prefix("Beta electrons :") {
+            electrons.1 = rest.trim().parse::<usize>().ok();
         } else if let Some(rest) = t.strip_prefix("closed shells") {
             shells_count.0 = rest.trim_start_matches([' ', '=']).trim().parse::<usize>().ok();
         } else if let Some(rest) = t.strip_prefix("open shells") {
@@ -109,12 +117,8 @@ pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Docum
             "none in the file",
         ));
     }
-    let why = match (&vectors, &basis, unrestricted) {
-        (_, _, Some(line)) => format!(
-            "the unrestricted orbitals of this output (line {}) are not read: open the job's Molden file (`property; moldenfile; end`)",
-            line + 1
-        ),
-        (Some((line, columns, decimals)), Some((cartesian, basis)), None) => {
+    let why = match (&vectors, &basis) {
+        (Some((line, sets, decimals)), Some((cartesian, basis))) => {
             let k = geometries.iter().rposition(|g| g.line < *line).unwrap_or(geometries.len() - 1);
             let (geometry, tags) = (&geometries[k], &tags[k]);
             let mut shells = Vec::with_capacity(tags.len());
@@ -141,20 +145,31 @@ pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Docum
                 }
                 shells.push(found.clone());
             }
-            let (closed, open) = (shells_count.0.unwrap_or(0), shells_count.1.unwrap_or(0));
-            for (k, coefficients) in columns.iter().enumerate() {
-                let (occupation, energy, symmetry) = analysis.get(&(k + 1)).cloned().unwrap_or_else(|| {
-                    (aufbau(k, Spin::Alpha, true, (closed + open, closed)), f64::NAN, String::new())
-                });
-                section.orbitals.push(Orbital {
-                    energy,
-                    occupation,
-                    spin: Spin::Alpha,
-                    symmetry,
-                    coefficients: coefficients.clone(),
-                });
+            // Restricted: closed and open shells; unrestricted: the DFT module's electrons.
+            let restricted = sets.len() == 1;
+            let counts = if restricted {
+                let (closed, open) = (shells_count.0.unwrap_or(0), shells_count.1.unwrap_or(0));
+                (closed + open, closed)
+            } else {
+                (electrons.0.unwrap_or(0), electrons.1.unwrap_or(0))
+            };
+            for (s, columns) in sets.iter().enumerate() {
+                let spin = if s == 0 { Spin::Alpha } else { Spin::Beta };
+                for (k, coefficients) in columns.iter().enumerate() {
+                    let (occupation, energy, symmetry) = analysis[s]
+                        .get(&(k + 1))
+                        .cloned()
+                        .unwrap_or_else(|| (aufbau(k, spin, restricted, counts), f64::NAN, String::new()));
+                    section.orbitals.push(Orbital {
+                        energy,
+                        occupation,
+                        spin,
+                        symmetry,
+                        coefficients: coefficients.clone(),
+                    });
+                }
             }
-            if section.rows.len() != columns.first().map_or(0, Vec::len) {
+            if sets.iter().flatten().any(|c| c.len() != section.rows.len()) {
                 return Err(log.error_at(
                     *line,
                     format!("{} rows of coefficients (the printed basis set's functions)", section.rows.len()),
@@ -189,10 +204,8 @@ pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Docum
             }
             return Ok(doc);
         }
-        (None, _, None) => format!("the output prints no orbital coefficients (add `{ORBITAL_KEYWORDS}`)"),
-        (Some(_), None, None) => {
-            "the output prints the orbitals but not the basis set (`Basis \"ao basis\"`)".to_string()
-        }
+        (None, _) => format!("the output prints no orbital coefficients (add `{ORBITAL_KEYWORDS}`)"),
+        (Some(_), None) => "the output prints the orbitals but not the basis set (`Basis \"ao basis\"`)".to_string(),
     };
     let mut doc = trajectory(file, file, &frames);
     doc.problems.push(format!("{file}: no orbitals to draw: {why}"));
@@ -318,23 +331,28 @@ fn ao_basis(log: &LogLines, header: usize) -> Result<(HashMap<String, Vec<Printe
     Ok((out, i))
 }
 
-/// The `Final MO vectors`: their header's line, each orbital's coefficients, their decimals.
-type Vectors = (usize, Vec<Vec<f64>>, u32);
+/// The `Final MO vectors`: their header's line, each set's orbitals' coefficients (one set, or
+/// alpha then beta), their decimals.
+type Vectors = (usize, Vec<Vec<Vec<f64>>>, u32);
 
 /// `Final MO vectors` at `header`: blocks of up to 6 orbitals — their numbers, dashes, rows
-/// `function coefficients`. Returns the header, each orbital's coefficients and the decimals.
+/// `function coefficients`; an unrestricted job's `global array: alpha evecs…` blocks, then its
+/// `global array: beta evecs…` ones. Returns the header, each set's orbitals and the decimals.
 fn final_vectors(log: &LogLines, header: usize) -> Result<(Vectors, usize), ParseError> {
-    let mut orbitals: Vec<Vec<f64>> = Vec::new();
+    let mut sets: Vec<Vec<Vec<f64>>> = vec![Vec::new()];
     let mut rows_first = None;
     let mut first_decimals = None;
     let mut i = header + 1;
     loop {
-        while log.lines.get(i).is_some_and(|l| {
-            let t = l.trim();
-            t.is_empty() || t.starts_with("---") || t.starts_with("global array")
-        }) {
+        while let Some(t) = log.lines.get(i).map(|l| l.trim()) {
+            if t.starts_with("global array") && t.contains("beta") && sets.len() == 1 && !sets[0].is_empty() {
+                sets.push(Vec::new());
+            } else if !(t.is_empty() || t.starts_with("---") || t.starts_with("global array")) {
+                break;
+            }
             i += 1;
         }
+        let orbitals = sets.last_mut().expect("a set");
         let Some(numbers) = log.lines.get(i).and_then(|l| column_numbers(l)) else { break };
         if numbers[0] != orbitals.len() + 1 {
             break;
@@ -365,10 +383,13 @@ fn final_vectors(log: &LogLines, header: usize) -> Result<(Vectors, usize), Pars
         rows_first = Some(row);
         orbitals.extend(columns);
     }
-    if orbitals.is_empty() {
+    if sets.iter().any(Vec::is_empty) {
         return Err(log.error_at(i, "a block of orbitals: their numbers `1 2 3 4 5 6`"));
     }
-    Ok(((header, orbitals, first_decimals.unwrap_or(5)), i))
+    if sets.len() == 2 && sets[0].len() != sets[1].len() {
+        return Err(log.error_at(i, format!("{} beta orbitals, as many as the alpha ones", sets[0].len())));
+    }
+    Ok(((header, sets, first_decimals.unwrap_or(5)), i))
 }
 
 #[cfg(test)]

@@ -56,3 +56,45 @@ fn without_printed_vectors_the_atoms_open_naming_the_keyword() {
     assert!(doc.wavefunction.is_none());
     assert!(doc.problems.iter().any(|p| p.contains("print \"final vectors\"")), "{:?}", doc.problems);
 }
+
+/// H₂⁺-like occupations in an unrestricted job's layout (NWChem 6.5's DFT module): the alpha and
+/// beta analyses, then `global array: alpha evecs…` and `… beta evecs…` blocks.
+#[test]
+fn an_unrestricted_jobs_alpha_and_beta_vectors_open() {
+    let vectors = H2.find(" global array: scf_init").unwrap();
+    let blocks_end = H2.find(" center of mass").unwrap();
+    let blocks = &H2[H2[vectors..].find('\n').unwrap() + vectors + 1..blocks_end];
+    let text = format!(
+        "{}{}{}{}{}",
+        &H2[..vectors],
+        " global array: alpha evecs[1:2,1:2],  handle: -995 \n",
+        blocks,
+        " global array: beta evecs[1:2,1:2],  handle: -990 \n",
+        &H2[vectors + H2[vectors..].find('\n').unwrap() + 1..]
+    )
+    .replacen("ROHF Final Molecular Orbital Analysis", "DFT Final Alpha Molecular Orbital Analysis", 1)
+    .replacen(
+        "\n\n                                 Final MO vectors",
+        "\n                       DFT Final Beta Molecular Orbital Analysis\n\n Vector    1  Occ=0.000000D+00  E=-4.000000D-01  Symmetry=ag\n Vector    2  Occ=0.000000D+00  E= 7.000000D-01  Symmetry=b1u\n\n                                 Final MO vectors",
+        1,
+    )
+    .replacen("Occ=2.000000D+00", "Occ=1.000000D+00", 1);
+    let doc = read(&text).unwrap_or_else(|e| panic!("{e}"));
+    let wf = doc.wavefunction.as_ref().expect("orbitals");
+    assert!(!wf.restricted);
+    let spins: Vec<(Spin, f64, f64)> = wf.orbitals.iter().map(|o| (o.spin, o.occupation, o.energy)).collect();
+    assert_eq!(
+        spins,
+        vec![
+            (Spin::Alpha, 1.0, -0.5785538),
+            (Spin::Alpha, 0.0, 0.671137),
+            (Spin::Beta, 0.0, -0.4),
+            (Spin::Beta, 0.0, 0.7)
+        ]
+    );
+    assert!(wf.normalization.residual < wf.normalization.expected_residual());
+    // The beta vectors cut short.
+    let cut = &text[..text.rfind("   2  ").unwrap()];
+    let e = read(cut).unwrap_err();
+    assert!(e.expected.contains("rows of coefficients"), "{e}");
+}
