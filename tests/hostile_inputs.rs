@@ -13,6 +13,9 @@ const FIXTURES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/wave
 const AIM: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/wfn_wfx_mkl");
 const LOG: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/logs/h2_sto3g.log");
 const ORCA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/logs/h2_orca.out");
+const LOGS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/logs");
+/// H₂ as GAMESS-US, NWChem, Psi4 and Q-Chem print it, with the basis and the orbitals.
+const NEW_LOGS: [&str; 4] = ["h2_gamess.out", "h2_nwchem.out", "h2_psi4.out", "h2_qchem.out"];
 
 /// A 2×2×3 bohr grid with one oxygen atom (line 7) and its 12 values (lines 8–9).
 fn cube(atom: &str, axes: [&str; 3], origin: &str) -> String {
@@ -349,8 +352,15 @@ fn truncated_files_never_panic() {
     let (wfn, wfx, mkl) = (aim("oh_rohf.wfn"), aim("oh_rohf.wfx"), aim("oh_rohf.mkl"));
     let log = std::fs::read_to_string(LOG).unwrap();
     let orca = std::fs::read_to_string(ORCA).unwrap();
+    let [gamess, nwchem, psi4, qchem] = NEW_LOGS.map(|name| std::fs::read_to_string(format!("{LOGS}/{name}")).unwrap());
+    let orca_freq = std::fs::read_to_string(format!("{LOGS}/h2o_orca_freq.out")).unwrap();
     for (name, text) in [
         ("t.out", &orca),
+        ("t.out", &orca_freq),
+        ("t.out", &gamess),
+        ("t.out", &nwchem),
+        ("t.out", &psi4),
+        ("t.out", &qchem),
         ("t.cube", &cube),
         ("t.molden", &molden),
         ("t.fchk", &fchk),
@@ -513,9 +523,12 @@ fn gaussian_logs_with_lying_counts_are_refused_at_their_line() {
     let e = refused("cut.log", bad.as_bytes());
     assert!(e.expected.contains("dashes that close the orientation table"), "{e}");
 
-    let e = refused("gamess.out", b" GAMESS VERSION = 30 SEP 2017 (R1)\n EXECUTION OF GAMESS BEGUN\n");
-    assert!(e.expected.contains("Entering Gaussian System") && e.expected.contains("O   R   C   A"), "{e}");
+    let e = refused("molpro.out", b" PROGRAM SYSTEM MOLPRO\n Molpro calculation of H2\n");
+    assert!(e.expected.contains("Entering Gaussian System") && e.expected.contains("GAMESS VERSION"), "{e}");
     assert_eq!(e.line, 1);
+    // A GAMESS banner and nothing else: refused for want of its geometry.
+    let e = refused("gamess.out", b" GAMESS VERSION = 30 SEP 2017 (R1)\n EXECUTION OF GAMESS BEGUN\n");
+    assert!(e.expected.contains("COORDINATES (BOHR)"), "{e}");
 }
 
 /// An ORCA output whose shell claims 10¹¹ primitives, or whose orbital rows name the wrong atom,
@@ -531,4 +544,45 @@ fn orca_outputs_with_lying_counts_are_refused_at_their_line() {
     let e = refused("atom.out", bad.as_bytes());
     assert_eq!(e.line, bad.lines().position(|l| l.starts_with("  0H") && l.contains('-')).unwrap() + 1, "{e}");
     assert!(e.expected.contains("function of atom 1"), "{e}");
+}
+
+/// GAMESS-US, NWChem, Psi4 and Q-Chem outputs cut inside their orbital blocks are refused naming
+/// the file and a line, never opened with part of an orbital; a shell claiming 10¹¹ primitives
+/// (Psi4, Q-Chem: GAMESS and NWChem print one primitive a line, no count) allocates nothing.
+#[test]
+fn other_programs_outputs_cut_inside_their_orbitals_are_refused_at_a_line() {
+    for name in NEW_LOGS {
+        let text = std::fs::read_to_string(format!("{LOGS}/{name}")).unwrap();
+        let doc = formats::load_bytes(Path::new(name), text.as_bytes()).unwrap_or_else(|e| panic!("{e}"));
+        assert!(doc.wavefunction.is_some(), "{name}");
+        // Cut after each line of the orbital section's last rows: every cut either refuses the
+        // file at a line or opens whole orbitals (2 coefficients each).
+        let lines: Vec<&str> = text.lines().collect();
+        let last_row = lines.iter().rposition(|l| l.contains("-1.21245")).unwrap();
+        let first_row = lines.iter().position(|l| l.contains("1.21245")).unwrap();
+        for cut in first_row..=last_row {
+            let cut_text = lines[..cut].join("\n") + "\n";
+            match formats::load_bytes(Path::new(name), cut_text.as_bytes()) {
+                Err(e) => {
+                    let e = parse_error(e);
+                    assert_eq!(e.file, name);
+                    assert!(e.line >= 1 && e.line <= cut.max(1), "{name} cut at {cut}: {e}");
+                }
+                Ok(doc) => {
+                    let wf = doc.wavefunction.unwrap_or_else(|| panic!("{name} cut at {cut}: opened without orbitals"));
+                    assert!(wf.orbitals.iter().all(|o| o.coefficients.len() == 2), "{name} cut at {cut}");
+                }
+            }
+        }
+    }
+    for (name, from, to) in [
+        ("h2_psi4.out", "    S   3 1.00", "    S   99999999999 1.00"),
+        ("h2_qchem.out", "S    3    1.000000", "S    99999999999    1.000000"),
+    ] {
+        let text = std::fs::read_to_string(format!("{LOGS}/{name}")).unwrap().replacen(from, to, 1);
+        let start = Instant::now();
+        let e = refused(name, text.as_bytes());
+        assert!(start.elapsed() < Duration::from_secs(2), "{name}");
+        assert!(e.line > 1, "{name}: {e}");
+    }
 }

@@ -416,7 +416,11 @@ pub fn text(doc: &Document) -> String {
                 if m.is_imaginary() { format!("{:.2}i", -m.frequency_cm1) } else { format!("{:.2}", m.frequency_cm1) };
             let _ = writeln!(s, "  mode {:>3} {:>12} cm⁻¹  IR {:>10} km/mol", k + 1, mark, intensity);
         }
-    } else if info.wavefunction.as_ref().is_some_and(|w| w.normalization.program == "Q-Chem") {
+    } else if info
+        .wavefunction
+        .as_ref()
+        .is_some_and(|w| w.normalization.program == "Q-Chem" && w.normalization.printed_decimals.is_none())
+    {
         let _ = writeln!(s, "no normal modes: Q-Chem's fchk files carry none");
     }
     if let Some(x) = &info.excited_states {

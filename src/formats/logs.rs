@@ -1,7 +1,8 @@
 //! Program logs (`.log`, `.out`): many programs write files with these endings, so the program
 //! is told from the text, not the name. Gaussian prints "Entering Gaussian System" and its
 //! copyright ("Gaussian, Inc.") at the top; ORCA its banner "O   R   C   A"; Q-Chem "Welcome to
-//! Q-Chem" and "Q-Chem, Inc.".
+//! Q-Chem" and "Q-Chem, Inc."; GAMESS-US "GAMESS VERSION"; NWChem "Northwest Computational
+//! Chemistry Package"; Psi4 "Psi4: An Open-Source Ab Initio Electronic Structure Package".
 //!
 //! What the readers of logs share: the lines with their numbers, numbers in fixed-width
 //! columns, and the errors they raise.
@@ -10,7 +11,7 @@ use glam::DVec3;
 
 use super::text::{excerpt, parse_real};
 use super::wavefunction::OverlapFn;
-use super::{ParseError, gaussian_log, orca_log, qchem_log};
+use super::{ParseError, gamess_log, gaussian_log, nwchem_log, orca_log, psi4_log, qchem_log};
 use crate::model::Document;
 
 /// Lines of the file's top in which the program's banner is looked for: a job scheduler may
@@ -23,6 +24,9 @@ pub enum Program {
     Gaussian,
     Orca,
     QChem,
+    Gamess,
+    NwChem,
+    Psi4,
 }
 
 /// The program that wrote `text`, from its banner.
@@ -37,12 +41,21 @@ pub fn program(text: &str) -> Option<Program> {
         if line.contains("Welcome to Q-Chem") || line.contains("Q-Chem, Inc.") {
             return Some(Program::QChem);
         }
+        if line.contains("GAMESS VERSION =") {
+            return Some(Program::Gamess);
+        }
+        if line.contains("Northwest Computational Chemistry Package") {
+            return Some(Program::NwChem);
+        }
+        if line.contains("Psi4: An Open-Source Ab Initio Electronic Structure Package") {
+            return Some(Program::Psi4);
+        }
     }
     None
 }
 
 /// What the banner check looks for, in words.
-pub const BANNERS: &str = "a Gaussian log (\"Entering Gaussian System\" or \"Gaussian, Inc.\"), an ORCA output (\"O   R   C   A\") or a Q-Chem output (\"Welcome to Q-Chem\")";
+pub const BANNERS: &str = "a Gaussian log (\"Entering Gaussian System\" or \"Gaussian, Inc.\"), an ORCA output (\"O   R   C   A\"), a Q-Chem output (\"Welcome to Q-Chem\"), a GAMESS-US output (\"GAMESS VERSION =\"), an NWChem output (\"Northwest Computational Chemistry Package\") or a Psi4 output (\"Psi4: An Open-Source Ab Initio Electronic Structure Package\")";
 
 /// Parses a program's log into a document, the program told by its banner.
 pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Document, ParseError> {
@@ -52,12 +65,15 @@ pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Docum
     match program(text) {
         Some(Program::Gaussian) => gaussian_log::parse(file, text, overlap),
         Some(Program::Orca) => orca_log::parse(file, text, overlap),
-        Some(Program::QChem) => qchem_log::parse(file, text),
+        Some(Program::QChem) => qchem_log::parse(file, text, overlap),
+        Some(Program::Gamess) => gamess_log::parse(file, text, overlap),
+        Some(Program::NwChem) => nwchem_log::parse(file, text, overlap),
+        Some(Program::Psi4) => psi4_log::parse(file, text, overlap),
         None => Err(error(
             file,
             1,
             BANNERS,
-            format!("neither banner in the first {BANNER_LINES} lines (another program's output?)"),
+            format!("no banner in the first {BANNER_LINES} lines (another program's output?)"),
         )),
     }
 }
@@ -146,17 +162,23 @@ fn same_geometry(a: &Geometry, b: &Geometry) -> bool {
 /// The frames of a series (an optimisation's, a scan's, an IRC's steps): each geometry with the
 /// first energy printed after it and before the next; a geometry printed again unchanged, without
 /// an energy or with the same one (the converged one, printed or evaluated once more at the end),
-/// is no new frame.
+/// is no new frame, nor is one printed first without its energy and then again with it.
 pub(crate) fn frames<'a>(all: &'a [Geometry], energies: &[(usize, f64)]) -> Vec<(&'a Geometry, Option<f64>)> {
     let mut out: Vec<(&Geometry, Option<f64>)> = Vec::new();
     for (k, g) in all.iter().enumerate() {
         let end = all.get(k + 1).map_or(usize::MAX, |n| n.line);
         let energy = energies.iter().find(|(l, _)| *l > g.line && *l < end).map(|e| e.1);
-        if let Some((last, last_energy)) = out.last()
+        if let Some((last, last_energy)) = out.last_mut()
             && same_geometry(last, g)
-            && (energy.is_none() || energy == *last_energy)
         {
-            continue;
+            if energy.is_none() || energy == *last_energy {
+                continue;
+            }
+            if last_energy.is_none() {
+                // Printed first without its energy (an optimiser's next step, the input echo).
+                *last_energy = energy;
+                continue;
+            }
         }
         out.push((g, energy));
     }
@@ -205,13 +227,21 @@ mod tests {
         let energies = [(5, -1.0), (15, -1.5), (25, -1.5), (45, -1.6)];
         let kept: Vec<(usize, Option<f64>)> = frames(&all, &energies).iter().map(|(g, e)| (g.line, *e)).collect();
         assert_eq!(kept, vec![(0, Some(-1.0)), (10, Some(-1.5)), (40, Some(-1.6))]);
+        // An optimiser's next geometry, printed again by the SCF that gives its energy.
+        let all = [g(0, 0.0), g(10, 0.5), g(20, 0.5)];
+        let energies = [(5, -1.0), (25, -1.5)];
+        let kept: Vec<(usize, Option<f64>)> = frames(&all, &energies).iter().map(|(g, e)| (g.line, *e)).collect();
+        assert_eq!(kept, vec![(0, Some(-1.0)), (10, Some(-1.5))]);
     }
 
     #[test]
     fn programs_are_told_by_their_banner() {
         assert_eq!(program(" Entering Gaussian System, Link 0=g16\n"), Some(Program::Gaussian));
         assert_eq!(program("\n  * O   R   C   A *\n"), Some(Program::Orca));
-        assert_eq!(program(" GAMESS VERSION = 30 SEP 2017\n"), None);
+        assert_eq!(program(" *  GAMESS VERSION = 30 SEP 2017 (R1)  *\n"), Some(Program::Gamess));
+        assert_eq!(program(" Northwest Computational Chemistry Package (NWChem) 6.5\n"), Some(Program::NwChem));
+        assert_eq!(program("  Psi4: An Open-Source Ab Initio Electronic Structure Package\n"), Some(Program::Psi4));
+        assert_eq!(program(" Molpro calculation\n"), None);
         let e = parse("x.out", " NWChem Input Module\n", None).unwrap_err();
         assert_eq!(e.line, 1);
         assert!(e.expected.contains("Entering Gaussian System") && e.expected.contains("O   R   C   A"), "{e}");

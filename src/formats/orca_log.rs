@@ -23,6 +23,12 @@
 //! normalised primitives, as input. Coefficients are printed to 6 decimals: the residual is
 //! measured and reported as such, no repair is tried on it. Each coordinate table followed by a
 //! `FINAL SINGLE POINT ENERGY` is a frame.
+//!
+//! A frequency job's modes: `VIBRATIONAL FREQUENCIES` (`  6:      43.87 cm**-1`, the first five or
+//! six, translations and rotations, exactly 0.00 and left out), `NORMAL MODES` (blocks of columns,
+//! one row per Cartesian coordinate x₀ y₀ z₀ x₁ …: ORCA's mass-weighted modes taken back to
+//! Cartesian displacements and normalised, as printed) and `IR SPECTRUM` (`Int` in km/mol), at the
+//! last coordinate table before them.
 
 use std::collections::HashMap;
 
@@ -35,6 +41,7 @@ use super::wavefunction::{OverlapFn, check_printed, orca_flipped};
 use super::{MAX_Z, ParseError};
 use crate::model::basis::{Basis, MAX_L, Shell, ShellKind};
 use crate::model::orbitals::{MolecularOrbital, Spin, Wavefunction};
+use crate::model::vibrations::{NormalMode, Vibrations};
 use crate::model::{Atom, Document, Molecule};
 
 /// The keywords that make ORCA print the basis set and the orbitals.
@@ -44,6 +51,11 @@ pub const ORBITAL_KEYWORDS: &str = "%output print[p_basis] 2 print[p_mos] 1 end"
 pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Document, ParseError> {
     let log = LogLines::new(file, text);
     let mut doc = read(&log, overlap)?;
+    // A malformed mode section leaves the modes out, not the file.
+    match vibrations(&log) {
+        Ok(modes) => doc.vibrations = modes,
+        Err(e) => doc.problems.push(format!("normal modes left out: {e}")),
+    }
     // A malformed table leaves the states out, not the file.
     match super::excited_logs::orca(&log) {
         Ok(states) => doc.excited = states,
@@ -404,6 +416,142 @@ fn wavefunction_document(
         wavefunction: Some(check_printed(wf, "ORCA", overlap, section.decimals)),
         ..Default::default()
     })
+}
+
+/// A frequency job's normal modes (see the module's documentation); `None` without
+/// `VIBRATIONAL FREQUENCIES` and `NORMAL MODES`.
+fn vibrations(log: &LogLines) -> Result<Option<Vibrations>, ParseError> {
+    let find = |title: &str| log.lines.iter().rposition(|l| l.trim() == title);
+    let (Some(freq_at), Some(modes_at)) = (find("VIBRATIONAL FREQUENCIES"), find("NORMAL MODES")) else {
+        return Ok(None);
+    };
+    // `  k:   wavenumber cm**-1 …`, from 0, after the title.
+    let mut frequencies: Vec<f64> = Vec::new();
+    let mut i = freq_at + 1;
+    while let Some(l) = log.lines.get(i) {
+        let t: Vec<&str> = l.split_whitespace().collect();
+        if let Some(k) = t.first().and_then(|k| k.strip_suffix(':')).and_then(|k| k.parse::<usize>().ok()) {
+            let row = format!("a frequency `{k}:  wavenumber cm**-1`");
+            if k != frequencies.len() || t.get(2) != Some(&"cm**-1") {
+                return Err(log.error_at(i, row));
+            }
+            frequencies.push(t.get(1).and_then(|v| parse_real(v)).ok_or_else(|| log.error_at(i, row))?);
+        } else if !frequencies.is_empty() && (t.is_empty() || l.trim().starts_with("---")) {
+            break;
+        }
+        i += 1;
+    }
+    if frequencies.is_empty() {
+        return Err(log.error_at(freq_at, "frequencies `0:  0.00 cm**-1` after `VIBRATIONAL FREQUENCIES`"));
+    }
+    let n = frequencies.len();
+    if !n.is_multiple_of(3) {
+        return Err(log.error_at(freq_at, format!("three frequencies per atom ({n} found)")));
+    }
+    // The blocks of columns: numbers, (irreps), rows `coordinate  values`.
+    let mut columns: Vec<Vec<f64>> = Vec::new();
+    let mut i = modes_at + 1;
+    while columns.len() < n {
+        let Some(l) = log.lines.get(i) else {
+            return Err(
+                log.error_at(i, format!("the modes' columns up to {} (NORMAL MODES at line {})", n - 1, modes_at + 1))
+            );
+        };
+        let Some(numbers) = super::gamess_log::column_numbers(l).filter(|c| c[0] == columns.len()) else {
+            if columns.is_empty() || l.trim().is_empty() {
+                i += 1;
+                if i > modes_at + 40 && columns.is_empty() {
+                    return Err(log.error_at(modes_at, "a block of modes: their numbers `0 1 2 …`"));
+                }
+                continue;
+            }
+            return Err(log.error_at(
+                i,
+                format!("the block of modes from {} (NORMAL MODES at line {})", columns.len(), modes_at + 1),
+            ));
+        };
+        let block = i;
+        let k = numbers.len();
+        i += 1;
+        // The irreps' line, when the point group has them.
+        if log.lines.get(i).is_some_and(|l| l.split_whitespace().next().is_some_and(|t| t.parse::<usize>().is_err())) {
+            i += 1;
+        }
+        let mut block_columns = vec![Vec::with_capacity(n); k];
+        for row in 0..n {
+            let expected =
+                format!("row {row} of the block at line {}: the coordinate's number and {k} displacements", block + 1);
+            let l = log.get(i, &expected)?;
+            let t: Vec<&str> = l.split_whitespace().collect();
+            let values: Option<Vec<f64>> =
+                t.get(1..).filter(|v| v.len() == k).and_then(|v| v.iter().map(|x| parse_real(x)).collect());
+            let values =
+                values.filter(|_| t[0].parse::<usize>().ok() == Some(row)).ok_or_else(|| log.error_at(i, expected))?;
+            for (c, v) in values.into_iter().enumerate() {
+                block_columns[c].push(v);
+            }
+            i += 1;
+        }
+        columns.extend(block_columns);
+    }
+    // `  k:  wavenumber  eps  Int  …` under the `IR SPECTRUM` heading's `Int` column.
+    let mut intensities: Vec<Option<f64>> = vec![None; n];
+    if let Some(ir_at) = find("IR SPECTRUM") {
+        let heading =
+            (ir_at + 1..(ir_at + 6).min(log.lines.len())).find(|&k| log.lines[k].trim_start().starts_with("Mode"));
+        let column = heading.and_then(|k| log.lines[k].split_whitespace().position(|w| w == "Int"));
+        if let (Some(heading), Some(column)) = (heading, column) {
+            let mut i = heading + 1;
+            while let Some(l) = log.lines.get(i) {
+                let t: Vec<&str> = l.split_whitespace().collect();
+                let Some(k) = t.first().and_then(|k| k.strip_suffix(':')).and_then(|k| k.parse::<usize>().ok()) else {
+                    // The units' line and the dashes under the heading; the table ends at the
+                    // first other line after its rows.
+                    if i <= heading + 3 {
+                        i += 1;
+                        continue;
+                    }
+                    break;
+                };
+                let value = t.get(column).and_then(|v| parse_real(v));
+                match (intensities.get_mut(k), value) {
+                    (Some(slot), Some(v)) => *slot = Some(v),
+                    _ => return Err(log.error_at(i, format!("a mode below {n} and its intensity in the `Int` column"))),
+                }
+                i += 1;
+            }
+        }
+    }
+    let atoms = n / 3;
+    let geometry_at = (0..modes_at).rev().find(|&k| log.lines[k].trim() == "CARTESIAN COORDINATES (A.U.)");
+    let Some(geometry_at) = geometry_at else {
+        return Err(log.error_at(modes_at, "a `CARTESIAN COORDINATES (A.U.)` table before the normal modes"));
+    };
+    let (geometry, _) = coordinates(log, geometry_at)?;
+    if geometry.z.len() != atoms {
+        return Err(log.error_at(
+            freq_at,
+            format!(
+                "three frequencies for each of the {} atoms of the geometry at line {}",
+                geometry.z.len(),
+                geometry_at + 1
+            ),
+        ));
+    }
+    // Translations and rotations: the leading modes ORCA sets to exactly zero.
+    let skip = frequencies.iter().take(6).take_while(|&&f| f == 0.0).count();
+    let modes = (skip..n)
+        .map(|m| NormalMode {
+            frequency_cm1: frequencies[m],
+            ir_intensity: intensities[m],
+            displacement: columns[m].chunks(3).map(|c| DVec3::new(c[0], c[1], c[2])).collect(),
+        })
+        .collect();
+    Ok(Some(Vibrations {
+        modes,
+        geometry: geometry.positions,
+        geometry_from: format!("the coordinates at line {}", geometry_at + 1),
+    }))
 }
 
 #[cfg(test)]

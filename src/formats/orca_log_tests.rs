@@ -217,3 +217,80 @@ fn a_cut_orbital_block_and_a_missing_basis_are_reported() {
     assert_eq!(doc.structure.as_ref().unwrap().structure.models[0].energy, Some(-76.012345678901));
     assert!(doc.problems.iter().any(|p| p.contains("print[p_basis] 2")), "{:?}", doc.problems);
 }
+
+/// Water's frequency job as ORCA 6 prints it: 9 frequencies (six zeros), the `NORMAL MODES`
+/// columns in blocks, the `IR SPECTRUM` table.
+fn frequency_output() -> String {
+    let mut t = "                                 * O   R   C   A *\n\n----------------------------\nCARTESIAN COORDINATES (A.U.)\n----------------------------\n".to_string();
+    t += "  NO LB      ZA    FRAG     MASS         X           Y           Z\n";
+    for (k, (symbol, p)) in ATOMS.iter().enumerate() {
+        let (za, mass) = if *symbol == "O" { (8.0, 15.999) } else { (1.0, 1.008) };
+        t += &format!("{k:>4} {symbol:<2} {za:>9.4}{:>5}{mass:>11.3}{:>12.6}{:>12.6}{:>12.6}\n", 0, p[0], p[1], p[2]);
+    }
+    t += "\nFINAL SINGLE POINT ENERGY       -75.012345678901\n\n-----------------------\nVIBRATIONAL FREQUENCIES\n-----------------------\n\n";
+    t += "Scaling factor for frequencies =  1.000000000  (already applied!)\n\n";
+    let freqs = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1600.5, 3650.25, 3755.75];
+    for (k, f) in freqs.iter().enumerate() {
+        t += &format!("{k:>6}:{f:>11.2} cm**-1\n");
+    }
+    t += "\n\n------------\nNORMAL MODES\n------------\n\nThese modes are the Cartesian displacements weighted by the diagonal matrix\n\n";
+    let value = |row: usize, col: usize| ((row * 7 + col * 3) as f64 * 0.37).sin() * 0.5;
+    for first in [0, 6] {
+        let cols: Vec<usize> = (first..(first + 6).min(9)).collect();
+        t += &format!("      {}\n", cols.iter().map(|c| format!("{c:>11}")).collect::<String>());
+        for row in 0..9 {
+            t += &format!("{row:>6}{}\n", cols.iter().map(|&c| format!("{:>11.6}", value(row, c))).collect::<String>());
+        }
+        t += "\n";
+    }
+    t += "\n-----------\nIR SPECTRUM\n-----------\n\n Mode   freq       eps      Int      T**2         TX        TY        TZ\n";
+    t += "       cm**-1   L/(mol*cm) km/mol    a.u.\n----------------------------------------------------------------------------\n";
+    for (k, (f, int)) in
+        [(6, 1600.5, 70.25), (7, 3650.25, 5.5), (8, 3755.75, 48.0)].iter().map(|(k, f, i)| (*k, (*f, *i)))
+    {
+        t += &format!("{k:>3}:{f:>10.2}   0.001000{int:>8.2}  0.000100  ( 0.000000  0.000000  0.010000)\n");
+    }
+    t + "\n* The epsilon (eps) is given for a Dirac delta lineshape.\n"
+}
+
+#[test]
+fn a_frequency_jobs_modes_open_without_translations_and_rotations() {
+    let text = frequency_output();
+    let doc = read(&text).unwrap_or_else(|e| panic!("{e}"));
+    let v = doc.vibrations.as_ref().unwrap_or_else(|| panic!("modes: {:?}", doc.problems));
+    assert_eq!(v.modes.len(), 3);
+    assert_eq!(v.geometry.len(), 3);
+    assert_eq!(v.geometry[1], DVec3::from_array(ATOMS[1].1));
+    let value = |row: usize, col: usize| ((row * 7 + col * 3) as f64 * 0.37).sin() * 0.5;
+    for (m, (f, int)) in v.modes.iter().zip([(1600.5, 70.25), (3650.25, 5.5), (3755.75, 48.0)]) {
+        assert_eq!((m.frequency_cm1, m.ir_intensity), (f, Some(int)));
+    }
+    // Mode 8 (the third kept), atom 2 (rows 6, 7, 8): x, y, z as printed, to 6 decimals.
+    let d = v.modes[2].displacement[2];
+    for (got, row) in [d.x, d.y, d.z].into_iter().zip(6..9) {
+        assert!((got - value(row, 8)).abs() < 1e-6, "{got} {}", value(row, 8));
+    }
+}
+
+#[test]
+fn a_malformed_mode_section_leaves_the_modes_out_not_the_file() {
+    let text = frequency_output();
+    // A block cut after its first rows.
+    let cut = text.replacen("\n     4  ", "\n  four  ", 1);
+    let doc = read(&cut).unwrap();
+    assert!(doc.vibrations.is_none());
+    assert!(
+        doc.problems.iter().any(|p| p.contains("normal modes left out") && p.contains("row 4")),
+        "{:?}",
+        doc.problems
+    );
+    // Frequencies for another molecule.
+    let more = text.replacen(
+        "     8:",
+        "     8:  3755.75 cm**-1\n     9:    100.00 cm**-1\n    10:    100.00 cm**-1\n    11:",
+        1,
+    );
+    let doc = read(&more).unwrap();
+    assert!(doc.vibrations.is_none());
+    assert!(!doc.problems.is_empty());
+}
