@@ -803,3 +803,18 @@ fn a_water_dimer_s_nci_surface_shows_its_hydrogen_bond_in_blue_green() {
     let unlit = blue_green(&picture(&mut h, dir.path(), "unlit"));
     assert!(lit * 10 > disc * 8 && unlit * 10 < disc, "the disc {disc} px, lit {lit}, grey {unlit}");
 }
+
+#[test]
+fn an_optimisation_log_plays_its_frames_with_their_energies_and_a_click_on_the_plot_picks_one() {
+    let Some(corpus) = common::refdata("a log's frames in the window") else { return };
+    let mut h = open(vec![corpus.join("logs/basicGaussian09_dvb_gopt.out")]);
+    wait_loaded(&mut h);
+    let shown = |h: &Harness<'static, OrbApp>| h.state().objects[0].doc.structure.as_ref().map(|s| s.model);
+    assert_eq!(shown(&h), Some(0), "the optimisation's first step");
+    let transform = h.state().models.energy_plot.expect("the frames' energies are plotted");
+    // The fourth step, converged but for the last digits: a click on its point shows it.
+    click_at(&mut h, transform.position_from_point(&egui_plot::PlotPoint::new(4.0, 0.0)), false);
+    wait_loaded(&mut h);
+    assert_eq!(shown(&h), Some(3), "the frame clicked on the plot");
+    assert!(h.query_by_label_contains("step 4: E = -382.3082").is_some(), "its energy named");
+}

@@ -17,6 +17,8 @@ const STEP: Duration = Duration::from_millis(120);
 pub struct Player {
     pub playing: bool,
     last: Option<Instant>,
+    /// Where the frames' energy plot was last drawn (tests click its points).
+    pub energy_plot: Option<egui_plot::PlotTransform>,
 }
 
 /// The slider and play button, when the active object has more than one model; the model
@@ -42,7 +44,50 @@ pub fn controls(ui: &mut egui::Ui, app: &mut OrbApp) -> Option<usize> {
     });
     let title = if model.title.is_empty() { format!("MODEL {}", model.number) } else { model.title.clone() };
     ui.label(RichText::new(title).small().weak());
-    chosen
+    let energies: Vec<Option<f64>> = view.structure.models.iter().map(|m| m.energy).collect();
+    let (picked, transform) = energy_plot(ui, &energies, view.model).unzip();
+    app.models.energy_plot = transform;
+    picked.flatten().or(chosen)
+}
+
+/// Height of the frames' energy plot, points.
+const ENERGY_PLOT_HEIGHT: f32 = 120.0;
+
+/// The frames' energies (an optimisation's, an IRC's, a scan's, as the log printed them),
+/// relative to the lowest, in kcal/mol against the frame's number, the frame shown marked; a
+/// click picks the frame nearest it. Nothing when fewer than two frames have an energy.
+fn energy_plot(
+    ui: &mut egui::Ui,
+    energies: &[Option<f64>],
+    shown: usize,
+) -> Option<(Option<usize>, egui_plot::PlotTransform)> {
+    const KCAL_PER_HARTREE: f64 = 627.509_474;
+    let known: Vec<(usize, f64)> = energies.iter().enumerate().filter_map(|(k, e)| Some((k, (*e)?))).collect();
+    if known.len() < 2 {
+        return None;
+    }
+    let lowest = known.iter().map(|&(_, e)| e).fold(f64::INFINITY, f64::min);
+    let points: Vec<[f64; 2]> = known.iter().map(|&(k, e)| [(k + 1) as f64, (e - lowest) * KCAL_PER_HARTREE]).collect();
+    let marked: Vec<[f64; 2]> = points.iter().filter(|p| p[0] as usize == shown + 1).copied().collect();
+    let response = egui_plot::Plot::new("frames' energies")
+        .height(ENERGY_PLOT_HEIGHT)
+        .x_axis_label("frame")
+        .y_axis_label("ΔE (kcal/mol)")
+        .allow_zoom(false)
+        .allow_drag(false)
+        .allow_scroll(false)
+        .allow_boxed_zoom(false)
+        .show(ui, |plot| {
+            plot.line(egui_plot::Line::new("energy", points.clone()));
+            plot.points(egui_plot::Points::new("frames", points).radius(2.0));
+            plot.points(egui_plot::Points::new("shown", marked).radius(5.0).color(egui::Color32::YELLOW));
+            plot.response().clicked().then(|| plot.pointer_coordinate()).flatten()
+        });
+    let picked = response.inner.and_then(|at| {
+        let distance = |k: usize| ((k + 1) as f64 - at.x).abs();
+        known.iter().map(|&(k, _)| k).min_by(|&a, &b| distance(a).total_cmp(&distance(b)))
+    });
+    Some((picked, response.transform))
 }
 
 /// The *show* field of a structure: which of its atoms are drawn (`chain A resi 30-50`,

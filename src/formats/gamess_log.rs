@@ -27,7 +27,9 @@
 use glam::DVec3;
 
 use super::logs::{Geometry, LogLines, decimals, error, frames, trailing_numbers, trajectory};
-use super::printed::{self, NamedShells, OpenShell, Orbital, PrintedShell, Row, Section, aufbau, cartesian_index};
+use super::printed::{
+    self, NamedShells, OpenShell, Orbital, PrintedShell, Row, Section, aufbau, cartesian_index, next_block,
+};
 use super::text::parse_real;
 use super::wavefunction::OverlapFn;
 use super::{MAX_Z, ParseError};
@@ -328,15 +330,8 @@ fn eigenvectors(log: &LogLines, header: usize) -> Result<(Section, usize), Parse
     let mut section = Section { line: header, ..Default::default() };
     let mut i = header + 2;
     let mut first_decimals = None;
-    loop {
-        while log.lines.get(i).is_some_and(|l| l.trim().is_empty()) {
-            i += 1;
-        }
-        let Some(numbers) = log.lines.get(i).and_then(|l| column_numbers(l)) else { break };
-        if numbers[0] != section.orbitals.len() + 1 {
-            break;
-        }
-        let block = i;
+    while let Some((block, numbers)) = next_block(log, i, section.orbitals.len()) {
+        i = block;
         let k = numbers.len();
         let l = log.get(i + 1, "the orbitals' energies")?;
         let energies: Option<Vec<f64>> = l.split_whitespace().map(parse_real).collect();
@@ -406,12 +401,6 @@ fn row_head(head: &str) -> Option<(usize, usize, &str)> {
     let mut tokens = rest[..digits_at].split_whitespace();
     let number = tokens.next()?.parse().ok()?;
     (!label.is_empty() && tokens.count() == 1).then_some((number, atom, label))
-}
-
-/// A block's header: the orbitals' numbers (from 1), one after another.
-pub(crate) fn column_numbers(line: &str) -> Option<Vec<usize>> {
-    let n: Option<Vec<usize>> = line.split_whitespace().map(|t| t.parse().ok()).collect();
-    n.filter(|n| !n.is_empty() && n.windows(2).all(|w| w[1] == w[0] + 1))
 }
 
 #[cfg(test)]

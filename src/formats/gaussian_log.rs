@@ -36,6 +36,7 @@
 use glam::DVec3;
 
 use super::logs::{Geometry as Orientation, LogLines, decimals, error, frames, trailing_numbers, trajectory};
+use super::printed::column_numbers;
 use super::text::parse_real;
 use super::wavefunction::{OverlapFn, check_printed, to_model_order};
 use super::{MAX_Z, ParseError};
@@ -606,12 +607,6 @@ fn mo_header(t: &str) -> Option<Option<Spin>> {
         "Beta Molecular Orbital Coefficients:" => Some(Some(Spin::Beta)),
         _ => None,
     }
-}
-
-/// A block's header: the orbitals' numbers, one after another.
-fn column_numbers(line: &str) -> Option<Vec<usize>> {
-    let n: Option<Vec<usize>> = line.split_whitespace().map(|t| t.parse().ok()).collect();
-    n.filter(|n| !n.is_empty() && n.windows(2).all(|w| w[1] == w[0] + 1))
 }
 
 /// Width of Gaussian's `F10.5` orbital columns.

@@ -29,8 +29,8 @@ use std::collections::HashMap;
 
 use glam::DVec3;
 
-use super::gamess_log::column_numbers;
 use super::logs::{Geometry, LogLines, decimals, error, frames, trailing_numbers, trajectory};
+use super::printed::column_numbers;
 use super::printed::{self, OpenShell, Orbital, PrintedShell, Row, Section, aufbau, pure_index};
 use super::text::parse_real;
 use super::wavefunction::OverlapFn;

@@ -457,7 +457,7 @@ fn vibrations(log: &LogLines) -> Result<Option<Vibrations>, ParseError> {
                 log.error_at(i, format!("the modes' columns up to {} (NORMAL MODES at line {})", n - 1, modes_at + 1))
             );
         };
-        let Some(numbers) = super::gamess_log::column_numbers(l).filter(|c| c[0] == columns.len()) else {
+        let Some(numbers) = super::printed::column_numbers(l).filter(|c| c[0] == columns.len()) else {
             if columns.is_empty() || l.trim().is_empty() {
                 i += 1;
                 if i > modes_at + 40 && columns.is_empty() {

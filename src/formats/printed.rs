@@ -243,6 +243,23 @@ fn model_shells_offset(shells: &[Shell]) -> usize {
     shells.iter().map(Shell::n_functions).sum()
 }
 
+/// A block's header: the orbitals' numbers (from 1), one after another.
+pub(crate) fn column_numbers(line: &str) -> Option<Vec<usize>> {
+    let n: Option<Vec<usize>> = line.split_whitespace().map(|t| t.parse().ok()).collect();
+    n.filter(|n| !n.is_empty() && n.windows(2).all(|w| w[1] == w[0] + 1))
+}
+
+/// The next block of printed orbital columns at or after line `i` (blank lines skipped): the
+/// line that numbers its columns and their numbers, when they continue the `done` orbitals
+/// already read (the first column numbered `done + 1`); `None` ends the section.
+pub(crate) fn next_block(log: &LogLines, mut i: usize, done: usize) -> Option<(usize, Vec<usize>)> {
+    while log.lines.get(i).is_some_and(|l| l.trim().is_empty()) {
+        i += 1;
+    }
+    let numbers = log.lines.get(i).and_then(|l| column_numbers(l))?;
+    (numbers[0] == done + 1).then_some((i, numbers))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

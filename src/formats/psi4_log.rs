@@ -33,9 +33,8 @@ use std::collections::HashMap;
 
 use glam::DVec3;
 
-use super::gamess_log::column_numbers;
 use super::logs::{Geometry, LogLines, decimals, error, frames, trailing_numbers, trajectory};
-use super::printed::{self, Orbital, PrintedShell, Row, Section, cartesian_index, pure_index};
+use super::printed::{self, Orbital, PrintedShell, Row, Section, cartesian_index, next_block, pure_index};
 use super::text::parse_real;
 use super::wavefunction::OverlapFn;
 use super::{MAX_Z, ParseError};
@@ -266,15 +265,8 @@ fn molecular_orbitals(log: &LogLines, header: usize) -> Result<(Section, usize),
     let mut section = Section { line: header, ..Default::default() };
     let mut first_decimals = None;
     let mut i = header + 1;
-    loop {
-        while log.lines.get(i).is_some_and(|l| l.trim().is_empty()) {
-            i += 1;
-        }
-        let Some(numbers) = log.lines.get(i).and_then(|l| column_numbers(l)) else { break };
-        if numbers[0] != section.orbitals.len() + 1 {
-            break;
-        }
-        let block = i;
+    while let Some((block, numbers)) = next_block(log, i, section.orbitals.len()) {
+        i = block;
         let k = numbers.len();
         i += 1;
         while log.lines.get(i).is_some_and(|l| l.trim().is_empty()) {

@@ -24,8 +24,8 @@
 
 use glam::DVec3;
 
-use super::gamess_log::column_numbers;
 use super::logs::{Geometry, LogLines, decimals, frames, trailing_numbers, trajectory};
+use super::printed::column_numbers;
 use super::printed::{self, Orbital, PrintedShell, Row, Section, aufbau, cartesian_index, pure_index};
 use super::text::parse_real;
 use super::wavefunction::OverlapFn;
