@@ -73,6 +73,8 @@ fn energy_plot(
         .height(ENERGY_PLOT_HEIGHT)
         .x_axis_label("frame")
         .y_axis_label("ΔE (kcal/mol)")
+        // Room on the right: the panel's edge (where it is resized) lies beside the last frame.
+        .include_x(known.last().map_or(1.0, |&(k, _)| k as f64 + 1.5))
         .allow_zoom(false)
         .allow_drag(false)
         .allow_scroll(false)
