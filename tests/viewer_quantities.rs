@@ -800,8 +800,19 @@ fn a_water_dimer_s_nci_surface_shows_its_hydrogen_bond_in_blue_green() {
     assert!((lo + 0.04).abs() < 0.004 && (hi + 0.01).abs() < 0.004, "[{lo}, {hi}]");
     let lit = blue_green(&picture(&mut h, dir.path(), "lit"));
     window_of(&mut h, 0.01, 0.04);
-    let unlit = blue_green(&picture(&mut h, dir.path(), "unlit"));
+    let grey = picture(&mut h, dir.path(), "unlit");
+    let unlit = blue_green(&grey);
     assert!(lit * 10 > disc * 8 && unlit * 10 < disc, "the disc {disc} px, lit {lit}, grey {unlit}");
+
+    // The same interaction as a cloud: blue (λ₂ < 0).
+    h.get_by_label("NCI cloud").click();
+    h.run_steps(3);
+    wait_loaded(&mut h);
+    let shown = h.state().objects[0].state.selected_quantity().map(|q| q.source);
+    assert_eq!(shown, Some(Source::Wavefunction(Quantity::NciCloud)));
+    // Against the grey disc's picture, which has no blue.
+    let (blue, blue0) = (red_and_blue(&picture(&mut h, dir.path(), "cloud")).1, red_and_blue(&grey).1);
+    assert!(blue > blue0 + 20, "the cloud adds {} blue pixels", blue.saturating_sub(blue0));
 }
 
 #[test]

@@ -421,6 +421,7 @@ impl PyDocument {
             Quantity::BasisFunction(k) => format!("basis function {k}"),
             Quantity::ReducedGradient => "reduced density gradient".into(),
             Quantity::NciGradient => "NCI reduced density gradient".into(),
+            Quantity::NciCloud => "NCI cloud".into(),
             Quantity::SignLambda2Rho => "sign(lambda2)*rho (a.u.)".into(),
             Quantity::DensityLaplacian => "Laplacian of the electron density (a.u.)".into(),
             Quantity::DifferenceDensity | Quantity::Attachment | Quantity::Detachment | Quantity::ExcitedDensity => {

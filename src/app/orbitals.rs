@@ -37,6 +37,9 @@ pub(crate) enum Pick {
     /// The NCI surface (s = 0.5 where ρ < 0.05, coloured by sign(λ₂)ρ) joins the object and is
     /// what it shows.
     NciSurface,
+    /// The NCI cloud (sign(λ₂)ρ where s is low, blue and red) joins the object and is what it
+    /// shows.
+    NciCloud,
 }
 
 /// How the view frames what a pick in the browser changed.
@@ -141,6 +144,11 @@ pub fn panel(
             if ui.button("NCI surface").on_hover_text(hint).clicked() {
                 pick = Some(Pick::NciSurface);
             }
+            let hint = "the same interactions as a cloud: opaque where s lies deep below 0.5 and the density is \
+                        high, blue where λ₂ < 0 (attraction), red where λ₂ > 0 (repulsion)";
+            if ui.button("NCI cloud").on_hover_text(hint).clicked() {
+                pick = Some(Pick::NciCloud);
+            }
         });
             ui.horizontal_wrapped(|ui| {
                 ui.label("add");
@@ -209,6 +217,7 @@ pub(crate) fn apply(
             reframe = Reframe::BesideBar;
             take_view(state, QuantityState::nci_surface(defaults));
         }
+        Pick::NciCloud => take_view(state, QuantityState::nci_cloud(defaults)),
         Pick::Beside(q) => {
             reframe = Reframe::Panes;
             if panes.count == 1 {

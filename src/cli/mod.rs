@@ -431,6 +431,7 @@ fn quantity_label(q: &Quantity, doc: &Document) -> String {
         Quantity::Potential => "electrostatic potential (a.u.)".into(),
         Quantity::ReducedGradient => "reduced density gradient".into(),
         Quantity::NciGradient => "NCI reduced density gradient (ρ ≤ 0.05)".into(),
+        Quantity::NciCloud => "NCI cloud, sign(λ₂)ρ (1 − s/0.5)".into(),
         Quantity::SignLambda2Rho => "sign(lambda2)*rho (a.u.)".into(),
         Quantity::DensityLaplacian => "Laplacian of the electron density (a.u.)".into(),
         Quantity::DifferenceDensity => format!("difference density (state {} minus ground)", state_of(wf)),

@@ -123,6 +123,7 @@ pub fn evaluate_wavefunction(
         | Quantity::Potential
         | Quantity::ReducedGradient
         | Quantity::NciGradient
+        | Quantity::NciCloud
         | Quantity::SignLambda2Rho
         | Quantity::DensityLaplacian
         | Quantity::DifferenceDensity

@@ -89,6 +89,7 @@ impl PreparedBasis {
             }
             Quantity::ReducedGradient
             | Quantity::NciGradient
+            | Quantity::NciCloud
             | Quantity::SignLambda2Rho
             | Quantity::DensityLaplacian => {
                 let points: Vec<DVec3> = (0..grid.dims[0])

@@ -107,7 +107,11 @@ pub fn quantity_box(wf: &Wavefunction, molecule: &Molecule, quantity: Quantity) 
         // density's box, where the surfaces it colours lie.
         Quantity::Potential => return quantity_box(wf, molecule, Quantity::Density),
         // s, sign(λ₂)ρ and ∇²ρ matter where the density does: the density's box.
-        Quantity::ReducedGradient | Quantity::NciGradient | Quantity::SignLambda2Rho | Quantity::DensityLaplacian => {
+        Quantity::ReducedGradient
+        | Quantity::NciGradient
+        | Quantity::NciCloud
+        | Quantity::SignLambda2Rho
+        | Quantity::DensityLaplacian => {
             return quantity_box(wf, molecule, Quantity::Density);
         }
     };

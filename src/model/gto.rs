@@ -531,6 +531,7 @@ impl PreparedBasis {
                     Quantity::Potential
                     | Quantity::ReducedGradient
                     | Quantity::NciGradient
+                    | Quantity::NciCloud
                     | Quantity::SignLambda2Rho
                     | Quantity::DensityLaplacian => f64::NAN,
                 }

@@ -19,6 +19,10 @@ use super::orbitals::{Quantity, Wavefunction};
 /// point that one fragment owns): both `-dens` and `-grad` say 100, beyond any isosurface.
 pub const CUT_VALUE: f32 = 100.0;
 
+/// The reduced density gradient an NCI cloud fades out at (NCIPLOT's surface level for SCF
+/// densities): [`Quantity::NciCloud`].
+pub const NCI_CLOUD_LEVEL: f64 = 0.5;
+
 /// The density cut of a wavefunction's density (NCIPLOT's default for SCF densities).
 pub const WAVEFUNCTION_DENSITY_CUT: f64 = 0.05;
 
@@ -92,6 +96,13 @@ impl DensityDerivatives {
                 true => CUT_VALUE as f64,
                 false => self.reduced_gradient().min(CUT_VALUE as f64),
             },
+            Quantity::NciCloud => {
+                let depth = 1.0 - self.reduced_gradient() / NCI_CLOUD_LEVEL;
+                match self.rho > WAVEFUNCTION_DENSITY_CUT || !(depth > 0.0) {
+                    true => 0.0,
+                    false => self.sign_lambda2_rho() * depth,
+                }
+            }
             Quantity::SignLambda2Rho => self.sign_lambda2_rho(),
             Quantity::DensityLaplacian => self.laplacian(),
             Quantity::Density => self.rho,

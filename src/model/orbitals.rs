@@ -195,6 +195,11 @@ pub enum Quantity {
     /// density (0.05 a.u.), and 100 where it is above: what NCI surfaces (s = 0.5) are cut from,
     /// so that the small s near the nuclei draws nothing.
     NciGradient,
+    /// An NCI cloud's field: sign(λ₂)ρ weighted by how far s lies below the NCI level,
+    /// sign(λ₂)ρ · (1 − s/0.5) where s < 0.5 and ρ ≤ 0.05 a.u., 0 elsewhere. Drawn as a signed
+    /// cloud: its opacity grows with the interaction's density and its depth below the level,
+    /// its colour is the sign (blue attraction, red repulsion).
+    NciCloud,
     /// sign(λ₂)·ρ, λ₂ the middle eigenvalue of the density's Hessian (NCI, a.u.).
     SignLambda2Rho,
     /// ∇²ρ, the Laplacian of the total density (a.u.).
@@ -215,7 +220,10 @@ impl Quantity {
     /// Whether the quantity is made of the total density's first and second derivatives
     /// (evaluated by [`super::nci`]).
     pub fn from_density_derivatives(self) -> bool {
-        matches!(self, Self::ReducedGradient | Self::NciGradient | Self::SignLambda2Rho | Self::DensityLaplacian)
+        matches!(
+            self,
+            Self::ReducedGradient | Self::NciGradient | Self::NciCloud | Self::SignLambda2Rho | Self::DensityLaplacian
+        )
     }
 
     /// Which of an excited state's densities the quantity is, if it is one.

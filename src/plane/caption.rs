@@ -17,6 +17,7 @@ pub fn unit(source: Source) -> &'static str {
         Source::Wavefunction(Quantity::DensityLaplacian) => "Laplacian of ρ (a.u.)",
         Source::Wavefunction(Quantity::ReducedGradient) => "s",
         Source::Wavefunction(Quantity::NciGradient) => "s (ρ ≤ 0.05 a.u.)",
+        Source::Wavefunction(Quantity::NciCloud) => "sign(λ₂)ρ (1 − s/0.5) (a.u.)",
         Source::Wavefunction(Quantity::SignLambda2Rho) => "sign(λ₂)ρ (a.u.)",
         Source::Wavefunction(Quantity::DifferenceDensity) => "ρ_exc − ρ_gs (a.u.)",
         Source::Wavefunction(Quantity::Attachment) => "attachment ρ (a.u.)",

@@ -30,6 +30,7 @@ impl Source {
                 Quantity::Density | Quantity::Potential => true,
                 Quantity::ReducedGradient
                 | Quantity::NciGradient
+                | Quantity::NciCloud
                 | Quantity::SignLambda2Rho
                 | Quantity::DensityLaplacian => true,
                 Quantity::SpinDensity => !wf.restricted,
@@ -73,6 +74,7 @@ impl Source {
             Source::Wavefunction(Quantity::Potential) => "electrostatic potential".into(),
             Source::Wavefunction(Quantity::ReducedGradient) => "reduced density gradient".into(),
             Source::Wavefunction(Quantity::NciGradient) => "NCI (s where ρ ≤ 0.05)".into(),
+            Source::Wavefunction(Quantity::NciCloud) => "NCI cloud".into(),
             Source::Wavefunction(Quantity::SignLambda2Rho) => "sign(λ₂)ρ".into(),
             Source::Wavefunction(Quantity::DensityLaplacian) => "density Laplacian".into(),
             Source::Wavefunction(Quantity::DifferenceDensity) => "difference density".into(),
@@ -203,6 +205,19 @@ impl QuantityState {
             color_scheme: super::coloring::ColorScheme::BlueGreenRed,
             ..Default::default()
         }];
+        nci
+    }
+}
+
+impl QuantityState {
+    /// An *NCI cloud*: [`Quantity::NciCloud`] as a signed cloud, blue where λ₂ < 0 (attraction)
+    /// and red where λ₂ > 0 (repulsion), opaque where the interaction's density is high and s
+    /// lies deep below the level; no surfaces.
+    pub fn nci_cloud(defaults: &RenderSettings) -> Self {
+        let mut nci = Self::new(Source::Wavefunction(Quantity::NciCloud), defaults);
+        nci.cloud.visible = true;
+        (nci.cloud.positive_color, nci.cloud.negative_color) = ([0.9, 0.1, 0.05], [0.05, 0.25, 0.95]);
+        nci.isosurfaces.iter_mut().for_each(|iso| iso.visible = false);
         nci
     }
 }
