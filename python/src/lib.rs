@@ -456,7 +456,7 @@ impl PyDocument {
 /// is taken.
 #[pyfunction]
 #[pyo3(signature = (docs, promolecular=false, step=None, margin=None, cut=None, rdg_cut=None, intermolecular=false, grid_like=None))]
-#[allow(clippy::too_many_arguments)]
+#[allow(clippy::too_many_arguments, reason = "the Python function's keyword arguments, one each")]
 fn nci<'py>(
     py: Python<'py>,
     docs: Vec<Bound<'py, PyDocument>>,
