@@ -570,7 +570,8 @@ def render(doc_or_path: Document | PathLike | None = None, size: tuple[int, int]
     """The picture ``orbcloud render`` draws of a document or file with the same options, as an
     RGBA image (height × width × 4, uint8) that IPython shows inline. Options are the command's,
     with underscores: ``orbital="lumo"``, ``iso=0.05``, ``view="z"``, ``yaw=30``,
-    ``no_volume=True``, ``colors="red-white"``, ``lavapipe=True``; see :func:`_words`."""
+    ``no_volume=True``, ``colors="red-white"``, ``lavapipe=True``, ``nci=True`` (the NCI
+    surface coloured by sign(λ₂)ρ, with ``nci_level`` and ``nci_range``); see :func:`_words`."""
     native = None
     if isinstance(doc_or_path, Document):
         doc_or_path, options = _resolved(doc_or_path, options)

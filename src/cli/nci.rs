@@ -1,6 +1,7 @@
 //! `nci`: NCIPLOT's two cubes (`PREFIX-dens.cube`: 100·sign(λ₂)ρ, `PREFIX-grad.cube`: the
 //! reduced density gradient s; both 100 at the points cut) of one or more files whose densities
-//! add: wavefunctions, or promolecular sums of spherical atoms for any structure.
+//! add: wavefunctions, or promolecular sums of spherical atoms for any structure ([`nci_of`],
+//! which the Python package's `nci` runs too).
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;

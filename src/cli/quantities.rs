@@ -344,6 +344,11 @@ mod tests {
         // `--beside` before any quantity option: the default quantity, then the next beside it.
         let (_, later) = split(line("orbcloud render f -o x.png --beside --orbital lumo")).unwrap();
         assert!(later.len() == 1 && later[0].beside);
+        // `--nci` starts a quantity too: the NCI surface with its own level, then the density.
+        let (first, later) =
+            split(line("orbcloud render f -o x.png --nci --nci-level 0.3 --density --iso 0.05")).unwrap();
+        assert_eq!(first, line("orbcloud render f -o x.png --nci --nci-level 0.3"));
+        assert_eq!(later[0].args, line("--density --iso 0.05"));
         let (whole, later) = split(line("orbcloud info f --density")).unwrap();
         assert!(later.is_empty() && whole.len() == 4);
     }
