@@ -37,6 +37,7 @@ __all__ = [
     "from_pyscf",
     "load",
     "load_scan",
+    "nci",
     "render",
     "scan_compute",
     "view",
@@ -146,6 +147,32 @@ class Grid(NamedTuple):
     def points(self) -> np.ndarray:
         """Every grid point's position (nx·ny·nz × 3, bohr) in the values' order."""
         idx = np.indices(self.values.shape).reshape(3, -1).T.astype(float)
+        return idx @ self.axes + self.origin
+
+
+class NciGrids(NamedTuple):
+    """NCIPLOT's two grids, as ``orbcloud nci`` writes them to ``PREFIX-dens.cube`` and
+    ``PREFIX-grad.cube``: nx × ny × nz values, x slowest (cube order)."""
+
+    dens: np.ndarray
+    """100·sign(λ₂)ρ (a.u.), 100 at the points cut (ρ above the cut)."""
+    grad: np.ndarray
+    """The reduced density gradient s, 100 at the points cut and where s is above ``rdg_cut``."""
+    world_from_grid: np.ndarray
+    """4 × 4 affine map from grid indices (i, j, k, 1) to bohr."""
+
+    @property
+    def origin(self) -> np.ndarray:
+        return self.world_from_grid[:3, 3]
+
+    @property
+    def axes(self) -> np.ndarray:
+        """The three step vectors (rows), bohr."""
+        return self.world_from_grid[:3, :3].T
+
+    def points(self) -> np.ndarray:
+        """Every grid point's position (nx·ny·nz × 3, bohr) in the values' order."""
+        idx = np.indices(self.dens.shape).reshape(3, -1).T.astype(float)
         return idx @ self.axes + self.origin
 
 
@@ -433,6 +460,10 @@ class Document:
         native, kind, index = self._quantity(orbital, spin, density, quantity, state)
         native.write_cube(os.fspath(path), kind, index, int(points))
 
+    def nci(self, **options) -> NciGrids:
+        """:func:`orbcloud.nci` of this document alone."""
+        return nci([self], **options)
+
     def render(self, **options) -> Image:
         """:func:`orbcloud.render` of this document."""
         return render(self, **options)
@@ -539,7 +570,8 @@ def render(doc_or_path: Document | PathLike | None = None, size: tuple[int, int]
     """The picture ``orbcloud render`` draws of a document or file with the same options, as an
     RGBA image (height × width × 4, uint8) that IPython shows inline. Options are the command's,
     with underscores: ``orbital="lumo"``, ``iso=0.05``, ``view="z"``, ``yaw=30``,
-    ``no_volume=True``, ``colors="red-white"``, ``lavapipe=True``; see :func:`_words`."""
+    ``no_volume=True``, ``colors="red-white"``, ``lavapipe=True``, ``nci=True`` (the NCI
+    surface coloured by sign(λ₂)ρ, with ``nci_level`` and ``nci_range``); see :func:`_words`."""
     native = None
     if isinstance(doc_or_path, Document):
         doc_or_path, options = _resolved(doc_or_path, options)
@@ -548,6 +580,38 @@ def render(doc_or_path: Document | PathLike | None = None, size: tuple[int, int]
     if native is None and doc_or_path is not None:
         words.insert(0, os.fspath(doc_or_path))
     return Image.of(_native.render(native, words))
+
+
+def nci(
+    docs: Document | PathLike | Sequence[Document | PathLike],
+    promolecular: bool = False,
+    step: float | None = None,
+    margin: float | None = None,
+    cut: float | None = None,
+    rdg_cut: float | None = None,
+    intermolecular: bool = False,
+    grid_like: PathLike | None = None,
+) -> NciGrids:
+    """NCIPLOT's grids of documents (or files) whose densities add, as ``orbcloud nci`` writes
+    them (the same code): 100·sign(λ₂)ρ and s on a grid ``step`` Å apart (0.1 by default) over
+    the atoms' box plus ``margin`` Å (0.75), or on the grid of the cube file ``grid_like``.
+    Points whose density is above ``cut`` (0.05 a.u., promolecular 0.07) hold 100 in both, and
+    ``grad`` holds 100 where s is above ``rdg_cut`` (1; 100 keeps every s). ``promolecular``:
+    sums of spherical atoms instead of wavefunctions; ``intermolecular``: only the points no
+    fragment holds more than 95 % of."""
+    items = docs if isinstance(docs, (list, tuple)) else [docs]
+    natives = [(d if isinstance(d, Document) else load(d))._native for d in items]
+    dens, grad, matrix = _native.nci(
+        natives,
+        promolecular=bool(promolecular),
+        step=None if step is None else float(step),
+        margin=None if margin is None else float(margin),
+        cut=None if cut is None else float(cut),
+        rdg_cut=None if rdg_cut is None else float(rdg_cut),
+        intermolecular=bool(intermolecular),
+        grid_like=None if grid_like is None else os.fspath(grid_like),
+    )
+    return NciGrids(dens, grad, matrix)
 
 
 def _resolved(doc: Document, options: dict) -> tuple[Document, dict]:

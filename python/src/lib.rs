@@ -110,6 +110,8 @@ impl PyDocument {
 type AtomArrays<'py> = (Bound<'py, PyArray1<u32>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>, Vec<bool>);
 /// A grid's values and its world-from-grid matrix.
 type GridArrays<'py> = (Bound<'py, PyArray3<f64>>, Bound<'py, PyArray2<f64>>);
+/// NCIPLOT's two grids (100·sign(λ₂)ρ, s) and their world-from-grid matrix.
+type NciArrays<'py> = (Bound<'py, PyArray3<f32>>, Bound<'py, PyArray3<f32>>, Bound<'py, PyArray2<f64>>);
 /// A scan's frame: the coordinate's value, the value as text, the frame.
 type ScanFrame = (f64, String, PyDocument);
 /// A shell: atom index, l, pure, exponents, coefficients of normalised primitives.
@@ -449,6 +451,48 @@ impl PyDocument {
     }
 }
 
+/// NCIPLOT's two grids of documents whose densities add, as `orbcloud nci` writes them:
+/// 100·sign(λ₂)ρ and s (x slowest, both 100 at the points cut) and the grid's 4 × 4
+/// world-from-grid matrix (bohr). `step` and `margin` in Å; `grid_like`: a cube file whose grid
+/// is taken.
+#[pyfunction]
+#[pyo3(signature = (docs, promolecular=false, step=None, margin=None, cut=None, rdg_cut=None, intermolecular=false, grid_like=None))]
+#[allow(clippy::too_many_arguments, reason = "the Python function's keyword arguments, one each")]
+fn nci<'py>(
+    py: Python<'py>,
+    docs: Vec<Bound<'py, PyDocument>>,
+    promolecular: bool,
+    step: Option<f64>,
+    margin: Option<f64>,
+    cut: Option<f64>,
+    rdg_cut: Option<f64>,
+    intermolecular: bool,
+    grid_like: Option<PathBuf>,
+) -> PyResult<NciArrays<'py>> {
+    let grid = match grid_like {
+        Some(path) => {
+            let doc = py.detach(|| formats::load(&path)).map_err(|e| load_error(&e))?;
+            let grid = doc
+                .volumes
+                .first()
+                .ok_or_else(|| PyValueError::new_err(format!("{}: no grid in it", path.display())))?;
+            Some(GridSpec { dims: grid.dims, world_from_grid: grid.world_from_grid })
+        }
+        None => None,
+    };
+    let docs: Vec<&Document> = docs.iter().map(|d| &d.get().doc).collect();
+    let names: Vec<String> = docs.iter().map(|d| d.source.clone()).collect();
+    let options = cli::NciOptions { promolecular, step, margin, grid, cut, rdg_cut, intermolecular };
+    let result =
+        py.detach(|| cli::nci_of(&docs, &names, &options)).map_err(|e| PyValueError::new_err(format!("{e:#}")))?;
+    let [nx, ny, nz] = result.spec.dims;
+    let dens = Array3::from_shape_vec((nx, ny, nz), result.grids.dens).map_err(runtime)?;
+    let grad = Array3::from_shape_vec((nx, ny, nz), result.grids.grad).map_err(runtime)?;
+    let m = result.spec.world_from_grid.to_cols_array_2d();
+    let matrix = Array2::from_shape_fn((4, 4), |(r, c)| m[c][r]);
+    Ok((dens.into_pyarray(py), grad.into_pyarray(py), matrix.into_pyarray(py)))
+}
+
 /// Reads a file as the viewer opens it.
 #[pyfunction]
 fn load(py: Python<'_>, path: PathBuf) -> PyResult<PyDocument> {
@@ -682,6 +726,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(from_parts, m)?)?;
     m.add_function(wrap_pyfunction!(load_scan, m)?)?;
     m.add_function(wrap_pyfunction!(render, m)?)?;
+    m.add_function(wrap_pyfunction!(nci, m)?)?;
     m.add_function(wrap_pyfunction!(run_viewer, m)?)?;
     m.add_function(wrap_pyfunction!(run_cli, m)?)?;
     m.add("NativeLoadError", m.py().get_type::<NativeLoadError>())?;

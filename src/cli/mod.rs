@@ -96,9 +96,12 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
-    /// Evaluate an orbital or the density at points (bohr in, `x y z value` out).
+    /// Evaluate an orbital or the density at points (bohr in, `x y z value` out). Several files
+    /// are fragments whose densities add: --density, --rdg, --sign-lambda2-rho and --laplacian
+    /// of the sum (as `nci` computes them).
     Eval {
-        file: PathBuf,
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
         #[command(flatten)]
         what: WhatArgs,
         /// File of points, one `x y z` (bohr) per line; `-` reads standard input.
@@ -220,6 +223,26 @@ const EXCITED_CONFLICTS: [&str; 10] = [
     "difference_density",
     "attachment",
     "detachment",
+];
+
+/// What `render --nci` excludes: the other quantities, and the isosurface and colouring options
+/// its surface sets itself.
+const NCI_CONFLICTS: [&str; 15] = [
+    "density",
+    "spin_density",
+    "esp",
+    "rdg",
+    "sign_lambda2_rho",
+    "laplacian",
+    "basis_function",
+    "difference_density",
+    "attachment",
+    "detachment",
+    "excited_density",
+    "values",
+    "sigmas",
+    "color_by",
+    "demo",
 ];
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -538,6 +561,19 @@ struct RenderArgs {
     /// orbital's energy.
     #[arg(long)]
     no_captions: bool,
+    /// The NCI surface as the viewer draws it (Johnson et al., 2010): the reduced density
+    /// gradient's surface s = 0.5 where ρ ≤ 0.05 a.u., opaque, coloured by sign(λ₂)ρ from blue
+    /// (−0.05, attraction: hydrogen bonds) through green (van der Waals) to red (+0.05,
+    /// repulsion), with its colour bar. Needs a wavefunction (`orbcloud nci --promolecular`
+    /// writes the cubes of a structure's spherical atoms).
+    #[arg(long, conflicts_with_all = NCI_CONFLICTS)]
+    nci: bool,
+    /// The reduced density gradient the NCI surface is drawn at, 0.01 to 2 (default 0.5).
+    #[arg(long, value_name = "S", requires = "nci", value_parser = within(limits::NCI_LEVEL))]
+    nci_level: Option<f32>,
+    /// The |sign(λ₂)ρ| (a.u.) where the NCI surface's colours saturate, 0.001 to 1 (default 0.05).
+    #[arg(long, value_name = "R", requires = "nci", value_parser = within(limits::NCI_RANGE))]
+    nci_range: Option<f32>,
     /// Render a bundled demo scene instead of a file (cycloaddition: several objects).
     #[arg(long, value_enum)]
     demo: Option<DemoArg>,
@@ -849,6 +885,7 @@ pub fn render_drawing(doc: Option<Document>, words: &[String]) -> Result<render:
     }
 }
 
+pub use nci::{NciOptions, NciResult, nci_of};
 pub use render::{Drawing, Picture};
 
 /// Image size, frame count and adapter of a frame-time benchmark.
@@ -900,7 +937,7 @@ fn dispatch(cli: Cli, later: &[quantities::Later]) -> Result<()> {
         Some(Command::Viewer { files, demo }) => Ok(crate::app::run(files, demo.map(DemoArg::demo))?),
         Some(Command::Render(args)) => render::render(args, later),
         Some(Command::Info { file, json }) => values::info(&file, json),
-        Some(Command::Eval { file, what, points, minus }) => values::eval(&file, &what, &points, minus.as_deref()),
+        Some(Command::Eval { files, what, points, minus }) => values::eval(&files, &what, &points, minus.as_deref()),
         Some(Command::Cube { file, what, grid, spacing, margin, minus, output }) => {
             values::cube(&file, &what, (grid, spacing, margin), minus.as_deref(), &output)
         }

@@ -1,6 +1,7 @@
 //! `nci`: NCIPLOT's two cubes (`PREFIX-dens.cube`: 100·sign(λ₂)ρ, `PREFIX-grad.cube`: the
 //! reduced density gradient s; both 100 at the points cut) of one or more files whose densities
-//! add: wavefunctions, or promolecular sums of spherical atoms for any structure.
+//! add: wavefunctions, or promolecular sums of spherical atoms for any structure ([`nci_of`],
+//! which the Python package's `nci` runs too).
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -66,26 +67,68 @@ impl Fragment<'_> {
     }
 }
 
-pub fn nci(args: &NciArgs) -> Result<()> {
-    if args.intermolecular && args.files.len() < 2 {
-        bail!("--intermolecular needs two files or more (the fragments), got {}", args.files.len());
-    }
-    let docs: Vec<Document> = args.files.iter().map(|f| formats::load(f)).collect::<Result<_, _>>()?;
-    let mut fragments = Vec::with_capacity(docs.len());
-    for (doc, file) in docs.iter().zip(&args.files) {
-        if doc.molecule.atoms.is_empty() {
-            bail!("{}: no atoms, so no density for nci", file.display());
+/// How NCIPLOT's grids are asked for: `nci`'s options, and the Python package's `nci(...)`.
+#[derive(Debug, Clone, Default)]
+pub struct NciOptions {
+    /// Sums of spherical atoms instead of the documents' wavefunctions.
+    pub promolecular: bool,
+    /// Grid step, Å (NCIPLOT's 0.1 when `None`).
+    pub step: Option<f64>,
+    /// Space around the atoms, Å (NCIPLOT's 0.75 when `None`).
+    pub margin: Option<f64>,
+    /// This grid instead of a box around the atoms.
+    pub grid: Option<GridSpec>,
+    /// The density cut, a.u. (0.05 for wavefunctions, 0.07 promolecular, when `None`).
+    pub cut: Option<f64>,
+    /// The `-grad` grid's RDG cutoff (NCIPLOT's 1 when `None`).
+    pub rdg_cut: Option<f64>,
+    /// Only the points between fragments (needs two documents or more).
+    pub intermolecular: bool,
+}
+
+/// NCIPLOT's grids of documents whose densities add, with the grid and the settings used and
+/// every document's atoms (what the cubes' headers list).
+pub struct NciResult {
+    pub spec: GridSpec,
+    pub grids: nci::NciGrids,
+    pub settings: NciSettings,
+    pub molecule: Molecule,
+    /// Seconds the grids took.
+    pub seconds: f64,
+}
+
+/// [`NciResult`] of `docs` (each named by `names`, for messages) as `options` ask: the grids
+/// `orbcloud nci` writes as cubes.
+pub fn nci_of(docs: &[&Document], names: &[String], options: &NciOptions) -> Result<NciResult> {
+    let ranges = [
+        ("step", options.step, &limits::SPACING),
+        ("margin", options.margin, &limits::MARGIN),
+        ("cut", options.cut, &limits::DENSITY_CUT),
+        ("rdg_cut", options.rdg_cut, &limits::RDG_CUT),
+    ];
+    for (name, value, range) in ranges {
+        if let Some(v) = value.filter(|v| !range.contains(v)) {
+            bail!("{name} {v}: expected {} to {}", range.start(), range.end());
         }
-        let fragment = if args.promolecular {
-            Fragment::Promolecular(
-                Promolecule::new(&doc.molecule).map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?,
-            )
+    }
+    if docs.is_empty() {
+        bail!("nci needs one file or more (fragments whose densities add)");
+    }
+    if options.intermolecular && docs.len() < 2 {
+        bail!("--intermolecular needs two files or more (the fragments), got {}", docs.len());
+    }
+    let mut fragments = Vec::with_capacity(docs.len());
+    for (doc, name) in docs.iter().zip(names) {
+        if doc.molecule.atoms.is_empty() {
+            bail!("{name}: no atoms, so no density for nci");
+        }
+        let fragment = if options.promolecular {
+            Fragment::Promolecular(Promolecule::new(&doc.molecule).map_err(|e| anyhow::anyhow!("{name}: {e}"))?)
         } else {
             match &doc.wavefunction {
                 Some(wf) => Fragment::Wavefunction(Box::new(WavefunctionDensity::new(wf))),
                 None => bail!(
-                    "{}: no wavefunction (Molden, fchk, wfn, wfx or MKL) for nci: --promolecular sums spherical atoms instead",
-                    file.display()
+                    "{name}: no wavefunction (Molden, fchk, wfn, wfx or MKL) for nci: --promolecular sums spherical atoms instead"
                 ),
             }
         };
@@ -93,12 +136,12 @@ pub fn nci(args: &NciArgs) -> Result<()> {
     }
     let atoms: Vec<_> = docs.iter().flat_map(|d| d.molecule.atoms.iter().cloned()).collect();
     let molecule = Molecule::new(atoms);
-    let spec = match &args.grid_like {
-        Some(cube) => grid_of(cube)?,
+    let spec = match options.grid {
+        Some(spec) => spec,
         None => {
             let (lo, hi) = molecule.bounds().context("no atoms")?;
-            let step = args.step.unwrap_or(nci::NCIPLOT_STEP_ANGSTROM) * BOHR_PER_ANGSTROM;
-            let margin = args.margin.unwrap_or(nci::NCIPLOT_MARGIN_ANGSTROM) * BOHR_PER_ANGSTROM;
+            let step = options.step.unwrap_or(nci::NCIPLOT_STEP_ANGSTROM) * BOHR_PER_ANGSTROM;
+            let margin = options.margin.unwrap_or(nci::NCIPLOT_MARGIN_ANGSTROM) * BOHR_PER_ANGSTROM;
             nci::nciplot_grid(lo, hi, margin, step)
         }
     };
@@ -114,20 +157,39 @@ pub fn nci(args: &NciArgs) -> Result<()> {
         );
     }
     let settings = NciSettings {
-        density_cut: args.cut.unwrap_or(if args.promolecular {
+        density_cut: options.cut.unwrap_or(if options.promolecular {
             nci::PROMOLECULAR_DENSITY_CUT
         } else {
             nci::WAVEFUNCTION_DENSITY_CUT
         }),
-        rdg_cut: args.rdg_cut.unwrap_or(nci::NCIPLOT_RDG_CUT),
-        intermolecular: args.intermolecular.then_some(nci::INTERMOLECULAR_SHARE),
+        rdg_cut: options.rdg_cut.unwrap_or(nci::NCIPLOT_RDG_CUT),
+        intermolecular: options.intermolecular.then_some(nci::INTERMOLECULAR_SHARE),
     };
     let sources: Vec<&dyn DensitySource> = fragments.iter().map(Fragment::source).collect();
     let start = Instant::now();
     let grids = nci::nci_grid(&sources, &spec, settings);
-    let seconds = start.elapsed().as_secs_f64();
-    let kind = if args.promolecular { "promolecular" } else { "wavefunction" };
+    Ok(NciResult { spec, grids, settings, molecule, seconds: start.elapsed().as_secs_f64() })
+}
+
+pub fn nci(args: &NciArgs) -> Result<()> {
+    if args.intermolecular && args.files.len() < 2 {
+        bail!("--intermolecular needs two files or more (the fragments), got {}", args.files.len());
+    }
+    let docs: Vec<Document> = args.files.iter().map(|f| formats::load(f)).collect::<Result<_, _>>()?;
     let names: Vec<String> = args.files.iter().map(|f| f.display().to_string()).collect();
+    let options = NciOptions {
+        promolecular: args.promolecular,
+        step: args.step,
+        margin: args.margin,
+        grid: args.grid_like.as_deref().map(grid_of).transpose()?,
+        cut: args.cut,
+        rdg_cut: args.rdg_cut,
+        intermolecular: args.intermolecular,
+    };
+    let NciResult { spec, grids, settings, molecule, seconds } =
+        nci_of(&docs.iter().collect::<Vec<_>>(), &names, &options)?;
+    let step = spec.step(0).length();
+    let kind = if args.promolecular { "promolecular" } else { "wavefunction" };
     let dens_path = with_suffix(&args.output, "-dens.cube");
     let grad_path = with_suffix(&args.output, "-grad.cube");
     let dens = VolumeGrid::new("100*sign(lambda2)*rho", spec.dims, spec.world_from_grid, grids.dens);

@@ -1,5 +1,5 @@
 //! Several quantities of one file on the `render` command line: each quantity option
-//! (`--orbital X`, `--density`, `--spin-density`, `--basis-function F`, `--volume N`) after the
+//! (`--orbital X`, `--density`, `--spin-density`, `--basis-function F`, `--volume N`, `--nci`) after the
 //! first starts another quantity, and the representation options after it (`--iso`,
 //! `--translucent`, `--no-volume`, transfer function, colours) are its own; `--beside` puts the
 //! next quantity in a pane of its own, side by side with the same camera.
@@ -9,7 +9,7 @@ use std::ffi::OsString;
 use crate::gpu::{GpuContext, OffscreenTarget, Renderer};
 use crate::layers::show_scene;
 use crate::model::Document;
-use crate::scene::{Camera, Evaluation, ObjectState, QuantityState, Source};
+use crate::scene::{Camera, Evaluation, IsoLevel, ObjectState, QuantityState, Source};
 use anyhow::{Result, bail};
 use clap::Parser;
 
@@ -17,7 +17,7 @@ use super::surface::IsoArgs;
 use super::{Cli, Command, RenderArgs, ViewArgs, WavefunctionArgs};
 
 /// The options that start a quantity.
-const STARTS: [&str; 5] = ["--orbital", "--density", "--spin-density", "--basis-function", "--volume"];
+const STARTS: [&str; 6] = ["--orbital", "--density", "--spin-density", "--basis-function", "--volume", "--nci"];
 /// The option that puts the next quantity beside the ones before, in a pane of its own.
 const BESIDE: &str = "--beside";
 /// Options that belong to the whole picture or file, not to a quantity: wherever they are
@@ -120,9 +120,37 @@ pub fn split(args: Vec<OsString>) -> Result<(Vec<OsString>, Vec<Later>)> {
     Ok((first, later))
 }
 
-/// One quantity of the file as `args` asks for it (its quantity option, cloud and isosurfaces).
+/// One quantity of the file as `args` asks for it (its quantity option, cloud and isosurfaces;
+/// `--nci`: the viewer's NCI surface).
 pub fn quantity(args: &RenderArgs, doc: &Document) -> Result<Option<QuantityState>> {
+    if args.nci {
+        check_nci(args, doc)?;
+        let mut q = QuantityState::nci_surface(&args.view.settings());
+        for iso in &mut q.isosurfaces {
+            if let Some(level) = args.nci_level {
+                iso.level = IsoLevel::Absolute(level);
+            }
+            if let Some(range) = args.nci_range {
+                iso.color_range = Some(range);
+            }
+        }
+        return Ok(Some(q));
+    }
     quantity_of(doc, &args.view, &args.wavefunction, &args.iso)
+}
+
+/// `--nci` refused for a file without a wavefunction: the surface is cut from its density's
+/// derivatives.
+pub fn check_nci(args: &RenderArgs, doc: &Document) -> Result<()> {
+    if args.nci && doc.wavefunction.is_none() {
+        bail!(
+            "{}: --nci needs a wavefunction (Molden, fchk, wfn, wfx or MKL), and this file has none: `orbcloud nci {} --promolecular -o PREFIX` writes NCIPLOT's cubes of its spherical atoms, `orbcloud compute {}` computes a wavefunction with PySCF",
+            doc.source,
+            doc.source,
+            doc.source
+        );
+    }
+    Ok(())
 }
 
 /// The quantity `what` names (or the data set `view` picks) with `view`'s cloud and `iso`'s
@@ -316,6 +344,11 @@ mod tests {
         // `--beside` before any quantity option: the default quantity, then the next beside it.
         let (_, later) = split(line("orbcloud render f -o x.png --beside --orbital lumo")).unwrap();
         assert!(later.len() == 1 && later[0].beside);
+        // `--nci` starts a quantity too: the NCI surface with its own level, then the density.
+        let (first, later) =
+            split(line("orbcloud render f -o x.png --nci --nci-level 0.3 --density --iso 0.05")).unwrap();
+        assert_eq!(first, line("orbcloud render f -o x.png --nci --nci-level 0.3"));
+        assert_eq!(later[0].args, line("--density --iso 0.05"));
         let (whole, later) = split(line("orbcloud info f --density")).unwrap();
         assert!(later.is_empty() && whole.len() == 4);
     }

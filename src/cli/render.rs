@@ -67,10 +67,13 @@ pub fn drawing(args: &RenderArgs, doc: Option<Document>, later: &[Later]) -> Res
     let camera = args.view.camera(&doc)?;
     args.vibration.apply(&mut doc)?;
     args.view.volume_index(&doc)?;
-    if !later.is_empty() {
+    if !later.is_empty() || args.nci {
         let later = quantities::parse_later(later)?;
+        for a in std::iter::once(args).chain(later.iter().map(|(_, a)| a)) {
+            quantities::check_nci(a, &doc)?;
+        }
         if args.pick.is_some() {
-            bail!("--pick reads one quantity's picture: give one quantity option");
+            bail!("--pick reads one quantity's picture: give one quantity option, other than --nci");
         }
         let ctx = gpu(args.lavapipe)?;
         let background = RenderSettings::default().background;

@@ -27,14 +27,41 @@ pub fn info(file: &Path, json: bool) -> Result<()> {
 }
 
 /// `eval`: the quantity `what` asks for at each point of `points` (`x y z` in bohr per line).
-/// With `minus`, that file's same quantity is subtracted ([`other_values`]).
-pub fn eval(file: &Path, what: &WhatArgs, points: &Path, minus: Option<&Path>) -> Result<()> {
-    let doc = formats::load(file)?;
-    let q = what.resolve(&doc)?;
-    let wf = wavefunction_of(&doc)?;
-    let prepared = PreparedBasis::new(&wf.basis);
-    let points = read_points(points)?;
-    let mut values = prepared.quantity_at_points(wf, &doc.molecule, q, &points);
+/// Several `files` are fragments whose densities add ([`fragments_at`]). With `minus`, that
+/// file's same quantity is subtracted ([`other_values`]).
+pub fn eval(files: &[std::path::PathBuf], what: &WhatArgs, points: &Path, minus: Option<&Path>) -> Result<()> {
+    let mut values;
+    let points = match files {
+        [file] => {
+            let doc = formats::load(file)?;
+            let q = what.resolve(&doc)?;
+            let wf = wavefunction_of(&doc)?;
+            let prepared = PreparedBasis::new(&wf.basis);
+            let points = read_points(points)?;
+            values = prepared.quantity_at_points(wf, &doc.molecule, q, &points);
+            points
+        }
+        _ => {
+            if minus.is_some() {
+                bail!("--minus subtracts from one file's quantity: give one file, or leave --minus out");
+            }
+            let docs: Vec<_> = files.iter().map(|f| formats::load(f)).collect::<Result<_, _>>()?;
+            let q = what.resolve(&docs[0])?;
+            if !matches!(
+                q,
+                Quantity::Density | Quantity::ReducedGradient | Quantity::SignLambda2Rho | Quantity::DensityLaplacian
+            ) {
+                bail!(
+                    "{} files are fragments whose densities add: eval gives --density, --rdg, --sign-lambda2-rho or --laplacian of their sum, not {}",
+                    files.len(),
+                    what.describe()
+                );
+            }
+            let points = read_points(points)?;
+            values = fragments_at(&docs, q, &points)?;
+            points
+        }
+    };
     if let Some(other) = minus {
         for (v, o) in values.iter_mut().zip(other_values(other, what, &points)?) {
             *v -= o;
@@ -46,6 +73,27 @@ pub fn eval(file: &Path, what: &WhatArgs, points: &Path, minus: Option<&Path>) -
         writeln!(out, "{:.10} {:.10} {:.10} {:.15e}", p.x, p.y, p.z, v)?;
     }
     Ok(())
+}
+
+/// `quantity` (one of ρ's derivatives) of the summed density of `docs` (fragments, each with a
+/// wavefunction) at `points`.
+pub fn fragments_at(docs: &[crate::model::Document], quantity: Quantity, points: &[DVec3]) -> Result<Vec<f64>> {
+    use crate::model::nci::{DensityDerivatives, DensitySource, WavefunctionDensity};
+    use rayon::prelude::*;
+    let sources: Vec<WavefunctionDensity> =
+        docs.iter().map(|d| wavefunction_of(d).map(WavefunctionDensity::new)).collect::<Result<_>>()?;
+    Ok(points
+        .par_chunks(256)
+        .flat_map_iter(|chunk| {
+            let mut total = vec![DensityDerivatives::default(); chunk.len()];
+            let mut part = vec![DensityDerivatives::default(); chunk.len()];
+            for s in &sources {
+                s.derivatives_at(chunk, &mut part);
+                total.iter_mut().zip(&part).for_each(|(t, p)| t.add(p));
+            }
+            total.into_iter().map(move |d| d.quantity(quantity))
+        })
+        .collect())
 }
 
 /// `cube`: the quantity on a grid of `grid` points per side (or `spacing` bohr), over the box

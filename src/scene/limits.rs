@@ -70,6 +70,10 @@ pub const SPACING: RangeInclusive<f64> = 1e-3..=10.0;
 pub const MARGIN: RangeInclusive<f64> = 0.0..=100.0;
 /// The density above which `nci` cuts points (a.u.).
 pub const DENSITY_CUT: RangeInclusive<f64> = 1e-6..=10.0;
+/// The reduced density gradient `render --nci` draws its surface at.
+pub const NCI_LEVEL: RangeInclusive<f32> = 0.01..=2.0;
+/// Where `render --nci`'s colours saturate, |sign(λ₂)ρ| (a.u.).
+pub const NCI_RANGE: RangeInclusive<f32> = 1e-3..=1.0;
 /// The RDG cutoff of `nci`'s -grad cube.
 pub const RDG_CUT: RangeInclusive<f64> = 1e-3..=100.0;
 /// The most points an `nci` grid may have: its two cubes are held in memory as f32.
