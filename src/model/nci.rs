@@ -98,7 +98,7 @@ impl DensityDerivatives {
             },
             Quantity::NciCloud => {
                 let depth = 1.0 - self.reduced_gradient() / NCI_CLOUD_LEVEL;
-                match self.rho > WAVEFUNCTION_DENSITY_CUT || !(depth > 0.0) {
+                match self.rho > WAVEFUNCTION_DENSITY_CUT || depth.is_nan() || depth <= 0.0 {
                     true => 0.0,
                     false => self.sign_lambda2_rho() * depth,
                 }
