@@ -26,13 +26,13 @@
 
 use glam::DVec3;
 
+use super::ParseError;
 use super::logs::{Geometry, LogLines, decimals, error, frames, trailing_numbers, trajectory};
 use super::printed::{
     self, NamedShells, OpenShell, Orbital, PrintedShell, Row, Section, aufbau, cartesian_index, next_block,
 };
 use super::text::parse_real;
 use super::wavefunction::OverlapFn;
-use super::{MAX_Z, ParseError};
 use crate::model::Document;
 use crate::model::basis::{MAX_L, ShellKind};
 use crate::model::elements::atomic_number;
@@ -175,15 +175,7 @@ fn coordinates(log: &LogLines, header: usize) -> Result<(Geometry, Vec<String>, 
         let v: Option<Vec<f64>> =
             t.get(1..).filter(|v| v.len() == 4).and_then(|v| v.iter().map(|x| parse_real(x)).collect());
         let v = v.ok_or_else(|| log.error_at(i, row))?;
-        let charge = v[0].round();
-        let z = if (1.0..=MAX_Z as f64).contains(&charge) {
-            charge as u32
-        } else {
-            // A pseudopotential's reduced charge or a ghost's 0: the name tells the element.
-            let letters: String = t[0].chars().take_while(char::is_ascii_alphabetic).collect();
-            atomic_number(&letters).or_else(|| atomic_number(&letters[..letters.len().min(1)])).unwrap_or(0)
-        };
-        g.z.push(z);
+        g.z.push(printed::element_of(v[0], t[0]));
         g.positions.push(DVec3::new(v[1], v[2], v[3]) * scale);
         names.push(t[0].to_ascii_uppercase());
         i += 1;

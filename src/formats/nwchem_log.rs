@@ -29,15 +29,14 @@ use std::collections::HashMap;
 
 use glam::DVec3;
 
+use super::ParseError;
 use super::logs::{Geometry, LogLines, decimals, error, frames, trailing_numbers, trajectory};
 use super::printed::column_numbers;
 use super::printed::{self, OpenShell, Orbital, PrintedShell, Row, Section, aufbau, pure_index};
 use super::text::parse_real;
 use super::wavefunction::OverlapFn;
-use super::{MAX_Z, ParseError};
 use crate::model::Document;
 use crate::model::basis::{MAX_L, ShellKind, n_cartesian};
-use crate::model::elements::atomic_number;
 use crate::model::orbitals::Spin;
 use crate::model::units::BOHR_PER_ANGSTROM;
 
@@ -264,14 +263,7 @@ fn coordinates(log: &LogLines, header: usize) -> Result<(Geometry, Vec<String>, 
         }
         let v: Option<Vec<f64>> = t[2..].iter().map(|x| parse_real(x)).collect();
         let v = v.ok_or_else(|| log.error_at(i, row))?;
-        let charge = v[0].round();
-        let z = if (1.0..=MAX_Z as f64).contains(&charge) {
-            charge as u32
-        } else {
-            let letters: String = t[1].chars().take_while(char::is_ascii_alphabetic).collect();
-            atomic_number(&letters).or_else(|| atomic_number(&letters[..letters.len().min(1)])).unwrap_or(0)
-        };
-        g.z.push(z);
+        g.z.push(printed::element_of(v[0], t[1]));
         g.positions.push(DVec3::new(v[1], v[2], v[3]) * scale);
         tags.push(t[1].to_ascii_uppercase());
         i += 1;

@@ -8,6 +8,7 @@ use super::ParseError;
 use super::logs::{Geometry, LogLines};
 use super::wavefunction::{OverlapFn, check_printed};
 use crate::model::basis::{Basis, Shell, ShellKind, cartesian_powers};
+use crate::model::elements::atomic_number;
 use crate::model::orbitals::{MolecularOrbital, Spin, Wavefunction};
 use crate::model::{Atom, Document, Molecule};
 
@@ -241,6 +242,18 @@ pub(crate) fn document(
 
 fn model_shells_offset(shells: &[Shell]) -> usize {
     shells.iter().map(Shell::n_functions).sum()
+}
+
+/// The element of an atom row that prints the nuclear `charge` and a `name`: the charge when
+/// it is an element's, else (a pseudopotential's reduced charge, a ghost's 0) the element the
+/// name starts with ("CL1" → Cl, "C12" → C); 0 when neither tells.
+pub(crate) fn element_of(charge: f64, name: &str) -> u32 {
+    let charge = charge.round();
+    if (1.0..=super::MAX_Z as f64).contains(&charge) {
+        return charge as u32;
+    }
+    let letters: String = name.chars().take_while(char::is_ascii_alphabetic).collect();
+    atomic_number(&letters).or_else(|| atomic_number(&letters[..letters.len().min(1)])).unwrap_or(0)
 }
 
 /// A block's header: the orbitals' numbers (from 1), one after another.
