@@ -80,6 +80,30 @@ pub(crate) struct Section {
     pub decimals: u32,
 }
 
+impl Section {
+    /// Takes a block's row `new` (number `row` of the block at line `header`'s section) and its
+    /// coefficients, one per column: the first block sets the rows, every later one must repeat
+    /// them (the same atom and label) or the file is refused at the row's line.
+    pub(crate) fn take_row(
+        &mut self,
+        log: &LogLines,
+        (header, row, first_block): (usize, usize, bool),
+        new: Row,
+        values: Vec<f64>,
+        columns: &mut [Vec<f64>],
+    ) -> Result<(), ParseError> {
+        if first_block {
+            self.rows.push(new);
+        } else if self.rows.get(row).is_none_or(|r| r.atom != new.atom || r.label != new.label) {
+            return Err(log.error_at(new.line, format!("row {} as in the first block (line {})", row + 1, header + 1)));
+        }
+        for (column, v) in columns.iter_mut().zip(values) {
+            column.push(v);
+        }
+        Ok(())
+    }
+}
+
 /// How a program names a shell's functions: for a row's label and the shell's l, the shell's
 /// kind and the function's index within the shell in the model's order; `None` when the label
 /// names no function of such a shell.

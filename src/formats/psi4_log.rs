@@ -289,14 +289,8 @@ fn molecular_orbitals(log: &LogLines, header: usize) -> Result<(Section, usize),
             if first_decimals.is_none() {
                 first_decimals = l.split_whitespace().last().and_then(decimals);
             }
-            if first_block {
-                section.rows.push(Row { line: i, atom: atom - 1, label: label.to_string() });
-            } else if section.rows.get(row).is_none_or(|r| r.atom != atom - 1 || r.label != label) {
-                return Err(log.error_at(i, format!("row {} as in the first block (line {})", row + 1, header + 1)));
-            }
-            for (c, v) in values.into_iter().enumerate() {
-                columns[c].push(v);
-            }
+            let new = Row { line: i, atom: atom - 1, label: label.to_string() };
+            section.take_row(log, (header, row, first_block), new, values, &mut columns)?;
             row += 1;
             i += 1;
         }

@@ -348,14 +348,7 @@ fn coefficients(log: &LogLines, header: usize) -> Result<(Section, usize), Parse
             if first_decimals.is_none() {
                 first_decimals = l.split_whitespace().last().and_then(decimals);
             }
-            if first_block {
-                section.rows.push(Row { line: i, atom: 0, label });
-            } else if section.rows.get(row).is_none_or(|r| r.label != label) {
-                return Err(log.error_at(i, format!("row {} as in the first block (line {})", row + 1, header + 1)));
-            }
-            for (c, v) in values.into_iter().enumerate() {
-                columns[c].push(v);
-            }
+            section.take_row(log, (header, row, first_block), Row { line: i, atom: 0, label }, values, &mut columns)?;
             row += 1;
             i += 1;
         }
