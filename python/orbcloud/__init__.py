@@ -129,6 +129,12 @@ def _quantity_name(quantity: str) -> str:
     return " ".join(str(quantity).lower().replace("_", " ").replace("-", " ").split())
 
 
+def _grid_points(shape, world_from_grid: np.ndarray) -> np.ndarray:
+    """Every point of a grid of `shape` (x slowest) mapped by `world_from_grid`, bohr."""
+    idx = np.indices(shape).reshape(3, -1).T.astype(float)
+    return idx @ world_from_grid[:3, :3].T + world_from_grid[:3, 3]
+
+
 class Grid(NamedTuple):
     values: np.ndarray
     """nx × ny × nz values, x slowest (cube order)."""
@@ -146,8 +152,7 @@ class Grid(NamedTuple):
 
     def points(self) -> np.ndarray:
         """Every grid point's position (nx·ny·nz × 3, bohr) in the values' order."""
-        idx = np.indices(self.values.shape).reshape(3, -1).T.astype(float)
-        return idx @ self.axes + self.origin
+        return _grid_points(self.values.shape, self.world_from_grid)
 
 
 class NciGrids(NamedTuple):
@@ -163,17 +168,16 @@ class NciGrids(NamedTuple):
 
     @property
     def origin(self) -> np.ndarray:
-        return self.world_from_grid[:3, 3]
+        return Grid.origin.fget(self)
 
     @property
     def axes(self) -> np.ndarray:
         """The three step vectors (rows), bohr."""
-        return self.world_from_grid[:3, :3].T
+        return Grid.axes.fget(self)
 
     def points(self) -> np.ndarray:
         """Every grid point's position (nx·ny·nz × 3, bohr) in the values' order."""
-        idx = np.indices(self.dens.shape).reshape(3, -1).T.astype(float)
-        return idx @ self.axes + self.origin
+        return _grid_points(self.dens.shape, self.world_from_grid)
 
 
 class Document:
