@@ -54,7 +54,7 @@ fn controls(ui: &mut egui::Ui, modes: &Vibrations, v: &mut VibrationState) {
         ui.spacing_mut().slider_width = 70.0;
         ui.add(Slider::new(&mut v.amplitude, 0.05..=1.5).text("bohr"))
             .on_hover_text("the largest atom's displacement at the turning points");
-        ui.add(Slider::new(&mut v.speed, 0.1..=3.0).text("per s")).on_hover_text("oscillations per second");
+        ui.add(Slider::new(&mut v.speed, 0.1..=3.0).text("/s")).on_hover_text("oscillations per second");
     });
     // The mode shown, named: what plays in the view.
     if let Some((k, m)) = v.mode.and_then(|k| modes.modes.get(k).map(|m| (k, m))) {
@@ -117,9 +117,11 @@ fn ir_spectrum(ui: &mut egui::Ui, modes: &Vibrations, v: &mut VibrationState) ->
         .label("wavenumber (cm-1)")
         .formatter(|mark, _| format!("{:.0}", (-mark.value).abs()))
         .label_spacing(32.0..=48.0);
+    // The intensity axis labelled at a few heights, not its 0 alone.
+    let intensity = egui_plot::AxisHints::new_y().label("IR (km/mol)").label_spacing(14.0..=24.0).min_thickness(28.0);
     let response = Plot::new("ir spectrum")
         .custom_x_axes(vec![axis])
-        .y_axis_label("IR (km/mol)")
+        .custom_y_axes(vec![intensity])
         .allow_zoom(false)
         .allow_drag(false)
         .allow_scroll(false)
