@@ -126,13 +126,7 @@ pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Docum
             }
             let shells = atom_shells(&log, geometry, names, basis, &section)?;
             let mut doc = printed::document(&log, "GAMESS", geometry, &shells, &section, &function_of, overlap)?;
-            if frames.len() > 1 {
-                doc.problems.push(format!(
-                    "{file}: its {} geometries are not shown: the orbitals open at the one they belong to (line {})",
-                    frames.len(),
-                    geometry.line + 1
-                ));
-            }
+            super::logs::note_one_geometry(&mut doc, file, frames.len(), geometry.line);
             return Ok(doc);
         }
         (None, _) => "the output prints no orbitals (`EIGENVECTORS`: NPRINT=-5 or lower hides them; NPRINT=3 or `$GUESS PRTMO=.T. $END` prints them all)".to_string(),

@@ -226,13 +226,7 @@ impl Scan {
             Orbitals::Read { section, basis_line } => {
                 let geometry = self.orientation_before(section.line).unwrap_or(last);
                 let mut doc = self.wavefunction_document(log, geometry, section, basis_line, overlap)?;
-                if frames.len() > 1 {
-                    doc.problems.push(format!(
-                        "{file}: its {} geometries are not shown: the orbitals open at the one they belong to (line {})",
-                        frames.len(),
-                        geometry.line + 1
-                    ));
-                }
+                super::logs::note_one_geometry(&mut doc, file, frames.len(), geometry.line);
                 doc
             }
             Orbitals::Missing(why) => {

@@ -215,6 +215,17 @@ pub(crate) fn decimals(token: &str) -> Option<u32> {
     u32::try_from(digits).ok()
 }
 
+/// Notes in `doc`'s problems that a log of `frames` geometries opens at one: a document with
+/// orbitals shows the geometry they belong to (printed at 0-based `line`).
+pub(crate) fn note_one_geometry(doc: &mut Document, file: &str, frames: usize, line: usize) {
+    if frames > 1 {
+        doc.problems.push(format!(
+            "{file}: its {frames} geometries are not shown: the orbitals open at the one they belong to (line {})",
+            line + 1
+        ));
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

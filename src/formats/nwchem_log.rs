@@ -194,13 +194,7 @@ pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Docum
                     "{file}: {missing} orbitals have no energy: the orbital analysis lists only some (`print \"final vectors analysis\"` lists all)"
                 ));
             }
-            if frames.len() > 1 {
-                doc.problems.push(format!(
-                    "{file}: its {} geometries are not shown: the orbitals open at the one they belong to (line {})",
-                    frames.len(),
-                    geometry.line + 1
-                ));
-            }
+            super::logs::note_one_geometry(&mut doc, file, frames.len(), geometry.line);
             return Ok(doc);
         }
         (None, _) => format!("the output prints no orbital coefficients (add `{ORBITAL_KEYWORDS}`)"),

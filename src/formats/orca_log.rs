@@ -37,12 +37,12 @@ use glam::DVec3;
 use super::logs::{Geometry, LogLines, decimals, error, frames, trailing_numbers, trajectory};
 use super::structure::element_of;
 use super::text::parse_real;
-use super::wavefunction::{OverlapFn, check_printed, orca_flipped};
+use super::wavefunction::{OverlapFn, orca_flipped};
 use super::{MAX_Z, ParseError};
 use crate::model::basis::{Basis, MAX_L, Shell, ShellKind};
-use crate::model::orbitals::{MolecularOrbital, Spin, Wavefunction};
+use crate::model::orbitals::{MolecularOrbital, Spin};
 use crate::model::vibrations::{NormalMode, Vibrations};
-use crate::model::{Atom, Document, Molecule};
+use crate::model::{Atom, Document};
 
 /// The keywords that make ORCA print the basis set and the orbitals.
 pub const ORBITAL_KEYWORDS: &str = "%output print[p_basis] 2 print[p_mos] 1 end";
@@ -116,13 +116,7 @@ fn read(log: &LogLines, overlap: Option<OverlapFn>) -> Result<Document, ParseErr
         (Some(section), Some((_, basis))) => {
             let geometry = geometries.iter().rev().find(|g| g.line < section.line).unwrap_or(last);
             let mut doc = wavefunction_document(log, geometry, basis, section, overlap)?;
-            if frames.len() > 1 {
-                doc.problems.push(format!(
-                    "{file}: its {} geometries are not shown: the orbitals open at the one they belong to (line {})",
-                    frames.len(),
-                    geometry.line + 1
-                ));
-            }
+            super::logs::note_one_geometry(&mut doc, file, frames.len(), geometry.line);
             doc.title = title;
             return Ok(doc);
         }
@@ -384,7 +378,6 @@ fn wavefunction_document(
     if section.rows.len() != n {
         return Err(log.error_at(section.line, format!("{n} rows of coefficients (the printed basis set's functions)")));
     }
-    let restricted = section.orbitals.iter().all(|o| o.2 == Spin::Alpha);
     let orbitals = section
         .orbitals
         .iter()
@@ -402,20 +395,7 @@ fn wavefunction_document(
             }
         })
         .collect();
-    let wf = Wavefunction {
-        basis: Basis { shells },
-        orbitals,
-        restricted,
-        normalization: Default::default(),
-        excited: None,
-    };
-    Ok(Document {
-        source: log.file.to_string(),
-        title: log.file.to_string(),
-        molecule: Molecule::new(atoms),
-        wavefunction: Some(check_printed(wf, "ORCA", overlap, section.decimals)),
-        ..Default::default()
-    })
+    Ok(super::printed::log_document(log, "ORCA", atoms, Basis { shells }, orbitals, overlap, section.decimals))
 }
 
 /// A frequency job's normal modes (see the module's documentation); `None` without

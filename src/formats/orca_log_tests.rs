@@ -4,6 +4,7 @@
 use super::super::ref_overlap::reference_overlap;
 use super::*;
 use crate::model::gto::PreparedBasis;
+use crate::model::orbitals::Wavefunction;
 
 /// Water (bohr): O with s, s, p, d and f shells, H with s.
 const ATOMS: [(&str, [f64; 3]); 3] = [("O", [0.0, 0.0, 0.22]), ("H", [0.0, 1.43, -0.89]), ("H", [0.0, -1.43, -0.89])];

@@ -230,7 +230,6 @@ pub(crate) fn document(
     if section.orbitals.iter().any(|o| o.coefficients.len() != n) {
         return Err(log.error_at(section.line, format!("{n} coefficients in every orbital")));
     }
-    let restricted = section.orbitals.iter().all(|o| o.spin == Spin::Alpha);
     let orbitals = section
         .orbitals
         .iter()
@@ -248,20 +247,29 @@ pub(crate) fn document(
             }
         })
         .collect();
-    let wf = Wavefunction {
-        basis: Basis { shells: model_shells },
-        orbitals,
-        restricted,
-        normalization: Default::default(),
-        excited: None,
-    };
-    Ok(Document {
+    Ok(log_document(log, program, atoms, Basis { shells: model_shells }, orbitals, overlap, section.decimals))
+}
+
+/// A log's document: its atoms and the wavefunction of `basis` and `orbitals` (restricted when
+/// every orbital is alpha) as `program` printed it to `decimals`, checked with `overlap`.
+pub(crate) fn log_document(
+    log: &LogLines,
+    program: &str,
+    atoms: Vec<Atom>,
+    basis: Basis,
+    orbitals: Vec<MolecularOrbital>,
+    overlap: Option<OverlapFn>,
+    decimals: u32,
+) -> Document {
+    let restricted = orbitals.iter().all(|o| o.spin == Spin::Alpha);
+    let wf = Wavefunction { basis, orbitals, restricted, normalization: Default::default(), excited: None };
+    Document {
         source: log.file.to_string(),
         title: log.file.to_string(),
         molecule: Molecule::new(atoms),
-        wavefunction: Some(check_printed(wf, program, overlap, section.decimals)),
+        wavefunction: Some(check_printed(wf, program, overlap, decimals)),
         ..Default::default()
-    })
+    }
 }
 
 fn model_shells_offset(shells: &[Shell]) -> usize {

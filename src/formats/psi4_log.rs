@@ -107,13 +107,7 @@ pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Docum
             let spherical = *spherical;
             let function_of = move |label: &str, l: u32| function_of(label, l, spherical);
             let mut doc = printed::document(&log, "Psi4", geometry, &shells, section, &function_of, overlap)?;
-            if frames.len() > 1 {
-                doc.problems.push(format!(
-                    "{file}: its {} geometries are not shown: the orbitals open at the one they belong to (line {})",
-                    frames.len(),
-                    geometry.line + 1
-                ));
-            }
+            super::logs::note_one_geometry(&mut doc, file, frames.len(), geometry.line);
             return Ok(doc);
         }
         (None, None) => format!("the output prints neither the basis set nor the orbitals (add `{ORBITAL_KEYWORDS}`)"),

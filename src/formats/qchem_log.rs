@@ -156,13 +156,7 @@ pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Docum
                 ));
             }
             let mut doc = printed::document(&log, "Q-Chem", geometry, shells, &section, &function_of, overlap)?;
-            if frames.len() > 1 {
-                doc.problems.push(format!(
-                    "{file}: its {} geometries are not shown: the orbitals open at the one they belong to (line {})",
-                    frames.len(),
-                    geometry.line + 1
-                ));
-            }
+            super::logs::note_one_geometry(&mut doc, file, frames.len(), geometry.line);
             doc
         }
         (first, basis) => {
