@@ -116,7 +116,11 @@ fn list(ui: &mut egui::Ui, doc: &Document, states: &ExcitedStates, view: &mut Ex
                         "difference",
                         "ρ(excited) − ρ(ground): where the electron goes (+) and whence (−)",
                     ),
-                    (Quantity::Attachment, "attachment", "where the electron goes (Head-Gordon et al., 1995)"),
+                    (
+                        Quantity::Attachment,
+                        "attachment",
+                        "where the electrons go: the difference density's positive part",
+                    ),
                     (Quantity::Detachment, "detachment", "where the electron comes from"),
                 ] {
                     if ui.button(name).on_hover_text(hint).clicked() {
