@@ -63,9 +63,9 @@ macro_rules! mirror {
 #[test]
 fn rust_mirrors_match_the_wgsl_layouts() {
     use orbcloud::gpu::{
-        arrows::ArrowUniforms, arrows::GpuArrow, atoms::AtomGlobals, basis_buffers::GpuShell, gto::FillParams,
-        isosurface::SurfaceUniforms, occlusion::CullUniforms, occlusion::GpuBatch, occlusion::PyramidSize,
-        oit::GpuOptics, oit::ListInfo, volume::VolumeUniforms,
+        arrows::ArrowUniforms, arrows::GpuArrow, atoms::AtomGlobals, basis_buffers::GpuShell,
+        density_hessian::HessianParams, gto::FillParams, isosurface::SurfaceUniforms, occlusion::CullUniforms,
+        occlusion::GpuBatch, occlusion::PyramidSize, oit::GpuOptics, oit::ListInfo, volume::VolumeUniforms,
     };
     let mirrors = [
         mirror!(
@@ -143,6 +143,7 @@ fn rust_mirrors_match_the_wgsl_layouts() {
         mirror!("isosurface.wgsl", "ListInfo", ListInfo, [width, capacity, surfaces, _pad]),
         mirror!("resolve.wgsl", "SurfaceOptics", GpuOptics, [a, b, c, d, f, g, glow_d, glow_f, glow_g, same_object]),
         mirror!("gto_fill.wgsl", "FillParams", FillParams, [world_from_grid, dims]),
+        mirror!("density_hessian.wgsl", "HessianParams", HessianParams, [world_from_grid, dims, chunk]),
         mirror!("gto_fill.wgsl", "GtoShell", GpuShell, [center, cutoff2, l, prim_offset, prim_count, weight_offset]),
     ];
     for (module_name, wgsl, size, fields) in mirrors {

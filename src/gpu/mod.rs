@@ -8,6 +8,7 @@ pub mod arrows;
 pub mod atoms;
 pub mod basis_buffers;
 pub mod context;
+pub mod density_hessian;
 pub mod frame;
 pub mod gto;
 pub mod isosurface;
@@ -57,6 +58,7 @@ pub const SHADERS: &[(&str, &str)] = &[
     ("surface_cull.wgsl", include_str!("../../shaders/surface_cull.wgsl")),
     ("gto_common.wgsl", include_str!("../../shaders/gto_common.wgsl")),
     ("gto_fill.wgsl", include_str!("../../shaders/gto_fill.wgsl")),
+    ("density_hessian.wgsl", include_str!("../../shaders/density_hessian.wgsl")),
     ("arrows.wgsl", include_str!("../../shaders/arrows.wgsl")),
 ];
 
@@ -82,6 +84,7 @@ pub const SHADER_MODULES: &[(&str, &[&str])] = &[
     ("volume_direct.wgsl", &["volume_common.wgsl", "gto_common.wgsl", "volume_direct.wgsl"]),
     ("volume_morph.wgsl", &["volume_common.wgsl", "volume_gradient.wgsl", "volume_slab.wgsl", "volume_morph.wgsl"]),
     ("gto_fill.wgsl", &["gto_common.wgsl", "gto_fill.wgsl"]),
+    ("density_hessian.wgsl", &["gto_common.wgsl", "density_hessian.wgsl"]),
     ("atoms.wgsl", &["atoms_common.wgsl", "atoms.wgsl"]),
     ("atoms_splat_pair.wgsl", &["atoms_common.wgsl", "atoms_cull.wgsl", "atoms_splat_pair.wgsl"]),
     ("atoms_splat_packed.wgsl", &["atoms_common.wgsl", "atoms_cull.wgsl", "atoms_splat_packed.wgsl"]),

@@ -53,8 +53,14 @@ impl CartesianExpansion {
     /// or a masked subset), shells with no weight left out.
     pub fn from_coefficients(basis: &super::gto::PreparedBasis, coefficients: &[f64]) -> Self {
         let (weights, active) = basis.monomial_coefficients(coefficients);
+        Self::over_shells(basis, &weights, &active)
+    }
+
+    /// The combination whose cartesian weights are `weights` (the basis's cartesians), over the
+    /// shells `keep` marks.
+    fn over_shells(basis: &super::gto::PreparedBasis, weights: &[f64], keep: &[bool]) -> Self {
         let mut shells = Vec::new();
-        for (s, &on) in basis.shells.iter().zip(&active) {
+        for (s, &on) in basis.shells.iter().zip(keep) {
             let n = super::basis::n_cartesian(s.l);
             if on {
                 shells.push(CartesianShell {
@@ -67,6 +73,41 @@ impl CartesianExpansion {
             }
         }
         Self { shells }
+    }
+}
+
+/// A density Σ_i n_i ψ_i² whose orbitals are written out over one set of shells (those any of
+/// them uses; an orbital's weights are zero on the shells it does not), so that a kernel reads
+/// each shell's primitives once for several orbitals: what the GPU's density-derivative pass
+/// evaluates. [`CartesianDensity::density`] is its CPU reference.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct CartesianDensity {
+    /// One expansion per orbital, all over the same shells in the same order.
+    pub orbitals: Vec<CartesianExpansion>,
+    /// n_i per orbital (any sign).
+    pub occupations: Vec<f64>,
+}
+
+impl CartesianDensity {
+    /// The density of `sets` (each an orbital's coefficients over `basis`'s functions and its
+    /// occupation).
+    pub fn new(basis: &super::gto::PreparedBasis, sets: &[(&[f64], f64)]) -> Self {
+        let expanded: Vec<(Vec<f64>, Vec<bool>)> = sets.iter().map(|(c, _)| basis.monomial_coefficients(c)).collect();
+        let mut used = vec![false; basis.shells.len()];
+        for (_, active) in &expanded {
+            for (u, a) in used.iter_mut().zip(active) {
+                *u |= a;
+            }
+        }
+        Self {
+            orbitals: expanded.iter().map(|(w, _)| CartesianExpansion::over_shells(basis, w, &used)).collect(),
+            occupations: sets.iter().map(|(_, n)| *n).collect(),
+        }
+    }
+
+    /// ρ at a point.
+    pub fn density(&self, p: DVec3) -> f64 {
+        self.orbitals.iter().zip(&self.occupations).map(|(o, n)| n * o.value(p).powi(2)).sum()
     }
 }
 

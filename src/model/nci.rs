@@ -10,6 +10,7 @@ use std::collections::HashMap;
 use glam::DVec3;
 use rayon::prelude::*;
 
+use super::cartesian::CartesianDensity;
 use super::eigen::symmetric_eigen;
 use super::grid::GridSpec;
 use super::gto::PreparedBasis;
@@ -56,6 +57,13 @@ impl DensityDerivatives {
                 *h += o;
             }
         }
+    }
+
+    /// The derivatives as the GPU writes them, in single precision: ρ, ∂xρ, ∂yρ, ∂zρ, then the
+    /// Hessian's xx, xy, xz, yy, yz, zz.
+    pub fn from_single(v: &[f32; 10]) -> Self {
+        let h: [f64; 6] = std::array::from_fn(|k| v[4 + k] as f64);
+        Self { rho: v[0] as f64, gradient: DVec3::new(v[1] as f64, v[2] as f64, v[3] as f64), hessian: symmetric(h) }
     }
 
     /// The reduced density gradient s; infinite where ρ ≤ 0 (s grows without bound as ρ → 0).
@@ -147,6 +155,18 @@ impl<'a> WavefunctionDensity<'a> {
     /// Basis functions the density is evaluated over (at most the basis's).
     pub fn contracted_functions(&self) -> usize {
         self.contracted.n_functions()
+    }
+
+    /// The occupied orbitals over the contracted basis written out as cartesian Gaussians
+    /// (what the GPU evaluates; its density is this source's).
+    pub fn cartesian(&self) -> CartesianDensity {
+        let n = self.occupations.len();
+        let columns: Vec<Vec<f64>> = (0..n)
+            .map(|i| (0..self.contracted.n_functions()).map(|k| self.coefficients[k * n + i]).collect())
+            .collect();
+        let sets: Vec<(&[f64], f64)> =
+            columns.iter().map(Vec::as_slice).zip(self.occupations.iter().copied()).collect();
+        CartesianDensity::new(&self.contracted, &sets)
     }
 }
 
@@ -342,6 +362,13 @@ pub fn quantity_at_points(source: &dyn DensitySource, quantity: Quantity, points
             d.into_iter().map(move |d| d.quantity(quantity))
         })
         .collect()
+}
+
+/// `quantity` of derivatives given in single precision ([`DensityDerivatives::from_single`]:
+/// what the GPU's pass writes), finished in double precision by
+/// [`DensityDerivatives::quantity`] (λ₂ by Jacobi, the same cuts as the CPU's), in parallel.
+pub fn quantity_of_single(derivatives: &[[f32; 10]], quantity: Quantity) -> Vec<f32> {
+    derivatives.par_iter().map(|d| DensityDerivatives::from_single(d).quantity(quantity) as f32).collect()
 }
 
 /// NCIPLOT's RDG cutoff (its `dimcut`, CUTOFFS' second number): its `-grad` cube holds 100
