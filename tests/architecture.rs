@@ -41,7 +41,7 @@ const CRATE_RULES: &[(&str, &[&str])] = &[
     ("scene", &["glam", "serde"]),
     ("sources", &["flate2", "serde", "serde_json", "thiserror", "log", "libc", "toml"]),
     ("gpu", &["glam", "thiserror", "wgpu", "bytemuck", "half", "image", "pollster", "log"]),
-    ("evaluate", &["glam", "wgpu"]),
+    ("evaluate", &["glam", "wgpu", "log"]),
     ("evaluate/meshes.rs", &["glam"]),
     ("evaluate/arithmetic.rs", &["glam"]),
     ("layers", &["glam", "thiserror", "wgpu", "image"]),

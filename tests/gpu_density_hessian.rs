@@ -43,7 +43,7 @@ fn grid_over(doc: &orbcloud::model::Document, margin: f64, n: usize) -> GridSpec
     GridSpec::cube(lo - DVec3::splat(margin), hi + DVec3::splat(margin) + DVec3::new(0.13, 0.07, 0.0), n)
 }
 
-fn cpu(source: &WavefunctionDensity, grid: &GridSpec) -> Vec<DensityDerivatives> {
+fn cpu_derivatives(source: &WavefunctionDensity, grid: &GridSpec) -> Vec<DensityDerivatives> {
     let [nx, ny, nz] = grid.dims;
     let points: Vec<DVec3> = (0..nx)
         .flat_map(|i| (0..ny).flat_map(move |j| (0..nz).map(move |k| (i, j, k))))
@@ -70,7 +70,7 @@ fn check(name: &str, doc: &orbcloud::model::Document, grid: &GridSpec, chunk: us
     let source = WavefunctionDensity::new(wf);
     let pass = DensityHessianPass::new(&ctx);
     let gpu = pass.derivatives_in_chunks(&ctx, &source.cartesian(), grid, chunk).unwrap();
-    let cpu = cpu(&source, grid);
+    let cpu = cpu_derivatives(&source, grid);
     assert_eq!(gpu.len(), cpu.len());
 
     // Valence and beyond (ρ ≤ 1, where every NCI feature lies), and the cores.
@@ -164,4 +164,61 @@ fn unrestricted_cation() {
     let doc = load("wavefunctions/h2o_cation_uhf_631gs.molden");
     assert!(!doc.wavefunction.as_ref().unwrap().restricted);
     check("H2O+ UHF", &doc, &grid_over(&doc, 2.5, 20), 1000);
+}
+
+#[test]
+fn the_viewer_grid_of_each_nci_quantity_matches_the_cpu() {
+    use orbcloud::model::gto::PreparedBasis;
+    let ctx = common::lavapipe();
+    let doc = load("nci/water_dimer_631gs.molden");
+    let wf = doc.wavefunction.as_ref().unwrap();
+    let pass = DensityHessianPass::new(&ctx);
+    let prepared = PreparedBasis::new(&wf.basis);
+    let source = WavefunctionDensity::new(wf);
+    for quantity in [
+        Quantity::NciGradient,
+        Quantity::NciCloud,
+        Quantity::SignLambda2Rho,
+        Quantity::ReducedGradient,
+        Quantity::DensityLaplacian,
+    ] {
+        let grid = orbcloud::evaluate::orbital_geometry(&doc, quantity, 28).unwrap();
+        let gpu = pass.quantity_grid(&ctx, wf, quantity, &grid).unwrap();
+        let cpu = prepared.quantity_grid_f32(wf, &doc.molecule, quantity, &grid);
+        let derivatives = cpu_derivatives(&source, &grid);
+        let largest = cpu.iter().fold(0.0f32, |m, v| m.max(v.abs()));
+        let largest_hessian =
+            derivatives.iter().flat_map(|d| d.hessian.into_iter().flatten()).fold(0.0f64, |m, v| m.max(v.abs()));
+        let mut ambiguous = 0;
+        for ((g, c), d) in gpu.iter().zip(&cpu).zip(&derivatives) {
+            let close = match quantity {
+                // ∇²ρ: the Hessian's tolerance (see the top of this file).
+                Quantity::DensityLaplacian => (g - c).abs() <= 1e-5 * (largest + c.abs()),
+                // s grows without bound where ρ → 0: relative.
+                Quantity::ReducedGradient => (g - c).abs() <= 1e-4 * c.abs().max(1e-3) || d.rho < 1e-6,
+                _ => (g - c).abs() <= 1e-4 * (c.abs() + 1e-3 * largest),
+            };
+            if !close {
+                // Only where the two sides of a cut or of λ₂ = 0 are within rounding.
+                let at_cut = (d.rho - 0.05).abs() < 1e-4 * d.rho;
+                let at_zero = d.lambda2().abs() < 1e-4 * largest_hessian;
+                assert!(at_cut || at_zero, "{quantity:?}: GPU {g} vs CPU {c} at ρ = {}, λ₂ = {}", d.rho, d.lambda2());
+                ambiguous += 1;
+            }
+        }
+        eprintln!("{quantity:?}: {} points, {ambiguous} on either side of a cut or of λ₂ = 0", gpu.len());
+    }
+}
+
+#[test]
+fn no_occupied_orbitals_and_no_points() {
+    let ctx = common::lavapipe();
+    let pass = DensityHessianPass::new(&ctx);
+    let grid = GridSpec::cube(DVec3::splat(-1.0), DVec3::splat(1.0), 5);
+    let empty = orbcloud::model::cartesian::CartesianDensity::default();
+    let values = pass.derivatives(&ctx, &empty, &grid).unwrap();
+    assert_eq!(values.len(), 125);
+    assert!(values.iter().all(|v| v.iter().all(|x| *x == 0.0)));
+    let none = GridSpec { dims: [0, 4, 4], ..grid };
+    assert!(pass.derivatives(&ctx, &empty, &none).unwrap().is_empty());
 }

@@ -532,6 +532,9 @@ enum BenchCommand {
     /// ms from a change to the coarse preview and to the full picture of several molecules
     /// with clouds and translucent surfaces.
     Scene(bench_scene::SceneBench),
+    /// ms to evaluate a wavefunction's NCI field on a grid, on the CPU and by the GPU pass of
+    /// the density's derivatives.
+    Nci(nci::NciBench),
 }
 
 #[derive(Args)]
@@ -955,6 +958,7 @@ fn dispatch(cli: Cli, later: &[quantities::Later]) -> Result<()> {
         Some(Command::Bench(BenchCommand::Surfaces(args))) => surface::bench_translucent(&args),
         Some(Command::Bench(BenchCommand::Surface(args))) => molsurface::bench(&args),
         Some(Command::Bench(BenchCommand::Scene(args))) => bench_scene::bench(&args),
+        Some(Command::Bench(BenchCommand::Nci(args))) => nci::bench(&args),
         Some(Command::Bench(BenchCommand::Render { file, view, frames, lavapipe, wavefunction })) => {
             render::bench(file.as_deref(), &view, frames, lavapipe, &wavefunction)
         }

@@ -232,3 +232,74 @@ fn with_suffix(prefix: &Path, suffix: &str) -> PathBuf {
     name.push(suffix);
     PathBuf::from(name)
 }
+
+#[derive(Args)]
+pub struct NciBench {
+    /// A wavefunction (Molden, fchk, wfn, wfx, MKL).
+    file: PathBuf,
+    /// Points per side of the grid: the viewer's box for the NCI field.
+    #[arg(long, default_value_t = 80, value_parser = within(limits::GRID_POINTS))]
+    points: usize,
+    /// Timed runs of each path (the best is reported).
+    #[arg(long, default_value_t = 3, value_parser = within(1..=1000usize))]
+    runs: usize,
+    /// Use the CPU Vulkan adapter (lavapipe) even when a GPU is present.
+    #[arg(long)]
+    lavapipe: bool,
+}
+
+/// `orbcloud bench nci`: the viewer's NCI field (s where ρ ≤ 0.05) of a wavefunction on its
+/// grid, by the CPU reference (every thread) and by the GPU pass of the density's derivatives
+/// (the pass, then the quantity finished on the CPU), with the largest difference of the two.
+pub fn bench(args: &NciBench) -> Result<()> {
+    use crate::gpu::density_hessian::DensityHessianPass;
+    use crate::model::gto::PreparedBasis;
+    use crate::model::orbitals::Quantity;
+
+    let doc = super::load(Some(&args.file))?;
+    let wf = super::wavefunction_of(&doc)?;
+    let quantity = Quantity::NciGradient;
+    let grid = crate::evaluate::orbital_geometry(&doc, quantity, args.points).context("the file has no grid box")?;
+    let ctx = super::gpu(args.lavapipe)?;
+    println!("adapter: {}", ctx.describe());
+    println!("{}: grid {:?} = {} points, {} threads", doc.source, grid.dims, grid.len(), rayon::current_num_threads());
+    let best = |times: &[f64]| times.iter().copied().fold(f64::INFINITY, f64::min);
+
+    let (mut cpu_ms, mut cpu) = (Vec::new(), Vec::new());
+    for _ in 0..args.runs {
+        let t = Instant::now();
+        cpu = PreparedBasis::new(&wf.basis).quantity_grid_f32(wf, &doc.molecule, quantity, &grid);
+        cpu_ms.push(t.elapsed().as_secs_f64() * 1e3);
+    }
+    let t = Instant::now();
+    let pass = DensityHessianPass::new(&ctx);
+    let pipeline_ms = t.elapsed().as_secs_f64() * 1e3;
+    let (mut pass_ms, mut finish_ms, mut gpu) = (Vec::new(), Vec::new(), Vec::new());
+    for _ in 0..args.runs {
+        let t = Instant::now();
+        let density = WavefunctionDensity::new(wf).cartesian();
+        let derivatives = pass.derivatives(&ctx, &density, &grid)?;
+        pass_ms.push(t.elapsed().as_secs_f64() * 1e3);
+        let t = Instant::now();
+        gpu = nci::quantity_of_single(&derivatives, quantity);
+        finish_ms.push(t.elapsed().as_secs_f64() * 1e3);
+    }
+    let kept = |v: &f32| *v < nci::CUT_VALUE;
+    let worst =
+        cpu.iter().zip(&gpu).filter(|(c, _)| kept(c)).map(|(c, g)| (c - g).abs() / c.max(1e-3)).fold(0.0f32, f32::max);
+    let differ = cpu.iter().zip(&gpu).filter(|(c, g)| kept(c) != kept(g)).count();
+    let gpu_ms: Vec<f64> = pass_ms.iter().zip(&finish_ms).map(|(a, b)| a + b).collect();
+    println!(
+        "cpu_ms={:.1} gpu_ms={:.1} (pass {:.1}, finish {:.1}; pipeline built once in {pipeline_ms:.1}) runs={}",
+        best(&cpu_ms),
+        best(&gpu_ms),
+        best(&pass_ms),
+        best(&finish_ms),
+        args.runs
+    );
+    println!(
+        "kept points: {}; worst relative difference of s there {worst:.2e}; points cut by one and not the other: {differ}",
+        cpu.iter().filter(|v| kept(v)).count()
+    );
+    Ok(())
+}

@@ -1,11 +1,13 @@
 //! Evaluating a wavefunction's quantities for display: orbitals filled on the GPU (a 3D texture,
-//! read back once for isosurfaces), densities on the CPU, Jang and Varetto's direct mode (no grid: the
+//! read back once for isosurfaces), densities on the CPU, NCI's quantities by the GPU's pass of
+//! the density's derivatives on a GPU (the CPU's on a CPU adapter, or when the pass fails), Jang and Varetto's direct mode (no grid: the
 //! orbital's range measured from CPU samples, a grid filled only when isosurfaces want one), on
 //! grids the device holds; and the opacity a cloud of the values starts with.
 
 pub mod arithmetic;
 pub mod meshes;
 
+use crate::gpu::density_hessian::DensityHessianPass;
 use crate::gpu::gto::{GtoFillPass, read_volume, volume_from_texture};
 use crate::gpu::renderer::Layer;
 use crate::gpu::volume::VolumeTexture;
@@ -116,8 +118,8 @@ pub fn evaluate_wavefunction(
     let combination = match view.quantity {
         Quantity::Orbital(i) => Some(restricted(&wf.orbitals[i].coefficients, view.functions.as_deref())),
         Quantity::BasisFunction(k) => Some(prepared.unit_coefficients(k)),
-        // Densities, the potential and the quantities of the density's derivatives are
-        // evaluated on the CPU.
+        // Densities and the potential are evaluated on the CPU, the quantities of the
+        // density's derivatives by the GPU's pass where it is faster ([`derivatives_on_gpu`]).
         Quantity::Density
         | Quantity::SpinDensity
         | Quantity::Potential
@@ -164,12 +166,32 @@ pub fn evaluate_wavefunction(
         }
         None => {
             let label = crate::scene::Source::Wavefunction(view.quantity).name(doc);
-            let values = prepared.quantity_grid_f32(wf, &doc.molecule, view.quantity, &geometry);
+            let gpu = view.quantity.from_density_derivatives() && derivatives_on_gpu(ctx);
+            let values = match gpu.then(|| {
+                crate::gpu::context::guarded(&ctx.device, || {
+                    DensityHessianPass::new(ctx).quantity_grid(ctx, wf, view.quantity, &geometry)
+                })
+            }) {
+                Some(Ok(values)) => values,
+                Some(Err(e)) => {
+                    log::warn!("{label}: the GPU's density derivatives failed ({e}); evaluated on the CPU");
+                    prepared.quantity_grid_f32(wf, &doc.molecule, view.quantity, &geometry)
+                }
+                None => prepared.quantity_grid_f32(wf, &doc.molecule, view.quantity, &geometry),
+            };
             let grid = VolumeGrid::new(label, geometry.dims, geometry.world_from_grid, values);
             let values = Values { grid: Some(grid), sampled: None };
             Ok(Some(Evaluated { values, cloud: Cloud::Values }))
         }
     }
+}
+
+/// Whether the quantities of the density's derivatives (NCI's) are evaluated by the GPU's pass
+/// ([`DensityHessianPass`]) on `ctx`'s device: on a GPU, not on a CPU adapter (lavapipe), where
+/// the CPU reference on every thread is faster than the same cores running the pass
+/// (docs/performance.md).
+pub fn derivatives_on_gpu(ctx: &GpuContext) -> bool {
+    ctx.info.device_type != wgpu::DeviceType::Cpu
 }
 
 /// An orbital's coefficients with those of the functions not in `keep` set to 0 (the orbital

@@ -190,7 +190,7 @@ impl DensityHessianPass {
         .into_iter()
         .max()
         .unwrap_or(0) as u64;
-        let binding = (limits.max_storage_buffer_binding_size as u64).min(limits.max_buffer_size);
+        let binding = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
         if largest > binding {
             return Err(GpuError::Rejected(format!(
                 "the orbitals' weights take {largest} bytes; this GPU binds at most {binding}"

@@ -120,6 +120,39 @@ mod tests {
     use crate::model::gto::PreparedBasis;
 
     #[test]
+    fn a_density_of_orbitals_over_shared_shells_equals_the_evaluator() {
+        // Two orbitals using different shells: each is written out over the union, with zero
+        // weights on the shells it does not use.
+        let shell = |l: u32, kind: ShellKind, x: f64| Shell {
+            atom: 0,
+            center: DVec3::new(x, 0.2, -0.1),
+            l,
+            kind,
+            exponents: vec![1.5, 0.3],
+            coefficients: vec![0.4, 0.7],
+        };
+        let basis = Basis {
+            shells: vec![
+                shell(0, ShellKind::Pure, 0.0),
+                shell(2, ShellKind::Pure, 1.0),
+                shell(3, ShellKind::Cartesian, -1.0),
+            ],
+        };
+        let prepared = PreparedBasis::new(&basis);
+        let n = prepared.n_functions();
+        let a: Vec<f64> = (0..n).map(|i| if i < 6 { 0.3 + 0.1 * i as f64 } else { 0.0 }).collect();
+        let b: Vec<f64> = (0..n).map(|i| if i == 0 || i >= 6 { 0.5 - 0.05 * i as f64 } else { 0.0 }).collect();
+        let density = CartesianDensity::new(&prepared, &[(&a, 2.0), (&b, -0.5)]);
+        assert_eq!(density.orbitals.len(), 2);
+        assert!(density.orbitals.iter().all(|o| o.shells.len() == 3));
+        for k in 0..20 {
+            let p = DVec3::new(k as f64 * 0.15 - 1.5, 0.1 * (k % 3) as f64, 0.3);
+            let want = 2.0 * prepared.orbital_value(&a, p).powi(2) - 0.5 * prepared.orbital_value(&b, p).powi(2);
+            assert!((density.density(p) - want).abs() <= 1e-12 * want.abs().max(1.0));
+        }
+    }
+
+    #[test]
     fn expansion_equals_the_evaluator() {
         // Cartesian and pure shells up to h, contracted, on three centres.
         let mut shells = Vec::new();
