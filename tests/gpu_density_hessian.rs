@@ -222,3 +222,12 @@ fn no_occupied_orbitals_and_no_points() {
     let none = GridSpec { dims: [0, 4, 4], ..grid };
     assert!(pass.derivatives(&ctx, &empty, &none).unwrap().is_empty());
 }
+
+#[test]
+fn benzene_in_two_batches_of_orbitals() {
+    // 21 occupied orbitals: more than one dispatch's 16, so the second batch adds to the first.
+    let doc = load("wavefunctions/benzene_631gs.molden");
+    let occupied = doc.wavefunction.as_ref().unwrap().orbitals.iter().filter(|o| o.occupation != 0.0).count();
+    assert!(occupied > 4 * orbcloud::gpu::density_hessian::BATCH, "{occupied} occupied orbitals");
+    check("benzene", &doc, &grid_over(&doc, 2.0, 18), 1000);
+}

@@ -19,15 +19,21 @@ use crate::model::orbitals::{Quantity, Wavefunction};
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
 pub struct HessianParams {
     pub world_from_grid: [[f32; 4]; 4],
-    /// nx, ny, nz, groups of four orbitals.
+    /// nx, ny, nz, groups of four orbitals (the buffers hold a multiple of [`BATCH`]).
     pub dims: [u32; 4],
-    /// The chunk's first point, its points, cartesian components per group, 0.
+    /// The chunk's first point, its points, cartesian components per group, the batch's first
+    /// group.
     pub chunk: [u32; 4],
 }
 const _: () = assert!(std::mem::size_of::<HessianParams>() == 96);
 
 /// f32 values the pass writes per point: ρ, ∇ρ, the Hessian's xx, xy, xz, yy, yz, zz.
 pub const VALUES_PER_POINT: usize = 10;
+
+/// Groups of four orbitals one dispatch evaluates (`BATCH` in density_hessian.wgsl): each
+/// shell's exponentials and monomials are taken once per batch of 16 orbitals, and the
+/// batches' sums add up in the output.
+pub const BATCH: usize = 4;
 
 /// Invocations per workgroup (`@workgroup_size` of `cs_density_hessian`).
 const WORKGROUP: u32 = 64;
@@ -39,13 +45,16 @@ pub const MAX_CHUNK_POINTS: usize = 1 << 18;
 /// The density's cartesian Gaussians as the pass reads them: the shells and primitives of
 /// [`GtoArrays`] and, per group of four orbitals, one weight per orbital and cartesian
 /// component (group g's component c at 4·(g·cartesians + c) + orbital), with the groups'
-/// occupations (0 for the padding orbitals).
+/// occupations; groups are padded to a multiple of [`BATCH`] with orbitals of no weight and no
+/// occupation.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct DensityArrays {
     pub gto: GtoArrays,
     pub occupations: Vec<[f32; 4]>,
     /// Cartesian components per group.
     pub cartesians: u32,
+    /// Groups holding an orbital (the rest pad to a multiple of [`BATCH`]).
+    pub live_groups: u32,
 }
 
 impl DensityArrays {
@@ -54,7 +63,7 @@ impl DensityArrays {
         let Some(first) = density.orbitals.first() else {
             return out;
         };
-        let groups = density.orbitals.len().div_ceil(4);
+        let groups = density.orbitals.len().div_ceil(4).div_ceil(BATCH) * BATCH;
         let mut offset = 0u32;
         for s in &first.shells {
             out.gto.shells.push(GpuShell {
@@ -69,6 +78,7 @@ impl DensityArrays {
             offset += s.weights.len() as u32;
         }
         out.cartesians = offset;
+        out.live_groups = density.orbitals.len().div_ceil(4) as u32;
         out.gto.weights = vec![0.0; groups * offset as usize * 4];
         for (i, orbital) in density.orbitals.iter().enumerate() {
             let (g, lane) = (i / 4, i % 4);
@@ -86,7 +96,7 @@ impl DensityArrays {
         out
     }
 
-    /// Groups of four orbitals.
+    /// Groups of four orbitals the buffers hold (a multiple of [`BATCH`]).
     pub fn groups(&self) -> u32 {
         self.occupations.len() as u32
     }
@@ -225,28 +235,37 @@ impl DensityHessianPass {
         });
 
         let mut out: Vec<[f32; 10]> = Vec::with_capacity(total);
+        if arrays.groups() == 0 {
+            // No occupied orbital: no density.
+            out.resize(total, [0.0; 10]);
+            return Ok(out);
+        }
         let mut first = 0usize;
         while first < total {
             let count = (total - first).min(chunk as usize);
-            let values = HessianParams {
-                world_from_grid: grid.world_from_grid.as_mat4().to_cols_array_2d(),
-                dims: [nx as u32, ny as u32, nz as u32, arrays.groups()],
-                chunk: [first as u32, count as u32, arrays.cartesians, 0],
-            };
-            ctx.queue.write_buffer(&params, 0, bytemuck::bytes_of(&values));
-            let mut encoder =
-                device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("density hessian") });
-            {
-                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some("density hessian"),
-                    timestamp_writes: None,
-                });
-                pass.set_pipeline(&self.pipeline);
-                pass.set_bind_group(0, &group, &[]);
-                pass.set_bind_group(1, &gto.bind_group, &[]);
-                pass.dispatch_workgroups((count as u32).div_ceil(WORKGROUP), 1, 1);
+            // One submission per batch: the parameters written before each are the ones it
+            // reads, and each batch adds to what the one before wrote.
+            for batch in (0..arrays.groups()).step_by(BATCH) {
+                let values = HessianParams {
+                    world_from_grid: grid.world_from_grid.as_mat4().to_cols_array_2d(),
+                    dims: [nx as u32, ny as u32, nz as u32, arrays.live_groups],
+                    chunk: [first as u32, count as u32, arrays.cartesians, batch],
+                };
+                ctx.queue.write_buffer(&params, 0, bytemuck::bytes_of(&values));
+                let mut encoder =
+                    device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("density hessian") });
+                {
+                    let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                        label: Some("density hessian"),
+                        timestamp_writes: None,
+                    });
+                    pass.set_pipeline(&self.pipeline);
+                    pass.set_bind_group(0, &group, &[]);
+                    pass.set_bind_group(1, &gto.bind_group, &[]);
+                    pass.dispatch_workgroups((count as u32).div_ceil(WORKGROUP), 1, 1);
+                }
+                ctx.queue.submit([encoder.finish()]);
             }
-            ctx.queue.submit([encoder.finish()]);
             let bytes = super::readback::read_buffer(device, &ctx.queue, &output, count as u64 * bytes_per_point)?;
             let floats: Vec<f32> = bytemuck::pod_collect_to_vec(&bytes);
             out.extend(floats.chunks_exact(VALUES_PER_POINT).map(|v| std::array::from_fn(|t| v[t])));
