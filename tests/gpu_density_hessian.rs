@@ -184,6 +184,9 @@ fn the_viewer_grid_of_each_nci_quantity_matches_the_cpu() {
     ] {
         let grid = orbcloud::evaluate::orbital_geometry(&doc, quantity, 28).unwrap();
         let gpu = pass.quantity_grid(&ctx, wf, quantity, &grid).unwrap();
+        // What the window evaluates on a GPU (on lavapipe it takes the CPU's path).
+        assert!(!orbcloud::evaluate::derivatives_on_gpu(&ctx));
+        assert_eq!(orbcloud::evaluate::derivative_quantity_on_gpu(&ctx, &doc, quantity, &grid), gpu);
         let cpu = prepared.quantity_grid_f32(wf, &doc.molecule, quantity, &grid);
         let derivatives = cpu_derivatives(&source, &grid);
         let largest = cpu.iter().fold(0.0f32, |m, v| m.max(v.abs()));

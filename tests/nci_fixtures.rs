@@ -211,3 +211,12 @@ fn eval_of_several_files_is_of_their_summed_density() {
         assert!(!out.status.success() && err.contains(said), "{args:?}: {err}");
     }
 }
+
+#[test]
+fn bench_nci_times_both_paths_and_they_agree() {
+    let out = orbcloud(&["bench", "nci", DIMER, "--points", "16", "--runs", "1", "--lavapipe"]);
+    let said = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(said.contains("grid [16, 16, 16]") && said.contains("cpu_ms=") && said.contains("gpu_ms="), "{said}");
+    assert!(said.contains("points cut by one and not the other: 0"), "{said}");
+}

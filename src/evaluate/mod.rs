@@ -166,18 +166,9 @@ pub fn evaluate_wavefunction(
         }
         None => {
             let label = crate::scene::Source::Wavefunction(view.quantity).name(doc);
-            let gpu = view.quantity.from_density_derivatives() && derivatives_on_gpu(ctx);
-            let values = match gpu.then(|| {
-                crate::gpu::context::guarded(&ctx.device, || {
-                    DensityHessianPass::new(ctx).quantity_grid(ctx, wf, view.quantity, &geometry)
-                })
-            }) {
-                Some(Ok(values)) => values,
-                Some(Err(e)) => {
-                    log::warn!("{label}: the GPU's density derivatives failed ({e}); evaluated on the CPU");
-                    prepared.quantity_grid_f32(wf, &doc.molecule, view.quantity, &geometry)
-                }
-                None => prepared.quantity_grid_f32(wf, &doc.molecule, view.quantity, &geometry),
+            let values = match view.quantity.from_density_derivatives() && derivatives_on_gpu(ctx) {
+                true => derivative_quantity_on_gpu(ctx, doc, view.quantity, &geometry),
+                false => prepared.quantity_grid_f32(wf, &doc.molecule, view.quantity, &geometry),
             };
             let grid = VolumeGrid::new(label, geometry.dims, geometry.world_from_grid, values);
             let values = Values { grid: Some(grid), sampled: None };
@@ -192,6 +183,21 @@ pub fn evaluate_wavefunction(
 /// (docs/performance.md).
 pub fn derivatives_on_gpu(ctx: &GpuContext) -> bool {
     ctx.info.device_type != wgpu::DeviceType::Cpu
+}
+
+/// A quantity of the density's derivatives of `doc`'s wavefunction on `grid` by the GPU's pass
+/// (in its own error scopes), or by the CPU, with a warning in the log, when the pass fails.
+pub fn derivative_quantity_on_gpu(ctx: &GpuContext, doc: &Document, quantity: Quantity, grid: &GridSpec) -> Vec<f32> {
+    let Some(wf) = &doc.wavefunction else {
+        return vec![f32::NAN; grid.len()];
+    };
+    let gpu = crate::gpu::context::guarded(&ctx.device, || {
+        DensityHessianPass::new(ctx).quantity_grid(ctx, wf, quantity, grid)
+    });
+    gpu.unwrap_or_else(|e| {
+        log::warn!("{}: the GPU's density derivatives failed ({e}); evaluated on the CPU", doc.source);
+        PreparedBasis::new(&wf.basis).quantity_grid_f32(wf, &doc.molecule, quantity, grid)
+    })
 }
 
 /// An orbital's coefficients with those of the functions not in `keep` set to 0 (the orbital
