@@ -38,8 +38,8 @@ pub const BATCH: usize = 4;
 /// Invocations per workgroup (`@workgroup_size` of `cs_density_hessian`).
 const WORKGROUP: u32 = 64;
 
-/// Points per dispatch at most: a dispatch stays well under a second on a slow GPU (an
-/// operating system resets a GPU whose work runs for seconds), and its output is 10 MiB.
+/// Points per dispatch at most: each dispatch stays short (an operating system resets a GPU
+/// whose work runs for seconds), and its output is 10 MiB.
 pub const MAX_CHUNK_POINTS: usize = 1 << 18;
 
 /// The density's cartesian Gaussians as the pass reads them: the shells and primitives of
