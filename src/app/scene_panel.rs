@@ -15,7 +15,7 @@ use crate::scene::{
 };
 
 pub fn section(ui: &mut egui::Ui, app: &mut OrbApp) {
-    if app.scan.is_some() || app.objects.is_empty() {
+    if app.scan_object().is_some() || app.objects.is_empty() {
         return;
     }
     ui.heading("Scene");
