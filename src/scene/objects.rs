@@ -318,17 +318,19 @@ pub fn changes(before: &ObjectState, after: &ObjectState) -> Changes {
             .collect()
     };
     let visible = |s: &ObjectState| (s.visible, s.quantities.iter().map(|q| (q.visible, q.pane)).collect::<Vec<_>>());
+    let scan_frame = before.scan.as_ref().map(|s| (s.value, s.mode)) != after.scan.as_ref().map(|s| (s.value, s.mode));
     Changes {
         layers,
         atoms: before.atoms != after.atoms || before.selection != after.selection,
         placement: before.placement != after.placement,
         visibility: visible(before) != visible(after),
+        // A molecular surface follows the atoms a selection shows, and a scan's skeleton.
         surface: before.surface != after.surface
-            || (after.surface.choice != SurfaceChoice::Off && before.selection != after.selection),
+            || (after.surface.choice != SurfaceChoice::Off && (before.selection != after.selection || scan_frame)),
         arrows: before.vibration.arrows_key() != after.vibration.arrows_key(),
         rest: before.vibration.mode.is_some() && after.vibration.mode.is_none(),
         clip: before.clip != after.clip,
-        scan_frame: before.scan.as_ref().map(|s| (s.value, s.mode)) != after.scan.as_ref().map(|s| (s.value, s.mode)),
+        scan_frame,
         quantities,
     }
 }
@@ -560,6 +562,23 @@ mod tests {
         cut.clip.enabled = true;
         let c = changes(&before, &cut);
         assert!(c.clip && !c.placement && !c.surface && !c.atoms && c.quantities.iter().all(|q| !q.any()));
+        // A scan's new value or interpolation: the frame only (atoms in place, mixing weights),
+        // no quantity evaluated anew; playing or its speed changes nothing on the GPU.
+        let scanned = ObjectState { scan: Some(super::ScanState::default()), ..before.clone() };
+        let mut twisted = scanned.clone();
+        twisted.scan.as_mut().unwrap().value = 30.0;
+        let c = changes(&scanned, &twisted);
+        assert!(c.scan_frame && !c.atoms && !c.layers && !c.surface && c.quantities.iter().all(|q| !q.any()));
+        let mut played = scanned.clone();
+        played.scan.as_mut().unwrap().playing = true;
+        played.scan.as_mut().unwrap().speed = 5.0;
+        assert!(changes(&scanned, &played).is_empty());
+        // A molecular surface follows the skeleton.
+        let mut surfaced = scanned.clone();
+        surfaced.surface.choice = SurfaceChoice::Gaussian;
+        let mut surfaced_twisted = surfaced.clone();
+        surfaced_twisted.scan.as_mut().unwrap().value = 30.0;
+        assert!(changes(&surfaced, &surfaced_twisted).surface);
         // Which atoms are shown restyles them, and wraps a molecular surface anew.
         let mut selected = before.clone();
         selected.surface.choice = SurfaceChoice::Gaussian;

@@ -136,3 +136,67 @@ impl LegacyScan {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Session;
+
+    #[test]
+    fn a_session_written_before_scans_were_objects_opens_its_scan_as_one() {
+        // The old layout: the playback's fields and the views' settings in one `[scan]` table.
+        #[derive(Serialize)]
+        struct Old {
+            scan: LegacyScan,
+        }
+        let mut settings = RenderSettings::default();
+        settings.volume.slices = 96;
+        settings.iso.visible = true;
+        let state = ScanState {
+            value: -45.0,
+            mode: Interpolation::ThreePass,
+            looping: false,
+            speed: 12.0,
+            orbitals: vec!["homo".into(), "lumo".into()],
+            ..ScanState::default()
+        };
+        let text = toml::to_string(&Old { scan: LegacyScan { state, settings } }).unwrap();
+        assert!(text.starts_with("[scan]\nmanifest") || text.contains("[scan]\nvalue = -45.0"), "{text}");
+        assert!(text.contains("[scan.settings.volume]"), "{text}");
+        let session: Session = toml::from_str(&text).unwrap();
+        let legacy = session.scan.expect("the old scan table is read");
+        assert_eq!((legacy.state.value, legacy.state.mode), (-45.0, Interpolation::ThreePass));
+        let object = legacy.into_object(2);
+        let scan = object.scan.as_ref().unwrap();
+        assert!(!scan.looping && scan.speed == 12.0 && scan.orbitals == ["homo", "lumo"]);
+        let views: Vec<(Source, Option<usize>)> = object.quantities.iter().map(|q| (q.source, q.pane)).collect();
+        assert_eq!(views, [(Source::Scan(0), Some(0)), (Source::Scan(1), Some(1))], "each view in its pane");
+        assert!(object.quantities.iter().all(|q| q.cloud.slices == 96 && q.isosurfaces[0].visible));
+        // Written again, the scan is the object's: no table of its own.
+        let again = toml::to_string(&Session { objects: vec![object], ..Session::default() }).unwrap();
+        assert!(!again.contains("[scan]") && again.contains("[objects.scan]"), "{again}");
+    }
+
+    #[test]
+    fn playing_bounces_between_the_ends_or_stops_and_keys_step_between_frames() {
+        let scan = crate::sources::demo::scan().unwrap().scan;
+        let (lo, hi) = scan.range();
+        let mut state = ScanState::opening(&scan, None);
+        assert!(scan.values().contains(&state.value), "opens on a key frame");
+        state.set_value(&scan, f64::NAN);
+        assert!(state.value.is_finite());
+        state.set_value(&scan, hi + 100.0);
+        assert_eq!(state.value, hi);
+        state.playing = true;
+        state.advance(&scan, 1.0);
+        assert!(state.backwards && state.value == hi && state.playing, "turns at the end");
+        state.advance(&scan, 0.1);
+        assert!(state.value < hi, "and comes back");
+        state.looping = false;
+        state.set_value(&scan, lo + 1e-3);
+        state.advance(&scan, 10.0);
+        assert!(!state.playing && state.value == lo, "stops at the end");
+        state.step_key(&scan, 1);
+        assert_eq!(state.value, scan.values()[1]);
+    }
+}
