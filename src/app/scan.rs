@@ -342,7 +342,7 @@ pub fn twist_input(ui: &egui::Ui, object: &SceneObject) -> Option<TwistInput> {
     // The bond's position matters only where a press may start a drag that grabs it.
     let pressed = ui.input(|i| i.pointer.primary_down());
     let direct = !matches!(s.coordinate, Coordinate::Dihedral(_) | Coordinate::Path(_));
-    let grab = (!state.drag_scans && pressed) || (direct && pressed);
+    let grab = pressed && (!state.drag_scans || direct);
     let placed = object.state.placement.world_from_object();
     let bond = grab.then(|| bond(s, state.value)).flatten().map(|b| b.map(|p| placed.transform_point3(p)));
     Some(TwistInput { drag_scans: state.drag_scans, bond, direct })
