@@ -239,6 +239,43 @@ fn the_scan_demo_opens_side_by_side_and_a_drag_twists_both_views() {
     assert_eq!(h.state().scan().map(|s| s.value), Some(value), "the scan stays open");
 }
 
+/// A scan is an object: its views are its quantities, one per pane, and its clipping plane is
+/// the object's, cutting its atoms' layer and every view along one plane that stays put while
+/// the coordinate moves.
+#[test]
+fn a_scan_is_an_object_whose_views_are_panes_cut_by_its_clipping_plane() {
+    use orbcloud::scene::Source;
+    let mut h = scan_demo();
+    let app = h.state();
+    assert_eq!(app.objects.len(), 1);
+    let views: Vec<_> = app.objects[0].state.quantities.iter().map(|q| (q.source, q.pane)).collect();
+    assert_eq!(views, [(Source::Scan(0), Some(0)), (Source::Scan(1), Some(1))]);
+    let coloured = |h: &Harness<'static, OrbApp>| {
+        let picture = h.state().pane_picture(0).expect("pane 1 drawn");
+        picture.pixels().filter(|p| (p[0] as i32 - p[2] as i32).abs() > 60).count()
+    };
+    let whole = coloured(&h);
+    assert!(whole > 2000, "the HOMO's red and blue: {whole} pixels");
+    {
+        let clip = &mut h.state_mut().objects[0].state.clip;
+        clip.enabled = true;
+        clip.normal = [0.0, 0.0, 1.0];
+        clip.offset = 0.0;
+    }
+    h.run_steps(3);
+    let cut = coloured(&h);
+    eprintln!("coloured pixels of the HOMO pane: {whole} whole, {cut} cut");
+    assert!(cut < whole * 3 / 4, "half the sweep's box cut away: {cut} of {whole} pixels");
+    let planes = h.state().clip_planes(0);
+    assert_eq!(planes.len(), 3, "the atoms and two views");
+    assert!(planes.iter().all(|p| p.is_some() && *p == planes[0]), "{planes:?}");
+    let value = h.state().scan().unwrap().value;
+    h.state_mut().set_scan_value(value + 20.0);
+    h.run_steps(3);
+    assert_eq!(h.state().scan().unwrap().shown()[0].map(|s| s.0), Some(value + 20.0));
+    assert_eq!(h.state().clip_planes(0), planes, "the plane stays where it was as the value moves");
+}
+
 #[test]
 fn a_scan_too_large_for_the_gpu_offers_a_coarser_grid() {
     let manifest = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets/psb3/psb3.scan.toml");

@@ -674,6 +674,11 @@ impl OrbApp {
         })
     }
 
+    /// Pane `p`'s last picture of a split view (tests, screenshots).
+    pub fn pane_picture(&self, p: usize) -> Option<image::RgbaImage> {
+        self.viewport.as_ref()?.pane_picture(p).ok()
+    }
+
     /// Moves the open scan to `value` (clamped into its range); the GPU follows in the next frame.
     pub fn set_scan_value(&mut self, value: f64) {
         if let Some(o) = self.scan_object_mut()
