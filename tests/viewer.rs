@@ -159,9 +159,9 @@ fn a_molden_file_opens_on_its_homo_and_the_browser_switches_orbitals() {
 
 /// Steps the app until a scan that satisfies `ready` is open (key volumes are made on a
 /// background thread), failing on an error or after five minutes.
-fn wait_for_scan(h: &mut Harness<'static, OrbApp>, ready: impl Fn(&orbcloud::app::scan::ScanView) -> bool) {
+fn wait_for_scan(h: &mut Harness<'static, OrbApp>, ready: impl Fn(&orbcloud::app::scan::OpenScan) -> bool) {
     let start = std::time::Instant::now();
-    while !h.state().scan.as_ref().is_some_and(&ready) {
+    while !h.state().scan().is_some_and(|s| ready(&s)) {
         assert!(h.state().error.is_none(), "scan failed: {:?}", h.state().error);
         assert!(start.elapsed().as_secs() < 300, "no scan after five minutes");
         std::thread::sleep(std::time::Duration::from_millis(50));
@@ -197,9 +197,10 @@ fn open_expecting_error(h: &mut Harness<'static, OrbApp>, path: std::path::PathB
 #[test]
 fn the_scan_demo_opens_side_by_side_and_a_drag_twists_both_views() {
     let mut h = scan_demo();
-    let scan = h.state().scan.as_ref().unwrap();
+    let scan = h.state().scan().unwrap();
     assert_eq!(scan.value, -90.0, "opens at the twisted geometry");
     assert_eq!(scan.shown().len(), 2, "HOMO and LUMO side by side");
+    assert_eq!(h.state().view.panes.count, 2, "each in a pane of its own");
     assert!(scan.shown().iter().all(|s| s.map(|(t, _)| t) == Some(-90.0)), "{:?}", scan.shown());
     h.get_by_label("Play");
     assert!(h.query_all_by_label("dihedral").count() >= 1, "the θ slider");
@@ -208,7 +209,7 @@ fn the_scan_demo_opens_side_by_side_and_a_drag_twists_both_views() {
     let during = drag_right(&mut h, egui::pos2(500.0, 260.0), 90.0);
     assert_drag_detail(&mut h, &during, 2);
     h.run_steps(1);
-    let scan = h.state().scan.as_ref().unwrap();
+    let scan = h.state().scan().unwrap();
     let value = scan.value;
     assert!(value > -85.0, "θ after dragging right: {value}");
     for (slot, shown) in scan.shown().iter().enumerate() {
@@ -218,14 +219,14 @@ fn the_scan_demo_opens_side_by_side_and_a_drag_twists_both_views() {
     // The interpolation mode switches both views.
     h.get_by_label("three-pass").click();
     h.run_steps(2);
-    let scan = h.state().scan.as_ref().unwrap();
+    let scan = h.state().scan().unwrap();
     assert!(scan.shown().iter().all(|s| s.map(|(_, m)| m) == Some(orbcloud::scene::Interpolation::ThreePass)));
 
     // Following orbitals by character makes the key volumes anew and keeps θ and the mode.
     h.get_by_label("follow character").click();
     h.run_steps(1);
     wait_for_scan(&mut h, |s| s.scene.tracks.follow == orbcloud::model::scan::Follow::Overlap);
-    let scan = h.state().scan.as_ref().unwrap();
+    let scan = h.state().scan().unwrap();
     assert_eq!(scan.value, value);
     assert_eq!(scan.mode, orbcloud::scene::Interpolation::ThreePass);
 
@@ -235,7 +236,44 @@ fn the_scan_demo_opens_side_by_side_and_a_drag_twists_both_views() {
     std::fs::write(&bad, "dihedral = [2, 3, 4, 5]\n[[frame]]\nangle = 0\nfile = \"a.molden\"\n").unwrap();
     let err = open_expecting_error(&mut h, bad);
     assert!(err.contains("bad.scan.toml:"), "{err}");
-    assert_eq!(h.state().scan.as_ref().map(|s| s.value), Some(value), "the scan stays open");
+    assert_eq!(h.state().scan().map(|s| s.value), Some(value), "the scan stays open");
+}
+
+/// A scan is an object: its views are its quantities, one per pane, and its clipping plane is
+/// the object's, cutting its atoms' layer and every view along one plane that stays put while
+/// the coordinate moves.
+#[test]
+fn a_scan_is_an_object_whose_views_are_panes_cut_by_its_clipping_plane() {
+    use orbcloud::scene::Source;
+    let mut h = scan_demo();
+    let app = h.state();
+    assert_eq!(app.objects.len(), 1);
+    let views: Vec<_> = app.objects[0].state.quantities.iter().map(|q| (q.source, q.pane)).collect();
+    assert_eq!(views, [(Source::Scan(0), Some(0)), (Source::Scan(1), Some(1))]);
+    let coloured = |h: &Harness<'static, OrbApp>| {
+        let picture = h.state().pane_picture(0).expect("pane 1 drawn");
+        picture.pixels().filter(|p| (p[0] as i32 - p[2] as i32).abs() > 60).count()
+    };
+    let whole = coloured(&h);
+    assert!(whole > 2000, "the HOMO's red and blue: {whole} pixels");
+    {
+        let clip = &mut h.state_mut().objects[0].state.clip;
+        clip.enabled = true;
+        clip.normal = [0.0, 0.0, 1.0];
+        clip.offset = 0.0;
+    }
+    h.run_steps(3);
+    let cut = coloured(&h);
+    eprintln!("coloured pixels of the HOMO pane: {whole} whole, {cut} cut");
+    assert!(cut < whole * 3 / 4, "half the sweep's box cut away: {cut} of {whole} pixels");
+    let planes = h.state().clip_planes(0);
+    assert_eq!(planes.len(), 3, "the atoms and two views");
+    assert!(planes.iter().all(|p| p.is_some() && *p == planes[0]), "{planes:?}");
+    let value = h.state().scan().unwrap().value;
+    h.state_mut().set_scan_value(value + 20.0);
+    h.run_steps(3);
+    assert_eq!(h.state().scan().unwrap().shown()[0].map(|s| s.0), Some(value + 20.0));
+    assert_eq!(h.state().clip_planes(0), planes, "the plane stays where it was as the value moves");
 }
 
 #[test]
@@ -253,7 +291,7 @@ fn a_scan_too_large_for_the_gpu_offers_a_coarser_grid() {
     h.get_by_label(&format!("Open with {fits} points")).click();
     h.run_steps(1);
     wait_for_scan(&mut h, |_| true);
-    let scan = h.state().scan.as_ref().unwrap();
+    let scan = h.state().scan().unwrap();
     assert!(scan.scene.bytes <= 1 << 20, "{} bytes", scan.scene.bytes);
 }
 
@@ -408,10 +446,10 @@ fn a_scan_shows_isosurfaces_at_theta_and_its_measured_dihedral_follows_theta() {
     h.run_steps(3);
 
     // Pick the four atoms of the scanned dihedral in the left view, Shift held after the first.
-    let dihedral = h.state().scan.as_ref().unwrap().scene.scan.coordinate.atoms().to_vec();
+    let dihedral = h.state().scan().unwrap().scene.scan.coordinate.atoms().to_vec();
     for (n, &atom) in dihedral.iter().enumerate() {
         let app = h.state();
-        let p = app.scan.as_ref().unwrap().atom_on_screen(0, atom, &app.view.camera).expect("on screen");
+        let p = app.atom_on_screen(atom).expect("on screen");
         click_at(&mut h, p, n > 0);
     }
     // An atom of the moving end may sit in front of the one aimed at; any dihedral about the
@@ -422,16 +460,16 @@ fn a_scan_shows_isosurfaces_at_theta_and_its_measured_dihedral_follows_theta() {
     assert!(m.atoms.len() == 4 && m.atoms[1..3] == dihedral[1..3], "{:?} about {dihedral:?}", m.atoms);
     assert!(app.status.ends_with('°'), "{}", app.status);
     let value_at = |app: &OrbApp| {
-        let scan = app.scan.as_ref().unwrap();
+        let scan = app.scan().unwrap();
         app.measurements.list[0].value(&scan.scene.scan.geometry_at(scan.value)).unwrap()
     };
     let before = value_at(app);
     // Step θ to the next key angle: the measured dihedral turns by as much.
-    let value = app.scan.as_ref().unwrap().value;
+    let value = app.scan().unwrap().value;
     h.key_press(egui::Key::CloseBracket);
     h.run_steps(2);
     let app = h.state();
-    let turned = app.scan.as_ref().unwrap().value - value;
+    let turned = app.scan().unwrap().value - value;
     assert!(turned > 1.0, "θ moved: {turned}");
     let change = (value_at(app) - before + 540.0).rem_euclid(360.0) - 180.0;
     assert!((change.abs() - turned).abs() < 1.0, "dihedral changed by {change:.2}°, θ by {turned:.2}°");
@@ -441,16 +479,17 @@ fn a_scan_shows_isosurfaces_at_theta_and_its_measured_dihedral_follows_theta() {
 fn a_session_keeps_the_scan_where_it_stood_with_its_measurements() {
     use orbcloud::scene::Interpolation;
     let mut h = scan_demo();
-    let (lo, hi) = h.state().scan.as_ref().unwrap().scene.scan.range();
-    let atoms = h.state().scan.as_ref().unwrap().scene.scan.coordinate.atoms().to_vec();
+    let (lo, hi) = h.state().scan().unwrap().scene.scan.range();
+    let atoms = h.state().scan().unwrap().scene.scan.coordinate.atoms().to_vec();
     let value = lo + 0.3 * (hi - lo);
     {
         let app = h.state_mut();
-        let scan = app.scan.as_mut().unwrap();
-        scan.set_value(value);
+        app.set_scan_value(value);
+        let object = app.scan_object_mut().unwrap();
+        let scan = object.state.scan.as_mut().unwrap();
         scan.mode = Interpolation::ThreePass;
         scan.looping = false;
-        scan.settings.iso.visible = true;
+        object.state.quantities[0].isosurfaces[0].visible = true;
         app.measurements.list = vec![orbcloud::model::measure::Measurement::new(&atoms).unwrap()];
     }
     h.run_steps(2);
@@ -458,20 +497,22 @@ fn a_session_keeps_the_scan_where_it_stood_with_its_measurements() {
     let path = dir.path().join("scan.orbcloud.toml");
     h.state_mut().save_session(&path);
     let saved = orbcloud::sources::session::read(&path).unwrap().session;
-    let kept = saved.scan.as_ref().expect("the session keeps the scan");
+    let kept = saved.objects.iter().find_map(|o| o.scan.as_ref()).expect("the session keeps the scan");
     assert!(kept.manifest.is_none() && (kept.value - value).abs() < 1e-9, "{kept:?}");
 
     // Somewhere else, then the session again: the scan comes back as it stood.
-    h.state_mut().scan.as_mut().unwrap().set_value(hi);
+    h.state_mut().set_scan_value(hi);
     h.state_mut().clear_scene();
     h.run_steps(2);
-    assert!(h.state().scan.is_none() && h.state().measurements.list.is_empty());
+    assert!(h.state().scan().is_none() && h.state().measurements.list.is_empty());
     let ctx = h.ctx.clone();
     h.state_mut().open_session(&path, &ctx);
     wait_for_scan(&mut h, |s| (s.value - value).abs() < 1e-9);
     let app = h.state();
-    let scan = app.scan.as_ref().unwrap();
-    assert_eq!((scan.mode, scan.looping, scan.settings.iso.visible), (Interpolation::ThreePass, false, true));
+    let scan = app.scan().unwrap();
+    let state = &scan.object.state;
+    let (looping, iso) = (state.scan.as_ref().unwrap().looping, state.quantities[0].isosurfaces[0].visible);
+    assert_eq!((scan.mode, looping, iso), (Interpolation::ThreePass, false, true));
     assert_eq!(app.measurements.list.len(), 1, "the measurement on the scan's atoms comes back");
     assert_eq!(app.measurements.list[0].atoms, atoms);
     assert_eq!(app.view.camera, saved.camera, "the session's camera, not a fresh framing");
@@ -518,7 +559,7 @@ fn files_open_without_a_system_dialog_and_a_failed_file_leaves_the_demo() {
         .wgpu_setup(wgpu_setup(true))
         .build_eframe(move |cc| OrbApp::new(cc, vec![bad.clone()]));
     let start = std::time::Instant::now();
-    while h.state().error.is_none() || h.state().scan.is_none() {
+    while h.state().error.is_none() || h.state().scan().is_none() {
         assert!(start.elapsed().as_secs() < 300, "no error and demo: {:?}", h.state().error);
         std::thread::sleep(std::time::Duration::from_millis(50));
         h.run_steps(1);
@@ -725,10 +766,10 @@ fn bending_scan(dir: &std::path::Path) -> Harness<'static, OrbApp> {
 fn grabbing_the_moving_hydrogen_bends_the_angle() {
     let dir = tempfile::tempdir().unwrap();
     let mut h = bending_scan(dir.path());
-    let start = h.state().scan.as_ref().unwrap().value;
+    let start = h.state().scan().unwrap().value;
     let screen = |h: &Harness<'static, OrbApp>, atom: usize| {
         let app = h.state();
-        app.scan.as_ref().unwrap().atom_on_screen(0, atom, &app.view.camera).expect("on screen")
+        app.atom_on_screen(atom).expect("on screen")
     };
     let (vertex, fixed, moving) = (screen(&h, 0), screen(&h, 1), screen(&h, 2));
     // Turn the moving hydrogen about the oxygen on screen, away from the fixed one, by 10°.
@@ -754,7 +795,7 @@ fn grabbing_the_moving_hydrogen_bends_the_angle() {
     }
     h.drop_at(target(10.0));
     h.run_steps(2);
-    let value = h.state().scan.as_ref().unwrap().value;
+    let value = h.state().scan().unwrap().value;
     let (held, wanted) = (opening(screen(&h, 2)), opening(target(10.0)));
     eprintln!("angle {start:.1}° → {value:.1}°; on screen the hydrogen at {held:.1}°, the pointer at {wanted:.1}°");
     assert!((held - wanted).abs() < 1.5, "the hydrogen follows the pointer: {held} vs {wanted}");
@@ -878,7 +919,7 @@ fn the_demo_shows_its_molecule_at_once_while_its_key_volumes_are_made() {
         .build_eframe(|cc| OrbApp::new(cc, Vec::new()));
     let start = std::time::Instant::now();
     while !h.state().shows_scan_skeleton() {
-        assert!(h.state().scan.is_none(), "the scan opened before its first frame was shown");
+        assert!(h.state().scan().is_none(), "the scan opened before its first frame was shown");
         assert!(start.elapsed().as_secs() < 60, "no molecule after a minute");
         std::thread::sleep(std::time::Duration::from_millis(10));
         h.run_steps(1);

@@ -68,7 +68,7 @@ fn scan_this_on_a_measured_dihedral_computes_a_scan_whose_frames_open_while_it_r
         let app = h.state();
         let run = app.computing.as_ref().expect("a computation");
         assert!(!run.progress.starts_with("computing failed"), "{}", run.progress);
-        let frames = app.scan.as_ref().map_or(0, |s| s.scene.scan.frames.len());
+        let frames = app.scan().map_or(0, |s| s.scene.scan.frames.len());
         if !run.ended && frames > 0 {
             seen_while_running.push(frames);
         }
@@ -83,7 +83,7 @@ fn scan_this_on_a_measured_dihedral_computes_a_scan_whose_frames_open_while_it_r
         !seen_while_running.is_empty() && seen_while_running.iter().all(|&n| n < 7),
         "frames opened while the rest were computed: {seen_while_running:?}"
     );
-    let scan = &app.scan.as_ref().unwrap().scene.scan;
+    let scan = &app.scan().unwrap().scene.scan;
     assert_eq!(scan.values(), vec![60.0, 80.0, 100.0, 120.0, 140.0, 160.0, 180.0]);
     assert_eq!(scan.coordinate.label(), "dihedral 3-1-2-4");
     assert!(run.progress.starts_with("computed: 7 of 7"), "{}", run.progress);

@@ -393,7 +393,7 @@ fn the_panels_follow_the_scene() {
     let ctx = h.ctx.clone();
     h.state_mut().open_demo(orbcloud::app::Demo::Scan, &ctx);
     let start = std::time::Instant::now();
-    while h.state().scan.is_none() {
+    while h.state().scan().is_none() {
         assert!(start.elapsed().as_secs() < 300, "no scan: {:?}", h.state().error);
         std::thread::sleep(std::time::Duration::from_millis(50));
         h.run_steps(1);

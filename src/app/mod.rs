@@ -36,7 +36,7 @@ use crate::model::{Atom, Document, Molecule};
 use crate::scene::framing::default_camera;
 use crate::scene::{ObjectState, RenderSettings, ViewPreset};
 use loader::LoadJob;
-use scan::{ScanFailure, ScanJob, ScanSource, ScanView};
+use scan::{ObjectScan, ScanFailure, ScanJob, ScanSource};
 pub use state::ViewState;
 use viewport::Viewport;
 
@@ -143,6 +143,8 @@ pub struct SceneObject {
     /// How many of its atoms its selection shows (counted when the selection or the model
     /// changes, not every frame).
     pub shown_atoms: usize,
+    /// The scan it is a frame of (its key volumes), when it is one.
+    pub scan: Option<ObjectScan>,
 }
 
 impl SceneObject {
@@ -216,8 +218,8 @@ pub struct OrbApp {
     pub uv_vis: Option<egui_plot::PlotTransform>,
     /// A session's measurements, kept until its files have loaded.
     restoring_measurements: Option<Vec<crate::model::measure::Measurement>>,
-    /// A session's scan being opened: where it stood, and its measurements.
-    restoring_scan: Option<(crate::scene::ScanState, Vec<crate::model::measure::Measurement>)>,
+    /// A session's scan being opened: its object as it was saved, and the measurements.
+    restoring_scan: Option<(ObjectState, Vec<crate::model::measure::Measurement>)>,
     /// Whether *Open…* and dropped files replace the scene instead of adding to it.
     pub open_replaces: bool,
     scroll_to_frontier: bool,
@@ -228,8 +230,7 @@ pub struct OrbApp {
     queue: Vec<(PathBuf, Opening)>,
     pub error: Option<String>,
     pub status: String,
-    /// An open dihedral scan (shown instead of the scene), and one being prepared.
-    pub scan: Option<ScanView>,
+    /// A scan being prepared (it opens as an object, in place of the scene).
     scan_job: Option<ScanJob>,
     /// A quantity minus another file's being made ([`difference`]).
     difference: Option<difference::DifferenceJob>,
@@ -420,7 +421,6 @@ impl OrbApp {
             queue: files.into_iter().rev().map(|p| (p, Opening::Add)).collect(),
             error: None,
             status: String::new(),
-            scan: None,
             scan_job: None,
             difference: None,
             scan_points: crate::layers::key_volumes::DEFAULT_SCAN_POINTS,
@@ -484,7 +484,7 @@ impl OrbApp {
                 crate::model::orbitals::Quantity::Orbital(_) | crate::model::orbitals::Quantity::BasisFunction(_),
             ) => true,
             crate::scene::Source::Wavefunction(_) => false,
-            crate::scene::Source::Volume(_) => true,
+            crate::scene::Source::Volume(_) | crate::scene::Source::Scan(_) => true,
         };
         // Direct mode without a grid: the σ of its samples over the same box.
         let sampled = || {
@@ -521,7 +521,7 @@ impl OrbApp {
 
     /// Whether a scan being prepared shows its first frame (no scan or file open yet).
     pub fn shows_scan_skeleton(&self) -> bool {
-        self.scan.is_none() && self.scan_job.as_ref().is_some_and(|j| j.skeleton_shown)
+        self.scan_object().is_none() && self.scan_job.as_ref().is_some_and(|j| j.skeleton_shown)
     }
 
     /// Where a point of the scene (bohr) is drawn in the single-file view.
@@ -618,7 +618,6 @@ impl OrbApp {
     /// Whether a click in a view waits for its picture to be whole before it is picked.
     pub fn is_picking(&self) -> bool {
         self.viewport.as_ref().is_some_and(viewport::Viewport::is_picking)
-            || self.scan.as_ref().is_some_and(|s| s.views.iter().any(viewport::Viewport::is_picking))
     }
 
     /// How much of a costly frame (drawn in bands) the single-file view has drawn (0..1);
@@ -646,19 +645,50 @@ impl OrbApp {
     /// Each view shown: (size on screen, size of its last frame), pixels. The frame is smaller
     /// while a drag or the animation runs on a CPU adapter ([`detail`]).
     pub fn view_sizes(&self) -> Vec<([u32; 2], [u32; 2])> {
-        if self.scan.is_none()
-            && let Some(panes) = self.viewport.as_ref().map(Viewport::pane_sizes).filter(|p| !p.is_empty())
-        {
+        if let Some(panes) = self.viewport.as_ref().map(Viewport::pane_sizes).filter(|p| !p.is_empty()) {
             return panes;
         }
-        let views: Vec<&Viewport> = match &self.scan {
-            Some(scan) => scan.views.iter().collect(),
-            None => self.viewport.iter().collect(),
-        };
-        views.into_iter().filter_map(|v| v.size().zip(v.rendered_size())).collect()
+        self.viewport.iter().filter_map(|v| v.size().zip(v.rendered_size())).collect()
     }
 
-    /// A new handle on the window's device (for scan views and the key-volume job).
+    /// The object that is a frame of a scan (the scan open), when there is one.
+    pub fn scan_object(&self) -> Option<&SceneObject> {
+        self.objects.iter().find(|o| o.scan.is_some())
+    }
+
+    pub fn scan_object_mut(&mut self) -> Option<&mut SceneObject> {
+        self.objects.iter_mut().find(|o| o.scan.is_some())
+    }
+
+    /// The open scan: its object's value and key volumes, and what the GPU shows of it.
+    pub fn scan(&self) -> Option<scan::OpenScan<'_>> {
+        let n = self.objects.iter().position(|o| o.scan.is_some())?;
+        let object = &self.objects[n];
+        let state = object.state.scan.as_ref()?;
+        Some(scan::OpenScan {
+            value: state.value,
+            mode: state.mode,
+            scene: &object.scan.as_ref()?.keys,
+            object,
+            shown: self.applied.get(n).and_then(|a| a.scan.as_ref()).map(|s| (s.value, s.mode)),
+        })
+    }
+
+    /// Pane `p`'s last picture of a split view (tests, screenshots).
+    pub fn pane_picture(&self, p: usize) -> Option<image::RgbaImage> {
+        self.viewport.as_ref()?.pane_picture(p).ok()
+    }
+
+    /// Moves the open scan to `value` (clamped into its range); the GPU follows in the next frame.
+    pub fn set_scan_value(&mut self, value: f64) {
+        if let Some(o) = self.scan_object_mut()
+            && let (Some(scan), Some(state)) = (&o.scan, &mut o.state.scan)
+        {
+            state.set_value(scan.scan(), value);
+        }
+    }
+
+    /// A new handle on the window's device (for the key-volume job).
     fn gpu_context(&self) -> Option<GpuContext> {
         Some(self.viewport.as_ref()?.ctx.clone())
     }
@@ -791,7 +821,6 @@ impl OrbApp {
                 return;
             }
         };
-        self.scan = None;
         self.status = note.unwrap_or_else(|| format!("opened {}", doc.source));
         // What the file held that could not be read (a malformed mode section, no orbitals)
         // stays in the status line until dismissed.
@@ -802,7 +831,7 @@ impl OrbApp {
             files::remember(&mut self.recent, path, RECENT_FILES);
         }
         self.applied.push(state.clone());
-        let mut object = SceneObject { doc, state, shown_atoms: 0 };
+        let mut object = SceneObject { doc, state, shown_atoms: 0, scan: None };
         object.count_shown_atoms();
         self.objects.push(object);
         self.active = self.objects.len() - 1;
@@ -814,6 +843,108 @@ impl OrbApp {
             self.view.camera = self.scene_camera();
         }
         self.scroll_to_frontier = true;
+    }
+
+    /// Shows a scan whose key volumes are made as an object in place of the scene: as a
+    /// session saved it (`restoring`), as it stood when it is the same scan reopened (following
+    /// orbitals another way), or as it opens.
+    fn open_scan_object(
+        &mut self,
+        keys: Arc<crate::layers::key_volumes::ScanScene>,
+        source: ScanSource,
+        restoring: Option<(ObjectState, Vec<crate::model::measure::Measurement>)>,
+    ) {
+        let name = match &source {
+            ScanSource::File(p) => p.display().to_string(),
+            ScanSource::Demo => crate::sources::demo::SCAN_NAME.to_string(),
+        };
+        let reopened =
+            self.scan_object().filter(|o| o.scan.as_ref().is_some_and(|s| s.source == source)).map(|o| o.state.clone());
+        let fresh = reopened.is_none() && restoring.is_none();
+        let measurements = match (&restoring, fresh) {
+            (Some((_, kept)), _) => {
+                // A session's measurements number the scan's atoms.
+                let atoms = keys.scan.frames.first().map_or(0, |f| f.molecule.atoms.len());
+                kept.iter().filter(|m| m.atoms.iter().all(|&a| a < atoms)).cloned().collect()
+            }
+            (None, true) => Vec::new(),
+            (None, false) => self.measurements.list.clone(),
+        };
+        let manifest = match &source {
+            ScanSource::File(path) => Some(path.clone()),
+            ScanSource::Demo => None,
+        };
+        let mut state = match restoring.map(|(state, _)| state).or(reopened) {
+            Some(mut state) => {
+                let playback = state.scan.get_or_insert_with(|| crate::scene::ScanState::opening(&keys.scan, None));
+                playback.manifest = manifest;
+                playback.orbitals = keys.scan.orbitals.clone();
+                playback.follow = keys.tracks.follow;
+                let value = playback.value;
+                playback.set_value(&keys.scan, value);
+                state
+            }
+            None => scan::opening_state(&keys, manifest, &self.defaults),
+        };
+        scan::fit_views(&mut state, keys.slots(), &self.defaults);
+        let value = state.scan.as_ref().map_or(0.0, |s| s.value);
+        let doc = Arc::new(keys.document_at(value, &name));
+        self.clear_scene();
+        if let Some(vp) = &mut self.viewport {
+            vp.set_scan_keys(0, Some(keys.clone()));
+        }
+        let camera = self.view.camera;
+        self.add_shared_object(doc, Opening::Restore(Box::new(state)));
+        if let Some(o) = self.objects.first_mut() {
+            o.scan = Some(ObjectScan::new(keys.clone(), source));
+        }
+        self.measurements.list = measurements;
+        // Each view in a pane of its own, one camera for all.
+        let views = keys.slots().clamp(1, crate::scene::objects::MAX_PANES);
+        while self.view.panes.count < views {
+            self.view.panes.add(camera);
+        }
+        self.view.panes.count = views;
+        self.view.panes.linked = true;
+        self.view.camera = if fresh { keys.camera() } else { camera };
+        self.status = format!(
+            "opened {name}: {} key volumes, {:.1} MiB of {:.0} MiB",
+            keys.slots() * keys.scan.frames.len(),
+            keys.bytes as f64 / 1048576.0,
+            keys.budget as f64 / 1048576.0
+        );
+        if !keys.tracks.swaps.is_empty() {
+            self.status +=
+                &format!("; {} orbital character swap(s) (see `orbcloud scan info`)", keys.tracks.swaps.len());
+        }
+    }
+
+    /// The open scan's controls below the view, its keys and its playing: the value moves in
+    /// the object's state (the GPU follows in [`Self::apply_changes`]); a change of the orbitals
+    /// followed makes its key volumes anew. Whether it plays.
+    fn scan_controls(&mut self, ui: &mut egui::Ui, ctx: &egui::Context) -> bool {
+        let whole = self.viewport.as_ref().is_none_or(|vp| vp.progress().is_none());
+        let Some(o) = self.scan_object_mut() else { return false };
+        let plays = scan::drive(ui, o, whole);
+        let (Some(scan), Some(state)) = (&mut o.scan, &mut o.state.scan) else { return plays };
+        let source = scan.source.clone();
+        let orbitals = scan.scan().orbitals.clone();
+        match scan::controls(ui, scan, state) {
+            Some(scan::ScanRequest::Follow(follow)) => self.open_scan_following(source, Some(follow), ctx),
+            Some(scan::ScanRequest::Show(name)) => {
+                // The clicked orbital in the first view, the others as they were; by character,
+                // as the diagram's line follows it.
+                let mut orbitals = orbitals;
+                if orbitals.is_empty() {
+                    orbitals.push(name);
+                } else {
+                    orbitals[0] = name;
+                }
+                self.open_scan_with(source, Some(crate::model::scan::Follow::Overlap), Some(orbitals), ctx);
+            }
+            None => {}
+        }
+        plays
     }
 
     /// Frames what the scene shows, keeping the direction the camera looks from.
@@ -946,7 +1077,7 @@ impl OrbApp {
     pub fn apply_changes(&mut self) {
         let mut moved = false;
         for n in 0..self.objects.len().min(self.applied.len()) {
-            let (Some(vp), Some(o)) = (&mut self.viewport, self.objects.get(n)) else { break };
+            let (Some(vp), Some(o)) = (&mut self.viewport, self.objects.get_mut(n)) else { break };
             if self.applied[n] == o.state {
                 continue;
             }
@@ -956,6 +1087,16 @@ impl OrbApp {
             if changes.is_empty() {
                 continue;
             }
+            // A scan's new value: its document is the skeleton there, the GPU moves the atoms
+            // in place and sets each view's mixing weight.
+            if changes.scan_frame
+                && let (Some(scan), Some(s)) = (&o.scan, &o.state.scan)
+            {
+                o.doc = Arc::new(scan.keys.document_at(s.value, &o.doc.source));
+                vp.set_scan_frame(n, &o.doc, &o.state);
+                moved = true;
+            }
+            let o = &*o;
             let mut notes = Vec::new();
             if changes.layers {
                 notes.push(vp.relayout_quantities(n, &o.doc, was, &o.state));
@@ -1029,7 +1170,7 @@ impl OrbApp {
     fn object_panels(&mut self, ui: &mut egui::Ui, ctx: &egui::Context) {
         let defaults = self.defaults;
         // A scan shows its own orbitals; the browser belongs to the scene's objects.
-        if let Some(o) = self.objects.get_mut(self.active).filter(|_| self.scan.is_none()) {
+        if let Some(o) = self.objects.get_mut(self.active).filter(|o| o.scan.is_none()) {
             let view = &mut self.view;
             let reframe = orbitals::panel(
                 ui,
@@ -1046,10 +1187,10 @@ impl OrbApp {
                 orbitals::Reframe::None => {}
             }
         }
-        if let Some(o) = self.objects.get_mut(self.active).filter(|_| self.scan.is_none()) {
+        if let Some(o) = self.objects.get_mut(self.active).filter(|o| o.scan.is_none()) {
             vibrations::panel(ui, &o.doc, &mut o.state.vibration, &mut self.spectrum);
         }
-        if let Some(o) = self.objects.get_mut(self.active).filter(|_| self.scan.is_none()) {
+        if let Some(o) = self.objects.get_mut(self.active).filter(|o| o.scan.is_none()) {
             // The surface's point under the pointer, in the object's own frame, marked on the plot.
             let active = self.active as u32;
             let nci = crate::scene::Source::Wavefunction(crate::model::orbitals::Quantity::NciGradient);
@@ -1061,7 +1202,7 @@ impl OrbApp {
             self.nci_plot.hover(&o.doc, hovered);
             self.nci_plot.panel(ui, &o.doc, o.state.selected_quantity_mut());
         }
-        if let Some(o) = self.objects.get_mut(self.active).filter(|_| self.scan.is_none()) {
+        if let Some(o) = self.objects.get_mut(self.active).filter(|o| o.scan.is_none()) {
             let picks = excited::panel(ui, &o.doc, &mut o.state.excited, &mut self.uv_vis);
             let view = &mut self.view;
             let reframes: Vec<_> = (picks.into_iter())
@@ -1072,8 +1213,7 @@ impl OrbApp {
             }
         }
         if self.plane.open
-            && self.scan.is_none()
-            && let Some(o) = self.objects.get(self.active)
+            && let Some(o) = self.objects.get(self.active).filter(|o| o.scan.is_none())
         {
             let source = o.state.selected_quantity().map(|q| q.source);
             let measured = self.measured_plane_atoms();
@@ -1125,7 +1265,7 @@ impl OrbApp {
     /// After a failed load with nothing open and nothing else coming, opens the bundled demo:
     /// the window never stays empty because a file did not open.
     fn show_demo_if_empty(&mut self, ctx: &egui::Context) {
-        let nothing = self.objects.is_empty() && self.scan.is_none() && self.scan_job.is_none();
+        let nothing = self.objects.is_empty() && self.scan_job.is_none();
         if nothing && self.queue.is_empty() && self.job.is_none() {
             self.open_scan(ScanSource::Demo, ctx);
         }
@@ -1269,41 +1409,7 @@ impl OrbApp {
             // A session's scan that does not open leaves nothing to restore into a later one.
             let restoring = self.restoring_scan.take();
             match result {
-                Ok(scene) => {
-                    // One device handle per view.
-                    let contexts: Option<Vec<GpuContext>> = (0..scene.slots()).map(|_| self.gpu_context()).collect();
-                    if let Some(contexts) = contexts {
-                        let reopened = self.scan.take().filter(|old| old.source == source);
-                        if reopened.is_none() && restoring.is_none() {
-                            self.view.camera = scene.camera();
-                            // Picks number the scan's atoms now.
-                            self.measurements = measure::Measurements::default();
-                        }
-                        self.status = format!(
-                            "opened {name}: {} key volumes, {:.1} MiB of {:.0} MiB",
-                            scene.slots() * scene.scan.frames.len(),
-                            scene.bytes as f64 / 1048576.0,
-                            scene.budget as f64 / 1048576.0
-                        );
-                        if !scene.tracks.swaps.is_empty() {
-                            self.status += &format!(
-                                "; {} orbital character swap(s) (see `orbcloud scan info`)",
-                                scene.tracks.swaps.len()
-                            );
-                        }
-                        if let Some((_, measurements)) = &restoring {
-                            let atoms = scene.scan.frames.first().map_or(0, |f| f.molecule.atoms.len());
-                            self.measurements = measure::Measurements::default();
-                            self.measurements.list =
-                                measurements.iter().filter(|m| m.atoms.iter().all(|&a| a < atoms)).cloned().collect();
-                        }
-                        let mut view = ScanView::new(scene, source, contexts);
-                        if let Some(state) = reopened.map(|old| old.state()).or(restoring.map(|(state, _)| state)) {
-                            view.restore(&state);
-                        }
-                        self.scan = Some(view);
-                    }
-                }
+                Ok(scene) => self.open_scan_object(Arc::new(scene), source, restoring),
                 Err(ScanFailure::Cancelled) => self.status = format!("{name}: cancelled"),
                 Err(ScanFailure::OverBudget { message, fits }) => {
                     self.error = Some(format!("{name}: {message}"));
@@ -1352,6 +1458,7 @@ impl eframe::App for OrbApp {
         picture::picture_window(&ctx, self);
         panels::side_panel(ui, self);
         self.object_panels(ui, &ctx);
+        let scan_plays = self.scan_controls(ui, &ctx);
         self.apply_changes();
         self.apply_scene_edits();
         let modes_play = self.animate_modes(ui.input(|i| i.time));
@@ -1378,11 +1485,11 @@ impl eframe::App for OrbApp {
             panels::Action::Record => self.open_record_dialog(),
             panels::Action::Screenshot => self.open_picture_dialog(),
             panels::Action::ResetView => {
-                self.view.camera = match &self.scan {
-                    Some(scan) => scan.scene.camera(),
+                self.view.camera = match self.scan_object().and_then(|o| o.scan.as_ref()) {
+                    Some(scan) => scan.keys.camera(),
                     None => self.scene_camera(),
                 };
-                if self.scan.is_none() {
+                if self.scan_object().is_none() {
                     self.frame_panes();
                 }
             }
@@ -1390,113 +1497,99 @@ impl eframe::App for OrbApp {
         }
         panels::error_window(ui, self);
         self.file_browser(&ctx);
-        let request = self.scan.as_mut().and_then(|scan| scan::controls(ui, scan).map(|r| (scan.source.clone(), r)));
-        match request {
-            Some((source, scan::ScanRequest::Follow(follow))) => self.open_scan_following(source, Some(follow), &ctx),
-            Some((source, scan::ScanRequest::Show(name))) => {
-                // The clicked orbital in the first view, the others as they were; by character,
-                // as the diagram's line follows it.
-                let mut orbitals = self.scan.as_ref().map(|s| s.scene.scan.orbitals.clone()).unwrap_or_default();
-                if orbitals.is_empty() {
-                    orbitals.push(name);
-                } else {
-                    orbitals[0] = name;
-                }
-                self.open_scan_with(source, Some(crate::model::scan::Follow::Overlap), Some(orbitals), &ctx);
-            }
-            None => {}
-        }
         egui::CentralPanel::no_frame().show(ui, |ui| {
             let Some(rs) = frame.wgpu_render_state() else { return };
-            match (&mut self.scan, &mut self.viewport) {
-                (Some(scan), _) => {
-                    if let Some(said) = scan::views(ui, rs, scan, &mut self.view, &mut self.measurements) {
+            if let Some(vp) = &mut self.viewport {
+                // A scan being prepared in an empty window: its first frame at once, framed.
+                if let Some(job) = self.scan_job.as_mut().filter(|j| !j.skeleton_shown && self.objects.is_empty())
+                    && let Some(molecule) = job.skeleton()
+                {
+                    vp.show_molecule(&molecule, self.defaults.atoms);
+                    // A session's scan keeps the session's camera.
+                    if let Some((lo, hi)) = molecule.bounds().filter(|_| self.restoring_scan.is_none()) {
+                        self.view.camera = crate::scene::Camera::framing(lo.as_vec3(), hi.as_vec3());
+                    }
+                    job.skeleton_shown = true;
+                }
+                // A mode or a scan playing redraws every frame, as a drag does.
+                let interacting = detail::interacting(ui.ctx(), modes_play || scan_plays);
+                // Panes share the pixels a frame may draw while something moves.
+                let panes = self.view.panes.count.max(1);
+                vp.detail = detail::Detail::for_frame(interacting, vp.ctx.info.device_type, panes);
+                let picture_ms = vp.take_picture_ms();
+                vp.detail.lod_scale = vp.lod_budget.next(interacting, picture_ms);
+                let states: Vec<&ObjectState> = self.objects.iter().map(|o| &o.state).collect();
+                vp.set_clouds(&states);
+                let count = self.view.panes.count;
+                let scan = self.objects.iter().position(|o| o.scan.is_some());
+                let twist = scan.and_then(|n| scan::twist_input(ui, &self.objects[n]));
+                let twisted = if count > 1 {
+                    let panes: Vec<viewport::Pane> = (0..count)
+                        .map(|p| viewport::Pane {
+                            camera: self.view.camera,
+                            layers: vp.pane_layers(&states, p, count),
+                            label: panes::label(&self.objects, p, count),
+                        })
+                        .collect();
+                    vp.show_split(ui, rs, &mut self.view, &panes, twist)
+                } else {
+                    vp.unsplit();
+                    let clip = self.objects.get_mut(self.active).map(|o| &mut o.state.clip);
+                    vp.show_twistable(ui, rs, &mut self.view, clip, twist)
+                };
+                if let Some(n) = scan
+                    && scan::apply_twist(&mut self.objects[n], twisted, vp, &self.view.camera)
+                {
+                    ui.ctx().request_repaint();
+                }
+                if let Some(o) = self.objects.get(self.active).filter(|o| o.state.surface.color_by_volume)
+                    && let Some(map) = vp.surface_map(self.active)
+                {
+                    let name = o.state.selected_quantity().map(|q| q.source.name(&o.doc)).unwrap_or_default();
+                    legend::value_bar(ui, ui.min_rect(), &map, &name);
+                } else if let Some(o) = self.objects.get(self.active)
+                    && let Some(k) = o
+                        .state
+                        .quantities
+                        .iter()
+                        .position(|q| q.visible && q.isosurfaces.iter().any(|i| i.visible && i.color_by.is_some()))
+                    && let Some((map, name)) = vp.isosurface_map(self.active, k)
+                {
+                    legend::value_bar(ui, ui.min_rect(), &map, &name);
+                }
+                if let Some(click) = vp.click.take() {
+                    let said = self.measurements.click(click, &self.world);
+                    if !said.is_empty() {
                         self.status = said;
                     }
                 }
-                (None, Some(vp)) => {
-                    // A scan being prepared in an empty window: its first frame at once, framed.
-                    if let Some(job) = self.scan_job.as_mut().filter(|j| !j.skeleton_shown && self.objects.is_empty())
-                        && let Some(molecule) = job.skeleton()
-                    {
-                        vp.show_molecule(&molecule, self.defaults.atoms);
-                        // A session's scan keeps the session's camera.
-                        if let Some((lo, hi)) = molecule.bounds().filter(|_| self.restoring_scan.is_none()) {
-                            self.view.camera = crate::scene::Camera::framing(lo.as_vec3(), hi.as_vec3());
-                        }
-                        job.skeleton_shown = true;
-                    }
-                    // A mode playing redraws every frame, as a drag does.
-                    let interacting = detail::interacting(ui.ctx(), modes_play);
-                    vp.detail = detail::Detail::for_frame(interacting, vp.ctx.info.device_type, 1);
-                    let picture_ms = vp.take_picture_ms();
-                    vp.detail.lod_scale = vp.lod_budget.next(interacting, picture_ms);
-                    let states: Vec<&ObjectState> = self.objects.iter().map(|o| &o.state).collect();
-                    vp.set_clouds(&states);
-                    let count = self.view.panes.count;
-                    if count > 1 {
-                        let panes: Vec<viewport::Pane> = (0..count)
-                            .map(|p| viewport::Pane {
-                                camera: self.view.camera,
-                                layers: vp.pane_layers(&states, p, count),
-                                label: panes::label(&self.objects, p, count),
+                measure::overlay(ui, vp, &self.view.camera, &self.world, &self.measurements, self.view.labels);
+                if let Some(o) = self.objects.get(self.active).filter(|_| self.plane.open) {
+                    plane_pane::outline(ui, vp, &self.view.camera, &self.plane, &o.state.placement);
+                    // Alt + wheel over the view moves the plane along its normal, 0.1 Å a notch.
+                    let notches: Vec<f32> = ui.input(|i| {
+                        (i.raw.events.iter())
+                            .filter_map(|e| match e {
+                                egui::Event::MouseWheel { delta, modifiers, .. } if modifiers.alt => {
+                                    Some(delta.y + delta.x)
+                                }
+                                _ => None,
                             })
-                            .collect();
-                        vp.show_split(ui, rs, &mut self.view, &panes);
-                    } else {
-                        vp.unsplit();
-                        let clip = self.objects.get_mut(self.active).map(|o| &mut o.state.clip);
-                        vp.show(ui, rs, &mut self.view, clip);
-                    }
-                    if let Some(o) = self.objects.get(self.active).filter(|o| o.state.surface.color_by_volume)
-                        && let Some(map) = vp.surface_map(self.active)
-                    {
-                        let name = o.state.selected_quantity().map(|q| q.source.name(&o.doc)).unwrap_or_default();
-                        legend::value_bar(ui, ui.min_rect(), &map, &name);
-                    } else if let Some(o) = self.objects.get(self.active)
-                        && let Some(k) =
-                            o.state.quantities.iter().position(|q| {
-                                q.visible && q.isosurfaces.iter().any(|i| i.visible && i.color_by.is_some())
-                            })
-                        && let Some((map, name)) = vp.isosurface_map(self.active, k)
-                    {
-                        legend::value_bar(ui, ui.min_rect(), &map, &name);
-                    }
-                    if let Some(click) = vp.click.take() {
-                        let said = self.measurements.click(click, &self.world);
-                        if !said.is_empty() {
-                            self.status = said;
-                        }
-                    }
-                    measure::overlay(ui, vp, &self.view.camera, &self.world, &self.measurements, self.view.labels);
-                    if let Some(o) = self.objects.get(self.active).filter(|_| self.plane.open) {
-                        plane_pane::outline(ui, vp, &self.view.camera, &self.plane, &o.state.placement);
-                        // Alt + wheel over the view moves the plane along its normal, 0.1 Å a notch.
-                        let notches: Vec<f32> = ui.input(|i| {
-                            (i.raw.events.iter())
-                                .filter_map(|e| match e {
-                                    egui::Event::MouseWheel { delta, modifiers, .. } if modifiers.alt => {
-                                        Some(delta.y + delta.x)
-                                    }
-                                    _ => None,
-                                })
-                                .filter(|d| *d != 0.0)
-                                .collect()
-                        });
-                        if vp.rect().is_some_and(|r| ui.rect_contains_pointer(r)) {
-                            for d in notches {
-                                self.plane.nudge(f64::from(d.signum()) * 0.1);
-                            }
+                            .filter(|d| *d != 0.0)
+                            .collect()
+                    });
+                    if vp.rect().is_some_and(|r| ui.rect_contains_pointer(r)) {
+                        for d in notches {
+                            self.plane.nudge(f64::from(d.signum()) * 0.1);
                         }
                     }
                 }
-                (None, None) => {}
             }
         });
         if self.is_loading() || self.recording.is_some() {
             ctx.request_repaint_after(std::time::Duration::from_millis(100));
         }
-        if modes_play {
+        if modes_play || scan_plays {
             ctx.request_repaint();
         }
     }

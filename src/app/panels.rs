@@ -72,17 +72,17 @@ pub fn top_bar(ui: &mut egui::Ui, app: &mut OrbApp) -> Action {
             ui.separator();
             // The view takes the room of a closed panel; a drag on a panel's edge resizes it.
             ui.toggle_value(&mut app.view.panels.scene, "Scene").on_hover_text("show or hide the scene panel");
-            if app.scan.is_none() && app.objects.get(app.active).is_some_and(|o| o.doc.wavefunction.is_some()) {
+            if app.objects.get(app.active).is_some_and(|o| o.doc.wavefunction.is_some()) {
                 ui.toggle_value(&mut app.view.panels.orbitals, "Orbitals")
                     .on_hover_text("show or hide the orbital browser");
             }
-            if app.scan.is_none() && app.objects.get(app.active).is_some_and(|o| o.doc.molecule.atoms.len() >= 3) {
+            if app.objects.get(app.active).is_some_and(|o| o.scan.is_none() && o.doc.molecule.atoms.len() >= 3) {
                 ui.toggle_value(&mut app.plane.open, "Plane map")
                     .on_hover_text("the selected quantity on a plane through three atoms, with contours");
             }
             ui.separator();
-            let source = match &app.scan {
-                Some(s) => s.scene.scan.title.clone(),
+            let source = match app.scan_object().and_then(|o| o.scan.as_ref()) {
+                Some(s) => s.scan().title.clone(),
                 None if app.objects.len() > 1 => format!("{} objects", app.objects.len()),
                 None => app.doc().source.clone(),
             };
@@ -144,8 +144,8 @@ fn status_line(ui: &mut egui::Ui, app: &OrbApp, cancel: &mut bool, dismiss: &mut
                 }
                 ui.separator();
             }
-            if let Some(scan) = &app.scan {
-                let s = &scan.scene.scan;
+            if let Some(scan) = app.scan_object().and_then(|o| o.scan.as_ref()) {
+                let s = scan.scan();
                 let c = &s.coordinate;
                 ui.label(format!(
                     "{}: {}, {} key frames {}…{}",
@@ -224,35 +224,23 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
         .show_collapsible(ui, &mut open, |ui| {
             egui::ScrollArea::vertical().show(ui, |ui| {
             super::scene_panel::section(ui, app);
-            if app.scan.is_none() && !app.objects.is_empty() {
+            if !app.objects.is_empty() {
                 ui.separator();
             }
             let (grid_sigma, grid_signed) = app.shown_grid();
             let subtractable = app.subtractable();
-            if let Some(scan) = &mut app.scan {
-                let g = scan.scene.grid.dims;
-                ui.heading("Volume");
-                ui.label(format!(
-                    "{} key volumes of {}×{}×{} points ({:.1} MiB resident)",
-                    scan.scene.slots() * scan.scene.scan.frames.len(),
-                    g[0],
-                    g[1],
-                    g[2],
-                    scan.scene.bytes as f64 / 1048576.0
-                ));
-                cloud_editor(ui, &mut scan.settings.volume, true);
-                ui.separator();
-                // A scan's isosurfaces are cut from the orbital at the value; levels are absolute there.
-                ui.heading("Isosurface");
-                let levels = LevelsOf { signed: true, sigma: None, gradient: false };
-                isosurface_editor(ui, &mut scan.settings.iso, levels);
-                ui.separator();
-                ui.heading("Atoms");
-                let s = &mut scan.settings;
-                atoms_editor(ui, &mut s.atoms, &mut s.atom_colors, &mut s.depth_cue);
-                ui.separator();
-                clip_editor(ui, &mut s.clip);
-            } else if let Some(o) = app.objects.get_mut(app.active) {
+            if let Some(o) = app.objects.get_mut(app.active) {
+                if let Some(scan) = &o.scan {
+                    let g = scan.keys.grid.dims;
+                    ui.label(format!(
+                        "{} key volumes of {}×{}×{} points ({:.1} MiB resident)",
+                        scan.keys.slots() * scan.scan().frames.len(),
+                        g[0],
+                        g[1],
+                        g[2],
+                        scan.keys.bytes as f64 / 1048576.0
+                    ));
+                }
                 let doc = o.doc.clone();
                 let mut subtract = None;
                 let state = &mut o.state;
@@ -302,24 +290,17 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
                 ui.label("background");
             });
             ui.checkbox(&mut view.labels, "atom labels");
-            if app.scan.is_none() {
-                view_presets(ui, app);
-            }
+            view_presets(ui, app);
             ui.separator();
-            match &app.scan {
-                // The measured values follow the value.
-                Some(s) => {
-                    super::measure::panel(ui, &s.scene.scan.geometry_at(s.value), &mut app.measurements, false);
-                }
-                None => {
-                    if let Some(n) = super::measure::panel(ui, &app.world.molecule, &mut app.measurements, true) {
-                        app.scan_measurement(n);
-                    }
-                }
+            // A scan's measured values follow its value (its skeleton is the scene's atoms); a
+            // measurement of a scan is not scanned again.
+            let scannable = app.scan_object().is_none();
+            if let Some(n) = super::measure::panel(ui, &app.world.molecule, &mut app.measurements, scannable) {
+                app.scan_measurement(n);
             }
             // A structure without orbitals offers to compute them (small molecules: PySCF).
             let bare = app.objects.get(app.active).filter(|o| {
-                app.scan.is_none() && o.doc.wavefunction.is_none() && (1..=60).contains(&o.doc.molecule.atoms.len())
+                o.scan.is_none() && o.doc.wavefunction.is_none() && (1..=60).contains(&o.doc.molecule.atoms.len())
             });
             if bare.is_some() && ui.button("Compute orbitals…").on_hover_text("with PySCF").clicked() {
                 app.orbitals_dialog = Some((app.active, crate::sources::compute::Settings::default()));
@@ -327,9 +308,8 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
 
             ui.separator();
             ui.collapsing("Atoms in file", |ui| {
-                // A scan's atoms where they are at the value.
-                let twisted = app.scan.as_ref().map(|s| s.scene.scan.geometry_at(s.value));
-                let molecule = twisted.as_ref().unwrap_or(&app.doc().molecule);
+                // A scan's atoms where they are at the value: its document's.
+                let molecule = &app.doc().molecule;
                 // Coordinates in columns of their own, so none is cut off by the panel's edge.
                 egui::Grid::new("atoms").striped(true).num_columns(5).show(ui, |ui| {
                     for h in ["", "", "x / Å", "y / Å", "z / Å"] {
@@ -349,14 +329,15 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
                 });
             });
             ui.separator();
-            let help = match &app.scan {
-                Some(s) if s.drag_twists => format!(
+            let scan = app.scan_object().and_then(|o| Some((o.scan.as_ref()?, o.state.scan.as_ref()?)));
+            let help = match scan {
+                Some((s, state)) if state.drag_scans => format!(
                     "drag: {} · right/middle drag: pan · wheel: zoom · arrows: rotate · Space: play · [ ]: key values",
-                    super::scan::drag_words(&s.scene.scan.coordinate)
+                    super::scan::drag_words(&s.scan().coordinate)
                 ),
-                Some(s) => format!(
+                Some((s, _)) => format!(
                     "drag: rotate (from the bond: {}) · right/middle drag: pan · wheel: zoom · Space: play",
-                    super::scan::drag_words(&s.scene.scan.coordinate)
+                    super::scan::drag_words(&s.scan().coordinate)
                 ),
                 None if app.plane.open => {
                     "drag: rotate · right/middle drag: pan · wheel: zoom · Alt + wheel: move the plane".into()

@@ -25,8 +25,12 @@ pub fn label(objects: &[SceneObject], pane: usize, count: usize) -> String {
     if lines.is_empty() { "atoms".into() } else { lines.join("\n") }
 }
 
-/// A quantity's name, with an orbital's energy and occupation.
+/// A quantity's name, with an orbital's energy and occupation (a scan's view: its energy and
+/// the coordinate at the value).
 fn describe(o: &SceneObject, q: &QuantityState) -> String {
+    if let (crate::scene::Source::Scan(slot), Some(scan), Some(state)) = (q.source, &o.scan, &o.state.scan) {
+        return super::scan::view_label(scan, slot, state.value);
+    }
     let name = q.source.name(&o.doc);
     match (q.source.orbital(), &o.doc.wavefunction) {
         (Some(i), Some(wf)) => {

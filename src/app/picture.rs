@@ -51,13 +51,9 @@ pub fn picture_name(source: &str, quantity: Option<&str>) -> String {
 }
 
 impl OrbApp {
-    /// The size of the view on screen (each scan view's).
+    /// The size of the view on screen.
     fn shown_size(&self) -> [u32; 2] {
-        let shown = match &self.scan {
-            Some(scan) => scan.views.first().and_then(super::viewport::Viewport::size),
-            None => self.viewport.as_ref().and_then(super::viewport::Viewport::size),
-        };
-        shown.unwrap_or([1280, 800])
+        self.viewport.as_ref().and_then(super::viewport::Viewport::size).unwrap_or([1280, 800])
     }
 
     /// Opens the *Save PNG* window at the view's size.
@@ -68,8 +64,8 @@ impl OrbApp {
 
     /// The name *Save PNG* proposes: the file and its orbital, or a scan's title and value.
     fn proposed_picture_name(&self) -> String {
-        match &self.scan {
-            Some(scan) => picture_name(&scan.scene.scan.title, Some(&format!("{:.0}deg", scan.value))),
+        match self.scan_object().and_then(|o| Some((o.scan.as_ref()?, o.state.scan.as_ref()?))) {
+            Some((scan, state)) => picture_name(&scan.scan().title, Some(&format!("{:.0}deg", state.value))),
             None => {
                 let quantity = (self.objects.get(self.active))
                     .and_then(|o| o.state.quantities.get(o.state.selected).map(|q| q.source.name(&o.doc)));
@@ -90,32 +86,17 @@ impl OrbApp {
     /// window says and writes it to `path` as PNG.
     pub fn save_png(&mut self, path: &Path) {
         let size = self.picture.size.unwrap_or_else(|| self.shown_size()).map(|s| s.clamp(16, 8192));
+        // A scan's panes are captioned as the window labels them (its view `p` in pane `p`).
+        let scan = self.scan_object().and_then(|o| Some((o.scan.as_ref()?.keys.clone(), o.state.scan.as_ref()?.value)));
         let Some(vp) = &mut self.viewport else { return };
         let d = &self.picture;
         let figure = Figure { scale: d.scale.clamp(1, MAX_SCALE), transparent: d.transparent };
         let drawn = figure.drawn_size(size);
         let mut view = self.view;
         let background = view.background;
-        let shot: Result<image::RgbaImage, GpuError> = match &mut self.scan {
-            Some(scan) => {
-                let mut out = image::RgbaImage::new(size[0] * scan.views.len() as u32, size[1]);
-                let mut result = Ok(());
-                for (n, v) in scan.views.iter_mut().enumerate() {
-                    let picture = figure.draw(background, |bg| {
-                        view.background = bg;
-                        v.snapshot(&view, drawn)
-                    });
-                    match picture {
-                        Ok(img) => image::imageops::replace(&mut out, &img, (n as u32 * size[0]) as i64, 0),
-                        Err(e) => result = Err(e),
-                    }
-                }
-                let slots: Vec<usize> = (0..scan.views.len()).collect();
-                caption_views(&mut out, &scan.scene, &slots, scan.value, size[0]);
-                result.map(|()| out)
-            }
+        let shot: Result<image::RgbaImage, GpuError> = match () {
             // A split view: its panes side by side, as drawn.
-            None if !vp.pane_sizes().is_empty() => {
+            () if !vp.pane_sizes().is_empty() => {
                 let pictures: Result<Vec<_>, _> = (0..vp.pane_sizes().len()).map(|p| vp.pane_picture(p)).collect();
                 pictures.map(|pictures| {
                     let (w, h) = pictures.first().map_or((1, 1), image::ImageBuffer::dimensions);
@@ -123,10 +104,14 @@ impl OrbApp {
                     for (n, picture) in pictures.iter().enumerate() {
                         image::imageops::replace(&mut out, picture, (n as u32 * w) as i64, 0);
                     }
+                    if let Some((keys, value)) = &scan {
+                        let slots: Vec<usize> = (0..pictures.len().min(keys.slots())).collect();
+                        caption_views(&mut out, keys, &slots, *value, w);
+                    }
                     out
                 })
             }
-            None => figure.draw(background, |bg| {
+            () => figure.draw(background, |bg| {
                 view.background = bg;
                 vp.snapshot(&view, drawn)
             }),
@@ -149,15 +134,14 @@ pub fn picture_window(ctx: &egui::Context, app: &mut OrbApp) {
     }
     let mut open = true;
     let mut save = false;
-    let scan = app.scan.is_some();
     let shown = app.shown_size();
-    let panes = app.viewport.as_ref().is_some_and(|v| !v.pane_sizes().is_empty()) && !scan;
+    let panes = app.viewport.as_ref().is_some_and(|v| !v.pane_sizes().is_empty());
     egui::Window::new("Save PNG").open(&mut open).resizable(false).show(ctx, |ui| {
         let d = &mut app.picture;
         let size = d.size.get_or_insert(shown);
         ui.add_enabled_ui(!panes, |ui| {
             egui::Grid::new("picture options").num_columns(2).show(ui, |ui| {
-                ui.label(if scan { "each view" } else { "size" });
+                ui.label("size");
                 ui.horizontal(|ui| {
                     ui.add(egui::DragValue::new(&mut size[0]).range(16..=8192));
                     ui.label("×");

@@ -88,12 +88,12 @@ impl OrbApp {
     /// Opens the *Record…* window with choices fitting what is shown.
     pub fn open_record_dialog(&mut self) {
         let vibrating = self.objects.get(self.active).is_some_and(|o| o.state.vibration.mode.is_some());
-        let what = match (&self.scan, vibrating) {
+        let what = match (self.scan_object(), vibrating) {
             (Some(_), _) => RecordWhat::Sweep,
             (None, true) => RecordWhat::Vibration,
             (None, false) => RecordWhat::Turntable,
         };
-        let source = match self.scan.as_ref().map(|s| &s.source) {
+        let source = match self.scan_object().and_then(|o| o.scan.as_ref()).map(|s| &s.source) {
             Some(super::scan::ScanSource::File(path)) => path.display().to_string(),
             Some(super::scan::ScanSource::Demo) => "psb3".into(),
             None => self.doc().source.clone(),
@@ -126,12 +126,15 @@ impl OrbApp {
         let out = path.clone();
         let waker = egui_ctx.clone();
         let repaint = move || waker.request_repaint();
-        let work: Box<dyn FnOnce() -> Result<PathBuf, ShotError> + Send> = match (d.what, &self.scan) {
-            (RecordWhat::Sweep, Some(scan)) => {
-                let scene = scan.scene.clone();
+        let scan = self.scan_object().and_then(|o| Some((o, o.scan.as_ref()?, o.state.scan.as_ref()?)));
+        let work: Box<dyn FnOnce() -> Result<PathBuf, ShotError> + Send> = match (d.what, scan) {
+            (RecordWhat::Sweep, Some((object, scan, state))) => {
+                let scene = scan.keys.clone();
                 let (lo, hi) = scene.scan.range();
                 let values = sweep(lo, hi, frames, d.bounce);
-                let (camera, settings, mode) = (self.view.camera, scan.settings, scan.mode);
+                // Every view drawn as the first is (the views of a sweep share their settings).
+                let settings = object.state.render_settings(0, self.view.background);
+                let (camera, mode) = (self.view.camera, state.mode);
                 let views = scene.slots() as u32;
                 Box::new(move || {
                     let mut shots = ScanShots::new(&ctx, scene, values, camera, settings, mode, figure, size);
@@ -210,7 +213,7 @@ pub fn record_window(ctx: &egui::Context, app: &mut OrbApp) {
     }
     let mut open = true;
     let mut start = false;
-    let has_scan = app.scan.is_some();
+    let has_scan = app.scan_object().is_some();
     let has_modes = app.objects.get(app.active).is_some_and(|o| o.doc.vibrations.is_some());
     egui::Window::new("Record").open(&mut open).resizable(false).show(ctx, |ui| {
         let d = &mut app.record;

@@ -14,8 +14,9 @@ pub struct Carried {
     active: usize,
     view: ViewState,
     recent: Vec<std::path::PathBuf>,
-    /// An open dihedral scan: its key volumes lived on the lost device, so they are made again.
-    scan: Option<super::scan::ScanSource>,
+    /// An open scan and its object: its key volumes lived on the lost device, so they are made
+    /// again.
+    scan: Option<(super::scan::ScanSource, crate::scene::ObjectState)>,
     /// What the driver said.
     reason: String,
 }
@@ -45,11 +46,13 @@ impl OrbApp {
     pub(super) fn carry_away(&mut self, reason: &str, ctx: &egui::Context) -> bool {
         let Some(slot) = self.restart.clone() else { return false };
         let carried = Carried {
-            objects: self.objects.iter().map(|o| (Arc::clone(&o.doc), o.state.clone())).collect(),
+            objects: (self.objects.iter().filter(|o| o.scan.is_none()))
+                .map(|o| (Arc::clone(&o.doc), o.state.clone()))
+                .collect(),
             active: self.active,
             view: self.view,
             recent: self.recent.clone(),
-            scan: self.scan.as_ref().map(|s| s.source.clone()),
+            scan: self.scan_object().and_then(|o| Some((o.scan.as_ref()?.source.clone(), o.state.clone()))),
             reason: reason.to_string(),
         };
         *slot.lock().unwrap_or_else(std::sync::PoisonError::into_inner) = Some(carried);
@@ -83,8 +86,9 @@ impl OrbApp {
         }
         app.select(carried.active);
         app.view = carried.view;
-        if let Some(source) = carried.scan {
+        if let Some((source, state)) = carried.scan {
             app.open_scan(source, &cc.egui_ctx);
+            app.restoring_scan = Some((state, Vec::new()));
         }
         app.notice = Some(format!("{} ({}): the scene is back on a new device", super::DEVICE_LOST, carried.reason));
         app

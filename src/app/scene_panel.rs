@@ -15,7 +15,7 @@ use crate::scene::{
 };
 
 pub fn section(ui: &mut egui::Ui, app: &mut OrbApp) {
-    if app.scan.is_some() || app.objects.is_empty() {
+    if app.objects.is_empty() {
         return;
     }
     ui.heading("Scene");
@@ -117,6 +117,10 @@ fn representations(q: &QuantityState) -> String {
 pub fn quantity_choices(doc: &Document) -> Vec<(Source, String)> {
     let mut choices: Vec<(Source, String)> =
         (0..doc.volumes.len()).map(|i| (Source::Volume(i), Source::Volume(i).name(doc))).collect();
+    // A scan's views, each again (a second representation of one orbital in another pane).
+    if let Some(scan) = &doc.scan {
+        choices.extend((0..scan.orbitals.len()).map(|slot| (Source::Scan(slot), scan.slot_name(slot))));
+    }
     if let Some(wf) = &doc.wavefunction {
         let spins: &[Spin] = if wf.restricted { &[Spin::Alpha] } else { &[Spin::Alpha, Spin::Beta] };
         for &spin in spins {

@@ -8,17 +8,20 @@ use crate::scene::Session;
 pub use crate::sources::session::{Read, add_volume, last_session_path, parse, read, with_suffix, write};
 
 impl OrbApp {
-    /// The scene as a session: every object read from a file (the bundled demo is left out),
-    /// the open scan, the camera and the background.
+    /// The scene as a session: every object read from a file or made from a scan (the bundled
+    /// cube demo is left out), the camera and the background.
     pub fn session(&mut self) -> Session {
         Session {
             camera: self.view.camera,
             panes: self.view.panes,
             measurements: self.measurements.list.clone(),
             background: Some(self.view.background),
-            objects: self.objects.iter().filter(|o| o.state.path.is_some()).map(|o| o.state.clone()).collect(),
+            objects: (self.objects.iter())
+                .filter(|o| o.state.path.is_some() || o.state.scan.is_some())
+                .map(|o| o.state.clone())
+                .collect(),
             recent: self.recent.clone(),
-            scan: self.scan.as_ref().map(super::scan::ScanView::state),
+            scan: None,
         }
     }
 
@@ -46,26 +49,32 @@ impl OrbApp {
         if !notes.is_empty() {
             self.error = Some(format!("{}: values out of range were replaced:\n{}", path.display(), notes.join("\n")));
         }
-        let files: Vec<(PathBuf, Opening)> = session
-            .objects
-            .into_iter()
-            .filter_map(|state| Some((state.path.clone()?, Opening::Restore(Box::new(state)))))
-            .collect();
-        if files.is_empty() && session.scan.is_none() {
+        // A scan opens as an object in place of the others (sessions before scans were objects
+        // kept it beside them).
+        let scan = (session.objects.iter().find(|o| o.scan.is_some()).cloned())
+            .or_else(|| session.scan.map(|legacy| legacy.into_object(0)));
+        let files: Vec<(PathBuf, Opening)> = match scan {
+            Some(_) => Vec::new(),
+            None => (session.objects.into_iter())
+                .filter_map(|state| Some((state.path.clone()?, Opening::Restore(Box::new(state)))))
+                .collect(),
+        };
+        if files.is_empty() && scan.is_none() {
             self.error = Some(format!("{}: the session names no file", path.display()));
             return;
         }
         self.clear_scene();
         self.view.camera = session.camera;
         self.view.panes = session.panes;
-        match session.scan {
-            // A scan is shown instead of the objects, and its measurements number its atoms:
-            // they come back with it once its key volumes are made.
-            Some(scan) => {
-                let source = scan.manifest.clone().map_or(super::scan::ScanSource::Demo, super::scan::ScanSource::File);
-                let orbitals = (!scan.orbitals.is_empty()).then(|| scan.orbitals.clone());
-                self.open_scan_with(source, Some(scan.follow), orbitals, ctx);
-                self.restoring_scan = Some((scan, session.measurements));
+        match scan {
+            // A scan's measurements number its atoms: they come back with it once its key
+            // volumes are made.
+            Some(object) => {
+                let playback = object.scan.clone().unwrap_or_default();
+                let source = playback.manifest.map_or(super::scan::ScanSource::Demo, super::scan::ScanSource::File);
+                let orbitals = (!playback.orbitals.is_empty()).then_some(playback.orbitals);
+                self.open_scan_with(source, Some(playback.follow), orbitals, ctx);
+                self.restoring_scan = Some((object, session.measurements));
             }
             // Measurements number the scene's atoms: they come back once every file has loaded.
             None => self.restoring_measurements = Some(session.measurements),
@@ -84,7 +93,6 @@ impl OrbApp {
         self.objects.clear();
         self.applied.clear();
         self.active = 0;
-        self.scan = None;
         self.measurements = Default::default();
         if let Some(vp) = &mut self.viewport {
             vp.clear();

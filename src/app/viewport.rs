@@ -19,9 +19,7 @@ use crate::model::isosurface::Mesh;
 use crate::model::{Document, VolumeGrid};
 use crate::scene::objects::Part;
 use crate::scene::translucency::SurfaceLook;
-use crate::scene::{
-    ClipPlane, IsosurfaceSettings, ObjectState, Source, SurfaceChoice, SurfaceSettings, VolumeSettings,
-};
+use crate::scene::{ClipPlane, ObjectState, Source, SurfaceChoice, SurfaceSettings, VolumeSettings};
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use std::sync::{Arc, Mutex};
 
@@ -61,7 +59,7 @@ struct PaneTarget {
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct TwistInput {
     /// Every primary drag twists (else the view orbits, unless the drag starts on the bond).
-    pub drag_twists: bool,
+    pub drag_scans: bool,
     /// The rotatable bond (world, bohr): a drag that starts on it twists.
     pub bond: Option<[glam::Vec3; 2]>,
     /// A drag that starts on the bond moves its atom to the pointer (a bond length, an angle)
@@ -76,6 +74,8 @@ pub struct Twist {
     pub along: f32,
     /// Where the pointer holds the grabbed atom (points, in the window).
     pub pointer: Option<egui::Pos2>,
+    /// The pane of a split view the drag is in.
+    pub pane: usize,
 }
 
 /// The note for a document's data set `i` shown at every `step`-th point (`None` when whole).
@@ -241,10 +241,6 @@ pub struct Viewport {
     grabbed: bool,
     /// The coarse picture shown while a costly frame is drawn ([`Detail::PREVIEW`]).
     preview: Option<(OffscreenTarget, egui::TextureId)>,
-    /// The scan frame shown: (value, interpolation), for tests and redraws.
-    pub scan_shown: Option<(f64, crate::scene::Interpolation)>,
-    /// The value and settings a scan view's isosurfaces were last asked for (`None`: hidden).
-    pub scan_iso: Option<(f64, IsosurfaceSettings)>,
     /// A frame with translucent surfaces was drawn and its fragment counts are not back yet.
     awaiting_fragments: bool,
     /// The last frame's fragment counts, when it had translucent surfaces.
@@ -253,6 +249,8 @@ pub struct Viewport {
     split: Vec<PaneTarget>,
     /// Where each pane was laid out, and the size it was drawn at.
     pane_layout: Vec<(egui::Rect, [u32; 2])>,
+    /// The key volumes of the objects that are frames of a scan, by object.
+    scan_keys: std::collections::BTreeMap<usize, Arc<ScanScene>>,
 }
 
 impl Viewport {
@@ -285,13 +283,12 @@ impl Viewport {
             layout: None,
             twisting: false,
             grabbed: false,
-            scan_shown: None,
             preview: None,
-            scan_iso: None,
             awaiting_fragments: false,
             fragments: None,
             split: Vec::new(),
             pane_layout: Vec::new(),
+            scan_keys: Default::default(),
         }
     }
 
@@ -344,9 +341,11 @@ impl Viewport {
             self.remove_layer(l);
         }
         self.insert_layer(at, n, Part::Atoms);
+        let keys = self.scan_keys.get(&n).cloned();
         let (ctx, layer) = (&self.ctx, self.renderer.layer_mut(&self.ctx, at));
         guarded(&ctx.device, || {
             crate::layers::show_object_atoms(ctx, layer, doc, state);
+            layer.clip_centre = clip_centre(doc, keys.as_deref());
             Ok(())
         })?;
         self.update_surface(n, doc, state);
@@ -407,11 +406,19 @@ impl Viewport {
         let (Some(l), Some(q)) = (self.layer_of(n, Part::Quantity(k)), state.quantities.get(k)) else {
             return Ok(None);
         };
+        let keys = self.scan_keys.get(&n).cloned();
         let (ctx, layer) = (&self.ctx, self.renderer.layer_mut(&self.ctx, l));
         crate::layers::place_layer(layer, state, Part::Quantity(k));
-        layer.clip_centre = crate::layers::object_centre(doc);
+        layer.clip_centre = clip_centre(doc, keys.as_deref());
         self.generation += 1;
         match q.source {
+            Source::Scan(_) => {
+                let slot = &mut self.slots[l];
+                slot.evaluation.cancel();
+                slot.sampled = None;
+                self.show_scan_view(n, k, state);
+                Ok(None)
+            }
             Source::Volume(i) => {
                 let step = guarded(&ctx.device, || layer.set_volume(ctx, doc.volumes.get(i)))?;
                 let slot = &mut self.slots[l];
@@ -439,15 +446,64 @@ impl Viewport {
         }
     }
 
+    /// Gives object `n` the key volumes of the scan it is a frame of (`None`: it is none); its
+    /// [`Source::Scan`] quantities draw from them. Set before [`Self::set_object`].
+    pub fn set_scan_keys(&mut self, n: usize, keys: Option<Arc<ScanScene>>) {
+        match keys {
+            Some(keys) => self.scan_keys.insert(n, keys),
+            None => self.scan_keys.remove(&n),
+        };
+    }
+
+    /// Object `n`'s scan view `k` at the scan's value: the mixing weight of its key volumes (the
+    /// bind groups stay while the value is between the same two), the values at the value
+    /// mixed for its isosurfaces and the panels, and the isosurfaces cut again.
+    fn show_scan_view(&mut self, n: usize, k: usize, state: &ObjectState) {
+        let (Some(l), Some(q), Some(scan)) =
+            (self.layer_of(n, Part::Quantity(k)), state.quantities.get(k), &state.scan)
+        else {
+            return;
+        };
+        let (Source::Scan(slot), Some(keys)) = (q.source, self.scan_keys.get(&n).cloned()) else { return };
+        keys.show_view(&self.ctx, self.renderer.layer_mut(&self.ctx, l), slot, scan.value, scan.mode);
+        self.slots[l].computed = Some(Arc::new(keys.values_at(slot, scan.value)));
+        let levels = q.isosurfaces.clone();
+        let computed = self.slots[l].computed.clone();
+        let max_bytes = self.ctx.device.limits().max_buffer_size;
+        self.slots[l].extraction.request(move |_| match computed {
+            Some(grid) => prepared(isosurfaces_within(&grid, &levels, max_bytes)),
+            None => prepared(Default::default()),
+        });
+        self.generation += 1;
+    }
+
+    /// Moves object `n` (a scan's frame) to its scan's value: the skeleton in place (`doc` is
+    /// the frame at the value) and every view's key volumes and isosurfaces.
+    pub fn set_scan_frame(&mut self, n: usize, doc: &Document, state: &ObjectState) {
+        if let Some(l) = self.layer_of(n, Part::Atoms) {
+            let layer = self.renderer.layer_mut(&self.ctx, l);
+            if !layer.move_atoms(&self.ctx, &doc.molecule) {
+                self.set_atoms(n, doc, state);
+            }
+        }
+        for k in 0..state.quantities.len() {
+            self.show_scan_view(n, k, state);
+        }
+        self.generation += 1;
+    }
+
     /// Cuts every isosurface of object `n`'s quantity `k` from its grid in the background;
     /// [`Self::poll`] shows them when they are done.
     pub fn update_isosurfaces(&mut self, n: usize, k: usize, doc: &Arc<Document>, state: &ObjectState) {
         let (Some(l), Some(q)) = (self.layer_of(n, Part::Quantity(k)), state.quantities.get(k)) else { return };
+        if let Source::Scan(_) = q.source {
+            return self.show_scan_view(n, k, state);
+        }
         let computed = self.slots[l].computed.clone();
         let doc = doc.clone();
         let volume = match q.source {
             Source::Volume(i) => Some(i),
-            Source::Wavefunction(_) => None,
+            Source::Wavefunction(_) | Source::Scan(_) => None,
         };
         let levels = q.isosurfaces.clone();
         let max_bytes = self.ctx.device.limits().max_buffer_size;
@@ -485,7 +541,7 @@ impl Viewport {
         let shown = self.layer_of(n, Part::Quantity(state.selected)).and_then(|q| self.slots[q].computed.clone());
         let volume = state.selected_quantity().and_then(|q| match q.source {
             Source::Volume(i) => Some(i),
-            Source::Wavefunction(_) => None,
+            Source::Wavefunction(_) | Source::Scan(_) => None,
         });
         let slot = &self.slots[l];
         let (cache, progress) = (slot.surface.clone(), slot.surface_progress.clone());
@@ -564,8 +620,12 @@ impl Viewport {
                 Err(e) => said.push(Err(format!("{}: {e}", doc.source))),
             }
         }
+        // A scan's isosurfaces are cut at its value: say which.
+        let scan = self.scan_keys.get(&n).zip(state.scan.as_ref());
+        let isosurfaces =
+            scan.map_or("isosurfaces".into(), |(k, s)| format!("isosurfaces at {}", k.coordinate_label(s.value)));
         for l in self.layers_of(n) {
-            let what = if self.parts[l].1 == Part::Atoms { "molecular surface" } else { "isosurfaces" };
+            let what = if self.parts[l].1 == Part::Atoms { "molecular surface" } else { isosurfaces.as_str() };
             match self.poll_meshes(l) {
                 Some(Ok((0, _))) | None => {}
                 Some(Ok((triangles, note))) => said
@@ -627,7 +687,7 @@ impl Viewport {
     ) -> Option<&'a VolumeGrid> {
         match state.quantities.get(k)?.source {
             Source::Volume(i) => doc.volumes.get(i),
-            Source::Wavefunction(_) => self.computed_grid(n, k),
+            Source::Wavefunction(_) | Source::Scan(_) => self.computed_grid(n, k),
         }
     }
 
@@ -775,7 +835,8 @@ impl Viewport {
         render_state: &egui_wgpu::RenderState,
         view: &mut ViewState,
         panes: &[Pane],
-    ) {
+        twist: Option<TwistInput>,
+    ) -> Twist {
         let rect = ui.available_rect_before_wrap();
         let response = ui.allocate_rect(rect, Sense::click_and_drag());
         let count = panes.len().max(1);
@@ -790,7 +851,14 @@ impl Viewport {
             .collect();
         let pointer = response.interact_pointer_pos().or(response.hover_pos());
         let under = pointer.and_then(|pos| rects.iter().position(|r| r.contains(pos))).unwrap_or(0);
-        if view.panes.linked || under == 0 {
+        let mut twisted = Twist::default();
+        if let (Some(t), Some(&layout)) = (twist, self.pane_layout.get(under)) {
+            twisted = self.twist(&response, layout, &view.panes.camera(under, &view.camera), t);
+            twisted.pane = under;
+        }
+        if self.twisting {
+            // The drag moves the coordinate, not the camera.
+        } else if view.panes.linked || under == 0 {
             handle_input(ui, &response, view, None);
         } else {
             let mut own = ViewState { camera: view.panes.cameras[under], ..*view };
@@ -859,6 +927,7 @@ impl Viewport {
                 Err(e) => log::warn!("picking failed: {e}"),
             }
         }
+        twisted
     }
 
     /// Draws `pane` into its target whole (translucent surfaces settled, in bands if need be),
@@ -923,6 +992,7 @@ impl Viewport {
         self.renderer.truncate(1);
         self.renderer.main().clear(&self.ctx);
         self.slots.clear();
+        self.scan_keys.clear();
         self.generation += 1;
     }
 
@@ -936,6 +1006,11 @@ impl Viewport {
                 p.0 -= 1;
             }
         }
+        self.scan_keys.remove(&n);
+        self.scan_keys = std::mem::take(&mut self.scan_keys)
+            .into_iter()
+            .map(|(m, keys)| (if m > n { m - 1 } else { m }, keys))
+            .collect();
     }
 
     /// The object a pick id's layer belongs to, in place of the layer (views of one layer
@@ -955,29 +1030,6 @@ impl Viewport {
         self.generation += 1;
     }
 
-    /// Shows slot `slot` of a scan at the value (both key volumes and the twisted skeleton).
-    /// Cuts a single-layer view (a scan's) with `clip`; draws again when it moved.
-    pub fn set_clip(&mut self, clip: ClipPlane) {
-        let layer = self.renderer.main();
-        if layer.clip != clip {
-            layer.clip = clip;
-            self.generation += 1;
-        }
-    }
-
-    pub fn show_scan(
-        &mut self,
-        scene: &ScanScene,
-        slot: usize,
-        value: f64,
-        mode: crate::scene::Interpolation,
-        style: crate::scene::AtomStyle,
-    ) {
-        scene.show(&self.ctx, &mut self.renderer, slot, value, mode, style);
-        self.scan_shown = Some((value, mode));
-        self.generation += 1;
-    }
-
     /// Shows the view in the remaining space of `ui`, applying mouse and keyboard input to
     /// `view.camera`; Ctrl + drag moves `clip` (the edited object's clipping plane) when it is on.
     pub fn show(
@@ -988,6 +1040,38 @@ impl Viewport {
         clip: Option<&mut ClipPlane>,
     ) {
         let _ = self.show_twistable(ui, render_state, view, clip, None);
+    }
+
+    /// What this frame's drag in the view laid out at `layout` (seen from `camera`) does to a
+    /// scan's coordinate; whether the drag twists rather than turns the camera is kept until
+    /// it ends.
+    fn twist(
+        &mut self,
+        response: &egui::Response,
+        layout: (egui::Rect, [u32; 2]),
+        camera: &crate::scene::Camera,
+        t: TwistInput,
+    ) -> Twist {
+        let mut twisted = Twist::default();
+        if response.drag_started_by(PointerButton::Primary) {
+            let on_bond = t.bond.zip(response.interact_pointer_pos()).is_some_and(|(bond, p)| {
+                let ends = (self.to_screen_at(layout, camera, bond[0]), self.to_screen_at(layout, camera, bond[1]));
+                matches!(ends, (Some(a), Some(b)) if distance_to_segment(p, a, b) < BOND_GRAB)
+            });
+            self.twisting = t.drag_scans || on_bond;
+            self.grabbed = on_bond && t.direct;
+        }
+        if !response.dragged() {
+            self.twisting = false;
+            self.grabbed = false;
+        }
+        if self.twisting && response.dragged_by(PointerButton::Primary) {
+            match response.interact_pointer_pos().filter(|_| self.grabbed) {
+                Some(p) => twisted.pointer = Some(p),
+                None => twisted.along = response.drag_delta().x / layout.0.width().max(1.0),
+            }
+        }
+        twisted
     }
 
     /// [`Self::show`] for a scan view: returns the drag of this frame on the coordinate (its
@@ -1004,28 +1088,10 @@ impl Viewport {
         let response = ui.allocate_rect(rect, Sense::click_and_drag());
         let ppp = ui.ctx().pixels_per_point();
         let size = [(rect.width() * ppp).round().max(1.0) as u32, (rect.height() * ppp).round().max(1.0) as u32];
-        let mut twisted = Twist::default();
-        if let Some(t) = twist {
-            if response.drag_started_by(PointerButton::Primary) {
-                self.layout = Some((rect, size));
-                let on_bond = t.bond.zip(response.interact_pointer_pos()).is_some_and(|(bond, p)| {
-                    let ends = (self.to_screen(&view.camera, bond[0]), self.to_screen(&view.camera, bond[1]));
-                    matches!(ends, (Some(a), Some(b)) if distance_to_segment(p, a, b) < BOND_GRAB)
-                });
-                self.twisting = t.drag_twists || on_bond;
-                self.grabbed = on_bond && t.direct;
-            }
-            if !response.dragged() {
-                self.twisting = false;
-                self.grabbed = false;
-            }
-            if self.twisting && response.dragged_by(PointerButton::Primary) {
-                match response.interact_pointer_pos().filter(|_| self.grabbed) {
-                    Some(p) => twisted.pointer = Some(p),
-                    None => twisted.along = response.drag_delta().x / rect.width().max(1.0),
-                }
-            }
-        }
+        let twisted = match twist {
+            Some(t) => self.twist(&response, (rect, size), &view.camera, t),
+            None => Twist::default(),
+        };
         if !self.twisting {
             handle_input(ui, &response, view, clip);
         }
@@ -1267,8 +1333,23 @@ impl Viewport {
 
     /// Where world point `p` (bohr) lies on screen in the last frame laid out.
     pub fn to_screen(&self, camera: &crate::scene::Camera, p: glam::Vec3) -> Option<egui::Pos2> {
-        let (rect, size) = self.layout?;
-        // A split view's first pane is drawn from its camera stood back to fit the pane's width.
+        self.to_screen_at(self.layout?, camera, p)
+    }
+
+    /// Where world point `p` is drawn in pane `pane` of a split view seen from `camera` (the
+    /// single view's place when the view is not split).
+    pub fn to_screen_in(&self, pane: usize, camera: &crate::scene::Camera, p: glam::Vec3) -> Option<egui::Pos2> {
+        let layout = self.pane_layout.get(pane).copied().or(self.layout)?;
+        self.to_screen_at(layout, camera, p)
+    }
+
+    fn to_screen_at(
+        &self,
+        (rect, size): (egui::Rect, [u32; 2]),
+        camera: &crate::scene::Camera,
+        p: glam::Vec3,
+    ) -> Option<egui::Pos2> {
+        // A split view's panes are drawn from their camera stood back to fit the pane's width.
         let camera = if self.pane_layout.is_empty() { *camera } else { fit_width(*camera, size) };
         let c = self.renderer.clip_from_world(&camera, size) * p.extend(1.0);
         (c.w > 1e-6).then(|| {
@@ -1325,6 +1406,12 @@ impl Viewport {
 
 /// `camera` stood back so that what fits its height fits a view of `size` narrower than it is
 /// tall (a pane of a split view): the panes show the whole molecule, not a slice of it.
+/// Where an object's clipping plane is measured from: the middle of what its scan's sweep shows
+/// (the same at every value), else of its document.
+fn clip_centre(doc: &Document, keys: Option<&ScanScene>) -> glam::Vec3 {
+    keys.map_or_else(|| crate::layers::object_centre(doc), ScanScene::clip_centre)
+}
+
 fn fit_width(mut camera: crate::scene::Camera, size: [u32; 2]) -> crate::scene::Camera {
     let aspect = size[0] as f32 / size[1].max(1) as f32;
     if aspect < 1.0 {

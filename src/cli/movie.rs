@@ -194,6 +194,11 @@ fn session_scene(path: &Path) -> Result<(Objects, Camera, [f32; 3])> {
     let session = read.session;
     let mut scene = Vec::new();
     for mut state in session.objects {
+        if let Some(scan) = &state.scan {
+            let manifest =
+                scan.manifest.as_ref().map_or("(none: the bundled scan)".into(), |m| m.display().to_string());
+            bail!("{}: the session holds a scan; `orbcloud movie {manifest}` sweeps it", path.display());
+        }
         let Some(file) = state.path.clone() else { continue };
         let mut doc =
             crate::formats::load(&file).with_context(|| format!("{}: opening {}", path.display(), file.display()))?;

@@ -20,7 +20,7 @@ pub fn counterpart(doc: &Document, source: Source, other: &Document) -> Option<S
     };
     let own = match source {
         Source::Wavefunction(q) if density_like(q) => Some(q),
-        Source::Wavefunction(_) => return None,
+        Source::Wavefunction(_) | Source::Scan(_) => return None,
         Source::Volume(i) if i < doc.volumes.len() => None,
         Source::Volume(_) => return None,
     };
@@ -74,6 +74,7 @@ pub fn difference(doc: &Document, source: Source, points: usize, other: &Documen
             VolumeGrid::new(source.name(doc), spec.dims, spec.world_from_grid, values)
         }
         (Source::Wavefunction(_), None) => return Err(format!("{}: no wavefunction", doc.source)),
+        (Source::Scan(_), _) => return Err(format!("{}: a scan's orbital changes with its coordinate", doc.source)),
     };
     let at = grid_points(mine.dims, |i, j, k| mine.point(i, j, k));
     let (subtract, _) = values_of(other, theirs, &at)?;

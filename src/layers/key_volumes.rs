@@ -9,13 +9,14 @@ use glam::DVec3;
 use thiserror::Error;
 
 use crate::gpu::gto::{GtoFillPass, read_volume};
+use crate::gpu::renderer::Layer;
 use crate::gpu::volume::{VolumeTexture, residency_budget, texel_bytes};
 use crate::gpu::{FrameInput, GpuContext, GpuError, OffscreenTarget, Renderer};
 use crate::model::GridSpec;
 use crate::model::cartesian::CartesianExpansion;
 use crate::model::scan::{Bracket, Follow, Scan, ScanError, Tracks};
 use crate::model::units::EV_PER_HARTREE;
-use crate::model::{PreparedBasis, VolumeGrid};
+use crate::model::{Document, PreparedBasis, VolumeGrid};
 use crate::scene::framing::ORBITAL_MARGIN;
 use crate::scene::{AtomStyle, Camera, Interpolation, RenderSettings};
 
@@ -57,7 +58,8 @@ impl Default for KeyOptions {
 
 /// A scan with all its key volumes resident on the GPU.
 pub struct ScanScene {
-    pub scan: Scan,
+    /// Shared with the documents of the scan's object ([`crate::model::Document::scan`]).
+    pub scan: Arc<Scan>,
     pub tracks: Tracks,
     pub grid: GridSpec,
     /// `keys[slot][frame]`, phase-aligned, each with the slot's common opacity scale.
@@ -158,15 +160,15 @@ impl ScanScene {
             scale.push(max_abs);
         }
         let key_grids = grids.into_iter().map(|g| g.into_iter().map(Arc::new).collect()).collect();
-        Ok(Self { scan, tracks, grid, keys, key_grids, scale, visible, bytes: needed, budget })
+        Ok(Self { scan: Arc::new(scan), tracks, grid, keys, key_grids, scale, visible, bytes: needed, budget })
     }
 
     pub fn slots(&self) -> usize {
         self.keys.len()
     }
 
-    /// Puts slot `slot` at the value into `renderer`: the two key volumes around the value and the skeleton
-    /// turned to the value.
+    /// Puts slot `slot` at the value into `renderer`'s first layer: the two key volumes around
+    /// the value and the skeleton turned to the value.
     pub fn show(
         &self,
         ctx: &GpuContext,
@@ -176,13 +178,42 @@ impl ScanScene {
         mode: Interpolation,
         style: AtomStyle,
     ) {
-        let Bracket { a, b, k } = self.scan.bracket(value);
-        let keys = &self.keys[slot];
         let layer = renderer.main();
-        layer.set_morph(ctx, keys[a].clone(), keys[b].clone(), k as f32, mode);
-        // A clipping plane's offset is measured from the middle of what the sweep shows.
-        layer.clip_centre = (0.5 * (self.visible.0 + self.visible.1)).as_vec3();
+        self.show_view(ctx, layer, slot, value, mode);
         layer.set_molecule(ctx, &self.scan.geometry_at(value), style);
+    }
+
+    /// Puts view `slot` at the value into `layer`: the two key volumes around the value, mixed
+    /// as `mode` says. Within one pair of key volumes only the mixing weight changes.
+    pub fn show_view(&self, ctx: &GpuContext, layer: &mut Layer, slot: usize, value: f64, mode: Interpolation) {
+        let Bracket { a, b, k } = self.scan.bracket(value);
+        let Some(keys) = self.keys.get(slot) else { return };
+        layer.set_morph(ctx, keys[a].clone(), keys[b].clone(), k as f32, mode);
+        layer.clip_centre = self.clip_centre();
+    }
+
+    /// Where a clipping plane's offset is measured from: the middle of what the sweep shows (the
+    /// same at every value, so a plane stays put while the coordinate moves).
+    pub fn clip_centre(&self) -> glam::Vec3 {
+        (0.5 * (self.visible.0 + self.visible.1)).as_vec3()
+    }
+
+    /// View `slot`'s values at the value, mixed on the CPU from the two key volumes around it (what
+    /// its isosurfaces are cut from).
+    pub fn values_at(&self, slot: usize, value: f64) -> VolumeGrid {
+        let (a, b, k) = self.bracket_grids(slot, value);
+        mix(&a, &b, k)
+    }
+
+    /// The document of the scan's object at the value: the skeleton there, the scan shared.
+    pub fn document_at(&self, value: f64, source: &str) -> Document {
+        Document {
+            source: source.to_string(),
+            title: self.scan.title.clone(),
+            molecule: self.scan.geometry_at(value),
+            scan: Some(self.scan.clone()),
+            ..Document::default()
+        }
     }
 
     /// A camera framing what the sweep shows ([`ScanScene::visible`]), looking at the first key
@@ -219,10 +250,7 @@ impl ScanScene {
 
     /// "HOMO  −0.3012 Eh  (−8.20 eV)" (after the view's caption, if any) at the value, the energy interpolated between key frames.
     pub fn label(&self, slot: usize, value: f64) -> String {
-        let mut name = self.scan.orbitals[slot].to_uppercase().replace('-', "−");
-        if let Some(caption) = self.scan.captions.get(slot).filter(|c| !c.is_empty()) {
-            name = format!("{caption}: {name}");
-        }
+        let name = self.scan.slot_name(slot);
         match self.scan.energy_at(&self.tracks, slot, value) {
             Some(e) => format!("{name}  {e:.4} Eh  ({:.2} eV)", e * EV_PER_HARTREE).replace('-', "−"),
             None => name,

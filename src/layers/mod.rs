@@ -119,7 +119,7 @@ pub fn show_object(
     let quantity = state.selected_quantity();
     let grid = quantity.and_then(|q| match q.source {
         Source::Volume(i) => doc.volumes.get(i),
-        Source::Wavefunction(_) => None,
+        Source::Wavefunction(_) | Source::Scan(_) => None,
     });
     layer.set_volume(ctx, grid)?;
     let meshes: Vec<_> = match (grid, quantity) {
@@ -168,6 +168,8 @@ pub fn show_quantity(
             let view = WavefunctionView { quantity, direct: e.direct, points: e.grid_points, functions, grid };
             show_wavefunction(ctx, layer, fill, doc, &view)?
         }
+        // Its key volumes live with the window's scan ([`key_volumes::ScanScene`]).
+        Source::Scan(_) => None,
     };
     let mut color_map = None;
     if let Some(grid) = values.as_ref().and_then(|v| v.grid.as_ref()) {

@@ -610,6 +610,17 @@ pub fn align_frames(frames: &mut [&mut KeyFrame]) -> Result<(), ScanError> {
 }
 
 impl Scan {
+    /// What view `slot` shows, as the window names it: "HOMO", "LUMO+1", after the view's
+    /// caption when it has one ("RHF: HOMO").
+    pub fn slot_name(&self, slot: usize) -> String {
+        let name = self.orbitals.get(slot).map_or_else(|| format!("orbital {}", slot + 1), |o| o.to_uppercase());
+        let name = name.replace('-', "−");
+        match self.captions.get(slot).filter(|c| !c.is_empty()) {
+            Some(caption) => format!("{caption}: {name}"),
+            None => name,
+        }
+    }
+
     /// Checks the coordinate against the molecule and finds the atoms that move with it.
     /// `frames` must be sorted by value without duplicates (the manifest reader reports those
     /// with their lines).

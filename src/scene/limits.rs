@@ -12,7 +12,7 @@ use std::ops::RangeInclusive;
 use super::camera::PITCH_LIMIT;
 use super::excited_view::ExcitedView;
 use super::objects::MAX_PANES;
-use super::objects::ScanState;
+use super::scan_state::{LegacyScan, ScanState};
 use super::translucency::OpticsTuning;
 use super::vibration::VibrationState;
 use super::{
@@ -190,6 +190,12 @@ impl ScanState {
             n.note(&format!("{key}.orbitals"), format!("{orbitals} orbitals; the first {MAX_SCAN_ORBITALS} kept"));
             self.orbitals.truncate(MAX_SCAN_ORBITALS);
         }
+    }
+}
+
+impl LegacyScan {
+    fn sanitize(&mut self, key: &str, n: &mut Notes) {
+        self.state.sanitize(key, n);
         let s = &mut self.settings;
         s.volume.sanitize(&format!("{key}.settings.volume"), n);
         s.iso.sanitize(&format!("{key}.settings.iso"), n);
@@ -248,6 +254,9 @@ impl ObjectState {
         let default = ExcitedView::default();
         n.real(&format!("{key}.excited.fwhm_ev"), &mut self.excited.fwhm_ev, FWHM_EV, default.fwhm_ev);
         self.clip.sanitize(&format!("{key}.clip"), n);
+        if let Some(scan) = &mut self.scan {
+            scan.sanitize(&format!("{key}.scan"), n);
+        }
     }
 }
 
@@ -471,8 +480,9 @@ mod tests {
         object.evaluation.grid_points = usize::MAX;
         object.clip.normal = [0.0; 3];
         s.objects.push(object);
-        let mut scan = ScanState { value: f64::NAN, speed: f64::INFINITY, diagram: 100, ..Default::default() };
-        scan.orbitals = vec!["homo".into(); 40];
+        let state = ScanState { value: f64::NAN, speed: f64::INFINITY, diagram: 100, ..Default::default() };
+        let mut scan = LegacyScan { state, ..Default::default() };
+        scan.state.orbitals = vec!["homo".into(); 40];
         scan.settings.volume.slices = 4_000_000_000;
         s.scan = Some(scan);
         let notes = s.sanitize();
@@ -499,8 +509,9 @@ mod tests {
         assert_eq!(notes.len(), 15, "{notes:#?}");
         let q = &s.objects[0].quantities[0];
         let scan = s.scan.as_ref().unwrap();
-        assert!(scan.value.is_finite() && scan.speed.is_finite() && scan.orbitals.len() == MAX_SCAN_ORBITALS);
-        assert_eq!((scan.diagram, scan.settings.volume.slices), (8, *SLICES.end()));
+        let state = &scan.state;
+        assert!(state.value.is_finite() && state.speed.is_finite() && state.orbitals.len() == MAX_SCAN_ORBITALS);
+        assert_eq!((scan.state.diagram, scan.settings.volume.slices), (8, *SLICES.end()));
         assert_eq!((q.cloud.slices, s.panes.count, s.objects[0].selected), (*SLICES.end(), MAX_PANES, 0));
         assert_eq!(q.isosurfaces[0].level, IsosurfaceSettings::default().level);
         assert_eq!(s.camera.distance, Camera::default().distance);

@@ -11,6 +11,7 @@ pub mod objects;
 pub mod occupancy;
 pub mod opacity;
 pub mod quantity;
+pub mod scan_state;
 pub mod selection;
 pub mod settings;
 pub mod slicing;
@@ -22,9 +23,10 @@ pub mod view;
 pub use camera::Camera;
 pub use coloring::AtomColors;
 pub use molsurface::{SurfaceChoice, SurfaceSettings};
-pub use objects::{Changes, ObjectState, Panes, Placement, QuantityChanges, ScanState, Session, changes};
+pub use objects::{Changes, ObjectState, Panes, Placement, QuantityChanges, Session, changes};
 pub use opacity::DensityScale;
 pub use quantity::{AtomLook, ESP_MAP_DENSITY, Evaluation, QuantityState, Source};
+pub use scan_state::{LegacyScan, ScanState};
 pub use settings::{
     AtomColoring, AtomStyle, Interpolation, IsoLevel, IsosurfaceSettings, RenderSettings, SliceMode, VolumeSettings,
 };

@@ -9,6 +9,7 @@ use crate::model::orbitals::Quantity;
 
 use super::excited_view::ExcitedView;
 use super::quantity::{AtomLook, Evaluation, QuantityState, Source, first_source};
+pub use super::scan_state::{LegacyScan, ScanState};
 use super::vibration::VibrationState;
 use super::{Camera, ClipPlane, IsosurfaceSettings, RenderSettings, SurfaceChoice, SurfaceSettings};
 
@@ -95,6 +96,9 @@ pub struct ObjectState {
     /// object's frame, its offset from the centre of the object's bounds
     /// ([`crate::model::Document::bounds`]).
     pub clip: ClipPlane,
+    /// The scan it is a frame of: where the coordinate stands and how it plays (its views are
+    /// its quantities, [`Source::Scan`]).
+    pub scan: Option<ScanState>,
 }
 
 /// A data set an object holds beyond its file's own, made again when a session reopens.
@@ -124,6 +128,7 @@ impl Default for ObjectState {
             vibration: VibrationState::default(),
             excited: ExcitedView::default(),
             clip: ClipPlane::default(),
+            scan: None,
         }
     }
 }
@@ -222,6 +227,9 @@ pub struct Changes {
     pub rest: bool,
     /// The clipping plane moved, or was turned on or off.
     pub clip: bool,
+    /// The scan's value or interpolation changed: the skeleton moves in place and each view's
+    /// mixing weight is set (the key volumes stay bound), its isosurfaces cut at the value.
+    pub scan_frame: bool,
     /// Per quantity (when `layers` is false): what to redo.
     pub quantities: Vec<QuantityChanges>,
 }
@@ -253,7 +261,8 @@ impl Changes {
             || self.surface
             || self.arrows
             || self.rest
-            || self.clip)
+            || self.clip
+            || self.scan_frame)
             && self.quantities.iter().all(|q| !q.any())
     }
 }
@@ -309,16 +318,19 @@ pub fn changes(before: &ObjectState, after: &ObjectState) -> Changes {
             .collect()
     };
     let visible = |s: &ObjectState| (s.visible, s.quantities.iter().map(|q| (q.visible, q.pane)).collect::<Vec<_>>());
+    let scan_frame = before.scan.as_ref().map(|s| (s.value, s.mode)) != after.scan.as_ref().map(|s| (s.value, s.mode));
     Changes {
         layers,
         atoms: before.atoms != after.atoms || before.selection != after.selection,
         placement: before.placement != after.placement,
         visibility: visible(before) != visible(after),
+        // A molecular surface follows the atoms a selection shows, and a scan's skeleton.
         surface: before.surface != after.surface
-            || (after.surface.choice != SurfaceChoice::Off && before.selection != after.selection),
+            || (after.surface.choice != SurfaceChoice::Off && (before.selection != after.selection || scan_frame)),
         arrows: before.vibration.arrows_key() != after.vibration.arrows_key(),
         rest: before.vibration.mode.is_some() && after.vibration.mode.is_none(),
         clip: before.clip != after.clip,
+        scan_frame,
         quantities,
     }
 }
@@ -348,6 +360,7 @@ struct StoredObject {
     isosurfaces: Vec<IsosurfaceSettings>,
     volume: usize,
     quantity: Option<Quantity>,
+    scan: Option<ScanState>,
 }
 
 impl From<StoredObject> for ObjectState {
@@ -381,6 +394,7 @@ impl From<StoredObject> for ObjectState {
             vibration: s.vibration,
             excited: s.excited,
             clip: clip.unwrap_or_default(),
+            scan: s.scan,
         }
     }
 }
@@ -437,51 +451,10 @@ pub struct Session {
     pub objects: Vec<ObjectState>,
     /// Files opened recently, newest first (the session kept between runs).
     pub recent: Vec<std::path::PathBuf>,
-    /// The scan open in the window, shown instead of the objects.
-    pub scan: Option<ScanState>,
-}
-
-/// A scan as a session keeps it: where it comes from, where its coordinate stood, how frames
-/// between its key volumes are mixed and drawn, and which orbitals its views follow.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
-pub struct ScanState {
-    /// Its manifest (`*.scan.toml`); `None`: the bundled PSB3 scan.
-    pub manifest: Option<std::path::PathBuf>,
-    /// The coordinate's value in its unit (degrees, Å, or a path's position).
-    pub value: f64,
-    pub mode: super::Interpolation,
-    /// Bounce between the ends when playing.
-    pub looping: bool,
-    /// Animation speed, the coordinate's units per second.
-    pub speed: f64,
-    /// A horizontal drag changes the value (else it orbits and only a drag on the bond does).
-    pub drag_scans: bool,
-    /// How its views draw the orbitals at the value: cloud, isosurfaces, atoms.
-    pub settings: RenderSettings,
-    /// The orbitals its views show, as manifests name them (empty: the manifest's own).
-    pub orbitals: Vec<String>,
-    /// How orbitals are followed across frames.
-    pub follow: crate::model::scan::Follow,
-    /// How many orbitals below the HOMO and above the LUMO the correlation diagram shows.
-    pub diagram: usize,
-}
-
-impl Default for ScanState {
-    fn default() -> Self {
-        Self {
-            manifest: None,
-            value: 0.0,
-            mode: super::Interpolation::default(),
-            looping: true,
-            speed: 30.0,
-            drag_scans: true,
-            settings: RenderSettings::default(),
-            orbitals: Vec::new(),
-            follow: crate::model::scan::Follow::default(),
-            diagram: 2,
-        }
-    }
+    /// A scan as sessions kept it before scans were objects: read, never written (it opens as an
+    /// object, [`LegacyScan::into_object`]).
+    #[serde(skip_serializing)]
+    pub scan: Option<LegacyScan>,
 }
 
 /// What a session file is called.
@@ -589,6 +562,23 @@ mod tests {
         cut.clip.enabled = true;
         let c = changes(&before, &cut);
         assert!(c.clip && !c.placement && !c.surface && !c.atoms && c.quantities.iter().all(|q| !q.any()));
+        // A scan's new value or interpolation: the frame only (atoms in place, mixing weights),
+        // no quantity evaluated anew; playing or its speed changes nothing on the GPU.
+        let scanned = ObjectState { scan: Some(super::ScanState::default()), ..before.clone() };
+        let mut twisted = scanned.clone();
+        twisted.scan.as_mut().unwrap().value = 30.0;
+        let c = changes(&scanned, &twisted);
+        assert!(c.scan_frame && !c.atoms && !c.layers && !c.surface && c.quantities.iter().all(|q| !q.any()));
+        let mut played = scanned.clone();
+        played.scan.as_mut().unwrap().playing = true;
+        played.scan.as_mut().unwrap().speed = 5.0;
+        assert!(changes(&scanned, &played).is_empty());
+        // A molecular surface follows the skeleton.
+        let mut surfaced = scanned.clone();
+        surfaced.surface.choice = SurfaceChoice::Gaussian;
+        let mut surfaced_twisted = surfaced.clone();
+        surfaced_twisted.scan.as_mut().unwrap().value = 30.0;
+        assert!(changes(&surfaced, &surfaced_twisted).surface);
         // Which atoms are shown restyles them, and wraps a molecular surface anew.
         let mut selected = before.clone();
         selected.surface.choice = SurfaceChoice::Gaussian;

@@ -17,6 +17,9 @@ pub enum Source {
     Volume(usize),
     /// An orbital or density evaluated from the file's wavefunction.
     Wavefunction(Quantity),
+    /// View `slot` of the scan the document is a frame of ([`Document::scan`]): its orbital at
+    /// the object's value, mixed from the two key volumes around it.
+    Scan(usize),
 }
 
 impl Source {
@@ -39,6 +42,7 @@ impl Source {
                 | Quantity::Detachment
                 | Quantity::ExcitedDensity => wf.excited.is_some(),
             }),
+            Source::Scan(slot) => doc.scan.as_ref().is_some_and(|s| slot < s.orbitals.len()),
         }
     }
 
@@ -48,6 +52,7 @@ impl Source {
     pub fn is_potential(self, doc: &Document) -> bool {
         match self {
             Source::Wavefunction(q) => q == Quantity::Potential,
+            Source::Scan(_) => false,
             Source::Volume(i) => doc.volumes.get(i).is_some_and(|v| {
                 let label = v.label.to_ascii_lowercase();
                 label.contains("potential")
@@ -69,6 +74,7 @@ impl Source {
     pub fn name(self, doc: &Document) -> String {
         match self {
             Source::Volume(i) => doc.volumes.get(i).map_or_else(|| format!("data set {}", i + 1), |v| v.label.clone()),
+            Source::Scan(slot) => doc.scan.as_ref().map_or_else(|| format!("view {}", slot + 1), |s| s.slot_name(slot)),
             Source::Wavefunction(Quantity::Density) => "total density".into(),
             Source::Wavefunction(Quantity::SpinDensity) => "spin density".into(),
             Source::Wavefunction(Quantity::Potential) => "electrostatic potential".into(),
@@ -326,6 +332,9 @@ impl Evaluation {
 /// What a file shows first: a wavefunction's HOMO (α), a cube's first data set, nothing for a
 /// structure.
 pub fn first_source(doc: &Document) -> Option<Source> {
+    if doc.scan.as_ref().is_some_and(|s| !s.orbitals.is_empty()) {
+        return Some(Source::Scan(0));
+    }
     if let Some(wf) = &doc.wavefunction {
         return Some(Source::Wavefunction(wf.homo(Spin::Alpha).map_or(Quantity::Density, Quantity::Orbital)));
     }
