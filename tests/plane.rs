@@ -9,6 +9,8 @@ use std::process::{Command, Output};
 use glam::DVec3;
 use orbcloud::model::units::BOHR_PER_ANGSTROM;
 
+mod common;
+
 fn orbcloud(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_orbcloud")).args(args).output().expect("run orbcloud")
 }
@@ -257,4 +259,64 @@ fn second_derivative_quantities_map_as_eval_gives_them() {
             assert!(text.contains(r#"class="gradient""#), "gradient lines drawn");
         }
     }
+}
+
+/// The plane map's frame in the view is a representation of its own (`gpu::plane_frame`): lines
+/// of a constant width on screen where the plane lies, hidden where an atom stands in front.
+#[test]
+fn the_plane_frame_is_drawn_where_the_plane_lies_and_atoms_in_front_hide_it() {
+    use glam::Vec3;
+    use orbcloud::gpu::{FrameInput, OffscreenTarget, Renderer};
+    use orbcloud::model::Molecule;
+    use orbcloud::model::atom::Atom;
+    use orbcloud::scene::{AtomStyle, Camera, RenderSettings, VolumeSettings};
+    let ctx = common::lavapipe();
+    let size = [200u32, 200];
+    // A carbon at the origin, space filling (radius about 3 bohr), in front of the plane z = −1.
+    let carbon = Atom { z: 6, charge: 6.0, position: DVec3::ZERO, ghost: false };
+    let mut renderer = Renderer::new(&ctx);
+    renderer.main().set_molecule(&ctx, &Molecule::new(vec![carbon]), AtomStyle::SpaceFilling);
+    let c = |x: f32, y: f32| Vec3::new(x, y, -1.0);
+    let square = [c(-6.0, -6.0), c(6.0, -6.0), c(6.0, 6.0), c(-6.0, 6.0)];
+    let mut lines: Vec<[Vec3; 2]> = (0..4).map(|k| [square[k], square[(k + 1) % 4]]).collect();
+    lines.push([square[0], square[2]]);
+    let amber = [1.0, 0.72, 0.19];
+    renderer.main().plane_frame.set_lines(&ctx, &lines, amber);
+    assert_eq!(renderer.main().plane_frame.count(), 5);
+    let camera = Camera::framing(Vec3::splat(-8.0), Vec3::splat(8.0));
+    let hidden = [VolumeSettings { visible: false, ..Default::default() }];
+    let target = OffscreenTarget::new(&ctx.device, size);
+    let mut encoder = ctx.device.create_command_encoder(&Default::default());
+    let frame = FrameInput {
+        camera: &camera,
+        background: RenderSettings::default().background,
+        clouds: &hidden,
+        size,
+        tile: None,
+    };
+    renderer.render(&ctx, &mut encoder, &target.color_view, &frame);
+    ctx.queue.submit([encoder.finish()]);
+    let picture = target.read_rgba(&ctx.device, &ctx.queue).unwrap();
+    let is_amber = |p: &image::Rgba<u8>| p[0] > 200 && (120..230).contains(&p[1]) && p[2] < 140;
+    let clip = renderer.clip_from_world(&camera, size);
+    let pixel = |p: Vec3| {
+        let q = clip * p.extend(1.0);
+        let ndc = q.truncate() / q.w;
+        [((ndc.x * 0.5 + 0.5) * size[0] as f32) as u32, ((0.5 - ndc.y * 0.5) * size[1] as f32) as u32]
+    };
+    // Along each edge of the square (nothing in front), the frame's colour within a pixel.
+    for [a, b] in &lines[..4] {
+        for t in [0.25f32, 0.5, 0.75] {
+            let [x, y] = pixel(a.lerp(*b, t));
+            let near = (x.saturating_sub(1)..=x + 1).flat_map(|x| (y.saturating_sub(1)..=y + 1).map(move |y| (x, y)));
+            assert!(near.into_iter().any(|(x, y)| is_amber(picture.get_pixel(x, y))), "edge at {x},{y}");
+        }
+    }
+    // The diagonal runs behind the carbon: hidden at its middle, seen near the corners.
+    let [x, y] = pixel(c(0.0, 0.0));
+    assert!(!is_amber(picture.get_pixel(x, y)), "the atom hides the frame behind it");
+    let drawn = picture.pixels().filter(|p| is_amber(p)).count();
+    eprintln!("plane frame: {drawn} pixels");
+    // Five segments of some 50–70 pixels, two pixels wide, less what the atom covers.
+    assert!((300..1200).contains(&drawn), "{drawn} pixels of the frame's colour");
 }

@@ -526,3 +526,26 @@ fn per_point_fchk_files_with_optimisation_histories_make_a_scan() {
         }
     }
 }
+
+#[test]
+fn playing_bounces_between_the_ends_or_stops_and_keys_step_between_frames() {
+    let scan = demo::scan().unwrap().scan;
+    let (lo, hi) = scan.range();
+    let mut state = orbcloud::scene::ScanState::opening(&scan, None);
+    assert!(scan.values().contains(&state.value), "opens on a key frame");
+    state.set_value(&scan, f64::NAN);
+    assert!(state.value.is_finite());
+    state.set_value(&scan, hi + 100.0);
+    assert_eq!(state.value, hi);
+    state.playing = true;
+    state.advance(&scan, 1.0);
+    assert!(state.backwards && state.value == hi && state.playing, "turns at the end");
+    state.advance(&scan, 0.1);
+    assert!(state.value < hi, "and comes back");
+    state.looping = false;
+    state.set_value(&scan, lo + 1e-3);
+    state.advance(&scan, 10.0);
+    assert!(!state.playing && state.value == lo, "stops at the end");
+    state.step_key(&scan, 1);
+    assert_eq!(state.value, scan.values()[1]);
+}

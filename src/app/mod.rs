@@ -1521,6 +1521,9 @@ impl eframe::App for OrbApp {
                 let states: Vec<&ObjectState> = self.objects.iter().map(|o| &o.state).collect();
                 vp.set_clouds(&states);
                 let count = self.view.panes.count;
+                // The plane map's frame where the plane lies, in the active object.
+                let frame = if self.plane.open { plane_pane::frame_lines(&self.plane) } else { Vec::new() };
+                vp.show_plane_frame(self.active, frame);
                 let scan = self.objects.iter().position(|o| o.scan.is_some());
                 let twist = scan.and_then(|n| scan::twist_input(ui, &self.objects[n]));
                 let twisted = if count > 1 {
@@ -1564,8 +1567,7 @@ impl eframe::App for OrbApp {
                     }
                 }
                 measure::overlay(ui, vp, &self.view.camera, &self.world, &self.measurements, self.view.labels);
-                if let Some(o) = self.objects.get(self.active).filter(|_| self.plane.open) {
-                    plane_pane::outline(ui, vp, &self.view.camera, &self.plane, &o.state.placement);
+                if self.objects.get(self.active).is_some() && self.plane.open {
                     // Alt + wheel over the view moves the plane along its normal, 0.1 Å a notch.
                     let notches: Vec<f32> = ui.input(|i| {
                         (i.raw.events.iter())

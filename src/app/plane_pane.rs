@@ -8,16 +8,15 @@
 use std::path::Path;
 use std::sync::Arc;
 
-use egui::{Color32, RichText, Stroke};
+use egui::RichText;
 
 use super::jobs::Latest;
-use super::viewport::Viewport;
 use glam::DVec3;
 
 use crate::model::Document;
 use crate::model::units::BOHR_PER_ANGSTROM;
 use crate::plane::{self, ColorScale, Frame, Levels, MapPicture, PlaneMap};
-use crate::scene::{Camera, Placement, Source};
+use crate::scene::Source;
 
 /// Points per side of the map drawn while the plane moves, before the full one.
 const COARSE_POINTS: usize = 60;
@@ -328,19 +327,16 @@ pub fn panel(
     save
 }
 
-/// The plane's outline in the view: the map's rectangle, placed as its object is.
-pub fn outline(ui: &egui::Ui, vp: &Viewport, camera: &Camera, pane: &PlanePane, placement: &Placement) {
-    let Some(made) = pane.made() else { return };
+/// The plane's frame in the view, in its object's frame: the map's rectangle and a diagonal
+/// (none before a map is made). The renderer draws it where the plane lies
+/// ([`crate::gpu::plane_frame`]), so atoms in front of the plane hide it.
+pub fn frame_lines(pane: &PlanePane) -> Vec<[glam::Vec3; 2]> {
+    let Some(made) = pane.made() else { return Vec::new() };
     let plane = &made.map.plane;
-    let m = placement.world_from_object().as_dmat4();
     let [w, h] = plane.size.map(|s| s * 0.5);
     let corners = [(-w, -h), (w, -h), (w, h), (-w, h)]
-        .map(|(x, y)| m.transform_point3(plane.center + plane.frame.u * x + plane.frame.v * y).as_vec3());
-    let Some(points) = corners.iter().map(|&p| vp.to_screen(camera, p)).collect::<Option<Vec<_>>>() else { return };
-    let stroke = Stroke::new(1.5, Color32::from_rgba_unmultiplied(255, 220, 120, 200));
-    let painter = ui.painter();
-    for k in 0..4 {
-        painter.line_segment([points[k], points[(k + 1) % 4]], stroke);
-    }
-    painter.line_segment([points[0], points[2]], Stroke::new(0.5, stroke.color.gamma_multiply(0.5)));
+        .map(|(x, y)| (plane.center + plane.frame.u * x + plane.frame.v * y).as_vec3());
+    let mut lines: Vec<[glam::Vec3; 2]> = (0..4).map(|k| [corners[k], corners[(k + 1) % 4]]).collect();
+    lines.push([corners[0], corners[2]]);
+    lines
 }

@@ -251,6 +251,8 @@ pub struct Viewport {
     pane_layout: Vec<(egui::Rect, [u32; 2])>,
     /// The key volumes of the objects that are frames of a scan, by object.
     scan_keys: std::collections::BTreeMap<usize, Arc<ScanScene>>,
+    /// The plane map's frame drawn: the object and its lines.
+    plane_frame: Option<(usize, Vec<[glam::Vec3; 2]>)>,
 }
 
 impl Viewport {
@@ -289,6 +291,7 @@ impl Viewport {
             split: Vec::new(),
             pane_layout: Vec::new(),
             scan_keys: Default::default(),
+            plane_frame: None,
         }
     }
 
@@ -444,6 +447,25 @@ impl Viewport {
                 Ok(None)
             }
         }
+    }
+
+    /// Draws the plane map's frame `lines` (object `n`'s frame) with object `n`'s atoms; none
+    /// when empty. Uploaded only when they changed.
+    pub fn show_plane_frame(&mut self, n: usize, lines: Vec<[glam::Vec3; 2]>) {
+        let wanted = (!lines.is_empty()).then_some((n, lines));
+        if self.plane_frame == wanted {
+            return;
+        }
+        if let Some(l) = self.plane_frame.as_ref().and_then(|(was, _)| self.layer_of(*was, Part::Atoms)) {
+            self.renderer.layer_mut(&self.ctx, l).plane_frame.set_lines(&self.ctx, &[], PLANE_FRAME_COLOR);
+        }
+        if let Some((n, lines)) = &wanted
+            && let Some(l) = self.layer_of(*n, Part::Atoms)
+        {
+            self.renderer.layer_mut(&self.ctx, l).plane_frame.set_lines(&self.ctx, lines, PLANE_FRAME_COLOR);
+        }
+        self.plane_frame = wanted;
+        self.generation += 1;
     }
 
     /// Gives object `n` the key volumes of the scan it is a frame of (`None`: it is none); its
@@ -993,11 +1015,14 @@ impl Viewport {
         self.renderer.main().clear(&self.ctx);
         self.slots.clear();
         self.scan_keys.clear();
+        self.plane_frame = None;
         self.generation += 1;
     }
 
     /// Removes object `n`; the objects after it move down by one.
     pub fn remove_object(&mut self, n: usize) {
+        // The plane's frame is drawn again where the next frame asks.
+        self.show_plane_frame(n, Vec::new());
         for l in self.layers_of(n).rev() {
             self.remove_layer(l);
         }
@@ -1406,6 +1431,9 @@ impl Viewport {
 
 /// `camera` stood back so that what fits its height fits a view of `size` narrower than it is
 /// tall (a pane of a split view): the panes show the whole molecule, not a slice of it.
+/// The plane map's frame in the view (linear RGB): the amber of the map's outline.
+const PLANE_FRAME_COLOR: [f32; 3] = [1.0, 0.72, 0.19];
+
 /// Where an object's clipping plane is measured from: the middle of what its scan's sweep shows
 /// (the same at every value), else of its document.
 fn clip_centre(doc: &Document, keys: Option<&ScanScene>) -> glam::Vec3 {

@@ -11,6 +11,7 @@ use super::arrows::ArrowsPass;
 use super::atoms::AtomsPass;
 use super::frame::{Draw, Representation, Shared};
 use super::isosurface::IsosurfacePass;
+use super::plane_frame::PlaneFramePass;
 use super::volume::{VolumePass, VolumeTexture};
 use super::{GpuContext, GpuError};
 use crate::model::GridSpec;
@@ -61,6 +62,8 @@ representations! {
     arrows: ArrowsPass,
     surfaces: IsosurfacePass,
     volume: VolumePass,
+    /// The plane map's frame where the plane lies.
+    plane_frame: PlaneFramePass,
 }
 
 /// One object of the scene on the GPU: its representations, drawn where `world_from_object`

@@ -15,6 +15,7 @@ pub mod isosurface;
 pub mod layer;
 pub mod occlusion;
 pub mod oit;
+pub mod plane_frame;
 pub mod readback;
 pub mod renderer;
 pub mod resolve;
@@ -60,6 +61,7 @@ pub const SHADERS: &[(&str, &str)] = &[
     ("gto_fill.wgsl", include_str!("../../shaders/gto_fill.wgsl")),
     ("density_hessian.wgsl", include_str!("../../shaders/density_hessian.wgsl")),
     ("arrows.wgsl", include_str!("../../shaders/arrows.wgsl")),
+    ("plane_frame.wgsl", include_str!("../../shaders/plane_frame.wgsl")),
 ];
 
 /// Shaders that are only complete with others prepended (WGSL has no includes): the module

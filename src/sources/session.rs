@@ -76,3 +76,48 @@ pub fn add_volume(doc: &mut Document, added: &AddedVolume) -> Result<(), String>
         }
     }
 }
+
+#[cfg(test)]
+mod scan_tests {
+    use super::*;
+
+    #[test]
+    fn a_session_written_before_scans_were_objects_opens_its_scan_as_one() {
+        // The old layout: the playback's fields and the views' settings in one `[scan]` table.
+        #[derive(serde::Serialize)]
+        struct Old {
+            scan: crate::scene::LegacyScan,
+        }
+        let mut settings = crate::scene::RenderSettings::default();
+        settings.volume.slices = 96;
+        settings.iso.visible = true;
+        let state = crate::scene::ScanState {
+            value: -45.0,
+            mode: crate::scene::Interpolation::ThreePass,
+            looping: false,
+            speed: 12.0,
+            orbitals: vec!["homo".into(), "lumo".into()],
+            ..crate::scene::ScanState::default()
+        };
+        let text = toml::to_string(&Old { scan: crate::scene::LegacyScan { state, settings } }).unwrap();
+        assert!(text.starts_with("[scan]\nmanifest") || text.contains("[scan]\nvalue = -45.0"), "{text}");
+        assert!(text.contains("[scan.settings.volume]"), "{text}");
+        let session: Session = toml::from_str(&text).unwrap();
+        let legacy = session.scan.expect("the old scan table is read");
+        assert_eq!((legacy.state.value, legacy.state.mode), (-45.0, crate::scene::Interpolation::ThreePass));
+        let object = legacy.into_object(2);
+        let scan = object.scan.as_ref().unwrap();
+        assert!(!scan.looping && scan.speed == 12.0 && scan.orbitals == ["homo", "lumo"]);
+        let views: Vec<(crate::scene::Source, Option<usize>)> =
+            object.quantities.iter().map(|q| (q.source, q.pane)).collect();
+        assert_eq!(
+            views,
+            [(crate::scene::Source::Scan(0), Some(0)), (crate::scene::Source::Scan(1), Some(1))],
+            "each view in its pane"
+        );
+        assert!(object.quantities.iter().all(|q| q.cloud.slices == 96 && q.isosurfaces[0].visible));
+        // Written again, the scan is the object's: no table of its own.
+        let again = toml::to_string(&Session { objects: vec![object], ..Session::default() }).unwrap();
+        assert!(!again.contains("[scan]") && again.contains("[objects.scan]"), "{again}");
+    }
+}

@@ -1,0 +1,154 @@
+//! Lines of constant width on screen, depth-tested with the opaque scene: the plane map's
+//! frame drawn where the plane lies, so atoms in front of it hide it (`shaders/plane_frame.wgsl`).
+
+use std::sync::Arc;
+
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+use wgpu::util::DeviceExt;
+
+use super::GpuContext;
+use super::frame::{Draw, Phase, Prepare, opaque_depth, opaque_targets};
+
+/// Mirror of `LineUniforms` in plane_frame.wgsl.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct LineUniforms {
+    pub clip_from_object: [[f32; 4]; 4],
+    pub color: [f32; 4],
+    /// The frame's size in pixels, the lines' width in pixels, unused.
+    pub screen: [f32; 4],
+}
+const _: () = assert!(std::mem::size_of::<LineUniforms>() == 96);
+
+/// The lines' width on screen, pixels.
+const WIDTH: f32 = 2.0;
+
+/// One layer's lines: their segments' buffer, drawn in the opaque phase.
+pub struct PlaneFramePass {
+    pipeline: Arc<wgpu::RenderPipeline>,
+    layout: Arc<wgpu::BindGroupLayout>,
+    uniforms: wgpu::Buffer,
+    /// The segments' buffer bound with the uniforms, and how many there are.
+    segments: Option<(wgpu::BindGroup, u32)>,
+    color: [f32; 3],
+}
+
+impl PlaneFramePass {
+    fn with(ctx: &GpuContext, pipeline: Arc<wgpu::RenderPipeline>, layout: Arc<wgpu::BindGroupLayout>) -> Self {
+        let uniforms = super::uniform_buffer(&ctx.device, "plane frame uniforms", std::mem::size_of::<LineUniforms>());
+        Self { pipeline, layout, uniforms, segments: None, color: [1.0, 0.75, 0.3] }
+    }
+
+    /// Draws the segments `lines` (the object's frame) in linear RGB `color` from the next
+    /// frame on; none when empty.
+    pub fn set_lines(&mut self, ctx: &GpuContext, lines: &[[Vec3; 2]], color: [f32; 3]) {
+        self.color = color;
+        if lines.is_empty() {
+            self.segments = None;
+            return;
+        }
+        let data: Vec<[f32; 8]> = lines.iter().map(|[a, b]| [a.x, a.y, a.z, 1.0, b.x, b.y, b.z, 1.0]).collect();
+        let buffer = ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("plane frame segments"),
+            contents: bytemuck::cast_slice(&data),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        let bind = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("plane frame bind group"),
+            layout: &self.layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: self.uniforms.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: buffer.as_entire_binding() },
+            ],
+        });
+        self.segments = Some((bind, data.len() as u32));
+    }
+
+    /// How many segments it draws.
+    pub fn count(&self) -> u32 {
+        self.segments.as_ref().map_or(0, |s| s.1)
+    }
+}
+
+impl super::frame::Representation for PlaneFramePass {
+    fn new(ctx: &GpuContext, _shared: &super::frame::Shared<'_>) -> Self {
+        let device = &ctx.device;
+        let module = super::shader_module(device, "plane_frame.wgsl");
+        let stages = wgpu::ShaderStages::VERTEX_FRAGMENT;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("plane frame bind group layout"),
+            entries: &[
+                super::uniform_entry(0, stages),
+                super::buffer_entry(
+                    1,
+                    wgpu::ShaderStages::VERTEX,
+                    wgpu::BufferBindingType::Storage { read_only: true },
+                ),
+            ],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("plane frame pipeline layout"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("plane frame"),
+            layout: Some(&pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            // A quad faces the eye whichever way its segment runs: both windings drawn.
+            primitive: wgpu::PrimitiveState::default(),
+            depth_stencil: Some(opaque_depth()),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets: &opaque_targets(),
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        Self::with(ctx, Arc::new(pipeline), Arc::new(layout))
+    }
+
+    fn instance(&self, ctx: &GpuContext) -> Self {
+        Self::with(ctx, self.pipeline.clone(), self.layout.clone())
+    }
+
+    fn clear(&mut self, _ctx: &GpuContext) {
+        self.segments = None;
+    }
+}
+
+impl Draw for PlaneFramePass {
+    fn prepare(&mut self, f: &Prepare<'_>) {
+        if self.segments.is_none() {
+            return;
+        }
+        let [r, g, b] = self.color;
+        let u = LineUniforms {
+            clip_from_object: f.view.clip_from_object.to_cols_array_2d(),
+            color: [r, g, b, 1.0],
+            screen: [f.size[0] as f32, f.size[1] as f32, WIDTH, 0.0],
+        };
+        f.ctx.queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
+    }
+
+    fn phases(&self) -> &'static [Phase] {
+        &[Phase::Opaque]
+    }
+
+    fn draw(&self, _phase: Phase, pass: &mut wgpu::RenderPass<'_>) {
+        if let Some((bind, count)) = &self.segments {
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, bind, &[]);
+            pass.draw(0..6, 0..*count);
+        }
+    }
+}
