@@ -1441,6 +1441,102 @@ impl OrbApp {
     }
 }
 
+impl OrbApp {
+    /// The 3-D view in the window's centre: the scene (split into panes when asked), a scan's
+    /// drags, the colour bars, picks and measurements, the plane map's frame and its Alt + wheel.
+    /// `playing`: a mode or a scan moves, so the view draws as while a drag runs.
+    fn view_panel(&mut self, ui: &mut egui::Ui, rs: &egui_wgpu::RenderState, playing: bool) {
+        if let Some(vp) = &mut self.viewport {
+            // A scan being prepared in an empty window: its first frame at once, framed.
+            if let Some(job) = self.scan_job.as_mut().filter(|j| !j.skeleton_shown && self.objects.is_empty())
+                && let Some(molecule) = job.skeleton()
+            {
+                vp.show_molecule(&molecule, self.defaults.atoms);
+                // A session's scan keeps the session's camera.
+                if let Some((lo, hi)) = molecule.bounds().filter(|_| self.restoring_scan.is_none()) {
+                    self.view.camera = crate::scene::Camera::framing(lo.as_vec3(), hi.as_vec3());
+                }
+                job.skeleton_shown = true;
+            }
+            // A mode or a scan playing redraws every frame, as a drag does.
+            let interacting = detail::interacting(ui.ctx(), playing);
+            // Panes share the pixels a frame may draw while something moves.
+            let panes = self.view.panes.count.max(1);
+            vp.detail = detail::Detail::for_frame(interacting, vp.ctx.info.device_type, panes);
+            let picture_ms = vp.take_picture_ms();
+            vp.detail.lod_scale = vp.lod_budget.next(interacting, picture_ms);
+            let states: Vec<&ObjectState> = self.objects.iter().map(|o| &o.state).collect();
+            vp.set_clouds(&states);
+            let count = self.view.panes.count;
+            // The plane map's frame where the plane lies, in the active object.
+            let frame = if self.plane.open { plane_pane::frame_lines(&self.plane) } else { Vec::new() };
+            vp.show_plane_frame(self.active, frame);
+            let scan = self.objects.iter().position(|o| o.scan.is_some());
+            let twist = scan.and_then(|n| scan::twist_input(ui, &self.objects[n]));
+            let twisted = if count > 1 {
+                let panes: Vec<viewport::Pane> = (0..count)
+                    .map(|p| viewport::Pane {
+                        camera: self.view.camera,
+                        layers: vp.pane_layers(&states, p, count),
+                        label: panes::label(&self.objects, p, count),
+                    })
+                    .collect();
+                vp.show_split(ui, rs, &mut self.view, &panes, twist)
+            } else {
+                vp.unsplit();
+                let clip = self.objects.get_mut(self.active).map(|o| &mut o.state.clip);
+                vp.show_twistable(ui, rs, &mut self.view, clip, twist)
+            };
+            if let Some(n) = scan
+                && scan::apply_twist(&mut self.objects[n], twisted, vp, &self.view.camera)
+            {
+                ui.ctx().request_repaint();
+            }
+            if let Some(o) = self.objects.get(self.active).filter(|o| o.state.surface.color_by_volume)
+                && let Some(map) = vp.surface_map(self.active)
+            {
+                let name = o.state.selected_quantity().map(|q| q.source.name(&o.doc)).unwrap_or_default();
+                legend::value_bar(ui, ui.min_rect(), &map, &name);
+            } else if let Some(o) = self.objects.get(self.active)
+                && let Some(k) = o
+                    .state
+                    .quantities
+                    .iter()
+                    .position(|q| q.visible && q.isosurfaces.iter().any(|i| i.visible && i.color_by.is_some()))
+                && let Some((map, name)) = vp.isosurface_map(self.active, k)
+            {
+                legend::value_bar(ui, ui.min_rect(), &map, &name);
+            }
+            if let Some(click) = vp.click.take() {
+                let said = self.measurements.click(click, &self.world);
+                if !said.is_empty() {
+                    self.status = said;
+                }
+            }
+            measure::overlay(ui, vp, &self.view.camera, &self.world, &self.measurements, self.view.labels);
+            if self.objects.get(self.active).is_some() && self.plane.open {
+                // Alt + wheel over the view moves the plane along its normal, 0.1 Å a notch.
+                let notches: Vec<f32> = ui.input(|i| {
+                    (i.raw.events.iter())
+                        .filter_map(|e| match e {
+                            egui::Event::MouseWheel { delta, modifiers, .. } if modifiers.alt => {
+                                Some(delta.y + delta.x)
+                            }
+                            _ => None,
+                        })
+                        .filter(|d| *d != 0.0)
+                        .collect()
+                });
+                if vp.rect().is_some_and(|r| ui.rect_contains_pointer(r)) {
+                    for d in notches {
+                        self.plane.nudge(f64::from(d.signum()) * 0.1);
+                    }
+                }
+            }
+        }
+    }
+}
+
 impl eframe::App for OrbApp {
     fn on_exit(&mut self) {
         self.save_last_session();
@@ -1498,94 +1594,8 @@ impl eframe::App for OrbApp {
         panels::error_window(ui, self);
         self.file_browser(&ctx);
         egui::CentralPanel::no_frame().show(ui, |ui| {
-            let Some(rs) = frame.wgpu_render_state() else { return };
-            if let Some(vp) = &mut self.viewport {
-                // A scan being prepared in an empty window: its first frame at once, framed.
-                if let Some(job) = self.scan_job.as_mut().filter(|j| !j.skeleton_shown && self.objects.is_empty())
-                    && let Some(molecule) = job.skeleton()
-                {
-                    vp.show_molecule(&molecule, self.defaults.atoms);
-                    // A session's scan keeps the session's camera.
-                    if let Some((lo, hi)) = molecule.bounds().filter(|_| self.restoring_scan.is_none()) {
-                        self.view.camera = crate::scene::Camera::framing(lo.as_vec3(), hi.as_vec3());
-                    }
-                    job.skeleton_shown = true;
-                }
-                // A mode or a scan playing redraws every frame, as a drag does.
-                let interacting = detail::interacting(ui.ctx(), modes_play || scan_plays);
-                // Panes share the pixels a frame may draw while something moves.
-                let panes = self.view.panes.count.max(1);
-                vp.detail = detail::Detail::for_frame(interacting, vp.ctx.info.device_type, panes);
-                let picture_ms = vp.take_picture_ms();
-                vp.detail.lod_scale = vp.lod_budget.next(interacting, picture_ms);
-                let states: Vec<&ObjectState> = self.objects.iter().map(|o| &o.state).collect();
-                vp.set_clouds(&states);
-                let count = self.view.panes.count;
-                // The plane map's frame where the plane lies, in the active object.
-                let frame = if self.plane.open { plane_pane::frame_lines(&self.plane) } else { Vec::new() };
-                vp.show_plane_frame(self.active, frame);
-                let scan = self.objects.iter().position(|o| o.scan.is_some());
-                let twist = scan.and_then(|n| scan::twist_input(ui, &self.objects[n]));
-                let twisted = if count > 1 {
-                    let panes: Vec<viewport::Pane> = (0..count)
-                        .map(|p| viewport::Pane {
-                            camera: self.view.camera,
-                            layers: vp.pane_layers(&states, p, count),
-                            label: panes::label(&self.objects, p, count),
-                        })
-                        .collect();
-                    vp.show_split(ui, rs, &mut self.view, &panes, twist)
-                } else {
-                    vp.unsplit();
-                    let clip = self.objects.get_mut(self.active).map(|o| &mut o.state.clip);
-                    vp.show_twistable(ui, rs, &mut self.view, clip, twist)
-                };
-                if let Some(n) = scan
-                    && scan::apply_twist(&mut self.objects[n], twisted, vp, &self.view.camera)
-                {
-                    ui.ctx().request_repaint();
-                }
-                if let Some(o) = self.objects.get(self.active).filter(|o| o.state.surface.color_by_volume)
-                    && let Some(map) = vp.surface_map(self.active)
-                {
-                    let name = o.state.selected_quantity().map(|q| q.source.name(&o.doc)).unwrap_or_default();
-                    legend::value_bar(ui, ui.min_rect(), &map, &name);
-                } else if let Some(o) = self.objects.get(self.active)
-                    && let Some(k) = o
-                        .state
-                        .quantities
-                        .iter()
-                        .position(|q| q.visible && q.isosurfaces.iter().any(|i| i.visible && i.color_by.is_some()))
-                    && let Some((map, name)) = vp.isosurface_map(self.active, k)
-                {
-                    legend::value_bar(ui, ui.min_rect(), &map, &name);
-                }
-                if let Some(click) = vp.click.take() {
-                    let said = self.measurements.click(click, &self.world);
-                    if !said.is_empty() {
-                        self.status = said;
-                    }
-                }
-                measure::overlay(ui, vp, &self.view.camera, &self.world, &self.measurements, self.view.labels);
-                if self.objects.get(self.active).is_some() && self.plane.open {
-                    // Alt + wheel over the view moves the plane along its normal, 0.1 Å a notch.
-                    let notches: Vec<f32> = ui.input(|i| {
-                        (i.raw.events.iter())
-                            .filter_map(|e| match e {
-                                egui::Event::MouseWheel { delta, modifiers, .. } if modifiers.alt => {
-                                    Some(delta.y + delta.x)
-                                }
-                                _ => None,
-                            })
-                            .filter(|d| *d != 0.0)
-                            .collect()
-                    });
-                    if vp.rect().is_some_and(|r| ui.rect_contains_pointer(r)) {
-                        for d in notches {
-                            self.plane.nudge(f64::from(d.signum()) * 0.1);
-                        }
-                    }
-                }
+            if let Some(rs) = frame.wgpu_render_state() {
+                self.view_panel(ui, rs, modes_play || scan_plays);
             }
         });
         if self.is_loading() || self.recording.is_some() {

@@ -1181,28 +1181,7 @@ impl Viewport {
                     self.fragments = None;
                 }
             }
-            let uv = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
-            let painter = ui.painter();
-            match (&self.preview, self.progressive.rows_drawn()) {
-                (Some((_, coarse)), Some(rows)) if self.progressive.is_previewing() => {
-                    // The coarse picture, with the rows of the full one drawn so far over it.
-                    painter.image(*coarse, rect, uv, egui::Color32::WHITE);
-                    let done = rows as f32 / size[1].max(1) as f32;
-                    let top = egui::Rect::from_min_size(rect.min, egui::vec2(rect.width(), rect.height() * done));
-                    painter.image(
-                        *id,
-                        top,
-                        egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, done)),
-                        egui::Color32::WHITE,
-                    );
-                }
-                _ => {
-                    painter.image(*id, rect, uv, egui::Color32::WHITE);
-                }
-            }
-            if let Some(rows) = self.progressive.rows_drawn().filter(|_| self.progressive.shows_progress()) {
-                progress_bar(painter, rect, rows as f32 / size[1].max(1) as f32);
-            }
+            self.paint(ui.painter(), rect, *id, size[1]);
         }
         self.check_fragments(ui.ctx());
         self.layout = Some((rect, size));
@@ -1217,23 +1196,7 @@ impl Viewport {
         if response.clicked_by(PointerButton::Primary)
             && let Some(pos) = response.interact_pointer_pos()
         {
-            // Shift as it was at the release (the frame's modifiers may already have moved on).
-            let shift = ui.input(|i| {
-                i.events
-                    .iter()
-                    .rev()
-                    .find_map(|e| match e {
-                        egui::Event::PointerButton {
-                            button: PointerButton::Primary,
-                            pressed: false,
-                            modifiers,
-                            ..
-                        } => Some(modifiers.shift),
-                        _ => None,
-                    })
-                    .unwrap_or(i.modifiers.shift)
-            });
-            self.pending_click = Some((pos, shift));
+            self.pending_click = Some((pos, shift_at_release(ui)));
         }
         if let Some((pos, shift)) = self.pending_click.filter(|&(pos, _)| self.ids_ready(pos)) {
             self.pending_click = None;
@@ -1243,6 +1206,32 @@ impl Viewport {
             }
         }
         twisted
+    }
+
+    /// Paints the view's picture into `rect`: while a frame is drawn in bands over a coarse
+    /// picture, the coarse one with the rows drawn so far over it, and the bands' progress.
+    fn paint(&self, painter: &egui::Painter, rect: egui::Rect, id: egui::TextureId, rows_total: u32) {
+        let uv = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
+        match (&self.preview, self.progressive.rows_drawn()) {
+            (Some((_, coarse)), Some(rows)) if self.progressive.is_previewing() => {
+                // The coarse picture, with the rows of the full one drawn so far over it.
+                painter.image(*coarse, rect, uv, egui::Color32::WHITE);
+                let done = rows as f32 / rows_total.max(1) as f32;
+                let top = egui::Rect::from_min_size(rect.min, egui::vec2(rect.width(), rect.height() * done));
+                painter.image(
+                    id,
+                    top,
+                    egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, done)),
+                    egui::Color32::WHITE,
+                );
+            }
+            _ => {
+                painter.image(id, rect, uv, egui::Color32::WHITE);
+            }
+        }
+        if let Some(rows) = self.progressive.rows_drawn().filter(|_| self.progressive.shows_progress()) {
+            progress_bar(painter, rect, rows as f32 / rows_total.max(1) as f32);
+        }
     }
 
     /// Whether the ids at window position `pos` are the current picture's: it is whole, or
@@ -1431,6 +1420,21 @@ impl Viewport {
 
 /// `camera` stood back so that what fits its height fits a view of `size` narrower than it is
 /// tall (a pane of a split view): the panes show the whole molecule, not a slice of it.
+/// Whether Shift was held as the primary button was released (the frame's modifiers may
+/// already have moved on).
+fn shift_at_release(ui: &egui::Ui) -> bool {
+    ui.input(|i| {
+        (i.events.iter().rev())
+            .find_map(|e| match e {
+                egui::Event::PointerButton { button: PointerButton::Primary, pressed: false, modifiers, .. } => {
+                    Some(modifiers.shift)
+                }
+                _ => None,
+            })
+            .unwrap_or(i.modifiers.shift)
+    })
+}
+
 /// The plane map's frame in the view (linear RGB): the amber of the map's outline.
 const PLANE_FRAME_COLOR: [f32; 3] = [1.0, 0.72, 0.19];
 
