@@ -80,6 +80,47 @@ fn record_starts_and_cancels_while_the_window_answers() {
     assert_eq!(n, 6);
 }
 
+/// A scan is recorded as any object is: *Record…* proposes its sweep, and the movie holds its
+/// views side by side; *Play* moves its value.
+#[test]
+fn a_scan_plays_and_records_its_sweep() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = Harness::builder()
+        .with_size([1100.0, 720.0])
+        .wgpu_setup(orbcloud::app::wgpu_setup(true))
+        .build_eframe(|cc| OrbApp::new(cc, Vec::new()));
+    step_until(&mut h, 300, "the scan", |app| app.scan().is_some());
+    h.run_steps(2);
+    let start = h.state().scan().unwrap().value;
+    h.get_by_label("Play").click();
+    step_until(&mut h, 60, "the value to move", |app| app.scan().is_some_and(|s| s.value != start));
+    h.get_by_label("Pause").click();
+    h.run_steps(1);
+    h.get_by_label("Record…").click();
+    h.run_steps(2);
+    assert!(h.state().record.output.ends_with("_sweep.gif"), "{}", h.state().record.output);
+    let gif_path = dir.path().join("sweep.gif");
+    {
+        let d = &mut h.state_mut().record;
+        d.frames = 4;
+        d.size = [64, 48];
+        d.output = gif_path.display().to_string();
+    }
+    h.run_steps(1);
+    h.get_by_label("Start").click();
+    h.run_steps(1);
+    assert!(h.state().recording.is_some(), "recording: {:?}", h.state().error);
+    step_until(&mut h, 180, "the sweep to finish", |app| app.recording.is_none());
+    assert!(h.state().status.starts_with("wrote"), "{}", h.state().status);
+    let mut decoder = gif::DecodeOptions::new().read_info(std::fs::File::open(&gif_path).unwrap()).unwrap();
+    assert_eq!((decoder.width(), decoder.height()), (128, 48), "HOMO and LUMO side by side");
+    let mut n = 0;
+    while decoder.read_next_frame().unwrap().is_some() {
+        n += 1;
+    }
+    assert_eq!(n, 4);
+}
+
 #[test]
 fn save_png_writes_any_size_supersampled_and_transparent() {
     let dir = tempfile::tempdir().unwrap();
