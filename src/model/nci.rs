@@ -12,7 +12,8 @@ use rayon::prelude::*;
 
 use super::eigen::symmetric_eigen;
 use super::grid::GridSpec;
-use super::gto::PreparedBasis;
+use super::gto::{BLOCK, BlockScratch, PreparedBasis};
+use super::orbital_sums::{COMPONENTS, OccupiedOrbitals};
 use super::orbitals::{Quantity, Wavefunction};
 
 /// What NCIPLOT's cubes hold where a point is cut (ρ above the cut, or an intermolecular
@@ -127,9 +128,8 @@ pub struct WavefunctionDensity<'a> {
     /// What the density is evaluated over: the basis contracted for the occupied orbitals
     /// ([`occupied_contraction`]).
     contracted: PreparedBasis,
-    /// Per function of `contracted`, its coefficient in each occupied orbital.
-    coefficients: Vec<f64>,
-    occupations: Vec<f64>,
+    /// The occupied orbitals over `contracted`.
+    orbitals: OccupiedOrbitals,
 }
 
 impl<'a> WavefunctionDensity<'a> {
@@ -141,7 +141,8 @@ impl<'a> WavefunctionDensity<'a> {
     pub fn with_basis(basis: PreparedBasis, wavefunction: &'a Wavefunction) -> Self {
         let (coefficients, occupations) = occupied_matrix(&basis, wavefunction);
         let (contracted, coefficients) = occupied_contraction(&basis, &coefficients, occupations.len());
-        Self { basis, wavefunction, contracted, coefficients, occupations }
+        let orbitals = OccupiedOrbitals::new(&coefficients, occupations);
+        Self { basis, wavefunction, contracted, orbitals }
     }
 
     /// Basis functions the density is evaluated over (at most the basis's).
@@ -152,7 +153,7 @@ impl<'a> WavefunctionDensity<'a> {
 
 impl DensitySource for WavefunctionDensity<'_> {
     fn derivatives_at(&self, points: &[DVec3], out: &mut [DensityDerivatives]) {
-        self.contracted.occupied_derivatives_into(&self.coefficients, &self.occupations, points, out);
+        self.contracted.occupied_derivatives_into(&self.orbitals, points, out);
     }
 }
 
@@ -227,94 +228,98 @@ impl PreparedBasis {
     pub fn density_derivatives(&self, wf: &Wavefunction, points: &[DVec3]) -> Vec<DensityDerivatives> {
         let mut out = vec![DensityDerivatives::default(); points.len()];
         let (coefficients, occupations) = occupied_matrix(self, wf);
-        self.occupied_derivatives_into(&coefficients, &occupations, points, &mut out);
+        self.occupied_derivatives_into(&OccupiedOrbitals::new(&coefficients, occupations), points, &mut out);
         out
     }
 
-    /// [`Self::density_derivatives`] of orbitals given as a function-major matrix
-    /// (`coefficients[k · n + i]`: function k in orbital i, n = `occupations.len()`).
-    fn occupied_derivatives_into(
-        &self,
-        coefficients: &[f64],
-        occupations: &[f64],
-        points: &[DVec3],
-        out: &mut [DensityDerivatives],
-    ) {
+    /// [`Self::density_derivatives`] of `orbitals` over this basis.
+    fn occupied_derivatives_into(&self, orbitals: &OccupiedOrbitals, points: &[DVec3], out: &mut [DensityDerivatives]) {
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
             // SAFETY: the CPU has the features the function is compiled for.
-            unsafe { self.occupied_derivatives_avx2(coefficients, occupations, points, out) };
+            unsafe { self.occupied_derivatives_avx2(orbitals, points, out) };
             return;
         }
-        self.occupied_derivatives_kernel(coefficients, occupations, points, out);
+        self.occupied_derivatives_kernel(orbitals, points, out);
     }
 
     /// [`Self::occupied_derivatives_kernel`] compiled for AVX2 and FMA (the same sums, fused:
     /// last-digit differences only).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
-    fn occupied_derivatives_avx2(
-        &self,
-        coefficients: &[f64],
-        occupations: &[f64],
-        points: &[DVec3],
-        out: &mut [DensityDerivatives],
-    ) {
-        self.occupied_derivatives_kernel(coefficients, occupations, points, out);
+    fn occupied_derivatives_avx2(&self, orbitals: &OccupiedOrbitals, points: &[DVec3], out: &mut [DensityDerivatives]) {
+        self.occupied_derivatives_kernel(orbitals, points, out);
     }
 
     #[inline(always)]
     fn occupied_derivatives_kernel(
         &self,
-        coefficients: &[f64],
-        occupations: &[f64],
+        orbitals: &OccupiedOrbitals,
         points: &[DVec3],
         out: &mut [DensityDerivatives],
     ) {
-        let n = occupations.len();
-        let mut phi = vec![[0.0; 10]; self.n_functions()];
-        // Component-major: psi[t · n + i] is component t of orbital i.
-        let mut psi = vec![0.0; 10 * n];
-        let mut cart = Vec::new();
+        let occupations = &orbitals.occupations;
+        let mut phi = vec![[[0.0; BLOCK]; COMPONENTS]; self.n_functions()];
+        let mut psi = vec![0.0; orbitals.scratch_len()];
+        let mut scratch = BlockScratch::default();
         let mut active: Vec<usize> = Vec::new();
+        // Per shell that reaches a point of the block: the points it reaches, as bits.
+        let mut reached: Vec<(usize, u32)> = Vec::new();
         // Shells that can reach any of the points: the rest are never looked at.
         let (lo, hi) = bounds(points);
         let (centre, half) = ((lo + hi) * 0.5, (hi - lo).length() * 0.5);
         let near: Vec<usize> = (0..self.shells.len())
             .filter(|&s| self.shells[s].center().distance(centre) <= self.shells[s].cutoff + half)
             .collect();
-        for (p, o) in points.iter().zip(out.iter_mut()) {
-            active.clear();
+        for (points, out) in points.chunks(BLOCK).zip(out.chunks_mut(BLOCK)) {
+            reached.clear();
             for &si in &near {
                 let s = &self.shells[si];
-                let d = *p - s.center();
-                if d.length_squared() <= s.cutoff * s.cutoff {
-                    self.shell_second_derivatives(s, d, &mut phi[s.functions()], &mut cart);
-                    active.extend(s.functions());
+                let (d, r2, bits) = offsets(points, s.center(), s.cutoff);
+                if bits != 0 {
+                    self.shell_second_derivatives_block(s, &d, &r2, &mut phi[s.functions()], &mut scratch);
+                    reached.push((si, bits));
                 }
             }
-            psi.fill(0.0);
-            for &k in &active {
-                let row = &coefficients[k * n..(k + 1) * n];
-                for (t, &v) in phi[k].iter().enumerate() {
-                    for (p, c) in psi[t * n..(t + 1) * n].iter_mut().zip(row) {
-                        *p += v * c;
+            for (i, o) in out.iter_mut().enumerate() {
+                active.clear();
+                for &(si, bits) in &reached {
+                    if bits >> i & 1 != 0 {
+                        active.extend(self.shells[si].functions());
                     }
                 }
+                orbitals.sums(&phi, i, &active, &mut psi);
+                let c = |t: usize| orbitals.component(&psi, t);
+                let dot = |a: &[f64], b: &[f64]| -> f64 {
+                    a.iter().zip(b).zip(occupations).map(|((x, y), w)| w * x * y).sum()
+                };
+                let v = c(0);
+                let rho = dot(v, v);
+                let g: [f64; 3] = std::array::from_fn(|a| 2.0 * dot(v, c(1 + a)));
+                let h: [f64; 6] = std::array::from_fn(|k| {
+                    let (a, b) = PAIRS[k];
+                    2.0 * (dot(v, c(4 + k)) + dot(c(1 + a), c(1 + b)))
+                });
+                *o = DensityDerivatives { rho, gradient: DVec3::from_array(g), hessian: symmetric(h) };
             }
-            let c = |t: usize| &psi[t * n..(t + 1) * n];
-            let dot =
-                |a: &[f64], b: &[f64]| -> f64 { a.iter().zip(b).zip(occupations).map(|((x, y), w)| w * x * y).sum() };
-            let v = c(0);
-            let rho = dot(v, v);
-            let g: [f64; 3] = std::array::from_fn(|a| 2.0 * dot(v, c(1 + a)));
-            let h: [f64; 6] = std::array::from_fn(|k| {
-                let (a, b) = PAIRS[k];
-                2.0 * (dot(v, c(4 + k)) + dot(c(1 + a), c(1 + b)))
-            });
-            *o = DensityDerivatives { rho, gradient: DVec3::from_array(g), hessian: symmetric(h) };
         }
     }
+}
+
+/// A block's offsets from `centre` per axis, squared distances, and which of `points` lie
+/// within `cutoff` (bits); the last point fills the block's remaining places.
+#[inline(always)]
+fn offsets(points: &[DVec3], centre: DVec3, cutoff: f64) -> ([[f64; BLOCK]; 3], [f64; BLOCK], u32) {
+    let (mut d, mut r2, mut bits) = ([[0.0; BLOCK]; 3], [0.0; BLOCK], 0);
+    for i in 0..BLOCK {
+        let v = points[i.min(points.len() - 1)] - centre;
+        (d[0][i], d[1][i], d[2][i]) = (v.x, v.y, v.z);
+        r2[i] = v.length_squared();
+        if i < points.len() && r2[i] <= cutoff * cutoff {
+            bits |= 1 << i;
+        }
+    }
+    (d, r2, bits)
 }
 
 /// The six independent components' (row, column): xx, xy, xz, yy, yz, zz.
