@@ -79,9 +79,29 @@ impl DensityDerivatives {
         self.eigenvalues()[1]
     }
 
+    /// Whether λ₂ < 0, without the eigenvalues where that is safe. The Hessian's eigenvalues
+    /// are the roots of x³ − e₁x² + e₂x − e₃ (e₁ the trace, e₂ the sum of the principal 2×2
+    /// minors, e₃ the determinant); all three are real, so by Descartes' rule as many are
+    /// positive as the coefficients change sign, and λ₂ < 0 when at most one is. Where a
+    /// coefficient is too close to 0 for its rounding to be sure of its sign (λ₂ near 0 among
+    /// them), the eigenvalues decide.
+    pub fn lambda2_is_negative(&self) -> bool {
+        let [[a, b, c], [_, d, e], [_, _, f]] = self.hessian;
+        let e1 = a + d + f;
+        let e2 = a * d - b * b + a * f - c * c + d * f - e * e;
+        let e3 = a * (d * f - e * e) - b * (b * f - e * c) + c * (b * e - d * c);
+        let norm = (a * a + d * d + f * f + 2.0 * (b * b + c * c + e * e)).sqrt();
+        let sure = |v: f64, scale: f64| v.abs() > 1e-8 * scale;
+        if !(sure(e1, norm) && sure(e2, norm * norm) && sure(e3, norm * norm * norm)) {
+            return self.lambda2() < 0.0;
+        }
+        let coefficients = [1.0, -e1, e2, -e3];
+        coefficients.windows(2).filter(|w| (w[0] < 0.0) != (w[1] < 0.0)).count() <= 1
+    }
+
     /// sign(λ₂)·ρ: negative in bonding regions (hydrogen bonds), positive in steric clashes.
     pub fn sign_lambda2_rho(&self) -> f64 {
-        if self.lambda2() < 0.0 { -self.rho } else { self.rho }
+        if self.lambda2_is_negative() { -self.rho } else { self.rho }
     }
 
     /// ∇²ρ, the Hessian's trace.
@@ -258,7 +278,6 @@ impl PreparedBasis {
         points: &[DVec3],
         out: &mut [DensityDerivatives],
     ) {
-        let occupations = &orbitals.occupations;
         let mut phi = vec![[[0.0; BLOCK]; COMPONENTS]; self.n_functions()];
         let mut psi = vec![0.0; orbitals.scratch_len()];
         let mut scratch = BlockScratch::default();
@@ -289,17 +308,7 @@ impl PreparedBasis {
                     }
                 }
                 orbitals.sums(&phi, i, &active, &mut psi);
-                let c = |t: usize| orbitals.component(&psi, t);
-                let dot = |a: &[f64], b: &[f64]| -> f64 {
-                    a.iter().zip(b).zip(occupations).map(|((x, y), w)| w * x * y).sum()
-                };
-                let v = c(0);
-                let rho = dot(v, v);
-                let g: [f64; 3] = std::array::from_fn(|a| 2.0 * dot(v, c(1 + a)));
-                let h: [f64; 6] = std::array::from_fn(|k| {
-                    let (a, b) = PAIRS[k];
-                    2.0 * (dot(v, c(4 + k)) + dot(c(1 + a), c(1 + b)))
-                });
+                let (rho, g, h) = orbitals.density_derivatives(&psi);
                 *o = DensityDerivatives { rho, gradient: DVec3::from_array(g), hessian: symmetric(h) };
             }
         }
@@ -321,9 +330,6 @@ fn offsets(points: &[DVec3], centre: DVec3, cutoff: f64) -> ([[f64; BLOCK]; 3], 
     }
     (d, r2, bits)
 }
-
-/// The six independent components' (row, column): xx, xy, xz, yy, yz, zz.
-const PAIRS: [(usize, usize); 6] = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
 
 fn symmetric(h: [f64; 6]) -> [[f64; 3]; 3] {
     [[h[0], h[1], h[2]], [h[1], h[3], h[4]], [h[2], h[4], h[5]]]
@@ -536,6 +542,21 @@ mod tests {
         assert!(e[0] < e[1] && e[1] < e[2]);
         assert!((e.iter().sum::<f64>() - turned.laplacian()).abs() < 1e-12);
         assert_eq!(DensityDerivatives::default().reduced_gradient(), f64::INFINITY);
+    }
+
+    #[test]
+    fn the_sign_of_lambda2_agrees_with_the_eigenvalues() {
+        // Random symmetric matrices, matrices with λ₂ near 0 relative to the others, and one
+        // with a zero trace (a coefficient the rule cannot trust).
+        let r = crate::model::gto::tests::pseudo_random(6 * 400, 3);
+        let mut matrices: Vec<[f64; 6]> = r.chunks_exact(6).map(|c| std::array::from_fn(|k| c[k])).collect();
+        matrices.push([1.0, 0.0, 0.0, 1e-12, 0.0, -2.0]);
+        matrices.push([1.0, 0.0, 0.0, -1e-12, 0.0, 2.0]);
+        matrices.push([1.0, 0.3, 0.0, -0.5, 0.2, -0.5]);
+        for h in matrices {
+            let d = DensityDerivatives { rho: 0.01, hessian: symmetric(h), ..Default::default() };
+            assert_eq!(d.lambda2_is_negative(), d.lambda2() < 0.0, "{h:?}");
+        }
     }
 
     #[test]

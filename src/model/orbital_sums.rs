@@ -8,7 +8,7 @@
 //! stay in registers while the functions stream past. Both ways add the same products in the
 //! same order, without fused multiply-adds, so their results are identical to the bit.
 
-use super::gto::DerivativeBlock;
+use super::gto::{DerivativeBlock, HESSIAN_PAIRS};
 
 /// Value, gradient and the Hessian's six components.
 pub const COMPONENTS: usize = 10;
@@ -52,6 +52,28 @@ impl OccupiedOrbitals {
     /// Component t of every orbital, from the sums [`Self::sums`] wrote (`len()` values).
     pub fn component<'a>(&self, psi: &'a [f64], t: usize) -> &'a [f64] {
         &psi[t * self.stride..t * self.stride + self.len()]
+    }
+
+    /// ρ = Σ_i n_i ψ_i², ∇ρ = 2 Σ_i n_i ψ_i ∇ψ_i and the Hessian's six components
+    /// ∂a∂bρ = 2 Σ_i n_i (ψ_i ∂a∂bψ_i + ∂aψ_i ∂bψ_i) (xx, xy, xz, yy, yz, zz) from the sums
+    /// [`Self::sums`] wrote: the sixteen sums in one pass over the orbitals, each in the
+    /// orbitals' order, independent of one another (no chain of additions to wait on).
+    pub fn density_derivatives(&self, psi: &[f64]) -> (f64, [f64; 3], [f64; 6]) {
+        let c: [&[f64]; COMPONENTS] = std::array::from_fn(|t| self.component(psi, t));
+        let mut s = [-0.0f64; 16];
+        for (i, &w) in self.occupations.iter().enumerate() {
+            let x: [f64; COMPONENTS] = std::array::from_fn(|t| c[t][i]);
+            let wv = w * x[0];
+            s[0] += wv * x[0];
+            for a in 0..3 {
+                s[1 + a] += wv * x[1 + a];
+            }
+            for (k, &(a, b)) in HESSIAN_PAIRS.iter().enumerate() {
+                s[4 + k] += wv * x[4 + k];
+                s[10 + k] += w * x[1 + a] * x[1 + b];
+            }
+        }
+        (s[0], std::array::from_fn(|a| 2.0 * s[1 + a]), std::array::from_fn(|k| 2.0 * (s[4 + k] + s[10 + k])))
     }
 
     /// ψ[t][i] = Σ_{k ∈ active} φ[k][t] · C[k][i] into `psi` (at least [`Self::scratch_len`]),
