@@ -399,8 +399,29 @@ pub struct NciGrids {
     pub kept: usize,
 }
 
-/// [`NciGrids`] of the fragments' summed density on `grid`, x-slabs in parallel, a row of
-/// points at a time.
+/// Rows of an x-slab whose points are evaluated together.
+const GROUP_ROWS: usize = 4;
+
+/// Points along z per tile: a group's points go to the sources tile by tile, [`GROUP_ROWS`]
+/// rows × this many points, so that a block of [`BLOCK`] points (what a wavefunction's basis
+/// functions are evaluated over at once) is a compact square rather than a long stretch of a
+/// row, and rows' ends fill blocks together instead of each leaving one mostly empty.
+const TILE_COLUMNS: usize = BLOCK / GROUP_ROWS;
+
+/// The (row within the group, z index) of each point of a group of `rows` rows of `nz`
+/// points, tile by tile.
+fn tile_order(rows: usize, nz: usize) -> Vec<(usize, usize)> {
+    let mut order = Vec::with_capacity(rows * nz);
+    for z0 in (0..nz).step_by(TILE_COLUMNS) {
+        for r in 0..rows {
+            order.extend((z0..nz.min(z0 + TILE_COLUMNS)).map(|iz| (r, iz)));
+        }
+    }
+    order
+}
+
+/// [`NciGrids`] of the fragments' summed density on `grid`, x-slabs in parallel, a few rows
+/// of points at a time.
 pub fn nci_grid(fragments: &[&dyn DensitySource], grid: &GridSpec, settings: NciSettings) -> NciGrids {
     let [_, ny, nz] = grid.dims;
     let slab = ny * nz;
@@ -409,35 +430,38 @@ pub fn nci_grid(fragments: &[&dyn DensitySource], grid: &GridSpec, settings: Nci
     if grid.is_empty() {
         return NciGrids { dens, grad, kept: 0 };
     }
+    let group = GROUP_ROWS * nz;
     let kept: usize = dens
         .par_chunks_mut(slab)
         .zip(grad.par_chunks_mut(slab))
         .enumerate()
         .map(|(ix, (dens, grad))| {
-            let mut points = Vec::with_capacity(nz);
-            let mut total = vec![DensityDerivatives::default(); nz];
-            let mut part = vec![DensityDerivatives::default(); nz];
-            let mut largest = vec![0.0f64; nz];
+            let mut points = Vec::with_capacity(group);
+            let mut total = vec![DensityDerivatives::default(); group];
+            let mut part = vec![DensityDerivatives::default(); group];
+            let mut largest = vec![0.0f64; group];
             let mut kept = 0;
-            for iy in 0..ny {
+            for y0 in (0..ny).step_by(GROUP_ROWS) {
+                let order = tile_order(GROUP_ROWS.min(ny - y0), nz);
+                let n = order.len();
                 points.clear();
-                points.extend((0..nz).map(|iz| grid.point(ix, iy, iz)));
-                total.fill(DensityDerivatives::default());
-                largest.fill(0.0);
+                points.extend(order.iter().map(|&(r, iz)| grid.point(ix, y0 + r, iz)));
+                total[..n].fill(DensityDerivatives::default());
+                largest[..n].fill(0.0);
                 for f in fragments {
-                    f.derivatives_at(&points, &mut part);
-                    for ((t, p), l) in total.iter_mut().zip(&part).zip(largest.iter_mut()) {
+                    f.derivatives_at(&points, &mut part[..n]);
+                    for ((t, p), l) in total.iter_mut().zip(&part[..n]).zip(largest.iter_mut()) {
                         t.add(p);
                         *l = l.max(p.rho);
                     }
                 }
-                for (iz, (t, l)) in total.iter().zip(&largest).enumerate() {
+                for (&(r, iz), (t, l)) in order.iter().zip(total.iter().zip(&largest)) {
                     let own = settings.intermolecular.is_some_and(|share| *l > share * t.rho);
                     if t.rho > settings.density_cut || own || t.rho.is_nan() || t.rho <= 0.0 {
                         continue;
                     }
                     let s = t.reduced_gradient();
-                    let k = iy * nz + iz;
+                    let k = (y0 + r) * nz + iz;
                     dens[k] = (100.0 * t.sign_lambda2_rho()) as f32;
                     grad[k] =
                         if s.is_finite() && s <= settings.rdg_cut { s.min(CUT_VALUE as f64) as f32 } else { CUT_VALUE };
