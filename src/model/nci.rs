@@ -603,6 +603,19 @@ mod tests {
     }
 
     #[test]
+    fn tiles_cover_every_point_of_a_group_once() {
+        // A full group's first block is a square: every row, the first few points of each.
+        let first = &tile_order(GROUP_ROWS, 51)[..BLOCK];
+        assert!(first.iter().all(|&(_, z)| z < TILE_COLUMNS));
+        for (rows, nz) in [(4, 51), (1, 3), (3, 8), (4, 1)] {
+            let mut order = tile_order(rows, nz);
+            order.sort_unstable();
+            let all: Vec<_> = (0..rows).flat_map(|r| (0..nz).map(move |z| (r, z))).collect();
+            assert_eq!(order, all);
+        }
+    }
+
+    #[test]
     fn the_sign_of_lambda2_agrees_with_the_eigenvalues() {
         // Random symmetric matrices, matrices with λ₂ near 0 relative to the others, and one
         // with a zero trace (a coefficient the rule cannot trust).

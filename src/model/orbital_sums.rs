@@ -31,7 +31,7 @@ impl OccupiedOrbitals {
     pub fn new(matrix: &[f64], occupations: Vec<f64>) -> Self {
         let n = occupations.len();
         let stride = n.div_ceil(LANES) * LANES;
-        let functions = if n == 0 { 0 } else { matrix.len() / n };
+        let functions = matrix.len().checked_div(n).unwrap_or(0);
         let mut rows = vec![0.0; functions * stride];
         for (row, from) in rows.chunks_exact_mut(stride.max(1)).zip(matrix.chunks_exact(n.max(1))) {
             row[..n].copy_from_slice(from);
@@ -182,14 +182,14 @@ mod tests {
             let (mut a, mut b) = (vec![f64::NAN; orbitals.scratch_len()], vec![f64::NAN; orbitals.scratch_len()]);
             orbitals.sums(&phi, point, &active, &mut a);
             orbitals.sums_plain(&phi, point, &active, &mut b);
+            let at = |k: usize, t: usize| phi[k][t][point];
             for t in 0..COMPONENTS {
                 let (x, y) = (orbitals.component(&a, t), orbitals.component(&b, t));
                 assert_eq!(
                     x.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
                     y.iter().map(|v| v.to_bits()).collect::<Vec<_>>()
                 );
-                let want: f64 =
-                    active.iter().map(|&k| phi[k][t][point] * orbitals.rows[k * orbitals.stride + n - 1]).sum();
+                let want: f64 = active.iter().map(|&k| at(k, t) * orbitals.rows[k * orbitals.stride + n - 1]).sum();
                 assert!((x[n - 1] - want).abs() < 1e-12);
             }
         }
