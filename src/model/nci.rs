@@ -12,7 +12,7 @@ use rayon::prelude::*;
 
 use super::eigen::symmetric_eigen;
 use super::grid::GridSpec;
-use super::gto::{BLOCK, BlockScratch, PreparedBasis};
+use super::gto::{BLOCK, BlockScratch, DerivativeBlock, PreparedBasis};
 use super::orbital_sums::{COMPONENTS, OccupiedOrbitals};
 use super::orbitals::{Quantity, Wavefunction};
 
@@ -135,8 +135,8 @@ impl DensityDerivatives {
 /// A density whose value and first and second derivatives can be had at points.
 pub trait DensitySource: Sync {
     /// ρ and its derivatives at each of `points` (bohr), written to `out` (as long as `points`).
-    /// Callers pass nearby points together (a grid row): sources screen their centres once
-    /// per call.
+    /// Callers pass nearby points together (a few grid rows, in tiles: [`nci_grid`]): sources
+    /// screen their centres once per call.
     fn derivatives_at(&self, points: &[DVec3], out: &mut [DensityDerivatives]);
 }
 
@@ -290,6 +290,9 @@ impl PreparedBasis {
         self.occupied_derivatives_kernel(orbitals, points, out);
     }
 
+    /// ρ and its derivatives at `points`, [`BLOCK`] points at a time: the basis functions'
+    /// derivatives over the block for every shell within reach of one of its points, then per
+    /// point the orbitals' sums over the functions within reach of that point.
     #[inline(always)]
     fn occupied_derivatives_kernel(
         &self,
@@ -310,16 +313,7 @@ impl PreparedBasis {
             .filter(|&s| self.shells[s].center().distance(centre) <= self.shells[s].cutoff + half)
             .collect();
         for (points, out) in points.chunks(BLOCK).zip(out.chunks_mut(BLOCK)) {
-            reached.clear();
-            let axes = block_axes(points);
-            for &si in &near {
-                let s = &self.shells[si];
-                let (d, r2, bits) = offsets(&axes, points.len(), s.center(), s.cutoff);
-                if bits != 0 {
-                    self.shell_second_derivatives_block(s, &d, &r2, &mut phi[s.functions()], &mut scratch);
-                    reached.push((si, bits));
-                }
-            }
+            self.block_derivatives(&near, points, &mut phi, &mut scratch, &mut reached);
             for (i, o) in out.iter_mut().enumerate() {
                 active.clear();
                 for &(si, bits) in &reached {
@@ -334,6 +328,35 @@ impl PreparedBasis {
         }
     }
 }
+
+impl PreparedBasis {
+    /// The derivatives of the functions of each of the `near` shells that reaches one of the
+    /// block's `points`, into `phi` (indexed by function); `reached` gets those shells, each
+    /// with the points it reaches as bits.
+    #[inline(always)]
+    fn block_derivatives(
+        &self,
+        near: &[usize],
+        points: &[DVec3],
+        phi: &mut [DerivativeBlock],
+        scratch: &mut BlockScratch,
+        reached: &mut Vec<(usize, u32)>,
+    ) {
+        reached.clear();
+        let axes = block_axes(points);
+        for &si in near {
+            let s = &self.shells[si];
+            let (d, r2, bits) = offsets(&axes, points.len(), s.center(), s.cutoff);
+            if bits != 0 {
+                self.shell_second_derivatives_block(s, &d, &r2, &mut phi[s.functions()], scratch);
+                reached.push((si, bits));
+            }
+        }
+    }
+}
+
+// A block's points are bits of a u32.
+const _: () = assert!(BLOCK <= 32);
 
 /// A block's points by axis, the last point repeated to fill the block.
 #[inline(always)]
