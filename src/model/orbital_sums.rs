@@ -5,8 +5,9 @@
 //!
 //! A plain loop over the functions reads and writes all 10 × n sums once per function: loads
 //! and stores, not arithmetic, bound it. With AVX-512 the 10 × 16 sums of a block of 16 orbitals
-//! stay in registers while the functions stream past. Both ways add the same products in the
-//! same order, without fused multiply-adds, so their results are identical to the bit.
+//! stay in registers while the functions stream past (with AVX2, 5 × 8 of them). Every way adds
+//! the same products in the same order, without fused multiply-adds, so their results are
+//! identical to the bit.
 
 use super::gto::{DerivativeBlock, HESSIAN_PAIRS};
 
@@ -85,6 +86,12 @@ impl OccupiedOrbitals {
             unsafe { self.sums_avx512(phi, point, active, psi) };
             return;
         }
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has the feature the function is compiled for.
+            unsafe { self.sums_avx2(phi, point, active, psi) };
+            return;
+        }
         self.sums_plain(phi, point, active, psi);
     }
 
@@ -100,6 +107,57 @@ impl OccupiedOrbitals {
                 for (p, c) in psi[t * stride..t * stride + n].iter_mut().zip(row) {
                     *p += v * c;
                 }
+            }
+        }
+    }
+
+    /// [`Self::sums`] with AVX2's 16 registers: 8 orbitals and 5 components at a time, the
+    /// 40 sums in 10 registers.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn sums_avx2(&self, phi: &[DerivativeBlock], point: usize, active: &[usize], psi: &mut [f64]) {
+        for start in (0..self.stride).step_by(LANES) {
+            for first in [0, COMPONENTS / 2] {
+                self.block_avx2(phi, point, active, start, first, psi);
+            }
+        }
+    }
+
+    /// The sums of orbitals `start .. start + 8`, components `first .. first + 5`.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    fn block_avx2(
+        &self,
+        phi: &[DerivativeBlock],
+        point: usize,
+        active: &[usize],
+        start: usize,
+        first: usize,
+        psi: &mut [f64],
+    ) {
+        use std::arch::x86_64::{_mm256_add_pd, _mm256_loadu_pd, _mm256_mul_pd, _mm256_set1_pd};
+        use std::arch::x86_64::{_mm256_setzero_pd, _mm256_storeu_pd};
+        const HALF: usize = COMPONENTS / 2;
+        let stride = self.stride;
+        let mut acc = [[_mm256_setzero_pd(); 2]; HALF];
+        for &k in active {
+            let row = &self.rows[k * stride + start..k * stride + start + LANES];
+            // SAFETY: `row` holds 8 values.
+            let b = unsafe { [_mm256_loadu_pd(row.as_ptr()), _mm256_loadu_pd(row.as_ptr().add(4))] };
+            for (acc, a) in acc.iter_mut().zip(&phi[k][first..first + HALF]) {
+                let a = _mm256_set1_pd(a[point]);
+                for (acc, &b) in acc.iter_mut().zip(&b) {
+                    *acc = _mm256_add_pd(*acc, _mm256_mul_pd(a, b));
+                }
+            }
+        }
+        for (t, acc) in acc.iter().enumerate() {
+            let at = (first + t) * stride + start;
+            let out = &mut psi[at..at + LANES];
+            for (v, acc) in acc.iter().enumerate() {
+                // SAFETY: `out` holds 8 values.
+                unsafe { _mm256_storeu_pd(out.as_mut_ptr().add(4 * v), *acc) };
             }
         }
     }
@@ -182,6 +240,16 @@ mod tests {
             let (mut a, mut b) = (vec![f64::NAN; orbitals.scratch_len()], vec![f64::NAN; orbitals.scratch_len()]);
             orbitals.sums(&phi, point, &active, &mut a);
             orbitals.sums_plain(&phi, point, &active, &mut b);
+            #[cfg(target_arch = "x86_64")]
+            if std::arch::is_x86_feature_detected!("avx2") {
+                let mut c = vec![f64::NAN; orbitals.scratch_len()];
+                // SAFETY: the CPU has AVX2.
+                unsafe { orbitals.sums_avx2(&phi, point, &active, &mut c) };
+                for t in 0..COMPONENTS {
+                    let (x, y) = (orbitals.component(&c, t), orbitals.component(&b, t));
+                    assert!(x.iter().zip(y).all(|(x, y)| x.to_bits() == y.to_bits()), "AVX2, {n} orbitals");
+                }
+            }
             let at = |k: usize, t: usize| phi[k][t][point];
             for t in 0..COMPONENTS {
                 let (x, y) = (orbitals.component(&a, t), orbitals.component(&b, t));
