@@ -30,6 +30,7 @@ pub mod molecule;
 pub mod nci;
 pub mod neighbours;
 pub mod octree;
+mod orbital_sums;
 pub mod orbitals;
 pub mod overlap;
 pub mod promolecular;

@@ -13,7 +13,8 @@ use rayon::prelude::*;
 use super::cartesian::CartesianDensity;
 use super::eigen::symmetric_eigen;
 use super::grid::GridSpec;
-use super::gto::PreparedBasis;
+use super::gto::{BLOCK, BlockScratch, DerivativeBlock, PreparedBasis};
+use super::orbital_sums::{COMPONENTS, OccupiedOrbitals};
 use super::orbitals::{Quantity, Wavefunction};
 
 /// What NCIPLOT's cubes hold where a point is cut (ρ above the cut, or an intermolecular
@@ -86,9 +87,29 @@ impl DensityDerivatives {
         self.eigenvalues()[1]
     }
 
+    /// Whether λ₂ < 0, without the eigenvalues where that is safe. The Hessian's eigenvalues
+    /// are the roots of x³ − e₁x² + e₂x − e₃ (e₁ the trace, e₂ the sum of the principal 2×2
+    /// minors, e₃ the determinant); all three are real, so by Descartes' rule as many are
+    /// positive as the coefficients change sign, and λ₂ < 0 when at most one is. Where a
+    /// coefficient is too close to 0 for its rounding to be sure of its sign (λ₂ near 0 among
+    /// them), the eigenvalues decide.
+    pub fn lambda2_is_negative(&self) -> bool {
+        let [[a, b, c], [_, d, e], [_, _, f]] = self.hessian;
+        let e1 = a + d + f;
+        let e2 = a * d - b * b + a * f - c * c + d * f - e * e;
+        let e3 = a * (d * f - e * e) - b * (b * f - e * c) + c * (b * e - d * c);
+        let norm = (a * a + d * d + f * f + 2.0 * (b * b + c * c + e * e)).sqrt();
+        let sure = |v: f64, scale: f64| v.abs() > 1e-8 * scale;
+        if !(sure(e1, norm) && sure(e2, norm * norm) && sure(e3, norm * norm * norm)) {
+            return self.lambda2() < 0.0;
+        }
+        let coefficients = [1.0, -e1, e2, -e3];
+        coefficients.windows(2).filter(|w| (w[0] < 0.0) != (w[1] < 0.0)).count() <= 1
+    }
+
     /// sign(λ₂)·ρ: negative in bonding regions (hydrogen bonds), positive in steric clashes.
     pub fn sign_lambda2_rho(&self) -> f64 {
-        if self.lambda2() < 0.0 { -self.rho } else { self.rho }
+        if self.lambda2_is_negative() { -self.rho } else { self.rho }
     }
 
     /// ∇²ρ, the Hessian's trace.
@@ -122,8 +143,8 @@ impl DensityDerivatives {
 /// A density whose value and first and second derivatives can be had at points.
 pub trait DensitySource: Sync {
     /// ρ and its derivatives at each of `points` (bohr), written to `out` (as long as `points`).
-    /// Callers pass nearby points together (a grid row): sources screen their centres once
-    /// per call.
+    /// Callers pass nearby points together (a few grid rows, in tiles: [`nci_grid`]): sources
+    /// screen their centres once per call.
     fn derivatives_at(&self, points: &[DVec3], out: &mut [DensityDerivatives]);
 }
 
@@ -135,9 +156,8 @@ pub struct WavefunctionDensity<'a> {
     /// What the density is evaluated over: the basis contracted for the occupied orbitals
     /// ([`occupied_contraction`]).
     contracted: PreparedBasis,
-    /// Per function of `contracted`, its coefficient in each occupied orbital.
-    coefficients: Vec<f64>,
-    occupations: Vec<f64>,
+    /// The occupied orbitals over `contracted`.
+    orbitals: OccupiedOrbitals,
 }
 
 impl<'a> WavefunctionDensity<'a> {
@@ -149,7 +169,8 @@ impl<'a> WavefunctionDensity<'a> {
     pub fn with_basis(basis: PreparedBasis, wavefunction: &'a Wavefunction) -> Self {
         let (coefficients, occupations) = occupied_matrix(&basis, wavefunction);
         let (contracted, coefficients) = occupied_contraction(&basis, &coefficients, occupations.len());
-        Self { basis, wavefunction, contracted, coefficients, occupations }
+        let orbitals = OccupiedOrbitals::new(&coefficients, occupations);
+        Self { basis, wavefunction, contracted, orbitals }
     }
 
     /// Basis functions the density is evaluated over (at most the basis's).
@@ -172,7 +193,7 @@ impl<'a> WavefunctionDensity<'a> {
 
 impl DensitySource for WavefunctionDensity<'_> {
     fn derivatives_at(&self, points: &[DVec3], out: &mut [DensityDerivatives]) {
-        self.contracted.occupied_derivatives_into(&self.coefficients, &self.occupations, points, out);
+        self.contracted.occupied_derivatives_into(&self.orbitals, points, out);
     }
 }
 
@@ -247,98 +268,145 @@ impl PreparedBasis {
     pub fn density_derivatives(&self, wf: &Wavefunction, points: &[DVec3]) -> Vec<DensityDerivatives> {
         let mut out = vec![DensityDerivatives::default(); points.len()];
         let (coefficients, occupations) = occupied_matrix(self, wf);
-        self.occupied_derivatives_into(&coefficients, &occupations, points, &mut out);
+        self.occupied_derivatives_into(&OccupiedOrbitals::new(&coefficients, occupations), points, &mut out);
         out
     }
 
-    /// [`Self::density_derivatives`] of orbitals given as a function-major matrix
-    /// (`coefficients[k · n + i]`: function k in orbital i, n = `occupations.len()`).
-    fn occupied_derivatives_into(
-        &self,
-        coefficients: &[f64],
-        occupations: &[f64],
-        points: &[DVec3],
-        out: &mut [DensityDerivatives],
-    ) {
+    /// [`Self::density_derivatives`] of `orbitals` over this basis.
+    fn occupied_derivatives_into(&self, orbitals: &OccupiedOrbitals, points: &[DVec3], out: &mut [DensityDerivatives]) {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx512f") {
+            // SAFETY: the CPU has the features the function is compiled for.
+            unsafe { self.occupied_derivatives_avx512(orbitals, points, out) };
+            return;
+        }
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
             // SAFETY: the CPU has the features the function is compiled for.
-            unsafe { self.occupied_derivatives_avx2(coefficients, occupations, points, out) };
+            unsafe { self.occupied_derivatives_avx2(orbitals, points, out) };
             return;
         }
-        self.occupied_derivatives_kernel(coefficients, occupations, points, out);
+        self.occupied_derivatives_kernel(orbitals, points, out);
     }
 
-    /// [`Self::occupied_derivatives_kernel`] compiled for AVX2 and FMA (the same sums, fused:
-    /// last-digit differences only).
+    /// [`Self::occupied_derivatives_kernel`] compiled for AVX-512: the blocks' loops over
+    /// points in 8-wide registers. The same operations, so the same bits (Rust never fuses a
+    /// multiply and an add on its own).
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma")]
-    fn occupied_derivatives_avx2(
+    #[target_feature(enable = "avx512f,avx2,fma")]
+    fn occupied_derivatives_avx512(
         &self,
-        coefficients: &[f64],
-        occupations: &[f64],
+        orbitals: &OccupiedOrbitals,
         points: &[DVec3],
         out: &mut [DensityDerivatives],
     ) {
-        self.occupied_derivatives_kernel(coefficients, occupations, points, out);
+        self.occupied_derivatives_kernel(orbitals, points, out);
     }
 
+    /// [`Self::occupied_derivatives_kernel`] compiled for AVX2 (4-wide registers).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    fn occupied_derivatives_avx2(&self, orbitals: &OccupiedOrbitals, points: &[DVec3], out: &mut [DensityDerivatives]) {
+        self.occupied_derivatives_kernel(orbitals, points, out);
+    }
+
+    /// ρ and its derivatives at `points`, [`BLOCK`] points at a time: the basis functions'
+    /// derivatives over the block for every shell within reach of one of its points, then per
+    /// point the orbitals' sums over the functions within reach of that point.
     #[inline(always)]
     fn occupied_derivatives_kernel(
         &self,
-        coefficients: &[f64],
-        occupations: &[f64],
+        orbitals: &OccupiedOrbitals,
         points: &[DVec3],
         out: &mut [DensityDerivatives],
     ) {
-        let n = occupations.len();
-        let mut phi = vec![[0.0; 10]; self.n_functions()];
-        // Component-major: psi[t · n + i] is component t of orbital i.
-        let mut psi = vec![0.0; 10 * n];
-        let mut cart = Vec::new();
+        let mut phi = vec![[[0.0; BLOCK]; COMPONENTS]; self.n_functions()];
+        let mut psi = vec![0.0; orbitals.scratch_len()];
+        let mut scratch = BlockScratch::default();
         let mut active: Vec<usize> = Vec::new();
+        // Per shell that reaches a point of the block: the points it reaches, as bits.
+        let mut reached: Vec<(usize, u32)> = Vec::new();
         // Shells that can reach any of the points: the rest are never looked at.
         let (lo, hi) = bounds(points);
         let (centre, half) = ((lo + hi) * 0.5, (hi - lo).length() * 0.5);
         let near: Vec<usize> = (0..self.shells.len())
             .filter(|&s| self.shells[s].center().distance(centre) <= self.shells[s].cutoff + half)
             .collect();
-        for (p, o) in points.iter().zip(out.iter_mut()) {
-            active.clear();
-            for &si in &near {
-                let s = &self.shells[si];
-                let d = *p - s.center();
-                if d.length_squared() <= s.cutoff * s.cutoff {
-                    self.shell_second_derivatives(s, d, &mut phi[s.functions()], &mut cart);
-                    active.extend(s.functions());
-                }
-            }
-            psi.fill(0.0);
-            for &k in &active {
-                let row = &coefficients[k * n..(k + 1) * n];
-                for (t, &v) in phi[k].iter().enumerate() {
-                    for (p, c) in psi[t * n..(t + 1) * n].iter_mut().zip(row) {
-                        *p += v * c;
+        for (points, out) in points.chunks(BLOCK).zip(out.chunks_mut(BLOCK)) {
+            self.block_derivatives(&near, points, &mut phi, &mut scratch, &mut reached);
+            for (i, o) in out.iter_mut().enumerate() {
+                active.clear();
+                for &(si, bits) in &reached {
+                    if bits >> i & 1 != 0 {
+                        active.extend(self.shells[si].functions());
                     }
                 }
+                orbitals.sums(&phi, i, &active, &mut psi);
+                let (rho, g, h) = orbitals.density_derivatives(&psi);
+                *o = DensityDerivatives { rho, gradient: DVec3::from_array(g), hessian: symmetric(h) };
             }
-            let c = |t: usize| &psi[t * n..(t + 1) * n];
-            let dot =
-                |a: &[f64], b: &[f64]| -> f64 { a.iter().zip(b).zip(occupations).map(|((x, y), w)| w * x * y).sum() };
-            let v = c(0);
-            let rho = dot(v, v);
-            let g: [f64; 3] = std::array::from_fn(|a| 2.0 * dot(v, c(1 + a)));
-            let h: [f64; 6] = std::array::from_fn(|k| {
-                let (a, b) = PAIRS[k];
-                2.0 * (dot(v, c(4 + k)) + dot(c(1 + a), c(1 + b)))
-            });
-            *o = DensityDerivatives { rho, gradient: DVec3::from_array(g), hessian: symmetric(h) };
         }
     }
 }
 
-/// The six independent components' (row, column): xx, xy, xz, yy, yz, zz.
-const PAIRS: [(usize, usize); 6] = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
+impl PreparedBasis {
+    /// The derivatives of the functions of each of the `near` shells that reaches one of the
+    /// block's `points`, into `phi` (indexed by function); `reached` gets those shells, each
+    /// with the points it reaches as bits.
+    #[inline(always)]
+    fn block_derivatives(
+        &self,
+        near: &[usize],
+        points: &[DVec3],
+        phi: &mut [DerivativeBlock],
+        scratch: &mut BlockScratch,
+        reached: &mut Vec<(usize, u32)>,
+    ) {
+        reached.clear();
+        let axes = block_axes(points);
+        for &si in near {
+            let s = &self.shells[si];
+            let (d, r2, bits) = offsets(&axes, points.len(), s.center(), s.cutoff);
+            if bits != 0 {
+                self.shell_second_derivatives_block(s, &d, &r2, &mut phi[s.functions()], scratch);
+                reached.push((si, bits));
+            }
+        }
+    }
+}
+
+// A block's points are bits of a u32.
+const _: () = assert!(BLOCK <= 32);
+
+/// A block's points by axis, the last point repeated to fill the block.
+#[inline(always)]
+fn block_axes(points: &[DVec3]) -> [[f64; BLOCK]; 3] {
+    let mut axes = [[0.0; BLOCK]; 3];
+    for i in 0..BLOCK {
+        let p = points[i.min(points.len() - 1)];
+        (axes[0][i], axes[1][i], axes[2][i]) = (p.x, p.y, p.z);
+    }
+    axes
+}
+
+/// A block's offsets from `centre` per axis, their squared lengths (as `DVec3` computes
+/// them), and which of the block's first `n` points lie within `cutoff` (bits).
+#[inline(always)]
+fn offsets(axes: &[[f64; BLOCK]; 3], n: usize, centre: DVec3, cutoff: f64) -> ([[f64; BLOCK]; 3], [f64; BLOCK], u32) {
+    let mut d = [[0.0; BLOCK]; 3];
+    for (d, (axis, c)) in d.iter_mut().zip(axes.iter().zip(centre.to_array())) {
+        for (d, x) in d.iter_mut().zip(axis) {
+            *d = x - c;
+        }
+    }
+    let mut r2 = [0.0; BLOCK];
+    let mut bits = 0u32;
+    for (i, r2) in r2.iter_mut().enumerate() {
+        *r2 = d[0][i] * d[0][i] + d[1][i] * d[1][i] + d[2][i] * d[2][i];
+        bits |= u32::from(*r2 <= cutoff * cutoff) << i;
+    }
+    (d, r2, bits & (u32::MAX >> (32 - n)))
+}
 
 fn symmetric(h: [f64; 6]) -> [[f64; 3]; 3] {
     [[h[0], h[1], h[2]], [h[1], h[3], h[4]], [h[2], h[4], h[5]]]
@@ -415,8 +483,29 @@ pub struct NciGrids {
     pub kept: usize,
 }
 
-/// [`NciGrids`] of the fragments' summed density on `grid`, x-slabs in parallel, a row of
-/// points at a time.
+/// Rows of an x-slab whose points are evaluated together.
+const GROUP_ROWS: usize = 4;
+
+/// Points along z per tile: a group's points go to the sources tile by tile, [`GROUP_ROWS`]
+/// rows × this many points, so that a block of [`BLOCK`] points (what a wavefunction's basis
+/// functions are evaluated over at once) is a compact square rather than a long stretch of a
+/// row, and rows' ends fill blocks together instead of each leaving one mostly empty.
+const TILE_COLUMNS: usize = BLOCK / GROUP_ROWS;
+
+/// The (row within the group, z index) of each point of a group of `rows` rows of `nz`
+/// points, tile by tile.
+fn tile_order(rows: usize, nz: usize) -> Vec<(usize, usize)> {
+    let mut order = Vec::with_capacity(rows * nz);
+    for z0 in (0..nz).step_by(TILE_COLUMNS) {
+        for r in 0..rows {
+            order.extend((z0..nz.min(z0 + TILE_COLUMNS)).map(|iz| (r, iz)));
+        }
+    }
+    order
+}
+
+/// [`NciGrids`] of the fragments' summed density on `grid`, x-slabs in parallel, a few rows
+/// of points at a time.
 pub fn nci_grid(fragments: &[&dyn DensitySource], grid: &GridSpec, settings: NciSettings) -> NciGrids {
     let [_, ny, nz] = grid.dims;
     let slab = ny * nz;
@@ -425,35 +514,38 @@ pub fn nci_grid(fragments: &[&dyn DensitySource], grid: &GridSpec, settings: Nci
     if grid.is_empty() {
         return NciGrids { dens, grad, kept: 0 };
     }
+    let group = GROUP_ROWS * nz;
     let kept: usize = dens
         .par_chunks_mut(slab)
         .zip(grad.par_chunks_mut(slab))
         .enumerate()
         .map(|(ix, (dens, grad))| {
-            let mut points = Vec::with_capacity(nz);
-            let mut total = vec![DensityDerivatives::default(); nz];
-            let mut part = vec![DensityDerivatives::default(); nz];
-            let mut largest = vec![0.0f64; nz];
+            let mut points = Vec::with_capacity(group);
+            let mut total = vec![DensityDerivatives::default(); group];
+            let mut part = vec![DensityDerivatives::default(); group];
+            let mut largest = vec![0.0f64; group];
             let mut kept = 0;
-            for iy in 0..ny {
+            for y0 in (0..ny).step_by(GROUP_ROWS) {
+                let order = tile_order(GROUP_ROWS.min(ny - y0), nz);
+                let n = order.len();
                 points.clear();
-                points.extend((0..nz).map(|iz| grid.point(ix, iy, iz)));
-                total.fill(DensityDerivatives::default());
-                largest.fill(0.0);
+                points.extend(order.iter().map(|&(r, iz)| grid.point(ix, y0 + r, iz)));
+                total[..n].fill(DensityDerivatives::default());
+                largest[..n].fill(0.0);
                 for f in fragments {
-                    f.derivatives_at(&points, &mut part);
-                    for ((t, p), l) in total.iter_mut().zip(&part).zip(largest.iter_mut()) {
+                    f.derivatives_at(&points, &mut part[..n]);
+                    for ((t, p), l) in total.iter_mut().zip(&part[..n]).zip(largest.iter_mut()) {
                         t.add(p);
                         *l = l.max(p.rho);
                     }
                 }
-                for (iz, (t, l)) in total.iter().zip(&largest).enumerate() {
+                for (&(r, iz), (t, l)) in order.iter().zip(total.iter().zip(&largest)) {
                     let own = settings.intermolecular.is_some_and(|share| *l > share * t.rho);
                     if t.rho > settings.density_cut || own || t.rho.is_nan() || t.rho <= 0.0 {
                         continue;
                     }
                     let s = t.reduced_gradient();
-                    let k = iy * nz + iz;
+                    let k = (y0 + r) * nz + iz;
                     dens[k] = (100.0 * t.sign_lambda2_rho()) as f32;
                     grad[k] =
                         if s.is_finite() && s <= settings.rdg_cut { s.min(CUT_VALUE as f64) as f32 } else { CUT_VALUE };
@@ -558,6 +650,34 @@ mod tests {
         assert!(e[0] < e[1] && e[1] < e[2]);
         assert!((e.iter().sum::<f64>() - turned.laplacian()).abs() < 1e-12);
         assert_eq!(DensityDerivatives::default().reduced_gradient(), f64::INFINITY);
+    }
+
+    #[test]
+    fn tiles_cover_every_point_of_a_group_once() {
+        // A full group's first block is a square: every row, the first few points of each.
+        let first = &tile_order(GROUP_ROWS, 51)[..BLOCK];
+        assert!(first.iter().all(|&(_, z)| z < TILE_COLUMNS));
+        for (rows, nz) in [(4, 51), (1, 3), (3, 8), (4, 1)] {
+            let mut order = tile_order(rows, nz);
+            order.sort_unstable();
+            let all: Vec<_> = (0..rows).flat_map(|r| (0..nz).map(move |z| (r, z))).collect();
+            assert_eq!(order, all);
+        }
+    }
+
+    #[test]
+    fn the_sign_of_lambda2_agrees_with_the_eigenvalues() {
+        // Random symmetric matrices, matrices with λ₂ near 0 relative to the others, and one
+        // with a zero trace (a coefficient the rule cannot trust).
+        let r = crate::model::gto::tests::pseudo_random(6 * 400, 3);
+        let mut matrices: Vec<[f64; 6]> = r.chunks_exact(6).map(|c| std::array::from_fn(|k| c[k])).collect();
+        matrices.push([1.0, 0.0, 0.0, 1e-12, 0.0, -2.0]);
+        matrices.push([1.0, 0.0, 0.0, -1e-12, 0.0, 2.0]);
+        matrices.push([1.0, 0.3, 0.0, -0.5, 0.2, -0.5]);
+        for h in matrices {
+            let d = DensityDerivatives { rho: 0.01, hessian: symmetric(h), ..Default::default() };
+            assert_eq!(d.lambda2_is_negative(), d.lambda2() < 0.0, "{h:?}");
+        }
     }
 
     #[test]
