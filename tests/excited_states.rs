@@ -328,3 +328,97 @@ fn cube_and_eval_of_state_densities_and_refusals() {
     );
     refused(&["cube", td.to_str().unwrap(), "--attachment", "--density", "-o", "x.cube"], &["cannot be used with"]);
 }
+
+/// An independent reading of a Gaussian TD log's printed amplitudes and its fchk twin's
+/// orbitals (numpy): each state's NTO weights (σ² of the amplitude matrix's SVD over Σσ²) and its
+/// first hole and particle over the basis functions (C_occ U₁, C_virt V₁, each vector's largest
+/// MO coefficient positive).
+const NTO_SCRIPT: &str = r#"
+import json, re, sys
+import numpy as np
+log, fchk = sys.argv[1], sys.argv[2]
+text = open(fchk).read()
+def record(name):
+    m = re.search(r"^" + re.escape(name) + r"\s+R\s+N=\s+(\d+)\n", text, re.M)
+    n = int(m.group(1))
+    return np.array(text[m.end():].split()[:n], dtype=float)
+nbf = int(re.search(r"^Number of basis functions\s+I\s+(\d+)", text, re.M).group(1))
+c = record("Alpha MO coefficients").reshape(-1, nbf)
+states, current = [], None
+for line in open(log):
+    if line.startswith(" Excited State"):
+        current = []
+        states.append(current)
+    elif current is not None:
+        m = re.match(r"^\s+(\d+)\s*->\s*(\d+)\s+(-?\d+\.\d+)\s*$", line)
+        if m:
+            current.append((int(m.group(1)), int(m.group(2)), float(m.group(3))))
+        elif not re.match(r"^\s+(\d+)\s*<-\s*(\d+)", line):
+            current = None
+out = []
+for tr in states:
+    occ = sorted({t[0] for t in tr}); vir = sorted({t[1] for t in tr})
+    t = np.zeros((len(occ), len(vir)))
+    for i, a, x in tr:
+        t[occ.index(i), vir.index(a)] += x
+    u, s, vt = np.linalg.svd(t / np.linalg.norm(t))
+    u1, v1 = u[:, 0], vt[0]
+    u1 = u1 * np.sign(u1[np.argmax(np.abs(u1))]); v1 = v1 * np.sign(v1[np.argmax(np.abs(v1))])
+    hole = sum(w * c[i - 1] for w, i in zip(u1, occ))
+    particle = sum(w * c[a - 1] for w, a in zip(v1, vir))
+    out.append({"weights": (s**2).tolist(), "hole": hole.tolist(), "particle": particle.tolist()})
+print(json.dumps(out))
+"#;
+
+/// Natural transition orbitals from a TD log's printed amplitudes over its fchk twin's orbitals
+/// (what Multiwfn's hole–electron analysis reads): the weights and the first pair equal an
+/// independent SVD of the same printed numbers, the orbitals are normalised, and the document
+/// made of them names its orbitals `hole 1`, `particle 1`, … occupied by their weights.
+#[test]
+fn ntos_from_a_td_logs_amplitudes_equal_an_independent_svd() {
+    use orbcloud::model::nto;
+    let Some(dir) = logs("excited_states::ntos_from_a_td_logs_amplitudes_equal_an_independent_svd") else { return };
+    let (log, fchk) = (dir.join("basicGaussian09_dvb_td.out"), dir.join("basicGaussian09_dvb_td.fchk"));
+    let doc = load(&fchk);
+    let states = load(&log).excited.expect("the log's states");
+    let wf = doc.wavefunction.as_ref().unwrap();
+    let out = std::process::Command::new(orbcloud::sources::compute::python())
+        .args(["-c", NTO_SCRIPT])
+        .arg(&log)
+        .arg(&fchk)
+        .output()
+        .expect("python (scripts/test sets ORBCLOUD_PYTHON)");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let reference: Vec<serde_json::Value> = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(reference.len(), states.states.len());
+    let overlap = orbcloud::model::overlap::overlap_matrix(&wf.basis);
+    let n = wf.basis.n_functions();
+    let norm = |c: &[f64]| (0..n).map(|i| (0..n).map(|j| c[i] * overlap[i * n + j] * c[j]).sum::<f64>()).sum::<f64>();
+    for (state, expected) in states.states.iter().zip(&reference) {
+        let ntos = nto::from_transitions(wf, state).expect("NTOs");
+        let weights: Vec<f64> = expected["weights"].as_array().unwrap().iter().map(|w| w.as_f64().unwrap()).collect();
+        eprintln!(
+            "state {}: printed Σc² {:.5}, weights {:?}",
+            state.number,
+            ntos.printed_norm,
+            ntos.pairs.iter().map(|p| format!("{:.4}", p.weight)).collect::<Vec<_>>()
+        );
+        for (p, w) in ntos.pairs.iter().zip(&weights) {
+            assert!((p.weight - w).abs() < 1e-10, "state {}: {} vs {w}", state.number, p.weight);
+        }
+        let first = &ntos.pairs[0];
+        for (ours, key) in [(&first.hole, "hole"), (&first.particle, "particle")] {
+            let theirs: Vec<f64> = expected[key].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
+            let worst = ours.iter().zip(&theirs).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+            assert!(worst < 1e-8, "state {} {key}: {worst}", state.number);
+            assert!((norm(ours) - 1.0).abs() < 1e-4, "state {} {key} is normalised: {}", state.number, norm(ours));
+        }
+        // Gaussian prints amplitudes down to 0.01 here: most of each singlet's 0.5.
+        assert!(ntos.printed_norm > 0.45 && ntos.printed_norm < 0.55, "{}", ntos.printed_norm);
+        let made = ntos.document(&doc).expect("a document");
+        let orbitals = &made.wavefunction.as_ref().unwrap().orbitals;
+        assert_eq!(orbitals[0].symmetry, "hole 1");
+        assert_eq!(orbitals[1].symmetry, "particle 1");
+        assert_eq!(orbitals[0].occupation, first.weight);
+    }
+}

@@ -724,6 +724,52 @@ fn a_td_checkpoint_lists_its_states_and_a_click_on_a_band_picks_one_its_density_
     assert!(h.query_by_label_contains("1.001 electrons move").is_some(), "the electrons moved");
 }
 
+/// A TD log opened after its checkpoint gives the checkpoint's states their printed
+/// transitions (the log writes the molecule turned: the same molecule, other coordinates), and
+/// *hole | particle* shows the state's natural transition orbitals side by side in panes, each
+/// captioned with its weight, while the file's list stays to pick the next state.
+#[test]
+fn a_td_log_joins_its_checkpoint_and_a_state_shows_hole_and_particle_in_panes() {
+    let Some(corpus) = common::refdata("natural transition orbitals in the window") else { return };
+    let (td, log) = (corpus.join("logs/basicGaussian09_dvb_td.fchk"), corpus.join("logs/basicGaussian09_dvb_td.out"));
+    let mut h = open(vec![td, log]);
+    wait_loaded(&mut h);
+    assert_eq!(h.state().objects.len(), 1, "the log joined the checkpoint");
+    let notice = h.state().notice.clone().unwrap_or_default();
+    assert!(notice.contains("5 states' transitions"), "{notice}");
+    h.get_by_label_contains("6.062").click();
+    h.run_steps(2);
+    h.get_by_label("hole | particle").click();
+    h.run_steps(2);
+    wait_loaded(&mut h);
+    let app = h.state();
+    assert_eq!(app.objects.len(), 2, "the state's NTOs are an object of their own");
+    assert!(!app.objects[0].state.visible, "the file steps aside");
+    assert_eq!(app.active, 0, "the file's list of states stays");
+    assert_eq!(app.view.panes.count, 2);
+    let ntos = &app.objects[1];
+    let names: Vec<String> = ntos.state.quantities.iter().map(|q| q.source.name(&ntos.doc)).collect();
+    assert_eq!(names, ["hole 1", "particle 1"]);
+    assert_eq!(ntos.state.quantities.iter().map(|q| q.pane).collect::<Vec<_>>(), [Some(0), Some(1)]);
+    // State 2 is one pair, nearly: 0.972 of its weight.
+    let weight = ntos.doc.wavefunction.as_ref().unwrap().orbitals[0].occupation;
+    assert!((weight - 0.972).abs() < 1e-3 && ntos.doc.title.starts_with("state 2"), "{weight} {}", ntos.doc.title);
+    // Each pane shows its orbital's two lobes.
+    for p in 0..2 {
+        let picture = h.state().pane_picture(p).expect("the pane is drawn");
+        let (red, blue) = red_and_blue(&picture);
+        assert!(red > 150 && blue > 150, "pane {p}: {red} red, {blue} blue pixels");
+    }
+    // Another state's NTOs take their place.
+    h.get_by_label_contains("5.629").click();
+    h.run_steps(2);
+    h.get_by_label("hole | particle").click();
+    h.run_steps(2);
+    wait_loaded(&mut h);
+    assert_eq!(h.state().objects.len(), 2);
+    assert!(h.state().objects[1].doc.source.ends_with("(state 1 NTOs)"), "{}", h.state().objects[1].doc.source);
+}
+
 /// Pixels of `img` that are an NCI surface's blue-green (attraction): green and blue above red.
 fn blue_green(img: &image::RgbaImage) -> usize {
     img.pixels().filter(|p| p[1] as i32 > p[0] as i32 + 40 && p[2] as i32 > p[0] as i32 + 40).count()

@@ -17,27 +17,32 @@ use crate::scene::excited_view::ExcitedView;
 /// The panel's height, points.
 const HEIGHT: f32 = 240.0;
 
+/// What a click in the panel asks for.
+#[derive(Default)]
+pub struct Asked {
+    /// What the object shows, in order.
+    pub picks: Vec<Pick>,
+    /// The state (index into the list) whose natural transition orbitals are shown, hole |
+    /// particle in panes ([`crate::model::nto`]).
+    pub ntos: Option<usize>,
+}
+
 /// Shows the panel when `doc` lists excited states, editing `view` in place; `spectrum` keeps
-/// where the spectrum was drawn (for tests to click its bands). Returns what a click asks the
-/// object to show, in order.
-pub fn panel(
-    ui: &mut egui::Ui,
-    doc: &Document,
-    view: &mut ExcitedView,
-    spectrum: &mut Option<PlotTransform>,
-) -> Vec<Pick> {
+/// where the spectrum was drawn (for tests to click its bands). Returns what a click asks for.
+pub fn panel(ui: &mut egui::Ui, doc: &Document, view: &mut ExcitedView, spectrum: &mut Option<PlotTransform>) -> Asked {
     let Some(states) = doc.excited.as_ref().filter(|s| !s.states.is_empty()) else {
         *spectrum = None;
-        return Vec::new();
+        return Asked::default();
     };
     let before = view.state;
-    let mut picks = Vec::new();
+    let mut asked = Asked::default();
     egui::Panel::bottom("excited states").exact_size(HEIGHT).show(ui, |ui| {
         ui.columns(2, |columns| {
-            picks = list(&mut columns[0], doc, states, view);
+            asked = list(&mut columns[0], doc, states, view);
             *spectrum = Some(uv_vis(&mut columns[1], states, view));
         });
     });
+    let mut picks = std::mem::take(&mut asked.picks);
     // A state picked on the spectrum or in the list shows at once what it can.
     if view.state != before
         && picks.is_empty()
@@ -45,7 +50,7 @@ pub fn panel(
     {
         picks = shown_for(doc, states, k, Quantity::DifferenceDensity);
     }
-    picks
+    Asked { picks, ..asked }
 }
 
 /// What picking state `k` shows: `density` (difference, attachment, detachment) where the file
@@ -85,8 +90,9 @@ fn row_text(s: &ExcitedState) -> String {
     format!("{:>3} {:>7.3} {:>6.1} {:>7} {} {main}", s.number, s.energy_ev, s.wavelength_nm(), f, kind.join("-"))
 }
 
-fn list(ui: &mut egui::Ui, doc: &Document, states: &ExcitedStates, view: &mut ExcitedView) -> Vec<Pick> {
+fn list(ui: &mut egui::Ui, doc: &Document, states: &ExcitedStates, view: &mut ExcitedView) -> Asked {
     let mut picks = Vec::new();
+    let mut ntos = None;
     ui.heading("Excited states");
     let method = if states.method.is_empty() { String::new() } else { format!(" {}", states.method) };
     let density = match states.density_of {
@@ -129,6 +135,19 @@ fn list(ui: &mut egui::Ui, doc: &Document, states: &ExcitedStates, view: &mut Ex
                 }
             });
         }
+        // Its printed amplitudes over the file's orbitals: the natural transition orbitals.
+        if doc.wavefunction.is_some()
+            && s.transitions.iter().any(|t| !t.deexcitation)
+            && ui
+                .button("hole | particle")
+                .on_hover_text(
+                    "the state's natural transition orbitals from its printed amplitudes: where the electron \
+                     leaves | where it goes, side by side, each pair's weight in its caption",
+                )
+                .clicked()
+        {
+            ntos = view.state;
+        }
     }
     let transitions = states.states.iter().any(|s| !s.transitions.is_empty());
     let header =
@@ -151,7 +170,7 @@ fn list(ui: &mut egui::Ui, doc: &Document, states: &ExcitedStates, view: &mut Ex
         }
     });
     ui.data_mut(|d| d.insert_temp(scrolled_id, view.state));
-    picks
+    Asked { picks, ntos }
 }
 
 /// The UV-vis spectrum: a stick per state at its energy, as high as its oscillator strength, and
@@ -210,4 +229,64 @@ fn uv_vis(ui: &mut egui::Ui, states: &ExcitedStates, view: &mut ExcitedView) -> 
         view.state = Some(k);
     }
     response.transform
+}
+
+impl super::OrbApp {
+    /// Shows state `k` of object `n` as its natural transition orbitals: an object of its own
+    /// beside the file's (in its place, which it hides), hole 1 in the first pane and particle 1
+    /// in the second, one camera; a state's NTOs shown before make way.
+    pub fn show_ntos(&mut self, n: usize, k: usize) {
+        let Some(parent) = self.objects.get(n) else { return };
+        let doc = parent.doc.clone();
+        let (Some(wf), Some(state)) = (&doc.wavefunction, doc.excited.as_ref().and_then(|e| e.states.get(k))) else {
+            return;
+        };
+        let Some(ntos) = crate::model::nto::from_transitions(wf, state) else {
+            self.status = format!("state {}: no printed transition names orbitals of {}", state.number, doc.source);
+            return;
+        };
+        let Some(made) = ntos.document(&doc) else { return };
+        // One state's NTOs at a time: the ones shown before go.
+        let before = format!("{} (state ", doc.source);
+        if let Some(old) = self.objects.iter().position(|o| o.doc.source.starts_with(&before)) {
+            self.remove_object(old);
+        }
+        let Some(parent) = self.objects.iter_mut().find(|o| o.doc.source == doc.source) else { return };
+        parent.state.visible = false;
+        let defaults = self.defaults;
+        let mut shown = crate::scene::ObjectState {
+            placement: parent.state.placement,
+            atoms: parent.state.atoms,
+            ..crate::scene::ObjectState::default()
+        };
+        for (orbital, pane) in [(0, 0), (1, 1)] {
+            let source = crate::scene::Source::Wavefunction(Quantity::Orbital(orbital));
+            let mut q =
+                crate::scene::QuantityState { pane: Some(pane), ..crate::scene::QuantityState::new(source, &defaults) };
+            // Readable at once, as an orbital opens: its ± surfaces over the cloud.
+            for iso in &mut q.isosurfaces {
+                iso.visible = true;
+                iso.translucent = true;
+            }
+            shown.quantities.push(q);
+        }
+        let weights: Vec<String> = ntos.pairs.iter().map(|p| format!("{:.2}", p.weight)).collect();
+        let camera = self.view.camera;
+        self.add_shared_object(std::sync::Arc::new(made), super::Opening::Restore(Box::new(shown)));
+        while self.view.panes.count < 2 {
+            self.view.panes.add(camera);
+        }
+        self.view.panes.linked = true;
+        // The file stays the one the panels edit: its states' list picks the next state.
+        if let Some(parent) = self.objects.iter().position(|o| o.doc.source == doc.source) {
+            self.active = parent;
+        }
+        self.frame_panes();
+        self.status = format!(
+            "state {}: natural transition orbitals of the printed amplitudes (Σc² {:.4}), weights {}",
+            state.number,
+            ntos.printed_norm,
+            weights.join(", ")
+        );
+    }
 }

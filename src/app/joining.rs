@@ -23,7 +23,7 @@ impl OrbApp {
     /// The object `doc` would join: the active one when it matches, else the last that does
     /// (objects read from a file only).
     fn join_target(&self, doc: &Document, how: &Opening) -> Option<usize> {
-        if *how != Opening::Add || !doc.is_grid_only() {
+        if *how != Opening::Add || !(doc.is_grid_only() || doc.carries_transitions()) {
             return None;
         }
         // Not onto the bundled demo (sessions leave it out, and what joined it with it), and
@@ -35,10 +35,7 @@ impl OrbApp {
                 AddedVolume::Joined { path } => Some(path),
                 AddedVolume::Difference { .. } => None,
             }));
-            o.state.path.is_some()
-                && !files.map(PathBuf::as_path).any(same_file)
-                && o.doc.is_grid_only()
-                && o.doc.same_atoms(doc)
+            o.state.path.is_some() && !files.map(PathBuf::as_path).any(same_file) && o.doc.joins(doc)
         };
         std::iter::once(self.active).chain((0..self.objects.len()).rev()).filter(|n| *n < self.objects.len()).find(fits)
     }
@@ -53,6 +50,7 @@ impl OrbApp {
         }
         let path = PathBuf::from(&doc.source);
         let name = doc.source.clone();
+        let states = doc.carries_transitions();
         let object = &mut self.objects[n];
         let mut merged = (*object.doc).clone();
         let first = match merged.join(doc) {
@@ -90,7 +88,19 @@ impl OrbApp {
                 }
             }
         }
-        state.selected = state.quantities.len() - 1;
+        if states {
+            let count =
+                merged.excited.as_ref().map_or(0, |e| e.states.iter().filter(|s| !s.transitions.is_empty()).count());
+            self.notice = Some(format!(
+                "{name} joined {} (the same molecule): {count} states' transitions over its orbitals; pick a \
+                 state for its natural transition orbitals (hole | particle)",
+                object.doc.source
+            ));
+        }
+        // A joined data set is the one the panels edit; joined states leave the selection.
+        if !states {
+            state.selected = state.quantities.len() - 1;
+        }
         object.doc = Arc::new(merged);
         self.active = n;
     }

@@ -1202,15 +1202,22 @@ impl OrbApp {
             self.nci_plot.hover(&o.doc, hovered);
             self.nci_plot.panel(ui, &o.doc, o.state.selected_quantity_mut());
         }
+        let mut ntos = None;
         if let Some(o) = self.objects.get_mut(self.active).filter(|o| o.scan.is_none()) {
-            let picks = excited::panel(ui, &o.doc, &mut o.state.excited, &mut self.uv_vis);
+            let asked = excited::panel(ui, &o.doc, &mut o.state.excited, &mut self.uv_vis);
+            if let Some(k) = asked.ntos {
+                ntos = Some((self.active, k));
+            }
             let view = &mut self.view;
-            let reframes: Vec<_> = (picks.into_iter())
+            let reframes: Vec<_> = (asked.picks.into_iter())
                 .map(|p| orbitals::apply(p, &mut o.state, &defaults, (&mut view.panes, &view.camera)))
                 .collect();
             if reframes.contains(&orbitals::Reframe::Panes) {
                 self.frame_panes();
             }
+        }
+        if let Some((n, k)) = ntos {
+            self.show_ntos(n, k);
         }
         if self.plane.open
             && let Some(o) = self.objects.get(self.active).filter(|o| o.scan.is_none())

@@ -762,11 +762,13 @@ pub fn translucency_editor(ui: &mut egui::Ui, iso: &mut IsosurfaceSettings) -> b
             .on_hover_text("see every surface through the others, in exact depth order; overlaps with other objects' surfaces glow")
             .changed();
         if iso.translucent {
-            egui::ComboBox::from_id_salt(ui.next_auto_id()).selected_text(iso.optics.label()).show_ui(ui, |ui| {
-                for preset in OpticsPreset::ALL {
-                    changed |= ui.selectable_value(&mut iso.optics, preset, preset.label()).changed();
-                }
-            });
+            let optics =
+                egui::ComboBox::from_id_salt(ui.next_auto_id()).selected_text(iso.optics.label()).show_ui(ui, |ui| {
+                    for preset in OpticsPreset::ALL {
+                        changed |= ui.selectable_value(&mut iso.optics, preset, preset.label()).changed();
+                    }
+                });
+            optics.response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::ComboBox, true, "optics"));
         }
         changed
     })

@@ -33,6 +33,10 @@ fn describe(o: &SceneObject, q: &QuantityState) -> String {
     }
     let name = q.source.name(&o.doc);
     match (q.source.orbital(), &o.doc.wavefunction) {
+        // A natural transition orbital: its pair's weight, no energy.
+        (Some(i), Some(wf)) if crate::model::nto::is_nto_label(&wf.orbitals[i].symmetry) => {
+            format!("{name}  weight {:.3} · {}", wf.orbitals[i].occupation, o.doc.title)
+        }
         (Some(i), Some(wf)) => {
             format!("{name}  {}, occ {:.2}", wf.energy_text(i), wf.orbitals[i].occupation)
         }

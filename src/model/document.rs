@@ -64,15 +64,78 @@ impl Document {
         !self.volumes.is_empty() && self.wavefunction.is_none() && self.structure.is_none()
     }
 
-    /// Appends `other`'s data sets to this document's (a potential cube joining the density
-    /// cube made beside it); returns the index of the first one appended. Refused, with the
-    /// reason, unless both are grid-only files of the same atoms.
+    /// Whether it lists excited states with their printed transitions and has no orbitals of its
+    /// own (a TD job's log): the orbitals of another file of the same atoms give them their
+    /// natural transition orbitals ([`Self::join`]).
+    pub fn carries_transitions(&self) -> bool {
+        self.wavefunction.is_none()
+            && self.excited.as_ref().is_some_and(|e| e.states.iter().any(|s| !s.transitions.is_empty()))
+    }
+
+    /// Whether `other` holds the same molecule, perhaps turned or moved: the same elements in
+    /// the same order at the same distances from one another (a program's log and its
+    /// checkpoint may write different orientations). Molecules of more than
+    /// [`MOST_ATOMS_COMPARED`] atoms are compared in place ([`Self::same_atoms`]).
+    pub fn same_molecule(&self, other: &Document) -> bool {
+        let (a, b) = (&self.molecule.atoms, &other.molecule.atoms);
+        if a.len() > MOST_ATOMS_COMPARED {
+            return self.same_atoms(other);
+        }
+        a.len() == b.len()
+            && a.iter().zip(b).all(|(x, y)| x.z == y.z)
+            && (0..a.len()).all(|i| {
+                (0..i).all(|j| {
+                    let d = a[i].position.distance(a[j].position) - b[i].position.distance(b[j].position);
+                    d.abs() <= SAME_SHAPE
+                })
+            })
+    }
+
+    /// Whether `other` can [`Self::join`] this document.
+    pub fn joins(&self, other: &Document) -> bool {
+        let grids = self.is_grid_only() && other.is_grid_only() && self.same_atoms(other);
+        let states = self.wavefunction.is_some() && other.carries_transitions() && self.same_molecule(other);
+        grids || states
+    }
+
+    /// Takes in `other`, a file of the same atoms: its data sets appended to this grid-only
+    /// document's (a potential cube joining the density cube made beside it; returns the index
+    /// of the first one appended), or its excited states' printed transitions given to this
+    /// document's orbitals (a TD log joining its checkpoint: the states this document lists take
+    /// their transitions, matched by number and energy; a document listing none takes the log's).
+    /// Refused, with the reason, otherwise.
     pub fn join(&mut self, other: Document) -> Result<usize, String> {
-        if !self.is_grid_only() || !other.is_grid_only() {
-            return Err(format!("{}: only data sets on grids join another file's", other.source));
+        // Transitions name orbitals, not places: a log may write its molecule turned.
+        if self.wavefunction.is_some() && other.carries_transitions() {
+            if !self.same_molecule(&other) {
+                return Err(format!("{}: its molecule is not that of {}", other.source, self.source));
+            }
+            let theirs = other.excited.unwrap_or_default();
+            match &mut self.excited {
+                None => self.excited = Some(theirs),
+                Some(ours) => {
+                    for state in &mut ours.states {
+                        let twin = theirs
+                            .states
+                            .iter()
+                            .find(|t| t.number == state.number && (t.energy_ev - state.energy_ev).abs() < STATE_ENERGY);
+                        if let Some(twin) = twin {
+                            state.transitions = twin.transitions.clone();
+                        }
+                    }
+                }
+            }
+            self.problems.extend(other.problems);
+            return Ok(self.volumes.len());
         }
         if !self.same_atoms(&other) {
             return Err(format!("{}: its atoms are not those of {}", other.source, self.source));
+        }
+        if !self.is_grid_only() || !other.is_grid_only() {
+            return Err(format!(
+                "{}: only data sets on grids, or a TD log's states onto orbitals, join another file's",
+                other.source
+            ));
         }
         let first = self.volumes.len();
         self.volumes.extend(other.volumes);
@@ -80,6 +143,17 @@ impl Document {
         Ok(first)
     }
 }
+
+/// The most atoms whose distances [`Document::same_molecule`] compares (n² of them).
+const MOST_ATOMS_COMPARED: usize = 2000;
+
+/// How much two files' interatomic distances may differ in one molecule (bohr): logs print
+/// ångström to 6 decimals.
+const SAME_SHAPE: f64 = 1e-3;
+
+/// How far two files' excitation energies of one state may differ (eV): a log prints 4
+/// decimals, an fchk's `ETran` records more.
+const STATE_ENERGY: f64 = 1e-3;
 
 #[cfg(test)]
 mod tests {

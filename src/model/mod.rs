@@ -29,6 +29,7 @@ pub mod measure;
 pub mod molecule;
 pub mod nci;
 pub mod neighbours;
+pub mod nto;
 pub mod octree;
 mod orbital_sums;
 pub mod orbitals;

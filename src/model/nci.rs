@@ -181,12 +181,11 @@ impl<'a> WavefunctionDensity<'a> {
     /// The occupied orbitals over the contracted basis written out as cartesian Gaussians
     /// (what the GPU evaluates; its density is this source's).
     pub fn cartesian(&self) -> CartesianDensity {
-        let n = self.occupations.len();
-        let columns: Vec<Vec<f64>> = (0..n)
-            .map(|i| (0..self.contracted.n_functions()).map(|k| self.coefficients[k * n + i]).collect())
+        let occupations = &self.orbitals.occupations;
+        let columns: Vec<Vec<f64>> = (0..occupations.len())
+            .map(|i| (0..self.contracted.n_functions()).map(|k| self.orbitals.coefficient(k, i)).collect())
             .collect();
-        let sets: Vec<(&[f64], f64)> =
-            columns.iter().map(Vec::as_slice).zip(self.occupations.iter().copied()).collect();
+        let sets: Vec<(&[f64], f64)> = columns.iter().map(Vec::as_slice).zip(occupations.iter().copied()).collect();
         CartesianDensity::new(&self.contracted, &sets)
     }
 }

@@ -40,6 +40,11 @@ impl OccupiedOrbitals {
         Self { rows, stride, occupations }
     }
 
+    /// Function `k`'s coefficient in occupied orbital `i`.
+    pub fn coefficient(&self, k: usize, i: usize) -> f64 {
+        self.rows[k * self.stride + i]
+    }
+
     /// Occupied orbitals.
     fn len(&self) -> usize {
         self.occupations.len()

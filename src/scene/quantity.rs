@@ -105,7 +105,9 @@ impl Source {
 pub fn orbital_name(wf: &Wavefunction, i: usize) -> String {
     let Some(o) = wf.orbitals.get(i) else { return format!("MO {}", i + 1) };
     let number = wf.of_spin(o.spin).position(|(j, _)| j == i).map_or(0, |p| p + 1);
-    let name = wf.frontier_label(i, 5).unwrap_or_else(|| format!("MO {number}"));
+    // Natural transition orbitals go by their labels ("hole 1"), not by the frontier.
+    let nto = crate::model::nto::is_nto_label(&o.symmetry).then(|| o.symmetry.clone());
+    let name = nto.or_else(|| wf.frontier_label(i, 5)).unwrap_or_else(|| format!("MO {number}"));
     match (wf.restricted, o.spin) {
         (false, Spin::Beta) => format!("{name} β"),
         (false, Spin::Alpha) => format!("{name} α"),
