@@ -178,6 +178,38 @@ impl Coordinate {
     }
 }
 
+/// The coordinate a program's scan job varied (Gaussian's ModRedundant `S` line), read from the
+/// job rather than guessed from the geometries, with its value at each of the document's frames.
+#[derive(Debug, Clone, PartialEq)]
+pub struct JobScan {
+    pub coordinate: Coordinate,
+    /// The value at each frame (Å or degrees), measured in the frame's geometry; a dihedral's
+    /// unwrapped so that the values run on past ±180° as the job stepped them.
+    pub values: Vec<f64>,
+    /// Where the job names it ("line 93: D 3 4 9 10 S 12 30.000"), for messages.
+    pub from: String,
+}
+
+impl JobScan {
+    /// `coordinate` measured in each of `frames`. A dihedral is carried across ±180° so that
+    /// each value lies within half a turn of the one before (a scan stepping 30° from 180° goes
+    /// to 210°, not −150°). `None` when an atom of the coordinate lies beyond a frame's.
+    pub fn measured(coordinate: Coordinate, frames: &[Molecule], from: String) -> Option<Self> {
+        let mut values: Vec<f64> = Vec::with_capacity(frames.len());
+        for m in frames {
+            if coordinate.atoms().iter().any(|&i| i >= m.atoms.len()) {
+                return None;
+            }
+            let mut v = coordinate.measure(m)?;
+            if let (Coordinate::Dihedral(_), Some(&last)) = (coordinate, values.last()) {
+                v = last + wrap_degrees(v - last);
+            }
+            values.push(v);
+        }
+        Some(Self { coordinate, values, from })
+    }
+}
+
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum ScanError {
     #[error("a scan needs at least two frames, found {0}")]

@@ -1,0 +1,116 @@
+#!/usr/bin/env python3
+"""Writes tests/fixtures/logs/h2o2_scan.log: a Gaussian relaxed scan of hydrogen peroxide's
+H-O-O-H dihedral (`opt=modredundant`, `D 3 1 2 4 S 4 60.0`: 120 to 360 degrees in 4 steps of
+60), in the layout Gaussian 09 writes, with PySCF's geometries and energies.
+
+The layout was checked against cclib's regression files data/Gaussian/basicGaussian09/
+dvb_scan_relaxed.log (Gaussian 09 D.01) and dvb_scan.log (A.02), read line by line: the route
+between dashes, "Symbolic Z-matrix:", the echoed section "The following ModRedundant input
+section has been read:" with the type letter Gaussian adds (`D 3 4 9 10 S 12 30.000`), then per
+optimisation step a "Standard orientation:" table and its `SCF Done` line, "Step number N out
+of a maximum of M on scan point P out of Q", and per point "Optimization completed." /
+"-- Stationary point found."; at the end "Summary of Optimized Potential Surface Scan" with the
+energies in blocks of five (`Eigenvalues --`) and the dihedral wrapped to (-180, 180] as
+Gaussian prints it (210 degrees as -150). Nothing is copied from those files: the molecule,
+numbers and spacing here are this script's.
+
+Each point is two steps: the start (the previous point's O-O length, the dihedral set) and the
+converged geometry (the O-O length that minimises the RHF/STO-3G energy at that dihedral, by a
+parabola through three lengths). The dihedral is set by turning the second hydrogen about the
+O-O bond, so it is exact in every geometry; a reader measures it there.
+
+Run:   python3 scripts/make_scan_log_fixtures.py   (PySCF, numpy; a few seconds)
+"""
+from pathlib import Path
+
+import numpy as np
+from pyscf import gto, scf
+
+OUT = Path(__file__).resolve().parent.parent / "tests" / "fixtures" / "logs" / "h2o2_scan.log"
+START, STEPS, SIZE = 120.0, 4, 60.0
+OH, OOH = 0.97, 100.0  # Å, degrees: fixed in this fixture
+
+
+def geometry(oo: float, dihedral: float) -> np.ndarray:
+    """O1, O2, H3 (on O1), H4 (on O2) in Å, H3-O1-O2-H4 = dihedral."""
+    o1 = np.array([0.0, 0.0, 0.0])
+    o2 = np.array([0.0, 0.0, oo])
+    a = np.radians(OOH)
+    h3 = o1 + OH * np.array([np.sin(a), 0.0, np.cos(a)])
+    d = np.radians(dihedral)
+    h4 = o2 + OH * np.array([np.sin(a) * np.cos(d), np.sin(a) * np.sin(d), -np.cos(a)])
+    return np.array([o1, o2, h3, h4])
+
+
+def energy(xyz: np.ndarray) -> float:
+    mol = gto.M(atom=[(s, p) for s, p in zip("OOHH", xyz)], basis="sto-3g", unit="Angstrom", verbose=0)
+    return scf.RHF(mol).run(conv_tol=1e-10).e_tot
+
+
+def best_oo(dihedral: float) -> float:
+    """The O-O length at the minimum of a parabola through three lengths."""
+    xs = np.array([1.34, 1.40, 1.46])
+    es = np.array([energy(geometry(x, dihedral)) for x in xs])
+    c = np.polyfit(xs, es, 2)
+    return float(-c[1] / (2 * c[0]))
+
+
+def orientation(xyz: np.ndarray) -> str:
+    rule = " " + "-" * 69 + "\n"
+    s = "                         Standard orientation:                         \n" + rule
+    s += " Center     Atomic      Atomic             Coordinates (Angstroms)\n"
+    s += " Number     Number       Type             X           Y           Z\n" + rule
+    for k, (z, p) in enumerate(zip([8, 8, 1, 1], xyz)):
+        s += "%7d%11d%12d    %12.6f%12.6f%12.6f\n" % (k + 1, z, 0, *p)
+    return s + rule
+
+
+def scf_done(e: float) -> str:
+    return " SCF Done:  E(RHF) =  %.12f     A.U. after    8 cycles\n" % e
+
+
+def main() -> None:
+    s = " Entering Gaussian System, Link 0=g09\n"
+    s += " ******************************************\n Gaussian 09:  ES64L-G09RevD.01 24-Apr-2013\n"
+    s += " ******************************************\n"
+    s += " ---------------------------------\n #p hf/sto-3g opt=modredundant\n ---------------------------------\n"
+    s += " ----------------------\n H2O2 dihedral scan\n ----------------------\n"
+    s += " Symbolic Z-matrix:\n Charge =  0 Multiplicity = 1\n"
+    for sym, p in zip("OOHH", geometry(1.40, START)):
+        s += " %-20s%10.5f%10.5f%10.5f \n" % (sym, *p)
+    s += " \n The following ModRedundant input section has been read:\n"
+    s += " D       3       1       2       4 S   %d %.3f" % (STEPS, SIZE) + " " * 32 + "\n"
+    s += " \n"
+    points = STEPS + 1
+    oo = 1.40
+    summary = []
+    for p in range(points):
+        dihedral = START + p * SIZE
+        steps = [(oo, dihedral)]
+        oo = best_oo(dihedral)
+        steps.append((oo, dihedral))
+        for n, (x, d) in enumerate(steps):
+            xyz = geometry(x, d)
+            e = energy(xyz)
+            s += orientation(xyz)
+            s += scf_done(e)
+            s += "\n GradGradGradGradGradGradGradGradGradGradGradGradGradGradGradGradGradGrad\n"
+            s += " Berny optimization.\n"
+            s += " Step number %3d out of a maximum of   20 on scan point %5d out of %5d\n" % (n + 1, p + 1, points)
+        s += " Optimization completed.\n    -- Stationary point found.\n"
+        summary.append((e, x, d))
+    s += "\n Summary of Optimized Potential Surface Scan\n"
+    for first in range(0, points, 5):
+        block = summary[first:first + 5]
+        s += "           " + "".join("%10d" % (first + k + 1) for k in range(len(block))) + "\n"
+        s += "     Eigenvalues -- " + "".join("%10.5f" % e for e, _, _ in block) + "\n"
+        s += "           R1     " + "".join("%10.5f" % x for _, x, _ in block) + "\n"
+        wrapped = [((d + 180.0) % 360.0) - 180.0 if ((d + 180.0) % 360.0) != 0.0 else 180.0 for _, _, d in block]
+        s += "           D1     " + "".join("%10.5f" % d for d in wrapped) + "\n"
+    s += " Normal termination of Gaussian 09.\n"
+    OUT.write_text(s)
+    print(OUT)
+
+
+if __name__ == "__main__":
+    main()
