@@ -5,8 +5,8 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
 use crate::formats::scan::Computed;
-use crate::model::scan::{Coordinate, PathMeasure};
 use crate::model::Document;
+use crate::model::scan::{Coordinate, PathMeasure};
 use crate::sources::compute::{self, Event, FrameJob, Held, Job, Settings};
 use anyhow::{Context, Result, bail};
 use clap::Args;
@@ -260,6 +260,9 @@ pub fn scan_compute(args: ScanComputeArgs) -> Result<()> {
     if done.len() < 2 {
         bail!("{} of {} frames computed: a scan needs two", done.len(), job.frames.len());
     }
+    // A relaxed scan job's frames are relaxed geometries, though each is computed as a single
+    // point here: the record says what the frames are.
+    let settings = Settings { relaxed: settings.relaxed || (args.frames && doc.job_scan.is_some()), ..settings };
     let computed = Computed::of(&settings, &args.file.display().to_string(), versions, failed);
     let title = compute::stem(&args.file);
     let path = compute::write_manifest(&args.output, &title, &coordinate, &settings, &done, computed)?;

@@ -19,9 +19,9 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use crate::formats::scan::{Computed, manifest_text};
-use crate::model::{Document, Molecule};
 use crate::model::scan::{Coordinate, ScanError, rigid_frames, wrap_degrees};
 use crate::model::units::ANGSTROM_PER_BOHR;
+use crate::model::{Document, Molecule};
 
 /// The Python side: a module of the `orbcloud` package and the script the commands run.
 pub const SCRIPT: &str = include_str!("../../python/orbcloud/_compute.py");
