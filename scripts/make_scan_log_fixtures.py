@@ -19,14 +19,30 @@ converged geometry (the O-O length that minimises the RHF/STO-3G energy at that 
 parabola through three lengths). The dihedral is set by turning the second hydrogen about the
 O-O bond, so it is exact in every geometry; a reader measures it there.
 
+It also writes tests/fixtures/scan_jobs/h2o2_relaxed_scan.fchk, the formatted checkpoint of the
+same job: the last point's geometry and RHF/STO-3G orbitals (scripts/make_wavefunction_fixtures.py's
+fchk writer), then the records a relaxed scan adds, one set per point: "Opt point N Results for
+each geome" (two values a step, "Optimization Num results per geometry" = 2: the energy, then the
+dihedral in degrees, which readers do not use) and "Opt point N Geometries" (every step, bohr).
+cclib's water-pes.fchk (a rigid Z-matrix scan) holds none of these records, only the last
+point's geometry and orbitals; the per-point layout follows what readers of Gaussian's relaxed-scan
+checkpoints take from it (one "Opt point N" pair per scan point, the converged step last).
+
 Run:   python3 scripts/make_scan_log_fixtures.py   (PySCF, numpy; a few seconds)
 """
+import sys
 from pathlib import Path
 
 import numpy as np
 from pyscf import gto, scf
 
-OUT = Path(__file__).resolve().parent.parent / "tests" / "fixtures" / "logs" / "h2o2_scan.log"
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+import make_wavefunction_fixtures as fx  # noqa: E402
+
+OUT = HERE.parent / "tests" / "fixtures" / "logs" / "h2o2_scan.log"
+FCHK = HERE.parent / "tests" / "fixtures" / "scan_jobs" / "h2o2_relaxed_scan.fchk"
+BOHR = 0.52917721090380
 START, STEPS, SIZE = 120.0, 4, 60.0
 OH, OOH = 0.97, 100.0  # Å, degrees: fixed in this fixture
 
@@ -42,9 +58,12 @@ def geometry(oo: float, dihedral: float) -> np.ndarray:
     return np.array([o1, o2, h3, h4])
 
 
+def molecule(xyz: np.ndarray):
+    return gto.M(atom=[(s, p) for s, p in zip("OOHH", xyz)], basis="sto-3g", unit="Angstrom", verbose=0)
+
+
 def energy(xyz: np.ndarray) -> float:
-    mol = gto.M(atom=[(s, p) for s, p in zip("OOHH", xyz)], basis="sto-3g", unit="Angstrom", verbose=0)
-    return scf.RHF(mol).run(conv_tol=1e-10).e_tot
+    return scf.RHF(molecule(xyz)).run(conv_tol=1e-10).e_tot
 
 
 def best_oo(dihedral: float) -> float:
@@ -84,14 +103,17 @@ def main() -> None:
     points = STEPS + 1
     oo = 1.40
     summary = []
+    history = []  # per point: every step's (xyz, energy, dihedral)
     for p in range(points):
         dihedral = START + p * SIZE
         steps = [(oo, dihedral)]
         oo = best_oo(dihedral)
         steps.append((oo, dihedral))
+        history.append([])
         for n, (x, d) in enumerate(steps):
             xyz = geometry(x, d)
             e = energy(xyz)
+            history[-1].append((xyz, e, d))
             s += orientation(xyz)
             s += scf_done(e)
             s += "\n GradGradGradGradGradGradGradGradGradGradGradGradGradGradGradGradGradGrad\n"
@@ -110,6 +132,27 @@ def main() -> None:
     s += " Normal termination of Gaussian 09.\n"
     OUT.write_text(s)
     print(OUT)
+    write_fchk(history)
+
+
+def write_fchk(history) -> None:
+    """The job's checkpoint: the last point's orbitals, every point's steps."""
+    xyz = history[-1][-1][0]
+    mol = molecule(xyz)
+    mf = scf.RHF(mol).run(conv_tol=1e-10)
+    FCHK.parent.mkdir(parents=True, exist_ok=True)
+    fx.write_fchk(str(FCHK), "H2O2 dihedral scan", "RHF", "STO-3G", mol, mf, mol.nao)
+    lines = FCHK.read_text().splitlines()
+    lines[1] = "Scan" + lines[1][4:] if lines[1].startswith("SP  ") else lines[1]
+    f = fx.Fchk()
+    f.int("Optimization Num results per geometry", 2)
+    f.int("Optimization Num geometry variables", 3 * mol.natm)
+    f.ints("Optimization Number of geometries", [len(point) for point in history])
+    for k, point in enumerate(history):
+        f.reals("Opt point %7d Results for each geome" % (k + 1), [v for _, e, d in point for v in (e, d)])
+        f.reals("Opt point %7d Geometries" % (k + 1), np.concatenate([g for g, _, _ in point]) / BOHR)
+    FCHK.write_text("\n".join(lines + f.lines) + "\n")
+    print(FCHK)
 
 
 if __name__ == "__main__":

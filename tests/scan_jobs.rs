@@ -189,3 +189,44 @@ fn scan_compute_of_the_log_writes_a_manifest_of_its_frames_at_their_values() {
         assert!(printed.iter().any(|p| (p - e).abs() < 1e-6), "{e} among {printed:?}");
     }
 }
+
+#[test]
+fn a_relaxed_scan_fchk_opens_its_points_with_their_energies() {
+    // Written by scripts/make_scan_log_fixtures.py beside the log: the same job's checkpoint.
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/scan_jobs/h2o2_relaxed_scan.fchk");
+    let doc = formats::load(&path).unwrap();
+    assert!(doc.wavefunction.is_none(), "the orbitals are the last point's only");
+    let models = &doc.structure.as_ref().expect("frames").structure.models;
+    assert_eq!(models.len(), 5, "one frame per `Opt point N` record");
+    let log = formats::load(&fixture()).unwrap();
+    let log_models = &log.structure.as_ref().unwrap().structure.models;
+    for (m, l) in models.iter().zip(log_models) {
+        // The fchk's eight significant digits against the log's.
+        assert!((m.energy.unwrap() - l.energy.unwrap()).abs() < 1e-5, "{:?} vs {:?}", m.energy, l.energy);
+    }
+    // Each frame the point's converged (last) step: the log's geometry of that point.
+    let frames = orbcloud::sources::compute::frame_molecules(&doc);
+    let log_frames = orbcloud::sources::compute::frame_molecules(&log);
+    for (a, b) in frames.iter().zip(&log_frames) {
+        let d = a.atoms.iter().zip(&b.atoms).map(|(p, q)| p.position.distance(q.position)).fold(0.0, f64::max);
+        assert!(d < 1e-5, "{d}");
+    }
+    assert!(doc.problems.iter().any(|p| p.contains("relaxed scan's 5 points") && p.contains("last point only")));
+
+    // A results record of the wrong length leaves that point's energy out, not the frames.
+    let text = std::fs::read_to_string(&path).unwrap();
+    let header = "Opt point       2 Results for each geome   R   N=           4";
+    let at = text.find(header).unwrap();
+    let (row, end) = (at + header.len() + 1, at + header.len() + 1 + text[at + header.len() + 1..].find('\n').unwrap());
+    // Three values (16 columns each) where there were four.
+    let bad = format!(
+        "{}{}\n{}{}",
+        &text[..at],
+        header.replace("N=           4", "N=           3"),
+        &text[row..end - 16],
+        &text[end..]
+    );
+    let doc = formats::load_bytes(Path::new("bad.fchk"), bad.as_bytes()).unwrap();
+    let energies: Vec<bool> = doc.structure.unwrap().structure.models.iter().map(|m| m.energy.is_some()).collect();
+    assert_eq!(energies, [true, false, true, true, true]);
+}
