@@ -589,7 +589,7 @@ fn modredundant_line(log: &LogLines, i: usize) -> Result<Option<(Coordinate, usi
     // Atom numbers, then any values given before the action.
     let fields = &t[usize::from(typed)..s];
     let atoms: Vec<usize> = fields.iter().map_while(|w| w.parse::<usize>().ok()).collect();
-    if atoms.contains(&0) || fields.iter().any(|w| *w == "*") {
+    if atoms.contains(&0) || fields.contains(&"*") {
         return Err(log.error_at(i, format!("{SCAN}: atoms numbered from 1, no `*`")));
     }
     let expected = match kind.as_str() {
