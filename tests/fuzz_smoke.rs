@@ -150,6 +150,9 @@ fn readers_survive_mutated_fixtures() {
     fuzz("cube", &[cube_seed()], read("fuzz.cube"));
     fuzz("molden", &files("molden"), read("fuzz.molden"));
     fuzz("fchk", &files("fchk"), read("fuzz.fchk"));
+    // A relaxed scan's fchk: its `Opt point N` records open as frames.
+    let scans = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/scan_jobs");
+    fuzz("scan fchk", &files_in(scans, "fchk"), read("fuzz.fchk"));
     let gz = {
         use std::io::Write;
         let mut e = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());

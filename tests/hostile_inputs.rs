@@ -14,6 +14,7 @@ const AIM: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/wfn_wfx_m
 const LOG: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/logs/h2_sto3g.log");
 const ORCA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/logs/h2_orca.out");
 const LOGS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/logs");
+const SCAN_FCHK: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/scan_jobs/h2o2_relaxed_scan.fchk");
 /// H₂ as GAMESS-US, NWChem, Psi4 and Q-Chem print it, with the basis and the orbitals.
 const NEW_LOGS: [&str; 4] = ["h2_gamess.out", "h2_nwchem.out", "h2_psi4.out", "h2_qchem.out"];
 
@@ -354,7 +355,11 @@ fn truncated_files_never_panic() {
     let orca = std::fs::read_to_string(ORCA).unwrap();
     let [gamess, nwchem, psi4, qchem] = NEW_LOGS.map(|name| std::fs::read_to_string(format!("{LOGS}/{name}")).unwrap());
     let orca_freq = std::fs::read_to_string(format!("{LOGS}/h2o_orca_freq.out")).unwrap();
+    let scan_log = std::fs::read_to_string(format!("{LOGS}/h2o2_scan.log")).unwrap();
+    let scan_fchk = std::fs::read_to_string(SCAN_FCHK).unwrap();
     for (name, text) in [
+        ("t.log", &scan_log),
+        ("t.fchk", &scan_fchk),
         ("t.out", &orca),
         ("t.out", &orca_freq),
         ("t.out", &gamess),
@@ -529,6 +534,42 @@ fn gaussian_logs_with_lying_counts_are_refused_at_their_line() {
     // A GAMESS banner and nothing else: refused for want of its geometry.
     let e = refused("gamess.out", b" GAMESS VERSION = 30 SEP 2017 (R1)\n EXECUTION OF GAMESS BEGUN\n");
     assert!(e.expected.contains("COORDINATES (BOHR)"), "{e}");
+}
+
+/// A relaxed scan's ModRedundant line whose numbers lie (atoms and steps past any count, a step
+/// that is no number) leaves the coordinate out saying where, the frames open; a scan fchk whose
+/// results claim more values than it holds is refused at its line.
+#[test]
+fn scan_jobs_with_lying_numbers_open_their_frames_or_are_refused() {
+    let log = std::fs::read_to_string(format!("{LOGS}/h2o2_scan.log")).unwrap();
+    let line = log.lines().find(|l| l.trim_start().starts_with("D       3")).unwrap();
+    for lie in [
+        " D 99999999999999999999999 1 2 4 S 4 60.0",
+        " D 3 1 2 18446744073709551615 S 4 60.0",
+        " D 3 1 2 4 S 99999999999999999999 60.0",
+        " D 3 1 2 4 S 4 nan",
+        " D 3 1 2 4 S 4 1e999",
+        " D 3 1 2 4 S -4 60.0",
+        " * * * * S 4 60.0",
+        " D 3 1 2 4 S 4 60.0\n D 3 1 2 4 S 4 60.0",
+    ] {
+        let bad = log.replacen(line, lie, 1);
+        let doc = formats::load_bytes(Path::new("lie.log"), bad.as_bytes()).unwrap_or_else(|e| panic!("{lie}: {e}"));
+        assert!(doc.job_scan.is_none(), "{lie}");
+        assert_eq!(doc.structure.as_ref().unwrap().structure.models.len(), 5, "{lie}");
+        let left_out = doc.problems.iter().any(|p| p.contains("coordinate left out") && p.contains("lie.log:"));
+        assert!(left_out, "{lie}: {:?}", doc.problems);
+    }
+    // A line that names no coordinate ends the section: no scan, nothing to say.
+    let doc = formats::load_bytes(Path::new("lie.log"), log.replacen(line, " S S S S S S", 1).as_bytes()).unwrap();
+    assert!(doc.job_scan.is_none() && !doc.problems.iter().any(|p| p.contains("coordinate")));
+    let fchk = std::fs::read_to_string(SCAN_FCHK).unwrap();
+    let header = "Opt point       3 Results for each geome   R   N=           4";
+    let bad = fchk.replacen(header, &header.replace("N=           4", "N= 99999999999"), 1);
+    let start = Instant::now();
+    let e = refused("lie.fchk", bad.as_bytes());
+    assert!(start.elapsed() < Duration::from_secs(10));
+    assert_eq!(e.line, bad.lines().position(|l| l.starts_with("Opt point       3 Results")).unwrap() + 1, "{e}");
 }
 
 /// An ORCA output whose shell claims 10¹¹ primitives, or whose orbital rows name the wrong atom,

@@ -113,3 +113,55 @@ fn a_structure_without_orbitals_computes_them_and_opens_them_in_its_place() {
     assert!(std::path::Path::new(&doc.source).starts_with(dir.path()), "beside the file: {}", doc.source);
     assert_eq!(doc.wavefunction.as_ref().unwrap().orbitals.len(), 12, "RHF/STO-3G of H2O2: 12 orbitals");
 }
+
+/// A Gaussian relaxed scan's log (scripts/make_scan_log_fixtures.py) offers *Compute orbitals for
+/// these frames…*: its own five geometries are computed and open as a scan of the dihedral the
+/// job scanned, at the values measured in them.
+#[test]
+fn a_scan_jobs_frames_compute_into_a_scan_of_its_coordinate() {
+    require_pyscf();
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("h2o2_scan.log");
+    let fixture = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/logs/h2o2_scan.log");
+    std::fs::copy(fixture, &log).unwrap();
+    let mut h = Harness::builder()
+        .with_size([1280.0, 800.0])
+        .wgpu_setup(wgpu_setup(true))
+        .build_eframe(move |cc| OrbApp::new(cc, vec![log]));
+    wait_loaded(&mut h);
+    assert!(h.state().models.energy_plot.is_some(), "the frames' energies are plotted");
+    h.get_by_label("Compute orbitals for these frames…").click();
+    h.run_steps(2);
+    let dialog = &h.state().scan_dialog;
+    assert!(dialog.open && dialog.job, "the Scan window for the job's frames");
+    assert_eq!(dialog.coordinate.label(), "dihedral 3-1-2-4");
+    assert!((dialog.from - 120.0).abs() < 1e-3 && (dialog.to - 360.0).abs() < 1e-3, "{dialog:?}");
+    let d = &mut h.state_mut().scan_dialog;
+    (d.settings.method, d.settings.basis, d.workers) = ("hf".into(), "sto-3g".into(), 2);
+    h.run_steps(1);
+    h.get_by_label("Compute").click();
+    let start = std::time::Instant::now();
+    loop {
+        assert!(start.elapsed().as_secs() < 300, "the scan did not finish: {}", h.state().status);
+        std::thread::sleep(std::time::Duration::from_millis(20));
+        h.run_steps(1);
+        let app = h.state();
+        let run = app.computing.as_ref().expect("a computation");
+        assert!(!run.progress.starts_with("computing failed"), "{}", run.progress);
+        let frames = app.scan().map_or(0, |s| s.scene.scan.frames.len());
+        if run.ended && run.shown == run.done.len() && !app.is_loading() && frames == run.done.len() {
+            break;
+        }
+    }
+    let app = h.state();
+    let scan = &app.scan().unwrap().scene.scan;
+    assert_eq!(scan.coordinate.label(), "dihedral 3-1-2-4");
+    let values = scan.values();
+    assert_eq!(values.len(), 5);
+    for (v, e) in values.iter().zip([120.0, 180.0, 240.0, 300.0, 360.0]) {
+        assert!((v - e).abs() < 1e-3, "{values:?}");
+    }
+    let manifest = dir.path().join("h2o2_scan_frames/h2o2_scan.scan.toml");
+    let loaded = orbcloud::formats::scan::load_scan(&manifest).unwrap();
+    assert!(loaded.computed.is_some_and(|c| c.relaxed), "the frames are the job's relaxed geometries");
+}

@@ -1,5 +1,6 @@
-//! *Scan this…* (a measured distance, angle or dihedral scanned with PySCF) and *Compute
-//! orbitals* (a structure's wavefunction): computations of [`crate::sources::compute`] run in the
+//! *Scan this…* (a measured distance, angle or dihedral scanned with PySCF), *Compute orbitals
+//! for these frames…* (a scan job's own frames, each a single point at its geometry) and
+//! *Compute orbitals* (a structure's wavefunction): computations of [`crate::sources::compute`] run in the
 //! background from the window. A scan's frames open as they finish: the manifest of the frames
 //! done so far is written and opened again whenever more are done, so the slider's range grows
 //! while the rest are computed.
@@ -33,6 +34,9 @@ pub struct ScanDialog {
     pub dask: String,
     /// Where the frames and the manifest go.
     pub folder: String,
+    /// The frames are the object's own (a scan job's, [`Document::job_scan`]), each computed
+    /// at its geometry: no range, no geometry to choose.
+    pub job: bool,
 }
 
 impl Default for ScanDialog {
@@ -49,6 +53,7 @@ impl Default for ScanDialog {
             workers: compute::cores(),
             dask: String::new(),
             folder: String::new(),
+            job: false,
         }
     }
 }
@@ -89,6 +94,30 @@ impl ScanDialog {
             to,
             step,
             folder: folder.display().to_string(),
+            ..Self::default()
+        }
+    }
+}
+
+impl ScanDialog {
+    /// The window for the frames of a scan job object `object` holds (a Gaussian relaxed scan's
+    /// log): its coordinate, the range its frames cover, the folder beside the file.
+    pub fn for_job(object: usize, doc: &Document) -> Self {
+        let Some(job) = &doc.job_scan else { return Self::default() };
+        let (from, to) =
+            job.values.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+        let source = Path::new(&doc.source);
+        let folder = beside(source).join(format!("{}_frames", compute::stem(source)));
+        Self {
+            open: true,
+            object,
+            coordinate: job.coordinate,
+            now: doc.structure.as_ref().and_then(|v| job.values.get(v.model).copied()).unwrap_or(from),
+            from,
+            to,
+            step: 0.0,
+            folder: folder.display().to_string(),
+            job: true,
             ..Self::default()
         }
     }
@@ -167,14 +196,22 @@ impl ComputeRun {
 
     /// Starts the scan `dialog` asks for on `doc`'s geometry.
     pub fn scan(dialog: &ScanDialog, doc: &Document, repaint: impl Fn() + Send + 'static) -> Result<Self, String> {
-        let values = compute::values(dialog.from, dialog.to, dialog.step)?;
         let source = Path::new(&doc.source);
         let title = compute::stem(source);
-        let (frames, start) =
-            compute::rigid_scan(&doc.molecule, &dialog.coordinate, &values, &title).map_err(|e| e.to_string())?;
+        let (frames, start) = if dialog.job {
+            let job = compute::job_scan_frames(doc, &title).ok_or("the object holds no scan job's frames")?;
+            (job?.1, 0)
+        } else {
+            let values = compute::values(dialog.from, dialog.to, dialog.step)?;
+            compute::rigid_scan(&doc.molecule, &dialog.coordinate, &values, &title).map_err(|e| e.to_string())?
+        };
+        // A scan job's frames are its relaxed geometries, each computed as a single point: the
+        // manifest's record says what the frames are.
+        let recorded = Settings { relaxed: dialog.settings.relaxed || dialog.job, ..dialog.settings.clone() };
+        let settings = Settings { relaxed: dialog.settings.relaxed && !dialog.job, ..dialog.settings.clone() };
         let folder = PathBuf::from(dialog.folder.trim());
         let job = Job {
-            settings: dialog.settings.clone(),
+            settings,
             coordinate: Held::of(&dialog.coordinate),
             start,
             dir: folder.clone(),
@@ -187,7 +224,7 @@ impl ComputeRun {
             folder,
             title,
             coordinate: dialog.coordinate,
-            settings: dialog.settings.clone(),
+            settings: recorded,
             input: doc.source.clone(),
         };
         Ok(Self::start(job, purpose, repaint))
@@ -296,17 +333,28 @@ pub fn scan_window(ctx: &egui::Context, dialog: &mut ScanDialog, run: Option<&Co
     window.show(ctx, |ui| {
         ui.label(format!("{} = {}", dialog.coordinate.label(), dialog.coordinate.value_text(dialog.now)));
         egui::Grid::new("scan range").num_columns(2).show(ui, |ui| {
-            for (label, value) in [("from", &mut dialog.from), ("to", &mut dialog.to), ("step", &mut dialog.step)] {
-                ui.label(label);
-                ui.add(egui::DragValue::new(value).speed(0.1).suffix(format!(" {unit}")));
+            if dialog.job {
+                // The job's own frames: their values and geometries are given.
+                ui.label("frames");
+                ui.label(format!(
+                    "the job's, {} to {}",
+                    dialog.coordinate.value_text(dialog.from),
+                    dialog.coordinate.value_text(dialog.to)
+                ));
+                ui.end_row();
+            } else {
+                for (label, value) in [("from", &mut dialog.from), ("to", &mut dialog.to), ("step", &mut dialog.step)] {
+                    ui.label(label);
+                    ui.add(egui::DragValue::new(value).speed(0.1).suffix(format!(" {unit}")));
+                    ui.end_row();
+                }
+                ui.label("geometry");
+                ui.horizontal(|ui| {
+                    ui.radio_value(&mut dialog.settings.relaxed, false, "rigid");
+                    ui.radio_value(&mut dialog.settings.relaxed, true, "relaxed");
+                });
                 ui.end_row();
             }
-            ui.label("geometry");
-            ui.horizontal(|ui| {
-                ui.radio_value(&mut dialog.settings.relaxed, false, "rigid");
-                ui.radio_value(&mut dialog.settings.relaxed, true, "relaxed");
-            });
-            ui.end_row();
             ui.label("method");
             ui.text_edit_singleline(&mut dialog.settings.method);
             ui.end_row();
@@ -339,7 +387,10 @@ pub fn scan_window(ctx: &egui::Context, dialog: &mut ScanDialog, run: Option<&Co
             ui.text_edit_singleline(&mut dialog.folder);
             ui.end_row();
         });
-        let frames = compute::values(dialog.from, dialog.to, dialog.step);
+        let frames = match dialog.job {
+            true => Ok(Vec::new()),
+            false => compute::values(dialog.from, dialog.to, dialog.step),
+        };
         match (run, &frames) {
             (Some(r), _) if !r.ended => {
                 ui.label(&r.progress);
@@ -355,7 +406,11 @@ pub fn scan_window(ctx: &egui::Context, dialog: &mut ScanDialog, run: Option<&Co
                         ui.label(egui::RichText::new(format!("left out: {f}")).small());
                     }
                 }
-                ui.label(format!("{} frames, {}", values.len(), dialog.settings.level()));
+                if dialog.job {
+                    ui.label(format!("each frame's geometry, {}", dialog.settings.level()));
+                } else {
+                    ui.label(format!("{} frames, {}", values.len(), dialog.settings.level()));
+                }
                 if ui.button("Compute").clicked() {
                     start = true;
                 }

@@ -45,8 +45,31 @@ pub fn controls(ui: &mut egui::Ui, app: &mut OrbApp) -> Option<usize> {
     let title = if model.title.is_empty() { format!("MODEL {}", model.number) } else { model.title.clone() };
     ui.label(RichText::new(title).small().weak());
     let energies: Vec<Option<f64>> = view.structure.models.iter().map(|m| m.energy).collect();
-    let (picked, transform) = energy_plot(ui, &energies, view.model).unzip();
+    // A scan job's frames (a Gaussian relaxed scan) lie along the coordinate it scanned: the
+    // plot is against its values, and their orbitals can be computed to make a scan of them.
+    let doc = &app.objects[app.active].doc;
+    let job = doc.job_scan.as_ref().filter(|j| j.values.len() == count);
+    let axis = match job {
+        Some(j) => (j.values.clone(), format!("{} ({})", j.coordinate.label(), j.coordinate.unit().trim())),
+        None => ((1..=count).map(|k| k as f64).collect(), "frame".to_string()),
+    };
+    let mut compute = false;
+    if let Some(j) = job {
+        ui.label(format!(
+            "{} = {} (the job's scan)",
+            j.coordinate.label(),
+            j.coordinate.value_text(j.values[view.model])
+        ));
+        compute = ui
+            .button("Compute orbitals for these frames…")
+            .on_hover_text("a single point at each frame's geometry with PySCF, opened as a scan of its coordinate")
+            .clicked();
+    }
+    let (picked, transform) = energy_plot(ui, &energies, &axis, view.model).unzip();
     app.models.energy_plot = transform;
+    if compute {
+        app.scan_dialog = super::compute::ScanDialog::for_job(app.active, &app.objects[app.active].doc);
+    }
     picked.flatten().or(chosen)
 }
 
@@ -59,6 +82,7 @@ const ENERGY_PLOT_HEIGHT: f32 = 120.0;
 fn energy_plot(
     ui: &mut egui::Ui,
     energies: &[Option<f64>],
+    (xs, x_label): &(Vec<f64>, String),
     shown: usize,
 ) -> Option<(Option<usize>, egui_plot::PlotTransform)> {
     const KCAL_PER_HARTREE: f64 = 627.509_474;
@@ -67,14 +91,17 @@ fn energy_plot(
         return None;
     }
     let lowest = known.iter().map(|&(_, e)| e).fold(f64::INFINITY, f64::min);
-    let points: Vec<[f64; 2]> = known.iter().map(|&(k, e)| [(k + 1) as f64, (e - lowest) * KCAL_PER_HARTREE]).collect();
-    let marked: Vec<[f64; 2]> = points.iter().filter(|p| p[0] as usize == shown + 1).copied().collect();
+    let x = |k: usize| xs.get(k).copied().unwrap_or((k + 1) as f64);
+    let points: Vec<[f64; 2]> = known.iter().map(|&(k, e)| [x(k), (e - lowest) * KCAL_PER_HARTREE]).collect();
+    let marked: Vec<[f64; 2]> = known.iter().zip(&points).filter(|((k, _), _)| *k == shown).map(|(_, p)| *p).collect();
+    // Room past the last frame: the panel's edge (where it is resized) lies beside it.
+    let (lo, hi) = points.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p[0]), hi.max(p[0])));
+    let room = (hi - lo) / (points.len() - 1) as f64 * 0.5;
     let response = egui_plot::Plot::new("frames' energies")
         .height(ENERGY_PLOT_HEIGHT)
-        .x_axis_label("frame")
+        .x_axis_label(x_label.as_str())
         .y_axis_label("ΔE (kcal/mol)")
-        // Room on the right: the panel's edge (where it is resized) lies beside the last frame.
-        .include_x(known.last().map_or(1.0, |&(k, _)| k as f64 + 1.5))
+        .include_x(hi + room)
         .allow_zoom(false)
         .allow_drag(false)
         .allow_scroll(false)
@@ -86,7 +113,7 @@ fn energy_plot(
             plot.response().clicked().then(|| plot.pointer_coordinate()).flatten()
         });
     let picked = response.inner.and_then(|at| {
-        let distance = |k: usize| ((k + 1) as f64 - at.x).abs();
+        let distance = |k: usize| (x(k) - at.x).abs();
         known.iter().map(|&(k, _)| k).min_by(|&a, &b| distance(a).total_cmp(&distance(b)))
     });
     Some((picked, response.transform))

@@ -5,8 +5,8 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
 use crate::formats::scan::Computed;
+use crate::model::Document;
 use crate::model::scan::{Coordinate, PathMeasure};
-use crate::model::{Document, Molecule};
 use crate::sources::compute::{self, Event, FrameJob, Held, Job, Settings};
 use anyhow::{Context, Result, bail};
 use clap::Args;
@@ -71,11 +71,13 @@ pub struct ComputeArgs {
 #[derive(Args)]
 pub struct ScanComputeArgs {
     /// The geometry to start from (any file orbcloud reads), or with --frames a multi-frame
-    /// XYZ file whose every frame is computed.
+    /// XYZ file whose every frame is computed, or a scan job's log (a Gaussian relaxed scan),
+    /// its frames computed at the values of the coordinate it scanned.
     file: PathBuf,
     #[command(flatten)]
     coordinate: CoordinateArgs,
-    /// Every frame of FILE (a trajectory, an IRC) as a path.
+    /// Every frame of FILE: a scan job's at its coordinate's values, any other's (a trajectory,
+    /// an IRC) as a path.
     #[arg(long, group = "coordinate")]
     frames: bool,
     /// The first value (Å or degrees).
@@ -193,7 +195,12 @@ fn scan_frames(args: &ScanComputeArgs, doc: &Document) -> Result<(Coordinate, Ve
         if args.relaxed {
             bail!("--relaxed holds a coordinate: give --distance, --angle or --dihedral, not --frames");
         }
-        let models = trajectory(doc);
+        // A scan job's frames (a Gaussian relaxed scan's log) keep the coordinate it scanned.
+        if let Some(job) = compute::job_scan_frames(doc, &stem) {
+            let (c, frames) = job.map_err(anyhow::Error::msg)?;
+            return Ok((c, frames, 0));
+        }
+        let models = compute::frame_molecules(doc);
         if models.len() < 2 {
             bail!(
                 "{}: --frames needs a file of several geometries (a multi-frame XYZ), found {}",
@@ -229,24 +236,6 @@ fn scan_frames(args: &ScanComputeArgs, doc: &Document) -> Result<(Coordinate, Ve
     Ok((coordinate, frames, start))
 }
 
-/// Every geometry of a multi-frame file (one for any other).
-fn trajectory(doc: &Document) -> Vec<Molecule> {
-    let Some(s) = doc.structure.as_ref().map(|v| &v.structure).filter(|s| s.models.len() > 1) else {
-        return vec![doc.molecule.clone()];
-    };
-    (s.model_positions(doc.molecule.atoms.len()).into_iter())
-        .map(|positions| {
-            let atoms = doc
-                .molecule
-                .atoms
-                .iter()
-                .zip(positions)
-                .map(|(a, position)| crate::model::Atom { position, ..a.clone() });
-            Molecule { atoms: atoms.collect(), bonds: doc.molecule.bonds.clone() }
-        })
-        .collect()
-}
-
 pub fn scan_compute(args: ScanComputeArgs) -> Result<()> {
     let doc = load(&args.file)?;
     let (coordinate, frames, start) = scan_frames(&args, &doc)?;
@@ -271,6 +260,9 @@ pub fn scan_compute(args: ScanComputeArgs) -> Result<()> {
     if done.len() < 2 {
         bail!("{} of {} frames computed: a scan needs two", done.len(), job.frames.len());
     }
+    // A relaxed scan job's frames are relaxed geometries, though each is computed as a single
+    // point here: the record says what the frames are.
+    let settings = Settings { relaxed: settings.relaxed || (args.frames && doc.job_scan.is_some()), ..settings };
     let computed = Computed::of(&settings, &args.file.display().to_string(), versions, failed);
     let title = compute::stem(&args.file);
     let path = compute::write_manifest(&args.output, &title, &coordinate, &settings, &done, computed)?;

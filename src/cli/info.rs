@@ -122,8 +122,23 @@ pub struct DocumentInfo {
     pub modes_geometry: Option<String>,
     /// Excited states the file lists, and what its excited state's density says.
     pub excited_states: Option<ExcitedInfo>,
+    /// The coordinate a scan job varied and its value at each frame (a Gaussian relaxed scan).
+    pub scan: Option<JobScanInfo>,
     /// Parts of the file left out, each saying where and why.
     pub problems: Vec<String>,
+}
+
+/// A scan job's coordinate: `coordinate` as chemists write it ("dihedral 3-4-9-10", atoms
+/// 1-based), its kind and atoms (1-based), its unit, its value at each frame, and where the job
+/// names it.
+#[derive(Serialize)]
+pub struct JobScanInfo {
+    pub coordinate: String,
+    pub kind: String,
+    pub atoms: Vec<usize>,
+    pub unit: String,
+    pub values: Vec<f64>,
+    pub from: String,
 }
 
 #[derive(Serialize)]
@@ -295,6 +310,14 @@ pub fn describe(doc: &Document) -> DocumentInfo {
         modes: doc.vibrations.as_ref().map(|v| v.modes.clone()).unwrap_or_default(),
         modes_geometry: doc.vibrations.as_ref().map(|v| v.geometry_from.clone()),
         excited_states: excited_info(doc),
+        scan: doc.job_scan.as_ref().map(|j| JobScanInfo {
+            coordinate: j.coordinate.label(),
+            kind: j.coordinate.kind().to_string(),
+            atoms: j.coordinate.atoms().iter().map(|a| a + 1).collect(),
+            unit: j.coordinate.unit().trim().to_string(),
+            values: j.values.clone(),
+            from: j.from.clone(),
+        }),
         problems: doc.problems.clone(),
     }
 }
@@ -319,9 +342,14 @@ pub fn text(doc: &Document) -> String {
     if let Some(st) = &info.structure
         && st.models.iter().any(|m| m.energy_hartree.is_some())
     {
-        for m in &st.models {
+        if let Some(j) = &doc.job_scan {
+            let _ = writeln!(s, "scan of {} ({})", j.coordinate.label(), j.from);
+        }
+        for (k, m) in st.models.iter().enumerate() {
             let e = m.energy_hartree.map_or("no energy".to_string(), |e| format!("E = {e:.9} Eh"));
-            let _ = writeln!(s, "  frame {:>3}: {e}", m.number);
+            let at =
+                doc.job_scan.as_ref().and_then(|j| Some(format!(", {}", j.coordinate.value_text(*j.values.get(k)?))));
+            let _ = writeln!(s, "  frame {:>3}: {e}{}", m.number, at.unwrap_or_default());
         }
     }
     for a in &info.atoms {

@@ -20,7 +20,10 @@
 //!
 //! Optimisations, scans and IRCs store further geometries in records such as
 //! `Opt point       1 Geometries` or `IRC point       1 Geometries` (3 × atoms × steps reals);
-//! they are kept in [`FchkFile::geometries`] and returned by [`geometries`].
+//! they are kept in [`FchkFile::geometries`] and returned by [`geometries`]. A relaxed scan
+//! writes one `Opt point N` record per point (cclib's `water-pes.fchk`, a rigid Z-matrix scan,
+//! holds none: its last point's geometry and orbitals only): such a file opens as the points'
+//! converged geometries with their energies (`Opt point N Results for each geome`).
 
 use std::collections::HashMap;
 
@@ -94,7 +97,9 @@ impl FchkFile {
 }
 
 /// The records [`FchkFile::parse`] keeps.
-const NEEDED: [&str; 32] = [
+const NEEDED: [&str; 33] = [
+    // A relaxed scan's: how many values each step of `Opt point N Results for each geome` has.
+    "Optimization Num results per geometry",
     "Number of atoms",
     "Number of electrons",
     "Number of alpha electrons",
@@ -154,6 +159,12 @@ fn is_geometry_label(label: &str) -> bool {
     label.contains(" point ") && label.ends_with("Geometries")
 }
 
+/// `Opt point N Results for each geome`: per step the energy first, then what else Gaussian
+/// records there (`Optimization Num results per geometry` values a step).
+fn is_results_label(label: &str) -> bool {
+    label.contains(" point ") && label.ends_with("Results for each geome")
+}
+
 impl FchkFile {
     /// Reads the records the viewer needs. Every malformation is an error naming its line.
     pub fn parse(file: &str, text: &str) -> Result<Self, ParseError> {
@@ -190,7 +201,8 @@ impl FchkFile {
                 Some(t) if t.starts_with("N=") => Some(&t[2..]),
                 _ => None,
             };
-            let wanted = NEEDED.contains(&label) || (kind == 'R' && is_geometry_label(label));
+            let wanted =
+                NEEDED.contains(&label) || (kind == 'R' && (is_geometry_label(label) || is_results_label(label)));
             out.labels_of_qchem |= QCHEM_ONLY.contains(&label);
             let Some(count) = count else {
                 // A scalar.
@@ -390,6 +402,10 @@ impl FchkFile {
             });
         }
 
+        // A relaxed scan's file: its points, whose orbitals it does not hold (but the last's).
+        if let Some(doc) = self.scan_document(source, &atoms) {
+            return Ok(doc);
+        }
         // An optimisation's or scan's file without a basis: its geometries, as a trajectory.
         if !self.records.contains_key("Shell types") {
             return Ok(self.geometry_document(source, &atoms));
@@ -571,6 +587,62 @@ impl FchkFile {
             Err(e) => doc.problems.push(format!("normal modes left out: {e}")),
         }
         Ok(doc)
+    }
+
+    /// A relaxed scan's file (`opt=modredundant` with an `S` line): one `Opt point N
+    /// Geometries` record per point (every optimisation step of that point), each with its `Opt
+    /// point N Results for each geome` (energy first). Its points open as the frames of a
+    /// trajectory, each its last (converged) geometry with that step's energy; the orbitals,
+    /// which the file holds for the last point only, are left out, saying so. `None` for any
+    /// other file (an optimisation has one point). The file does not name the scanned
+    /// coordinate (no ModRedundant section): the frames have none.
+    fn scan_document(&self, source: &str, atoms: &[Atom]) -> Option<Document> {
+        let points: Vec<&GeometrySet> = self.geometries.iter().filter(|g| g.label.starts_with("Opt point")).collect();
+        if points.len() < 2 {
+            return None;
+        }
+        let per_step = match self.records.get("Optimization Num results per geometry") {
+            Some((_, Value::Int(n))) => usize::try_from(*n).ok().filter(|&n| n > 0),
+            _ => None,
+        }
+        .unwrap_or(2);
+        let z: Vec<u8> = atoms.iter().map(|a| a.z as u8).collect();
+        let mut frames = Vec::with_capacity(points.len());
+        let mut energies = Vec::with_capacity(points.len());
+        for set in &points {
+            let Some(last) = set.frames.last() else { continue };
+            let results = set.label.replace("Geometries", "Results for each geome");
+            // The last step's energy, when the record has one per step.
+            let energy = match self.records.get(&results) {
+                Some((_, Value::Reals(v))) if v.len() == per_step * set.frames.len() => {
+                    v.get(v.len() - per_step).copied()
+                }
+                _ => None,
+            };
+            let point = set.label.trim_start_matches("Opt point").trim_end_matches("Geometries").trim();
+            let name = match energy {
+                Some(e) => format!("point {point}: E = {e:.9} Eh"),
+                None => format!("point {point}"),
+            };
+            frames.push((name, last.clone()));
+            energies.push(energy);
+        }
+        let mut doc = super::structure::trajectory(source, &self.title, &z, &frames);
+        if let Some(view) = doc.structure.as_mut() {
+            for (model, e) in view.structure.models.iter_mut().zip(&energies) {
+                model.energy = *e;
+            }
+        }
+        let orbitals = match self.records.contains_key("Shell types") {
+            true => "its orbitals belong to the last point only and are not shown",
+            false => "it holds no orbitals",
+        };
+        doc.problems.push(format!(
+            "{source}: a relaxed scan's {} points open as frames, each its converged geometry; {orbitals} \
+             (compute orbitals for the frames, or keep a checkpoint per point and run formchk on each)",
+            frames.len()
+        ));
+        Some(doc)
     }
 
     /// A file with geometries but no orbitals: its current geometry, then every step of its

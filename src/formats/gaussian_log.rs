@@ -26,7 +26,11 @@
 //! Each orientation followed by an `SCF Done` energy is a frame (an optimisation's, an IRC's
 //! steps): an orientation printed again without a new energy (the converged geometry after
 //! "Optimization completed") is no new frame; a relaxed scan (several "Optimization completed")
-//! keeps one frame per point, its converged geometry. The orbitals belong to the last orientation
+//! keeps one frame per point, its converged geometry, and the coordinate it scans from the
+//! echoed ModRedundant section (`D 3 4 9 10 S 12 30.000`), measured in each point's geometry
+//! (the layout of cclib's regression files `dvb_scan_relaxed.log` and `dvb_scan.log`, Gaussian
+//! 09 D.01 and A.02). A rigid scan of Z-matrix variables (`Scan`, cclib's `water-pes.g09`: two
+//! variables, a grid of points) keeps every point as a frame without a coordinate. The orbitals belong to the last orientation
 //! printed before them. Within a shell Gaussian orders functions as its fchk files do
 //! ([`super::fchk::gaussian_cartesian_order`], pure m = 0, +1, −1, …); the AO labels of the
 //! orbital rows (`3D 0` or `3XX`) say whether each shell is pure or cartesian, and must agree
@@ -42,6 +46,7 @@ use super::wavefunction::{OverlapFn, check_printed, to_model_order};
 use super::{MAX_Z, ParseError};
 use crate::model::basis::{Basis, MAX_L, Shell, ShellKind};
 use crate::model::orbitals::{MolecularOrbital, Spin, Wavefunction};
+use crate::model::scan::{Coordinate, JobScan};
 use crate::model::units::BOHR_PER_ANGSTROM;
 use crate::model::vibrations::{NormalMode, Vibrations};
 use crate::model::{Atom, Document, Molecule};
@@ -109,6 +114,11 @@ struct Scan {
     electrons: Option<(usize, usize)>,
     /// Lines of "Optimization completed": several make a relaxed scan.
     completed: Vec<usize>,
+    /// The echoed ModRedundant section's lines (0-based), after "The following ModRedundant
+    /// input section has been read:".
+    modredundant: Vec<usize>,
+    /// The line of "Scan the potential surface." (a rigid scan of Z-matrix variables).
+    zmatrix_scan: Option<usize>,
     modes: Option<(usize, Vec<NormalMode>)>,
 }
 
@@ -153,6 +163,19 @@ impl Scan {
                 continue;
             } else if t.starts_with("Optimization completed") {
                 s.completed.push(i);
+            } else if t.starts_with("The following ModRedundant input section has been read") {
+                // Its lines up to a blank line or one that names no coordinate (G09 A.02 goes on
+                // straight to "Isotopes and Nuclear Properties:").
+                i += 1;
+                while let Some(l) = log.lines.get(i)
+                    && is_modredundant_line(l)
+                {
+                    s.modredundant.push(i);
+                    i += 1;
+                }
+                continue;
+            } else if t.starts_with("Scan the potential surface") {
+                s.zmatrix_scan = Some(i);
             } else if t.contains("alpha electrons") && t.contains("beta electrons") {
                 let n: Vec<usize> = t.split_whitespace().filter_map(|w| w.parse().ok()).collect();
                 if let [a, b] = n[..] {
@@ -232,12 +255,77 @@ impl Scan {
             Orbitals::Missing(why) => {
                 let mut doc = trajectory(file, &title, &frames);
                 doc.problems.push(format!("{file}: no orbitals to draw: {why}"));
+                // A malformed ModRedundant section leaves the coordinate out, not the frames.
+                match self.job_scan(log, &frames) {
+                    Ok(scan) => doc.job_scan = scan,
+                    Err(e) => doc.problems.push(format!("the scan's coordinate left out: {e}")),
+                }
                 doc
             }
         };
         doc.title = title;
         doc.vibrations = modes;
         Ok(doc)
+    }
+
+    /// The coordinate of a relaxed scan (`opt=modredundant` with an `S` line) and its value at
+    /// each frame, the frames being the scan's points. `None` for any other job; an error for a
+    /// ModRedundant line that cannot be read, a scan of two coordinates (a grid) or of another
+    /// kind than a bond, an angle or a dihedral, and a scan of Z-matrix variables.
+    fn job_scan(&self, log: &LogLines, frames: &[(&Orientation, Option<f64>)]) -> Result<Option<JobScan>, ParseError> {
+        let mut scanned: Option<(usize, Coordinate, usize)> = None;
+        for &i in &self.modredundant {
+            let Some((coordinate, steps)) = modredundant_line(log, i)? else { continue };
+            if let Some((first, ..)) = scanned {
+                return Err(log.error_at(
+                    i,
+                    format!(
+                        "one scanned coordinate (line {} scans one already: a scan of two is a grid of points, not a series along one coordinate)",
+                        first + 1
+                    ),
+                ));
+            }
+            scanned = Some((i, coordinate, steps));
+        }
+        let Some((line, coordinate, steps)) = scanned else {
+            if let Some(z) = self.zmatrix_scan {
+                return Err(log.error_at(
+                    z,
+                    "a scan of ModRedundant coordinates (`opt=modredundant` with an `S` line): a rigid scan of Z-matrix \
+                     variables opens as frames without its coordinate",
+                ));
+            }
+            return Ok(None);
+        };
+        if self.completed.len() < 2 {
+            return Err(log.error_at(
+                line,
+                format!(
+                    "at least two of the scan's points optimised (\"Optimization completed\" {} times)",
+                    self.completed.len()
+                ),
+            ));
+        }
+        let molecules: Vec<Molecule> = frames
+            .iter()
+            .map(|(o, _)| Molecule {
+                atoms: o
+                    .z
+                    .iter()
+                    .zip(&o.positions)
+                    .map(|(&z, &position)| Atom { z, charge: z as f64, position, ghost: false })
+                    .collect(),
+                bonds: Vec::new(),
+            })
+            .collect();
+        let from = format!("line {}: {}", line + 1, log.lines[line].split_whitespace().collect::<Vec<_>>().join(" "));
+        let atoms = frames.first().map_or(0, |f| f.0.z.len());
+        let mut scan = JobScan::measured(coordinate, &molecules, from)
+            .ok_or_else(|| log.error_at(line, format!("atoms among the {atoms} of the molecule")))?;
+        if scan.values.len() < steps + 1 {
+            scan.from += &format!(" ({} of its {} points)", scan.values.len(), steps + 1);
+        }
+        Ok(Some(scan))
     }
 
     /// The last orientation printed before line `line`.
@@ -474,6 +562,59 @@ fn route(log: &LogLines, first: usize) -> String {
         s.push_str(l.strip_prefix(' ').unwrap_or(l));
     }
     s.trim().to_string()
+}
+
+/// Whether a line of the echoed ModRedundant section names a coordinate: a type letter (`B`,
+/// `A`, `D`, `L`, `O`, `X`) or an atom number (or `*`) first. Gaussian echoes the type letter
+/// even where the input left it out (`10 9 4 3 S 12 30.0` is echoed `D 3 4 9 10 S 12 30.000`).
+fn is_modredundant_line(line: &str) -> bool {
+    let Some(first) = line.split_whitespace().next() else { return false };
+    matches!(first.to_ascii_uppercase().as_str(), "B" | "A" | "D" | "L" | "O" | "X" | "*")
+        || first.parse::<usize>().is_ok()
+}
+
+/// A ModRedundant line at `i`: the coordinate and its number of steps when it is scanned (`S
+/// steps size`), `None` for any other action (frozen, added, removed …).
+///
+/// ```text
+///  D       3       4       9      10 S  12 30.000      type, atoms, `S`, steps, step size
+///  B 1 2 F                                             another action: no scan
+/// ```
+fn modredundant_line(log: &LogLines, i: usize) -> Result<Option<(Coordinate, usize)>, ParseError> {
+    const SCAN: &str = "a scanned coordinate `B i j S steps size` (or `A i j k`, `D i j k l`)";
+    let t: Vec<&str> = log.lines[i].split_whitespace().collect();
+    let Some(s) = t.iter().position(|w| w.eq_ignore_ascii_case("S")) else { return Ok(None) };
+    let kind = t[0].to_ascii_uppercase();
+    let typed = kind.parse::<usize>().is_err() && kind != "*";
+    // Atom numbers, then any values given before the action.
+    let fields = &t[usize::from(typed)..s];
+    let atoms: Vec<usize> = fields.iter().map_while(|w| w.parse::<usize>().ok()).collect();
+    if atoms.contains(&0) || fields.contains(&"*") {
+        return Err(log.error_at(i, format!("{SCAN}: atoms numbered from 1, no `*`")));
+    }
+    let expected = match kind.as_str() {
+        "B" => Some(2),
+        "A" => Some(3),
+        "D" => Some(4),
+        _ if !typed => None,
+        _ => return Err(log.error_at(i, format!("{SCAN}: only bonds, angles and dihedrals are scanned here"))),
+    };
+    let n = expected.unwrap_or(atoms.len());
+    if atoms.len() != n || !(2..=4).contains(&n) {
+        return Err(log.error_at(i, format!("{SCAN}: {n} atom numbers")));
+    }
+    let steps = t.get(s + 1).and_then(|w| w.parse::<usize>().ok()).filter(|&n| n > 0);
+    let size = t.get(s + 2).and_then(|w| parse_real(w)).filter(|v| v.is_finite() && *v != 0.0);
+    let (Some(steps), Some(_)) = (steps, size) else {
+        return Err(log.error_at(i, format!("{SCAN}: `S`, a number of steps and a step size")));
+    };
+    let a = |k: usize| atoms[k] - 1;
+    let coordinate = match n {
+        2 => Coordinate::Distance([a(0), a(1)]),
+        3 => Coordinate::Angle([a(0), a(1), a(2)]),
+        _ => Coordinate::Dihedral([a(0), a(1), a(2), a(3)]),
+    };
+    Ok(Some((coordinate, steps)))
 }
 
 /// `(d cartesian, f and up cartesian)` from a basis line's "(5D, 7F)".

@@ -483,7 +483,8 @@ pub fn init(dir: &Path, coordinate: Option<Coordinate>) -> Result<ScanInit, Load
                     &path.display().to_string(),
                     0,
                     "one Molden or fchk file per angle (a scan job's fchk holds orbitals for its last geometry \
-                     only: keep a checkpoint per point and run formchk on each)",
+                     only: keep a checkpoint per point and run formchk on each, or compute the frames' orbitals \
+                     with `orbcloud scan compute FILE --frames`)",
                     format!("{n} geometries in one file"),
                 )
                 .into());

@@ -25,6 +25,9 @@ pub struct Document {
     /// Parts of the file that could not be read while the rest opened, each saying where and
     /// what was expected (a malformed mode section).
     pub problems: Vec<String>,
+    /// The coordinate a scan job varied and its value at each frame of `structure` (a Gaussian
+    /// `opt=modredundant` scan's log): its frames are a scan of geometries.
+    pub job_scan: Option<super::scan::JobScan>,
     /// The scan this document is a frame of (a `.scan.toml`): `molecule` is its skeleton at the
     /// object's value, and its orbitals are quantities of their own ([`crate::scene::Source::Scan`]).
     pub scan: Option<std::sync::Arc<super::scan::Scan>>,

@@ -178,6 +178,38 @@ impl Coordinate {
     }
 }
 
+/// The coordinate a program's scan job varied (Gaussian's ModRedundant `S` line), read from the
+/// job rather than guessed from the geometries, with its value at each of the document's frames.
+#[derive(Debug, Clone, PartialEq)]
+pub struct JobScan {
+    pub coordinate: Coordinate,
+    /// The value at each frame (Å or degrees), measured in the frame's geometry; a dihedral's
+    /// unwrapped so that the values run on past ±180° as the job stepped them.
+    pub values: Vec<f64>,
+    /// Where the job names it ("line 93: D 3 4 9 10 S 12 30.000"), for messages.
+    pub from: String,
+}
+
+impl JobScan {
+    /// `coordinate` measured in each of `frames`. A dihedral is carried across ±180° so that
+    /// each value lies within half a turn of the one before (a scan stepping 30° from 180° goes
+    /// to 210°, not −150°). `None` when an atom of the coordinate lies beyond a frame's.
+    pub fn measured(coordinate: Coordinate, frames: &[Molecule], from: String) -> Option<Self> {
+        let mut values: Vec<f64> = Vec::with_capacity(frames.len());
+        for m in frames {
+            if coordinate.atoms().iter().any(|&i| i >= m.atoms.len()) {
+                return None;
+            }
+            let mut v = coordinate.measure(m)?;
+            if let (Coordinate::Dihedral(_), Some(&last)) = (coordinate, values.last()) {
+                v = last + wrap_degrees(v - last);
+            }
+            values.push(v);
+        }
+        Some(Self { coordinate, values, from })
+    }
+}
+
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum ScanError {
     #[error("a scan needs at least two frames, found {0}")]
@@ -969,6 +1001,38 @@ mod tests {
     }
 
     /// Butane-like chain C–C–C–C with one H on each end carbon.
+    #[test]
+    fn a_job_scan_carries_its_dihedral_across_a_half_turn_either_way() {
+        // H–O–O–H turned about the O–O bond in steps of 50°, up from 150° and down from −150°.
+        let frame = |d: f64| {
+            let d = d.to_radians();
+            Molecule::new(vec![
+                atom(1, [1.0, 0.0, 0.0]),
+                atom(8, [0.0, 0.0, 0.0]),
+                atom(8, [0.0, 0.0, 1.4]),
+                atom(1, [d.cos(), d.sin(), 1.4]),
+            ])
+        };
+        let c = Coordinate::Dihedral([0, 1, 2, 3]);
+        for (from, step) in [(150.0, 50.0), (-150.0, -50.0)] {
+            let frames: Vec<Molecule> = (0..6).map(|k| frame(from + step * k as f64)).collect();
+            let job = JobScan::measured(c, &frames, "test".into()).unwrap();
+            // Steps of 50° one way throughout (whatever sign the convention gives), none of
+            // them a jump of a turn back across ±180°.
+            assert!((job.values[0].abs() - 150.0).abs() < 1e-9, "{:?}", job.values);
+            let steps: Vec<f64> = job.values.windows(2).map(|w| w[1] - w[0]).collect();
+            assert!(
+                steps.iter().all(|s| (s.abs() - 50.0).abs() < 1e-9 && s.signum() == steps[0].signum()),
+                "{steps:?}"
+            );
+            assert!(job.values[5].abs() > 360.0, "{:?}", job.values);
+        }
+        // A distance is measured as it is, in Å; an atom beyond the frames' is no scan.
+        let d = JobScan::measured(Coordinate::Distance([1, 2]), &[frame(0.0)], "test".into()).unwrap();
+        assert!((d.values[0] - 1.4 * crate::model::units::ANGSTROM_PER_BOHR).abs() < 1e-12);
+        assert!(JobScan::measured(Coordinate::Distance([1, 4]), &[frame(0.0)], "test".into()).is_none());
+    }
+
     fn chain() -> Molecule {
         Molecule::new(vec![
             atom(6, [-1.9, 1.9, 0.0]),

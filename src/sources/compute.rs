@@ -19,9 +19,9 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use crate::formats::scan::{Computed, manifest_text};
-use crate::model::Molecule;
 use crate::model::scan::{Coordinate, ScanError, rigid_frames, wrap_degrees};
 use crate::model::units::ANGSTROM_PER_BOHR;
+use crate::model::{Document, Molecule};
 
 /// The Python side: a module of the `orbcloud` package and the script the commands run.
 pub const SCRIPT: &str = include_str!("../../python/orbcloud/_compute.py");
@@ -319,6 +319,59 @@ pub fn rigid_scan(
     let frames =
         values.iter().zip(&molecules).map(|(&v, m)| FrameJob::new(frame_file(stem, coordinate, v), v, m)).collect();
     Ok((frames, start))
+}
+
+/// Every geometry of a multi-frame document (a trajectory, a program log's steps, an XYZ file's
+/// frames) as a molecule with the document's atoms; the document's one geometry for any other.
+pub fn frame_molecules(doc: &Document) -> Vec<Molecule> {
+    let Some(s) = doc.structure.as_ref().map(|v| &v.structure).filter(|s| s.models.len() > 1) else {
+        return vec![doc.molecule.clone()];
+    };
+    (s.model_positions(doc.molecule.atoms.len()).into_iter())
+        .map(|positions| {
+            let atoms = doc
+                .molecule
+                .atoms
+                .iter()
+                .zip(positions)
+                .map(|(a, position)| crate::model::Atom { position, ..a.clone() });
+            Molecule { atoms: atoms.collect(), bonds: doc.molecule.bonds.clone() }
+        })
+        .collect()
+}
+
+/// The frames of a scan job the document read ([`Document::job_scan`]: a Gaussian relaxed
+/// scan) as frames to compute, each at the job's value of its coordinate and named after it:
+/// the geometries are the job's own, so each frame is a single point and nothing is moved or
+/// optimised again. `None` when the document holds no scan job; an error when two frames would
+/// share a value (and a file).
+pub fn job_scan_frames(doc: &Document, stem: &str) -> Option<Result<(Coordinate, Vec<FrameJob>), String>> {
+    let job = doc.job_scan.as_ref()?;
+    let molecules = frame_molecules(doc);
+    if molecules.len() != job.values.len() {
+        return Some(Err(format!(
+            "{}: {} frames and {} values of {}",
+            doc.source,
+            molecules.len(),
+            job.values.len(),
+            job.coordinate.label()
+        )));
+    }
+    let mut frames: Vec<FrameJob> = Vec::with_capacity(molecules.len());
+    for (m, &at) in molecules.iter().zip(&job.values) {
+        let file = frame_file(stem, &job.coordinate, at);
+        if frames.iter().any(|f| f.file == file) {
+            return Some(Err(format!(
+                "{}: two frames at {} of {}: a scan's frames lie at different values",
+                doc.source,
+                job.coordinate.value_text(at),
+                job.coordinate.label()
+            )));
+        }
+        frames.push(FrameJob::new(file, at, m));
+    }
+    frames.sort_by(|a, b| a.at.total_cmp(&b.at));
+    Some(Ok((job.coordinate, frames)))
 }
 
 /// Writes `dir/<title>.scan.toml` naming the frames computed so far (file, value), with how

@@ -1,0 +1,232 @@
+//! A Gaussian relaxed scan's log (`opt=modredundant` with an `S` line) opens as a scan of
+//! geometries: one frame per point with its energy, the coordinate read from the echoed
+//! ModRedundant section and measured in each point's geometry, reported by `info` and `info
+//! --json`, and computed frame by frame into a scan manifest by `scan compute LOG --frames`.
+//!
+//! The fixture, tests/fixtures/logs/h2o2_scan.log, is written by
+//! scripts/make_scan_log_fixtures.py (PySCF) in the layout of cclib's regression files
+//! data/Gaussian/basicGaussian09/dvb_scan_relaxed.log and dvb_scan.log (Gaussian 09 D.01 and
+//! A.02), read line by line; nothing is copied from them.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use orbcloud::formats;
+use orbcloud::model::scan::Coordinate;
+
+fn fixture() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/logs/h2o2_scan.log")
+}
+
+fn orbcloud(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_orbcloud")).args(args).env("NODEVICE_SELECT", "1").output().expect("run")
+}
+
+/// The energies the fixture prints after `SCF Done:`, in file order.
+fn printed_energies(text: &str) -> Vec<f64> {
+    text.lines()
+        .filter_map(|l| l.trim_start().strip_prefix("SCF Done:"))
+        .map(|l| l.split('=').nth(1).unwrap().split_whitespace().next().unwrap().parse().unwrap())
+        .collect()
+}
+
+#[test]
+fn a_relaxed_scan_opens_its_points_with_the_coordinate_it_scanned() {
+    let doc = formats::load(&fixture()).unwrap();
+    let models = &doc.structure.as_ref().expect("frames").structure.models;
+    assert_eq!(models.len(), 5, "one frame per point (two optimisation steps each)");
+    // Each point's energy is its converged (second) step's.
+    let printed = printed_energies(&std::fs::read_to_string(fixture()).unwrap());
+    assert_eq!(printed.len(), 10);
+    let energies: Vec<f64> = models.iter().map(|m| m.energy.unwrap()).collect();
+    let converged: Vec<f64> = printed.iter().skip(1).step_by(2).copied().collect();
+    assert_eq!(energies, converged);
+
+    let job = doc.job_scan.as_ref().expect("the scan's coordinate");
+    assert_eq!(job.coordinate, Coordinate::Dihedral([2, 0, 1, 3]), "D 3 1 2 4, 0-based");
+    assert_eq!(job.coordinate.label(), "dihedral 3-1-2-4");
+    assert!(job.from.starts_with("line 19: D 3 1 2 4 S 4 60.000"), "{}", job.from);
+    // 120° in four steps of 60°, run on past 180° as the job stepped them (not −120°, −60°, 0°).
+    let expected = [120.0, 180.0, 240.0, 300.0, 360.0];
+    assert_eq!(job.values.len(), 5);
+    for (v, e) in job.values.iter().zip(expected) {
+        assert!((v - e).abs() < 1e-3, "{:?}", job.values);
+    }
+}
+
+#[test]
+fn info_reports_the_scan_and_each_frames_value() {
+    let path = fixture();
+    let out = orbcloud(&["info", "--json", path.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let scan = &json["scan"];
+    assert_eq!(scan["coordinate"], "dihedral 3-1-2-4");
+    assert_eq!(scan["kind"], "dihedral");
+    assert_eq!(scan["atoms"], serde_json::json!([3, 1, 2, 4]));
+    assert_eq!(scan["unit"], "°");
+    let values: Vec<f64> = scan["values"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+    assert_eq!(values.len(), json["structure"]["models"].as_array().unwrap().len());
+    assert!((values[4] - 360.0).abs() < 1e-3, "{values:?}");
+
+    let out = orbcloud(&["info", path.to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("scan of dihedral 3-1-2-4 (line 19:"), "{text}");
+    assert!(text.contains("frame   5: E = ") && text.contains(", 360.0°"), "{text}");
+}
+
+/// The fixture with its ModRedundant line replaced, opened.
+fn with_line(line: &str) -> orbcloud::model::Document {
+    let text = std::fs::read_to_string(fixture()).unwrap();
+    let echoed = text.lines().find(|l| l.trim_start().starts_with("D       3")).unwrap();
+    let changed = text.replacen(echoed, line, 1);
+    formats::load_bytes(Path::new("scan.log"), changed.as_bytes()).unwrap()
+}
+
+#[test]
+fn a_malformed_or_unsupported_scan_line_leaves_the_coordinate_out_saying_where() {
+    for (line, expected) in [
+        (" D       3       1       2 S   4 60.000", "4 atom numbers"),
+        (" B       1       x S   4 0.1", "2 atom numbers"),
+        (" D       3       1       2       4 S   4", "a number of steps and a step size"),
+        (" D       3       1       2       4 S   0 60.0", "a number of steps and a step size"),
+        (" L       3       1       2 S   4 60.000", "only bonds, angles and dihedrals"),
+        (" D       3       1       2       9 S   4 60.000", "atoms among the 4 of the molecule"),
+        (" D       3       0       2       4 S   4 60.000", "atoms numbered from 1"),
+        (" D       3       1       2       4 S   4 60.000\n B 1 2 S 3 0.1", "one scanned coordinate"),
+    ] {
+        let doc = with_line(line);
+        assert!(doc.job_scan.is_none(), "{line}");
+        assert_eq!(doc.structure.as_ref().unwrap().structure.models.len(), 5, "the frames open: {line}");
+        let p = doc.problems.iter().find(|p| p.contains("coordinate left out")).unwrap_or_else(|| panic!("{line}"));
+        assert!(p.contains("scan.log:19:") || p.contains("scan.log:20:"), "file and line: {p}");
+        assert!(p.contains(expected), "{line}: {p}");
+    }
+    // Lines that scan nothing (a frozen bond) are no scan, and type letters may be left out.
+    let doc = with_line(" B       1       2 F\n 3 1 2 4 S 4 60.0");
+    assert_eq!(
+        doc.job_scan.as_ref().map(|j| j.coordinate),
+        Some(Coordinate::Dihedral([2, 0, 1, 3])),
+        "{:?}",
+        doc.problems
+    );
+    let doc = with_line(" B       1       2 F");
+    assert!(doc.job_scan.is_none() && !doc.problems.iter().any(|p| p.contains("coordinate")), "{:?}", doc.problems);
+}
+
+#[test]
+fn a_rigid_zmatrix_scan_keeps_its_frames_and_says_its_coordinate_is_not_read() {
+    // The layout of cclib's water-pes.g09 (a `Scan` job over two Z-matrix variables), written
+    // here: every point is a frame.
+    let text = std::fs::read_to_string(fixture()).unwrap();
+    let start = text.find(" The following ModRedundant").unwrap();
+    let end = start + text[start..].find("\n \n").unwrap() + 3;
+    let rigid = format!(
+        "{}{}{}",
+        &text[..start].replace("opt=modredundant", "scan"),
+        " Scan the potential surface.\n Variable   Value     No. Steps Step-Size\n",
+        &text[end..].replace(" Optimization completed.\n", "")
+    );
+    let doc = formats::load_bytes(Path::new("rigid.log"), rigid.as_bytes()).unwrap();
+    assert_eq!(doc.structure.as_ref().unwrap().structure.models.len(), 10, "every point a frame");
+    assert!(doc.job_scan.is_none());
+    assert!(doc.problems.iter().any(|p| p.contains("rigid.log:") && p.contains("Z-matrix")), "{:?}", doc.problems);
+}
+
+/// Fails at once, saying what to install, when the computing Python lacks PySCF.
+fn require_pyscf() {
+    let python = orbcloud::sources::compute::python();
+    let ok = Command::new(&python).args(["-c", "import pyscf"]).output().is_ok_and(|o| o.status.success());
+    assert!(ok, "`{python}` cannot import pyscf: run scripts/test (it sets ORBCLOUD_PYTHON) or pip install pyscf");
+}
+
+#[test]
+fn scan_compute_of_the_log_writes_a_manifest_of_its_frames_at_their_values() {
+    require_pyscf();
+    let dir = tempfile::tempdir().unwrap();
+    let log = fixture();
+    let out = orbcloud(&[
+        "scan",
+        "compute",
+        log.to_str().unwrap(),
+        "--frames",
+        "--method",
+        "hf",
+        "--basis",
+        "sto-3g",
+        "--workers",
+        "2",
+        "-o",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let manifest = dir.path().join("h2o2_scan.scan.toml");
+    let loaded = formats::scan::load_scan(&manifest).unwrap();
+    assert_eq!(loaded.scan.coordinate, Coordinate::Dihedral([2, 0, 1, 3]));
+    let values = loaded.scan.values();
+    for (v, e) in values.iter().zip([120.0, 180.0, 240.0, 300.0, 360.0]) {
+        assert!((v - e).abs() < 1e-3, "{values:?}");
+    }
+    let computed = loaded.computed.expect("the record");
+    assert!(computed.relaxed && computed.input.ends_with("h2o2_scan.log"), "{computed:?}");
+    // Each frame is the log's geometry at that point, and its energy the log's (the same level).
+    let doc = formats::load(&log).unwrap();
+    let printed: Vec<f64> =
+        doc.structure.as_ref().unwrap().structure.models.iter().map(|m| m.energy.unwrap()).collect();
+    let geometries = orbcloud::sources::compute::frame_molecules(&doc);
+    for (k, frame) in loaded.scan.frames.iter().enumerate() {
+        let d = frame.molecule.atoms.iter().zip(&geometries[k].atoms).map(|(a, b)| a.position.distance(b.position));
+        assert!(d.fold(0.0, f64::max) < 1e-4, "frame {k}'s geometry is the log's");
+    }
+    let log_text = std::fs::read_to_string(dir.path().join("compute-log.jsonl")).unwrap();
+    let energies: Vec<f64> = log_text
+        .lines()
+        .filter_map(|l| serde_json::from_str::<serde_json::Value>(l).ok())
+        .filter_map(|v| v["energy"].as_f64())
+        .collect();
+    assert_eq!(energies.len(), 5, "{log_text}");
+    for e in energies {
+        assert!(printed.iter().any(|p| (p - e).abs() < 1e-6), "{e} among {printed:?}");
+    }
+}
+
+#[test]
+fn a_relaxed_scan_fchk_opens_its_points_with_their_energies() {
+    // Written by scripts/make_scan_log_fixtures.py beside the log: the same job's checkpoint.
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/scan_jobs/h2o2_relaxed_scan.fchk");
+    let doc = formats::load(&path).unwrap();
+    assert!(doc.wavefunction.is_none(), "the orbitals are the last point's only");
+    let models = &doc.structure.as_ref().expect("frames").structure.models;
+    assert_eq!(models.len(), 5, "one frame per `Opt point N` record");
+    let log = formats::load(&fixture()).unwrap();
+    let log_models = &log.structure.as_ref().unwrap().structure.models;
+    for (m, l) in models.iter().zip(log_models) {
+        // The fchk's eight significant digits against the log's.
+        assert!((m.energy.unwrap() - l.energy.unwrap()).abs() < 1e-5, "{:?} vs {:?}", m.energy, l.energy);
+    }
+    // Each frame the point's converged (last) step: the log's geometry of that point.
+    let frames = orbcloud::sources::compute::frame_molecules(&doc);
+    let log_frames = orbcloud::sources::compute::frame_molecules(&log);
+    for (a, b) in frames.iter().zip(&log_frames) {
+        let d = a.atoms.iter().zip(&b.atoms).map(|(p, q)| p.position.distance(q.position)).fold(0.0, f64::max);
+        assert!(d < 1e-5, "{d}");
+    }
+    assert!(doc.problems.iter().any(|p| p.contains("relaxed scan's 5 points") && p.contains("last point only")));
+
+    // A results record of the wrong length leaves that point's energy out, not the frames.
+    let text = std::fs::read_to_string(&path).unwrap();
+    let header = "Opt point       2 Results for each geome   R   N=           4";
+    let at = text.find(header).unwrap();
+    let (row, end) = (at + header.len() + 1, at + header.len() + 1 + text[at + header.len() + 1..].find('\n').unwrap());
+    // Three values (16 columns each) where there were four.
+    let bad = format!(
+        "{}{}\n{}{}",
+        &text[..at],
+        header.replace("N=           4", "N=           3"),
+        &text[row..end - 16],
+        &text[end..]
+    );
+    let doc = formats::load_bytes(Path::new("bad.fchk"), bad.as_bytes()).unwrap();
+    let energies: Vec<bool> = doc.structure.unwrap().structure.models.iter().map(|m| m.energy.is_some()).collect();
+    assert_eq!(energies, [true, false, true, true, true]);
+}
