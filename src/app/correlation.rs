@@ -82,7 +82,9 @@ pub fn plot(ui: &mut egui::Ui, view: &mut DiagramView, scan: &Scan, value: f64) 
     // within the plot; a line above it is named at its top edge.
     let ends: Vec<f64> = diagram.lines.iter().map(|l| l.points.last().map_or(0.0, |p| ev(p.1)).min(y_hi)).collect();
     let labels = spread_labels(&ends, 0.07 * (y_hi - y_lo + 2.0 * pad));
-    Plot::new("correlation diagram")
+    // The plot keeps its first bounds: a scan whose range grows (frames still being computed)
+    // or another scan is a new plot.
+    Plot::new(("correlation diagram", lo.to_bits(), hi.to_bits()))
         .x_axis_label(x_label)
         .y_axis_label("orbital energy (eV)")
         .allow_scroll(false)
