@@ -372,8 +372,9 @@ print(json.dumps(out))
 
 /// Natural transition orbitals from a TD log's printed amplitudes over its fchk twin's orbitals
 /// (what Multiwfn's hole–electron analysis reads): the weights and the first pair equal an
-/// independent SVD of the same printed numbers, the orbitals are normalised, and the document
-/// made of them names its orbitals `hole 1`, `particle 1`, … occupied by their weights.
+/// independent SVD of the same printed numbers, the orbitals are normalised, the hole's and the
+/// electron's centroids from the dipole integrals are those of a grid, and the document made of
+/// them names its orbitals `hole 1`, `particle 1`, … occupied by their weights.
 #[test]
 fn ntos_from_a_td_logs_amplitudes_equal_an_independent_svd() {
     use orbcloud::model::nto;
@@ -415,6 +416,24 @@ fn ntos_from_a_td_logs_amplitudes_equal_an_independent_svd() {
         }
         // Gaussian prints amplitudes down to 0.01 here: most of each singlet's 0.5.
         assert!(ntos.printed_norm > 0.45 && ntos.printed_norm < 0.55, "{}", ntos.printed_norm);
+        // The hole and electron: the centroids from the dipole integrals are the grid's, and
+        // each density integrates to the pairs' weight.
+        let he = ntos.hole_electron(&wf.basis, &doc.molecule).expect("atoms");
+        let total: f64 = ntos.pairs.iter().map(|p| p.weight).sum();
+        eprintln!(
+            "state {}: D {:.3} bohr (grid {:.3}), Sr {:.3}, ∫ hole {:.4}, ∫ electron {:.4} of {total:.4}",
+            state.number,
+            he.distance_bohr,
+            he.grid.centroid_distance_bohr,
+            he.overlap,
+            he.grid.detachment_integral,
+            he.grid.attachment_integral
+        );
+        assert!((he.distance_bohr - he.grid.centroid_distance_bohr).abs() < 0.02, "{he:?}");
+        for integral in [he.grid.attachment_integral, he.grid.detachment_integral] {
+            assert!((integral - total).abs() < 1e-3 * total, "{integral} of {total}");
+        }
+        assert!(he.overlap > 0.2 && he.overlap < 1.0, "Sr {}", he.overlap);
         let made = ntos.document(&doc).expect("a document");
         let orbitals = &made.wavefunction.as_ref().unwrap().orbitals;
         assert_eq!(orbitals[0].symmetry, "hole 1");

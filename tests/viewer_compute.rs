@@ -59,23 +59,12 @@ fn scan_this_on_a_measured_dihedral_computes_a_scan_whose_frames_open_while_it_r
     (d.from, d.to, d.step, d.workers) = (60.0, 180.0, 20.0, 1);
     h.run_steps(1);
     h.get_by_label("Compute").click();
-    let start = std::time::Instant::now();
     let mut seen_while_running = Vec::new();
-    loop {
-        assert!(start.elapsed().as_secs() < 300, "the scan did not finish: {}", h.state().status);
-        std::thread::sleep(std::time::Duration::from_millis(20));
-        h.run_steps(1);
-        let app = h.state();
-        let run = app.computing.as_ref().expect("a computation");
-        assert!(!run.progress.starts_with("computing failed"), "{}", run.progress);
-        let frames = app.scan().map_or(0, |s| s.scene.scan.frames.len());
-        if !run.ended && frames > 0 {
+    wait_computed(&mut h, |ended, frames| {
+        if !ended && frames > 0 {
             seen_while_running.push(frames);
         }
-        if run.ended && run.shown == run.done.len() && !app.is_loading() && frames == run.done.len() {
-            break;
-        }
-    }
+    });
     let app = h.state();
     let run = app.computing.as_ref().unwrap();
     assert_eq!(run.done.len(), 7, "{}", run.progress);
@@ -140,19 +129,7 @@ fn a_scan_jobs_frames_compute_into_a_scan_of_its_coordinate() {
     (d.settings.method, d.settings.basis, d.workers) = ("hf".into(), "sto-3g".into(), 2);
     h.run_steps(1);
     h.get_by_label("Compute").click();
-    let start = std::time::Instant::now();
-    loop {
-        assert!(start.elapsed().as_secs() < 300, "the scan did not finish: {}", h.state().status);
-        std::thread::sleep(std::time::Duration::from_millis(20));
-        h.run_steps(1);
-        let app = h.state();
-        let run = app.computing.as_ref().expect("a computation");
-        assert!(!run.progress.starts_with("computing failed"), "{}", run.progress);
-        let frames = app.scan().map_or(0, |s| s.scene.scan.frames.len());
-        if run.ended && run.shown == run.done.len() && !app.is_loading() && frames == run.done.len() {
-            break;
-        }
-    }
+    wait_computed(&mut h, |_, _| {});
     let app = h.state();
     let scan = &app.scan().unwrap().scene.scan;
     assert_eq!(scan.coordinate.label(), "dihedral 3-1-2-4");
@@ -164,4 +141,24 @@ fn a_scan_jobs_frames_compute_into_a_scan_of_its_coordinate() {
     let manifest = dir.path().join("h2o2_scan_frames/h2o2_scan.scan.toml");
     let loaded = orbcloud::formats::scan::load_scan(&manifest).unwrap();
     assert!(loaded.computed.is_some_and(|c| c.relaxed), "the frames are the job's relaxed geometries");
+}
+
+/// Steps the window until the computation under way has ended and the open scan shows every
+/// frame it made (failing on a failed computation or after five minutes); `watch` sees each
+/// step's (ended, frames the scan shows).
+fn wait_computed(h: &mut Harness<'static, OrbApp>, mut watch: impl FnMut(bool, usize)) {
+    let start = std::time::Instant::now();
+    loop {
+        assert!(start.elapsed().as_secs() < 300, "the scan did not finish: {}", h.state().status);
+        std::thread::sleep(std::time::Duration::from_millis(20));
+        h.run_steps(1);
+        let app = h.state();
+        let run = app.computing.as_ref().expect("a computation");
+        assert!(!run.progress.starts_with("computing failed"), "{}", run.progress);
+        let frames = app.scan().map_or(0, |s| s.scene.scan.frames.len());
+        watch(run.ended, frames);
+        if run.ended && run.shown == run.done.len() && !app.is_loading() && frames == run.done.len() {
+            return;
+        }
+    }
 }

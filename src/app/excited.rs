@@ -271,6 +271,10 @@ impl super::OrbApp {
             shown.quantities.push(q);
         }
         let weights: Vec<String> = ntos.pairs.iter().map(|p| format!("{:.2}", p.weight)).collect();
+        // How far the electron moves: the hole's and the electron's centroids, from the dipole
+        // integrals (exact and quick; their overlap needs a grid).
+        let (hole, electron) = ntos.centroids(&wf.basis);
+        let distance = hole.distance(electron) * crate::model::units::ANGSTROM_PER_BOHR;
         let camera = self.view.camera;
         self.add_shared_object(std::sync::Arc::new(made), super::Opening::Restore(Box::new(shown)));
         while self.view.panes.count < 2 {
@@ -283,7 +287,8 @@ impl super::OrbApp {
         }
         self.frame_panes();
         self.status = format!(
-            "state {}: natural transition orbitals of the printed amplitudes (Σc² {:.4}), weights {}",
+            "state {}: natural transition orbitals of the printed amplitudes (Σc² {:.4}), weights {}; the \
+             electron moves {distance:.2} Å from the hole's centroid to its own",
             state.number,
             ntos.printed_norm,
             weights.join(", ")

@@ -8,7 +8,7 @@ use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 
 use super::GpuContext;
-use super::frame::{Draw, Phase, Prepare, opaque_depth, opaque_targets};
+use super::frame::{Draw, Phase, Prepare};
 use crate::model::arrow::Arrow;
 
 /// Mirror of `Arrow` in arrows.wgsl.
@@ -64,43 +64,7 @@ pub struct ArrowsPass {
 
 impl ArrowsPass {
     pub fn new(ctx: &GpuContext) -> Self {
-        let device = &ctx.device;
-        let module = super::shader_module(device, "arrows.wgsl");
-        let stages = wgpu::ShaderStages::VERTEX_FRAGMENT;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("arrows bind group layout"),
-            entries: &[
-                super::uniform_entry(0, stages),
-                super::buffer_entry(1, stages, wgpu::BufferBindingType::Storage { read_only: true }),
-            ],
-        });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("arrows pipeline layout"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("arrows"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            // Both sides of the box: whichever faces the eye, every pixel of the arrow is met.
-            primitive: wgpu::PrimitiveState::default(),
-            depth_stencil: Some(opaque_depth()),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &opaque_targets(),
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let (pipeline, layout) = super::frame::opaque_storage_pipeline(&ctx.device, "arrows.wgsl", "arrows");
         Self::with(ctx, Arc::new(pipeline), Arc::new(layout))
     }
 

@@ -347,6 +347,54 @@ pub fn opaque_targets() -> [Option<wgpu::ColorTargetState>; 2] {
     ]
 }
 
+/// The pipeline of a representation drawn in the opaque phase from a uniform block (binding 0)
+/// and a read-only storage buffer (binding 1) alone, no vertex buffers (arrow impostors, the
+/// plane's frame): `shader`'s `vs_main` and `fs_main`, both windings, into the opaque targets
+/// with depth. Returns it with its bind group's layout.
+pub fn opaque_storage_pipeline(
+    device: &wgpu::Device,
+    shader: &str,
+    label: &str,
+) -> (wgpu::RenderPipeline, wgpu::BindGroupLayout) {
+    let module = super::shader_module(device, shader);
+    let stages = wgpu::ShaderStages::VERTEX_FRAGMENT;
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(&format!("{label} bind group layout")),
+        entries: &[
+            super::uniform_entry(0, stages),
+            super::buffer_entry(1, stages, wgpu::BufferBindingType::Storage { read_only: true }),
+        ],
+    });
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(&format!("{label} pipeline layout")),
+        bind_group_layouts: &[Some(&layout)],
+        immediate_size: 0,
+    });
+    let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(label),
+        layout: Some(&pipeline_layout),
+        vertex: wgpu::VertexState {
+            module: &module,
+            entry_point: Some("vs_main"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        // Both windings: an impostor's box or a line's quad is drawn whichever way it faces.
+        primitive: wgpu::PrimitiveState::default(),
+        depth_stencil: Some(opaque_depth()),
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module: &module,
+            entry_point: Some("fs_main"),
+            compilation_options: Default::default(),
+            targets: &opaque_targets(),
+        }),
+        multiview_mask: None,
+        cache: None,
+    });
+    (pipeline, layout)
+}
+
 /// Depth state of opaque geometry: tested and written.
 pub fn opaque_depth() -> wgpu::DepthStencilState {
     wgpu::DepthStencilState {

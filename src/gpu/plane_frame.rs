@@ -8,7 +8,7 @@ use glam::Vec3;
 use wgpu::util::DeviceExt;
 
 use super::GpuContext;
-use super::frame::{Draw, Phase, Prepare, opaque_depth, opaque_targets};
+use super::frame::{Draw, Phase, Prepare};
 
 /// Mirror of `LineUniforms` in plane_frame.wgsl.
 #[repr(C)]
@@ -73,47 +73,7 @@ impl PlaneFramePass {
 
 impl super::frame::Representation for PlaneFramePass {
     fn new(ctx: &GpuContext, _shared: &super::frame::Shared<'_>) -> Self {
-        let device = &ctx.device;
-        let module = super::shader_module(device, "plane_frame.wgsl");
-        let stages = wgpu::ShaderStages::VERTEX_FRAGMENT;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("plane frame bind group layout"),
-            entries: &[
-                super::uniform_entry(0, stages),
-                super::buffer_entry(
-                    1,
-                    wgpu::ShaderStages::VERTEX,
-                    wgpu::BufferBindingType::Storage { read_only: true },
-                ),
-            ],
-        });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("plane frame pipeline layout"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("plane frame"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            // A quad faces the eye whichever way its segment runs: both windings drawn.
-            primitive: wgpu::PrimitiveState::default(),
-            depth_stencil: Some(opaque_depth()),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &opaque_targets(),
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let (pipeline, layout) = super::frame::opaque_storage_pipeline(&ctx.device, "plane_frame.wgsl", "plane frame");
         Self::with(ctx, Arc::new(pipeline), Arc::new(layout))
     }
 

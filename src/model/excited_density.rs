@@ -215,18 +215,7 @@ pub const DESCRIPTOR_POINTS: usize = 4_000_000;
 impl ExcitedDensity {
     /// ∫ r ρ / ∫ ρ of `part` (bohr) from the dipole matrices `moments` of the basis.
     pub fn centroid(&self, part: StatePart, moments: &[Vec<f64>; 3]) -> DVec3 {
-        let n = self.n;
-        let sets = self.sets(part);
-        let electrons: f64 = sets.iter().map(|(_, w)| w).sum();
-        let first = moments.each_ref().map(|x| {
-            (sets.iter())
-                .map(|(c, w)| {
-                    let quadratic: f64 = (0..n).map(|i| c[i] * (0..n).map(|j| x[i * n + j] * c[j]).sum::<f64>()).sum();
-                    w * quadratic
-                })
-                .sum::<f64>()
-        });
-        DVec3::from_array(first) / electrons.max(f64::MIN_POSITIVE)
+        weighted_centroid(&self.sets(part), moments, self.n)
     }
 
     /// Every descriptor of the excitation: electrons moved, exact centroids from the dipole
@@ -252,49 +241,78 @@ impl ExcitedDensity {
     /// their electrons, centroids, the centroids' distance and the densities' overlap. `None`
     /// without atoms.
     pub fn grid_descriptors(&self, basis: &PreparedBasis, molecule: &Molecule) -> Option<GridDescriptors> {
-        let (lo, hi) = molecule.bounds()?;
-        let (lo, hi) = (lo - DVec3::splat(DESCRIPTOR_MARGIN), hi + DVec3::splat(DESCRIPTOR_MARGIN));
-        let extent = hi - lo;
-        let mut h = DESCRIPTOR_SPACING;
-        while ((extent.x / h) as usize + 1) * ((extent.y / h) as usize + 1) * ((extent.z / h) as usize + 1)
-            > DESCRIPTOR_POINTS
-        {
-            h *= 1.25;
-        }
-        let spec = GridSpec::spaced(lo, hi, h);
-        let att = basis.weighted_density_grid(&self.sets(StatePart::Attachment), &spec);
-        let det = basis.weighted_density_grid(&self.sets(StatePart::Detachment), &spec);
-        let volume = h * h * h;
-        let (mut na, mut nd, mut overlap) = (0.0, 0.0, 0.0);
-        let (mut ra, mut rd) = (DVec3::ZERO, DVec3::ZERO);
-        let d = spec.dims;
-        for i in 0..d[0] {
-            for j in 0..d[1] {
-                for k in 0..d[2] {
-                    let idx = (i * d[1] + j) * d[2] + k;
-                    let p = spec.point(i, j, k);
-                    let (a, b) = (att[idx].max(0.0), det[idx].max(0.0));
-                    na += a;
-                    nd += b;
-                    ra += a * p;
-                    rd += b * p;
-                    overlap += (a * b).sqrt();
-                }
+        let (att, det) = (self.sets(StatePart::Attachment), self.sets(StatePart::Detachment));
+        pair_descriptors(basis, molecule, (&att, &det), self.electrons_moved())
+    }
+}
+
+/// ∫ r ρ / ∫ ρ (bohr) of the density Σ w |φ|² of `sets` (coefficients over `n` basis functions
+/// with their weights), from the basis's dipole matrices `moments`.
+pub fn weighted_centroid(sets: &[(&[f64], f64)], moments: &[Vec<f64>; 3], n: usize) -> DVec3 {
+    let electrons: f64 = sets.iter().map(|(_, w)| w).sum();
+    let first = moments.each_ref().map(|x| {
+        (sets.iter())
+            .map(|(c, w)| {
+                let quadratic: f64 = (0..n).map(|i| c[i] * (0..n).map(|j| x[i * n + j] * c[j]).sum::<f64>()).sum();
+                w * quadratic
+            })
+            .sum::<f64>()
+    });
+    DVec3::from_array(first) / electrons.max(f64::MIN_POSITIVE)
+}
+
+/// Integrals of two densities made of weighted orbitals (`gain`: where electrons go, `loss`:
+/// whence they come: attachment and detachment, or an excitation's electron and hole) on a grid
+/// over `molecule` (the atoms' box plus [`DESCRIPTOR_MARGIN`], spacing [`DESCRIPTOR_SPACING`] or
+/// coarser): their electrons, centroids, the centroids' distance and their overlap
+/// ∫√(ρ₁ρ₂) over `electrons`. `None` without atoms.
+pub fn pair_descriptors(
+    basis: &PreparedBasis,
+    molecule: &Molecule,
+    (gain, loss): (&[(&[f64], f64)], &[(&[f64], f64)]),
+    electrons: f64,
+) -> Option<GridDescriptors> {
+    let (lo, hi) = molecule.bounds()?;
+    let (lo, hi) = (lo - DVec3::splat(DESCRIPTOR_MARGIN), hi + DVec3::splat(DESCRIPTOR_MARGIN));
+    let extent = hi - lo;
+    let mut h = DESCRIPTOR_SPACING;
+    while ((extent.x / h) as usize + 1) * ((extent.y / h) as usize + 1) * ((extent.z / h) as usize + 1)
+        > DESCRIPTOR_POINTS
+    {
+        h *= 1.25;
+    }
+    let spec = GridSpec::spaced(lo, hi, h);
+    let att = basis.weighted_density_grid(gain, &spec);
+    let det = basis.weighted_density_grid(loss, &spec);
+    let volume = h * h * h;
+    let (mut na, mut nd, mut overlap) = (0.0, 0.0, 0.0);
+    let (mut ra, mut rd) = (DVec3::ZERO, DVec3::ZERO);
+    let d = spec.dims;
+    for i in 0..d[0] {
+        for j in 0..d[1] {
+            for k in 0..d[2] {
+                let idx = (i * d[1] + j) * d[2] + k;
+                let p = spec.point(i, j, k);
+                let (a, b) = (att[idx].max(0.0), det[idx].max(0.0));
+                na += a;
+                nd += b;
+                ra += a * p;
+                rd += b * p;
+                overlap += (a * b).sqrt();
             }
         }
-        let (ca, cd) = (ra / na.max(f64::MIN_POSITIVE), rd / nd.max(f64::MIN_POSITIVE));
-        let moved = self.electrons_moved().max(f64::MIN_POSITIVE);
-        Some(GridDescriptors {
-            attachment_integral: na * volume,
-            detachment_integral: nd * volume,
-            attachment_centroid: ca.to_array(),
-            detachment_centroid: cd.to_array(),
-            centroid_distance_bohr: ca.distance(cd),
-            overlap: overlap * volume / moved,
-            grid_points: d,
-            spacing_bohr: h,
-        })
     }
+    let (ca, cd) = (ra / na.max(f64::MIN_POSITIVE), rd / nd.max(f64::MIN_POSITIVE));
+    Some(GridDescriptors {
+        attachment_integral: na * volume,
+        detachment_integral: nd * volume,
+        attachment_centroid: ca.to_array(),
+        detachment_centroid: cd.to_array(),
+        centroid_distance_bohr: ca.distance(cd),
+        overlap: overlap * volume / electrons.max(f64::MIN_POSITIVE),
+        grid_points: d,
+        spacing_bohr: h,
+    })
 }
 
 #[cfg(test)]

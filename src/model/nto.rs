@@ -164,3 +164,53 @@ impl Ntos {
 pub fn is_nto_label(label: &str) -> bool {
     label.strip_prefix("hole ").or_else(|| label.strip_prefix("particle ")).is_some_and(|n| n.parse::<usize>().is_ok())
 }
+
+/// Where an excitation's hole and electron lie, from its natural transition orbitals: the hole
+/// density Σ_k w_k |h_k|² and the electron density Σ_k w_k |p_k|² (Multiwfn's hole–electron
+/// analysis, exact in the NTO basis where the amplitudes are whole).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct HoleElectron {
+    /// ∫ r ρ / ∫ ρ of each (bohr), from the basis functions' dipole integrals.
+    pub hole_centroid_bohr: [f64; 3],
+    pub electron_centroid_bohr: [f64; 3],
+    /// D: the distance between the centroids (bohr).
+    pub distance_bohr: f64,
+    /// Sr: ∫ √(ρ_hole ρ_electron), 1 when they coincide, 0 when they never meet, on the grid of
+    /// [`super::excited_density::pair_descriptors`], and that grid's own centroids and integrals.
+    pub overlap: f64,
+    pub grid: super::excited_density::GridDescriptors,
+}
+
+impl Ntos {
+    /// The hole and electron densities' centroids ∫ r ρ / ∫ ρ (bohr), from the dipole integrals
+    /// of `basis` (the NTOs' own).
+    pub fn centroids(&self, basis: &super::basis::Basis) -> (glam::DVec3, glam::DVec3) {
+        let moments = super::overlap::moment_matrices(basis);
+        let n = basis.n_functions();
+        let of = |particle: bool| {
+            let sets: Vec<(&[f64], f64)> = (self.pairs.iter())
+                .map(|p| (if particle { p.particle.as_slice() } else { p.hole.as_slice() }, p.weight))
+                .collect();
+            super::excited_density::weighted_centroid(&sets, &moments, n)
+        };
+        (of(false), of(true))
+    }
+
+    /// The hole and electron densities' centroids, their distance and overlap, over `basis`
+    /// (the NTOs' own) and `molecule`. `None` without atoms.
+    pub fn hole_electron(&self, basis: &super::basis::Basis, molecule: &super::Molecule) -> Option<HoleElectron> {
+        let holes: Vec<(&[f64], f64)> = self.pairs.iter().map(|p| (p.hole.as_slice(), p.weight)).collect();
+        let electrons: Vec<(&[f64], f64)> = self.pairs.iter().map(|p| (p.particle.as_slice(), p.weight)).collect();
+        let total: f64 = self.pairs.iter().map(|p| p.weight).sum();
+        let prepared = super::gto::PreparedBasis::new(basis);
+        let grid = super::excited_density::pair_descriptors(&prepared, molecule, (&electrons, &holes), total)?;
+        let (h, e) = self.centroids(basis);
+        Some(HoleElectron {
+            hole_centroid_bohr: h.to_array(),
+            electron_centroid_bohr: e.to_array(),
+            distance_bohr: h.distance(e),
+            overlap: grid.overlap,
+            grid,
+        })
+    }
+}
