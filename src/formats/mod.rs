@@ -177,6 +177,17 @@ pub fn extensions() -> impl Iterator<Item = &'static str> {
     FORMATS.iter().flat_map(|f| f.endings.iter().copied())
 }
 
+/// Whether `name` (maybe gzipped) ends as a Molden or fchk file does: the wavefunctions a scan's
+/// frames are.
+pub fn is_molden_or_fchk(name: &str) -> bool {
+    let n = name.to_ascii_lowercase();
+    let n = n.strip_suffix(".gz").unwrap_or(&n);
+    (FORMATS.iter())
+        .filter(|f| matches!(f.reader, Reader::Molden | Reader::Fchk))
+        .flat_map(|f| f.endings.iter())
+        .any(|e| n.ends_with(e))
+}
+
 /// The formats in words: "Gaussian cube (.cube, .cub), Molden (…), … or XYZ (.xyz), each also
 /// gzipped (.gz)".
 pub fn described() -> String {

@@ -440,11 +440,10 @@ pub struct ScanInit {
     pub frames: Vec<(String, f64)>,
 }
 
-/// Whether a file name is a wavefunction the readers take (Molden or fchk, maybe gzipped).
+/// Whether a file name is a wavefunction the readers take as a scan's frame (Molden or fchk,
+/// maybe gzipped), by the endings the format table gives them.
 fn is_wavefunction_file(name: &str) -> bool {
-    let n = name.to_ascii_lowercase();
-    let n = n.strip_suffix(".gz").unwrap_or(&n);
-    [".molden", ".molden.input", ".mold", ".fchk", ".fch"].iter().any(|e| n.ends_with(e))
+    super::is_molden_or_fchk(name)
 }
 
 /// Builds `DIR/<dir name>.scan.toml` from the Molden/fchk files in `dir`: each frame's value is

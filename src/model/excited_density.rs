@@ -242,7 +242,7 @@ impl ExcitedDensity {
     /// without atoms.
     pub fn grid_descriptors(&self, basis: &PreparedBasis, molecule: &Molecule) -> Option<GridDescriptors> {
         let (att, det) = (self.sets(StatePart::Attachment), self.sets(StatePart::Detachment));
-        pair_descriptors(basis, molecule, (&att, &det), self.electrons_moved())
+        pair_descriptors(basis, molecule, &att, &det, self.electrons_moved())
     }
 }
 
@@ -269,7 +269,8 @@ pub fn weighted_centroid(sets: &[(&[f64], f64)], moments: &[Vec<f64>; 3], n: usi
 pub fn pair_descriptors(
     basis: &PreparedBasis,
     molecule: &Molecule,
-    (gain, loss): (&[(&[f64], f64)], &[(&[f64], f64)]),
+    gain: &[(&[f64], f64)],
+    loss: &[(&[f64], f64)],
     electrons: f64,
 ) -> Option<GridDescriptors> {
     let (lo, hi) = molecule.bounds()?;

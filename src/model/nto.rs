@@ -203,7 +203,7 @@ impl Ntos {
         let electrons: Vec<(&[f64], f64)> = self.pairs.iter().map(|p| (p.particle.as_slice(), p.weight)).collect();
         let total: f64 = self.pairs.iter().map(|p| p.weight).sum();
         let prepared = super::gto::PreparedBasis::new(basis);
-        let grid = super::excited_density::pair_descriptors(&prepared, molecule, (&electrons, &holes), total)?;
+        let grid = super::excited_density::pair_descriptors(&prepared, molecule, &electrons, &holes, total)?;
         let (h, e) = self.centroids(basis);
         Some(HoleElectron {
             hole_centroid_bohr: h.to_array(),
