@@ -441,3 +441,37 @@ fn ntos_from_a_td_logs_amplitudes_equal_an_independent_svd() {
         assert_eq!(orbitals[0].occupation, first.weight);
     }
 }
+
+/// `info --transitions LOG` joins a TD log's printed transitions to its checkpoint's states and
+/// lists each state's NTO weights and hole–electron distance and overlap; a file without
+/// transitions is refused by name.
+#[test]
+fn info_with_a_logs_transitions_lists_each_states_ntos() {
+    let Some(dir) = logs("excited_states::info_with_a_logs_transitions_lists_each_states_ntos") else { return };
+    let (log, fchk) = (dir.join("basicGaussian09_dvb_td.out"), dir.join("basicGaussian09_dvb_td.fchk"));
+    let out = orbcloud(&["info", "--json", fchk.to_str().unwrap(), "--transitions", log.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let info: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let states = info["excited_states"]["states"].as_array().unwrap();
+    assert_eq!(states.len(), 5);
+    let second = &states[1]["ntos"];
+    let weight = second["weights"][0].as_f64().unwrap();
+    assert!((weight - 0.9722).abs() < 1e-3, "{second}");
+    let distance = second["hole_electron"]["distance_bohr"].as_f64().unwrap();
+    let sr = second["hole_electron"]["overlap"].as_f64().unwrap();
+    assert!((distance - 0.328).abs() < 0.01 && (sr - 0.927).abs() < 0.01, "{second}");
+    assert!(
+        info["problems"].as_array().unwrap().is_empty(),
+        "the log's own problems stay its own: {}",
+        info["problems"]
+    );
+    let text = orbcloud(&["info", fchk.to_str().unwrap(), "--transitions", log.to_str().unwrap()]);
+    assert!(String::from_utf8_lossy(&text.stdout).contains("NTO weights 0.972"));
+    let sp = dir.join("basicGaussian09_dvb_sp.fchk");
+    let bad = orbcloud(&["info", fchk.to_str().unwrap(), "--transitions", sp.to_str().unwrap()]);
+    let e = String::from_utf8_lossy(&bad.stderr);
+    assert!(
+        !bad.status.success() && e.contains("basicGaussian09_dvb_sp.fchk") && e.contains("no excited states"),
+        "{e}"
+    );
+}

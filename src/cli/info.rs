@@ -153,6 +153,18 @@ pub struct StateInfo {
     pub total_energy_hartree: Option<f64>,
     /// The largest transitions (at most 5), orbitals numbered from 1 within their spin.
     pub main_transitions: Vec<Transition>,
+    /// Its natural transition orbitals, where the file has orbitals and the state its printed
+    /// transitions ([`crate::model::nto`]).
+    pub ntos: Option<NtoInfo>,
+}
+
+/// A state's natural transition orbitals: the pairs' weights, the printed amplitudes' Σc², and
+/// the hole and electron densities' centroids, distance D and overlap Sr.
+#[derive(Serialize)]
+pub struct NtoInfo {
+    pub weights: Vec<f64>,
+    pub printed_norm: f64,
+    pub hole_electron: Option<crate::model::nto::HoleElectron>,
 }
 
 #[derive(Serialize)]
@@ -186,6 +198,11 @@ fn excited_info(doc: &Document) -> Option<ExcitedInfo> {
             s_squared: s.s_squared,
             total_energy_hartree: s.total_energy_hartree,
             main_transitions: s.main_transitions(5).into_iter().cloned().collect(),
+            ntos: wf.and_then(|wf| crate::model::nto::from_transitions(wf, s)).map(|n| NtoInfo {
+                weights: n.pairs.iter().map(|p| p.weight).collect(),
+                printed_norm: n.printed_norm,
+                hole_electron: wf.and_then(|wf| n.hole_electron(&wf.basis, &doc.molecule)),
+            }),
         })
         .collect();
     Some(ExcitedInfo {
@@ -479,6 +496,17 @@ fn excited_text(s: &mut String, x: &ExcitedInfo) {
             label.join(" "),
             transitions.join(", ")
         );
+        if let Some(n) = &st.ntos {
+            let weights: Vec<String> = n.weights.iter().map(|w| format!("{w:.3}")).collect();
+            let moved = n.hole_electron.map_or(String::new(), |h| {
+                format!(
+                    "; hole and electron {:.3} Å apart (D), overlap Sr {:.3}",
+                    h.distance_bohr * ANGSTROM_PER_BOHR,
+                    h.overlap
+                )
+            });
+            let _ = writeln!(s, "      NTO weights {}{moved}", weights.join(", "));
+        }
     }
     if let Some(d) = &x.density {
         let g = &d.grid;

@@ -95,6 +95,11 @@ enum Command {
         /// Machine-readable JSON instead of text.
         #[arg(long)]
         json: bool,
+        /// A TD log whose printed transitions join the file's states (the same molecule, in any
+        /// orientation): each state's natural transition orbitals' weights, and how far its
+        /// electron moves (the hole's and electron's centroid distance D and their overlap Sr).
+        #[arg(long, value_name = "LOG")]
+        transitions: Option<PathBuf>,
     },
     /// Evaluate an orbital or the density at points (bohr in, `x y z value` out). Several files
     /// are fragments whose densities add: --density, --rdg, --sign-lambda2-rho and --laplacian
@@ -939,7 +944,7 @@ fn dispatch(cli: Cli, later: &[quantities::Later]) -> Result<()> {
         None => Ok(crate::app::run(cli.files, cli.demo.map(DemoArg::demo))?),
         Some(Command::Viewer { files, demo }) => Ok(crate::app::run(files, demo.map(DemoArg::demo))?),
         Some(Command::Render(args)) => render::render(args, later),
-        Some(Command::Info { file, json }) => values::info(&file, json),
+        Some(Command::Info { file, json, transitions }) => values::info(&file, json, transitions.as_deref()),
         Some(Command::Eval { files, what, points, minus }) => values::eval(&files, &what, &points, minus.as_deref()),
         Some(Command::Cube { file, what, grid, spacing, margin, minus, output }) => {
             values::cube(&file, &what, (grid, spacing, margin), minus.as_deref(), &output)

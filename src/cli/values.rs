@@ -15,9 +15,17 @@ use glam::DVec3;
 
 use super::{WhatArgs, wavefunction_of};
 
-/// `info`: what `file` holds, as text or JSON.
-pub fn info(file: &Path, json: bool) -> Result<()> {
-    let doc = formats::load(file)?;
+/// `info`: what `file` holds, as text or JSON; with `transitions`, a TD log's printed
+/// transitions joined to its states ([`crate::model::Document::join`]).
+pub fn info(file: &Path, json: bool, transitions: Option<&Path>) -> Result<()> {
+    let mut doc = formats::load(file)?;
+    if let Some(log) = transitions {
+        let other = formats::load(log)?;
+        if !other.carries_transitions() {
+            anyhow::bail!("{}: it lists no excited states' transitions to join {}", log.display(), file.display());
+        }
+        doc.join(other).map_err(anyhow::Error::msg)?;
+    }
     if json {
         println!("{}", serde_json::to_string_pretty(&info::describe(&doc))?);
     } else {

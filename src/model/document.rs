@@ -128,7 +128,7 @@ impl Document {
                     }
                 }
             }
-            self.problems.extend(other.problems);
+            // The log's own problems (it has no orbitals to draw) are not this document's.
             return Ok(self.volumes.len());
         }
         if !self.same_atoms(&other) {
