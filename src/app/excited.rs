@@ -246,12 +246,15 @@ impl super::OrbApp {
             return;
         };
         let Some(made) = ntos.document(&doc) else { return };
-        // One state's NTOs at a time: the ones shown before go.
+        // One state's NTOs at a time: the ones shown before go (the file moves down when they
+        // stood before it).
         let before = format!("{} (state ", doc.source);
+        let mut n = n;
         if let Some(old) = self.objects.iter().position(|o| o.doc.source.starts_with(&before)) {
             self.remove_object(old);
+            n -= usize::from(old < n);
         }
-        let Some(parent) = self.objects.iter_mut().find(|o| o.doc.source == doc.source) else { return };
+        let Some(parent) = self.objects.get_mut(n) else { return };
         parent.state.visible = false;
         let defaults = self.defaults;
         let mut shown = crate::scene::ObjectState {
@@ -282,9 +285,7 @@ impl super::OrbApp {
         }
         self.view.panes.linked = true;
         // The file stays the one the panels edit: its states' list picks the next state.
-        if let Some(parent) = self.objects.iter().position(|o| o.doc.source == doc.source) {
-            self.active = parent;
-        }
+        self.active = n;
         self.frame_panes();
         self.status = format!(
             "state {}: natural transition orbitals of the printed amplitudes (Σc² {:.4}), weights {}; the \

@@ -488,15 +488,20 @@ impl Viewport {
         };
         let (Source::Scan(slot), Some(keys)) = (q.source, self.scan_keys.get(&n).cloned()) else { return };
         keys.show_view(&self.ctx, self.renderer.layer_mut(&self.ctx, l), slot, scan.value, scan.mode);
-        self.slots[l].computed = Some(Arc::new(keys.values_at(slot, scan.value)));
-        let levels = q.isosurfaces.clone();
-        let computed = self.slots[l].computed.clone();
-        let max_bytes = self.ctx.device.limits().max_buffer_size;
-        self.slots[l].extraction.request(move |_| match computed {
-            Some(grid) => prepared(isosurfaces_within(&grid, &levels, max_bytes)),
-            None => prepared(Default::default()),
-        });
         self.generation += 1;
+        // The values at the value are mixed (a grid per view and value) only while an isosurface
+        // of the view is shown; hiding the last one clears the surfaces once.
+        if !q.wants_grid() {
+            if self.slots[l].computed.take().is_some() {
+                self.slots[l].extraction.request(|_| prepared(Default::default()));
+            }
+            return;
+        }
+        let grid = Arc::new(keys.values_at(slot, scan.value));
+        self.slots[l].computed = Some(grid.clone());
+        let levels = q.isosurfaces.clone();
+        let max_bytes = self.ctx.device.limits().max_buffer_size;
+        self.slots[l].extraction.request(move |_| prepared(isosurfaces_within(&grid, &levels, max_bytes)));
     }
 
     /// Moves object `n` (a scan's frame) to its scan's value: the skeleton in place (`doc` is
@@ -642,19 +647,23 @@ impl Viewport {
                 Err(e) => said.push(Err(format!("{}: {e}", doc.source))),
             }
         }
-        // A scan's isosurfaces are cut at its value: say which.
-        let scan = self.scan_keys.get(&n).zip(state.scan.as_ref());
-        let isosurfaces =
-            scan.map_or("isosurfaces".into(), |(k, s)| format!("isosurfaces at {}", k.coordinate_label(s.value)));
+        // A scan's isosurfaces are cut at its value: say which (when some arrive).
+        let scan = self.scan_keys.get(&n).cloned().zip(state.scan.as_ref());
+        let isosurfaces = || {
+            scan.as_ref()
+                .map_or("isosurfaces".into(), |(k, s)| format!("isosurfaces at {}", k.coordinate_label(s.value)))
+        };
         for l in self.layers_of(n) {
-            let what = if self.parts[l].1 == Part::Atoms { "molecular surface" } else { isosurfaces.as_str() };
-            match self.poll_meshes(l) {
+            let atoms = self.parts[l].1 == Part::Atoms;
+            let meshes = self.poll_meshes(l);
+            let what = || if atoms { "molecular surface".to_string() } else { isosurfaces() };
+            match meshes {
                 Some(Ok((0, _))) | None => {}
-                Some(Ok((triangles, note))) => said
-                    .push(Ok(note.map_or(format!("{what}: {triangles} triangles"), |note| {
-                        format!("{note}: {triangles} triangles")
-                    }))),
-                Some(Err(e)) => said.push(Err(format!("{}: {what}: {e}", doc.source))),
+                Some(Ok((triangles, note))) => said.push(Ok(note.map_or_else(
+                    || format!("{}: {triangles} triangles", what()),
+                    |note| format!("{note}: {triangles} triangles"),
+                ))),
+                Some(Err(e)) => said.push(Err(format!("{}: {}: {e}", doc.source, what()))),
             }
         }
         (said, evaluated)
@@ -878,14 +887,15 @@ impl Viewport {
             twisted = self.twist(&response, layout, &view.panes.camera(under, &view.camera), t);
             twisted.pane = under;
         }
-        if self.twisting {
-            // The drag moves the coordinate, not the camera.
-        } else if view.panes.linked || under == 0 {
-            handle_input(ui, &response, view, None);
-        } else {
-            let mut own = ViewState { camera: view.panes.cameras[under], ..*view };
-            handle_input(ui, &response, &mut own, None);
-            view.panes.cameras[under] = own.camera;
+        // A drag that moves a scan's coordinate does not move the camera.
+        if !self.twisting {
+            if view.panes.linked || under == 0 {
+                handle_input(ui, &response, view, None);
+            } else {
+                let mut own = ViewState { camera: view.panes.cameras[under], ..*view };
+                handle_input(ui, &response, &mut own, None);
+                view.panes.cameras[under] = own.camera;
+            }
         }
         let ppp = ui.ctx().pixels_per_point();
         let shown = [(width * ppp).round().max(1.0) as u32, (rect.height() * ppp).round().max(1.0) as u32];

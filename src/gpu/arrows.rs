@@ -5,10 +5,9 @@
 use std::sync::Arc;
 
 use bytemuck::{Pod, Zeroable};
-use wgpu::util::DeviceExt;
 
 use super::GpuContext;
-use super::frame::{Draw, Phase, Prepare};
+use super::frame::{Draw, Phase, Prepare, opaque_storage_bind_group};
 use crate::model::arrow::Arrow;
 
 /// Mirror of `Arrow` in arrows.wgsl.
@@ -87,19 +86,8 @@ impl ArrowsPass {
             return;
         }
         let data: Vec<GpuArrow> = arrows.iter().map(GpuArrow::from).collect();
-        let buffer = ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("arrows"),
-            contents: bytemuck::cast_slice(&data),
-            usage: wgpu::BufferUsages::STORAGE,
-        });
-        let bind = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("arrows bind group"),
-            layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: self.uniforms.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: buffer.as_entire_binding() },
-            ],
-        });
+        let bytes = bytemuck::cast_slice(&data);
+        let bind = opaque_storage_bind_group(&ctx.device, &self.layout, &self.uniforms, "arrows", bytes);
         self.arrows = Some((bind, data.len() as u32));
     }
 

@@ -395,6 +395,31 @@ pub fn opaque_storage_pipeline(
     (pipeline, layout)
 }
 
+/// The bind group of an [`opaque_storage_pipeline`]: `uniforms` at binding 0 and a new storage
+/// buffer of `contents` at binding 1.
+pub fn opaque_storage_bind_group(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    uniforms: &wgpu::Buffer,
+    label: &str,
+    contents: &[u8],
+) -> wgpu::BindGroup {
+    use wgpu::util::DeviceExt;
+    let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents,
+        usage: wgpu::BufferUsages::STORAGE,
+    });
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(&format!("{label} bind group")),
+        layout,
+        entries: &[
+            wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 1, resource: buffer.as_entire_binding() },
+        ],
+    })
+}
+
 /// Depth state of opaque geometry: tested and written.
 pub fn opaque_depth() -> wgpu::DepthStencilState {
     wgpu::DepthStencilState {

@@ -5,10 +5,9 @@ use std::sync::Arc;
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
-use wgpu::util::DeviceExt;
 
 use super::GpuContext;
-use super::frame::{Draw, Phase, Prepare};
+use super::frame::{Draw, Phase, Prepare, opaque_storage_bind_group};
 
 /// Mirror of `LineUniforms` in plane_frame.wgsl.
 #[repr(C)]
@@ -49,19 +48,8 @@ impl PlaneFramePass {
             return;
         }
         let data: Vec<[f32; 8]> = lines.iter().map(|[a, b]| [a.x, a.y, a.z, 1.0, b.x, b.y, b.z, 1.0]).collect();
-        let buffer = ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("plane frame segments"),
-            contents: bytemuck::cast_slice(&data),
-            usage: wgpu::BufferUsages::STORAGE,
-        });
-        let bind = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("plane frame bind group"),
-            layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: self.uniforms.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: buffer.as_entire_binding() },
-            ],
-        });
+        let bytes = bytemuck::cast_slice(&data);
+        let bind = opaque_storage_bind_group(&ctx.device, &self.layout, &self.uniforms, "plane frame segments", bytes);
         self.segments = Some((bind, data.len() as u32));
     }
 
