@@ -22,6 +22,7 @@ use crate::sources::demo;
 use anyhow::{Context, Result, bail};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
+mod bench_orbital;
 mod bench_scene;
 mod compute;
 pub mod info;
@@ -540,6 +541,8 @@ enum BenchCommand {
     /// ms to evaluate a wavefunction's NCI field on a grid, on the CPU and by the GPU pass of
     /// the density's derivatives.
     Nci(nci::NciBench),
+    /// Grid points per second of an orbital evaluated on the CPU and by the GPU's fill pass.
+    Orbital(bench_orbital::OrbitalBench),
 }
 
 #[derive(Args)]
@@ -964,6 +967,7 @@ fn dispatch(cli: Cli, later: &[quantities::Later]) -> Result<()> {
         Some(Command::Bench(BenchCommand::Surface(args))) => molsurface::bench(&args),
         Some(Command::Bench(BenchCommand::Scene(args))) => bench_scene::bench(&args),
         Some(Command::Bench(BenchCommand::Nci(args))) => nci::bench(&args),
+        Some(Command::Bench(BenchCommand::Orbital(args))) => bench_orbital::bench(&args),
         Some(Command::Bench(BenchCommand::Render { file, view, frames, lavapipe, wavefunction })) => {
             render::bench(file.as_deref(), &view, frames, lavapipe, &wavefunction)
         }
