@@ -776,6 +776,36 @@ fn blue_green(img: &image::RgbaImage) -> usize {
 }
 
 #[test]
+fn a_structures_nci_surface_between_a_selection_and_the_rest_shows_its_hydrogen_bond() {
+    let mut h = open(vec![fixture("nci/water_dimer.pdb")]);
+    let dir = tempfile::tempdir().unwrap();
+    let before = blue_green(&picture(&mut h, dir.path(), "atoms"));
+    h.state_mut().nci_between = "resn LIG".into();
+    h.get_by_label("NCI surface").click();
+    h.run_steps(3);
+    wait_loaded(&mut h);
+    let q = h.state().objects[0].state.selected_quantity().expect("the NCI surface is selected").clone();
+    assert_eq!(q.source, Source::Promolecular(Quantity::NciGradient));
+    assert_eq!(q.between.as_deref(), Some("resn LIG"));
+    assert_eq!(q.isosurfaces[0].color_by, Some(Source::Promolecular(Quantity::SignLambda2Rho)));
+    let disc = blue_green(&picture(&mut h, dir.path(), "nci"));
+    eprintln!("blue-green pixels: {before} with the atoms, {disc} with the NCI surface");
+    assert!(disc > 30 && disc > 5 * before.max(1), "the hydrogen bond's disc: {disc} pixels");
+    // Its plot: the hydrogen bond's spike of low s at negative sign(λ₂)ρ.
+    let start = std::time::Instant::now();
+    while h.state().nci_plot.points.is_empty() {
+        assert!(start.elapsed().as_secs() < 300, "no NCI plot: {:?}", h.state().nci_plot.error);
+        std::thread::sleep(std::time::Duration::from_millis(50));
+        h.run_steps(1);
+    }
+    let points = h.state().nci_plot.points.clone();
+    let lowest = |range: std::ops::Range<f64>| {
+        points.iter().filter(|p| range.contains(&p[0])).map(|p| p[1]).fold(f64::INFINITY, f64::min)
+    };
+    assert!(lowest(-0.05..-0.005) < 0.5, "lowest s at the hydrogen bond: {:.2}", lowest(-0.05..-0.005));
+}
+
+#[test]
 fn a_water_dimer_s_nci_surface_shows_its_hydrogen_bond_in_blue_green() {
     let mut h = open(vec![fixture("nci/water_dimer_631gs.molden")]);
     wait_loaded(&mut h);

@@ -271,6 +271,8 @@ pub struct OrbApp {
     pub plane: plane_pane::PlanePane,
     /// The NCI plot below the view, while an NCI surface is the selected quantity.
     pub nci_plot: nci_plot::NciPlot,
+    /// The selection a structure's NCI surface is asked between (and the rest); empty: all atoms.
+    pub nci_between: String,
     pub computing: Option<compute::ComputeRun>,
     /// The *Compute orbitals* window: the object and the level of theory.
     pub orbitals_dialog: Option<(usize, crate::sources::compute::Settings)>,
@@ -442,6 +444,7 @@ impl OrbApp {
                 let repaint = cc.egui_ctx.clone();
                 plane_pane::PlanePane::new(move || repaint.request_repaint())
             },
+            nci_between: String::new(),
             nci_plot: {
                 let repaint = cc.egui_ctx.clone();
                 nci_plot::NciPlot::new(move || repaint.request_repaint())
@@ -483,7 +486,7 @@ impl OrbApp {
             crate::scene::Source::Wavefunction(
                 crate::model::orbitals::Quantity::Orbital(_) | crate::model::orbitals::Quantity::BasisFunction(_),
             ) => true,
-            crate::scene::Source::Wavefunction(_) => false,
+            crate::scene::Source::Wavefunction(_) | crate::scene::Source::Promolecular(_) => false,
             crate::scene::Source::Volume(_) | crate::scene::Source::Scan(_) => true,
         };
         // Direct mode without a grid: the σ of its samples over the same box.
@@ -972,7 +975,7 @@ impl OrbApp {
 
     /// Frames the active object's ρ = 0.002 surface (its atoms padded by the surface's reach)
     /// in the part of the view its colour bar leaves free, looking as the view does.
-    fn frame_beside_bar(&mut self) {
+    pub(crate) fn frame_beside_bar(&mut self) {
         // The 0.002 a.u. density surface lies about a van der Waals radius beyond the nuclei.
         const REACH: f32 = 3.8;
         let (Some(o), Some(vp)) = (self.objects.get(self.active), &self.viewport) else { return };
@@ -983,10 +986,7 @@ impl OrbApp {
         let camera = &mut self.view.camera;
         let free = ((rect.width() - legend::BAR_ROOM) / rect.width().max(1.0)).clamp(0.3, 1.0);
         camera.fit_exactly(&atoms, aspect * free, REACH);
-        // The framed scene's centre moves to the middle of the free part, left of the bar.
-        let (right, _) = camera.screen_axes();
-        let world_per_point = 2.0 * camera.distance * (0.5 * camera.fov_y).tan() / rect.height().max(1.0);
-        camera.target += right * (0.5 * legend::BAR_ROOM * world_per_point);
+        camera.leave_room_right(legend::BAR_ROOM, [rect.width(), rect.height()], true);
     }
 
     /// A camera that frames every object where it is placed, looking at the first one as a new
@@ -1193,8 +1193,7 @@ impl OrbApp {
         if let Some(o) = self.objects.get_mut(self.active).filter(|o| o.scan.is_none()) {
             // The surface's point under the pointer, in the object's own frame, marked on the plot.
             let active = self.active as u32;
-            let nci = crate::scene::Source::Wavefunction(crate::model::orbitals::Quantity::NciGradient);
-            let shows_nci = o.state.selected_quantity().is_some_and(|q| q.source == nci);
+            let shows_nci = o.state.selected_quantity().is_some_and(|q| nci_plot::is_nci_surface(q.source));
             let hovered = (self.viewport.as_ref().filter(|_| shows_nci))
                 .and_then(|vp| vp.hovered_surface_point(&self.view.camera))
                 .filter(|&(object, _)| object == active)

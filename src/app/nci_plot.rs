@@ -66,11 +66,17 @@ impl NciPlot {
             return;
         }
         self.hovered_at = at;
-        self.hovered = at.zip(doc.wavefunction.as_ref()).map(|(p, wf)| {
-            let mut d = [nci::DensityDerivatives::default()];
-            nci::WavefunctionDensity::new(wf).derivatives_at(&[p.as_dvec3()], &mut d);
-            [d[0].sign_lambda2_rho(), d[0].reduced_gradient()]
+        // The wavefunction's density, or a structure's spherical atoms.
+        let at = at.map(|p| p.as_dvec3());
+        let d = at.and_then(|p| match &doc.wavefunction {
+            Some(wf) => {
+                let mut d = [nci::DensityDerivatives::default()];
+                nci::WavefunctionDensity::new(wf).derivatives_at(&[p], &mut d);
+                Some(d[0])
+            }
+            None => crate::evaluate::promolecular::derivatives_at(doc, p),
         });
+        self.hovered = d.map(|d| [d.sign_lambda2_rho(), d.reduced_gradient()]);
     }
 
     /// Whether its points are being made.
@@ -81,11 +87,15 @@ impl NciPlot {
     /// Shows the plot when `quantity`, of `doc`, is an NCI surface; a drag across it sets the
     /// surface's colour window.
     pub fn panel(&mut self, ui: &mut egui::Ui, doc: &Document, quantity: Option<&mut QuantityState>) {
-        let Some(q) = quantity.filter(|q| q.source == Source::Wavefunction(Quantity::NciGradient)) else {
+        let Some(q) = quantity.filter(|q| is_nci_surface(q.source)) else {
             self.transform = None;
             return;
         };
-        self.refresh(doc);
+        self.refresh(doc, q);
+        let cut = match q.source {
+            Source::Promolecular(_) => nci::PROMOLECULAR_DENSITY_CUT,
+            _ => WAVEFUNCTION_DENSITY_CUT,
+        };
         let Some(iso) = q.isosurfaces.first_mut() else { return };
         egui::Panel::bottom("nci plot").exact_size(HEIGHT).show(ui, |ui| {
             ui.horizontal(|ui| {
@@ -93,7 +103,7 @@ impl NciPlot {
                 let how = match (&self.error, self.job.is_busy()) {
                     (Some(e), _) => e.clone(),
                     (None, true) => "computing s and sign(λ₂)ρ on a grid…".to_string(),
-                    (None, false) => format!("{} points with ρ < {WAVEFUNCTION_DENSITY_CUT}", self.points.len()),
+                    (None, false) => format!("{} points with ρ < {cut}", self.points.len()),
                 };
                 ui.label(RichText::new(how).small().weak());
                 if iso.color_window.is_some() && ui.small_button("show all").clicked() {
@@ -154,35 +164,51 @@ impl NciPlot {
         });
     }
 
-    /// Starts making the points when they were made for another document; takes them when made.
-    fn refresh(&mut self, doc: &Document) {
+    /// Starts making the points when they were made for another document or surface; takes
+    /// them when made.
+    fn refresh(&mut self, doc: &Document, q: &QuantityState) {
         if let Some(result) = self.job.poll() {
             match result.and_then(|r| r) {
                 Ok(points) => (self.points, self.error) = (points, None),
                 Err(e) => (self.points, self.error) = (Vec::new(), Some(e)),
             }
         }
-        if self.made_for.as_deref() == Some(doc.source.as_str()) {
+        let key = format!("{} {:?} {:?}", doc.source, q.source, q.between);
+        if self.made_for.as_deref() == Some(key.as_str()) {
             return;
         }
-        self.made_for = Some(doc.source.clone());
+        self.made_for = Some(key);
         self.points.clear();
-        let doc = doc.clone();
-        self.job.request(move |_| plot_points(&doc));
+        let (doc, source, between) = (doc.clone(), q.source, q.between.clone());
+        self.job.request(move |_| plot_points(&doc, source, between.as_deref()));
     }
 }
 
-/// (sign(λ₂)ρ, s) at the points of a grid over `doc`'s density where ρ is below the cut and s
-/// below [`TOP_S`].
-pub fn plot_points(doc: &Document) -> Result<Vec<[f64; 2]>, String> {
-    let wf = doc.wavefunction.as_ref().ok_or("an NCI plot needs a wavefunction")?;
-    let (lo, hi) = quantity_box(wf, &doc.molecule, Quantity::Density).ok_or("the molecule has no atoms")?;
-    let grid = GridSpec::cubic_voxels(lo, hi, PLOT_POINTS);
-    let density = WavefunctionDensity::new(wf);
-    // Every s kept (the plot's own top cuts it): NCIPLOT's s > 1 cut is for its cubes.
-    let settings =
-        NciSettings { density_cut: WAVEFUNCTION_DENSITY_CUT, rdg_cut: nci::CUT_VALUE as f64, intermolecular: None };
-    let grids = nci::nci_grid(&[&density], &grid, settings);
+/// Whether `source` is an NCI surface's: a wavefunction's, or a structure's spherical atoms'.
+pub fn is_nci_surface(source: Source) -> bool {
+    matches!(source, Source::Wavefunction(Quantity::NciGradient) | Source::Promolecular(Quantity::NciGradient))
+}
+
+/// (sign(λ₂)ρ, s) at the points of a grid over the density of `source` (a wavefunction's, or
+/// the spherical atoms' between the parts `between` makes) where ρ is below the cut and s below
+/// [`TOP_S`].
+pub fn plot_points(doc: &Document, source: Source, between: Option<&str>) -> Result<Vec<[f64; 2]>, String> {
+    let grids = match source {
+        Source::Promolecular(_) => crate::evaluate::promolecular::nci_grids(doc, between, PLOT_POINTS)?,
+        _ => {
+            let wf = doc.wavefunction.as_ref().ok_or("an NCI plot needs a wavefunction")?;
+            let (lo, hi) = quantity_box(wf, &doc.molecule, Quantity::Density).ok_or("the molecule has no atoms")?;
+            let grid = GridSpec::cubic_voxels(lo, hi, PLOT_POINTS);
+            let density = WavefunctionDensity::new(wf);
+            // Every s kept (the plot's own top cuts it): NCIPLOT's s > 1 cut is for its cubes.
+            let settings = NciSettings {
+                density_cut: WAVEFUNCTION_DENSITY_CUT,
+                rdg_cut: nci::CUT_VALUE as f64,
+                intermolecular: None,
+            };
+            nci::nci_grid(&[&density], &grid, settings)
+        }
+    };
     Ok((grids.dens.iter().zip(&grids.grad))
         .filter(|&(&d, &s)| d != nci::CUT_VALUE && f64::from(s) < TOP_S)
         .map(|(&d, &s)| [f64::from(d) / 100.0, f64::from(s)])

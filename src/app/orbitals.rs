@@ -259,7 +259,7 @@ fn add(state: &mut ObjectState, q: Quantity, defaults: &RenderSettings) {
 fn shown_quantity(state: &ObjectState) -> Option<Quantity> {
     match state.selected_quantity()?.source {
         Source::Wavefunction(q) => Some(q),
-        Source::Volume(_) | Source::Scan(_) => None,
+        Source::Volume(_) | Source::Scan(_) | Source::Promolecular(_) => None,
     }
 }
 

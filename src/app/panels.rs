@@ -256,6 +256,7 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
                         let gradient = matches!(
                             q.source,
                             Source::Wavefunction(Quantity::ReducedGradient | Quantity::NciGradient)
+                                | Source::Promolecular(Quantity::ReducedGradient | Quantity::NciGradient)
                         );
                         let levels = LevelsOf { signed: grid_signed, sigma: grid_sigma, gradient };
                         isosurfaces_editor(ui, &mut q.isosurfaces, levels, &colors);
@@ -305,6 +306,7 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
             if bare.is_some() && ui.button("Compute orbitals…").on_hover_text("with PySCF").clicked() {
                 app.orbitals_dialog = Some((app.active, crate::sources::compute::Settings::default()));
             }
+            promolecular_nci(ui, app);
 
             ui.separator();
             ui.collapsing("Atoms in file", |ui| {
@@ -348,6 +350,38 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
         });
         });
     app.view.panels.scene = open;
+}
+
+/// A structure without a wavefunction offers the NCI surface of its spherical atoms: of all of
+/// them, or between the atoms a selection picks (a ligand) and the rest (its pocket).
+fn promolecular_nci(ui: &mut egui::Ui, app: &mut OrbApp) {
+    let Some(o) = app.objects.get_mut(app.active) else { return };
+    if o.scan.is_some() || o.doc.wavefunction.is_some() || o.doc.molecule.atoms.is_empty() {
+        return;
+    }
+    ui.separator();
+    ui.label(RichText::new("Non-covalent interactions").strong());
+    ui.horizontal(|ui| {
+        let label = ui.label("between");
+        let edit = egui::TextEdit::singleline(&mut app.nci_between)
+            .hint_text("resn LIG (empty: all atoms)")
+            .desired_width(150.0);
+        ui.add(edit)
+            .labelled_by(label.id)
+            .on_hover_text("the atoms this selection picks and all the others: a ligand and its pocket");
+        ui.label("and the rest");
+    });
+    let hint = "the reduced density gradient of the spherical atoms (s = 0.3 where ρ < 0.07), coloured by \
+                sign(λ₂)ρ: blue hydrogen bonds, green van der Waals contacts, red steric clashes";
+    if !ui.button("NCI surface").on_hover_text(hint).clicked() {
+        return;
+    }
+    let between = Some(app.nci_between.trim().to_string()).filter(|b| !b.is_empty());
+    let state = &mut o.state;
+    state.quantities.iter_mut().for_each(|q| q.visible = false);
+    state.quantities.push(crate::scene::QuantityState::promolecular_nci(&app.defaults, between));
+    state.selected = state.quantities.len() - 1;
+    app.frame_beside_bar();
 }
 
 /// *minus*: another open file whose same quantity is subtracted from this one, as a new data

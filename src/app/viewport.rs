@@ -446,6 +446,18 @@ impl Viewport {
                 });
                 Ok(None)
             }
+            Source::Promolecular(quantity) => {
+                let (doc, between, points) = (doc.clone(), q.between.clone(), state.evaluation.grid_points);
+                self.slots[l].evaluation.request(move |_| {
+                    // What cannot be made (an element without an atomic density, a selection that
+                    // picks no atom) is said, and nothing is shown.
+                    Ok(match crate::evaluate::promolecular::grid(&doc, quantity, between.as_deref(), points) {
+                        Ok(grid) => (Some(Evaluated::of_values(grid)), crate::evaluate::promolecular::note(&doc)),
+                        Err(why) => (None, Some(why)),
+                    })
+                });
+                Ok(None)
+            }
         }
     }
 
@@ -530,7 +542,7 @@ impl Viewport {
         let doc = doc.clone();
         let volume = match q.source {
             Source::Volume(i) => Some(i),
-            Source::Wavefunction(_) | Source::Scan(_) => None,
+            Source::Wavefunction(_) | Source::Scan(_) | Source::Promolecular(_) => None,
         };
         let levels = q.isosurfaces.clone();
         let max_bytes = self.ctx.device.limits().max_buffer_size;
@@ -568,7 +580,7 @@ impl Viewport {
         let shown = self.layer_of(n, Part::Quantity(state.selected)).and_then(|q| self.slots[q].computed.clone());
         let volume = state.selected_quantity().and_then(|q| match q.source {
             Source::Volume(i) => Some(i),
-            Source::Wavefunction(_) | Source::Scan(_) => None,
+            Source::Wavefunction(_) | Source::Scan(_) | Source::Promolecular(_) => None,
         });
         let slot = &self.slots[l];
         let (cache, progress) = (slot.surface.clone(), slot.surface_progress.clone());
@@ -718,7 +730,7 @@ impl Viewport {
     ) -> Option<&'a VolumeGrid> {
         match state.quantities.get(k)?.source {
             Source::Volume(i) => doc.volumes.get(i),
-            Source::Wavefunction(_) | Source::Scan(_) => self.computed_grid(n, k),
+            Source::Wavefunction(_) | Source::Scan(_) | Source::Promolecular(_) => self.computed_grid(n, k),
         }
     }
 

@@ -575,8 +575,8 @@ struct RenderArgs {
     /// The NCI surface as the viewer draws it (Johnson et al., 2010): the reduced density
     /// gradient's surface s = 0.5 where ρ ≤ 0.05 a.u., opaque, coloured by sign(λ₂)ρ from blue
     /// (−0.05, attraction: hydrogen bonds) through green (van der Waals) to red (+0.05,
-    /// repulsion), with its colour bar. Needs a wavefunction (`orbcloud nci --promolecular`
-    /// writes the cubes of a structure's spherical atoms).
+    /// repulsion), with its colour bar. A structure without a wavefunction (PDB, mmCIF, XYZ)
+    /// shows that of its spherical atoms (the promolecular density, s = 0.3 where ρ ≤ 0.07).
     #[arg(long, conflicts_with_all = NCI_CONFLICTS)]
     nci: bool,
     /// The reduced density gradient the NCI surface is drawn at, 0.01 to 2 (default 0.5).
@@ -585,6 +585,11 @@ struct RenderArgs {
     /// The |sign(λ₂)ρ| (a.u.) where the NCI surface's colours saturate, 0.001 to 1 (default 0.05).
     #[arg(long, value_name = "R", requires = "nci", value_parser = within(limits::NCI_RANGE))]
     nci_range: Option<f32>,
+    /// A structure's NCI between the atoms this selection picks and all the others, e.g. a
+    /// ligand and its pocket: `resn LIG` (also `chain A`, `resi 30-50`, `not …`). The surface is drawn
+    /// around the selection where neither part holds 95 % of the density.
+    #[arg(long, value_name = "SELECTION", requires = "nci")]
+    nci_between: Option<String>,
     /// Render a bundled demo scene instead of a file (cycloaddition: several objects).
     #[arg(long, value_enum)]
     demo: Option<DemoArg>,

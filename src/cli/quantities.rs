@@ -125,7 +125,10 @@ pub fn split(args: Vec<OsString>) -> Result<(Vec<OsString>, Vec<Later>)> {
 pub fn quantity(args: &RenderArgs, doc: &Document) -> Result<Option<QuantityState>> {
     if args.nci {
         check_nci(args, doc)?;
-        let mut q = QuantityState::nci_surface(&args.view.settings());
+        let mut q = match doc.wavefunction {
+            Some(_) => QuantityState::nci_surface(&args.view.settings()),
+            None => QuantityState::promolecular_nci(&args.view.settings(), args.nci_between.clone()),
+        };
         for iso in &mut q.isosurfaces {
             if let Some(level) = args.nci_level {
                 iso.level = IsoLevel::Absolute(level);
@@ -142,15 +145,24 @@ pub fn quantity(args: &RenderArgs, doc: &Document) -> Result<Option<QuantityStat
 /// `--nci` refused for a file without a wavefunction: the surface is cut from its density's
 /// derivatives.
 pub fn check_nci(args: &RenderArgs, doc: &Document) -> Result<()> {
-    if args.nci && doc.wavefunction.is_none() {
-        bail!(
-            "{}: --nci needs a wavefunction (Molden, fchk, wfn, wfx or MKL), and this file has none: `orbcloud nci {} --promolecular -o PREFIX` writes NCIPLOT's cubes of its spherical atoms, `orbcloud compute {}` computes a wavefunction with PySCF",
-            doc.source,
-            doc.source,
-            doc.source
-        );
+    if !args.nci {
+        return Ok(());
     }
-    Ok(())
+    match (&doc.wavefunction, &args.nci_between) {
+        (Some(_), Some(_)) => bail!(
+            "{}: --nci-between splits a structure's spherical atoms, and this file has a wavefunction: `orbcloud nci A B --intermolecular -o PREFIX` keeps what lies between the wavefunctions of two fragments' files",
+            doc.source
+        ),
+        (Some(_), None) => Ok(()),
+        // A structure's NCI comes from its spherical atoms.
+        (None, between) => {
+            crate::evaluate::promolecular::check(doc, between.as_deref()).map_err(anyhow::Error::msg)?;
+            if let Some(note) = crate::evaluate::promolecular::note(doc) {
+                eprintln!("{note}");
+            }
+            Ok(())
+        }
+    }
 }
 
 /// The quantity `what` names (or the data set `view` picks) with `view`'s cloud and `iso`'s
@@ -274,8 +286,14 @@ pub fn render(
         let points = first.wavefunction.grid_points.clamp(8, 512);
         let shown = show_scene(ctx, &mut renderer, &pane_scene, points)?;
         let target = OffscreenTarget::new(&ctx.device, [pane_width, height]);
+        // A lone picture with a colour bar is framed left of it, as the window frames maps.
+        let mut camera = *camera;
+        if let (Some((map, name)), 1) = (&shown.color_map, count) {
+            let room = crate::pictures::shots::value_bar_width(height, map, name);
+            camera.leave_room_right(room, [pane_width as f32, height as f32], false);
+        }
         let (mut picture, _) =
-            crate::pictures::headless::picture(ctx, &mut renderer, &target, camera, background, &shown.clouds)?;
+            crate::pictures::headless::picture(ctx, &mut renderer, &target, &camera, background, &shown.clouds)?;
         if let Some((map, name)) = &shown.color_map {
             crate::pictures::shots::value_bar(&mut picture, map, name);
         }

@@ -20,7 +20,7 @@ pub fn counterpart(doc: &Document, source: Source, other: &Document) -> Option<S
     };
     let own = match source {
         Source::Wavefunction(q) if density_like(q) => Some(q),
-        Source::Wavefunction(_) | Source::Scan(_) => return None,
+        Source::Wavefunction(_) | Source::Scan(_) | Source::Promolecular(_) => return None,
         Source::Volume(i) if i < doc.volumes.len() => None,
         Source::Volume(_) => return None,
     };
@@ -75,6 +75,7 @@ pub fn difference(doc: &Document, source: Source, points: usize, other: &Documen
         }
         (Source::Wavefunction(_), None) => return Err(format!("{}: no wavefunction", doc.source)),
         (Source::Scan(_), _) => return Err(format!("{}: a scan's orbital changes with its coordinate", doc.source)),
+        (Source::Promolecular(q), _) => super::promolecular::grid(doc, q, None, points)?,
     };
     let at = grid_points(mine.dims, |i, j, k| mine.point(i, j, k));
     let (subtract, _) = values_of(other, theirs, &at)?;

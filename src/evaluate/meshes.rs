@@ -226,6 +226,10 @@ pub fn values_at(doc: &Document, source: Source, points: &[glam::Vec3]) -> Vec<O
             prepared.quantity_at_points(wf, &doc.molecule, q, &points).into_iter().map(Some).collect()
         }
         (Source::Volume(i), _) if i < doc.volumes.len() => sample_grid(points, &doc.volumes[i]),
+        (Source::Promolecular(q), _) => {
+            let points: Vec<glam::DVec3> = points.iter().map(|p| p.as_dvec3()).collect();
+            super::promolecular::values_at(doc, q, &points)
+        }
         _ => vec![None; points.len()],
     }
 }

@@ -6,6 +6,7 @@
 
 pub mod arithmetic;
 pub mod meshes;
+pub mod promolecular;
 
 use crate::gpu::density_hessian::DensityHessianPass;
 use crate::gpu::gto::{GtoFillPass, read_volume, volume_from_texture};
@@ -247,6 +248,11 @@ pub fn evaluate_within(
 }
 
 impl Evaluated {
+    /// Values computed on the CPU, shown as a cloud uploaded from them.
+    pub fn of_values(grid: VolumeGrid) -> Self {
+        Self { values: Values { grid: Some(grid), sampled: None }, cloud: Cloud::Values }
+    }
+
     /// Shows the cloud in `layer`; returns the values behind it.
     pub fn show(self, ctx: &GpuContext, layer: &mut Layer) -> Result<Values, GpuError> {
         match self.cloud {

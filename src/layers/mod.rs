@@ -119,7 +119,7 @@ pub fn show_object(
     let quantity = state.selected_quantity();
     let grid = quantity.and_then(|q| match q.source {
         Source::Volume(i) => doc.volumes.get(i),
-        Source::Wavefunction(_) | Source::Scan(_) => None,
+        Source::Wavefunction(_) | Source::Scan(_) | Source::Promolecular(_) => None,
     });
     layer.set_volume(ctx, grid)?;
     let meshes: Vec<_> = match (grid, quantity) {
@@ -170,6 +170,18 @@ pub fn show_quantity(
         }
         // Its key volumes live with the window's scan ([`key_volumes::ScanScene`]).
         Source::Scan(_) => None,
+        Source::Promolecular(quantity) => {
+            match crate::evaluate::promolecular::grid(doc, quantity, q.between.as_deref(), state.evaluation.grid_points) {
+                Ok(grid) => {
+                    layer.set_volume(ctx, Some(&grid))?;
+                    Some(Values { grid: Some(grid), sampled: None })
+                }
+                Err(why) => {
+                    log::warn!("{why}");
+                    None
+                }
+            }
+        }
     };
     let mut color_map = None;
     if let Some(grid) = values.as_ref().and_then(|v| v.grid.as_ref()) {

@@ -150,9 +150,8 @@ pub fn color_bar(img: &mut RgbaImage, color: impl Fn(f32) -> [u8; 3], ticks: [&s
     let pad = (px * 0.5).ceil();
     let bar_w = (px * 0.8).ceil();
     let bar_h = (h * 0.55).round();
-    let label_w = ticks.iter().map(|t| text_width(t, px)).fold(0.0, f32::max);
     let title_w = text_width(title, px);
-    let panel_w = (label_w + bar_w + 3.0 * pad).max(title_w + 2.0 * pad);
+    let panel_w = color_bar_width(img.height(), ticks, title) - pad;
     let (x0, y0) = (w - panel_w - pad, (h - bar_h) * 0.5 - px * 1.4);
     let panel_h = bar_h + px * 1.4 + px + 2.0 * pad;
     shade(img, x0 as i64, (y0 - pad) as i64, panel_w.ceil() as i64, panel_h.ceil() as i64, [0, 0, 0], 0.55);
@@ -169,6 +168,16 @@ pub fn color_bar(img: &mut RgbaImage, color: impl Fn(f32) -> [u8; 3], ticks: [&s
         let y = bar_top + bar_h * (1.0 - n as f32 * 0.5) - px * 0.6;
         draw_text(img, tick, bar_x - pad * 0.6 - text_width(tick, px), y, px, [235, 235, 235]);
     }
+}
+
+/// How much of an image `height` pixels tall [`color_bar`] covers from its right edge, its
+/// margin included (pixels): what a picture's framing leaves free for it.
+pub fn color_bar_width(height: u32, ticks: [&str; 3], title: &str) -> f32 {
+    let px = caption_px(height);
+    let pad = (px * 0.5).ceil();
+    let bar_w = (px * 0.8).ceil();
+    let label_w = ticks.iter().map(|t| text_width(t, px)).fold(0.0, f32::max);
+    (label_w + bar_w + 3.0 * pad).max(text_width(title, px) + 2.0 * pad) + pad
 }
 
 /// sRGB-encoded byte to linear light.

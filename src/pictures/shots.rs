@@ -213,6 +213,12 @@ impl<D: std::borrow::Borrow<Document>> SceneShots<D> {
 
 /// The colour bar of a surface coloured by a volume's values, at the right of `img`: the map's
 /// range, in atomic units, titled with the volume's name.
+/// The width [`value_bar`] covers at the right of an image `height` pixels tall.
+pub fn value_bar_width(height: u32, map: &ValueMap, name: &str) -> f32 {
+    let [lo, mid, hi] = map.ticks();
+    crate::pictures::figure::color_bar_width(height, [&lo, &mid, &hi], &ValueMap::title(name))
+}
+
 pub fn value_bar(img: &mut image::RgbaImage, map: &ValueMap, name: &str) {
     let color = |t: f32| map.at(t).map(crate::pictures::figure::encoded);
     let [lo, mid, hi] = map.ticks();

@@ -79,6 +79,21 @@ impl Camera {
         self.fit_points(points.iter().copied(), aspect, margin);
     }
 
+    /// Moves what the view frames into the part of a view `size` pixels (width, height) that a
+    /// bar `room` pixels wide at its right edge leaves free: centred there, and stood back by
+    /// how much narrower that part is (`fitted`: the framing already fits that part; only the
+    /// centre moves).
+    pub fn leave_room_right(&mut self, room: f32, size: [f32; 2], fitted: bool) {
+        let [width, height] = size.map(|s| s.max(1.0));
+        let free = ((width - room) / width).clamp(0.3, 1.0);
+        if !fitted {
+            self.distance /= free;
+        }
+        let (right, _) = self.screen_axes();
+        let world_per_pixel = 2.0 * self.distance * (0.5 * self.fov_y).tan() / height;
+        self.target += right * (0.5 * room * world_per_pixel);
+    }
+
     /// Unit vector from the target towards the eye.
     pub fn backward(&self) -> Vec3 {
         let (sy, cy) = self.yaw.sin_cos();

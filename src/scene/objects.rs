@@ -307,8 +307,13 @@ pub fn changes(before: &ObjectState, after: &ObjectState) -> Changes {
                 let (was, now) = (&a.cloud, &b.cloud);
                 // Direct mode fills a grid only for isosurfaces: showing the first asks for one.
                 let grid = wavefunction && after.evaluation.direct && b.wants_grid() && !a.wants_grid();
+                let promolecular = matches!(b.source, Source::Promolecular(_));
+                let points = before.evaluation.grid_points != after.evaluation.grid_points;
                 QuantityChanges {
-                    values: a.source != b.source || (wavefunction && (evaluation || grid)),
+                    values: a.source != b.source
+                        || a.between != b.between
+                        || (wavefunction && (evaluation || grid))
+                        || (promolecular && points),
                     isosurfaces: a.isosurfaces != b.isosurfaces,
                     opacity: was.k2 != now.k2
                         || was.density_scale != now.density_scale
@@ -372,7 +377,7 @@ impl From<StoredObject> for ObjectState {
             // A file with a wavefunction resolves `Volume` to its first quantity ([`ObjectState::fit_to`]).
             let source = s.quantity.map_or(Source::Volume(s.volume), Source::Wavefunction);
             let isosurfaces = std::iter::once(settings.iso).chain(s.isosurfaces).collect();
-            quantities.push(QuantityState { source, visible: true, cloud: settings.volume, isosurfaces, pane: None });
+            quantities.push(QuantityState { source, visible: true, cloud: settings.volume, isosurfaces, pane: None, between: None });
         }
         let clouds = quantities.iter().map(|q| q.cloud.stored_clip).chain(s.settings.map(|s| s.volume.stored_clip));
         let stored: Vec<ClipPlane> = clouds.flatten().collect();

@@ -20,6 +20,10 @@ pub enum Source {
     /// View `slot` of the scan the document is a frame of ([`Document::scan`]): its orbital at
     /// the object's value, mixed from the two key volumes around it.
     Scan(usize),
+    /// A quantity of the promolecular density (a sum of spherical atoms) of the document's
+    /// atoms, for structures without a wavefunction: the NCI surface's s, the NCI cloud,
+    /// sign(λ₂)ρ or ρ. [`QuantityState::between`] may keep only what lies between two parts.
+    Promolecular(Quantity),
 }
 
 impl Source {
@@ -43,6 +47,7 @@ impl Source {
                 | Quantity::ExcitedDensity => wf.excited.is_some(),
             }),
             Source::Scan(slot) => doc.scan.as_ref().is_some_and(|s| slot < s.orbitals.len()),
+            Source::Promolecular(q) => !doc.molecule.atoms.is_empty() && is_promolecular(q),
         }
     }
 
@@ -52,7 +57,7 @@ impl Source {
     pub fn is_potential(self, doc: &Document) -> bool {
         match self {
             Source::Wavefunction(q) => q == Quantity::Potential,
-            Source::Scan(_) => false,
+            Source::Scan(_) | Source::Promolecular(_) => false,
             Source::Volume(i) => doc.volumes.get(i).is_some_and(|v| {
                 let label = v.label.to_ascii_lowercase();
                 label.contains("potential")
@@ -75,6 +80,12 @@ impl Source {
         match self {
             Source::Volume(i) => doc.volumes.get(i).map_or_else(|| format!("data set {}", i + 1), |v| v.label.clone()),
             Source::Scan(slot) => doc.scan.as_ref().map_or_else(|| format!("view {}", slot + 1), |s| s.slot_name(slot)),
+            Source::Promolecular(Quantity::NciGradient) => "NCI of spherical atoms (s where ρ ≤ 0.07)".into(),
+            Source::Promolecular(Quantity::NciCloud) => "NCI cloud of spherical atoms".into(),
+            // What its colour bar says: the same quantity as a wavefunction's.
+            Source::Promolecular(Quantity::SignLambda2Rho) => "sign(λ₂)ρ".into(),
+            Source::Promolecular(Quantity::ReducedGradient) => "reduced gradient of spherical atoms".into(),
+            Source::Promolecular(_) => "density of spherical atoms".into(),
             Source::Wavefunction(Quantity::Density) => "total density".into(),
             Source::Wavefunction(Quantity::SpinDensity) => "spin density".into(),
             Source::Wavefunction(Quantity::Potential) => "electrostatic potential".into(),
@@ -98,6 +109,19 @@ impl Source {
                 .unwrap_or_else(|| format!("basis function {}", k + 1)),
         }
     }
+}
+
+/// Whether the promolecular density gives `quantity` ([`Source::Promolecular`]): those of
+/// the density and its derivatives that need no wavefunction.
+pub fn is_promolecular(quantity: Quantity) -> bool {
+    matches!(
+        quantity,
+        Quantity::Density
+            | Quantity::ReducedGradient
+            | Quantity::NciGradient
+            | Quantity::NciCloud
+            | Quantity::SignLambda2Rho
+    )
 }
 
 /// "HOMO", "LUMO+2", or "MO 12" away from the frontier; " β" after a beta orbital of an
@@ -131,6 +155,11 @@ pub struct QuantityState {
     /// The pane of a split view it is drawn in (`None`: every pane; past the last pane: the last).
     #[serde(default)]
     pub pane: Option<usize>,
+    /// A promolecular quantity between two parts of the structure: the atoms this selection
+    /// picks (a ligand: `resn LIG`) and all the others (its pocket). Only the points where
+    /// neither part holds almost all of the density are kept (NCIPLOT's intermolecular mode).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub between: Option<String>,
 }
 
 fn yes() -> bool {
@@ -141,7 +170,7 @@ impl QuantityState {
     /// A quantity as `defaults` shows a new one: their cloud and one isosurface (hidden unless
     /// they show it).
     pub fn new(source: Source, defaults: &RenderSettings) -> Self {
-        Self { source, visible: true, cloud: defaults.volume, isosurfaces: vec![defaults.iso], pane: None }
+        Self { source, visible: true, cloud: defaults.volume, isosurfaces: vec![defaults.iso], pane: None, between: None }
     }
 
     /// Whether its values on a grid are wanted: an isosurface of it is shown (direct mode fills
@@ -215,6 +244,20 @@ impl QuantityState {
         }];
         nci
     }
+
+    /// The NCI surface of a structure's spherical atoms ([`Source::Promolecular`]): s =
+    /// [`PROMOLECULAR_NCI_LEVEL`] where ρ is below NCIPLOT's promolecular cut, coloured as
+    /// [`Self::nci_surface`]; between the atoms `between` selects and the rest when given.
+    pub fn promolecular_nci(defaults: &RenderSettings, between: Option<String>) -> Self {
+        let mut nci = Self::nci_surface(defaults);
+        nci.source = Source::Promolecular(Quantity::NciGradient);
+        nci.between = between;
+        for iso in &mut nci.isosurfaces {
+            iso.level = super::IsoLevel::Absolute(PROMOLECULAR_NCI_LEVEL);
+            iso.color_by = Some(Source::Promolecular(Quantity::SignLambda2Rho));
+        }
+        nci
+    }
 }
 
 impl QuantityState {
@@ -233,6 +276,11 @@ impl QuantityState {
 /// The reduced density gradient an NCI surface of a wavefunction's density is drawn at
 /// (NCIPLOT's default for SCF densities).
 pub const NCI_LEVEL: f32 = 0.5;
+
+/// The reduced gradient a promolecular NCI surface is drawn at: lower than a wavefunction's
+/// ([`NCI_LEVEL`]), since spherical atoms' s runs lower between them (NCIPLOT's promolecular
+/// pictures use 0.3).
+pub const PROMOLECULAR_NCI_LEVEL: f32 = 0.3;
 
 /// The |sign(λ₂)ρ| (a.u.) where an NCI surface's colours saturate (NCIPLOT's −0.05…0.05).
 pub const NCI_RANGE: f32 = 0.05;

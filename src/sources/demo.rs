@@ -109,6 +109,7 @@ pub fn density_and_orbital(orbital: Option<usize>, positive: [f32; 3], negative:
         cloud: VolumeSettings { visible: false, ..VolumeSettings::default() },
         isosurfaces: vec![iso],
         pane: None,
+        between: None,
     };
     let density = quantity(
         Source::Wavefunction(Quantity::Density),
