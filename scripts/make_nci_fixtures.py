@@ -4,6 +4,8 @@ pointing at the acceptor's O, O···O 2.91 Å), written as
   tests/fixtures/nci/water_dimer_631gs.molden   PySCF's Molden writer
   tests/fixtures/nci/water_dimer.pdb            the same atoms as a structure of two residues,
                                                 the donor HOH 1 and the acceptor LIG 2
+  tests/fixtures/nci/water_donor_631gs.molden   each water alone at its place in the dimer
+  tests/fixtures/nci/water_acceptor_631gs.molden  (HF/6-31G*): fragments whose densities add
 
 The viewer's NCI surface and plot tests open the Molden file; the structure's spherical atoms
 give the promolecular NCI between `resn LIG` and the rest. The viewer's tests open it: its hydrogen bond is the disc of low reduced
@@ -56,6 +58,14 @@ def main() -> None:
     path = os.path.join(OUT, "water_dimer_631gs.molden")
     molden.from_scf(mf, path)
     print(path, mf.e_tot)
+    lines = DIMER.strip().splitlines()
+    for name, atoms in [("donor", lines[:3]), ("acceptor", lines[3:])]:
+        monomer = gto.M(atom="\n".join(atoms), basis="6-31g*", unit="Angstrom", verbose=0)
+        mf = scf.RHF(monomer).run()
+        assert mf.converged
+        path = os.path.join(OUT, f"water_{name}_631gs.molden")
+        molden.from_scf(mf, path)
+        print(path, mf.e_tot)
 
 
 if __name__ == "__main__":

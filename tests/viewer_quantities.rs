@@ -786,7 +786,7 @@ fn a_structures_nci_surface_between_a_selection_and_the_rest_shows_its_hydrogen_
     wait_loaded(&mut h);
     let q = h.state().objects[0].state.selected_quantity().expect("the NCI surface is selected").clone();
     assert_eq!(q.source, Source::Promolecular(Quantity::NciGradient));
-    assert_eq!(q.between.as_deref(), Some("resn LIG"));
+    assert_eq!(q.fragments.selection.as_deref(), Some("resn LIG"));
     assert_eq!(q.isosurfaces[0].color_by, Some(Source::Promolecular(Quantity::SignLambda2Rho)));
     let disc = blue_green(&picture(&mut h, dir.path(), "nci"));
     eprintln!("blue-green pixels: {before} with the atoms, {disc} with the NCI surface");
@@ -803,6 +803,33 @@ fn a_structures_nci_surface_between_a_selection_and_the_rest_shows_its_hydrogen_
         points.iter().filter(|p| range.contains(&p[0])).map(|p| p[1]).fold(f64::INFINITY, f64::min)
     };
     assert!(lowest(-0.05..-0.005) < 0.5, "lowest s at the hydrogen bond: {:.2}", lowest(-0.05..-0.005));
+}
+
+#[test]
+fn two_files_are_fragments_whose_nci_lies_between_them() {
+    let mut h = open(vec![fixture("nci/water_donor_631gs.molden"), fixture("nci/water_acceptor_631gs.molden")]);
+    assert_eq!((h.state().objects.len(), h.state().active), (2, 1));
+    // Opened beside each other, as any two files.
+    let placed = |h: &Harness<'static, OrbApp>| h.state().objects.iter().map(|o| o.state.placement).collect::<Vec<_>>();
+    assert_ne!(placed(&h)[0], placed(&h)[1]);
+    h.state_mut().objects[1].state.evaluation.grid_points = 48;
+    h.get_by_label("NCI surface").click();
+    h.run_steps(3);
+    wait_loaded(&mut h);
+    let dir = tempfile::tempdir().unwrap();
+    let alone = blue_green(&picture(&mut h, dir.path(), "alone"));
+    h.get_by_label("+ water_donor_631gs.molden").click();
+    h.run_steps(3);
+    wait_loaded(&mut h);
+    let q = h.state().objects[1].state.selected_quantity().unwrap().clone();
+    assert_eq!(q.source, Source::Wavefunction(Quantity::NciGradient));
+    assert_eq!(q.fragments.files, vec![h.state().objects[0].doc.source.clone()]);
+    assert!(q.fragments.between_only, "the first fragment keeps what lies between them");
+    // The donor now stands where its file puts it beside the acceptor: both drawn as summed.
+    assert_eq!(placed(&h)[0], placed(&h)[1]);
+    let disc = blue_green(&picture(&mut h, dir.path(), "pair"));
+    eprintln!("blue-green pixels: {alone} with the acceptor alone, {disc} with the donor added");
+    assert!(disc > 30 && disc > 3 * alone.max(1), "the hydrogen bond's disc: {disc} pixels (alone {alone})");
 }
 
 #[test]

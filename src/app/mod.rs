@@ -816,6 +816,7 @@ impl OrbApp {
             self.error = Some(format!("{}: the scene is full ({} objects and their quantities)", doc.source, keep));
             return;
         }
+        vp.documents = self.objects.iter().map(|o| o.doc.clone()).chain([doc.clone()]).collect();
         let note = match vp.set_object(keep, &doc, &state) {
             Ok(note) => note,
             Err(e) => {
@@ -840,6 +841,21 @@ impl OrbApp {
         self.active = self.objects.len() - 1;
         for k in 0..self.objects[self.active].state.quantities.len() {
             self.auto_opacity(self.active, k);
+        }
+        // Quantities of the objects before it whose fragments name it (a session's, restored in
+        // order) are made again, now with its density.
+        let source = self.objects[self.active].doc.source.clone();
+        if let Some(vp) = &mut self.viewport {
+            vp.documents.push(self.objects[self.active].doc.clone());
+            for (n, o) in self.objects.iter().enumerate().take(self.active) {
+                for (k, q) in o.state.quantities.iter().enumerate() {
+                    if q.fragments.files.contains(&source)
+                        && let Err(e) = vp.set_quantity(n, k, &o.doc, &o.state)
+                    {
+                        log::warn!("{}: {e}", o.doc.source);
+                    }
+                }
+            }
         }
         self.world = World::of(&self.objects);
         if !restoring {
@@ -1076,6 +1092,9 @@ impl OrbApp {
     /// call, as [`crate::scene::changes`] decides; called once a frame, after the panels.
     pub fn apply_changes(&mut self) {
         let mut moved = false;
+        if let Some(vp) = &mut self.viewport {
+            vp.documents = self.objects.iter().map(|o| o.doc.clone()).collect();
+        }
         for n in 0..self.objects.len().min(self.applied.len()) {
             let (Some(vp), Some(o)) = (&mut self.viewport, self.objects.get_mut(n)) else { break };
             if self.applied[n] == o.state {
@@ -1190,6 +1209,7 @@ impl OrbApp {
         if let Some(o) = self.objects.get_mut(self.active).filter(|o| o.scan.is_none()) {
             vibrations::panel(ui, &o.doc, &mut o.state.vibration, &mut self.spectrum);
         }
+        let documents: Vec<Arc<Document>> = self.objects.iter().map(|o| o.doc.clone()).collect();
         if let Some(o) = self.objects.get_mut(self.active).filter(|o| o.scan.is_none()) {
             // The surface's point under the pointer, in the object's own frame, marked on the plot.
             let active = self.active as u32;
@@ -1198,8 +1218,12 @@ impl OrbApp {
                 .and_then(|vp| vp.hovered_surface_point(&self.view.camera))
                 .filter(|&(object, _)| object == active)
                 .map(|(_, p)| o.state.placement.world_from_object().inverse().transform_point3(p));
-            self.nci_plot.hover(&o.doc, hovered);
-            self.nci_plot.panel(ui, &o.doc, o.state.selected_quantity_mut());
+            let others: Vec<Arc<Document>> = documents.clone();
+            if let Some(q) = o.state.selected_quantity() {
+                let of = crate::evaluate::meshes::Evaluating { doc: &o.doc, fragments: &q.fragments, others: &others };
+                self.nci_plot.hover(of, q.source, hovered);
+            }
+            self.nci_plot.panel(ui, &o.doc, &others, o.state.selected_quantity_mut());
         }
         let mut ntos = None;
         if let Some(o) = self.objects.get_mut(self.active).filter(|o| o.scan.is_none()) {

@@ -9,12 +9,14 @@ use egui::RichText;
 use egui_plot::{HLine, Plot, PlotPoints, PlotTransform, Points, VLine};
 
 use super::jobs::Latest;
+use crate::evaluate::interaction::{self, Kind};
+use crate::evaluate::meshes::Evaluating;
 use crate::model::Document;
 use crate::model::GridSpec;
 use crate::model::extent::quantity_box;
 use crate::model::nci::{self, DensitySource, NciSettings, WAVEFUNCTION_DENSITY_CUT, WavefunctionDensity};
 use crate::model::orbitals::Quantity;
-use crate::scene::{IsoLevel, QuantityState, Source};
+use crate::scene::{Fragments, IsoLevel, QuantityState, Source};
 
 /// The panel's height, points.
 const HEIGHT: f32 = 220.0;
@@ -61,20 +63,20 @@ impl NciPlot {
 
     /// Marks on the plot the point `at` (bohr, in `doc`'s own frame) of the surface under the
     /// pointer, or nothing.
-    pub fn hover(&mut self, doc: &Document, at: Option<glam::Vec3>) {
+    pub fn hover(&mut self, of: Evaluating, source: Source, at: Option<glam::Vec3>) {
         if at == self.hovered_at {
             return;
         }
         self.hovered_at = at;
-        // The wavefunction's density, or a structure's spherical atoms.
-        let at = at.map(|p| p.as_dvec3());
-        let d = at.and_then(|p| match &doc.wavefunction {
-            Some(wf) => {
+        // The wavefunction's density, or a structure's spherical atoms, with its fragments'.
+        let d = at.map(glam::Vec3::as_dvec3).and_then(|p| match (kind(source, of.fragments), &of.doc.wavefunction) {
+            (Some(kind), _) => interaction::derivatives_at(of.doc, kind, of.fragments, of.others, p),
+            (None, Some(wf)) => {
                 let mut d = [nci::DensityDerivatives::default()];
                 nci::WavefunctionDensity::new(wf).derivatives_at(&[p], &mut d);
                 Some(d[0])
             }
-            None => crate::evaluate::promolecular::derivatives_at(doc, p),
+            (None, None) => None,
         });
         self.hovered = d.map(|d| [d.sign_lambda2_rho(), d.reduced_gradient()]);
     }
@@ -86,12 +88,18 @@ impl NciPlot {
 
     /// Shows the plot when `quantity`, of `doc`, is an NCI surface; a drag across it sets the
     /// surface's colour window.
-    pub fn panel(&mut self, ui: &mut egui::Ui, doc: &Document, quantity: Option<&mut QuantityState>) {
+    pub fn panel(
+        &mut self,
+        ui: &mut egui::Ui,
+        doc: &Document,
+        others: &[std::sync::Arc<Document>],
+        quantity: Option<&mut QuantityState>,
+    ) {
         let Some(q) = quantity.filter(|q| is_nci_surface(q.source)) else {
             self.transform = None;
             return;
         };
-        self.refresh(doc, q);
+        self.refresh(doc, others, q);
         let cut = match q.source {
             Source::Promolecular(_) => nci::PROMOLECULAR_DENSITY_CUT,
             _ => WAVEFUNCTION_DENSITY_CUT,
@@ -166,21 +174,22 @@ impl NciPlot {
 
     /// Starts making the points when they were made for another document or surface; takes
     /// them when made.
-    fn refresh(&mut self, doc: &Document, q: &QuantityState) {
+    fn refresh(&mut self, doc: &Document, others: &[std::sync::Arc<Document>], q: &QuantityState) {
         if let Some(result) = self.job.poll() {
             match result.and_then(|r| r) {
                 Ok(points) => (self.points, self.error) = (points, None),
                 Err(e) => (self.points, self.error) = (Vec::new(), Some(e)),
             }
         }
-        let key = format!("{} {:?} {:?}", doc.source, q.source, q.between);
+        let key = format!("{} {:?} {:?}", doc.source, q.source, q.fragments);
         if self.made_for.as_deref() == Some(key.as_str()) {
             return;
         }
         self.made_for = Some(key);
         self.points.clear();
-        let (doc, source, between) = (doc.clone(), q.source, q.between.clone());
-        self.job.request(move |_| plot_points(&doc, source, between.as_deref()));
+        let (doc, source, fragments, others) = (doc.clone(), q.source, q.fragments.clone(), others.to_vec());
+        self.job
+            .request(move |_| plot_points(Evaluating { doc: &doc, fragments: &fragments, others: &others }, source));
     }
 }
 
@@ -189,13 +198,23 @@ pub fn is_nci_surface(source: Source) -> bool {
     matches!(source, Source::Wavefunction(Quantity::NciGradient) | Source::Promolecular(Quantity::NciGradient))
 }
 
+/// The interaction `source` with `fragments` evaluates, when it is one ([`interaction`]): a
+/// structure's spherical atoms, or a wavefunction's density with other fragments.
+fn kind(source: Source, fragments: &Fragments) -> Option<Kind> {
+    match source {
+        Source::Promolecular(_) => Some(Kind::Spherical),
+        Source::Wavefunction(_) if !fragments.is_empty() => Some(Kind::Wavefunction),
+        _ => None,
+    }
+}
+
 /// (sign(λ₂)ρ, s) at the points of a grid over the density of `source` (a wavefunction's, or
-/// the spherical atoms' between the parts `between` makes) where ρ is below the cut and s below
-/// [`TOP_S`].
-pub fn plot_points(doc: &Document, source: Source, between: Option<&str>) -> Result<Vec<[f64; 2]>, String> {
-    let grids = match source {
-        Source::Promolecular(_) => crate::evaluate::promolecular::nci_grids(doc, between, PLOT_POINTS)?,
-        _ => {
+/// spherical atoms', with `of`'s fragments) where ρ is below the cut and s below [`TOP_S`].
+pub fn plot_points(of: Evaluating, source: Source) -> Result<Vec<[f64; 2]>, String> {
+    let doc = of.doc;
+    let grids = match kind(source, of.fragments) {
+        Some(kind) => interaction::nci_grids(doc, kind, of.fragments, of.others, PLOT_POINTS)?,
+        None => {
             let wf = doc.wavefunction.as_ref().ok_or("an NCI plot needs a wavefunction")?;
             let (lo, hi) = quantity_box(wf, &doc.molecule, Quantity::Density).ok_or("the molecule has no atoms")?;
             let grid = GridSpec::cubic_voxels(lo, hi, PLOT_POINTS);

@@ -229,6 +229,11 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
             }
             let (grid_sigma, grid_signed) = app.shown_grid();
             let subtractable = app.subtractable();
+            let open: Vec<String> = (app.objects.iter().enumerate())
+                .filter(|&(n, o)| n != app.active && o.scan.is_none())
+                .map(|(_, o)| o.doc.source.clone())
+                .collect();
+            let mut joined = None;
             if let Some(o) = app.objects.get_mut(app.active) {
                 if let Some(scan) = &o.scan {
                     let g = scan.keys.grid.dims;
@@ -251,6 +256,7 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
                             data_set_choice(ui, &doc, &mut q.source);
                         }
                         subtract = minus_choice(ui, &subtractable);
+                        joined = fragments_editor(ui, q, &open);
                         // Isosurfaces first: for orbitals the most used, and never below the fold.
                         let colors = super::scene_panel::quantity_choices(&doc);
                         let gradient = matches!(
@@ -279,6 +285,14 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
                 clip_editor(ui, &mut state.clip);
                 if let Some(m) = subtract {
                     app.start_difference(m, ui.ctx());
+                }
+                // A fragment added stands where its file puts it, as the active object's
+                // atoms do: both are drawn as their densities are summed.
+                if let Some(file) = joined {
+                    let placement = app.objects[app.active].state.placement;
+                    if let Some(f) = app.objects.iter_mut().find(|o| o.doc.source == file) {
+                        f.state.placement = placement;
+                    }
                 }
             }
             if let Some(model) = super::models::controls(ui, app) {
@@ -350,6 +364,44 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
         });
         });
     app.view.panels.scene = open;
+}
+
+/// An NCI quantity's fragments: the other open files whose densities add to the object's (as
+/// NCIPLOT adds its files'), and whether only what lies between them is kept. Returns a file
+/// just added.
+fn fragments_editor(ui: &mut egui::Ui, q: &mut crate::scene::QuantityState, open: &[String]) -> Option<String> {
+    let nci = matches!(
+        q.source,
+        Source::Promolecular(_)
+            | Source::Wavefunction(Quantity::NciGradient | Quantity::NciCloud | Quantity::SignLambda2Rho)
+    );
+    if !nci || open.is_empty() {
+        return None;
+    }
+    let mut added = None;
+    ui.label(RichText::new("fragments: their densities add").small());
+    let fragments = &mut q.fragments;
+    for file in open {
+        let name = file.rsplit(['/', '\\']).next().unwrap_or(file);
+        let mut with = fragments.files.contains(file);
+        if ui.checkbox(&mut with, format!("+ {name}")).on_hover_text(file.as_str()).changed() {
+            match with {
+                true => {
+                    // The first fragment: what lies between them is what is usually asked.
+                    fragments.between_only |= fragments.files.is_empty();
+                    fragments.files.push(file.clone());
+                    added = Some(file.clone());
+                }
+                false => fragments.files.retain(|f| f != file),
+            }
+        }
+    }
+    if !fragments.files.is_empty() {
+        ui.checkbox(&mut fragments.between_only, "only between the fragments").on_hover_text(
+            "keep the points where no fragment holds 95 % of the density (NCIPLOT's intermolecular mode)",
+        );
+    }
+    added
 }
 
 /// A structure without a wavefunction offers the NCI surface of its spherical atoms: of all of

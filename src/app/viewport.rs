@@ -7,6 +7,7 @@ use super::detail::Detail;
 use super::jobs::Latest;
 use super::progressive::{Progressive, Turn};
 use super::state::{DRAG_ROTATE, KEY_ROTATE, KEY_ZOOM, ViewState};
+use crate::evaluate::interaction::{self, Kind};
 use crate::evaluate::meshes::{color_isosurfaces, isosurfaces_within, molecular_surface};
 use crate::evaluate::{Evaluated, WavefunctionView, evaluate_within};
 use crate::gpu::context::guarded;
@@ -18,6 +19,7 @@ use crate::layers::key_volumes::ScanScene;
 use crate::model::isosurface::Mesh;
 use crate::model::{Document, VolumeGrid};
 use crate::scene::objects::Part;
+use crate::scene::quantity::is_promolecular;
 use crate::scene::translucency::SurfaceLook;
 use crate::scene::{ClipPlane, ObjectState, Source, SurfaceChoice, SurfaceSettings, VolumeSettings};
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
@@ -227,6 +229,9 @@ pub struct Viewport {
     pub clouds: Vec<VolumeSettings>,
     /// The last click, until the caller takes it.
     pub click: Option<Click>,
+    /// The scene's documents, which a quantity's fragments may name (set by the caller before
+    /// quantities are shown).
+    pub documents: Vec<Arc<Document>>,
     /// A click on a picture still being drawn: where, and whether Shift was held. It is picked
     /// once the whole picture (and so every pixel's id) is there.
     pending_click: Option<(egui::Pos2, bool)>,
@@ -279,6 +284,7 @@ impl Viewport {
             repaint: Arc::new(|| {}),
             clouds: Vec::new(),
             click: None,
+            documents: Vec::new(),
             pending_click: None,
             hovered: None,
             hovered_at: None,
@@ -431,6 +437,15 @@ impl Viewport {
                 self.update_isosurfaces(n, k, doc, state);
                 Ok(coarser(doc, i, step))
             }
+            Source::Promolecular(quantity) => {
+                self.request_interaction(l, Kind::Spherical, doc, q, state, quantity);
+                Ok(None)
+            }
+            // The density's quantities of several fragments (NCI) sum every fragment's density.
+            Source::Wavefunction(quantity) if !q.fragments.is_empty() && is_promolecular(quantity) => {
+                self.request_interaction(l, Kind::Wavefunction, doc, q, state, quantity);
+                Ok(None)
+            }
             Source::Wavefunction(quantity) => {
                 let e = &state.evaluation;
                 let functions = doc.wavefunction.as_ref().and_then(|wf| e.restriction(&wf.basis));
@@ -446,19 +461,33 @@ impl Viewport {
                 });
                 Ok(None)
             }
-            Source::Promolecular(quantity) => {
-                let (doc, between, points) = (doc.clone(), q.between.clone(), state.evaluation.grid_points);
-                self.slots[l].evaluation.request(move |_| {
-                    // What cannot be made (an element without an atomic density, a selection that
-                    // picks no atom) is said, and nothing is shown.
-                    Ok(match crate::evaluate::promolecular::grid(&doc, quantity, between.as_deref(), points) {
-                        Ok(grid) => (Some(Evaluated::of_values(grid)), crate::evaluate::promolecular::note(&doc)),
-                        Err(why) => (None, Some(why)),
-                    })
-                });
-                Ok(None)
-            }
         }
+    }
+
+    /// Evaluates `quantity` of the summed densities of an interaction (`q`'s fragments, the
+    /// spherical atoms' for `kind` [`Kind::Spherical`]) on the CPU into layer `l`.
+    fn request_interaction(
+        &mut self,
+        l: usize,
+        kind: Kind,
+        doc: &Arc<Document>,
+        q: &crate::scene::QuantityState,
+        state: &ObjectState,
+        quantity: crate::model::orbitals::Quantity,
+    ) {
+        let (doc, fragments, points) = (doc.clone(), q.fragments.clone(), state.evaluation.grid_points);
+        let others = self.documents.clone();
+        self.slots[l].evaluation.request(move |_| {
+            // What cannot be made (an element without an atomic density, a selection that picks
+            // no atom, a fragment not open) is said, and nothing is shown.
+            Ok(match interaction::grid(&doc, kind, &fragments, &others, quantity, points) {
+                Ok(grid) => {
+                    let note = (kind == Kind::Spherical).then(|| interaction::note(&doc)).flatten();
+                    (Some(Evaluated::of_values(grid)), note)
+                }
+                Err(why) => (None, Some(why)),
+            })
+        });
     }
 
     /// Draws the plane map's frame `lines` (object `n`'s frame) with object `n`'s atoms; none
@@ -547,12 +576,14 @@ impl Viewport {
         let levels = q.isosurfaces.clone();
         let max_bytes = self.ctx.device.limits().max_buffer_size;
         let iso_map = self.slots[l].iso_map.clone();
+        let (fragments, others) = (q.fragments.clone(), self.documents.clone());
         self.slots[l].extraction.request(move |_| {
             let grid = computed.as_deref().or(volume.and_then(|i| doc.volumes.get(i)));
             let Some(grid) = grid else { return prepared(Default::default()) };
             let (mut meshes, note) = isosurfaces_within(grid, &levels, max_bytes);
             let signed = grid.kind == crate::model::grid::ValueKind::Signed;
-            let map = color_isosurfaces(&doc, &levels, signed, &mut meshes);
+            let of = crate::evaluate::meshes::Evaluating { doc: &doc, fragments: &fragments, others: &others };
+            let map = color_isosurfaces(of, &levels, signed, &mut meshes);
             *iso_map.lock().unwrap_or_else(std::sync::PoisonError::into_inner) = map;
             prepared((meshes, note))
         });

@@ -310,7 +310,12 @@ pub fn bench(args: &NciBench) -> Result<()> {
     for _ in 0..args.runs {
         let t = Instant::now();
         let (mut meshes, _) = crate::evaluate::meshes::isosurfaces_within(&field, &levels, u64::MAX);
-        crate::evaluate::meshes::color_isosurfaces(&doc, &levels, false, &mut meshes);
+        crate::evaluate::meshes::color_isosurfaces(
+            crate::evaluate::meshes::Evaluating::alone(&doc),
+            &levels,
+            false,
+            &mut meshes,
+        );
         iso_ms.push(t.elapsed().as_secs_f64() * 1e3);
         vertices = meshes.iter().map(|(m, _)| m.positions.len()).sum::<usize>();
     }

@@ -156,8 +156,10 @@ pub fn check_nci(args: &RenderArgs, doc: &Document) -> Result<()> {
         (Some(_), None) => Ok(()),
         // A structure's NCI comes from its spherical atoms.
         (None, between) => {
-            crate::evaluate::promolecular::check(doc, between.as_deref()).map_err(anyhow::Error::msg)?;
-            if let Some(note) = crate::evaluate::promolecular::note(doc) {
+            use crate::evaluate::interaction::{self, Kind};
+            let fragments = crate::scene::Fragments { selection: between.clone(), ..Default::default() };
+            interaction::check(doc, Kind::Spherical, &fragments, &[]).map_err(anyhow::Error::msg)?;
+            if let Some(note) = interaction::note(doc) {
                 eprintln!("{note}");
             }
             Ok(())

@@ -112,7 +112,11 @@ impl IsoArgs {
 
     /// Colours `meshes` by `source` of `doc` ([`Self::color_source`]), one map for all of them.
     pub fn color(&self, doc: &Document, source: Source, meshes: &mut [(Mesh, SurfaceLook)]) -> Colored {
-        let values = values_on(doc, source, &meshes.iter().map(|(m, _)| m).collect::<Vec<_>>());
+        let values = values_on(
+            crate::evaluate::meshes::Evaluating::alone(doc),
+            source,
+            &meshes.iter().map(|(m, _)| m).collect::<Vec<_>>(),
+        );
         let mut colored: Vec<&mut Mesh> = meshes.iter_mut().map(|(m, _)| m).collect();
         let map = color_meshes(&mut colored, &values, self.color_range, ColorScheme::RedWhiteBlue);
         let name = color_name(doc, source);

@@ -75,7 +75,10 @@ pub fn difference(doc: &Document, source: Source, points: usize, other: &Documen
         }
         (Source::Wavefunction(_), None) => return Err(format!("{}: no wavefunction", doc.source)),
         (Source::Scan(_), _) => return Err(format!("{}: a scan's orbital changes with its coordinate", doc.source)),
-        (Source::Promolecular(q), _) => super::promolecular::grid(doc, q, None, points)?,
+        (Source::Promolecular(q), _) => {
+            use super::interaction::{Kind, grid};
+            grid(doc, Kind::Spherical, &Default::default(), &[], q, points)?
+        }
     };
     let at = grid_points(mine.dims, |i, j, k| mine.point(i, j, k));
     let (subtract, _) = values_of(other, theirs, &at)?;

@@ -14,7 +14,7 @@ use crate::scene::coloring::{ColorScheme, ValueMap};
 use crate::scene::quantity::Source;
 use crate::scene::selection::shown_atoms;
 use crate::scene::translucency::SurfaceLook;
-use crate::scene::{IsosurfaceSettings, SurfaceSettings};
+use crate::scene::{Fragments, IsosurfaceSettings, SurfaceSettings};
 
 /// The isosurfaces `iso` asks for on `grid`, each with its colour: ψ = +v and ψ = −v for a
 /// signed grid, ρ = v for a density. Empty when `iso` is hidden.
@@ -28,11 +28,30 @@ pub fn isosurfaces(grid: &VolumeGrid, iso: &IsosurfaceSettings) -> Vec<(Mesh, Su
     isosurface::extract(grid, &levels).into_iter().zip(colors.into_iter().map(|c| iso.look(c))).collect()
 }
 
+/// What a quantity's values at points are evaluated from: its document, and the fragments an
+/// NCI quantity adds to its density (other open documents, or its atoms split in two).
+#[derive(Clone, Copy)]
+pub struct Evaluating<'a> {
+    pub doc: &'a Document,
+    pub fragments: &'a Fragments,
+    /// The open documents `fragments` may name.
+    pub others: &'a [std::sync::Arc<Document>],
+}
+
+static NO_FRAGMENTS: Fragments = Fragments { selection: None, files: Vec::new(), between_only: false };
+
+impl<'a> Evaluating<'a> {
+    /// The document's own quantities.
+    pub fn alone(doc: &'a Document) -> Self {
+        Self { doc, fragments: &NO_FRAGMENTS, others: &[] }
+    }
+}
+
 /// Colours the meshes [`isosurfaces_within`] cut at `levels` (one per sign of a `signed` grid
 /// for each visible level, in order) by the quantity each level's `color_by` names, one map for
 /// all of them; returns that map and the quantity's name, when any level asks for it.
 pub fn color_isosurfaces(
-    doc: &Document,
+    of: Evaluating,
     levels: &[IsosurfaceSettings],
     signed: bool,
     meshes: &mut [(Mesh, SurfaceLook)],
@@ -49,8 +68,8 @@ pub fn color_isosurfaces(
     sources.dedup();
     for source in sources {
         let ks: Vec<usize> = asking.iter().filter(|(_, s)| *s == source).map(|&(k, _)| k).collect();
-        let of: Vec<&Mesh> = ks.iter().map(|&k| &meshes[k].0).collect();
-        for (k, v) in ks.iter().zip(values_on(doc, source, &of)) {
+        let meshes_of: Vec<&Mesh> = ks.iter().map(|&k| &meshes[k].0).collect();
+        for (k, v) in ks.iter().zip(values_on(of, source, &meshes_of)) {
             per_mesh[*k] = Some(v);
         }
     }
@@ -66,7 +85,7 @@ pub fn color_isosurfaces(
             }
         }
     }
-    Some((map, color_name(doc, last.0)))
+    Some((map, color_name(of.doc, last.0)))
 }
 
 /// The grey of a coloured surface's vertices outside its colour window.
@@ -88,9 +107,9 @@ pub fn color_name(doc: &Document, source: Source) -> String {
 
 /// `source`'s values at the vertices of each of `meshes` ([`values_at`]), evaluated in one pass
 /// over all of them (one potential built, one basis prepared).
-pub fn values_on(doc: &Document, source: Source, meshes: &[&Mesh]) -> Vec<Vec<Option<f64>>> {
+pub fn values_on(of: Evaluating, source: Source, meshes: &[&Mesh]) -> Vec<Vec<Option<f64>>> {
     let points: Vec<glam::Vec3> = meshes.iter().flat_map(|m| m.positions.iter().copied()).collect();
-    let mut all = values_at(doc, source, &points).into_iter();
+    let mut all = values_at(of, source, &points).into_iter();
     meshes.iter().map(|m| all.by_ref().take(m.positions.len()).collect()).collect()
 }
 
@@ -216,9 +235,24 @@ pub fn sample_grid(points: &[glam::Vec3], grid: &VolumeGrid) -> Vec<Option<f64>>
         .collect()
 }
 
-/// The values of `source`, a quantity of `doc`, at each point (bohr): a wavefunction's quantity
-/// evaluated exactly there, a data set sampled trilinearly (`None` outside its grid).
-pub fn values_at(doc: &Document, source: Source, points: &[glam::Vec3]) -> Vec<Option<f64>> {
+/// The values of `source`, a quantity of `of`'s document, at each point (bohr): a
+/// wavefunction's quantity evaluated exactly there (of the fragments' summed density for those
+/// of the density, when `of` has fragments), a data set sampled trilinearly (`None` outside its
+/// grid), a quantity of the spherical atoms.
+pub fn values_at(of: Evaluating, source: Source, points: &[glam::Vec3]) -> Vec<Option<f64>> {
+    use super::interaction::{self, Kind};
+    let doc = of.doc;
+    let kind = match source {
+        Source::Promolecular(_) => Some(Kind::Spherical),
+        Source::Wavefunction(q) if !of.fragments.is_empty() && crate::scene::quantity::is_promolecular(q) => {
+            Some(Kind::Wavefunction)
+        }
+        _ => None,
+    };
+    if let (Some(kind), Source::Wavefunction(q) | Source::Promolecular(q)) = (kind, source) {
+        let points: Vec<glam::DVec3> = points.iter().map(|p| p.as_dvec3()).collect();
+        return interaction::values_at(doc, kind, of.fragments, of.others, q, &points);
+    }
     match (source, &doc.wavefunction) {
         (Source::Wavefunction(q), Some(wf)) => {
             let points: Vec<glam::DVec3> = points.iter().map(|p| p.as_dvec3()).collect();
@@ -226,10 +260,6 @@ pub fn values_at(doc: &Document, source: Source, points: &[glam::Vec3]) -> Vec<O
             prepared.quantity_at_points(wf, &doc.molecule, q, &points).into_iter().map(Some).collect()
         }
         (Source::Volume(i), _) if i < doc.volumes.len() => sample_grid(points, &doc.volumes[i]),
-        (Source::Promolecular(q), _) => {
-            let points: Vec<glam::DVec3> = points.iter().map(|p| p.as_dvec3()).collect();
-            super::promolecular::values_at(doc, q, &points)
-        }
         _ => vec![None; points.len()],
     }
 }

@@ -5,8 +5,8 @@
 //! grids the device holds; and the opacity a cloud of the values starts with.
 
 pub mod arithmetic;
+pub mod interaction;
 pub mod meshes;
-pub mod promolecular;
 
 use crate::gpu::density_hessian::DensityHessianPass;
 use crate::gpu::gto::{GtoFillPass, read_volume, volume_from_texture};

@@ -171,7 +171,8 @@ pub fn show_quantity(
         // Its key volumes live with the window's scan ([`key_volumes::ScanScene`]).
         Source::Scan(_) => None,
         Source::Promolecular(quantity) => {
-            match crate::evaluate::promolecular::grid(doc, quantity, q.between.as_deref(), state.evaluation.grid_points) {
+            use crate::evaluate::interaction::{Kind, grid};
+            match grid(doc, Kind::Spherical, &q.fragments, &[], quantity, state.evaluation.grid_points) {
                 Ok(grid) => {
                     layer.set_volume(ctx, Some(&grid))?;
                     Some(Values { grid: Some(grid), sampled: None })
@@ -187,7 +188,8 @@ pub fn show_quantity(
     if let Some(grid) = values.as_ref().and_then(|v| v.grid.as_ref()) {
         let mut meshes: Vec<_> = q.isosurfaces.iter().flat_map(|iso| isosurfaces(grid, iso)).collect();
         let signed = grid.kind == crate::model::grid::ValueKind::Signed;
-        color_map = color_isosurfaces(doc, &q.isosurfaces, signed, &mut meshes);
+        let of = crate::evaluate::meshes::Evaluating { doc, fragments: &q.fragments, others: &[] };
+        color_map = color_isosurfaces(of, &q.isosurfaces, signed, &mut meshes);
         show_meshes(ctx, layer, &meshes);
     }
     Ok(ShownQuantity { values, color_map })

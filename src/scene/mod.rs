@@ -25,7 +25,7 @@ pub use coloring::AtomColors;
 pub use molsurface::{SurfaceChoice, SurfaceSettings};
 pub use objects::{Changes, ObjectState, Panes, Placement, QuantityChanges, Session, changes};
 pub use opacity::DensityScale;
-pub use quantity::{AtomLook, ESP_MAP_DENSITY, Evaluation, QuantityState, Source};
+pub use quantity::{AtomLook, ESP_MAP_DENSITY, Evaluation, Fragments, QuantityState, Source};
 pub use scan_state::{LegacyScan, ScanState};
 pub use settings::{
     AtomColoring, AtomStyle, Interpolation, IsoLevel, IsosurfaceSettings, RenderSettings, SliceMode, VolumeSettings,

@@ -311,7 +311,7 @@ pub fn changes(before: &ObjectState, after: &ObjectState) -> Changes {
                 let points = before.evaluation.grid_points != after.evaluation.grid_points;
                 QuantityChanges {
                     values: a.source != b.source
-                        || a.between != b.between
+                        || a.fragments != b.fragments
                         || (wavefunction && (evaluation || grid))
                         || (promolecular && points),
                     isosurfaces: a.isosurfaces != b.isosurfaces,
@@ -377,7 +377,14 @@ impl From<StoredObject> for ObjectState {
             // A file with a wavefunction resolves `Volume` to its first quantity ([`ObjectState::fit_to`]).
             let source = s.quantity.map_or(Source::Volume(s.volume), Source::Wavefunction);
             let isosurfaces = std::iter::once(settings.iso).chain(s.isosurfaces).collect();
-            quantities.push(QuantityState { source, visible: true, cloud: settings.volume, isosurfaces, pane: None, between: None });
+            quantities.push(QuantityState {
+                source,
+                visible: true,
+                cloud: settings.volume,
+                isosurfaces,
+                pane: None,
+                fragments: Default::default(),
+            });
         }
         let clouds = quantities.iter().map(|q| q.cloud.stored_clip).chain(s.settings.map(|s| s.volume.stored_clip));
         let stored: Vec<ClipPlane> = clouds.flatten().collect();

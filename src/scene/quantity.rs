@@ -22,7 +22,7 @@ pub enum Source {
     Scan(usize),
     /// A quantity of the promolecular density (a sum of spherical atoms) of the document's
     /// atoms, for structures without a wavefunction: the NCI surface's s, the NCI cloud,
-    /// sign(λ₂)ρ or ρ. [`QuantityState::between`] may keep only what lies between two parts.
+    /// sign(λ₂)ρ or ρ. [`QuantityState::fragments`] may add other files' or split the atoms.
     Promolecular(Quantity),
 }
 
@@ -155,11 +155,34 @@ pub struct QuantityState {
     /// The pane of a split view it is drawn in (`None`: every pane; past the last pane: the last).
     #[serde(default)]
     pub pane: Option<usize>,
-    /// A promolecular quantity between two parts of the structure: the atoms this selection
-    /// picks (a ligand: `resn LIG`) and all the others (its pocket). Only the points where
-    /// neither part holds almost all of the density are kept (NCIPLOT's intermolecular mode).
+    /// The fragments an NCI quantity's density is made of besides the object's own.
+    #[serde(default, skip_serializing_if = "Fragments::is_empty")]
+    pub fragments: Fragments,
+}
+
+/// What an NCI quantity's density is made of besides the object's own, as NCIPLOT makes it:
+/// other files' densities added (fragments), or the object's atoms split in two.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct Fragments {
+    /// A selection of a structure's atoms (a ligand: `resn LIG`): it and all the other atoms
+    /// (its pocket) are two parts, and only what lies between them is kept.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub between: Option<String>,
+    pub selection: Option<String>,
+    /// Other open files whose densities add, by path, each at its file's coordinates (as
+    /// NCIPLOT reads them).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub files: Vec<String>,
+    /// With files: only the points where no fragment holds 95 % of the density are kept
+    /// (NCIPLOT's intermolecular mode).
+    #[serde(default)]
+    pub between_only: bool,
+}
+
+impl Fragments {
+    /// Whether the object's density is all there is.
+    pub fn is_empty(&self) -> bool {
+        self.selection.is_none() && self.files.is_empty()
+    }
 }
 
 fn yes() -> bool {
@@ -170,7 +193,14 @@ impl QuantityState {
     /// A quantity as `defaults` shows a new one: their cloud and one isosurface (hidden unless
     /// they show it).
     pub fn new(source: Source, defaults: &RenderSettings) -> Self {
-        Self { source, visible: true, cloud: defaults.volume, isosurfaces: vec![defaults.iso], pane: None, between: None }
+        Self {
+            source,
+            visible: true,
+            cloud: defaults.volume,
+            isosurfaces: vec![defaults.iso],
+            pane: None,
+            fragments: Fragments::default(),
+        }
     }
 
     /// Whether its values on a grid are wanted: an isosurface of it is shown (direct mode fills
@@ -251,7 +281,7 @@ impl QuantityState {
     pub fn promolecular_nci(defaults: &RenderSettings, between: Option<String>) -> Self {
         let mut nci = Self::nci_surface(defaults);
         nci.source = Source::Promolecular(Quantity::NciGradient);
-        nci.between = between;
+        nci.fragments.selection = between;
         for iso in &mut nci.isosurfaces {
             iso.level = super::IsoLevel::Absolute(PROMOLECULAR_NCI_LEVEL);
             iso.color_by = Some(Source::Promolecular(Quantity::SignLambda2Rho));

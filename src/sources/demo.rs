@@ -109,7 +109,7 @@ pub fn density_and_orbital(orbital: Option<usize>, positive: [f32; 3], negative:
         cloud: VolumeSettings { visible: false, ..VolumeSettings::default() },
         isosurfaces: vec![iso],
         pane: None,
-        between: None,
+        fragments: Default::default(),
     };
     let density = quantity(
         Source::Wavefunction(Quantity::Density),
