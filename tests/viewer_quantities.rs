@@ -803,6 +803,18 @@ fn a_structures_nci_surface_between_a_selection_and_the_rest_shows_its_hydrogen_
         points.iter().filter(|p| range.contains(&p[0])).map(|p| p[1]).fold(f64::INFINITY, f64::min)
     };
     assert!(lowest(-0.05..-0.005) < 0.5, "lowest s at the hydrogen bond: {:.2}", lowest(-0.05..-0.005));
+    // The same interaction as a cloud: blue (λ₂ < 0) between the molecules.
+    let (_, blue_before) = red_and_blue(&picture(&mut h, dir.path(), "surface"));
+    h.get_by_label("NCI cloud").click();
+    h.run_steps(3);
+    wait_loaded(&mut h);
+    let q = h.state().objects[0].state.selected_quantity().unwrap().clone();
+    assert_eq!(
+        (q.source, q.fragments.selection.as_deref()),
+        (Source::Promolecular(Quantity::NciCloud), Some("resn LIG"))
+    );
+    let (_, blue) = red_and_blue(&picture(&mut h, dir.path(), "cloud"));
+    assert!(blue > 20 && blue > blue_before, "the cloud's blue pixels: {blue} (the surface's picture: {blue_before})");
 }
 
 #[test]

@@ -224,6 +224,8 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
         .show_collapsible(ui, &mut open, |ui| {
             egui::ScrollArea::vertical().show(ui, |ui| {
             super::scene_panel::section(ui, app);
+            // Before the quantity's editors, which it adds to: never below the fold.
+            promolecular_nci(ui, app);
             if !app.objects.is_empty() {
                 ui.separator();
             }
@@ -320,7 +322,6 @@ pub fn side_panel(ui: &mut egui::Ui, app: &mut OrbApp) {
             if bare.is_some() && ui.button("Compute orbitals…").on_hover_text("with PySCF").clicked() {
                 app.orbitals_dialog = Some((app.active, crate::sources::compute::Settings::default()));
             }
-            promolecular_nci(ui, app);
 
             ui.separator();
             ui.collapsing("Atoms in file", |ui| {
@@ -423,17 +424,31 @@ fn promolecular_nci(ui: &mut egui::Ui, app: &mut OrbApp) {
             .on_hover_text("the atoms this selection picks and all the others: a ligand and its pocket");
         ui.label("and the rest");
     });
-    let hint = "the reduced density gradient of the spherical atoms (s = 0.3 where ρ < 0.07), coloured by \
-                sign(λ₂)ρ: blue hydrogen bonds, green van der Waals contacts, red steric clashes";
-    if !ui.button("NCI surface").on_hover_text(hint).clicked() {
-        return;
-    }
     let between = Some(app.nci_between.trim().to_string()).filter(|b| !b.is_empty());
+    let mut shown = None;
+    ui.horizontal(|ui| {
+        let hint = "the reduced density gradient of the spherical atoms (s = 0.3 where ρ < 0.07), coloured by \
+                    sign(λ₂)ρ: blue hydrogen bonds, green van der Waals contacts, red steric clashes";
+        if ui.button("NCI surface").on_hover_text(hint).clicked() {
+            shown = Some(crate::scene::QuantityState::promolecular_nci(&app.defaults, between.clone()));
+        }
+        let hint = "the same interactions as a cloud: blue where λ₂ < 0 (attraction), red where λ₂ > 0";
+        if ui.button("NCI cloud").on_hover_text(hint).clicked() {
+            let mut cloud = crate::scene::QuantityState::nci_cloud(&app.defaults);
+            cloud.source = Source::Promolecular(Quantity::NciCloud);
+            cloud.fragments.selection = between.clone();
+            shown = Some(cloud);
+        }
+    });
+    let Some(quantity) = shown else { return };
+    let surface = quantity.isosurfaces.iter().any(|i| i.visible);
     let state = &mut o.state;
     state.quantities.iter_mut().for_each(|q| q.visible = false);
-    state.quantities.push(crate::scene::QuantityState::promolecular_nci(&app.defaults, between));
+    state.quantities.push(quantity);
     state.selected = state.quantities.len() - 1;
-    app.frame_beside_bar();
+    if surface {
+        app.frame_beside_bar();
+    }
 }
 
 /// *minus*: another open file whose same quantity is subtracted from this one, as a new data
