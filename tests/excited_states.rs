@@ -475,3 +475,131 @@ fn info_with_a_logs_transitions_lists_each_states_ntos() {
         "{e}"
     );
 }
+
+/// PySCF's TDA (HF/6-31G*) of water: the SCF as Molden, then per state its energy (eV, by
+/// PySCF's constant), oscillator strength and every amplitude X_ia (1-based orbital numbers).
+const TDA_SCRIPT: &str = r#"
+import json, sys
+import numpy as np
+from pyscf import gto, scf, tdscf
+from pyscf.data import nist
+from pyscf.tools import molden
+mol = gto.M(atom="O 0 0 0.1173; H 0 0.7572 -0.4692; H 0 -0.7572 -0.4692", basis="6-31g*", verbose=0)
+mf = scf.RHF(mol).run(conv_tol=1e-11)
+molden.from_scf(mf, sys.argv[1])
+td = tdscf.TDA(mf)
+td.nstates = 5
+td.conv_tol = 1e-10
+td.kernel()
+nocc = int((mf.mo_occ > 0).sum())
+f = td.oscillator_strength(gauge="length")
+states = []
+for k, (x, _) in enumerate(td.xy):
+    amplitudes = [[int(i) + 1, int(nocc + a) + 1, float(x[i, a])] for i in range(x.shape[0]) for a in range(x.shape[1])]
+    states.append({"ev": float(td.e[k] * nist.HARTREE2EV), "f": float(f[k]), "x": amplitudes})
+print(json.dumps(states))
+"#;
+
+#[test]
+fn a_tda_states_transition_density_gives_pyscfs_oscillator_strength() {
+    use orbcloud::model::excited::{ExcitedState, ExcitedStates, Transition};
+    use orbcloud::model::transition::TransitionDensity;
+    let dir = tempfile::tempdir().unwrap();
+    let molden = dir.path().join("water.molden");
+    let out = std::process::Command::new(orbcloud::sources::compute::python())
+        .args(["-c", TDA_SCRIPT])
+        .arg(&molden)
+        .output()
+        .expect("python (scripts/test sets ORBCLOUD_PYTHON)");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let reference: Vec<serde_json::Value> = serde_json::from_slice(&out.stdout).unwrap();
+    let mut doc = load(&molden);
+    let states = reference
+        .iter()
+        .enumerate()
+        .map(|(k, s)| ExcitedState {
+            number: k + 1,
+            energy_ev: s["ev"].as_f64().unwrap(),
+            spin: "Singlet".into(),
+            transitions: (s["x"].as_array().unwrap().iter())
+                .map(|t| Transition {
+                    from: t[0].as_u64().unwrap() as usize,
+                    to: t[1].as_u64().unwrap() as usize,
+                    coefficient: t[2].as_f64().unwrap(),
+                    spin: String::new(),
+                    deexcitation: false,
+                })
+                .collect(),
+            ..ExcitedState::default()
+        })
+        .collect();
+    doc.excited = Some(ExcitedStates { program: "PySCF".into(), method: "TDA".into(), states, density_of: None });
+    let wf = doc.wavefunction.clone().unwrap();
+    let moments = orbcloud::model::overlap::moment_matrices(&wf.basis);
+    let prepared = orbcloud::model::gto::PreparedBasis::new(&wf.basis);
+    let mut bright = 0;
+    for (k, expected) in reference.iter().enumerate() {
+        let t = TransitionDensity::of_state(&doc, k + 1).expect("a transition density");
+        let (ev, printed) = (expected["ev"].as_f64().unwrap(), expected["f"].as_f64().unwrap());
+        let f = t.oscillator_strength(&wf, &moments, ev);
+        eprintln!("state {}: f {f:.8} here, {printed:.8} PySCF's", k + 1);
+        assert!((f - printed).abs() < 1e-6 * printed.max(1e-3), "state {}: f {f} against PySCF's {printed}", k + 1);
+        bright += (printed > 0.01) as usize;
+        // ∫ ρ₀ₙ = 0 (orthogonal orbitals), and its dipole on a grid is the matrices' one.
+        let (lo, hi) = doc.molecule.bounds().unwrap();
+        let pad = glam::DVec3::splat(7.0);
+        let grid = orbcloud::model::GridSpec::cube(lo - pad, hi + pad, 80);
+        let values = t.grid(&wf, &prepared, &grid);
+        let dv = grid.step(0).x * grid.step(1).y * grid.step(2).z;
+        let [nx, ny, nz] = grid.dims;
+        let (mut total, mut mu) = (0.0, glam::DVec3::ZERO);
+        for i in 0..nx {
+            for j in 0..ny {
+                for k in 0..nz {
+                    let v = f64::from(values[(i * ny + j) * nz + k]) * dv;
+                    total += v;
+                    mu += v * grid.point(i, j, k);
+                }
+            }
+        }
+        let exact = glam::DVec3::from_array(t.dipole(&wf, &moments));
+        assert!(total.abs() < 2e-3, "state {}: ∫ρ₀ₙ = {total}", k + 1);
+        assert!((mu - exact).length() < 0.01 + 0.02 * exact.length(), "state {}: μ {mu} on the grid, {exact}", k + 1);
+        // At points, as on the grid.
+        let p = [grid.point(nx / 2, ny / 3, nz / 2)];
+        let at = t.at_points(&wf, &prepared, &p)[0];
+        let on = f64::from(values[((nx / 2) * ny + ny / 3) * nz + nz / 2]);
+        assert!((at - on).abs() < 1e-5 * (1.0 + at.abs()), "state {}: {at} at the point, {on} on the grid", k + 1);
+    }
+    assert!(bright >= 1, "no bright state among {}", reference.len());
+}
+
+#[test]
+fn cube_writes_a_states_transition_density_from_a_td_logs_amplitudes_joined_to_its_checkpoint() {
+    let Some(dir) = logs("excited_states::cube_writes_a_states_transition_density") else { return };
+    let (log, fchk) = (dir.join("basicGaussian09_dvb_td.out"), dir.join("basicGaussian09_dvb_td.fchk"));
+    let out_dir = tempfile::tempdir().unwrap();
+    let cube = out_dir.path().join("t2.cube");
+    let run = |extra: &[&str], output: &Path| {
+        let mut args: Vec<String> = vec!["cube".into(), fchk.display().to_string()];
+        args.extend(extra.iter().map(ToString::to_string));
+        args.extend(["--grid".into(), "40".into(), "-o".into(), output.display().to_string()]);
+        std::process::Command::new(env!("CARGO_BIN_EXE_orbcloud")).args(&args).output().unwrap()
+    };
+    let log_arg = log.display().to_string();
+    let out = run(&["--transitions", &log_arg, "--transition-density", "--state", "2"], &cube);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let written = load(&cube);
+    let grid = &written.volumes[0];
+    assert!(grid.label.contains("transition density (state 2)"), "{}", grid.label);
+    // Signed, like an orbital, and summing to about nothing (∫ρ₀ₙ = 0).
+    let (lo, hi) = (grid.stats.min, grid.stats.max);
+    assert!(lo < -1e-3 && hi > 1e-3, "values {lo} … {hi}");
+    // Refusals name what is missing: a state not listed; the amplitudes without a log.
+    let out = run(&["--transitions", &log_arg, "--transition-density", "--state", "99"], &cube);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("no excited state 99"), "{err}");
+    let out = run(&["--transition-density", "--state", "2"], &cube);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("state 2"), "{err}");
+}

@@ -768,6 +768,14 @@ fn a_td_log_joins_its_checkpoint_and_a_state_shows_hole_and_particle_in_panes() 
     wait_loaded(&mut h);
     assert_eq!(h.state().objects.len(), 2);
     assert!(h.state().objects[1].doc.source.ends_with("(state 1 NTOs)"), "{}", h.state().objects[1].doc.source);
+    // The same amplitudes make the state's transition density, a quantity of the file.
+    h.get_by_label("transition density").click();
+    h.run_steps(3);
+    wait_loaded(&mut h);
+    let file = &h.state().objects[0];
+    let shown = file.state.selected_quantity().map(|q| q.source);
+    assert_eq!(shown, Some(Source::Wavefunction(Quantity::TransitionDensity(1))));
+    assert!(file.state.visible, "the file shows it");
 }
 
 /// Pixels of `img` that are an NCI surface's blue-green (attraction): green and blue above red.

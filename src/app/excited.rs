@@ -148,6 +148,18 @@ fn list(ui: &mut egui::Ui, doc: &Document, states: &ExcitedStates, view: &mut Ex
         {
             ntos = view.state;
         }
+        // The same amplitudes make its transition density (a singlet's, from the ground state).
+        if crate::model::transition::TransitionDensity::of_state(doc, s.number).is_some()
+            && ui
+                .button("transition density")
+                .on_hover_text(
+                    "where the density oscillates as light drives the transition: 2 Σ X φ_occ φ_virt from the \
+                     printed amplitudes, signed; its dipole gives the oscillator strength",
+                )
+                .clicked()
+        {
+            picks = vec![Pick::Switch(Quantity::TransitionDensity(s.number))];
+        }
     }
     let transitions = states.states.iter().any(|s| !s.transitions.is_empty());
     let header =

@@ -484,7 +484,9 @@ impl OrbApp {
     pub fn shown_grid(&self) -> (Option<f64>, bool) {
         let signed = |q: &crate::scene::QuantityState| match q.source {
             crate::scene::Source::Wavefunction(
-                crate::model::orbitals::Quantity::Orbital(_) | crate::model::orbitals::Quantity::BasisFunction(_),
+                crate::model::orbitals::Quantity::Orbital(_)
+                | crate::model::orbitals::Quantity::BasisFunction(_)
+                | crate::model::orbitals::Quantity::TransitionDensity(_),
             ) => true,
             crate::scene::Source::Wavefunction(_) | crate::scene::Source::Promolecular(_) => false,
             crate::scene::Source::Volume(_) | crate::scene::Source::Scan(_) => true,
@@ -1232,6 +1234,12 @@ impl OrbApp {
                 ntos = Some((self.active, k));
             }
             let view = &mut self.view;
+            // A state's transition density is the file's to show, also when its NTOs stood in
+            // for it.
+            let transition = |p: &orbitals::Pick| {
+                matches!(p, orbitals::Pick::Switch(crate::model::orbitals::Quantity::TransitionDensity(_)))
+            };
+            o.state.visible |= asked.picks.iter().any(transition);
             let reframes: Vec<_> = (asked.picks.into_iter())
                 .map(|p| orbitals::apply(p, &mut o.state, &defaults, (&mut view.panes, &view.camera)))
                 .collect();

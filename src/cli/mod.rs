@@ -209,16 +209,25 @@ struct WhatArgs {
     /// The excited state's own density.
     #[arg(long, conflicts_with_all = &EXCITED_CONFLICTS[..10])]
     excited_density: bool,
+    /// State N's transition density (--state N) from the amplitudes the file lists: where the
+    /// density oscillates as light drives the transition (signed, like an orbital). Needs the
+    /// orbitals and the printed transitions together (a log with both, or PySCF's).
+    #[arg(long, requires = "state", conflicts_with_all = &EXCITED_CONFLICTS[..11])]
+    transition_density: bool,
+    /// A TD log whose printed transitions join the file (its checkpoint, the same molecule in
+    /// any orientation): what --transition-density reads.
+    #[arg(long, value_name = "LOG", requires = "transition_density")]
+    transitions: Option<PathBuf>,
     /// The excited state (numbered as the program numbers them) whose density the options
     /// above show; a Gaussian TD fchk holds one state's density, and another is refused.
     #[arg(long, value_name = "N", value_parser = within(1..=100_000usize))]
     state: Option<usize>,
 }
 
-/// What an excited state's densities exclude: every other quantity. Each of the four conflicts
+/// What an excited state's densities exclude: every other quantity. Each of the five conflicts
 /// with what comes before its own name (clap makes conflicts mutual, and refuses an option that
-/// conflicts with itself), so they take the first 7, 8, 9 and 10 names.
-const EXCITED_CONFLICTS: [&str; 10] = [
+/// conflicts with itself), so they take the first 7, 8, 9, 10 and 11 names.
+const EXCITED_CONFLICTS: [&str; 11] = [
     "density",
     "spin_density",
     "esp",
@@ -229,6 +238,7 @@ const EXCITED_CONFLICTS: [&str; 10] = [
     "difference_density",
     "attachment",
     "detachment",
+    "excited_density",
 ];
 
 /// What `render --nci` excludes: the other quantities, and the isosurface and colouring options
@@ -323,6 +333,15 @@ impl WavefunctionArgs {
 }
 
 impl WhatArgs {
+    /// `file`, with the TD log `--transitions` names joined to it.
+    fn load(&self, file: &std::path::Path) -> Result<Document> {
+        let mut doc = formats::load(file)?;
+        if let Some(log) = &self.transitions {
+            doc.join(formats::load(log)?).map_err(anyhow::Error::msg)?;
+        }
+        Ok(doc)
+    }
+
     /// The excited-state quantity asked for, with its option's name.
     fn state_quantity(&self) -> Option<(Quantity, &'static str)> {
         [
@@ -337,6 +356,13 @@ impl WhatArgs {
     }
 
     fn resolve(&self, doc: &Document) -> Result<Quantity> {
+        if self.transition_density {
+            let n = self.state.context("--transition-density needs --state N")?;
+            return match crate::model::transition::TransitionDensity::of_state(doc, n) {
+                Some(_) => Ok(Quantity::TransitionDensity(n)),
+                None => bail!("{}", crate::model::transition::why_none(doc, n)),
+            };
+        }
         if let Some((quantity, flag)) = self.state_quantity() {
             let excited = doc.wavefunction.as_ref().and_then(|wf| wf.excited.as_ref());
             let Some(excited) = excited else { return Err(no_state_density(doc, flag)) };
@@ -354,7 +380,7 @@ impl WhatArgs {
         let wf = wavefunction_of(doc)?;
         if let Some(n) = self.state {
             bail!(
-                "--state {n} picks the excited state of --difference-density, --attachment, --detachment or --excited-density; none is asked for"
+                "--state {n} picks the excited state of --difference-density, --attachment, --detachment, --excited-density or --transition-density; none is asked for"
             );
         }
         if let Some(name) = &self.basis_function {
@@ -399,6 +425,9 @@ impl WhatArgs {
         }
         if self.density {
             return "density".into();
+        }
+        if let (true, Some(n)) = (self.transition_density, self.state) {
+            return format!("transition_density_{n}");
         }
         if let Some((_, flag)) = self.state_quantity() {
             return flag.trim_start_matches("--").replace('-', "_");
@@ -446,6 +475,7 @@ impl WhatArgs {
             "difference_density" | "attachment" | "detachment" | "excited_density" => {
                 format!("--{}", self.short_name().replace('_', "-"))
             }
+            name if name.starts_with("transition_density") => "--transition-density".into(),
             name => format!("--orbital {name}"),
         }
     }
@@ -467,6 +497,7 @@ fn quantity_label(q: &Quantity, doc: &Document) -> String {
         Quantity::Attachment => format!("attachment density (state {})", state_of(wf)),
         Quantity::Detachment => format!("detachment density (state {})", state_of(wf)),
         Quantity::ExcitedDensity => format!("excited-state density (state {})", state_of(wf)),
+        Quantity::TransitionDensity(n) => format!("transition density (state {n})"),
         Quantity::BasisFunction(k) => {
             let name = crate::model::basis_labels::function_name(&doc.molecule, &wf.basis, *k);
             format!("basis function {}", name.unwrap_or_default())

@@ -58,9 +58,11 @@ pub fn drawing(args: &RenderArgs, doc: Option<Document>, later: &[Later]) -> Res
         (Some(DemoArg::Scan), None) => bail!("the scan demo renders with `orbcloud scan render`"),
         _ => {}
     }
-    let mut doc = match doc {
-        Some(doc) => doc,
-        None => load(args.file.as_deref())?,
+    let mut doc = match (doc, &args.file) {
+        (Some(doc), _) => doc,
+        // A TD log's transitions join the file (`--transitions`).
+        (None, Some(file)) => args.wavefunction.what.load(file)?,
+        (None, None) => load(None)?,
     };
     // Arguments that depend on the file are checked before any GPU work. The camera frames the
     // file's geometry, so pictures of a vibration's phases line up.

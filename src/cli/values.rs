@@ -41,12 +41,17 @@ pub fn eval(files: &[std::path::PathBuf], what: &WhatArgs, points: &Path, minus:
     let mut values;
     let points = match files {
         [file] => {
-            let doc = formats::load(file)?;
+            let doc = what.load(file)?;
             let q = what.resolve(&doc)?;
             let wf = wavefunction_of(&doc)?;
             let prepared = PreparedBasis::new(&wf.basis);
             let points = read_points(points)?;
-            values = prepared.quantity_at_points(wf, &doc.molecule, q, &points);
+            values = match q {
+                Quantity::TransitionDensity(n) => crate::model::transition::TransitionDensity::of_state(&doc, n)
+                    .context("no transition density")?
+                    .at_points(wf, &prepared, &points),
+                _ => prepared.quantity_at_points(wf, &doc.molecule, q, &points),
+            };
             points
         }
         _ => {
@@ -113,7 +118,7 @@ pub fn cube(
     minus: Option<&Path>,
     output: &Path,
 ) -> Result<()> {
-    let doc = formats::load(file)?;
+    let doc = what.load(file)?;
     let q = what.resolve(&doc)?;
     let wf = wavefunction_of(&doc)?;
     let (lo, hi) = match margin {
@@ -133,7 +138,7 @@ pub fn cube(
     }
     let prepared = PreparedBasis::new(&wf.basis);
     let t = Instant::now();
-    let mut values = prepared.quantity_grid_f32(wf, &doc.molecule, q, &spec);
+    let mut values = crate::evaluate::quantity_grid(&doc, &prepared, q, &spec);
     let mut label = super::quantity_label(&q, &doc);
     if let Some(other) = minus {
         let points = crate::evaluate::arithmetic::grid_points(dims, |i, j, k| spec.point(i, j, k));

@@ -254,6 +254,14 @@ pub fn values_at(of: Evaluating, source: Source, points: &[glam::Vec3]) -> Vec<O
         return interaction::values_at(doc, kind, of.fragments, of.others, q, &points);
     }
     match (source, &doc.wavefunction) {
+        (Source::Wavefunction(crate::model::orbitals::Quantity::TransitionDensity(n)), Some(wf)) => {
+            let points: Vec<glam::DVec3> = points.iter().map(|p| p.as_dvec3()).collect();
+            let prepared = crate::model::gto::PreparedBasis::new(&wf.basis);
+            match crate::model::transition::TransitionDensity::of_state(doc, n) {
+                Some(t) => t.at_points(wf, &prepared, &points).into_iter().map(Some).collect(),
+                None => vec![None; points.len()],
+            }
+        }
         (Source::Wavefunction(q), Some(wf)) => {
             let points: Vec<glam::DVec3> = points.iter().map(|p| p.as_dvec3()).collect();
             let prepared = crate::model::gto::PreparedBasis::new(&wf.basis);

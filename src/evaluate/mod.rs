@@ -132,7 +132,8 @@ pub fn evaluate_wavefunction(
         | Quantity::DifferenceDensity
         | Quantity::Attachment
         | Quantity::Detachment
-        | Quantity::ExcitedDensity => None,
+        | Quantity::ExcitedDensity
+        | Quantity::TransitionDensity(_) => None,
     };
     match combination {
         Some(coefficients) => {
@@ -169,12 +170,27 @@ pub fn evaluate_wavefunction(
             let label = crate::scene::Source::Wavefunction(view.quantity).name(doc);
             let values = match view.quantity.from_density_derivatives() && derivatives_on_gpu(ctx) {
                 true => derivative_quantity_on_gpu(ctx, doc, view.quantity, &geometry),
-                false => prepared.quantity_grid_f32(wf, &doc.molecule, view.quantity, &geometry),
+                false => quantity_grid(doc, &prepared, view.quantity, &geometry),
             };
             let grid = VolumeGrid::new(label, geometry.dims, geometry.world_from_grid, values);
             let values = Values { grid: Some(grid), sampled: None };
             Ok(Some(Evaluated { values, cloud: Cloud::Values }))
         }
+    }
+}
+
+/// `quantity` of `doc` on `grid` (its wavefunction's basis `prepared`): what
+/// [`PreparedBasis::quantity_grid_f32`] gives, and a state's transition density from the
+/// document's listed transitions (NaN where the document has none for it: callers check
+/// [`crate::scene::Source::exists_in`]).
+pub fn quantity_grid(doc: &Document, prepared: &PreparedBasis, quantity: Quantity, grid: &GridSpec) -> Vec<f32> {
+    let Some(wf) = &doc.wavefunction else { return vec![f32::NAN; grid.len()] };
+    match quantity {
+        Quantity::TransitionDensity(n) => match crate::model::transition::TransitionDensity::of_state(doc, n) {
+            Some(t) => t.grid(wf, prepared, grid),
+            None => vec![f32::NAN; grid.len()],
+        },
+        _ => prepared.quantity_grid_f32(wf, &doc.molecule, quantity, grid),
     }
 }
 

@@ -87,6 +87,9 @@ impl PreparedBasis {
             Quantity::DifferenceDensity | Quantity::Attachment | Quantity::Detachment | Quantity::ExcitedDensity => {
                 self.grid_sum(&state_sets(wf, quantity), true, grid)
             }
+            // Made of the document's listed transitions, not of the wavefunction alone:
+            // `crate::evaluate::quantity_grid` evaluates it.
+            Quantity::TransitionDensity(_) => vec![f64::NAN; grid.len()],
             Quantity::ReducedGradient
             | Quantity::NciGradient
             | Quantity::NciCloud

@@ -96,7 +96,11 @@ pub fn quantity_box(wf: &Wavefunction, molecule: &Molecule, quantity: Quantity) 
     let (lo, hi) = molecule.bounds()?;
     let prepared = PreparedBasis::new(&wf.basis);
     let decay = match quantity {
-        Quantity::Orbital(_) | Quantity::BasisFunction(_) => Decay::Relative(FACE_FRACTION),
+        // A transition density is a sum of orbital products: as small at the box's faces,
+        // relative to its largest value, as an orbital's square.
+        Quantity::Orbital(_) | Quantity::BasisFunction(_) | Quantity::TransitionDensity(_) => {
+            Decay::Relative(FACE_FRACTION)
+        }
         Quantity::Density
         | Quantity::SpinDensity
         | Quantity::DifferenceDensity

@@ -658,7 +658,9 @@ impl PreparedBasis {
                     | Quantity::NciGradient
                     | Quantity::NciCloud
                     | Quantity::SignLambda2Rho
-                    | Quantity::DensityLaplacian => f64::NAN,
+                    | Quantity::DensityLaplacian
+                    // Of the document's transitions: `crate::evaluate::meshes::values_at`.
+                    | Quantity::TransitionDensity(_) => f64::NAN,
                 }
             })
             .collect()

@@ -45,6 +45,7 @@ pub mod structure;
 pub mod superpose;
 pub mod surface;
 pub mod synthetic;
+pub mod transition;
 pub mod units;
 pub mod vibrations;
 

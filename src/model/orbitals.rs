@@ -214,6 +214,9 @@ pub enum Quantity {
     Detachment,
     /// The excited state's own density.
     ExcitedDensity,
+    /// State n's transition density ρ₀ₙ (its number as the program prints it), from the
+    /// amplitudes the document lists ([`super::transition`]): signed, like an orbital.
+    TransitionDensity(usize),
 }
 
 impl Quantity {

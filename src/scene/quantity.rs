@@ -45,6 +45,9 @@ impl Source {
                 | Quantity::Attachment
                 | Quantity::Detachment
                 | Quantity::ExcitedDensity => wf.excited.is_some(),
+                Quantity::TransitionDensity(n) => {
+                    crate::model::transition::TransitionDensity::of_state(doc, n).is_some()
+                }
             }),
             Source::Scan(slot) => doc.scan.as_ref().is_some_and(|s| slot < s.orbitals.len()),
             Source::Promolecular(q) => !doc.molecule.atoms.is_empty() && is_promolecular(q),
@@ -98,6 +101,7 @@ impl Source {
             Source::Wavefunction(Quantity::Attachment) => "attachment density".into(),
             Source::Wavefunction(Quantity::Detachment) => "detachment density".into(),
             Source::Wavefunction(Quantity::ExcitedDensity) => "excited-state density".into(),
+            Source::Wavefunction(Quantity::TransitionDensity(n)) => format!("transition density (state {n})"),
             Source::Wavefunction(Quantity::Orbital(i)) => match &doc.wavefunction {
                 Some(wf) => orbital_name(wf, i),
                 None => format!("MO {}", i + 1),
