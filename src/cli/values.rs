@@ -91,22 +91,11 @@ pub fn eval(files: &[std::path::PathBuf], what: &WhatArgs, points: &Path, minus:
 /// `quantity` (one of ρ's derivatives) of the summed density of `docs` (fragments, each with a
 /// wavefunction) at `points`.
 pub fn fragments_at(docs: &[crate::model::Document], quantity: Quantity, points: &[DVec3]) -> Result<Vec<f64>> {
-    use crate::model::nci::{DensityDerivatives, DensitySource, WavefunctionDensity};
-    use rayon::prelude::*;
+    use crate::model::nci::{DensitySource, WavefunctionDensity, summed_quantity_at};
     let sources: Vec<WavefunctionDensity> =
         docs.iter().map(|d| wavefunction_of(d).map(WavefunctionDensity::new)).collect::<Result<_>>()?;
-    Ok(points
-        .par_chunks(256)
-        .flat_map_iter(|chunk| {
-            let mut total = vec![DensityDerivatives::default(); chunk.len()];
-            let mut part = vec![DensityDerivatives::default(); chunk.len()];
-            for s in &sources {
-                s.derivatives_at(chunk, &mut part);
-                total.iter_mut().zip(&part).for_each(|(t, p)| t.add(p));
-            }
-            total.into_iter().map(move |d| d.quantity(quantity))
-        })
-        .collect())
+    let sources: Vec<&dyn DensitySource> = sources.iter().map(|s| s as &dyn DensitySource).collect();
+    Ok(summed_quantity_at(&sources, quantity, points))
 }
 
 /// `cube`: the quantity on a grid of `grid` points per side (or `spacing` bohr), over the box

@@ -242,7 +242,7 @@ pub fn grid(
         }
         _ => {
             let points = super::arithmetic::grid_points(spec.dims, |i, j, k| spec.point(i, j, k));
-            summed_at(&parts.sources(), quantity, &points).into_iter().map(|v| v as f32).collect()
+            nci::summed_quantity_at(&parts.sources(), quantity, &points).into_iter().map(|v| v as f32).collect()
         }
     };
     let label = match kind {
@@ -277,7 +277,7 @@ pub fn values_at(
     points: &[DVec3],
 ) -> Vec<Option<f64>> {
     match parts(doc, kind, fragments, others) {
-        Ok(parts) => summed_at(&parts.sources(), quantity, points).into_iter().map(Some).collect(),
+        Ok(parts) => nci::summed_quantity_at(&parts.sources(), quantity, points).into_iter().map(Some).collect(),
         Err(_) => vec![None; points.len()],
     }
 }
@@ -299,21 +299,4 @@ pub fn derivatives_at(
         total.add(&d[0]);
     }
     Some(total)
-}
-
-/// `quantity` of the sum of `sources` at `points`.
-fn summed_at(sources: &[&dyn DensitySource], quantity: Quantity, points: &[DVec3]) -> Vec<f64> {
-    use rayon::prelude::*;
-    points
-        .par_chunks(256)
-        .flat_map_iter(|chunk| {
-            let mut total = vec![DensityDerivatives::default(); chunk.len()];
-            let mut part = total.clone();
-            for s in sources {
-                s.derivatives_at(chunk, &mut part);
-                total.iter_mut().zip(&part).for_each(|(t, p)| t.add(p));
-            }
-            total.into_iter().map(move |d| d.quantity(quantity))
-        })
-        .collect()
 }

@@ -177,10 +177,8 @@ pub fn show_quantity(
                     layer.set_volume(ctx, Some(&grid))?;
                     Some(Values { grid: Some(grid), sampled: None })
                 }
-                Err(why) => {
-                    log::warn!("{why}");
-                    None
-                }
+                // Callers check first (`interaction::check`, as `render --nci` does) and say why.
+                Err(_) => None,
             }
         }
     };

@@ -421,12 +421,21 @@ pub(super) fn bounds(points: &[DVec3]) -> (DVec3, DVec3) {
 
 /// The quantities of ρ's derivatives at `points` for one source, in parallel.
 pub fn quantity_at_points(source: &dyn DensitySource, quantity: Quantity, points: &[DVec3]) -> Vec<f64> {
+    summed_quantity_at(&[source], quantity, points)
+}
+
+/// `quantity` of the summed density of `sources` (fragments) at `points`, in parallel.
+pub fn summed_quantity_at(sources: &[&dyn DensitySource], quantity: Quantity, points: &[DVec3]) -> Vec<f64> {
     points
         .par_chunks(256)
         .flat_map_iter(|chunk| {
-            let mut d = vec![DensityDerivatives::default(); chunk.len()];
-            source.derivatives_at(chunk, &mut d);
-            d.into_iter().map(move |d| d.quantity(quantity))
+            let mut total = vec![DensityDerivatives::default(); chunk.len()];
+            let mut part = total.clone();
+            for s in sources {
+                s.derivatives_at(chunk, &mut part);
+                total.iter_mut().zip(&part).for_each(|(t, p)| t.add(p));
+            }
+            total.into_iter().map(move |d| d.quantity(quantity))
         })
         .collect()
 }
