@@ -905,7 +905,7 @@ impl Viewport {
             render_state.renderer.write().free_texture(&gone.id);
         }
         self.pane_layout.clear();
-        self.renderer.set_lod_scale(self.detail.lod_scale);
+        self.renderer.set_detail(&self.detail);
         for (p, pane) in panes.iter().enumerate() {
             let pane = Pane { camera: fit_width(view.panes.camera(p, &view.camera), size), ..pane.clone() };
             let key = (pane, clouds.clone(), size, view.background, self.generation);
@@ -1138,7 +1138,7 @@ impl Viewport {
             self.drawn = None;
         }
         let clouds: Vec<VolumeSettings> = self.clouds.iter().map(|&c| self.detail.cloud(c)).collect();
-        self.renderer.set_lod_scale(self.detail.lod_scale);
+        self.renderer.set_detail(&self.detail);
         let key = (drawn, clouds, size, self.generation, self.detail.lod_scale.to_bits());
         let changed = self.drawn.as_ref() != Some(&key);
         if changed && self.target.is_some() {
@@ -1267,13 +1267,13 @@ impl Viewport {
         sized_target(&mut self.preview, &self.ctx.device, render_state, size);
         let Some((target, _)) = &self.preview else { return };
         let clouds: Vec<VolumeSettings> = self.clouds.iter().map(|&c| detail.cloud(c)).collect();
-        self.renderer.set_lod_scale(detail.lod_scale);
+        self.renderer.set_detail(&detail);
         let frame = FrameInput { camera: &view.camera, background: view.background, clouds: &clouds, size, tile: None };
         let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
         self.renderer.render(&self.ctx, &mut encoder, &target.color_view, &frame);
         self.ctx.queue.submit([encoder.finish()]);
         let _ = self.ctx.device.poll(wgpu::PollType::wait_indefinitely());
-        self.renderer.set_lod_scale(self.detail.lod_scale);
+        self.renderer.set_detail(&self.detail);
     }
 
     /// Whether a coarse picture stands in while the full one is drawn.

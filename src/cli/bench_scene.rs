@@ -146,7 +146,7 @@ pub fn bench(args: &SceneBench) -> Result<()> {
             .collect();
         let renderer = if part == Part::Clouds { &mut clouds_renderer } else { &mut renderer };
         let target = OffscreenTarget::new(&ctx.device, size);
-        renderer.set_lod_scale(detail.lod_scale);
+        renderer.set_detail(&detail);
         let start = Instant::now();
         let frame = FrameInput { camera: &cam, background: [0.02, 0.02, 0.03], clouds: &clouds, size, tile: None };
         match band {
