@@ -1149,7 +1149,8 @@ impl Viewport {
             // drag) needs none.
             let cpu = self.ctx.info.device_type == wgpu::DeviceType::Cpu;
             let costly = self.renderer.is_costly();
-            if self.progressive.start(cpu || costly, self.detail == Detail::FULL, costly) {
+            let banded = self.progressive.bands_needed(cpu, costly);
+            if self.progressive.start(banded, self.detail == Detail::FULL, costly) {
                 self.draw_preview(render_state, &key.0, shown);
             }
         }
@@ -1183,7 +1184,13 @@ impl Viewport {
                     let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
                     self.renderer.render(&self.ctx, &mut encoder, color_view, &frame);
                     self.ctx.queue.submit([encoder.finish()]);
-                    self.progressive.finished_whole();
+                    // Timed when the GPU is done, without waiting for it here.
+                    let done = Arc::new(std::sync::OnceLock::new());
+                    let set = Arc::clone(&done);
+                    self.ctx.queue.on_submitted_work_done(move || {
+                        let _ = set.set(std::time::Instant::now());
+                    });
+                    self.progressive.submitted_whole(done);
                 }
                 self.drawn = Some(key);
                 self.awaiting_fragments = self.renderer.has_translucent();
@@ -1194,6 +1201,8 @@ impl Viewport {
             self.paint(ui.painter(), rect, *id, size[1]);
         }
         self.check_fragments(ui.ctx());
+        let _ = self.ctx.device.poll(wgpu::PollType::Poll);
+        self.progressive.poll_whole();
         self.layout = Some((rect, size));
         // Hover: read the id under the pointer when it moved and no button is held.
         let pointer = response.hover_pos().filter(|_| !ui.input(|i| i.pointer.any_down()));
