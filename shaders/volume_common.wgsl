@@ -41,7 +41,8 @@ struct VolumeUniforms {
     gradient_power: f32,
     boundary: f32,
     inv_max_grad: f32,
-    _pad2: f32,
+    // Grid cells per brick edge (the walk's shown-bricks texture, volume_interleave.wgsl).
+    brick_cells: f32,
     // xyz: unit normal, w: offset; fragments with n·p > offset are cut away
     clip: vec4<f32>,
     // xyz: unit direction towards the light

@@ -18,6 +18,13 @@
 @group(0) @binding(6) var volume3: texture_3d<f32>;
 // The opaque scene's depth: a cloud's samples stop there.
 @group(0) @binding(7) var scene_depth: texture_depth_2d;
+// Each cloud's bricks of grid cells (`brick_cells` on a side) that hold a value its transfer
+// function shows (1) or none (0): a ray skips the planes it meets inside an empty brick, where
+// every sample would be invisible. One texel "shown" where nothing is skipped.
+@group(0) @binding(8) var bricks0: texture_3d<u32>;
+@group(0) @binding(9) var bricks1: texture_3d<u32>;
+@group(0) @binding(10) var bricks2: texture_3d<u32>;
+@group(0) @binding(11) var bricks3: texture_3d<u32>;
 
 // How many clouds the walk takes (at most 4), and whether the one cloud is already drawn.
 override CLOUDS: u32 = 1u;
@@ -31,6 +38,27 @@ fn cloud_value(k: u32, uvw: vec3<f32>) -> f32 {
         case 2u: { return textureSampleLevel(volume2, volume_sampler, uvw, 0.0).r; }
         case 3u: { return textureSampleLevel(volume3, volume_sampler, uvw, 0.0).r; }
         default: { return textureSampleLevel(volume, volume_sampler, uvw, 0.0).r; }
+    }
+}
+
+// Whether cloud k's brick at `brick` (whole brick coordinates, within its texture) can show
+// anything.
+fn brick_shown(k: u32, brick: vec3<i32>) -> bool {
+    switch k {
+        case 1u: { return textureLoad(bricks1, brick, 0).r != 0u; }
+        case 2u: { return textureLoad(bricks2, brick, 0).r != 0u; }
+        case 3u: { return textureLoad(bricks3, brick, 0).r != 0u; }
+        default: { return textureLoad(bricks0, brick, 0).r != 0u; }
+    }
+}
+
+// The texel sizes of cloud k's volume and of its bricks' texture.
+fn cloud_dims(k: u32) -> array<vec3<u32>, 2> {
+    switch k {
+        case 1u: { return array(textureDimensions(volume1), textureDimensions(bricks1)); }
+        case 2u: { return array(textureDimensions(volume2), textureDimensions(bricks2)); }
+        case 3u: { return array(textureDimensions(volume3), textureDimensions(bricks3)); }
+        default: { return array(textureDimensions(volume), textureDimensions(bricks0)); }
     }
 }
 
@@ -115,6 +143,49 @@ fn nearest_depth() -> f32 {
     return min(min(d.x, d.y), min(d.z, d.w));
 }
 
+// Where the ray o + t·d (brick coordinates: brick b spans [b, b + 1)) first enters a brick of
+// cloud k that can show something, walking the bricks it crosses from t_a (Amanatides and Woo);
+// past t_b when none does before.
+fn first_shown(k: u32, o: vec3<f32>, d: vec3<f32>, top: vec3<f32>, t_a: f32, t_b: f32) -> f32 {
+    var b = clamp(floor(o + t_a * d), vec3<f32>(0.0), top);
+    let forward = d > vec3<f32>(0.0);
+    let step = select(vec3<f32>(-1.0), vec3<f32>(1.0), forward);
+    // The t at which the ray crosses the next face on each axis, and between faces.
+    let inv = 1.0 / d;
+    var cross = (b + select(vec3<f32>(0.0), vec3<f32>(1.0), forward) - o) * inv;
+    let between = abs(inv);
+    var t = t_a;
+    // A ray crosses at most this many bricks (a bound, should rounding keep it in one).
+    let most = u32(top.x + top.y + top.z) + 3u;
+    for (var n = 0u; n < most; n += 1u) {
+        if (t > t_b) {
+            return t;
+        }
+        if (brick_shown(k, vec3<i32>(b))) {
+            return t;
+        }
+        // On to the neighbour across the nearest face (an axis the ray runs along never
+        // crosses: its t is infinite).
+        if (cross.x <= cross.y && cross.x <= cross.z) {
+            t = cross.x;
+            b.x += step.x;
+            cross.x += between.x;
+        } else if (cross.y <= cross.z) {
+            t = cross.y;
+            b.y += step.y;
+            cross.y += between.y;
+        } else {
+            t = cross.z;
+            b.z += step.z;
+            cross.z += between.z;
+        }
+        if (any(b < vec3<f32>(0.0)) || any(b > top)) {
+            return max(t_b, t) + 1.0;
+        }
+    }
+    return t_a;
+}
+
 // Sets up every cloud's ray through the pixel at `xy`; returns the first sample's depth.
 fn begin_clouds(xy: vec2<f32>) -> f32 {
     plane_next = vec4<f32>(1.0);
@@ -159,6 +230,28 @@ fn begin_clouds(xy: vec2<f32>) -> f32 {
             n_dot_r[k] = along;
             plane_next[k] = max(ceil((e + t_in * along - c.slab.x) / step), 0.0);
             plane_last[k] = min(floor((e + t_out * along - c.slab.x) / step), c.slab.y - 1.0);
+            if (plane_next[k] <= plane_last[k]) {
+                // Only the planes between the first and the last brick the ray meets that can
+                // show anything: every sample before or after lies where nothing shows.
+                let t_a = (first[k] + plane_next[k] * step) / along;
+                let t_b = (first[k] + plane_last[k] * step) / along;
+                let dims = cloud_dims(k);
+                // Texel centres lie at (i + ½)/n in texture coordinates: index = uvw·n − ½.
+                let per_brick = vec3<f32>(dims[0]) / c.brick_cells;
+                let o = (c.tex_from_world * vec4<f32>(eye, 1.0)).xyz * per_brick - 0.5 / c.brick_cells;
+                let d = (c.tex_from_world * vec4<f32>(dir, 0.0)).xyz * per_brick;
+                let top = vec3<f32>(dims[1]) - 1.0;
+                let t_shown = first_shown(k, o, d, top, t_a, t_b);
+                let t_last = -first_shown(k, o, -d, top, -t_b, -t_a);
+                // Only where the bricks moved an end: the planes at the ends, recomputed, could
+                // round past themselves.
+                if (t_shown > t_a) {
+                    plane_next[k] = max(plane_next[k], ceil((t_shown * along - first[k]) / step));
+                }
+                if (t_last < t_b) {
+                    plane_last[k] = min(plane_last[k], floor((t_last * along - first[k]) / step));
+                }
+            }
         }
     }
     next_depth = next_depths();

@@ -103,7 +103,7 @@ fn rust_mirrors_match_the_wgsl_layouts() {
                 gradient_power,
                 boundary,
                 inv_max_grad,
-                _pad2,
+                brick_cells,
                 clip,
                 light,
                 world_from_clip,

@@ -75,7 +75,7 @@ impl Detail {
             wgpu::DeviceType::Cpu => CPU_INTERACTIVE_PIXELS / views.max(1) as u32,
             _ => u32::MAX,
         };
-        Self { max_slices: INTERACTIVE_SLICES, max_pixels, lod_scale: INTERACTIVE_LOD_SCALE }
+        Self { max_slices: INTERACTIVE_SLICES, max_pixels, lod_scale: INTERACTIVE_LOD_SCALE, ..Self::FULL }
     }
 }
 

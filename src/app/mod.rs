@@ -18,7 +18,7 @@ mod panels;
 pub mod panes;
 pub mod picture;
 pub mod plane_pane;
-mod progressive;
+pub mod progressive;
 pub mod record;
 pub mod restart;
 pub mod scan;

@@ -1,7 +1,15 @@
 //! A costly picture drawn over several UI frames: in bands of rows sized to a time budget, with
 //! a coarse preview standing in while they fill in, so the window answers within about 100 ms
 //! whatever the view shows. The viewport draws; this decides when and how much.
+//!
+//! Bands cost: each repeats the frame's fixed part (its set-up, every slice's triangles, the
+//! wait for the GPU), which on a GPU can be most of a band's time (a scene of clouds drawn in
+//! 32-row bands took six times as long as at once on one). So on a GPU a picture is drawn in
+//! bands only when the last one took longer, drawn at once or estimated from its bands, than
+//! a turn of bands may ([`AT_ONCE_MS`]); on a CPU rasteriser always, as the window must never
+//! wait on a slow picture there and an at-once picture is only known to be slow after it.
 
+use std::sync::{Arc, OnceLock};
 use std::time::{Duration, Instant};
 
 use crate::gpu::renderer::Tile;
@@ -17,6 +25,9 @@ const BAND_TIME: Duration = Duration::from_millis(40);
 const MAX_BANDS: u32 = 32;
 /// A full picture slower than this gets a coarse preview at once after the next change.
 const PREVIEW_AFTER_MS: f64 = 300.0;
+/// A picture that takes no longer than this at once holds the window no longer than a turn of
+/// bands with a preview standing in ([`REFINE_BUDGET`]): on a GPU it is drawn at once.
+pub const AT_ONCE_MS: f64 = 250.0;
 /// A picture still being drawn after this shows its progress.
 const PROGRESS_AFTER: Duration = Duration::from_millis(150);
 
@@ -52,11 +63,28 @@ pub struct Progressive {
     /// taken once).
     started: Option<Instant>,
     ms: Option<f64>,
+    /// How long the last picture took drawn at once (ms): measured when it was, else estimated
+    /// from its bands ([`whole_from_bands`]).
+    whole_ms: Option<f64>,
+    /// This picture's bands so far: seconds each.
+    band_times: Vec<f64>,
+    /// A picture drawn at once whose GPU work is not known to be done yet: set when it is.
+    pending: Option<Arc<OnceLock<Instant>>>,
 }
 
 impl Default for Progressive {
     fn default() -> Self {
-        Self { bands: None, band_rows: 8, previewing: false, last_full_slow: true, started: None, ms: None }
+        Self {
+            bands: None,
+            band_rows: 8,
+            previewing: false,
+            last_full_slow: true,
+            started: None,
+            ms: None,
+            whole_ms: None,
+            band_times: Vec::new(),
+            pending: None,
+        }
     }
 }
 
@@ -66,14 +94,43 @@ impl Progressive {
     /// one that was slow.
     pub fn start(&mut self, banded: bool, full: bool, costly: bool) -> bool {
         self.started = Some(Instant::now());
+        self.band_times.clear();
+        self.pending = None;
         self.bands = banded.then_some(Bands { next_row: 0, rows: self.band_rows });
         self.previewing = banded && full && (self.last_full_slow || costly);
         self.previewing
     }
 
-    /// The picture was drawn whole at once.
+    /// Whether the next picture should be drawn in bands: always on a CPU adapter (`cpu`); on
+    /// a GPU when the last picture took longer than [`AT_ONCE_MS`] at once, or, before any was
+    /// timed, when it is `costly` (orbitals evaluated per sample).
+    pub fn bands_needed(&self, cpu: bool, costly: bool) -> bool {
+        cpu || self.whole_ms.map_or(costly, |ms| ms > AT_ONCE_MS)
+    }
+
+    /// How long the last picture took, or would have taken, drawn at once (ms).
+    pub fn whole_ms(&self) -> Option<f64> {
+        self.whole_ms
+    }
+
+    /// The picture was drawn whole at once and has been waited for.
     pub fn finished_whole(&mut self) {
         self.ms = self.started.take().map(|t| t.elapsed().as_secs_f64() * 1e3);
+        self.whole_ms = self.ms;
+    }
+
+    /// The picture was submitted whole at once; `done` is set when the GPU has finished it
+    /// (a queue's work-done callback), which [`Self::poll_whole`] reads.
+    pub fn submitted_whole(&mut self, done: Arc<OnceLock<Instant>>) {
+        self.pending = Some(done);
+    }
+
+    /// Takes the time of a picture drawn at once once its GPU work is done.
+    pub fn poll_whole(&mut self) {
+        let Some(done) = self.pending.as_ref().and_then(|d| d.get().copied()) else { return };
+        self.pending = None;
+        self.ms = self.started.take().map(|t| done.saturating_duration_since(t).as_secs_f64() * 1e3);
+        self.whole_ms = self.ms;
     }
 
     /// Draws bands of a picture of `size` with `draw` (which waits for the GPU) until this
@@ -90,7 +147,9 @@ impl Progressive {
             let rows = p.rows.min(height - p.next_row);
             let band = Instant::now();
             draw(Tile { rect: [0, p.next_row, width, rows], first: p.next_row == 0 });
-            let per_row = band.elapsed().as_secs_f64() / f64::from(rows);
+            let seconds = band.elapsed().as_secs_f64();
+            self.band_times.push(seconds);
+            let per_row = seconds / f64::from(rows);
             p.next_row += rows;
             p.rows = next_band_rows(rows, height, per_row);
             // The rest will take long: a coarse picture stands in from now.
@@ -103,7 +162,8 @@ impl Progressive {
         self.band_rows = p.rows;
         if p.next_row >= height {
             self.bands = None;
-            self.finished_whole();
+            self.ms = self.started.take().map(|t| t.elapsed().as_secs_f64() * 1e3);
+            self.whole_ms = whole_from_bands(&self.band_times);
             if full {
                 self.last_full_slow = self.ms.is_some_and(|ms| ms > PREVIEW_AFTER_MS);
             }
@@ -156,6 +216,17 @@ impl Progressive {
     }
 }
 
+/// How long a picture would take at once, from its bands' seconds, in ms: the bands'
+/// sum less the fixed part each band after the first repeated, which is at most the quickest
+/// band's time (rows cost unevenly, clouds in some and background in others, so no line through
+/// the bands' times would do). A low estimate at worst: a picture then drawn at once and found
+/// slow is timed, and banded again the next time.
+fn whole_from_bands(bands: &[f64]) -> Option<f64> {
+    let total: f64 = bands.iter().sum();
+    let quickest = bands.iter().copied().reduce(f64::min)?;
+    Some((total - quickest * (bands.len() - 1) as f64) * 1e3)
+}
+
 /// Rows for the band after one of `rows` that took `per_row_s` seconds a row, in a picture of
 /// `height` rows: what fits [`BAND_TIME`], at most twice the band before (one band measured
 /// fast, its GPU work overlapping the last, must not turn the rest into one band that holds the
@@ -170,6 +241,34 @@ fn next_band_rows(rows: u32, height: u32, per_row_s: f64) -> u32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_whole_picture_is_estimated_without_the_bands_fixed_part() {
+        // 5 ms a band plus the rows' own: 50 ms of rows, four bands, 15 ms of fixed parts.
+        let bands = [0.005, 0.025, 0.02, 0.02];
+        let ms = whole_from_bands(&bands).unwrap();
+        assert!((ms - 55.0).abs() < 1e-9, "{ms}");
+        assert_eq!(whole_from_bands(&[]), None);
+    }
+
+    #[test]
+    fn a_gpu_bands_only_pictures_that_were_slow() {
+        let mut p = Progressive::default();
+        assert!(p.bands_needed(true, false), "a CPU adapter always bands");
+        assert!(!p.bands_needed(false, false) && p.bands_needed(false, true), "untimed: costly ones");
+        p.whole_ms = Some(AT_ONCE_MS * 0.5);
+        assert!(!p.bands_needed(false, true), "a costly picture that was quick is drawn at once");
+        p.whole_ms = Some(AT_ONCE_MS * 2.0);
+        assert!(p.bands_needed(false, false), "a slow picture is banded on a GPU too");
+        let done = Arc::new(OnceLock::new());
+        p.start(false, true, false);
+        p.submitted_whole(done.clone());
+        p.poll_whole();
+        assert_eq!(p.whole_ms, Some(AT_ONCE_MS * 2.0), "not done yet");
+        done.set(Instant::now()).unwrap();
+        p.poll_whole();
+        assert!(p.whole_ms.is_some_and(|ms| ms < AT_ONCE_MS) && !p.bands_needed(false, false));
+    }
 
     #[test]
     fn bands_fit_their_time_within_bounds() {

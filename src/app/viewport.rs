@@ -948,7 +948,7 @@ impl Viewport {
             render_state.renderer.write().free_texture(&gone.id);
         }
         self.pane_layout.clear();
-        self.renderer.set_lod_scale(self.detail.lod_scale);
+        self.renderer.set_detail(&self.detail);
         for (p, pane) in panes.iter().enumerate() {
             let pane = Pane { camera: fit_width(view.panes.camera(p, &view.camera), size), ..pane.clone() };
             let key = (pane, clouds.clone(), size, view.background, self.generation);
@@ -1181,7 +1181,7 @@ impl Viewport {
             self.drawn = None;
         }
         let clouds: Vec<VolumeSettings> = self.clouds.iter().map(|&c| self.detail.cloud(c)).collect();
-        self.renderer.set_lod_scale(self.detail.lod_scale);
+        self.renderer.set_detail(&self.detail);
         let key = (drawn, clouds, size, self.generation, self.detail.lod_scale.to_bits());
         let changed = self.drawn.as_ref() != Some(&key);
         if changed && self.target.is_some() {
@@ -1192,7 +1192,8 @@ impl Viewport {
             // drag) needs none.
             let cpu = self.ctx.info.device_type == wgpu::DeviceType::Cpu;
             let costly = self.renderer.is_costly();
-            if self.progressive.start(cpu || costly, self.detail == Detail::FULL, costly) {
+            let banded = self.progressive.bands_needed(cpu, costly);
+            if self.progressive.start(banded, self.detail == Detail::FULL, costly) {
                 self.draw_preview(render_state, &key.0, shown);
             }
         }
@@ -1226,7 +1227,13 @@ impl Viewport {
                     let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
                     self.renderer.render(&self.ctx, &mut encoder, color_view, &frame);
                     self.ctx.queue.submit([encoder.finish()]);
-                    self.progressive.finished_whole();
+                    // Timed when the GPU is done, without waiting for it here.
+                    let done = Arc::new(std::sync::OnceLock::new());
+                    let set = Arc::clone(&done);
+                    self.ctx.queue.on_submitted_work_done(move || {
+                        let _ = set.set(std::time::Instant::now());
+                    });
+                    self.progressive.submitted_whole(done);
                 }
                 self.drawn = Some(key);
                 self.awaiting_fragments = self.renderer.has_translucent();
@@ -1237,6 +1244,8 @@ impl Viewport {
             self.paint(ui.painter(), rect, *id, size[1]);
         }
         self.check_fragments(ui.ctx());
+        let _ = self.ctx.device.poll(wgpu::PollType::Poll);
+        self.progressive.poll_whole();
         self.layout = Some((rect, size));
         // Hover: read the id under the pointer when it moved and no button is held.
         let pointer = response.hover_pos().filter(|_| !ui.input(|i| i.pointer.any_down()));
@@ -1310,13 +1319,13 @@ impl Viewport {
         sized_target(&mut self.preview, &self.ctx.device, render_state, size);
         let Some((target, _)) = &self.preview else { return };
         let clouds: Vec<VolumeSettings> = self.clouds.iter().map(|&c| detail.cloud(c)).collect();
-        self.renderer.set_lod_scale(detail.lod_scale);
+        self.renderer.set_detail(&detail);
         let frame = FrameInput { camera: &view.camera, background: view.background, clouds: &clouds, size, tile: None };
         let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
         self.renderer.render(&self.ctx, &mut encoder, &target.color_view, &frame);
         self.ctx.queue.submit([encoder.finish()]);
         let _ = self.ctx.device.poll(wgpu::PollType::wait_indefinitely());
-        self.renderer.set_lod_scale(self.detail.lod_scale);
+        self.renderer.set_detail(&self.detail);
     }
 
     /// Whether a coarse picture stands in while the full one is drawn.

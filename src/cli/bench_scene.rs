@@ -4,6 +4,7 @@
 
 use std::time::Instant;
 
+use crate::app::progressive::{Progressive, Turn};
 use crate::gpu::{FrameInput, OffscreenTarget, Renderer, Tile};
 use crate::layers::show_scene;
 use crate::pictures::headless::draw_exact;
@@ -93,9 +94,6 @@ enum Part {
     Surfaces,
 }
 
-/// Rows of one band of a picture drawn band by band.
-const BAND_ROWS: u32 = 32;
-
 pub fn bench(args: &SceneBench) -> Result<()> {
     let ctx = super::gpu(args.bench.lavapipe)?;
     let scene = molecules(&args.files, args.molecules.max(1))?;
@@ -134,32 +132,76 @@ pub fn bench(args: &SceneBench) -> Result<()> {
     );
     // One picture at `detail` after the camera moved by `f` steps: ms from the change to the
     // picture done, and the picture.
-    // `band`: drawn as the window draws a slow picture, in tiles of that many rows, each
-    // waited for.
+    // `bands`: drawn as the window draws a picture after a change: in bands (each waited for)
+    // or at once, as its schedule decides ([`Progressive`]), the coarse preview first where it
+    // would stand in.
     // `part`: the whole scene, its surfaces alone or its clouds alone.
-    let mut part_picture = |part: Part, detail: Detail, f: u32, band: Option<u32>| -> Result<(f64, image::RgbaImage)> {
+    let cpu = ctx.info.device_type == wgpu::DeviceType::Cpu;
+    let mut part_picture = |part: Part,
+                            detail: Detail,
+                            f: u32,
+                            schedule: Option<&mut Progressive>|
+     -> Result<(f64, image::RgbaImage)> {
         let mut cam = camera;
         cam.orbit(0.05 * f as f32, 0.02 * f as f32);
-        let size = detail.render_size(size);
-        let clouds: Vec<_> = (shown.clouds.iter())
-            .map(|&c| crate::scene::VolumeSettings { visible: c.visible && part != Part::Surfaces, ..detail.cloud(c) })
-            .collect();
+        let render_size = detail.render_size(size);
+        let cloud_settings = |detail: Detail| -> Vec<_> {
+            (shown.clouds.iter())
+                .map(|&c| crate::scene::VolumeSettings {
+                    visible: c.visible && part != Part::Surfaces,
+                    ..detail.cloud(c)
+                })
+                .collect()
+        };
+        let clouds = cloud_settings(detail);
         let renderer = if part == Part::Clouds { &mut clouds_renderer } else { &mut renderer };
-        let target = OffscreenTarget::new(&ctx.device, size);
-        renderer.set_lod_scale(detail.lod_scale);
+        let target = OffscreenTarget::new(&ctx.device, render_size);
+        renderer.set_detail(&detail);
         let start = Instant::now();
-        let frame = FrameInput { camera: &cam, background: [0.02, 0.02, 0.03], clouds: &clouds, size, tile: None };
-        match band {
+        let frame =
+            FrameInput { camera: &cam, background: [0.02, 0.02, 0.03], clouds: &clouds, size: render_size, tile: None };
+        match schedule {
             None => {
                 draw_exact(&ctx, renderer, &target.color_view, &frame);
             }
-            Some(rows) => {
-                for y in (0..size[1]).step_by(rows.max(1) as usize) {
-                    let tile = Tile { rect: [0, y, size[0], rows.min(size[1] - y)], first: y == 0 };
+            Some(schedule) => {
+                let preview_clouds = cloud_settings(Detail::PREVIEW);
+                let preview_size = Detail::PREVIEW.render_size(size);
+                let preview_target = OffscreenTarget::new(&ctx.device, preview_size);
+                let preview = |renderer: &mut Renderer| {
+                    renderer.set_detail(&Detail::PREVIEW);
+                    let frame = FrameInput { clouds: &preview_clouds, size: preview_size, ..frame };
                     let mut encoder = ctx.device.create_command_encoder(&Default::default());
-                    renderer.render(&ctx, &mut encoder, &target.color_view, &FrameInput { tile: Some(tile), ..frame });
+                    renderer.render(&ctx, &mut encoder, &preview_target.color_view, &frame);
                     ctx.queue.submit([encoder.finish()]);
-                    ctx.device.poll(wgpu::PollType::wait_indefinitely())?;
+                    let _ = ctx.device.poll(wgpu::PollType::wait_indefinitely());
+                    renderer.set_detail(&detail);
+                };
+                let costly = renderer.is_costly();
+                let banded = schedule.bands_needed(cpu, costly);
+                if schedule.start(banded, true, costly) {
+                    preview(renderer);
+                }
+                let draw = |renderer: &mut Renderer, tile: Option<Tile>| {
+                    let mut encoder = ctx.device.create_command_encoder(&Default::default());
+                    renderer.render(&ctx, &mut encoder, &target.color_view, &FrameInput { tile, ..frame });
+                    ctx.queue.submit([encoder.finish()]);
+                    let _ = ctx.device.poll(wgpu::PollType::wait_indefinitely());
+                };
+                if banded {
+                    loop {
+                        match schedule.turn(render_size, true, |tile| draw(renderer, Some(tile))) {
+                            Turn::Done => break,
+                            Turn::More => {}
+                            Turn::WantPreview => {
+                                preview(renderer);
+                                schedule.preview_drawn();
+                            }
+                        }
+                    }
+                } else {
+                    draw(renderer, None);
+                    schedule.finished_whole();
                 }
             }
         }
@@ -167,20 +209,27 @@ pub fn bench(args: &SceneBench) -> Result<()> {
         let ms = start.elapsed().as_secs_f64() * 1e3;
         Ok((ms, target.read_rgba(&ctx.device, &ctx.queue)?))
     };
-    let mut picture = |detail, f, band| part_picture(Part::Whole, detail, f, band);
-    // Warm up: every pipeline built once, at both sizes.
+    let mut picture =
+        |detail: Detail, f: u32, schedule: Option<&mut Progressive>| part_picture(Part::Whole, detail, f, schedule);
+    // Warm up: every pipeline built once, at both sizes, and the window's schedule given a
+    // picture to measure (as the window's first picture after opening).
+    let mut schedule = Progressive::default();
     picture(Detail::PREVIEW, 0, None)?;
     picture(Detail::FULL, 0, None)?;
+    picture(Detail::FULL, 0, Some(&mut schedule))?;
     let median = |mut v: Vec<f64>| {
         v.sort_by(f64::total_cmp);
         v[v.len() / 2]
     };
     let (mut previews, mut fulls, mut banded) = (Vec::new(), Vec::new(), Vec::new());
+    // Whether the window would band the next picture, after each.
+    let mut bands_used = Vec::new();
     let mut last = None;
     for f in 1..=args.bench.frames.max(1) {
         let (preview_ms, preview) = picture(Detail::PREVIEW, f, None)?;
         let (full_ms, full) = picture(Detail::FULL, f, None)?;
-        banded.push(picture(Detail::FULL, f, Some(BAND_ROWS))?.0);
+        banded.push(picture(Detail::FULL, f, Some(&mut schedule))?.0);
+        bands_used.push(schedule.bands_needed(cpu, false));
         previews.push(preview_ms);
         fulls.push(preview_ms + full_ms);
         last = Some((preview, full));
@@ -194,7 +243,19 @@ pub fn bench(args: &SceneBench) -> Result<()> {
         median(previews)
     );
     println!("full picture: {:.0} ms after a change (the preview's time included)", median(fulls));
-    println!("full picture in bands of {BAND_ROWS} rows, as the window draws it: {:.0} ms", median(banded));
+    let how = match (cpu, bands_used.iter().all(|&b| b), bands_used.iter().any(|&b| b)) {
+        (true, _, _) => "in bands (a CPU adapter)".to_string(),
+        (false, true, _) => {
+            format!("in bands (drawn at once it took over {:.0} ms)", crate::app::progressive::AT_ONCE_MS)
+        }
+        (false, false, false) => format!("at once (it takes under {:.0} ms)", crate::app::progressive::AT_ONCE_MS),
+        (false, false, true) => "at once and in bands, in turn".to_string(),
+    };
+    println!(
+        "full picture as the window draws it, {how}: {:.0} ms (at once, estimated from its bands or measured: {:.0} ms)",
+        median(banded),
+        schedule.whole_ms().unwrap_or(f64::NAN)
+    );
     let parts = [Part::Clouds, Part::Surfaces].map(|part| {
         let times: Result<Vec<f64>> =
             (1..=args.bench.frames.max(1)).map(|f| Ok(part_picture(part, Detail::FULL, f, None)?.0)).collect();

@@ -433,14 +433,17 @@ pub fn bench_keyvolumes(args: KeyVolumeBench) -> Result<()> {
         let upload = t.elapsed().as_secs_f64();
         let mut renderer = Renderer::new(&ctx);
         renderer.main().set_molecule(&ctx, &molecule, settings.atoms);
-        let mut medians = Vec::new();
+        // The modes take turns frame by frame, each at the same value: whatever else slows the
+        // machine or the driver down for a while (on a fast GPU a frame is mostly its CPU side
+        // and the wait for the GPU) falls on all three alike, not on the mode timed then.
+        const MODES: [Interpolation; 3] = [Interpolation::Exact, Interpolation::ThreePass, Interpolation::AlphaMix];
+        let mut times: [Vec<f64>; 3] = Default::default();
         let mut last_frames = Vec::new();
-        for mode in [Interpolation::Exact, Interpolation::ThreePass, Interpolation::AlphaMix] {
-            let mut times = Vec::new();
-            for f in 0..args.frames.max(1) + 1 {
-                // Spread the frames over all K volumes, as a drag across the whole range would.
-                let i = (f * (k - 1)) / args.frames.max(1);
-                let (a, b) = (i.min(k - 2), i.min(k - 2) + 1);
+        for f in 0..args.frames.max(1) + 1 {
+            // Spread the frames over all K volumes, as a drag across the whole range would.
+            let i = (f * (k - 1)) / args.frames.max(1);
+            let (a, b) = (i.min(k - 2), i.min(k - 2) + 1);
+            for (m, &mode) in MODES.iter().enumerate() {
                 renderer.main().set_morph(&ctx, keys[a].clone(), keys[b].clone(), 0.37, mode);
                 let t = Instant::now();
                 let mut encoder =
@@ -449,14 +452,22 @@ pub fn bench_keyvolumes(args: KeyVolumeBench) -> Result<()> {
                 renderer.render(&ctx, &mut encoder, &target.color_view, &frame);
                 ctx.queue.submit([encoder.finish()]);
                 ctx.device.poll(wgpu::PollType::wait_indefinitely())?;
+                // The first round builds each mode's pipelines.
                 if f > 0 {
-                    times.push(t.elapsed().as_secs_f64() * 1e3);
+                    times[m].push(t.elapsed().as_secs_f64() * 1e3);
+                }
+                if f == args.frames.max(1) {
+                    last_frames.push(target.read_rgba(&ctx.device, &ctx.queue)?);
                 }
             }
-            times.sort_by(f64::total_cmp);
-            medians.push(times[times.len() / 2]);
-            last_frames.push(target.read_rgba(&ctx.device, &ctx.queue)?);
         }
+        let medians: Vec<f64> = times
+            .iter_mut()
+            .map(|t| {
+                t.sort_by(f64::total_cmp);
+                t[t.len() / 2]
+            })
+            .collect();
         // The three-pass approximation against the α-mix it approximates, on the last frame.
         let (mut sum, mut worst) = (0u64, 0u8);
         for (p, q) in last_frames[1].pixels().zip(last_frames[2].pixels()) {

@@ -176,6 +176,8 @@ pub struct Prepare<'a> {
     pub later_tile: bool,
     /// The factor on level-of-detail thresholds (above 1 while the user drags).
     pub lod_scale: f32,
+    /// Clouds' slice planes per texel along the view at most (infinite: as many as asked).
+    pub planes_per_texel: f32,
     /// The number of the layer's first translucent surface among the frame's.
     pub first_translucent: usize,
     /// The fragment lists translucent surfaces append to (when the frame has any and the layer

@@ -66,6 +66,7 @@ pub struct Renderer {
     pyramid: DepthPyramid,
     transparency: Transparency,
     lod_scale: f32,
+    planes_per_texel: f32,
     frame: &'static [PhaseNode],
     /// The targets at the last frame's size, and the resolve pass's view of their colour.
     targets: Option<(FrameTargets, wgpu::BindGroup)>,
@@ -99,6 +100,7 @@ impl Renderer {
             pyramid,
             transparency: Transparency::Exact,
             lod_scale: 1.0,
+            planes_per_texel: f32::INFINITY,
             frame: STANDARD_FRAME,
             targets: None,
         }
@@ -114,6 +116,19 @@ impl Renderer {
     /// points or coarser and the view keeps up.
     pub fn set_lod_scale(&mut self, scale: f32) {
         self.lod_scale = scale;
+    }
+
+    /// Caps every cloud's slice planes at this many per texel of its grid along the view
+    /// ([`crate::scene::detail::Detail::planes_per_texel`]); infinite (the default) draws the
+    /// slice count each cloud asks for.
+    pub fn set_planes_per_texel(&mut self, planes: f32) {
+        self.planes_per_texel = planes;
+    }
+
+    /// The level of detail `detail` asks of surfaces and clouds.
+    pub fn set_detail(&mut self, detail: &crate::scene::detail::Detail) {
+        self.lod_scale = detail.lod_scale;
+        self.planes_per_texel = detail.planes_per_texel;
     }
 
     /// Layer `n` (object `n`); layer 0 always exists.
@@ -291,6 +306,7 @@ impl Renderer {
                 depth: &targets.depth_view,
                 later_tile,
                 lod_scale: self.lod_scale,
+                planes_per_texel: self.planes_per_texel,
                 first_translucent,
                 lists: lists.filter(|_| layer.visible).map(|l| (l, self.transparency)),
                 cloud: frame.clouds.get(n).unwrap_or(&hidden),

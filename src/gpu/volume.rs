@@ -44,7 +44,8 @@ pub struct VolumeUniforms {
     pub gradient_power: f32,
     pub boundary: f32,
     pub inv_max_grad: f32,
-    pub _pad2: f32,
+    /// Grid cells per brick edge, the walk's empty-brick test's scale.
+    pub brick_cells: f32,
     pub clip: [f32; 4],
     pub light: [f32; 4],
     pub world_from_clip: [[f32; 4]; 4],
@@ -330,6 +331,9 @@ pub struct VolumePass {
     /// The occupied cells for the last visibility floor (None: nothing to skip), kept while
     /// the volume and the floor stay.
     occupancy: Option<(f32, Option<Occupancy>)>,
+    /// Which bricks can show a value, one texel each (1: may show), for the visibility floor it
+    /// was made for (None: every brick), read where a walk samples the cloud.
+    shown_bricks: Option<(Option<f32>, wgpu::TextureView)>,
     bind_group: Option<wgpu::BindGroup>,
     volume: Option<VolumeTexture>,
     /// Basis functions of the orbital shown in direct mode (then `volume` holds only its box).
@@ -342,6 +346,8 @@ pub struct VolumePass {
     depth_group: Option<(wgpu::TextureView, wgpu::BindGroup)>,
     /// The most planes a fragment of the texture's slices samples ([`SLAB_PLANES`]).
     slab_planes: usize,
+    /// This frame's most slice planes per texel along the view ([`super::frame::Prepare`]).
+    planes_per_texel: f32,
 }
 
 /// The override constants of `variant` (a walk's: whether any of its clouds needs each).
@@ -545,6 +551,7 @@ impl VolumePass {
             vertex_count: 0,
             slice_vertices: Vec::new(),
             occupancy: None,
+            shown_bricks: None,
             bind_group: None,
             volume: None,
             direct: None,
@@ -552,6 +559,7 @@ impl VolumePass {
             frame_uniforms: VolumeUniforms::zeroed(),
             depth_group: None,
             slab_planes: SLAB_PLANES,
+            planes_per_texel: f32::INFINITY,
         }
     }
 
@@ -609,6 +617,7 @@ impl VolumePass {
     pub fn set_texture(&mut self, ctx: &GpuContext, volume: Option<VolumeTexture>) {
         self.direct = None;
         self.occupancy = None;
+        self.shown_bricks = None;
         self.morph = None;
         self.volume = volume;
         self.bind_group = self.volume.as_ref().map(|v| {
@@ -678,15 +687,59 @@ impl VolumePass {
     /// in direct mode (no grid), nor where the values' bricks are unknown or the transfer
     /// function shows values near zero.
     fn occupancy(&mut self, settings: &VolumeSettings) -> Option<&Occupancy> {
-        let vol = self.volume.as_ref().filter(|_| settings.skip_empty && self.direct.is_none())?;
+        let floor = self.skip_floor(settings)?;
+        let vol = self.volume.as_ref()?;
         let bricks = vol.bricks.as_ref()?;
         let signed = vol.kind == ValueKind::Signed;
-        let floor = visible_floor(settings, signed, vol.max_abs)?;
         if self.occupancy.as_ref().is_none_or(|(f, _)| *f != floor) {
             let cells = Occupancy::new(&vol.grid_box, bricks, &bricks.occupied(floor, signed)).filter(|o| !o.is_full());
             self.occupancy = Some((floor, cells));
         }
         self.occupancy.as_ref()?.1.as_ref()
+    }
+
+    /// The smallest value `settings` shows, where bricks below it can be skipped (see
+    /// [`Self::occupancy`]).
+    fn skip_floor(&self, settings: &VolumeSettings) -> Option<f32> {
+        let vol = self.volume.as_ref().filter(|_| settings.skip_empty && self.direct.is_none())?;
+        vol.bricks.as_ref()?;
+        visible_floor(settings, vol.kind == ValueKind::Signed, vol.max_abs)
+    }
+
+    /// The bricks `settings` can show as a texture (texel x = the grid's k, as the volume's),
+    /// made again when the visibility floor changes; one texel "shown" where nothing is skipped.
+    fn update_shown_bricks(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, settings: &VolumeSettings) {
+        let floor = self.skip_floor(settings);
+        if self.shown_bricks.as_ref().is_some_and(|(f, _)| *f == floor) {
+            return;
+        }
+        let (counts, flags) = match (floor, self.volume.as_ref().and_then(|v| Some((v.kind, v.bricks.as_ref()?)))) {
+            (Some(floor), Some((kind, bricks))) => {
+                let flags = bricks.occupied(floor, kind == ValueKind::Signed);
+                (bricks.counts, flags.iter().map(|&o| o as u8).collect())
+            }
+            _ => ([1, 1, 1], vec![1u8]),
+        };
+        let texture = device.create_texture_with_data(
+            queue,
+            &wgpu::TextureDescriptor {
+                label: Some("shown bricks"),
+                size: wgpu::Extent3d {
+                    width: counts[2] as u32,
+                    height: counts[1] as u32,
+                    depth_or_array_layers: counts[0] as u32,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D3,
+                format: wgpu::TextureFormat::R8Uint,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+                view_formats: &[],
+            },
+            wgpu::util::TextureDataOrder::LayerMajor,
+            &flags,
+        );
+        self.shown_bricks = Some((floor, texture.create_view(&Default::default())));
     }
 
     /// Cuts this frame's slices and uploads them with the uniforms; `clip`: the object's
@@ -710,9 +763,15 @@ impl VolumePass {
         if !settings.visible {
             return;
         }
-        let (mode, count) = (settings.mode, settings.slices);
+        let mode = settings.mode;
         let cells = self.occupancy(settings).map(|o| (*o).clone());
+        self.update_shown_bricks(device, queue, settings);
         let Some(vol) = &self.volume else { return };
+        let count = match self.direct {
+            // Direct mode evaluates the orbital itself: it has no texels to count.
+            Some(_) => settings.slices,
+            None => settings.slices.min(texel_planes(vol, mode, eye, view_dir, self.planes_per_texel)),
+        };
         let slices = match &cells {
             Some(o) => o.slices(&vol.grid_box, mode, count, eye, view_dir),
             None => vol.grid_box.slices(mode, count, eye, view_dir),
@@ -792,7 +851,7 @@ impl VolumePass {
             gradient_power: t.gradient_power,
             boundary: t.boundary.clamp(0.0, 1.0),
             inv_max_grad: 1.0 / vol.max_grad,
-            _pad2: 0.0,
+            brick_cells: BRICK_CELLS as f32,
             clip: clip.unwrap_or(crate::scene::transfer::NO_CUT).to_array(),
             light: view.light.extend(0.0).to_array(),
             world_from_clip: view.clip_from_object.inverse().to_cols_array_2d(),
@@ -865,7 +924,10 @@ impl VolumePass {
             contents: bytemuck::cast_slice(&uniforms),
             usage: wgpu::BufferUsages::UNIFORM,
         });
+        let bricks: Vec<&wgpu::TextureView> =
+            clouds.iter().map(|c| c.shown_bricks.as_ref().map(|(_, v)| v)).collect::<Option<_>>()?;
         let view = |k: usize| wgpu::BindingResource::TextureView(views.get(k).copied().unwrap_or(views[0]));
+        let bricks_view = |k: usize| wgpu::BindingResource::TextureView(bricks.get(k).copied().unwrap_or(bricks[0]));
         let mut entries = vec![
             wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&shared.sampler) },
             wgpu::BindGroupEntry { binding: WALK_UNIFORMS, resource: walk_uniforms.as_entire_binding() },
@@ -873,6 +935,10 @@ impl VolumePass {
         ];
         entries.extend(
             WALK_TEXTURES.iter().enumerate().map(|(k, &binding)| wgpu::BindGroupEntry { binding, resource: view(k) }),
+        );
+        entries.extend(
+            (WALK_BRICKS.iter().enumerate())
+                .map(|(k, &binding)| wgpu::BindGroupEntry { binding, resource: bricks_view(k) }),
         );
         let bind_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("cloud walk bind group"),
@@ -920,6 +986,8 @@ const WALK_TEXTURES: [u32; MAX_WALKED] = [1, 4, 5, 6];
 const WALK_UNIFORMS: u32 = 3;
 /// The opaque scene's depth in a walk's group 0.
 const WALK_DEPTH: u32 = 7;
+/// Each walked cloud's shown bricks ([`VolumePass::update_shown_bricks`]).
+const WALK_BRICKS: [u32; MAX_WALKED] = [8, 9, 10, 11];
 
 /// Group 0 of a walk over clouds.
 fn walk_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
@@ -932,6 +1000,16 @@ fn walk_entries() -> Vec<wgpu::BindGroupLayoutEntry> {
     entries.push(super::uniform_entry(WALK_UNIFORMS, wgpu::ShaderStages::FRAGMENT));
     entries.extend(WALK_TEXTURES.map(volume_entry));
     entries.push(depth_entry(WALK_DEPTH));
+    entries.extend(WALK_BRICKS.map(|binding| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Uint,
+            view_dimension: wgpu::TextureViewDimension::D3,
+            multisampled: false,
+        },
+        count: None,
+    }));
     entries
 }
 
@@ -956,6 +1034,22 @@ fn before_near_plane(vertices: &[Vec3], clip_from_world: Mat4) -> bool {
         let c = clip_from_world * v.extend(1.0);
         c.w > 0.0 && c.z >= 0.0
     })
+}
+
+/// How many planes `mode` needs across `vol`'s box for `per_texel` of them per texel of its
+/// grid along the planes' normal, on the axis of the grid the normal crosses fastest (u32::MAX
+/// when unbounded). Samples closer than that along a ray meet the same trilinear cells.
+fn texel_planes(vol: &VolumeTexture, mode: crate::scene::SliceMode, eye: Vec3, view_dir: Vec3, per_texel: f32) -> u32 {
+    if !per_texel.is_finite() {
+        return u32::MAX;
+    }
+    // One plane spans the box: its spacing is the box's depth along the normal.
+    let whole = vol.grid_box.slices(mode, 1, eye, view_dir);
+    // Texels per unit of length along the normal, per texture axis (x is the grid's k).
+    let [ni, nj, nk] = vol.dims.map(|d| d as f32);
+    let along = vol.tex_from_world.transform_vector3(whole.normal).abs() * Vec3::new(nk, nj, ni);
+    let planes = (per_texel * whole.spacing * along.max_element()).ceil();
+    if planes.is_finite() { planes.max(1.0) as u32 } else { u32::MAX }
 }
 
 /// The box a walk samples the cloud in, as the map from the unit cube: the slices' box, cut to
@@ -994,6 +1088,7 @@ impl super::frame::Representation for VolumePass {
 
 impl super::frame::Draw for VolumePass {
     fn prepare(&mut self, f: &super::frame::Prepare<'_>) {
+        self.planes_per_texel = f.planes_per_texel;
         self.set_view(&f.ctx.device, &f.ctx.queue, f.view, f.cloud, f.clip, f.size);
         if self.variant.program.slabs() && self.depth_group.as_ref().is_none_or(|(v, _)| v != f.depth) {
             let group = f.ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {

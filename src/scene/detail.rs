@@ -13,16 +13,26 @@ pub struct Detail {
     pub max_pixels: u32,
     /// The factor on surfaces' level-of-detail thresholds (Lee et al., docs/references.md).
     pub lod_scale: f32,
+    /// At most this many slice planes per texel of a cloud's grid along the view, whatever its
+    /// slice count asks: trilinear samples closer than half a texel add time, not detail (the
+    /// opacity is corrected for the spacing, so the picture stays the same).
+    pub planes_per_texel: f32,
 }
 
 impl Detail {
-    pub const FULL: Self = Self { max_slices: u32::MAX, max_pixels: u32::MAX, lod_scale: 1.0 };
+    pub const FULL: Self =
+        Self { max_slices: u32::MAX, max_pixels: u32::MAX, lod_scale: 1.0, planes_per_texel: PLANES_PER_TEXEL };
 
     /// The coarse picture shown at once after a change on a slow adapter: few slices on few
     /// pixels (the texture filter scales it up), big surfaces' parts drawn as points sooner.
     /// Lavapipe on two cores draws three molecules with clouds and translucent surfaces so in
     /// under 200 ms (`orbcloud bench scene`).
-    pub const PREVIEW: Self = Self { max_slices: PREVIEW_SLICES, max_pixels: PREVIEW_PIXELS, lod_scale: 4.0 };
+    pub const PREVIEW: Self = Self {
+        max_slices: PREVIEW_SLICES,
+        max_pixels: PREVIEW_PIXELS,
+        lod_scale: 4.0,
+        planes_per_texel: PLANES_PER_TEXEL,
+    };
 
     /// The size to render a view shown at `size` pixels.
     pub fn render_size(&self, size: [u32; 2]) -> [u32; 2] {
@@ -40,6 +50,9 @@ impl Detail {
         cloud
     }
 }
+
+/// Slice planes per texel along the view at most (Nyquist: two samples per texel).
+pub const PLANES_PER_TEXEL: f32 = 2.0;
 
 /// Slices per cloud in a preview.
 pub const PREVIEW_SLICES: u32 = 48;
