@@ -51,8 +51,10 @@ impl Detail {
     }
 }
 
-/// Slice planes per texel along the view at most (Nyquist: two samples per texel).
-pub const PLANES_PER_TEXEL: f32 = 2.0;
+/// Slice planes per texel along the view at most: a trilinear field between texels needs
+/// little more than one sample each. At 1.75 the demo scene's full picture differs from 2's by
+/// at most 4/255 (mean 0.05/255; `bench scene --images`), from the 192 slices' by as little.
+pub const PLANES_PER_TEXEL: f32 = 1.75;
 
 /// Slices per cloud in a preview.
 pub const PREVIEW_SLICES: u32 = 48;
