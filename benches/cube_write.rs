@@ -44,7 +44,7 @@ fn bench(c: &mut Criterion) {
             memory.clear();
             cube_write::write_values_to(&mut memory, "t", "d", &molecule, &spec, &[(black_box(&values), 1)])
                 .expect("memory");
-        })
+        });
     });
     // A new file each time (the old one removed outside the timing): truncating the file just
     // written would wait for the kernel to write it back.
@@ -61,7 +61,7 @@ fn bench(c: &mut Criterion) {
                     .expect("file");
             },
             BatchSize::PerIteration,
-        )
+        );
     });
     // The limits: the same bytes copied in memory, and written to the file as they are.
     let mut copy = vec![0u8; text.len()];
@@ -76,7 +76,7 @@ fn bench(c: &mut Criterion) {
                 }
             },
             BatchSize::PerIteration,
-        )
+        );
     });
     group.finish();
     let _ = std::fs::remove_dir_all(&dir);

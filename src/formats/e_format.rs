@@ -144,7 +144,7 @@ fn words(v: f32, p: &Table, truncate: impl Fn(f64) -> u32) -> [u64; 2] {
 #[inline(always)]
 fn ascii_digits(n: u32) -> u64 {
     let n = n as u64;
-    let x = n / 10_000 | (n % 10_000) << 32;
+    let x = (n / 10_000) | ((n % 10_000) << 32);
     // ⌊q / 100⌋ = (q · 10486) >> 20 for q < 10⁴, in both 32-bit lanes at once.
     let hundreds = ((x * 10486) >> 20) & 0x0000_007f_0000_007f;
     let x = hundreds | (x - hundreds * 100) << 16;
