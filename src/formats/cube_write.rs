@@ -88,10 +88,19 @@ pub fn write_values_to(
     for start in (0..rows).step_by(block_rows) {
         let n = block_rows.min(rows - start);
         let bytes = &mut block[..n * row_bytes];
-        bytes.par_chunks_mut(row_bytes).enumerate().for_each_init(
-            || (Vec::new(), Vec::new()),
-            |(values, words), (r, out)| format_row(out, grids, start + r, nz, values, words),
-        );
+        if rayon::current_num_threads() > 1 {
+            bytes.par_chunks_mut(row_bytes).enumerate().for_each_init(
+                || (Vec::new(), Vec::new()),
+                |(values, words), (r, out)| format_row(out, grids, start + r, nz, values, words),
+            );
+        } else {
+            // One thread: on this one, rather than handing each block to the pool's only worker
+            // and waiting for it to wake.
+            let (values, words) = (&mut Vec::new(), &mut Vec::new());
+            for (r, out) in bytes.chunks_mut(row_bytes).enumerate() {
+                format_row(out, grids, start + r, nz, values, words);
+            }
+        }
         w.write_all(bytes)?;
     }
     w.flush()
