@@ -7,15 +7,15 @@ Molden file, so `orbcloud cube` can compute the same orbital on the same grid
 (scripts/bench_cube_vs_pyscf.sh runs both and compares the cube files).
 
 The Rust side is `cargo bench --bench gto_grid` (same molecule, basis, grid box: the atoms plus
-3 bohr, 80 points per axis). Prints `pyscf_s=<seconds>` (best of --repeat runs, cube file
-written to a temporary directory, SCF excluded) and `pyscf_eval_s=<seconds>` (AO evaluation and
+3 bohr, 80 points per axis). Prints `pyscf_s=<seconds>` (best of --repeat runs, each cube
+file new in a temporary directory, SCF excluded) and `pyscf_eval_s=<seconds>` (AO evaluation and
 the MO product alone, no file).
 """
 import os
 
-os.environ["OMP_NUM_THREADS"] = "1"
-os.environ["OPENBLAS_NUM_THREADS"] = "1"
-os.environ["MKL_NUM_THREADS"] = "1"
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+os.environ.setdefault("MKL_NUM_THREADS", "1")
 
 import argparse  # noqa: E402
 import shutil  # noqa: E402
@@ -41,15 +41,15 @@ C 1.8300 0.0950 0.0; H 1.9310 1.1770 0.0;
 N 2.9520 -0.5860 0.0; H 3.8580 -0.1350 0.0; H 2.9290 -1.5950 0.0"""
 
 
-def arguments(n, molecule):
-    """The options both benchmarks take; PySCF limited to one thread."""
+def arguments(n, molecule, threads=1):
+    """The options both benchmarks take; PySCF limited to `threads` OpenMP threads."""
     ap = argparse.ArgumentParser()
     ap.add_argument("--n", type=int, default=n)
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--molecule", choices=["benzene", "psb3"], default=molecule)
     ap.add_argument("--molden", default=None, help="also write the SCF as a Molden file here")
     ap.add_argument("--cube", default=None, help="keep PySCF's cube file here")
-    lib.num_threads(1)
+    lib.num_threads(threads)
     return ap.parse_args()
 
 
@@ -76,8 +76,10 @@ def main():
     n = args.n
     best = best_eval = float("inf")
     with tempfile.TemporaryDirectory() as tmp:
-        path = os.path.join(tmp, "homo.cube")
-        for _ in range(args.repeat):
+        # A new file each time: truncating the file the previous run has just written waits
+        # for the kernel to write it back, which is no part of either program's work.
+        for i in range(args.repeat):
+            path = os.path.join(tmp, f"homo{i}.cube")
             t = time.perf_counter()
             cubegen.orbital(mol, path, c, nx=n, ny=n, nz=n)
             best = min(best, time.perf_counter() - t)

@@ -192,15 +192,14 @@ pub fn nci(args: &NciArgs) -> Result<()> {
     let kind = if args.promolecular { "promolecular" } else { "wavefunction" };
     let dens_path = with_suffix(&args.output, "-dens.cube");
     let grad_path = with_suffix(&args.output, "-grad.cube");
-    let dens = VolumeGrid::new("100*sign(lambda2)*rho", spec.dims, spec.world_from_grid, grids.dens);
-    let grad = VolumeGrid::new("reduced density gradient", spec.dims, spec.world_from_grid, grids.grad);
-    for (path, grid, what) in
-        [(&dens_path, &dens, "100*sign(lambda2)*rho"), (&grad_path, &grad, "reduced density gradient")]
+    for (path, values, what) in
+        [(&dens_path, &grids.dens, "100*sign(lambda2)*rho"), (&grad_path, &grids.grad, "reduced density gradient")]
     {
         let title = format!("orbcloud nci ({kind}) {}", names.join(" + "));
         let file = std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
-        let mut w = std::io::BufWriter::with_capacity(1 << 20, file);
-        cube_write::write_to(&mut w, &title, what, &molecule, &[(grid, 0)])
+        // Smaller than the writer's blocks, which then go to the file without a copy.
+        let mut w = std::io::BufWriter::with_capacity(cube_write::BLOCK / 4, file);
+        cube_write::write_values_to(&mut w, &title, what, &molecule, &spec, &[(values, 0)])
             .with_context(|| format!("writing {}", path.display()))?;
         use std::io::Write;
         w.flush().with_context(|| format!("writing {}", path.display()))?;

@@ -6,9 +6,9 @@ use std::time::Instant;
 
 use super::info;
 use crate::formats::{self, cube_write};
+use crate::model::GridSpec;
 use crate::model::gto::PreparedBasis;
 use crate::model::orbitals::Quantity;
-use crate::model::{GridSpec, VolumeGrid};
 use crate::scene::Source;
 use anyhow::{Context, Result, bail};
 use glam::DVec3;
@@ -107,7 +107,10 @@ pub fn cube(
     minus: Option<&Path>,
     output: &Path,
 ) -> Result<()> {
+    // `ORBCLOUD_TIMINGS=1` prints where the command's time goes, phase by phase.
+    let mut phases = Phases::new();
     let doc = what.load(file)?;
+    phases.done("read and check the file");
     let q = what.resolve(&doc)?;
     let wf = wavefunction_of(&doc)?;
     let (lo, hi) = match margin {
@@ -126,6 +129,7 @@ pub fn cube(
         bail!("a {dims:?} grid is too large");
     }
     let prepared = PreparedBasis::new(&wf.basis);
+    phases.done("box and basis prepared");
     let t = Instant::now();
     let mut values = crate::evaluate::quantity_grid(&doc, &prepared, q, &spec);
     let mut label = super::quantity_label(&q, &doc);
@@ -137,18 +141,38 @@ pub fn cube(
         label = format!("{label} minus {}", other.display());
     }
     let seconds = t.elapsed().as_secs_f64();
-    let grid = VolumeGrid::new(&label, dims, spec.world_from_grid, values);
+    phases.done("evaluate");
     let id = match q {
         Quantity::Orbital(i) => wf.of_spin(wf.orbitals[i].spin).position(|(j, _)| j == i).map_or(0, |p| p + 1),
         _ => 0,
     };
     let file = std::fs::File::create(output).with_context(|| format!("creating {}", output.display()))?;
-    let mut w = std::io::BufWriter::with_capacity(1 << 20, file);
+    // Smaller than the writer's blocks, which then go to the file without a copy.
+    let mut w = std::io::BufWriter::with_capacity(cube_write::BLOCK / 4, file);
     let title = format!("{} {}", doc.source, label);
-    cube_write::write_to(&mut w, &title, &label, &doc.molecule, &[(&grid, id as i64)])
+    cube_write::write_values_to(&mut w, &title, &label, &doc.molecule, &spec, &[(&values, id as i64)])
         .with_context(|| format!("writing {}", output.display()))?;
+    phases.done("format and write");
+    drop(w);
+    phases.done("close");
     eprintln!("wrote {} ({}×{}×{}, {label}; evaluated in {seconds:.3} s)", output.display(), dims[0], dims[1], dims[2]);
     Ok(())
+}
+
+/// Milliseconds since the previous phase, printed to stderr when `ORBCLOUD_TIMINGS` is set.
+struct Phases(Option<Instant>);
+
+impl Phases {
+    fn new() -> Self {
+        Self(std::env::var_os("ORBCLOUD_TIMINGS").map(|_| Instant::now()))
+    }
+
+    fn done(&mut self, phase: &str) {
+        if let Some(t) = &mut self.0 {
+            eprintln!("{phase}: {:.2} ms", t.elapsed().as_secs_f64() * 1e3);
+            *t = Instant::now();
+        }
+    }
 }
 
 /// The quantity `what` asks for, of the file `other`, at `points` (bohr): evaluated from its

@@ -6,7 +6,8 @@ use std::io::Write;
 
 use rayon::prelude::*;
 
-use crate::model::{Molecule, VolumeGrid};
+use super::e_format;
+use crate::model::{GridSpec, Molecule, VolumeGrid};
 
 /// Cube text for one or more grids of identical geometry over `molecule` (all bohr); see
 /// [`write_to`].
@@ -34,19 +35,37 @@ pub fn write_to(
         grids.iter().all(|(g, _)| g.dims == first.dims && g.world_from_grid == first.world_from_grid),
         "grids of one cube file share their geometry"
     );
+    let spec = GridSpec { dims: first.dims, world_from_grid: first.world_from_grid };
+    let values: Vec<(&[f32], i64)> = grids.iter().map(|(g, id)| (&g.values[..], *id)).collect();
+    write_values_to(w, title, description, molecule, &spec, &values)
+}
+
+/// [`write_to`] for bare values on `spec` (cube order), which need no [`VolumeGrid`] and its
+/// statistics.
+///
+/// Panics if `grids` is empty or a grid's length is not the spec's.
+pub fn write_values_to(
+    w: &mut impl Write,
+    title: &str,
+    description: &str,
+    molecule: &Molecule,
+    spec: &GridSpec,
+    grids: &[(&[f32], i64)],
+) -> std::io::Result<()> {
+    assert!(!grids.is_empty() && grids.iter().all(|(g, _)| g.len() == spec.len()), "values fill the grid");
     let mut out = String::with_capacity(4096);
     let line = |s: &str| s.replace(['\n', '\r'], " ");
     let _ = writeln!(out, "{}", line(title));
     let _ = writeln!(out, "{}", line(description));
-    let o = first.origin();
+    let o = spec.origin();
     let natoms = molecule.atoms.len() as i64;
     let signed_natoms = if grids.len() > 1 { -natoms } else { natoms };
     // Ten decimals, not the customary six: a six-decimal spacing misplaces the last points of
     // an 80-point axis by ~1e-5 bohr, visible in the values read back.
     let _ = writeln!(out, "{signed_natoms:5} {:16.10} {:16.10} {:16.10}", o.x, o.y, o.z);
     for axis in 0..3 {
-        let v = first.step(axis);
-        let _ = writeln!(out, "{:5} {:16.10} {:16.10} {:16.10}", first.dims[axis], v.x, v.y, v.z);
+        let v = spec.step(axis);
+        let _ = writeln!(out, "{:5} {:16.10} {:16.10} {:16.10}", spec.dims[axis], v.x, v.y, v.z);
     }
     for a in &molecule.atoms {
         let p = a.position;
@@ -57,114 +76,59 @@ pub fn write_to(
         let _ = writeln!(out, "{:5} {}", grids.len(), ids.join(" "));
     }
     w.write_all(out.as_bytes())?;
-    let nz = first.dims[2].max(1);
+    let nz = spec.dims[2].max(1);
     // Every row has the same layout, so rows are formatted straight into their place in a block
-    // of rows (in parallel when there are threads) and each block is written at once: blocks of
-    // at least a megabyte pass a `BufWriter` by.
-    let row_bytes = row_len(nz * grids.len());
-    let rows = first.values.len() / nz;
-    let block_rows = ((2 << 20) / row_bytes).clamp(1, rows.max(1));
+    // of rows (in parallel when there are threads) and each block is written at once. A block
+    // of about 256 KiB stays in the cache between formatting and the write that copies it out,
+    // and its pages are reused block after block; it passes a `BufWriter` of less by.
+    let row_bytes = e_format::text_len(nz * grids.len());
+    let rows = spec.len() / nz;
+    let block_rows = (BLOCK / row_bytes).clamp(1, rows.max(1));
     let mut block = vec![0u8; block_rows * row_bytes];
     for start in (0..rows).step_by(block_rows) {
         let n = block_rows.min(rows - start);
         let bytes = &mut block[..n * row_bytes];
-        bytes
-            .par_chunks_mut(row_bytes)
-            .enumerate()
-            .for_each_init(Vec::new, |scratch, (r, out)| format_row(out, grids, start + r, nz, scratch));
+        if rayon::current_num_threads() > 1 {
+            bytes.par_chunks_mut(row_bytes).enumerate().for_each_init(
+                || (Vec::new(), Vec::new()),
+                |(values, words), (r, out)| format_row(out, grids, start + r, nz, values, words),
+            );
+        } else {
+            // One thread: on this one, rather than handing each block to the pool's only worker
+            // and waiting for it to wake.
+            let (values, words) = (&mut Vec::new(), &mut Vec::new());
+            for (r, out) in bytes.chunks_mut(row_bytes).enumerate() {
+                format_row(out, grids, start + r, nz, values, words);
+            }
+        }
         w.write_all(bytes)?;
     }
     w.flush()
 }
 
-/// Bytes of a row of `n` values: 13 per value, six values per line.
-fn row_len(n: usize) -> usize {
-    n * 13 + n.div_ceil(6)
-}
+/// Bytes of cube text written at a time (see [`write_values_to`]).
+pub const BLOCK: usize = 256 << 10;
 
 /// Row `row` (`nz` values of each grid, interleaved per point) into `out`, six values a line;
-/// `scratch` holds the interleaved values of several grids.
-fn format_row(out: &mut [u8], grids: &[(&VolumeGrid, i64)], row: usize, nz: usize, scratch: &mut Vec<f32>) {
-    let pow10 = pow10_table();
+/// `values` holds the interleaved values of several grids, `words` the formatter's scratch.
+fn format_row(
+    out: &mut [u8],
+    grids: &[(&[f32], i64)],
+    row: usize,
+    nz: usize,
+    values: &mut Vec<f32>,
+    words: &mut Vec<[u64; 2]>,
+) {
     let points = row * nz..(row + 1) * nz;
-    let values = match grids {
-        [(g, _)] => &g.values[points],
+    let row_values = match grids {
+        [(g, _)] => &g[points],
         _ => {
-            scratch.clear();
-            scratch.extend(points.flat_map(|k| grids.iter().map(move |(g, _)| g.values[k])));
-            &scratch[..]
+            values.clear();
+            values.extend(points.flat_map(|k| grids.iter().map(move |(g, _)| g[k])));
+            &values[..]
         }
     };
-    for (line, six) in out.chunks_mut(6 * 13 + 1).zip(values.chunks(6)) {
-        for (slot, &v) in line.chunks_exact_mut(13).zip(six) {
-            slot.copy_from_slice(&scientific(v, pow10));
-        }
-        line[six.len() * 13] = b'\n';
-    }
-}
-
-/// Powers of ten 10^k for k in [`POW10_LO`]..=60: an f32 with six digits never needs more.
-const POW10_LO: i32 = -60;
-
-fn pow10_table() -> &'static [f64] {
-    static TABLE: std::sync::OnceLock<Vec<f64>> = std::sync::OnceLock::new();
-    // Parsed, not multiplied, so each entry is the correctly rounded power.
-    TABLE.get_or_init(|| (POW10_LO..=60).map(|k| format!("1e{k}").parse().unwrap_or(0.0)).collect())
-}
-
-/// The two decimal digits of `n` < 100.
-fn digit_pair(n: u32) -> &'static [u8] {
-    const PAIRS: [u8; 200] = {
-        let mut t = [0u8; 200];
-        let mut i = 0;
-        while i < 100 {
-            t[2 * i] = b'0' + (i / 10) as u8;
-            t[2 * i + 1] = b'0' + (i % 10) as u8;
-            i += 1;
-        }
-        t
-    };
-    &PAIRS[2 * n as usize..2 * n as usize + 2]
-}
-
-/// ` ±d.dddddE±XX` (13 bytes), the Fortran layout cube files use, six significant digits —
-/// without `format!`, which dominates writing a large grid.
-fn scientific(v: f32, pow10: &[f64]) -> [u8; 13] {
-    if v == 0.0 || !v.is_finite() {
-        return *b"  0.00000E+00";
-    }
-    let a = v.abs() as f64;
-    let p = |k: i32| pow10[(k - POW10_LO).clamp(0, pow10.len() as i32 - 1) as usize];
-    // The decimal exponent from the binary one (log10 2 ≈ 0.30103), then corrected by one
-    // against the table.
-    let binary = ((a.to_bits() >> 52) & 0x7ff) as i32 - 1023;
-    // ⌊binary · log10 2⌋ with log10 2 ≈ 1233/4096; the arithmetic shift floors negatives too.
-    // (Integer arithmetic: `floor` and `round` are library calls on baseline x86-64.)
-    let mut e = (binary * 1233) >> 12;
-    // Branch-free: which way the estimate is off depends on the value, unpredictably.
-    e += (a >= p(e + 1)) as i32 - (a < p(e)) as i32;
-    // Round half up: within an ulp of a tie this may differ from exact decimal rounding in the
-    // sixth digit, which a cube file's precision does not notice.
-    let mut m = (a * p(5 - e) + 0.5) as i64 as u32;
-    // Rounding may carry into a seventh digit (9.999996 → 10.0000).
-    if m >= 1_000_000 {
-        m = (m + 5) / 10;
-        e += 1;
-    }
-    let mut b = *b"  0.00000E+00";
-    b[1] = if v < 0.0 { b'-' } else { b' ' };
-    let first = m / 100_000;
-    let rest = m - first * 100_000;
-    let (pair1, rest) = (rest / 1000, rest % 1000);
-    let (pair2, last) = (rest / 10, rest % 10);
-    b[2] = b'0' + first as u8;
-    b[4..6].copy_from_slice(digit_pair(pair1));
-    b[6..8].copy_from_slice(digit_pair(pair2));
-    b[8] = b'0' + last as u8;
-    b[10] = if e < 0 { b'-' } else { b'+' };
-    b[11..13].copy_from_slice(digit_pair(e.unsigned_abs().min(99)));
-    // f32 exponents stay within ±45: two digits always suffice.
-    b
+    e_format::write_lines(row_values, out, words);
 }
 
 #[cfg(test)]
@@ -173,30 +137,6 @@ mod tests {
 
     use super::*;
     use crate::model::Atom;
-
-    #[test]
-    fn scientific_digits_are_correctly_rounded() {
-        let mut s = 0x2545F4914F6CDD1Du64;
-        for i in 0..20_000 {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            let exp = (s % 70) as i32 - 40;
-            let mantissa = (s >> 11) as f64 / (1u64 << 53) as f64 * 9.0 + 1.0;
-            let sign = if i % 2 == 0 { 1.0 } else { -1.0 };
-            let v = (sign * mantissa * 10f64.powi(exp)) as f32;
-            let text = String::from_utf8(scientific(v, pow10_table()).to_vec()).unwrap();
-            // Exact decimal rounding may differ in the last digit when the value sits within an
-            // ulp of a tie; anything more is a bug.
-            let expected: f64 = format!("{:.5E}", v as f64).parse().unwrap();
-            let got: f64 = text.trim().parse().unwrap();
-            assert!((got - expected).abs() <= 1.01e-5 * expected.abs(), "{v:e} → {text}");
-            assert_eq!(text.len(), 13, "{text}");
-        }
-        for (v, text) in [(1.0f32, "  1.00000E+00"), (-0.000123456, " -1.23456E-04"), (9.999996e-3, "  1.00000E-02")] {
-            assert_eq!(String::from_utf8(scientific(v, pow10_table()).to_vec()).unwrap(), text);
-        }
-    }
 
     #[test]
     fn written_cubes_read_back() {

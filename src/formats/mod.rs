@@ -4,6 +4,7 @@
 mod cif;
 pub mod cube;
 pub mod cube_write;
+mod e_format;
 mod error;
 mod excited_logs;
 pub mod fchk;

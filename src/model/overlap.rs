@@ -207,26 +207,47 @@ pub fn orthonormality_error(s: &[f64], n: usize, orbitals: &[&[f64]]) -> f64 {
     let sc: Vec<Vec<f64>> = orbitals
         .par_iter()
         .map(|c| {
-            (0..n)
-                .map(|i| {
-                    let row = &s[i * n..(i + 1) * n];
-                    row.iter().zip(c.iter()).map(|(a, b)| a * b).sum()
-                })
-                .collect()
+            let rows: Vec<&[f64]> = s.chunks_exact(n.max(1)).take(n).collect();
+            rows.chunks(4).flat_map(|four| dots(four, c)).collect()
         })
         .collect();
     (0..orbitals.len())
         .into_par_iter()
         .map(|p| {
             let mut worst: f64 = 0.0;
-            for (q, scq) in sc.iter().enumerate() {
-                let v: f64 = orbitals[p].iter().zip(scq).map(|(a, b)| a * b).sum();
-                let want = if p == q { 1.0 } else { 0.0 };
-                worst = worst.max((v - want).abs());
+            let columns: Vec<&[f64]> = sc.iter().map(Vec::as_slice).collect();
+            for (first, four) in columns.chunks(4).enumerate() {
+                for (k, v) in dots(four, orbitals[p]).into_iter().enumerate() {
+                    let want = if p == 4 * first + k { 1.0 } else { 0.0 };
+                    worst = worst.max((v - want).abs());
+                }
             }
             worst
         })
         .reduce(|| 0.0, f64::max)
+}
+
+/// The dot products of up to four `rows` with `c`, each summed in order as `Iterator::sum`
+/// sums (so the same bits), side by side: four chains of additions that overlap, where one at a
+/// time waits on each addition's latency. Reading a file's orbitals checks CᵀSC with them.
+fn dots(rows: &[&[f64]], c: &[f64]) -> Vec<f64> {
+    let mut sums = [-0.0f64; 4];
+    let lanes = rows.len().min(4);
+    if lanes == 4 {
+        let len = rows.iter().map(|r| r.len()).min().unwrap_or(0).min(c.len());
+        let (r0, r1, r2, r3) = (&rows[0][..len], &rows[1][..len], &rows[2][..len], &rows[3][..len]);
+        for (k, &ck) in c[..len].iter().enumerate() {
+            sums[0] += r0[k] * ck;
+            sums[1] += r1[k] * ck;
+            sums[2] += r2[k] * ck;
+            sums[3] += r3[k] * ck;
+        }
+    } else {
+        for (sum, row) in sums.iter_mut().zip(rows) {
+            *sum = row.iter().zip(c).map(|(a, b)| a * b).sum();
+        }
+    }
+    sums[..lanes].to_vec()
 }
 
 /// max |CᵀSC − I| over each spin's orbitals of a wavefunction, with S from its basis.
