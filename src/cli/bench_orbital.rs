@@ -23,12 +23,8 @@ pub struct OrbitalBench {
     /// Points along the longest side of the grid: the viewer's box for the orbital.
     #[arg(long, default_value_t = 128, value_parser = within(limits::GRID_POINTS))]
     points: usize,
-    /// Timed runs of each path (the best is reported).
-    #[arg(long, default_value_t = 3, value_parser = within(1..=1000usize))]
-    runs: usize,
-    /// Use the CPU Vulkan adapter (lavapipe) even when a GPU is present.
-    #[arg(long)]
-    lavapipe: bool,
+    #[command(flatten)]
+    bench: super::BenchRuns,
 }
 
 pub fn bench(args: &OrbitalBench) -> Result<()> {
@@ -37,7 +33,7 @@ pub fn bench(args: &OrbitalBench) -> Result<()> {
     let quantity = args.what.resolve(&doc)?;
     let Quantity::Orbital(i) = quantity else { bail!("bench orbital times an orbital; {quantity:?} is not one") };
     let grid = crate::evaluate::orbital_geometry(&doc, quantity, args.points).context("the file has no grid box")?;
-    let ctx = super::gpu(args.lavapipe)?;
+    let ctx = super::gpu(args.bench.lavapipe)?;
     let points = grid.len() as f64;
     println!("adapter: {}", ctx.describe());
     println!(
@@ -53,7 +49,7 @@ pub fn bench(args: &OrbitalBench) -> Result<()> {
     let coefficients = &wf.orbitals[i].coefficients;
 
     let (mut cpu_ms, mut cpu) = (Vec::new(), Vec::new());
-    for _ in 0..args.runs {
+    for _ in 0..args.bench.runs {
         let t = Instant::now();
         cpu = PreparedBasis::new(&wf.basis).quantity_grid_f32(wf, &doc.molecule, quantity, &grid);
         cpu_ms.push(t.elapsed().as_secs_f64() * 1e3);
@@ -63,7 +59,7 @@ pub fn bench(args: &OrbitalBench) -> Result<()> {
     let pipeline_ms = t.elapsed().as_secs_f64() * 1e3;
     let prepared = PreparedBasis::new(&wf.basis);
     let (mut fill_ms, mut read_ms, mut gpu) = (Vec::new(), Vec::new(), Vec::new());
-    for _ in 0..args.runs + 1 {
+    for _ in 0..args.bench.runs + 1 {
         // The first run warms the driver's caches and is not counted.
         let t = Instant::now();
         let expansion = CartesianExpansion::from_coefficients(&prepared, coefficients);
@@ -86,7 +82,7 @@ pub fn bench(args: &OrbitalBench) -> Result<()> {
         best(fill_ms),
         rate(best(fill_ms)),
         best(read_ms),
-        args.runs
+        args.bench.runs
     );
     println!("largest difference GPU − CPU: {worst:.2e} of max |ψ|");
     Ok(())

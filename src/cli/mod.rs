@@ -949,6 +949,17 @@ struct BenchFrames {
     lavapipe: bool,
 }
 
+/// How often a computation's benchmark times each path, and on which adapter.
+#[derive(Args)]
+struct BenchRuns {
+    /// Timed runs of each path (the best is reported).
+    #[arg(long, default_value_t = 3, value_parser = within(1..=1000usize))]
+    runs: usize,
+    /// Use the CPU Vulkan adapter (lavapipe) even when a GPU is present.
+    #[arg(long)]
+    lavapipe: bool,
+}
+
 fn gpu(lavapipe: bool) -> Result<GpuContext> {
     let pref = if lavapipe { AdapterPreference::LavapipeOnly } else { AdapterPreference::HighPerformance };
     Ok(GpuContext::headless(pref)?)

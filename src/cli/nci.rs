@@ -239,12 +239,8 @@ pub struct NciBench {
     /// Points per side of the grid: the viewer's box for the NCI field.
     #[arg(long, default_value_t = 80, value_parser = within(limits::GRID_POINTS))]
     points: usize,
-    /// Timed runs of each path (the best is reported).
-    #[arg(long, default_value_t = 3, value_parser = within(1..=1000usize))]
-    runs: usize,
-    /// Use the CPU Vulkan adapter (lavapipe) even when a GPU is present.
-    #[arg(long)]
-    lavapipe: bool,
+    #[command(flatten)]
+    bench: super::BenchRuns,
 }
 
 /// `orbcloud bench nci`: the viewer's NCI field (s where ρ ≤ 0.05) of a wavefunction on its
@@ -259,13 +255,13 @@ pub fn bench(args: &NciBench) -> Result<()> {
     let wf = super::wavefunction_of(&doc)?;
     let quantity = Quantity::NciGradient;
     let grid = crate::evaluate::orbital_geometry(&doc, quantity, args.points).context("the file has no grid box")?;
-    let ctx = super::gpu(args.lavapipe)?;
+    let ctx = super::gpu(args.bench.lavapipe)?;
     println!("adapter: {}", ctx.describe());
     println!("{}: grid {:?} = {} points, {} threads", doc.source, grid.dims, grid.len(), rayon::current_num_threads());
     let best = |times: &[f64]| times.iter().copied().fold(f64::INFINITY, f64::min);
 
     let (mut cpu_ms, mut cpu) = (Vec::new(), Vec::new());
-    for _ in 0..args.runs {
+    for _ in 0..args.bench.runs {
         let t = Instant::now();
         cpu = PreparedBasis::new(&wf.basis).quantity_grid_f32(wf, &doc.molecule, quantity, &grid);
         cpu_ms.push(t.elapsed().as_secs_f64() * 1e3);
@@ -274,7 +270,7 @@ pub fn bench(args: &NciBench) -> Result<()> {
     let pass = DensityHessianPass::new(&ctx);
     let pipeline_ms = t.elapsed().as_secs_f64() * 1e3;
     let (mut pass_ms, mut finish_ms, mut gpu) = (Vec::new(), Vec::new(), Vec::new());
-    for _ in 0..args.runs {
+    for _ in 0..args.bench.runs {
         let t = Instant::now();
         let density = WavefunctionDensity::new(wf).cartesian();
         let derivatives = pass.derivatives(&ctx, &density, &grid)?;
@@ -294,7 +290,7 @@ pub fn bench(args: &NciBench) -> Result<()> {
         best(&gpu_ms),
         best(&pass_ms),
         best(&finish_ms),
-        args.runs
+        args.bench.runs
     );
     println!(
         "kept points: {}; worst relative difference of s there {worst:.2e}; points cut by one and not the other: {differ}",
@@ -306,7 +302,7 @@ pub fn bench(args: &NciBench) -> Result<()> {
     let levels = crate::scene::QuantityState::nci_surface(&Default::default()).isosurfaces;
     let mut iso_ms = Vec::new();
     let mut vertices = 0;
-    for _ in 0..args.runs {
+    for _ in 0..args.bench.runs {
         let t = Instant::now();
         let (mut meshes, _) = crate::evaluate::meshes::isosurfaces_within(&field, &levels, u64::MAX);
         crate::evaluate::meshes::color_isosurfaces(
