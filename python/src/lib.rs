@@ -410,7 +410,7 @@ impl PyDocument {
         let q = self.quantity(kind, index)?;
         let (wf, prepared) = self.prepared()?;
         let spec = grid_spec(&self.doc, wf, q, points)?;
-        let values = py.detach(|| prepared.quantity_grid_f32(wf, &self.doc.molecule, q, &spec));
+        let values = py.detach(|| orbcloud::evaluate::quantity_grid(&self.doc, prepared, q, &spec));
         let label = match q {
             Quantity::Orbital(i) => {
                 let o = &wf.orbitals[i];
@@ -436,6 +436,7 @@ impl PyDocument {
                 };
                 format!("{what} (state {state})")
             }
+            Quantity::TransitionDensity(n) => format!("transition density (state {n})"),
         };
         let id = match q {
             Quantity::Orbital(i) => wf.of_spin(wf.orbitals[i].spin).position(|(j, _)| j == i).map_or(0, |p| p + 1),
