@@ -405,11 +405,13 @@ fn fragments_editor(ui: &mut egui::Ui, q: &mut crate::scene::QuantityState, open
     added
 }
 
-/// A structure without a wavefunction offers the NCI surface of its spherical atoms: of all of
-/// them, or between the atoms a selection picks (a ligand) and the rest (its pocket).
+/// A structure (no wavefunction, no data set) offers the NCI surface of its spherical atoms: of
+/// all of them, or between the atoms a selection picks (a ligand) and the rest (its pocket).
 fn promolecular_nci(ui: &mut egui::Ui, app: &mut OrbApp) {
     let Some(o) = app.objects.get_mut(app.active) else { return };
-    if o.scan.is_some() || o.doc.wavefunction.is_some() || o.doc.molecule.atoms.is_empty() {
+    // A structure's (a cube file shows its own field; a wavefunction its NCI under Orbitals).
+    let structure = o.doc.wavefunction.is_none() && o.doc.volumes.is_empty();
+    if o.scan.is_some() || !structure || o.doc.molecule.atoms.is_empty() {
         return;
     }
     ui.separator();
