@@ -97,8 +97,12 @@ def test_render_nci_draws_the_hydrogen_bond(cli, tmp_path):
     expected = np.asarray(Image.open(out).convert("RGBA"), dtype=float)
     assert np.abs(np.asarray(img, dtype=float) - expected).mean() <= 1.0
     assert not blue_green(orbcloud.render(doc, density=True, **options)).any()
-    with pytest.raises(ValueError, match="needs a wavefunction"):
-        orbcloud.render(FIXTURES / "structures" / "ethane_trajectory.xyz", nci=True, lavapipe=True)
+    # A structure without a wavefunction: its spherical atoms' NCI, here between a selection
+    # (the acceptor, LIG 2) and the rest.
+    pdb = FIXTURES / "nci" / "water_dimer.pdb"
+    assert blue_green(orbcloud.render(pdb, nci=True, nci_between="resn LIG", size=(320, 240), lavapipe=True)).sum() >= 10
+    with pytest.raises(ValueError, match="picks 0 of 6 atoms"):
+        orbcloud.render(pdb, nci=True, nci_between="resn XYZ", lavapipe=True)
 
 
 def test_eval_of_two_files_sums_their_densities_as_pyscf_does(cli, tmp_path):
