@@ -603,3 +603,44 @@ fn cube_writes_a_states_transition_density_from_a_td_logs_amplitudes_joined_to_i
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success() && err.contains("state 2"), "{err}");
 }
+
+#[test]
+fn eval_gives_a_states_natural_transition_orbitals_by_their_labels() {
+    let Some(dir) = logs("excited_states::eval_gives_a_states_natural_transition_orbitals") else { return };
+    let (log, fchk) = (dir.join("basicGaussian09_dvb_td.out"), dir.join("basicGaussian09_dvb_td.fchk"));
+    let out_dir = tempfile::tempdir().unwrap();
+    let points_file = out_dir.path().join("points.txt");
+    let points: Vec<glam::DVec3> =
+        (0..12).map(|i| glam::DVec3::new(0.7 * i as f64 - 4.0, 1.1 * (0.5 * i as f64).sin(), 0.9)).collect();
+    std::fs::write(&points_file, points.iter().map(|p| format!("{} {} {}\n", p.x, p.y, p.z)).collect::<String>())
+        .unwrap();
+    let (log, fchk, pts) = (log.display().to_string(), fchk.display().to_string(), points_file.display().to_string());
+    let eval = |orbital: &str| {
+        let out =
+            orbcloud(&["eval", &fchk, "--transitions", &log, "--state", "2", "--orbital", orbital, "--points", &pts]);
+        assert!(out.status.success(), "{orbital}: {}", String::from_utf8_lossy(&out.stderr));
+        let text = String::from_utf8(out.stdout).unwrap();
+        text.lines().map(|l| l.split_whitespace().nth(3).unwrap().parse::<f64>().unwrap()).collect::<Vec<_>>()
+    };
+    // The same pair made here from the same two files.
+    let mut doc = load(Path::new(&fchk));
+    doc.join(load(Path::new(&log))).unwrap();
+    let state = doc.excited.as_ref().unwrap().states.iter().find(|s| s.number == 2).unwrap().clone();
+    let wf = doc.wavefunction.as_ref().unwrap();
+    let ntos = orbcloud::model::nto::from_transitions(wf, &state).unwrap();
+    let prepared = orbcloud::model::gto::PreparedBasis::new(&wf.basis);
+    for (label, coefficients) in [("hole 1", &ntos.pairs[0].hole), ("particle 1", &ntos.pairs[0].particle)] {
+        let values = eval(label);
+        for (p, v) in points.iter().zip(&values) {
+            let expected = prepared.orbital_value(coefficients, *p);
+            assert!((v - expected).abs() < 1e-9 * (1.0 + expected.abs()), "{label} at {p}: {v} against {expected}");
+        }
+    }
+    // Refusals name what is missing.
+    let out = orbcloud(&["eval", &fchk, "--orbital", "hole 1", "--points", &pts]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("--state N"), "{err}");
+    let out = orbcloud(&["eval", &fchk, "--state", "2", "--orbital", "hole 1", "--points", &pts]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("prints no transition"), "{err}");
+}

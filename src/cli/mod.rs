@@ -215,8 +215,8 @@ struct WhatArgs {
     #[arg(long, requires = "state", conflicts_with_all = &EXCITED_CONFLICTS[..11])]
     transition_density: bool,
     /// A TD log whose printed transitions join the file (its checkpoint, the same molecule in
-    /// any orientation): what --transition-density reads.
-    #[arg(long, value_name = "LOG", requires = "transition_density")]
+    /// any orientation): what --transition-density and --orbital "hole N" read.
+    #[arg(long, value_name = "LOG", requires = "state")]
     transitions: Option<PathBuf>,
     /// The excited state (numbered as the program numbers them) whose density the options
     /// above show; a Gaussian TD fchk holds one state's density, and another is refused.
@@ -333,13 +333,32 @@ impl WavefunctionArgs {
 }
 
 impl WhatArgs {
-    /// `file`, with the TD log `--transitions` names joined to it.
+    /// `file`, with the TD log `--transitions` names joined to it; for `--orbital "hole N"` or
+    /// `"particle N"`, `--state`'s natural transition orbitals as a document of their own.
     fn load(&self, file: &std::path::Path) -> Result<Document> {
         let mut doc = formats::load(file)?;
         if let Some(log) = &self.transitions {
             doc.join(formats::load(log)?).map_err(anyhow::Error::msg)?;
         }
+        if matches!(self.orbital, OrbitalSpec::Hole(_) | OrbitalSpec::Particle(_)) {
+            let n = self.state.with_context(|| {
+                format!(
+                    "--orbital {:?} is a natural transition orbital: --state N names the state",
+                    self.orbital.to_string()
+                )
+            })?;
+            let state = (doc.excited.as_ref().and_then(|e| e.states.iter().find(|s| s.number == n)))
+                .with_context(|| format!("{}: no excited state {n} is listed", doc.source))?;
+            let ntos = (doc.wavefunction.as_ref().and_then(|wf| crate::model::nto::from_transitions(wf, state)))
+                .with_context(|| format!("{}: state {n} prints no transition between orbitals the file has (a TD log joins its checkpoint with --transitions)", doc.source))?;
+            doc = ntos.document(&doc).context("no wavefunction")?;
+        }
         Ok(doc)
+    }
+
+    /// Whether `--state` names the state of a natural transition orbital (`--orbital hole N`).
+    fn names_nto(&self) -> bool {
+        matches!(self.orbital, OrbitalSpec::Hole(_) | OrbitalSpec::Particle(_))
     }
 
     /// The excited-state quantity asked for, with its option's name.
@@ -378,7 +397,7 @@ impl WhatArgs {
             return Ok(quantity);
         }
         let wf = wavefunction_of(doc)?;
-        if let Some(n) = self.state {
+        if let Some(n) = self.state.filter(|_| !self.names_nto()) {
             bail!(
                 "--state {n} picks the excited state of --difference-density, --attachment, --detachment, --excited-density or --transition-density; none is asked for"
             );
@@ -453,6 +472,8 @@ impl WhatArgs {
             OrbitalSpec::Lumo(0) => "lumo".to_string(),
             OrbitalSpec::Lumo(n) => format!("lumo+{n}"),
             OrbitalSpec::Index(n) => format!("mo{n}"),
+            OrbitalSpec::Hole(n) => format!("hole{n}"),
+            OrbitalSpec::Particle(n) => format!("particle{n}"),
         };
         match self.spin {
             SpinArg::Alpha => name,

@@ -251,6 +251,9 @@ pub enum OrbitalSpec {
     Lumo(usize),
     /// 1-based index within the spin's orbitals.
     Index(usize),
+    /// A natural transition orbital by its label: pair n's hole ("hole 1") or particle.
+    Hole(usize),
+    Particle(usize),
 }
 
 impl std::str::FromStr for OrbitalSpec {
@@ -266,6 +269,15 @@ impl std::str::FromStr for OrbitalSpec {
                 .and_then(|n| n.parse::<usize>().ok())
                 .ok_or_else(|| format!("expected homo, lumo, homo-N, lumo+N or an index, got {s:?}"))
         };
+        // "hole 1", "particle2": a natural transition orbital's label.
+        for (word, make) in [("hole", Self::Hole as fn(usize) -> Self), ("particle", Self::Particle)] {
+            if let Some(rest) = t.strip_prefix(word) {
+                return match rest.trim().parse::<usize>() {
+                    Ok(n) if n >= 1 => Ok(make(n)),
+                    _ => Err(format!("expected {word} N (a natural transition orbital, N from 1), got {s:?}")),
+                };
+            }
+        }
         if let Some(rest) = t.strip_prefix("homo") {
             Ok(Self::Homo(offset(rest, '-')?))
         } else if let Some(rest) = t.strip_prefix("lumo") {
@@ -288,6 +300,8 @@ impl std::fmt::Display for OrbitalSpec {
             Self::Lumo(0) => write!(f, "lumo"),
             Self::Lumo(k) => write!(f, "lumo+{k}"),
             Self::Index(n) => write!(f, "{n}"),
+            Self::Hole(n) => write!(f, "hole {n}"),
+            Self::Particle(n) => write!(f, "particle {n}"),
         }
     }
 }
@@ -336,6 +350,10 @@ impl Wavefunction {
                 let order = self.by_energy(spin);
                 let l = order.iter().position(|&i| Some(i) == self.lumo(spin))?;
                 order.get(l + k).copied()
+            }
+            OrbitalSpec::Hole(_) | OrbitalSpec::Particle(_) => {
+                let label = spec.to_string();
+                self.of_spin(spin).find(|(_, o)| o.symmetry == label).map(|(i, _)| i)
             }
         }
     }
@@ -416,6 +434,9 @@ mod tests {
         assert_eq!("HOMO-2".parse(), Ok(OrbitalSpec::Homo(2)));
         assert_eq!("lumo+1".parse(), Ok(OrbitalSpec::Lumo(1)));
         assert_eq!("7".parse(), Ok(OrbitalSpec::Index(7)));
+        assert_eq!("hole 1".parse(), Ok(OrbitalSpec::Hole(1)));
+        assert_eq!("Particle2".parse(), Ok(OrbitalSpec::Particle(2)));
+        assert!("hole".parse::<OrbitalSpec>().is_err() && "particle 0".parse::<OrbitalSpec>().is_err());
         assert!("0".parse::<OrbitalSpec>().is_err());
         assert!("homo+1".parse::<OrbitalSpec>().is_err());
         assert!("banana".parse::<OrbitalSpec>().is_err());
