@@ -848,7 +848,7 @@ impl OrbApp {
         // order) are made again, now with its density.
         let source = self.objects[self.active].doc.source.clone();
         if let Some(vp) = &mut self.viewport {
-            vp.documents.push(self.objects[self.active].doc.clone());
+            // `vp.documents` already holds it (set before its quantities were shown).
             for (n, o) in self.objects.iter().enumerate().take(self.active) {
                 for (k, q) in o.state.quantities.iter().enumerate() {
                     if q.fragments.files.contains(&source)

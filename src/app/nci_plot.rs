@@ -198,14 +198,9 @@ pub fn is_nci_surface(source: Source) -> bool {
     matches!(source, Source::Wavefunction(Quantity::NciGradient) | Source::Promolecular(Quantity::NciGradient))
 }
 
-/// The interaction `source` with `fragments` evaluates, when it is one ([`interaction`]): a
-/// structure's spherical atoms, or a wavefunction's density with other fragments.
+/// The interaction `source` with `fragments` evaluates, when it is one ([`interaction`]).
 fn kind(source: Source, fragments: &Fragments) -> Option<Kind> {
-    match source {
-        Source::Promolecular(_) => Some(Kind::Spherical),
-        Source::Wavefunction(_) if !fragments.is_empty() => Some(Kind::Wavefunction),
-        _ => None,
-    }
+    interaction::of_source(source, fragments).map(|(kind, _)| kind)
 }
 
 /// (sign(λ₂)ρ, s) at the points of a grid over the density of `source` (a wavefunction's, or

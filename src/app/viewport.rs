@@ -19,7 +19,6 @@ use crate::layers::key_volumes::ScanScene;
 use crate::model::isosurface::Mesh;
 use crate::model::{Document, VolumeGrid};
 use crate::scene::objects::Part;
-use crate::scene::quantity::is_promolecular;
 use crate::scene::translucency::SurfaceLook;
 use crate::scene::{ClipPlane, ObjectState, Source, SurfaceChoice, SurfaceSettings, VolumeSettings};
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
@@ -437,15 +436,15 @@ impl Viewport {
                 self.update_isosurfaces(n, k, doc, state);
                 Ok(coarser(doc, i, step))
             }
-            Source::Promolecular(quantity) => {
-                self.request_interaction(l, Kind::Spherical, doc, q, state, quantity);
+            // Spherical atoms' quantities, and the density's of several fragments (NCI), sum
+            // every part's density.
+            source @ (Source::Promolecular(_) | Source::Wavefunction(_))
+                if let Some((kind, quantity)) = interaction::of_source(source, &q.fragments) =>
+            {
+                self.request_interaction(l, kind, doc, q, state, quantity);
                 Ok(None)
             }
-            // The density's quantities of several fragments (NCI) sum every fragment's density.
-            Source::Wavefunction(quantity) if !q.fragments.is_empty() && is_promolecular(quantity) => {
-                self.request_interaction(l, Kind::Wavefunction, doc, q, state, quantity);
-                Ok(None)
-            }
+            Source::Promolecular(_) => Ok(None),
             Source::Wavefunction(quantity) => {
                 let e = &state.evaluation;
                 let functions = doc.wavefunction.as_ref().and_then(|wf| e.restriction(&wf.basis));

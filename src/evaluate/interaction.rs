@@ -57,6 +57,20 @@ impl Kind {
     }
 }
 
+/// Which interaction `source` of an object whose NCI quantities add `fragments` is, and its
+/// quantity: a structure's spherical atoms, or a wavefunction's density quantity with other
+/// fragments. `None` for every other source (the document's own evaluation).
+pub fn of_source(source: crate::scene::Source, fragments: &Fragments) -> Option<(Kind, Quantity)> {
+    use crate::scene::Source;
+    match source {
+        Source::Promolecular(q) => Some((Kind::Spherical, q)),
+        Source::Wavefunction(q) if !fragments.is_empty() && crate::scene::quantity::is_promolecular(q) => {
+            Some((Kind::Wavefunction, q))
+        }
+        _ => None,
+    }
+}
+
 /// One part's density.
 enum Density<'a> {
     Spherical(Promolecule),

@@ -240,16 +240,9 @@ pub fn sample_grid(points: &[glam::Vec3], grid: &VolumeGrid) -> Vec<Option<f64>>
 /// of the density, when `of` has fragments), a data set sampled trilinearly (`None` outside its
 /// grid), a quantity of the spherical atoms.
 pub fn values_at(of: Evaluating, source: Source, points: &[glam::Vec3]) -> Vec<Option<f64>> {
-    use super::interaction::{self, Kind};
+    use super::interaction;
     let doc = of.doc;
-    let kind = match source {
-        Source::Promolecular(_) => Some(Kind::Spherical),
-        Source::Wavefunction(q) if !of.fragments.is_empty() && crate::scene::quantity::is_promolecular(q) => {
-            Some(Kind::Wavefunction)
-        }
-        _ => None,
-    };
-    if let (Some(kind), Source::Wavefunction(q) | Source::Promolecular(q)) = (kind, source) {
+    if let Some((kind, q)) = interaction::of_source(source, of.fragments) {
         let points: Vec<glam::DVec3> = points.iter().map(|p| p.as_dvec3()).collect();
         return interaction::values_at(doc, kind, of.fragments, of.others, q, &points);
     }
