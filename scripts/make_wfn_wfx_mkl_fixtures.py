@@ -3,6 +3,8 @@
 files, each in the layout its programs write, beside the same wavefunction as a Molden file
 (PySCF's own writer). tests/aim_wavefunctions.rs checks that every file opens with the Molden
 file's orbitals, density, energies, occupations and spins.
+`--seeds DIR` writes the fuzzing seeds instead: H2 RHF/STO-3G and OH UHF/3-21G in each layout,
+occupied orbitals only, under DIR/wfn, DIR/wfx and DIR/mkl (scripts/fuzz.sh calls it).
 
 Systems (symmetry off, so the input coordinates are kept); the basis is cc-pVDZ with, on O, one
 f (exponent 1.4) and one g (1.2) function added, so that every file carries s to g:
@@ -80,8 +82,16 @@ SYSTEMS = [
 ]
 
 
-def run_scf(geometry, charge, spin, method):
-    mol = gto.M(atom=geometry, basis=basis(), charge=charge, spin=spin, symmetry=False,
+# Fuzzing seeds (`--seeds DIR`): the same layouts for the smallest molecules, since a fuzzer's
+# speed falls with its inputs' size (the fixtures above ran at 1 400 executions a second).
+SEEDS = [
+    ("h2_rhf", "H 0.0 0.0 0.0; H 0.0 0.0 0.74", 0, 0, "RHF", "sto-3g"),
+    ("oh_uhf", OH, 0, 1, "UHF", "3-21g"),
+]
+
+
+def run_scf(geometry, charge, spin, method, basis_set=None):
+    mol = gto.M(atom=geometry, basis=basis_set or basis(), charge=charge, spin=spin, symmetry=False,
                 unit="Angstrom", verbose=0)
     mf = {"RHF": scf.RHF, "UHF": scf.UHF, "ROHF": scf.ROHF}[method](mol)
     mf.conv_tol = 1e-11
@@ -463,7 +473,23 @@ def check_with_iodata(path, molden_path):
     return worst, notes
 
 
+def write_seeds(out):
+    """Each layout of each seed molecule, occupied orbitals only, into out/{wfn,wfx,mkl}/."""
+    for name, geometry, charge, spin, method, basis_set in SEEDS:
+        mol, mf = run_scf(geometry, charge, spin, method, basis_set)
+        title = "%s %s/%s" % (name, method, basis_set)
+        for kind in ("wfn", "wfx", "mkl"):
+            os.makedirs(os.path.join(out, kind), exist_ok=True)
+        write_wfn(os.path.join(out, "wfn", name + ".wfn"), title, mol, mf, "gaussian", occupied_only=True)
+        write_wfx(os.path.join(out, "wfx", name + ".wfx"), title, mol, mf, comments=False, occupied_only=True)
+        write_mkl(os.path.join(out, "mkl", name + ".mkl"), mol, mf)
+
+
 def main():
+    if "--seeds" in sys.argv[1:]:
+        lib.num_threads(1)
+        write_seeds(sys.argv[sys.argv.index("--seeds") + 1])
+        return
     check = "--check" in sys.argv[1:]
     os.makedirs(OUT, exist_ok=True)
     lib.num_threads(1)

@@ -84,6 +84,40 @@ fn far_away_the_potential_is_the_net_charge_over_the_distance() {
 }
 
 #[test]
+fn eight_points_at_a_time_give_each_points_own_bits() {
+    // Grids and point lists are evaluated eight neighbours at a time where the CPU allows,
+    // masking the pairs a point takes as far fields; each value must be the one-point sum's,
+    // bit for bit, for every angular momentum (s to h pairs), near nuclei and far out, with rows
+    // whose length is not a multiple of eight and short lists of points.
+    use orbcloud::model::GridSpec;
+    for file in ["wavefunctions/benzene_631gs.molden", "wavefunctions/h2_spdfgh.molden", "esp/hi_def2svp_ecp.fchk"] {
+        let doc = formats::load(&Path::new(FIXTURES).join(file)).unwrap();
+        let v = Potential::new(&doc.molecule, doc.wavefunction.as_ref().unwrap());
+        let (lo, hi) = doc.molecule.bounds().unwrap();
+        let grid = GridSpec::cube(lo - DVec3::splat(4.0), hi + DVec3::splat(4.0), 19);
+        let rows = v.on_grid(&grid);
+        let mut s = Scratch::default();
+        let mut points = Vec::new();
+        for i in 0..19 {
+            for j in 0..19 {
+                for k in 0..19 {
+                    let p = grid.point(i, j, k);
+                    let one = v.at(p, &mut s);
+                    let got = rows[(i * 19 + j) * 19 + k];
+                    assert_eq!(got.to_bits(), one.to_bits(), "{file}: point {p}: {got:e} against {one:e}");
+                    points.push(p);
+                }
+            }
+        }
+        for list in [&points[..], &points[5..16], &points[..3]] {
+            for (p, got) in list.iter().zip(v.at_points(list)) {
+                assert_eq!(got.to_bits(), v.at(*p, &mut s).to_bits(), "{file}: listed point {p}");
+            }
+        }
+    }
+}
+
+#[test]
 fn far_fields_agree_with_the_exact_sum_on_a_grid() {
     // Every point of a grid around the molecule, from inside the nuclei's cusps to the box's
     // corners: the far fields change the potential by less than their stated bound.

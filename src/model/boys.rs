@@ -13,14 +13,14 @@ use std::sync::OnceLock;
 pub const MAX_N: usize = 16;
 /// Largest T of the table; above it the asymptotic form is exact to double precision.
 pub const T_TABLE: f64 = 40.0;
-const STEP: f64 = 0.05;
+pub(super) const STEP: f64 = 0.05;
 /// Terms of the Taylor expansion between table points: error ≤ (STEP/2)^TAYLOR / TAYLOR! ≈ 3e-13.
-const TAYLOR: usize = 6;
-const ORDERS: usize = MAX_N + TAYLOR + 1;
+pub(super) const TAYLOR: usize = 6;
+pub(super) const ORDERS: usize = MAX_N + TAYLOR + 1;
 /// Up to this order every F_n comes from the table directly.
-const DIRECT: usize = 3;
+pub(super) const DIRECT: usize = 3;
 
-fn table() -> &'static Vec<[f64; ORDERS]> {
+pub(super) fn table() -> &'static Vec<[f64; ORDERS]> {
     static TABLE: OnceLock<Vec<[f64; ORDERS]>> = OnceLock::new();
     TABLE.get_or_init(|| {
         let points = (T_TABLE / STEP).round() as usize + 1;

@@ -28,6 +28,9 @@ use super::gto::{PreparedBasis, PreparedShell};
 use super::molecule::Molecule;
 use super::orbitals::Wavefunction;
 
+#[cfg(target_arch = "x86_64")]
+mod lanes;
+
 /// Primitive pairs whose charge is below this (a.u.) are left out.
 const PAIR_SCREEN: f64 = 1e-15;
 /// Highest t + u + v of a primitive pair: two h functions.
@@ -114,6 +117,9 @@ fn hermite_e(la: usize, lb: usize, xpa: f64, xpb: f64, p: f64) -> HermiteE {
 #[derive(Default)]
 pub struct Scratch {
     r: Vec<f64>,
+    /// The same, eight points at a time.
+    #[cfg(target_arch = "x86_64")]
+    lanes: Vec<[f64; 8]>,
 }
 
 /// One step of the R recursion: r[dst] = X_axis · r[from] + weight · r[back].
@@ -596,7 +602,28 @@ impl Potential {
 
     /// The potential at each of `points`, in parallel.
     pub fn at_points(&self, points: &[DVec3]) -> Vec<f64> {
-        points.par_iter().map_init(Scratch::default, |s, &p| self.at(p, s)).collect()
+        let mut out = vec![0.0; points.len()];
+        out.par_chunks_mut(8).zip(points.par_chunks(8)).for_each_init(Scratch::default, |s, (values, chunk)| {
+            self.at_neighbours(chunk, values, s);
+        });
+        out
+    }
+
+    /// The potential at up to eight points, near each other for speed (a grid row's, a list's
+    /// neighbours): eight at a time where the CPU has AVX-512 ([`lanes`]), with the same bits.
+    fn at_neighbours(&self, points: &[DVec3], values: &mut [f64], scratch: &mut Scratch) {
+        #[cfg(target_arch = "x86_64")]
+        if lanes::available() && !points.is_empty() {
+            // A short group repeats its last point in the spare lanes.
+            let group: [DVec3; lanes::LANES] = std::array::from_fn(|l| points[l.min(points.len() - 1)]);
+            // SAFETY: `available` checked the CPU's features.
+            let all = unsafe { self.at_lanes(&group, scratch) };
+            values.copy_from_slice(&all[..values.len()]);
+            return;
+        }
+        for (v, &p) in values.iter_mut().zip(points) {
+            *v = self.at(p, scratch);
+        }
     }
 
     /// The potential on a grid, in the grid's point order.
@@ -605,8 +632,12 @@ impl Potential {
         let mut out = vec![0.0; nx * ny * nz];
         out.par_chunks_mut(nz.max(1)).enumerate().for_each_init(Scratch::default, |s, (row, values)| {
             let (i, j) = (row / ny, row % ny);
-            for (k, v) in values.iter_mut().enumerate() {
-                *v = self.at(grid.point(i, j, k), s);
+            let mut points = [DVec3::ZERO; 8];
+            for (group, chunk) in values.chunks_mut(8).enumerate() {
+                for (l, p) in points.iter_mut().enumerate().take(chunk.len()) {
+                    *p = grid.point(i, j, group * 8 + l);
+                }
+                self.at_neighbours(&points[..chunk.len()], chunk, s);
             }
         });
         out
