@@ -180,6 +180,9 @@ fn far_fields(fields: &[Option<&FarField>; LANES], anchor: DVec3, at: Points, v:
     let offsets: [i64; LANES] = std::array::from_fn(|l| {
         fields[l].map_or(0, |f| (f.coefficients.as_ptr() as isize - origin as isize) as i64 / 8)
     });
+    // Points further out mostly share their level: one coefficient for all lanes then, read
+    // once rather than gathered.
+    let shared = fields.iter().flatten().all(|f| std::ptr::eq(*f, *base));
     let mut has = 0u8;
     for (l, field) in fields.iter().enumerate() {
         has |= u8::from(field.is_some()) << l;
@@ -198,10 +201,14 @@ fn far_fields(fields: &[Option<&FarField>; LANES], anchor: DVec3, at: Points, v:
         for b in (0..=order - a).rev() {
             let mut pz = splat(0.0);
             for _ in 0..=order - a - b {
-                let index = _mm512_add_epi64(offsets, _mm512_set1_epi64(next));
-                // SAFETY: each lane's index lies inside its own field's coefficients (or the
-                // first lane's), all in one allocation.
-                let c = unsafe { _mm512_i64gather_pd::<8>(index, origin) };
+                let c = if shared {
+                    splat(base.coefficients[next as usize])
+                } else {
+                    let index = _mm512_add_epi64(offsets, _mm512_set1_epi64(next));
+                    // SAFETY: each lane's index lies inside its own field's coefficients (or
+                    // the first lane's), all in one allocation.
+                    unsafe { _mm512_i64gather_pd::<8>(index, origin) }
+                };
                 pz = _mm512_add_pd(_mm512_mul_pd(pz, yz), c);
                 next += 1;
             }
