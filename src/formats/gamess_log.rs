@@ -46,6 +46,14 @@ const COLUMN: usize = 11;
 pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Document, ParseError> {
     let log = LogLines::new(file, text);
     let mut geometries = Vec::new();
+    let mut doc = read(&log, overlap, &mut geometries)?;
+    super::log_modes::attach(&mut doc, super::log_modes::gamess(&log, &geometries));
+    Ok(doc)
+}
+
+/// The document of `log` without its normal modes; `geometries` receives every geometry printed.
+fn read(log: &LogLines, overlap: Option<OverlapFn>, geometries: &mut Vec<Geometry>) -> Result<Document, ParseError> {
+    let file = log.file;
     let mut names: Vec<Vec<String>> = Vec::new();
     let mut energies = Vec::new();
     let mut basis: Option<NamedShells> = None;
