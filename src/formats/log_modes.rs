@@ -193,10 +193,10 @@ pub(crate) fn gamess(log: &LogLines, geometries: &[Geometry]) -> Result<Option<V
             let mut xyz = vec![[0.0; 3]; k];
             for (c, axis) in ["X", "Y", "Z"].into_iter().enumerate() {
                 let expected = format!(
-                    "atom {}'s {axis} row of the block at line {}: {}{axis} and {k} displacements (the {atoms} atoms at line {})",
+                    "atom {}'s {axis} row of the block at line {}: `{}{axis}` and {k} displacements (the {atoms} atoms at line {})",
                     a + 1,
                     block + 1,
-                    if c == 0 { format!("`{}  symbol  ", a + 1) } else { "`".to_string() },
+                    if c == 0 { format!("{}  symbol  ", a + 1) } else { String::new() },
                     geometry.line + 1
                 );
                 let l = log.get(i, &expected)?;
@@ -278,7 +278,8 @@ pub(crate) fn nwchem(log: &LogLines, geometries: &[Geometry]) -> Result<Option<V
         };
         let k = column_numbers(log.lines[block]).map_or(0, |c| c.len()).min(n - columns.len());
         i = skip_blank(log, block + 1);
-        let label = if log.lines[i].trim_start().starts_with("P.Frequency") { "P.Frequency" } else { "Frequency" };
+        let projected = log.get(i, "a `P.Frequency` line")?.trim_start().starts_with("P.Frequency");
+        let label = if projected { "P.Frequency" } else { "Frequency" };
         frequencies.extend(labelled_numbers(log, i, label, k)?);
         i = skip_blank(log, i + 1);
         let mut block_columns = vec![Vec::with_capacity(n); k];

@@ -72,7 +72,7 @@ fn read(log: &LogLines, overlap: Option<OverlapFn>, geometries: &mut Vec<Geometr
     while i < log.lines.len() {
         let t = log.lines[i].trim();
         if t.starts_with("Output coordinates in") {
-            let (g, n, next) = coordinates(&log, i)?;
+            let (g, n, next) = coordinates(log, i)?;
             geometries.push(g);
             tags.push(n);
             i = next;
@@ -83,7 +83,7 @@ fn read(log: &LogLines, overlap: Option<OverlapFn>, geometries: &mut Vec<Geometr
             energies.push((i, e));
         } else if t.starts_with("Basis \"ao basis\"") && !t.starts_with("Basis \"ao basis\" -> \"\"") {
             let cartesian = !t.contains("(spherical)");
-            let (b, next) = ao_basis(&log, i)?;
+            let (b, next) = ao_basis(log, i)?;
             basis = Some((cartesian, b));
             i = next;
             continue;
@@ -108,14 +108,14 @@ fn read(log: &LogLines, overlap: Option<OverlapFn>, geometries: &mut Vec<Geometr
         } else if let Some(rest) = t.strip_prefix("open shells") {
             shells_count.1 = rest.trim_start_matches([' ', '=']).trim().parse::<usize>().ok();
         } else if t == "Final MO vectors" {
-            let (v, next) = final_vectors(&log, i)?;
+            let (v, next) = final_vectors(log, i)?;
             vectors = Some(v);
             i = next;
             continue;
         }
         i += 1;
     }
-    let frames = frames(&geometries, &energies);
+    let frames = frames(geometries, &energies);
     if frames.is_empty() {
         return Err(error(
             file,
@@ -195,7 +195,7 @@ fn read(log: &LogLines, overlap: Option<OverlapFn>, geometries: &mut Vec<Geometr
                     Some((ShellKind::Pure, pure_index(f as i32 - l as i32)))
                 }
             };
-            let mut doc = printed::document(&log, "NWChem", geometry, &shells, &section, &function_of, overlap)?;
+            let mut doc = printed::document(log, "NWChem", geometry, &shells, &section, &function_of, overlap)?;
             let missing = section.orbitals.iter().filter(|o| o.energy.is_nan()).count();
             if missing > 0 {
                 doc.problems.push(format!(
