@@ -19,7 +19,8 @@
 //! The rows of `Final MO vectors` are numbered only: each atom (in the geometry's order) takes the
 //! shells of the basis tag of its own tag (else of its element), functions in NWChem's order:
 //! cartesian in the model's order (xx, xy, xz, yy, yz, zz), spherical m = −l … +l (p as x, y,
-//! z). Energies and occupations come from the orbital analysis (`Vector  n  Occ=… E=…`); an
+//! z) with the Condon–Shortley phase (the odd m > 0 functions change sign: [`condon_shortley`]).
+//! Energies and occupations come from the orbital analysis (`Vector  n  Occ=… E=…`); an
 //! orbital it leaves out gets its occupation from the closed and open shells and no energy.
 //! Coefficients are printed to 5 decimals and the basis' contraction coefficients to 6: the
 //! residual is measured and reported, never repaired. An unrestricted job prints its alpha
@@ -183,6 +184,9 @@ fn read(log: &LogLines, overlap: Option<OverlapFn>, geometries: &mut Vec<Geometr
                 ));
             }
             let cartesian = *cartesian;
+            if !cartesian {
+                condon_shortley(&mut section);
+            }
             let function_of = move |label: &str, l: u32| -> Option<(ShellKind, usize)> {
                 let (ll, f) = label.split_once(':')?;
                 let (ll, f): (u32, usize) = (ll.parse().ok()?, f.parse().ok()?);
@@ -211,6 +215,24 @@ fn read(log: &LogLines, overlap: Option<OverlapFn>, geometries: &mut Vec<Geometr
     let mut doc = trajectory(file, file, &frames);
     doc.problems.push(format!("{file}: no orbitals to draw: {why}"));
     Ok(doc)
+}
+
+/// NWChem's pure functions carry the Condon–Shortley phase: its m = +1, +3, +5 functions are
+/// the negatives of the model's real solid harmonics (d+1 = −xz, f+1, f+3, g+1, g+3, …), so their
+/// coefficients change sign. Seen in NWChem 7.0's RHF carbon atom (aug-cc-pCVQZ): every orbital
+/// is symmetric about the axis of its doubly occupied p orbital only with these signs.
+fn condon_shortley(section: &mut Section) {
+    let flipped: Vec<bool> = (section.rows.iter())
+        .map(|r| {
+            let lf = r.label.split_once(':').and_then(|(l, f)| Some((l.parse::<i64>().ok()?, f.parse::<i64>().ok()?)));
+            lf.is_some_and(|(l, f)| l >= 2 && (f - l) > 0 && (f - l) % 2 == 1)
+        })
+        .collect();
+    for o in &mut section.orbitals {
+        for (c, _) in o.coefficients.iter_mut().zip(&flipped).filter(|(_, f)| **f) {
+            *c = -*c;
+        }
+    }
 }
 
 /// `1  Occ=2.000000D+00  E=-1.104059D+01  Symmetry=bu` (after `Vector`).
