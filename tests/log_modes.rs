@@ -180,3 +180,28 @@ fn a_block_cut_short_or_an_atom_too_many_leaves_the_modes_out_naming_the_line() 
         }
     }
 }
+
+/// Psi4's finite differences print a geometry per displacement; the modes belong to the
+/// reference: the last geometry computed before `FINDIF` (Psi4 1.3), or the first after it when
+/// none was (1.7), never the last displaced one before the analysis.
+#[test]
+fn psi4_finite_difference_modes_belong_to_the_reference_geometry() {
+    let text = std::fs::read_to_string(format!("{LOGS}/h2o_psi4_freq.out")).unwrap();
+    let (head, rest) = text.split_at(text.find("  ==> Geometry <==").unwrap());
+    let (table, analysis) = rest.split_at(rest.find("  ==> Harmonic Vibrational Analysis <==").unwrap());
+    // The oxygen moved by 0.005 bohr along x, as a displacement would.
+    let o_row = table.lines().find(|l| l.trim_start().starts_with("O ")).unwrap();
+    let x: f64 = o_row.split_whitespace().nth(1).unwrap().parse().unwrap();
+    let displaced = table.replacen(o_row, &o_row.replacen(&format!("{x:.12}"), &format!("{:.12}", x + 0.005), 1), 1);
+    assert_ne!(displaced, table);
+    let banner = "                                   FINDIF\n";
+    let reference = expected("h2o").geometry[0];
+    for (version, text) in [
+        ("1.3", format!("{head}{table}{banner}{displaced}{displaced}{analysis}")),
+        ("1.7", format!("{head}{banner}{table}{displaced}{displaced}{analysis}")),
+    ] {
+        let doc = orbcloud::formats::load_bytes(Path::new("findif.out"), text.as_bytes()).unwrap();
+        let v = doc.vibrations.unwrap_or_else(|| panic!("{version}: {:?}", doc.problems));
+        assert!(v.geometry[0].distance(reference) < 1e-9, "{version}: {} from {}", v.geometry[0], v.geometry_from);
+    }
+}

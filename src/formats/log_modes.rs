@@ -35,8 +35,8 @@
 //! GAMESS and NWChem print Cartesian displacements normalised with the masses (Σ m·|d|² = 1),
 //! Psi4 and Q-Chem normalised to Σ |d|² = 1. GAMESS prints intensities in D²/(amu·Å²), here
 //! converted to km/mol. The geometry: the last one printed before the section, except Psi4's
-//! finite differences (`FINDIF`), whose reference is the first geometry computed after the
-//! banner (Psi4 1.3 and 1.7 compute it first; the displaced ones differ from it by ~0.005 bohr).
+//! finite differences, whose reference is the last geometry computed before they begin (Psi4 1.2
+//! and 1.3) or the first after (1.7); the displaced ones differ from it by ~0.005 bohr.
 
 use glam::DVec3;
 
@@ -365,10 +365,19 @@ pub(crate) fn psi4(log: &LogLines, geometries: &[Geometry]) -> Result<Option<Vib
     let Some(start) = last(log, |t| t == "==> Harmonic Vibrational Analysis <==") else {
         return Ok(None);
     };
-    // Psi4 1.3 prints `FINDIF` again just before the analysis: the banner that counts is the
-    // last one followed by computed geometries.
-    let banners = (0..start).rev().filter(|&k| log.lines[k].trim() == "FINDIF");
-    let reference = banners.filter_map(|f| geometries.iter().find(|g| g.line > f && g.line < start)).next();
+    // Finite differences begin at the first marker after any earlier analysis (`FINDIF` from
+    // Psi4 1.3, which prints it again before the analysis; a sentence in 1.2). The reference is
+    // the last geometry computed before it (1.2, 1.3: the gradient that chose the projection)
+    // or, when none was, the first after it (1.7 computes the reference first).
+    let previous = log.lines[..start].iter().rposition(|l| l.trim() == "==> Harmonic Vibrational Analysis <==");
+    let marker = (previous.map_or(0, |p| p + 1)..start).find(|&k| {
+        let t = log.lines[k].trim();
+        t == "FINDIF" || t.starts_with("Using finite-differences of gradients")
+    });
+    let reference = marker.and_then(|m| {
+        let before = geometries.iter().rfind(|g| g.line < m && previous.is_none_or(|p| g.line > p));
+        before.or_else(|| geometries.iter().find(|g| g.line > m && g.line < start))
+    });
     let geometry = match reference {
         Some(g) => g,
         None => geometry_before(log, geometries, start)?,
