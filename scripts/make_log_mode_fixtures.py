@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """Frequency-job fixtures in the layouts of GAMESS-US, NWChem, Psi4 and Q-Chem logs, computed
-with PySCF: water (RHF/STO-3G, near its minimum) in all four, and planar ammonia (RHF/STO-3G, the
-inversion's transition state: one imaginary mode) in GAMESS-US's, Psi4's and Q-Chem's, whose
-notations for an imaginary frequency differ.
+with PySCF: water (RHF/STO-3G, at the minimum geomeTRIC finds) in all four, and planar ammonia
+(RHF/STO-3G, the inversion's transition state: one imaginary mode) in GAMESS-US's, Psi4's and
+Q-Chem's, whose notations for an imaginary frequency differ.
 
     target/pyenv/bin/python scripts/make_log_mode_fixtures.py tests/fixtures/logs
 
