@@ -355,6 +355,8 @@ fn truncated_files_never_panic() {
     let orca = std::fs::read_to_string(ORCA).unwrap();
     let [gamess, nwchem, psi4, qchem] = NEW_LOGS.map(|name| std::fs::read_to_string(format!("{LOGS}/{name}")).unwrap());
     let orca_freq = std::fs::read_to_string(format!("{LOGS}/h2o_orca_freq.out")).unwrap();
+    let [gamess_freq, nwchem_freq, psi4_freq, qchem_freq] = ["gamess", "nwchem", "psi4", "qchem"]
+        .map(|p| std::fs::read_to_string(format!("{LOGS}/h2o_{p}_freq.out")).unwrap());
     let scan_log = std::fs::read_to_string(format!("{LOGS}/h2o2_scan.log")).unwrap();
     let scan_fchk = std::fs::read_to_string(SCAN_FCHK).unwrap();
     for (name, text) in [
@@ -362,6 +364,10 @@ fn truncated_files_never_panic() {
         ("t.fchk", &scan_fchk),
         ("t.out", &orca),
         ("t.out", &orca_freq),
+        ("t.out", &gamess_freq),
+        ("t.out", &nwchem_freq),
+        ("t.out", &psi4_freq),
+        ("t.out", &qchem_freq),
         ("t.out", &gamess),
         ("t.out", &nwchem),
         ("t.out", &psi4),

@@ -46,6 +46,14 @@ const COLUMN: usize = 11;
 pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Document, ParseError> {
     let log = LogLines::new(file, text);
     let mut geometries = Vec::new();
+    let mut doc = read(&log, overlap, &mut geometries)?;
+    super::log_modes::attach(&mut doc, super::log_modes::gamess(&log, &geometries));
+    Ok(doc)
+}
+
+/// The document of `log` without its normal modes; `geometries` receives every geometry printed.
+fn read(log: &LogLines, overlap: Option<OverlapFn>, geometries: &mut Vec<Geometry>) -> Result<Document, ParseError> {
+    let file = log.file;
     let mut names: Vec<Vec<String>> = Vec::new();
     let mut energies = Vec::new();
     let mut basis: Option<NamedShells> = None;
@@ -55,7 +63,7 @@ pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Docum
     while i < log.lines.len() {
         let t = log.lines[i].trim();
         if (t.starts_with("ATOM") && t.contains("COORDINATES (BOHR)")) || t == "COORDINATES OF ALL ATOMS ARE (ANGS)" {
-            let (g, n, next) = coordinates(&log, i)?;
+            let (g, n, next) = coordinates(log, i)?;
             geometries.push(g);
             names.push(n);
             i = next;
@@ -66,7 +74,7 @@ pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Docum
                 energies.push((i, e));
             }
         } else if t == "ATOMIC BASIS SET" {
-            let (b, next) = atomic_basis(&log, i)?;
+            let (b, next) = atomic_basis(log, i)?;
             basis = Some(b);
             i = next;
             continue;
@@ -86,7 +94,7 @@ pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Docum
             && log.lines.get(i + 1).is_some_and(|l| l.trim().starts_with("---"))
         {
             let beta = (i.saturating_sub(6)..i).any(|k| log.lines[k].contains("BETA SET"));
-            let (section, next) = eigenvectors(&log, i)?;
+            let (section, next) = eigenvectors(log, i)?;
             let spin = if beta { Spin::Beta } else { Spin::Alpha };
             // A later section of a spin replaces the earlier (the guess's, an earlier step's).
             if spin == Spin::Alpha {
@@ -99,7 +107,7 @@ pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Docum
         }
         i += 1;
     }
-    let frames = frames(&geometries, &energies);
+    let frames = frames(geometries, &energies);
     if frames.is_empty() {
         return Err(error(file, log.lines.len().max(1), "an `ATOM … COORDINATES (BOHR)` table", "none in the file"));
     }
@@ -124,8 +132,8 @@ pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Docum
                     section.orbitals.push(Orbital { occupation, spin: *spin, ..o.clone() });
                 }
             }
-            let shells = atom_shells(&log, geometry, names, basis, &section)?;
-            let mut doc = printed::document(&log, "GAMESS", geometry, &shells, &section, &function_of, overlap)?;
+            let shells = atom_shells(log, geometry, names, basis, &section)?;
+            let mut doc = printed::document(log, "GAMESS", geometry, &shells, &section, &function_of, overlap)?;
             super::logs::note_one_geometry(&mut doc, file, frames.len(), geometry.line);
             return Ok(doc);
         }

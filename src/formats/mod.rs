@@ -11,6 +11,7 @@ pub mod fchk;
 mod fchk_excited;
 pub mod gamess_log;
 pub mod gaussian_log;
+mod log_modes;
 pub mod logs;
 pub mod mesh_write;
 pub mod mkl;

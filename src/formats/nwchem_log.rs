@@ -19,7 +19,8 @@
 //! The rows of `Final MO vectors` are numbered only: each atom (in the geometry's order) takes the
 //! shells of the basis tag of its own tag (else of its element), functions in NWChem's order:
 //! cartesian in the model's order (xx, xy, xz, yy, yz, zz), spherical m = −l … +l (p as x, y,
-//! z). Energies and occupations come from the orbital analysis (`Vector  n  Occ=… E=…`); an
+//! z) with the Condon–Shortley phase (the odd m > 0 functions change sign: [`condon_shortley`]).
+//! Energies and occupations come from the orbital analysis (`Vector  n  Occ=… E=…`); an
 //! orbital it leaves out gets its occupation from the closed and open shells and no energy.
 //! Coefficients are printed to 5 decimals and the basis' contraction coefficients to 6: the
 //! residual is measured and reported, never repaired. An unrestricted job prints its alpha
@@ -50,6 +51,14 @@ pub const ORBITAL_KEYWORDS: &str = "print \"final vectors\" (in the scf or dft b
 pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Document, ParseError> {
     let log = LogLines::new(file, text);
     let mut geometries = Vec::new();
+    let mut doc = read(&log, overlap, &mut geometries)?;
+    super::log_modes::attach(&mut doc, super::log_modes::nwchem(&log, &geometries));
+    Ok(doc)
+}
+
+/// The document of `log` without its normal modes; `geometries` receives every geometry printed.
+fn read(log: &LogLines, overlap: Option<OverlapFn>, geometries: &mut Vec<Geometry>) -> Result<Document, ParseError> {
+    let file = log.file;
     let mut tags: Vec<Vec<String>> = Vec::new();
     let mut energies = Vec::new();
     let mut basis: Option<(bool, HashMap<String, Vec<PrintedShell>>)> = None;
@@ -64,7 +73,7 @@ pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Docum
     while i < log.lines.len() {
         let t = log.lines[i].trim();
         if t.starts_with("Output coordinates in") {
-            let (g, n, next) = coordinates(&log, i)?;
+            let (g, n, next) = coordinates(log, i)?;
             geometries.push(g);
             tags.push(n);
             i = next;
@@ -75,7 +84,7 @@ pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Docum
             energies.push((i, e));
         } else if t.starts_with("Basis \"ao basis\"") && !t.starts_with("Basis \"ao basis\" -> \"\"") {
             let cartesian = !t.contains("(spherical)");
-            let (b, next) = ao_basis(&log, i)?;
+            let (b, next) = ao_basis(log, i)?;
             basis = Some((cartesian, b));
             i = next;
             continue;
@@ -100,14 +109,14 @@ pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Docum
         } else if let Some(rest) = t.strip_prefix("open shells") {
             shells_count.1 = rest.trim_start_matches([' ', '=']).trim().parse::<usize>().ok();
         } else if t == "Final MO vectors" {
-            let (v, next) = final_vectors(&log, i)?;
+            let (v, next) = final_vectors(log, i)?;
             vectors = Some(v);
             i = next;
             continue;
         }
         i += 1;
     }
-    let frames = frames(&geometries, &energies);
+    let frames = frames(geometries, &energies);
     if frames.is_empty() {
         return Err(error(
             file,
@@ -175,6 +184,9 @@ pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Docum
                 ));
             }
             let cartesian = *cartesian;
+            if !cartesian {
+                condon_shortley(&mut section);
+            }
             let function_of = move |label: &str, l: u32| -> Option<(ShellKind, usize)> {
                 let (ll, f) = label.split_once(':')?;
                 let (ll, f): (u32, usize) = (ll.parse().ok()?, f.parse().ok()?);
@@ -187,7 +199,7 @@ pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Docum
                     Some((ShellKind::Pure, pure_index(f as i32 - l as i32)))
                 }
             };
-            let mut doc = printed::document(&log, "NWChem", geometry, &shells, &section, &function_of, overlap)?;
+            let mut doc = printed::document(log, "NWChem", geometry, &shells, &section, &function_of, overlap)?;
             let missing = section.orbitals.iter().filter(|o| o.energy.is_nan()).count();
             if missing > 0 {
                 doc.problems.push(format!(
@@ -203,6 +215,24 @@ pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Docum
     let mut doc = trajectory(file, file, &frames);
     doc.problems.push(format!("{file}: no orbitals to draw: {why}"));
     Ok(doc)
+}
+
+/// NWChem's pure functions carry the Condon–Shortley phase: its m = +1, +3, +5 functions are
+/// the negatives of the model's real solid harmonics (d+1 = −xz, f+1, f+3, g+1, g+3, …), so their
+/// coefficients change sign. Seen in NWChem 7.0's RHF carbon atom (aug-cc-pCVQZ): every orbital
+/// is symmetric about the axis of its doubly occupied p orbital only with these signs.
+fn condon_shortley(section: &mut Section) {
+    let flipped: Vec<bool> = (section.rows.iter())
+        .map(|r| {
+            let lf = r.label.split_once(':').and_then(|(l, f)| Some((l.parse::<i64>().ok()?, f.parse::<i64>().ok()?)));
+            lf.is_some_and(|(l, f)| l >= 2 && (f - l) > 0 && (f - l) % 2 == 1)
+        })
+        .collect();
+    for o in &mut section.orbitals {
+        for (c, _) in o.coefficients.iter_mut().zip(&flipped).filter(|(_, f)| **f) {
+            *c = -*c;
+        }
+    }
 }
 
 /// `1  Occ=2.000000D+00  E=-1.104059D+01  Symmetry=bu` (after `Vector`).

@@ -54,6 +54,14 @@ pub const ORBITAL_KEYWORDS: &str = "set { print_basis true  print_mos true }";
 pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Document, ParseError> {
     let log = LogLines::new(file, text);
     let mut geometries = Vec::new();
+    let mut doc = read(&log, overlap, &mut geometries)?;
+    super::log_modes::attach(&mut doc, super::log_modes::psi4(&log, &geometries));
+    Ok(doc)
+}
+
+/// The document of `log` without its normal modes; `geometries` receives every geometry printed.
+fn read(log: &LogLines, overlap: Option<OverlapFn>, geometries: &mut Vec<Geometry>) -> Result<Document, ParseError> {
+    let file = log.file;
     let mut labels: Vec<Vec<String>> = Vec::new();
     let mut energies = Vec::new();
     let mut basis: Option<AoBasis> = None;
@@ -62,7 +70,7 @@ pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Docum
     while i < log.lines.len() {
         let t = log.lines[i].trim();
         if t.starts_with("Geometry (in Angstrom)") || t.starts_with("Geometry (in Bohr)") {
-            let (g, n, next) = coordinates(&log, i)?;
+            let (g, n, next) = coordinates(log, i)?;
             geometries.push(g);
             labels.push(n);
             i = next;
@@ -73,19 +81,19 @@ pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Docum
         {
             energies.push((i, e));
         } else if t == "==> AO Basis Functions <==" {
-            let (b, next) = ao_basis(&log, i)?;
+            let (b, next) = ao_basis(log, i)?;
             basis = Some(b);
             i = next;
             continue;
         } else if t == "==> Molecular Orbitals <==" {
-            let (s, next) = molecular_orbitals(&log, i)?;
+            let (s, next) = molecular_orbitals(log, i)?;
             section = Some(s);
             i = next;
             continue;
         }
         i += 1;
     }
-    let frames = frames(&geometries, &energies);
+    let frames = frames(geometries, &energies);
     if frames.is_empty() {
         return Err(error(file, log.lines.len().max(1), "a `Geometry (in Angstrom)` table", "none in the file"));
     }
@@ -106,7 +114,7 @@ pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Docum
             }
             let spherical = *spherical;
             let function_of = move |label: &str, l: u32| function_of(label, l, spherical);
-            let mut doc = printed::document(&log, "Psi4", geometry, &shells, section, &function_of, overlap)?;
+            let mut doc = printed::document(log, "Psi4", geometry, &shells, section, &function_of, overlap)?;
             super::logs::note_one_geometry(&mut doc, file, frames.len(), geometry.line);
             return Ok(doc);
         }

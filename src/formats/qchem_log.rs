@@ -48,6 +48,14 @@ const COLUMN: usize = 10;
 pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Document, ParseError> {
     let log = LogLines::new(file, text);
     let mut geometries = Vec::new();
+    let mut doc = read(&log, overlap, &mut geometries)?;
+    super::log_modes::attach(&mut doc, super::log_modes::qchem(&log, &geometries));
+    Ok(doc)
+}
+
+/// The document of `log` without its normal modes; `geometries` receives every geometry printed.
+fn read(log: &LogLines, overlap: Option<OverlapFn>, geometries: &mut Vec<Geometry>) -> Result<Document, ParseError> {
+    let file = log.file;
     let mut energies = Vec::new();
     let mut electrons = None;
     let mut basis: Option<(usize, Vec<Vec<PrintedShell>>)> = None;
@@ -56,20 +64,20 @@ pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Docum
     while i < log.lines.len() {
         let t = log.lines[i].trim();
         if t.starts_with("Standard Nuclear Orientation") {
-            let (g, next) = orientation(&log, i)?;
+            let (g, next) = orientation(log, i)?;
             geometries.push(g);
             i = next;
             continue;
         }
         if t.starts_with("Basis set in general basis input format") {
-            let (b, next) = general_basis(&log, i)?;
+            let (b, next) = general_basis(log, i)?;
             basis = Some((i, b));
             i = next;
             continue;
         }
         if t.ends_with("MOLECULAR ORBITAL COEFFICIENTS") {
             let spin = if t.starts_with("BETA") { Spin::Beta } else { Spin::Alpha };
-            let (section, next) = coefficients(&log, i)?;
+            let (section, next) = coefficients(log, i)?;
             if spin == Spin::Alpha {
                 sections.clear();
             }
@@ -94,7 +102,7 @@ pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Docum
         }
         i += 1;
     }
-    let frames = frames(&geometries, &energies);
+    let frames = frames(geometries, &energies);
     if frames.is_empty() {
         return Err(log.error_at(log.lines.len(), "a `Standard Nuclear Orientation (Angstroms)` table"));
     }
@@ -155,7 +163,7 @@ pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Docum
                     format!("{} atoms in the printed basis set, as in the orientation", geometry.z.len()),
                 ));
             }
-            let mut doc = printed::document(&log, "Q-Chem", geometry, shells, &section, &function_of, overlap)?;
+            let mut doc = printed::document(log, "Q-Chem", geometry, shells, &section, &function_of, overlap)?;
             super::logs::note_one_geometry(&mut doc, file, frames.len(), geometry.line);
             doc
         }
@@ -178,7 +186,7 @@ pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Docum
     };
     if let Some(occupied) = electrons {
         // A malformed table leaves the states out, not the file.
-        match super::excited_logs::qchem(&log, occupied) {
+        match super::excited_logs::qchem(log, occupied) {
             Ok(states) => doc.excited = states,
             Err(e) => doc.problems.push(format!("excited states left out: {e}")),
         }

@@ -17,7 +17,7 @@ pub struct Document {
     /// Residues, chains, models and per-atom annotations (PDB, mmCIF, multi-frame XYZ);
     /// `molecule` is the model it shows.
     pub structure: Option<StructureView>,
-    /// Normal modes of vibration (Molden `[FREQ]`…, fchk `Vib-Modes`).
+    /// Normal modes of vibration (Molden `[FREQ]`…, fchk `Vib-Modes`, frequency jobs' logs).
     pub vibrations: Option<Vibrations>,
     /// Excited states the file lists (a TD job's log or fchk); their densities, where the file
     /// holds one, are the wavefunction's ([`Wavefunction::excited`]).
