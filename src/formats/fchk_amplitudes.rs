@@ -29,11 +29,11 @@ use crate::model::Wavefunction;
 use crate::model::excited::{ExcitedState, ExcitedStates, Transition};
 use crate::model::units::EV_PER_HARTREE;
 
-/// Amplitudes smaller than this are left out of a state's transitions: their squares sum to
-/// under 1e-12 of the state's ½ in any molecule a viewer opens, far below what the natural
-/// transition orbitals or a transition density can show, and a large molecule's states keep a
-/// fraction of their o × v values.
-const SMALLEST_AMPLITUDE: f64 = 1e-8;
+/// A state's smallest amplitudes are left out of its transitions while their squares sum to no
+/// more than this: the transition matrix then lies within 1e-7 (Frobenius) of the file's, so the
+/// natural transition orbitals' weights and coefficients within about 1e-7 of the whole's, and a
+/// large molecule's states keep the few amplitudes that matter of their o × v values.
+const DROPPED_NORM: f64 = 1e-14;
 
 /// How far a state's Σ X_ia² may lie from ½: the file prints 9 significant digits, so the sum
 /// agrees to about 1e-8; amplitudes read in another layout or another normalisation miss it by
@@ -102,7 +102,9 @@ impl FchkFile {
             s.number = k + 1;
         }
         let transitions = match left_out {
-            None => "transitions: every `Alpha Amplitudes` value of 1e-8 or more (X, square-summing to ½); ",
+            None => {
+                "transitions: `Alpha Amplitudes` (X, square-summing to ½) but the smallest, whose squares sum to under 1e-14; "
+            }
             Some(_) => "",
         };
         let note = format!(
@@ -175,8 +177,20 @@ impl FchkFile {
                     format!("{norm:.6} for state {} of the file", k + 1),
                 ));
             }
+            // The smallest first, dropped while their squares add up to at most DROPPED_NORM.
+            let mut order: Vec<usize> = (0..state.len()).collect();
+            order.sort_unstable_by(|&a, &b| state[a].abs().total_cmp(&state[b].abs()));
+            let mut dropped = 0.0;
+            let small = order.iter().take_while(|&&ia| {
+                dropped += state[ia] * state[ia];
+                dropped <= DROPPED_NORM
+            });
+            let mut keep = vec![true; state.len()];
+            for &ia in small {
+                keep[ia] = false;
+            }
             let transitions = (state.iter().enumerate())
-                .filter(|(_, c)| c.abs() >= SMALLEST_AMPLITUDE)
+                .filter(|&(ia, _)| keep[ia])
                 .map(|(ia, &c)| Transition {
                     from: ia / v + 1,
                     to: o + ia % v + 1,
