@@ -16,9 +16,9 @@
 //! o is the alpha electron count and v the orbitals past them (`Alpha Orbital Energies`' count
 //! less o). Each state's alpha amplitudes square-sum to ½ (Q-Chem's log prints √2·X, square-
 //! summing to 1), the spin-adapted normalisation Gaussian prints, so they are the transitions'
-//! coefficients as they are. As found in Q-Chem 5.4's and 7.0's files (cclib's `water_cis` and
-//! `dvb_td`): the file lists the triplets before the singlets, names neither, and the log numbers
-//! the states by excitation energy, as the states are numbered here.
+//! coefficients as they are. As found in Q-Chem 5.4's `water_cis` and `dvb_td` and 7.0's
+//! `water_cis` (cclib's regression data): the file lists the triplets before the singlets, names
+//! neither, and the log numbers the states by excitation energy, as the states are numbered here.
 //!
 //! A full TD-DFT's `Alpha X Amplitudes` and `Alpha Y Amplitudes` and an unrestricted run's
 //! amplitudes are not read: their states are listed without transitions, saying so.
@@ -56,7 +56,8 @@ pub(super) struct QchemStates {
 }
 
 impl FchkFile {
-    /// Q-Chem's `Number of Excited States` and what follows it; `None` without that record.
+    /// Q-Chem's `Number of Excited States` and what follows it; `None` without that record or
+    /// with no state.
     pub(super) fn qchem_excited_states(
         &self,
         file: &str,
@@ -70,6 +71,9 @@ impl FchkFile {
         let count = usize::try_from(count).map_err(|_| {
             error(file, self.line_of("Number of Excited States"), "a state count ≥ 0", format!("{count}"))
         })?;
+        if count == 0 {
+            return Ok(None);
+        }
         let energies = self.reals(file, "Excitation Energies", Some(count))?;
         let strengths = match self.records.get("Oscillator Strengths") {
             Some(_) => Some(self.reals(file, "Oscillator Strengths", Some(count))?),
