@@ -533,7 +533,7 @@ fn a_tda_states_transition_density_gives_pyscfs_oscillator_strength() {
             ..ExcitedState::default()
         })
         .collect();
-    doc.excited = Some(ExcitedStates { program: "PySCF".into(), method: "TDA".into(), states, density_of: None });
+    doc.excited = Some(ExcitedStates { program: "PySCF".into(), method: "TDA".into(), states, ..Default::default() });
     let wf = doc.wavefunction.clone().unwrap();
     let moments = orbcloud::model::overlap::moment_matrices(&wf.basis);
     let prepared = orbcloud::model::gto::PreparedBasis::new(&wf.basis);

@@ -153,6 +153,9 @@ fn readers_survive_mutated_fixtures() {
     // A relaxed scan's fchk: its `Opt point N` records open as frames.
     let scans = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/scan_jobs");
     fuzz("scan fchk", &files_in(scans, "fchk"), read("fuzz.fchk"));
+    // A Q-Chem CIS/TDA fchk: its states and every state's amplitudes.
+    let excited = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/excited");
+    fuzz("qchem td fchk", &files_in(excited, "fchk"), read("fuzz.fchk"));
     let gz = {
         use std::io::Write;
         let mut e = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());

@@ -633,3 +633,72 @@ fn other_programs_outputs_cut_inside_their_orbitals_are_refused_at_a_line() {
         assert!(e.line > 1, "{name}: {e}");
     }
 }
+
+/// A Q-Chem CIS/TDA fchk whose excited-state records lie (a state count past its energies, an
+/// energy that is no excitation, amplitudes too few or not normalised, a count the file cannot
+/// hold) opens its orbitals and leaves the states out, naming the file and the line, or is
+/// refused at its line; a full TD-DFT's X and Y amplitudes list the states without transitions.
+#[test]
+fn qchem_excited_state_records_that_lie_leave_the_states_out() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/excited/formaldehyde_qchem_tda.fchk");
+    let fchk = std::fs::read_to_string(path).unwrap();
+    let line_of = |text: &str, label: &str| text.lines().position(|l| l.starts_with(label)).unwrap() + 1;
+    let first_value = |label: &str| fchk.lines().nth(line_of(&fchk, label)).unwrap().to_string();
+    let energies = first_value("Excitation Energies");
+    let e1 = energies.split_whitespace().next().unwrap();
+    let amplitudes = first_value("Alpha Amplitudes");
+    let amplitude_header = fchk.lines().find(|l| l.starts_with("Alpha Amplitudes")).unwrap().to_string();
+    let cut_header = amplitude_header.replace("N=         672", "N=         671");
+    let cut_values = amplitudes.split_at(amplitudes.len() - 16).0.to_string();
+    let cases: Vec<(&str, String, &str)> = vec![
+        (
+            "count",
+            fchk.replacen(
+                "Number of Excited States                   I                6",
+                "Number of Excited States                   I     999999999999",
+                1,
+            ),
+            "Excitation Energies",
+        ),
+        (
+            "energy",
+            fchk.replacen(&energies, &energies.replacen(&format!(" {e1}"), &format!("-{e1}"), 1), 1),
+            "Excitation Energies",
+        ),
+        ("zero", fchk.replacen(&energies, &energies.replacen(e1, "0.00000000E+00", 1), 1), "Excitation Energies"),
+        ("norm", fchk.replacen(&amplitudes, &amplitudes.replacen("E-", "E+", 1), 1), "Alpha Amplitudes"),
+        (
+            "few",
+            fchk.replacen(&amplitude_header, &cut_header, 1).replacen(&amplitudes, &cut_values, 1),
+            "Alpha Amplitudes",
+        ),
+    ];
+    assert_eq!(amplitude_header.split_whitespace().last(), Some("672"), "6 states × 8 occupied × 14 virtual");
+    for (what, bad, label) in cases {
+        assert_ne!(bad, fchk, "{what}");
+        let start = Instant::now();
+        let doc = formats::load_bytes(Path::new("lie.fchk"), bad.as_bytes()).unwrap_or_else(|e| panic!("{what}: {e}"));
+        assert!(start.elapsed() < Duration::from_secs(5), "{what}");
+        assert!(doc.wavefunction.is_some() && doc.excited.is_none(), "{what}");
+        let at = format!("lie.fchk:{}:", line_of(&bad, label));
+        assert!(
+            doc.problems.iter().any(|p| p.starts_with("excited states left out") && p.contains(&at)),
+            "{what}: {:?} (expected {at})",
+            doc.problems
+        );
+    }
+    // A count the rest of the file cannot hold: refused at its line before anything is allocated.
+    let bad = fchk.replacen(&amplitude_header, &amplitude_header.replace("N=         672", "N= 99999999999"), 1);
+    let e = refused("lie.fchk", bad.as_bytes());
+    assert_eq!(e.line, line_of(&bad, "Alpha Amplitudes"), "{e}");
+    // A full TD-DFT's records (not read): the states, without transitions, saying so.
+    let xy = fchk.replacen("Alpha Amplitudes  ", "Alpha X Amplitudes", 1).replacen(
+        "Beta Amplitudes   ",
+        "Alpha Y Amplitudes",
+        1,
+    );
+    let doc = formats::load_bytes(Path::new("xy.fchk"), xy.as_bytes()).unwrap();
+    let states = doc.excited.as_ref().expect("the states");
+    assert!(states.states.len() == 6 && states.states.iter().all(|s| s.transitions.is_empty()));
+    assert!(doc.problems.iter().any(|p| p.contains("X Amplitudes") && p.contains("not read")), "{:?}", doc.problems);
+}

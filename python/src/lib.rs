@@ -363,7 +363,7 @@ impl PyDocument {
             .collect();
         let mut doc = self.doc.clone();
         let density_of = self.density_state();
-        doc.excited = Some(ExcitedStates { program, method, states, density_of });
+        doc.excited = Some(ExcitedStates { program, method, states, density_of, note: String::new() });
         PyDocument::new(doc)
     }
 

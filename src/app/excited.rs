@@ -106,6 +106,10 @@ fn list(ui: &mut egui::Ui, doc: &Document, states: &ExcitedStates, view: &mut Ex
             .small()
             .weak(),
     );
+    // What the file leaves unsaid (Q-Chem's fchk names no spins).
+    if !states.note.is_empty() {
+        ui.label(RichText::new(&states.note).small().weak());
+    }
     // The state picked, named, and what it can show.
     if let Some(s) = view.state.and_then(|k| states.states.get(k)) {
         ui.label(

@@ -178,6 +178,9 @@ pub struct ExcitedInfo {
     pub density: Option<Descriptors>,
     /// Where that density comes from ("Total CI Rho(1) Density").
     pub density_source: Option<String>,
+    /// What the file leaves unsaid about its states (Q-Chem's fchk names no spins), "" when
+    /// nothing.
+    pub note: String,
 }
 
 fn excited_info(doc: &Document) -> Option<ExcitedInfo> {
@@ -211,6 +214,7 @@ fn excited_info(doc: &Document) -> Option<ExcitedInfo> {
         states,
         density: density.and_then(|(wf, e)| e.descriptors(&wf.basis, &doc.molecule)),
         density_source: density.map(|(_, e)| e.source.clone()),
+        note: listed.note,
     })
 }
 
@@ -482,6 +486,9 @@ fn excited_text(s: &mut String, x: &ExcitedInfo) {
     use std::fmt::Write;
     let method = if x.method.is_empty() { String::new() } else { format!(" ({})", x.method) };
     let _ = writeln!(s, "{} excited states{method} from {}:", x.states.len(), x.program);
+    if !x.note.is_empty() {
+        let _ = writeln!(s, "  ({})", x.note);
+    }
     for st in &x.states {
         let f = st.oscillator_strength.map_or("—".to_string(), |f| format!("{f:.4}"));
         let label =

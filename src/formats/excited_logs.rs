@@ -62,7 +62,7 @@ pub(crate) fn gaussian(log: &LogLines) -> Result<Option<ExcitedStates>, ParseErr
         program: "Gaussian".into(),
         method: String::new(),
         states,
-        density_of: None,
+        ..Default::default()
     }))
 }
 
@@ -158,7 +158,7 @@ pub(crate) fn orca(log: &LogLines) -> Result<Option<ExcitedStates>, ParseError> 
     if let Some(header) = spectrum {
         orca_spectrum(log, header, &mut states)?;
     }
-    Ok(Some(ExcitedStates { program: "ORCA".into(), method, states, density_of: None }))
+    Ok(Some(ExcitedStates { program: "ORCA".into(), method, states, ..Default::default() }))
 }
 
 /// `33a ->  35a  :     0.562531 (c=  0.75002079)`: ORCA counts orbitals from 0; the
@@ -276,7 +276,7 @@ pub(crate) fn qchem(log: &LogLines, occupied: (usize, usize)) -> Result<Option<E
         }
         states.push(state);
     }
-    Ok((!states.is_empty()).then(|| ExcitedStates { program: "Q-Chem".into(), method, states, density_of: None }))
+    Ok((!states.is_empty()).then(|| ExcitedStates { program: "Q-Chem".into(), method, states, ..Default::default() }))
 }
 
 /// `D( 34) --> V(  1) amplitude =  0.7005` (with `alpha`/`beta` after it in unrestricted

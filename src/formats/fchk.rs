@@ -97,7 +97,7 @@ impl FchkFile {
 }
 
 /// The records [`FchkFile::parse`] keeps.
-const NEEDED: [&str; 33] = [
+const NEEDED: [&str; 40] = [
     // A relaxed scan's: how many values each step of `Opt point N Results for each geome` has.
     "Optimization Num results per geometry",
     "Number of atoms",
@@ -133,6 +133,14 @@ const NEEDED: [&str; 33] = [
     "ETran spin",
     "ETran sym",
     "ETran state values",
+    // A Q-Chem CIS/TDA job's (see `fchk_amplitudes`).
+    "Number of Excited States",
+    "Excitation Energies",
+    "Oscillator Strengths",
+    "Alpha Amplitudes",
+    "Beta Amplitudes",
+    "Alpha X Amplitudes",
+    "Alpha Y Amplitudes",
 ];
 
 fn error(file: &str, line: usize, expected: impl Into<String>, found: impl Into<String>) -> ParseError {
@@ -579,6 +587,19 @@ impl FchkFile {
             match self.excited_density(file, &file_to_model, wf, state) {
                 Ok(density) => wf.excited = density.map(std::sync::Arc::new),
                 Err(e) => doc.problems.push(format!("excited-state density left out: {e}")),
+            }
+        }
+        // Q-Chem's states carry their amplitudes instead (and no density).
+        if !self.records.contains_key("ETran scalars")
+            && let Some(wf) = doc.wavefunction.as_ref()
+        {
+            match self.qchem_excited_states(file, n_alpha, wf) {
+                Ok(Some(q)) => {
+                    doc.excited = Some(q.states);
+                    doc.problems.extend(q.left_out.map(|why| format!("excited states' transitions left out: {why}")));
+                }
+                Ok(None) => {}
+                Err(e) => doc.problems.push(format!("excited states left out: {e}")),
             }
         }
         // A malformed mode record leaves the modes out; the orbitals open all the same.

@@ -99,7 +99,7 @@ impl FchkFile {
             .collect::<Vec<_>>();
         let density_of = self.density_state(file, scalars, &states)?;
         let method = self.job.split_whitespace().nth(1).unwrap_or("").to_string();
-        Ok(Some(ExcitedStates { program: self.writer().to_string(), method, states, density_of }))
+        Ok(Some(ExcitedStates { program: self.writer().to_string(), method, states, density_of, note: String::new() }))
     }
 
     /// The state the excited density belongs to: the one `ETran scalars` names (its fifth

@@ -8,6 +8,7 @@ mod e_format;
 mod error;
 mod excited_logs;
 pub mod fchk;
+mod fchk_amplitudes;
 mod fchk_excited;
 pub mod gamess_log;
 pub mod gaussian_log;

@@ -105,7 +105,8 @@ impl Document {
     /// document's (a potential cube joining the density cube made beside it; returns the index
     /// of the first one appended), or its excited states' printed transitions given to this
     /// document's orbitals (a TD log joining its checkpoint: the states this document lists take
-    /// their transitions, matched by number and energy; a document listing none takes the log's).
+    /// their transitions, matched by number and energy, unless they have their own, and their
+    /// spin and symmetry where the file names none; a document listing none takes the log's).
     /// Refused, with the reason, otherwise.
     pub fn join(&mut self, other: Document) -> Result<usize, String> {
         // Transitions name orbitals, not places: a log may write its molecule turned.
@@ -122,9 +123,23 @@ impl Document {
                             .states
                             .iter()
                             .find(|t| t.number == state.number && (t.energy_ev - state.energy_ev).abs() < STATE_ENERGY);
+                        // A file's own amplitudes (Q-Chem's fchk holds them all) are kept over
+                        // a log's printed few; what the file leaves unsaid the log says.
                         if let Some(twin) = twin {
-                            state.transitions = twin.transitions.clone();
+                            if state.transitions.is_empty() {
+                                state.transitions = twin.transitions.clone();
+                            }
+                            if state.spin.is_empty() {
+                                state.spin = twin.spin.clone();
+                            }
+                            if state.symmetry.is_empty() {
+                                state.symmetry = twin.symmetry.clone();
+                            }
+                            state.s_squared = state.s_squared.or(twin.s_squared);
                         }
+                    }
+                    if ours.states.iter().all(|s| !s.spin.is_empty()) {
+                        ours.note.clear();
                     }
                 }
             }

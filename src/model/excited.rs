@@ -19,6 +19,9 @@ pub struct ExcitedStates {
     pub states: Vec<ExcitedState>,
     /// The state whose density the file holds (1-based, as `states[k].number`), if any.
     pub density_of: Option<usize>,
+    /// What the file leaves unsaid about its states (Q-Chem's fchk names no spins), "" when
+    /// nothing.
+    pub note: String,
 }
 
 /// One excited state.
