@@ -194,6 +194,14 @@ fn td_logs_list_their_states_as_printed() {
         let t = a.main_transitions(1)[0];
         assert_eq!((t.from, t.to, t.coefficient), main, "{name}");
         assert!((a.wavelength_nm() - 1239.841984 / first.1).abs() < 1e-9);
+        // Each program's normalisation, read off its own numbers (the transition density needs
+        // it): Gaussian's amplitudes square-sum to ½, ORCA's c and Q-Chem's log's to 1.
+        for s in &states.states {
+            let sum: f64 = s.transitions.iter().filter(|t| !t.deexcitation).map(|t| t.coefficient.powi(2)).sum();
+            let whole = if s.amplitudes_normalised_to_one { 1.0 } else { 0.5 };
+            eprintln!("{name} state {}: Σc² = {sum:.4} of {whole}", s.number);
+            assert!(sum > 0.6 * whole && sum < 1.1 * whole, "{name} state {}: Σc² = {sum} against {whole}", s.number);
+        }
     }
     // The strongest states, as each program prints them.
     let strongest = |name: &str| {
@@ -544,6 +552,19 @@ fn a_tda_states_transition_density_gives_pyscfs_oscillator_strength() {
         let f = t.oscillator_strength(&wf, &moments, ev);
         eprintln!("state {}: f {f:.8} here, {printed:.8} PySCF's", k + 1);
         assert!((f - printed).abs() < 1e-6 * printed.max(1e-3), "state {}: f {f} against PySCF's {printed}", k + 1);
+        // The same amplitudes as ORCA's and Q-Chem's logs print them, normalised to 1 (√2 ×
+        // PySCF's): the same strength.
+        let mut as_logs = doc.clone();
+        for state in &mut as_logs.excited.as_mut().unwrap().states {
+            state.amplitudes_normalised_to_one = true;
+            state.transitions.iter_mut().for_each(|t| t.coefficient *= std::f64::consts::SQRT_2);
+        }
+        let scaled = TransitionDensity::of_state(&as_logs, k + 1).unwrap().oscillator_strength(&wf, &moments, ev);
+        assert!(
+            (scaled - printed).abs() < 1e-6 * printed.max(1e-3),
+            "state {}: f {scaled} from amplitudes normalised to 1",
+            k + 1
+        );
         bright += (printed > 0.01) as usize;
         // ∫ ρ₀ₙ = 0 (orthogonal orbitals), and its dipole on a grid is the matrices' one.
         let (lo, hi) = doc.molecule.bounds().unwrap();

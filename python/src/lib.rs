@@ -359,6 +359,8 @@ impl PyDocument {
                         deexcitation,
                     })
                     .collect(),
+                // PySCF's restricted amplitudes are normalised to ½.
+                amplitudes_normalised_to_one: false,
             })
             .collect();
         let mut doc = self.doc.clone();

@@ -150,6 +150,8 @@ pub(crate) fn orca(log: &LogLines) -> Result<Option<ExcitedStates>, ParseError> 
         if state.transitions.iter().any(|t| t.spin == "beta") {
             state.transitions.iter_mut().filter(|t| t.spin.is_empty()).for_each(|t| t.spin = "alpha".into());
         }
+        // Its weights c² of a restricted state sum to 1.
+        state.amplitudes_normalised_to_one = true;
         states.push(state);
     }
     if states.is_empty() {
@@ -274,6 +276,8 @@ pub(crate) fn qchem(log: &LogLines, occupied: (usize, usize)) -> Result<Option<E
             }
             i += 1;
         }
+        // The log prints √2 times its fchk's amplitudes: a restricted state's squares sum to 1.
+        state.amplitudes_normalised_to_one = true;
         states.push(state);
     }
     Ok((!states.is_empty()).then(|| ExcitedStates { program: "Q-Chem".into(), method, states, ..Default::default() }))

@@ -94,6 +94,7 @@ impl FchkFile {
                     symmetry: syms.get(k).filter(|&&s| s != 0).map_or(String::new(), |s| format!("irrep {s}")),
                     s_squared: None,
                     transitions: Vec::new(),
+                    amplitudes_normalised_to_one: false,
                 }
             })
             .collect::<Vec<_>>();

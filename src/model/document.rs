@@ -128,6 +128,7 @@ impl Document {
                         if let Some(twin) = twin {
                             if state.transitions.is_empty() {
                                 state.transitions = twin.transitions.clone();
+                                state.amplitudes_normalised_to_one = twin.amplitudes_normalised_to_one;
                             }
                             if state.spin.is_empty() {
                                 state.spin = twin.spin.clone();

@@ -44,6 +44,10 @@ pub struct ExcitedState {
     pub s_squared: Option<f64>,
     /// The one-electron transitions printed for the state, largest first.
     pub transitions: Vec<Transition>,
+    /// Whether a restricted run's amplitudes are printed normalised to 1 (ORCA's `c`, Q-Chem's
+    /// log) rather than to ½ (Gaussian, PySCF, Q-Chem's fchk): the transition density needs
+    /// the convention, NTO weights (normalised) do not.
+    pub amplitudes_normalised_to_one: bool,
 }
 
 /// One orbital-to-orbital contribution to a state.

@@ -1,8 +1,9 @@
 //! A state's transition density ρ₀ₙ(r) = c Σ_ia X_ia φ_i(r) φ_a(r) from the excitation
 //! amplitudes a program prints for it (Gaussian's `->` lines; the de-excitations `<-` of a full
 //! TD-DFT solve are left out, as the natural transition orbitals leave them out: exact for TDA
-//! and CIS, where Y = 0), c = 2 for a restricted singlet's spin-adapted amplitudes (normalised
-//! to ½: each spin's excitation carries X) and 1 per spin of an unrestricted run. Where the electron density oscillates when light
+//! and CIS, where Y = 0), c = 2 for a restricted singlet's spin-adapted amplitudes normalised
+//! to ½ (Gaussian, PySCF, Q-Chem's fchk: each spin's excitation carries X), √2 for those
+//! normalised to 1 (ORCA's and Q-Chem's logs), and 1 per spin of an unrestricted run. Where the electron density oscillates when light
 //! drives the transition: its dipole μ = ∫ r ρ₀ₙ gives the oscillator strength ⅔ ΔE |μ|².
 
 use glam::DVec3;
@@ -52,7 +53,12 @@ impl TransitionDensity {
         if wf.restricted && listed.spin.to_ascii_lowercase().starts_with("triplet") {
             return None;
         }
-        let factor = if wf.restricted { 2.0 } else { 1.0 };
+        // A restricted singlet's amplitudes normalised to ½ carry c = 2; normalised to 1, √2.
+        let factor = match (wf.restricted, listed.amplitudes_normalised_to_one) {
+            (false, _) => 1.0,
+            (true, false) => 2.0,
+            (true, true) => std::f64::consts::SQRT_2,
+        };
         let mut terms: Vec<(f64, usize, usize)> = Vec::new();
         for t in listed.transitions.iter().filter(|t| !t.deexcitation) {
             let spin = match (wf.restricted, t.spin.as_str()) {
