@@ -16,6 +16,14 @@ const EXPECTED: &str = "an ORCA wavefunction (orca_2json: a \"Molecule\" object 
 
 /// Parses a JSON wavefunction, choosing the layout by the keys at its top.
 pub fn parse(file: &str, text: &str, overlap: Option<OverlapFn>) -> Result<Document, ParseError> {
+    if text.trim().is_empty() {
+        return Err(ParseError {
+            file: file.into(),
+            line: 1,
+            expected: EXPECTED.into(),
+            found: "an empty file".into(),
+        });
+    }
     let root: Value = serde_json::from_str(text).map_err(|e| syntax_error(file, &e))?;
     let top = Node::root(file, &root);
     let Value::Object(map) = &root else {

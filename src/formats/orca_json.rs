@@ -101,6 +101,14 @@ pub(super) fn read(root: Node, overlap: Option<OverlapFn>) -> Result<Document, P
         atoms.push(atom);
     }
     let n = file_to_model.len();
+    if n == 0 {
+        return Err(molecule.get("Atoms", "")?.error("atoms with at least one shell of basis functions"));
+    }
+    if (n as u64).saturating_mul(n as u64) > MAX_MO_VALUES {
+        return Err(molecule
+            .get("Atoms", "")?
+            .error(format!("a basis of at most {} functions", (MAX_MO_VALUES as f64).sqrt())));
+    }
     let mos = molecule.get("MolecularOrbitals", "the orbitals")?;
     if let Some(unit) = mos.opt("EnergyUnit")
         && unit.str()? != "Eh"

@@ -109,6 +109,9 @@ pub(super) fn read(root: Node, overlap: Option<OverlapFn>) -> Result<Document, P
         ));
     }
     let nao: usize = shells.iter().map(|s| if s.pure { 2 * s.l as usize + 1 } else { n_functions(s.l, false) }).sum();
+    if nao == 0 {
+        return Err(basis_node.error("a basis set of at least one shell"));
+    }
     if (nao as u64).saturating_mul(nao as u64) > MAX_MO_VALUES {
         return Err(basis_node.error(format!("a basis of at most {} functions", (MAX_MO_VALUES as f64).sqrt())));
     }
