@@ -61,11 +61,13 @@ import os
 
 import numpy as np
 import pyscf
-from pyscf import gto, lib, scf
+from pyscf import gto, scf
 from pyscf.tools import molden
 
 OUT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "fixtures", "json")
-X
+# Å per bohr for the Å coordinates of the ORCA 6.1 layout: CODATA 2018, the value orbcloud reads
+# them with, so that they come back to the bohr PySCF computed in.
+ANGSTROM = 0.529177210903
 
 H2O = "O 0.0 0.0 0.1173; H 0.0 0.7572 -0.4692; H 0.0 -0.7572 -0.4692"
 
