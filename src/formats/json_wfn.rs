@@ -67,7 +67,7 @@ pub(super) fn describe(v: &Value) -> String {
 }
 
 /// A value of the tree with its path, so that an error can say which one is at fault.
-#[derive(Clone)]
+#[derive(Clone, Debug)]
 pub(super) struct Node<'a> {
     pub file: &'a str,
     pub path: String,
