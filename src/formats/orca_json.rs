@@ -37,27 +37,21 @@ const LETTERS: &str = "spdfgh";
 pub(super) fn read(root: Node, overlap: Option<OverlapFn>) -> Result<Document, ParseError> {
     let file = root.file;
     let molecule = root.get("Molecule", "ORCA's molecule: atoms, basis and orbitals")?;
-    let scale = match molecule.opt("CoordinateUnits").map(|u| u.str().map(|s| (s, u.clone()))).transpose()? {
-        Some((u, _)) if u.eq_ignore_ascii_case("bohrs") || u.eq_ignore_ascii_case("bohr") => 1.0,
-        Some((u, _)) if u.eq_ignore_ascii_case("angs") || u.eq_ignore_ascii_case("angstrom") => BOHR_PER_ANGSTROM,
-        Some((_, node)) => return Err(node.error("\"Bohrs\" or \"Angs\"")),
-        None => {
-            return Err(ParseError {
-                file: file.into(),
-                line: 0,
-                expected: "Molecule.CoordinateUnits (\"Bohrs\" or \"Angs\")".into(),
-                found: "none: the coordinates' unit is unknown".into(),
-            });
-        }
+    let units = molecule.get("CoordinateUnits", "\"Bohrs\" or \"Angs\": the coordinates' unit")?;
+    let scale = match units.str()?.to_ascii_lowercase().as_str() {
+        "bohrs" | "bohr" => 1.0,
+        "angs" | "angstrom" => BOHR_PER_ANGSTROM,
+        _ => return Err(units.error("\"Bohrs\" or \"Angs\"")),
     };
     let mut atoms = Vec::new();
     let mut shells = Vec::new();
     // For each of the file's functions, its index in the model's order and its sign.
     let mut file_to_model = Vec::new();
     let mut signs = Vec::new();
-    let atom_nodes = molecule.get("Atoms", "the atoms")?.items("atoms")?;
+    let atoms_node = molecule.get("Atoms", "the atoms")?;
+    let atom_nodes = atoms_node.items("atoms")?;
     if atom_nodes.is_empty() {
-        return Err(molecule.get("Atoms", "")?.error("at least one atom"));
+        return Err(atoms_node.error("at least one atom"));
     }
     for (a, node) in atom_nodes.iter().enumerate() {
         let atom = read_atom(node, scale)?;
@@ -102,7 +96,7 @@ pub(super) fn read(root: Node, overlap: Option<OverlapFn>) -> Result<Document, P
     }
     let n = file_to_model.len();
     if n == 0 {
-        return Err(molecule.get("Atoms", "")?.error("atoms with at least one shell of basis functions"));
+        return Err(atoms_node.error("atoms with at least one shell of basis functions"));
     }
     if (n as u64).saturating_mul(n as u64) > MAX_MO_VALUES {
         return Err(molecule

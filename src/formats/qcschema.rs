@@ -51,9 +51,15 @@ struct Reading {
     folded: bool,
 }
 
+/// The readings tried, in turn, for a file Psi4 wrote and for any other.
+const PSI4_FIRST: [Reading; 4] = [Reading::PSI4, Reading::SPEC, Reading::SPEC_FOLDED, Reading::PSI4_UNFOLDED];
+const SPEC_FIRST: [Reading; 4] = [Reading::SPEC, Reading::SPEC_FOLDED, Reading::PSI4, Reading::PSI4_UNFOLDED];
+
 impl Reading {
     const PSI4: Reading = Reading { descending: true, folded: true };
+    const PSI4_UNFOLDED: Reading = Reading { descending: true, folded: false };
     const SPEC: Reading = Reading { descending: false, folded: false };
+    const SPEC_FOLDED: Reading = Reading { descending: false, folded: true };
 
     fn describe(self) -> String {
         let order = if self.descending { "m = +l … −l (Psi4's)" } else { "m = −l … +l (the specification's)" };
@@ -153,21 +159,8 @@ pub(super) fn read(root: Node, overlap: Option<OverlapFn>) -> Result<Document, P
         .and_then(|c| c.str().ok().map(str::to_string))
         .unwrap_or_default();
     let psi4 = creator.to_ascii_lowercase().starts_with("psi4");
-    let readings = if psi4 {
-        [
-            Reading::PSI4,
-            Reading::SPEC,
-            Reading { descending: false, folded: true },
-            Reading { descending: true, folded: false },
-        ]
-    } else {
-        [
-            Reading::SPEC,
-            Reading { descending: false, folded: true },
-            Reading::PSI4,
-            Reading { descending: true, folded: false },
-        ]
-    };
+    // The writer's reading first, then the other with and without the coefficients' folding.
+    let readings = if psi4 { PSI4_FIRST } else { SPEC_FIRST };
     // The first reading whose orbitals are orthonormal; without an overlap to measure with,
     // the writer's.
     let mut chosen = (readings[0], f64::INFINITY);
@@ -272,6 +265,7 @@ fn read_molecule(molecule: &Node) -> Result<(Vec<Atom>, f64, u32), ParseError> {
 /// The shells of every atom, in the file's order, and each atom's electrons replaced by an ECP.
 fn read_basis(basis: &Node, n_atoms: usize) -> Result<(Vec<FileShell>, Vec<i64>), ParseError> {
     let centers = basis.get("center_data", "the basis of each kind of centre")?;
+    // An object, even where atom_map names none of its entries.
     centers.members("centres")?;
     let atom_map = basis.get("atom_map", "the name of each atom's centre in center_data")?;
     let names = atom_map.items("centre names")?;
