@@ -258,3 +258,107 @@ fn qcschema_readings_are_told_apart_by_the_orbitals() {
         }
     }
 }
+
+/// The shapes of QCSchema shells no fixture writes as Psi4 does: sp shells
+/// (`angular_momentum: [0, 1]`, a row of coefficients per l), general contractions (several rows
+/// of one l over shared exponents) and numbers written as strings, as the schema's own examples
+/// have them. The same wavefunctions rewritten so (the orbitals' rows moved with their
+/// functions) open with the same orbitals.
+#[test]
+fn qcschema_sp_shells_general_contractions_and_string_numbers() {
+    for (name, sp) in [("h2o_cart.qcschema.json", true), ("h2o_rhf.qcschema.json", false)] {
+        let mut v: Value = serde_json::from_slice(&read(name)).expect("JSON");
+        let cartesian = name.contains("cart");
+        let size = |l: usize| if cartesian { (l + 1) * (l + 2) / 2 } else { 2 * l + 1 };
+        // Per centre: the new shells, each the old shells (index, functions) whose rows it takes.
+        let mut groups: std::collections::BTreeMap<String, Vec<Vec<(usize, usize)>>> = Default::default();
+        let mut merged = 0;
+        let centers = v["wavefunction"]["basis"]["center_data"].as_object_mut().expect("centres");
+        for (key, center) in centers.iter_mut() {
+            let shells = center["electron_shells"].as_array().expect("shells").clone();
+            let l_of = |s: &Value| s["angular_momentum"][0].as_u64().unwrap() as usize;
+            let mut out: Vec<Value> = Vec::new();
+            let mut group: Vec<Vec<usize>> = Vec::new();
+            for (i, s) in shells.iter().enumerate() {
+                // An sp partner: the earlier s shell of the same exponents; a general
+                // contraction: the previous shell of the same l and exponents.
+                let partner = if sp && l_of(s) == 1 {
+                    group.iter().position(|g| {
+                        g.len() == 1 && l_of(&shells[g[0]]) == 0 && shells[g[0]]["exponents"] == s["exponents"]
+                    })
+                } else if !sp
+                    && i > 0
+                    && l_of(&shells[i - 1]) == l_of(s)
+                    && shells[i - 1]["exponents"] == s["exponents"]
+                {
+                    Some(group.len() - 1)
+                } else {
+                    None
+                };
+                match partner {
+                    Some(k) => {
+                        if sp {
+                            out[k]["angular_momentum"] = serde_json::json!([0, 1]);
+                        }
+                        let row = s["coefficients"][0].clone();
+                        out[k]["coefficients"].as_array_mut().unwrap().push(row);
+                        group[k].push(i);
+                        merged += 1;
+                    }
+                    None => {
+                        out.push(s.clone());
+                        group.push(vec![i]);
+                    }
+                }
+            }
+            // Numbers as strings.
+            for s in &mut out {
+                let text = |x: &Value| Value::String(format!("{}", x.as_f64().unwrap()));
+                s["exponents"] = Value::Array(s["exponents"].as_array().unwrap().iter().map(text).collect());
+                for row in s["coefficients"].as_array_mut().unwrap() {
+                    *row = Value::Array(row.as_array().unwrap().iter().map(text).collect());
+                }
+            }
+            let with_sizes = group.into_iter().map(|g| g.into_iter().map(|i| (i, size(l_of(&shells[i])))).collect());
+            groups.insert(key.clone(), with_sizes.collect());
+            center["electron_shells"] = Value::Array(out);
+        }
+        assert!(merged >= 1, "{name}: {merged} shells merged");
+        // The functions' new order: atom by atom, new shell by new shell, its rows' old shells.
+        let atom_map: Vec<String> = v["wavefunction"]["basis"]["atom_map"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|a| a.as_str().unwrap().to_string())
+            .collect();
+        let mut order = Vec::new();
+        let mut first = 0;
+        for key in &atom_map {
+            // Where each old shell's functions started in the file: old shells in index order.
+            let mut old: Vec<(usize, usize)> = groups[key].iter().flatten().copied().collect();
+            old.sort();
+            let mut offsets = std::collections::BTreeMap::new();
+            for (i, n) in old {
+                offsets.insert(i, first);
+                first += n;
+            }
+            for &(i, n) in groups[key].iter().flatten() {
+                order.extend(offsets[&i]..offsets[&i] + n);
+            }
+        }
+        let wfn = v["wavefunction"].as_object_mut().unwrap();
+        let c = wfn["scf_orbitals_a"].as_array().unwrap().clone();
+        let nmo = c.len() / order.len();
+        wfn.insert(
+            "scf_orbitals_a".into(),
+            Value::Array(order.iter().flat_map(|&i| c[i * nmo..(i + 1) * nmo].to_vec()).collect()),
+        );
+        let bytes = serde_json::to_vec(&v).expect("JSON");
+        let doc = formats::load_bytes(Path::new(name), &bytes).unwrap_or_else(|e| panic!("{e}"));
+        let n = &doc.wavefunction.as_ref().expect("wf").normalization;
+        assert!(n.residual < 1e-9 && n.repair == "none", "{name}: {n:?}");
+        let molden = format!("{}.molden", name.split('.').next().unwrap());
+        let (failures, _) = compare(name, &doc, &molden);
+        assert!(failures.is_empty(), "{name}:\n{}", failures.join("\n"));
+    }
+}
