@@ -10,7 +10,7 @@ cd "$(dirname "$0")/.."
 execs="${1:-10000000}"
 shift || true
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(cube cube_gz molden fchk wfn wfx mkl scan_manifest session pdb mmcif xyz gaussian_log)
+[ ${#targets[@]} -gt 0 ] || targets=(cube cube_gz molden fchk wfn wfx mkl json scan_manifest session pdb mmcif xyz gaussian_log)
 
 command -v cargo-afl >/dev/null || cargo install cargo-afl --locked
 # Seeds: the fixtures each reader is tested with, kept small (AFL slows on big inputs).
@@ -64,6 +64,44 @@ if ! "$python" scripts/make_wfn_wfx_mkl_fixtures.py --seeds fuzz/seeds 2>/dev/nu
     seed wfx tests/fixtures/wfn_wfx_mkl/*.wfx
     seed mkl tests/fixtures/wfn_wfx_mkl/*.mkl
 fi
+# JSON: H2 in ORCA's orca_2json layout and as a Psi4 QCSchema result (under 1 kB each; the
+# fixtures are 20–130 kB).
+rm -rf fuzz/seeds/json
+mkdir -p fuzz/seeds/json
+cat > fuzz/seeds/json/h2.orca.json <<'JSON'
+{
+    "Molecule": {
+        "Atoms": [
+            {"BasisFunctions": [{"Coefficients": [0.15432897, 0.53532814, 0.44463454], "Exponents": [3.42525091, 0.62391373, 0.1688554], "Shell": "s"}],
+             "Coords": [0.0, 0.0, 0.0], "ElementLabel": "H", "ElementNumber": 1, "Idx": 0, "NuclearCharge": 1.0},
+            {"BasisFunctions": [{"Coefficients": [0.15432897, 0.53532814, 0.44463454], "Exponents": [3.42525091, 0.62391373, 0.1688554], "Shell": "s"}],
+             "Coords": [0.0, 0.0, 1.4], "ElementLabel": "H", "ElementNumber": 1, "Idx": 1, "NuclearCharge": 1.0}
+        ],
+        "BaseName": "h2", "Charge": 0, "CoordinateUnits": "Bohrs", "HFTyp": "RHF", "Multiplicity": 1,
+        "MolecularOrbitals": {
+            "EnergyUnit": "Eh",
+            "MOs": [
+                {"MOCoefficients": [0.54893, 0.54893], "Occupancy": 2.0, "OrbitalEnergy": -0.57823},
+                {"MOCoefficients": [1.21146, -1.21146], "Occupancy": 0.0, "OrbitalEnergy": 0.67029}
+            ],
+            "OrbitalLabels": ["0H   1s", "1H   1s"]
+        }
+    },
+    "ORCA Header": {"Version": "5.0 - current"}
+}
+JSON
+cat > fuzz/seeds/json/h2.qcschema.json <<'JSON'
+{"schema_name": "qcschema_output", "provenance": {"creator": "Psi4", "version": "1.10", "routine": "psi4.schema_runner.run_qcschema"},
+ "molecule": {"symbols": ["H", "H"], "geometry": [0.0, 0.0, 0.0, 0.0, 0.0, 1.4], "molecular_charge": 0.0, "molecular_multiplicity": 1},
+ "properties": {"calcinfo_nalpha": 1, "calcinfo_nbeta": 1},
+ "wavefunction": {"basis": {"name": "STO-3G", "center_data": {"STO-3G_H1": {"electron_shells": [
+   {"angular_momentum": [0], "harmonic_type": "spherical", "exponents": [3.42525091, 0.62391373, 0.1688554],
+    "coefficients": [[0.2769343609526476, 0.2678388517525271, 0.0834736696169253]]}]}},
+   "atom_map": ["STO-3G_H1", "STO-3G_H1"]},
+  "restricted": true, "scf_orbitals_a": [0.54893, 1.21146, 0.54893, -1.21146], "scf_eigenvalues_a": [-0.57823, 0.67029],
+  "scf_occupations_a": [1.0, 0.0], "orbitals_a": "scf_orbitals_a", "eigenvalues_a": "scf_eigenvalues_a",
+  "occupations_a": "scf_occupations_a"}}
+JSON
 seed gaussian_log tests/fixtures/logs/*.log tests/fixtures/logs/*.out
 seed scan_manifest assets/psb3/*.scan.toml tests/fixtures/*/*.scan.toml
 # A session: a camera, two panes, an object with a cloud, an isosurface and a clipping plane.

@@ -37,7 +37,7 @@ const NARROWER: &[(&str, &[&str])] = &[
 /// ARCHITECTURE.md says the same.
 const CRATE_RULES: &[(&str, &[&str])] = &[
     ("model", &["glam", "serde", "rayon", "thiserror", "bytemuck", "meshopt"]),
-    ("formats", &["glam", "serde", "rayon", "thiserror", "flate2", "fast_float2", "toml", "bytemuck"]),
+    ("formats", &["glam", "serde", "serde_json", "rayon", "thiserror", "flate2", "fast_float2", "toml", "bytemuck"]),
     ("scene", &["glam", "serde"]),
     ("sources", &["flate2", "serde", "serde_json", "thiserror", "log", "libc", "toml"]),
     ("gpu", &["glam", "thiserror", "wgpu", "bytemuck", "half", "image", "pollster", "log"]),

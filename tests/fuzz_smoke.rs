@@ -174,6 +174,12 @@ fn aim_and_mkl_readers_survive_mutated_fixtures() {
 }
 
 #[test]
+fn the_json_reader_survives_mutated_fixtures() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/json");
+    fuzz("json", &files_in(dir, "json"), read("fuzz.json"));
+}
+
+#[test]
 fn the_log_reader_survives_mutated_fixtures() {
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/logs");
     fuzz("log", &files_in(dir, "log"), read("fuzz.log"));

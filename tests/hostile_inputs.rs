@@ -351,6 +351,9 @@ fn truncated_files_never_panic() {
     let fchk = std::fs::read_to_string(format!("{FIXTURES}/h2o_cart_631gs.fchk")).unwrap();
     let aim = |name: &str| std::fs::read_to_string(format!("{AIM}/{name}")).unwrap();
     let (wfn, wfx, mkl) = (aim("oh_rohf.wfn"), aim("oh_rohf.wfx"), aim("oh_rohf.mkl"));
+    let json_dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/json");
+    let orca_json = std::fs::read_to_string(format!("{json_dir}/h2o_cation.orca.json")).unwrap();
+    let qcschema = std::fs::read_to_string(format!("{json_dir}/h2o_cart.qcschema.json")).unwrap();
     let log = std::fs::read_to_string(LOG).unwrap();
     let orca = std::fs::read_to_string(ORCA).unwrap();
     let [gamess, nwchem, psi4, qchem] = NEW_LOGS.map(|name| std::fs::read_to_string(format!("{LOGS}/{name}")).unwrap());
@@ -378,6 +381,8 @@ fn truncated_files_never_panic() {
         ("t.wfn", &wfn),
         ("t.wfx", &wfx),
         ("t.mkl", &mkl),
+        ("t.json", &orca_json),
+        ("t.json", &qcschema),
         ("t.log", &log),
     ] {
         let step = (text.len() / 97).max(1);
@@ -701,4 +706,117 @@ fn qchem_excited_state_records_that_lie_leave_the_states_out() {
     let states = doc.excited.as_ref().expect("the states");
     assert!(states.states.len() == 6 && states.states.iter().all(|s| s.transitions.is_empty()));
     assert!(doc.problems.iter().any(|p| p.contains("X Amplitudes") && p.contains("not read")), "{:?}", doc.problems);
+}
+
+/// ORCA's and QCSchema's JSON wavefunctions: values of the wrong type, counts that do not match,
+/// shells past h, a basis too big for its overlap matrix, files cut short, other JSON and deep
+/// nesting are refused with the path of the value at fault (or the line of a syntax error),
+/// fast; a valid file on one line longer than the line limit opens.
+#[test]
+fn json_wavefunctions_refuse_hostile_contents() {
+    use serde_json::{Value, json};
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/json");
+    let orca: Value = serde_json::from_slice(&std::fs::read(format!("{dir}/h2o_cation.orca.json")).unwrap()).unwrap();
+    let qcs: Value = serde_json::from_slice(&std::fs::read(format!("{dir}/h2o_cart.qcschema.json")).unwrap()).unwrap();
+    let with = |base: &Value, pointer: &str, value: Value| {
+        let mut v = base.clone();
+        *v.pointer_mut(pointer).unwrap_or_else(|| panic!("{pointer}")) = value;
+        serde_json::to_vec(&v).unwrap()
+    };
+    let check = |name: &str, bytes: &[u8], expected: &str| {
+        let e = refused(name, bytes);
+        assert!(e.expected.contains(expected), "{name}: {e}");
+        e
+    };
+    // Wrong types.
+    check("coords.json", &with(&orca, "/Molecule/Atoms/1/Coords", json!("0 0 0")), "Molecule.Atoms[1].Coords as");
+    check(
+        "mo.json",
+        &with(&orca, "/Molecule/MolecularOrbitals/MOs/3/MOCoefficients/2", json!("x")),
+        "MOs[3].MOCoefficients[2] as a finite number",
+    );
+    check(
+        "occ.json",
+        &with(&orca, "/Molecule/MolecularOrbitals/MOs/0/Occupancy", json!("1")),
+        "Occupancy as a finite number",
+    );
+    check("shell.json", &with(&orca, "/Molecule/Atoms/0/Basis/0/Shell", json!("k")), "Shell as a shell letter");
+    check(
+        "units.json",
+        &with(&orca, "/Molecule/CoordinateUnits", json!("nm")),
+        "CoordinateUnits as \"Bohrs\" or \"Angs\"",
+    );
+    check(
+        "ht.json",
+        &with(&qcs, "/wavefunction/basis/center_data/6-31G*_O1/electron_shells/0/harmonic_type", json!("polar")),
+        "harmonic_type as",
+    );
+    check(
+        "l.json",
+        &with(&qcs, "/wavefunction/basis/center_data/6-31G*_O1/electron_shells/0/angular_momentum", json!([7])),
+        "angular_momentum[0] as a whole number 0..=5",
+    );
+    check("restricted.json", &with(&qcs, "/wavefunction/restricted", json!(1)), "restricted as true or false");
+    check(
+        "nan.json",
+        &with(&qcs, "/wavefunction/scf_eigenvalues_a/0", json!("NaN")),
+        "scf_eigenvalues_a[0] as a finite number",
+    );
+    // Counts that do not match.
+    check(
+        "count.json",
+        &with(&orca, "/Molecule/MolecularOrbitals/MOs/5/MOCoefficients", json!([1.0, 2.0])),
+        "24 coefficients",
+    );
+    let mut odd = orca.clone();
+    odd.pointer_mut("/Molecule/MolecularOrbitals/MOs").unwrap().as_array_mut().unwrap().pop();
+    check("odd.json", &serde_json::to_vec(&odd).unwrap(), "an even number");
+    check("map.json", &with(&qcs, "/wavefunction/basis/atom_map", json!(["6-31G*_O1"])), "3 names");
+    check(
+        "exps.json",
+        &with(&qcs, "/wavefunction/basis/center_data/6-31G*_O1/electron_shells/0/exponents", json!([1.0])),
+        "one per exponent",
+    );
+    check(
+        "orbs.json",
+        &with(&qcs, "/wavefunction/scf_orbitals_a", Value::from(vec![0.5; 20])),
+        "a multiple of 19 coefficients",
+    );
+    check("eigen.json", &with(&qcs, "/wavefunction/scf_eigenvalues_a", json!([0.5])), "19 orbital energies");
+    check("geometry.json", &with(&qcs, "/molecule/geometry", json!([0.0, 1.0])), "9 coordinates");
+    check("nalpha.json", &with(&qcs, "/properties/calcinfo_nalpha", json!(1e15)), "a whole number 0..=1000000");
+    // A basis whose overlap matrix would be huge: 20 000 h shells on one atom, one orbital.
+    let shell = json!({"Coefficients": [1.0], "Exponents": [1.0], "Shell": "h"});
+    let mut big = with(&orca, "/Molecule/Atoms/0/Basis", Value::Array(vec![shell; 20_000]));
+    let mut v: Value = serde_json::from_slice(&big).unwrap();
+    v["Molecule"]["Atoms"][1]["Basis"] = json!([]);
+    v["Molecule"]["Atoms"][2]["Basis"] = json!([]);
+    big = serde_json::to_vec(&v).unwrap();
+    check("big.json", &big, "a basis of at most");
+    // Cut short anywhere: a syntax error at the line where the text ends.
+    let text = serde_json::to_string_pretty(&orca).unwrap();
+    for cut in [1, text.len() / 3, text.len() - 2] {
+        let e = refused("cut.json", &text.as_bytes()[..cut]);
+        assert!(e.found.contains("truncated"), "{e}");
+        assert_eq!(e.line, text[..cut].matches('\n').count() + 1, "{e}");
+    }
+    let e = refused("empty.json", b" \n");
+    assert_eq!(e.found, "an empty file", "{e}");
+    // Other JSON: what was expected is named.
+    let wrapper = serde_json::to_vec(&json!({"input": {}, "result": qcs})).unwrap();
+    check("wrapper.json", &wrapper, "QCSchema result");
+    let mut no_wfn = qcs.clone();
+    no_wfn.as_object_mut().unwrap().remove("wavefunction");
+    check("nowfn.json", &serde_json::to_vec(&no_wfn).unwrap(), "protocols");
+    // serde_json's recursion limit: a deep nest is an error, not a stack overflow.
+    let deep = format!("{}{}", "[".repeat(100_000), "]".repeat(100_000));
+    check("deep.json", deep.as_bytes(), "JSON text");
+    // A gzip bomb of blanks after a valid head.
+    let e = refused("bomb.json.gz", &bomb("{\"Molecule\": ", b" ", 4));
+    assert!(e.found.contains("decompression bomb"), "{e}");
+    // One line longer than the line limit (QCElemental writes a whole file on one line).
+    let mut long = qcs.clone();
+    long["stdout"] = Value::String("x".repeat(3 * MAX_LINE_BYTES));
+    let doc = formats::load_bytes(Path::new("long.json"), &serde_json::to_vec(&long).unwrap()).unwrap();
+    assert_eq!(doc.wavefunction.unwrap().basis.n_functions(), 19);
 }

@@ -60,7 +60,7 @@ impl PyDocument {
     fn wavefunction(&self) -> PyResult<&Wavefunction> {
         self.doc.wavefunction.as_ref().ok_or_else(|| {
             PyValueError::new_err(format!(
-                "{} holds no basis set or orbitals (a Molden, fchk, wfn, wfx or MKL file is needed)",
+                "{} holds no basis set or orbitals (a Molden, fchk, wfn, wfx, MKL or JSON file is needed)",
                 self.doc.source
             ))
         })

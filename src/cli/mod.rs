@@ -311,7 +311,7 @@ impl WavefunctionArgs {
             }
             if let Some(flag) = asked {
                 bail!(
-                    "{}: {flag} needs a wavefunction (Molden, fchk, wfn, wfx or MKL), and this file has none: `orbcloud compute {}` computes one with PySCF",
+                    "{}: {flag} needs a wavefunction (Molden, fchk, wfn, wfx, MKL or JSON), and this file has none: `orbcloud compute {}` computes one with PySCF",
                     doc.source,
                     doc.source
                 );
@@ -550,7 +550,7 @@ fn state_of(wf: &Wavefunction) -> String {
 fn wavefunction_of(doc: &Document) -> Result<&Wavefunction> {
     doc.wavefunction.as_ref().ok_or_else(|| {
         anyhow::anyhow!(
-            "{} holds no basis set or orbitals (a Molden, fchk, wfn, wfx or MKL file is needed)",
+            "{} holds no basis set or orbitals (a Molden, fchk, wfn, wfx, MKL or JSON file is needed)",
             doc.source
         )
     })

@@ -18,7 +18,7 @@ use crate::scene::limits::{self, within};
 
 #[derive(Args)]
 pub struct NciArgs {
-    /// Files whose densities add (fragments): wavefunctions (Molden, fchk, wfn, wfx, MKL), or
+    /// Files whose densities add (fragments): wavefunctions (Molden, fchk, wfn, wfx, MKL, JSON), or
     /// with --promolecular any file with atoms (XYZ, PDB, mmCIF, cube, a wavefunction's atoms).
     #[arg(required = true)]
     files: Vec<PathBuf>,
@@ -128,7 +128,7 @@ pub fn nci_of(docs: &[&Document], names: &[String], options: &NciOptions) -> Res
             match &doc.wavefunction {
                 Some(wf) => Fragment::Wavefunction(Box::new(WavefunctionDensity::new(wf))),
                 None => bail!(
-                    "{name}: no wavefunction (Molden, fchk, wfn, wfx or MKL) for nci: --promolecular sums spherical atoms instead"
+                    "{name}: no wavefunction (Molden, fchk, wfn, wfx, MKL or JSON) for nci: --promolecular sums spherical atoms instead"
                 ),
             }
         };
@@ -234,7 +234,7 @@ fn with_suffix(prefix: &Path, suffix: &str) -> PathBuf {
 
 #[derive(Args)]
 pub struct NciBench {
-    /// A wavefunction (Molden, fchk, wfn, wfx, MKL).
+    /// A wavefunction (Molden, fchk, wfn, wfx, MKL, JSON).
     file: PathBuf,
     /// Points per side of the grid: the viewer's box for the NCI field.
     #[arg(long, default_value_t = 80, value_parser = within(limits::GRID_POINTS))]

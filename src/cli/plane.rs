@@ -17,7 +17,7 @@ use super::WhatArgs;
 
 #[derive(Args)]
 pub struct PlaneArgs {
-    /// A wavefunction (Molden, fchk, wfn, wfx, MKL), whose quantity is evaluated exactly at
+    /// A wavefunction (Molden, fchk, wfn, wfx, MKL, JSON), whose quantity is evaluated exactly at
     /// every point, or a cube file, whose values are interpolated trilinearly.
     file: PathBuf,
     #[command(flatten)]

@@ -83,7 +83,10 @@ impl IsoArgs {
         };
         if let Some(q) = quantity {
             if doc.wavefunction.is_none() {
-                bail!("--color-by {what}: {} holds no wavefunction (a Molden, fchk, wfn, wfx or MKL file)", doc.source);
+                bail!(
+                    "--color-by {what}: {} holds no wavefunction (a Molden, fchk, wfn, wfx, MKL or JSON file)",
+                    doc.source
+                );
             }
             return Ok(Some(Source::Wavefunction(q)));
         }

@@ -12,6 +12,7 @@ mod fchk_amplitudes;
 mod fchk_excited;
 pub mod gamess_log;
 pub mod gaussian_log;
+pub mod json_wfn;
 mod log_modes;
 pub mod logs;
 pub mod mesh_write;
@@ -20,12 +21,14 @@ pub mod mmcif;
 pub mod modes;
 pub mod molden;
 pub mod nwchem_log;
+pub mod orca_json;
 pub mod orca_log;
 pub mod pdb;
 mod primitives;
 mod printed;
 pub mod psi4_log;
 pub mod qchem_log;
+pub mod qcschema;
 pub mod scan;
 mod structure;
 mod text;
@@ -82,7 +85,8 @@ pub const DEFAULT_OVERLAP: Option<OverlapFn<'static>> = Some(&crate::model::over
 /// Largest atomic number a file may give (oganesson); 0 is a ghost centre.
 pub const MAX_Z: u32 = 118;
 
-/// Longest line a reader accepts: a longer one is refused before it is buffered whole.
+/// Longest line a reader accepts: a longer one is refused before it is buffered whole (JSON,
+/// which writers may put on one line, is bounded by the gzip guard and its parser instead).
 pub const MAX_LINE_BYTES: usize = 1 << 20;
 
 /// Blank bytes a cube may carry after the values its header declares before reading stops.
@@ -123,6 +127,7 @@ fn parse_text(name: &str, reader: Reader, text: Bounded, overlap: Option<Overlap
         Reader::Wfn => wfn::parse(name, &text.text, overlap),
         Reader::Wfx => wfx::parse(name, &text.text, overlap),
         Reader::Mkl => mkl::parse(name, &text.text, overlap),
+        Reader::Json => json_wfn::parse(name, &text.text, overlap),
         Reader::Pdb => pdb::parse(name, &text.text),
         Reader::Mmcif => mmcif::parse(name, &text.text),
         Reader::Xyz => xyz::parse(name, &text.text),
@@ -146,6 +151,7 @@ enum Reader {
     Wfn,
     Wfx,
     Mkl,
+    Json,
     Pdb,
     Mmcif,
     Xyz,
@@ -169,6 +175,7 @@ pub const FORMATS: &[Format] = &[
     Format { name: "AIM wavefunction", endings: &[".wfn"], reader: Reader::Wfn },
     Format { name: "AIM extended wavefunction", endings: &[".wfx"], reader: Reader::Wfx },
     Format { name: "ORCA Molekel", endings: &[".mkl"], reader: Reader::Mkl },
+    Format { name: "JSON wavefunction (ORCA orca_2json, QCSchema)", endings: &[".json"], reader: Reader::Json },
     Format { name: "PDB", endings: &[".pdb", ".ent"], reader: Reader::Pdb },
     Format { name: "mmCIF", endings: &[".cif", ".mmcif"], reader: Reader::Mmcif },
     Format { name: "XYZ", endings: &[".xyz"], reader: Reader::Xyz },
@@ -290,7 +297,9 @@ fn read_stream(
 ) -> Result<Bounded, LoadError> {
     let mut out = Vec::new();
     let mut chunk = vec![0u8; 256 << 10];
-    let mut lines = LineGuard { line: 1, len: 0 };
+    // JSON writers (QCElemental) put a whole file on one line; its parser needs no lines.
+    let max_line = if matches!(reader, Some(Reader::Json)) { usize::MAX } else { MAX_LINE_BYTES };
+    let mut lines = LineGuard { line: 1, len: 0, max: max_line };
     let mut cube = matches!(reader, Some(Reader::Cube)).then(cube::ValueGuard::default);
     let mut stopped = None;
     loop {
@@ -344,6 +353,7 @@ fn read_stream(
 struct LineGuard {
     line: usize,
     len: usize,
+    max: usize,
 }
 
 impl LineGuard {
@@ -364,12 +374,8 @@ impl LineGuard {
                 self.len = 0;
             }
             self.len += segment.len();
-            if self.len > MAX_LINE_BYTES {
-                return Err(error(
-                    self.line,
-                    format!("a line of at most {MAX_LINE_BYTES} bytes"),
-                    "a longer line".into(),
-                ));
+            if self.len > self.max {
+                return Err(error(self.line, format!("a line of at most {} bytes", self.max), "a longer line".into()));
             }
         }
         Ok(())
