@@ -75,7 +75,7 @@ fn vibrations(modes: Vec<NormalMode>, geometry: &Geometry) -> Vibrations {
     Vibrations {
         modes,
         geometry: geometry.positions.clone(),
-        geometry_from: format!("the geometry at line {}", geometry.line + 1),
+        geometry_from: format!("the coordinates at line {}", geometry.line + 1),
     }
 }
 
