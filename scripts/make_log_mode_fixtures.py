@@ -234,22 +234,30 @@ def gamess(a):
 # ---- NWChem ---------------------------------------------------------------------------------
 
 
+def nwchem_header(mol):
+    """NWChem 7.0.2's banner and its geometry table (Å), as its logs begin; also used by
+    make_nwchem_spherical_fixture.py."""
+    out = [
+        "              Northwest Computational Chemistry Package (NWChem) 7.0.2",
+        "              --------------------------------------------------------",
+        "",
+        '                             Geometry "geometry" -> ""',
+        "                             -------------------------",
+        "",
+        " Output coordinates in angstroms (scale by  1.889725989 to convert to a.u.)",
+        "",
+        "  No.       Tag          Charge          X              Y              Z",
+        " ---- ---------------- ---------- -------------- -------------- --------------",
+    ]
+    for k, (s, z, p) in enumerate(zip(symbols(mol), mol.atom_charges(), mol.atom_coords() / ANGSTROM)):
+        out.append(f"{k + 1:5d} {s:<16s}{z:11.4f}{p[0]:15.8f}{p[1]:15.8f}{p[2]:15.8f}")
+    return out
+
+
 def nwchem(a):
     mol = a["mol"]
-    out = []
+    out = nwchem_header(mol)
     w = out.append
-    w("              Northwest Computational Chemistry Package (NWChem) 7.0.2")
-    w("              --------------------------------------------------------")
-    w("")
-    w('                             Geometry "geometry" -> ""')
-    w("                             -------------------------")
-    w("")
-    w(" Output coordinates in angstroms (scale by  1.889725989 to convert to a.u.)")
-    w("")
-    w("  No.       Tag          Charge          X              Y              Z")
-    w(" ---- ---------------- ---------- -------------- -------------- --------------")
-    for k, (s, z, p) in enumerate(zip(symbols(mol), mol.atom_charges(), mol.atom_coords() / ANGSTROM)):
-        w(f"{k + 1:5d} {s:<16s}{z:11.4f}{p[0]:15.8f}{p[1]:15.8f}{p[2]:15.8f}")
     w("")
     rows = everything(a)
     # Projected: the rigid modes' wavenumbers are zero.

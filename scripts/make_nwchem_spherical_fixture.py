@@ -30,6 +30,9 @@ import sys
 import numpy as np
 from pyscf import gto, scf
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from make_log_mode_fixtures import nwchem_header  # noqa: E402  (the same banner and table)
+
 ANGSTROM = 1.0 / 0.529177210903
 LETTER = "SPDFGH"
 
@@ -59,21 +62,8 @@ def main():
     assert len(signs) == mol.nao
     coefficients = mf.mo_coeff * signs[:, None]
 
-    lines = []
+    lines = nwchem_header(mol)
     w = lines.append
-    w("              Northwest Computational Chemistry Package (NWChem) 7.0.2")
-    w("              --------------------------------------------------------")
-    w("")
-    w('                             Geometry "geometry" -> ""')
-    w("                             -------------------------")
-    w("")
-    w(" Output coordinates in angstroms (scale by  1.889725989 to convert to a.u.)")
-    w("")
-    w("  No.       Tag          Charge          X              Y              Z")
-    w(" ---- ---------------- ---------- -------------- -------------- --------------")
-    for k in range(mol.natm):
-        p = mol.atom_coord(k) / ANGSTROM
-        w(f"{k + 1:5d} {mol.atom_symbol(k):<16s}{mol.atom_charge(k):11.4f}{p[0]:15.8f}{p[1]:15.8f}{p[2]:15.8f}")
     w("")
     w('                      Basis "ao basis" -> "ao basis" (spherical)')
     w("                      -----")

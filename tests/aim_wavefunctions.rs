@@ -7,6 +7,8 @@
 //! `.wfx` files expand it into cartesian primitives, the `.mkl` files keep it pure with ORCA's
 //! normalisation and sign quirks, which the reader must undo.
 
+mod common;
+
 use std::path::PathBuf;
 
 use glam::DVec3;
@@ -89,21 +91,8 @@ fn load(name: &str) -> Document {
     formats::load(&path).unwrap_or_else(|e| panic!("{e}"))
 }
 
-/// Deterministic points in the molecule's box padded by 3 bohr.
 fn points(doc: &Document) -> Vec<DVec3> {
-    let (lo, hi) =
-        doc.molecule.atoms.iter().fold((DVec3::splat(f64::MAX), DVec3::splat(f64::MIN)), |(lo, hi), a| {
-            (lo.min(a.position), hi.max(a.position))
-        });
-    let (lo, hi) = (lo - 3.0, hi + 3.0);
-    let mut x = 0x9e37_79b9_7f4a_7c15u64;
-    let mut next = move || {
-        x ^= x << 13;
-        x ^= x >> 7;
-        x ^= x << 17;
-        (x >> 11) as f64 / (1u64 << 53) as f64
-    };
-    (0..POINTS).map(|_| lo + (hi - lo) * DVec3::new(next(), next(), next())).collect()
+    common::points_around(doc, POINTS)
 }
 
 /// Checks one case; returns the values that are off (structural differences panic).

@@ -8,6 +8,8 @@
 //! f/g signs, Psi4's m = +l … −l) and cartesian d (QCSchema's x^l normalisation). A QCSchema file
 //! in the specification's own order, and one that does not name its writer, open the same.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 
 use glam::DVec3;
@@ -46,21 +48,8 @@ fn load(name: &str) -> Document {
     formats::load_bytes(&path, &read(name)).unwrap_or_else(|e| panic!("{e}"))
 }
 
-/// Deterministic points in the molecule's box padded by 3 bohr.
 fn points(doc: &Document) -> Vec<DVec3> {
-    let (lo, hi) =
-        doc.molecule.atoms.iter().fold((DVec3::splat(f64::MAX), DVec3::splat(f64::MIN)), |(lo, hi), a| {
-            (lo.min(a.position), hi.max(a.position))
-        });
-    let (lo, hi) = (lo - 3.0, hi + 3.0);
-    let mut x = 0x9e37_79b9_7f4a_7c15u64;
-    let mut next = move || {
-        x ^= x << 13;
-        x ^= x >> 7;
-        x ^= x << 17;
-        (x >> 11) as f64 / (1u64 << 53) as f64
-    };
-    (0..POINTS).map(|_| lo + (hi - lo) * DVec3::new(next(), next(), next())).collect()
+    common::points_around(doc, POINTS)
 }
 
 /// Compares `doc` with the Molden file's wavefunction; returns what is off, and the worst

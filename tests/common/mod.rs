@@ -192,3 +192,21 @@ pub fn compact_p_orbital(n: usize, axis: usize) -> orbcloud::model::VolumeGrid {
         .collect();
     orbcloud::model::VolumeGrid::new("compact p", [n, n, n], world, values)
 }
+
+/// `count` deterministic points (xorshift) in the box of `doc`'s atoms padded by 3 bohr: where
+/// two readers' wavefunctions are compared value by value.
+pub fn points_around(doc: &Document, count: usize) -> Vec<DVec3> {
+    let (lo, hi) =
+        doc.molecule.atoms.iter().fold((DVec3::splat(f64::MAX), DVec3::splat(f64::MIN)), |(lo, hi), a| {
+            (lo.min(a.position), hi.max(a.position))
+        });
+    let (lo, hi) = (lo - 3.0, hi + 3.0);
+    let mut x = 0x9e37_79b9_7f4a_7c15u64;
+    let mut next = move || {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        (x >> 11) as f64 / (1u64 << 53) as f64
+    };
+    (0..count).map(|_| lo + (hi - lo) * DVec3::new(next(), next(), next())).collect()
+}
