@@ -216,7 +216,9 @@ fn relaxed_scan(
     frames: &[(&Geometry, Option<f64>)],
 ) -> Result<JobScan, ParseError> {
     let Some((line, coordinate, points)) = scan_block(log, echoed)? else {
-        return Err(log.error_at(steps[0], "a `%geom Scan … end` block in the echoed input naming the scanned coordinate"));
+        return Err(
+            log.error_at(steps[0], "a `%geom Scan … end` block in the echoed input naming the scanned coordinate")
+        );
     };
     if frames.len() < 2 {
         return Err(log.error_at(
