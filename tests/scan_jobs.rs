@@ -391,3 +391,20 @@ fn an_orca_scan_cut_off_or_unconverged_says_so() {
     assert_eq!(doc.job_scan.as_ref().unwrap().values.len(), 5);
     assert!(doc.problems.iter().any(|p| p.contains("step 2 did not converge")), "{:?}", doc.problems);
 }
+
+#[test]
+fn an_orca_dihedral_scan_reads_from_the_value_it_asked_for() {
+    // The same geometries asked for a whole turn lower or higher: the measured values follow.
+    for (line, first) in [("|  4> D 2 0 1 3 = -240, 0, 5", -240.0), ("|  4> D 2 0 1 3 = [480 540 600 660 720]", 480.0)]
+    {
+        let doc = orca_with(ORCA_SCAN_LINE, line);
+        let values = &doc.job_scan.as_ref().unwrap().values;
+        for (k, v) in values.iter().enumerate() {
+            assert!((v - (first + 60.0 * k as f64)).abs() < 1e-3, "{line}: {values:?}");
+        }
+    }
+    // A bond is as measured whatever the input says.
+    let doc = orca_with("|  4> D 2 0 1 3 = 120, 360, 5", "|  4> B 0 1 = 9.0, 9.5, 5");
+    let values = &doc.job_scan.as_ref().unwrap().values;
+    assert!(values.iter().all(|v| (1.3..1.5).contains(v)), "{values:?}");
+}

@@ -39,7 +39,8 @@
 //! Energy'", one row per point. Such a log keeps one frame per point, the last geometry before
 //! the next banner, and the coordinate scanned from the echoed input block (atoms from 0, as
 //! ORCA numbers them; `first, last, points`, or the values listed in `[ ]`), measured in each
-//! point's geometry as the Gaussian reader does ([`super::logs::job_scan`]).
+//! point's geometry as the Gaussian reader does ([`super::logs::job_scan`]); a dihedral's values
+//! are turned by whole turns to start where the job asked (`= 200, …` reads 200°, not −160°).
 
 use std::collections::HashMap;
 
@@ -215,7 +216,7 @@ fn relaxed_scan(
     steps: &[usize],
     frames: &[(&Geometry, Option<f64>)],
 ) -> Result<JobScan, ParseError> {
-    let Some((line, coordinate, points)) = scan_block(log, echoed)? else {
+    let Some((line, coordinate, points, first)) = scan_block(log, echoed)? else {
         return Err(
             log.error_at(steps[0], "a `%geom Scan … end` block in the echoed input naming the scanned coordinate")
         );
@@ -227,13 +228,13 @@ fn relaxed_scan(
         ));
     }
     let text = echoed.iter().find(|e| e.0 == line).map_or("", |e| e.1);
-    super::logs::job_scan(log, line, text, coordinate, points, frames)
+    Ok(super::logs::job_scan(log, line, text, coordinate, points, frames)?.starting_near(first))
 }
 
-/// The echoed input's `Scan` block inside `%geom`: its coordinate's line, the coordinate and the
-/// number of points. `None` when the input scans nothing; an error for a block that cannot be
+/// The echoed input's `Scan` block inside `%geom`: its coordinate's line, the coordinate, the
+/// number of points and the first value asked for. `None` when the input scans nothing; an error for a block that cannot be
 /// read or that scans two coordinates (a grid of points, not a series along one coordinate).
-fn scan_block(log: &LogLines, echoed: &[(usize, &str)]) -> Result<Option<(usize, Coordinate, usize)>, ParseError> {
+fn scan_block(log: &LogLines, echoed: &[(usize, &str)]) -> Result<Option<(usize, Coordinate, usize, f64)>, ParseError> {
     // The input as tokens with their lines; `=`, `[` and `]` stand alone, commas separate.
     let mut tokens: Vec<(usize, String)> = Vec::new();
     for &(i, text) in echoed {
@@ -254,7 +255,7 @@ fn scan_block(log: &LogLines, echoed: &[(usize, &str)]) -> Result<Option<(usize,
         }
     }
     let Some(mut k) = start else { return Ok(None) };
-    let mut found: Option<(usize, Coordinate, usize)> = None;
+    let mut found: Option<(usize, Coordinate, usize, f64)> = None;
     loop {
         let Some((i, t)) = tokens.get(k) else {
             let last = echoed.last().map_or(0, |e| e.0);
@@ -293,8 +294,9 @@ fn scan_block(log: &LogLines, echoed: &[(usize, &str)]) -> Result<Option<(usize,
         }
         k += 1;
         let number = |k: usize| tokens.get(k).and_then(|(_, t)| parse_real(t)).filter(|v| v.is_finite());
-        let points = if tokens.get(k).is_some_and(|(_, t)| t == "[") {
+        let (points, first) = if tokens.get(k).is_some_and(|(_, t)| t == "[") {
             k += 1;
+            let first = number(k).unwrap_or(0.0);
             let mut n = 0;
             while number(k).is_some() {
                 n += 1;
@@ -304,14 +306,14 @@ fn scan_block(log: &LogLines, echoed: &[(usize, &str)]) -> Result<Option<(usize,
                 return Err(log.error_at(i, format!("{SCAN}: two or more values between `[` and `]`")));
             }
             k += 1;
-            n
+            (n, first)
         } else {
             let count = tokens.get(k + 2).and_then(|(_, t)| t.parse::<usize>().ok()).filter(|&n| n >= 2);
-            let (Some(_), Some(_), Some(count)) = (number(k), number(k + 1), count) else {
+            let (Some(first), Some(_), Some(count)) = (number(k), number(k + 1), count) else {
                 return Err(log.error_at(i, format!("{SCAN}: a first value, a last value and a number of points")));
             };
             k += 3;
-            count
+            (count, first)
         };
         let coordinate = match atoms[..] {
             [a, b] => Coordinate::Distance([a, b]),
@@ -319,7 +321,7 @@ fn scan_block(log: &LogLines, echoed: &[(usize, &str)]) -> Result<Option<(usize,
             [a, b, c, d] => Coordinate::Dihedral([a, b, c, d]),
             _ => return Err(log.error_at(i, format!("{SCAN}: {expected} atom numbers, then `=`"))),
         };
-        found = Some((i, coordinate, points));
+        found = Some((i, coordinate, points, first));
     }
 }
 
