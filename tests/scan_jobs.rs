@@ -6,7 +6,9 @@
 //! The fixture, tests/fixtures/logs/h2o2_scan.log, is written by
 //! scripts/make_scan_log_fixtures.py (PySCF) in the layout of cclib's regression files
 //! data/Gaussian/basicGaussian09/dvb_scan_relaxed.log and dvb_scan.log (Gaussian 09 D.01 and
-//! A.02), read line by line; nothing is copied from them.
+//! A.02), read line by line; nothing is copied from them. An ORCA relaxed surface scan of the
+//! same dihedral (tests/fixtures/logs/h2o2_scan_orca.out, the same script, in the layout of
+//! cclib's data/ORCA/basicORCA6.0/dvb_scan_relaxed.out) opens the same way.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
