@@ -28,7 +28,27 @@ cclib's water-pes.fchk (a rigid Z-matrix scan) holds none of these records, only
 point's geometry and orbitals; the per-point layout follows what readers of Gaussian's relaxed-scan
 checkpoints take from it (one "Opt point N" pair per scan point, the converged step last).
 
+It also writes tests/fixtures/logs/h2o2_scan_orca.out: the same scan as ORCA runs it
+(`! HF STO-3G Opt` with `%geom Scan D 2 0 1 3 = 120, 360, 5 end end`: atoms from 0, the first and
+last value and the number of points), in the layout of cclib's regression file
+data/ORCA/basicORCA6.0/dvb_scan_relaxed.out (ORCA 6.0.1; cclib commit
+21daa960123d28aa21eeaaacc2a1dea39e136829, file at a2b0886a669d4f01d092b638fb6ce44de58cc083),
+read part by part: the banner, "INPUT FILE" with the input echoed as `| 10> D 9 8 3 2 = 0, 360,
+12`, the "Relaxed Surface Scan" box with `Dihedral (  9,   8,   3,   2):   range= ... steps =
+12`, then per point a box "RELAXED SURFACE SCAN STEP   n" naming the value, per optimisation
+cycle a box "GEOMETRY OPTIMIZATION CYCLE   k" with "CARTESIAN COORDINATES (ANGSTROEM)", "CARTESIAN
+COORDINATES (A.U.)" (`NO LB ZA FRAG MASS X Y Z`) and "FINAL SINGLE POINT ENERGY", the "Geometry
+convergence" table, "THE OPTIMIZATION HAS CONVERGED" in its HURRAY box, "FINAL ENERGY EVALUATION
+AT THE STATIONARY POINT" with the coordinates and energy once more, "*** OPTIMIZATION RUN DONE
+***" and "Storing optimized geometry in NAME.00n.xyz"; at the end "**** RELAXED SURFACE SCAN
+DONE ***", "RELAXED SURFACE SCAN RESULTS", "Column   1: NONAME", "The Calculated Surface using
+the 'Actual Energy'" and "... using the SCF energy" (`%13.8f %13.8f` rows: the value as
+requested, 0 to 360 in 12 points there, and the energy) and "****ORCA TERMINATED NORMALLY****".
+The SCF, gradient and property sections between them, which the reader skips, are left out;
+nothing is copied from that file: the molecule, numbers and spacing here are this script's.
+
 Run:   python3 scripts/make_scan_log_fixtures.py   (PySCF, numpy; a few seconds)
+       python3 scripts/make_scan_log_fixtures.py orca   (the ORCA output only)
 """
 import sys
 from pathlib import Path
@@ -42,6 +62,7 @@ import make_wavefunction_fixtures as fx  # noqa: E402
 
 OUT = HERE.parent / "tests" / "fixtures" / "logs" / "h2o2_scan.log"
 FCHK = HERE.parent / "tests" / "fixtures" / "scan_jobs" / "h2o2_relaxed_scan.fchk"
+ORCA = HERE.parent / "tests" / "fixtures" / "logs" / "h2o2_scan_orca.out"
 BOHR = 0.52917721090380
 START, STEPS, SIZE = 120.0, 4, 60.0
 OH, OOH = 0.97, 100.0  # Å, degrees: fixed in this fixture
@@ -155,5 +176,116 @@ def write_fchk(history) -> None:
     print(FCHK)
 
 
+STAR = "         " + "*" * 61 + "\n"
+
+
+def box(*rows: str) -> str:
+    """ORCA's boxes: 61 stars wide, each row between `*`s."""
+    return STAR + "".join("         *" + r.ljust(59) + "*\n" for r in rows) + STAR
+
+
+def orca_coordinates(xyz: np.ndarray) -> str:
+    s = "---------------------------------\nCARTESIAN COORDINATES (ANGSTROEM)\n---------------------------------\n"
+    for sym, p in zip("OOHH", xyz):
+        s += "  %-2s %12.6f%12.6f%12.6f\n" % (sym, *p)
+    s += "\n----------------------------\nCARTESIAN COORDINATES (A.U.)\n----------------------------\n"
+    s += "  NO LB      ZA    FRAG     MASS         X           Y           Z\n"
+    for k, (sym, p) in enumerate(zip("OOHH", xyz)):
+        za, mass = (8.0, 15.999) if sym == "O" else (1.0, 1.008)
+        s += "%4d %-2s%10.4f%5d%10.3f%12.6f%12.6f%12.6f\n" % (k, sym, za, 0, mass, *(p / BOHR))
+    return s + "\n"
+
+
+def orca_energy(e: float) -> str:
+    rule = "-------------------------   --------------------\n"
+    return "\n" + rule + "FINAL SINGLE POINT ENERGY %22.12f\n" % e + rule + "\n"
+
+
+def convergence(converged: bool) -> str:
+    flag = "YES" if converged else "NO"
+    s = "                                .--------------------.\n"
+    s += "          ----------------------|Geometry convergence|-------------------------\n"
+    s += "          Item                value                   Tolerance       Converged\n"
+    s += "          " + "-" * 69 + "\n"
+    for item, tol in (("RMS gradient", 1e-4), ("MAX gradient", 3e-4), ("RMS step", 2e-3), ("MAX step", 4e-3)):
+        s += "          %-18s%13.10f%19.10f      %s\n" % (item, tol / 2 if converged else tol * 20, tol, flag)
+    s += "          " + "-" * 69 + "\n\n"
+    if converged:
+        s += "                    ***********************HURRAY********************\n"
+        s += "                    ***        THE OPTIMIZATION HAS CONVERGED     ***\n"
+        s += "                    *************************************************\n\n"
+    else:
+        s += "The optimization has not yet converged - more geometry cycles are needed\n\n"
+    return s
+
+
+def write_orca() -> None:
+    """The scan as ORCA 6 prints it: two cycles a point (the start, then the converged O-O
+    length) and the final evaluation at the converged geometry."""
+    name = "h2o2_scan"
+    points = STEPS + 1
+    last = START + STEPS * SIZE
+    lines = ["! HF STO-3G Opt", "", "%geom Scan", "D 2 0 1 3 = %g, %g, %d" % (START, last, points), "end", "end", "",
+             "* xyz 0 1"]
+    lines += ["%-2s %12.5f %12.5f %12.5f" % (sym, *p) for sym, p in zip("OOHH", geometry(1.40, START))]
+    lines += ["*", ""]
+    s = "\n                                 *****************\n"
+    s += "                                 * O   R   C   A *\n"
+    s += "                                 *****************\n\n"
+    s += "                         Program Version 6.0.1  -  RELEASE   -\n\n"
+    s += "=" * 80 + "\n" + " " * 39 + "INPUT FILE\n" + "=" * 80 + "\n"
+    s += "NAME = %s.inp\n" % name
+    for k, text in enumerate(lines):
+        s += "|%3d> %s\n" % (k + 1, text)
+    s += "|%3d>                          ****END OF INPUT****\n" % (len(lines) + 1)
+    s += "=" * 80 + "\n\n"
+    s += "                       ******************************\n"
+    s += "                       *    Relaxed Surface Scan    *\n"
+    s += "                       ******************************\n\n"
+    atoms = "(  2,   0,   1,   3)"
+    s += "        Dihedral %s:   range= %12.8f .. %12.8f  steps = %4d\n\n" % (atoms, START, last, points)
+    s += "There is 1 parameter to be scanned.\n"
+    s += "There will be %4d constrained geometry optimizations.\n\n\n" % points
+    oo = 1.40
+    table = []
+    for p in range(points):
+        dihedral = START + p * SIZE
+        s += box(" " * 15 + "RELAXED SURFACE SCAN STEP %3d" % (p + 1), "", "   Dihedral %s  : %12.8f" % (atoms, dihedral))
+        s += "\nGeometry optimization settings:\nUpdate method            Update   .... BFGS\n\n"
+        cycles = [oo]
+        oo = best_oo(dihedral)
+        cycles.append(oo)
+        for c, x in enumerate(cycles):
+            xyz = geometry(x, dihedral)
+            e = energy(xyz)
+            s += "\n" + box(" " * 16 + "GEOMETRY OPTIMIZATION CYCLE %3d" % (c + 1))
+            s += orca_coordinates(xyz) + orca_energy(e) + convergence(c + 1 == len(cycles))
+        s += "                 " + "*" * 55 + "\n"
+        s += "                 *** FINAL ENERGY EVALUATION AT THE STATIONARY POINT ***\n"
+        s += "                 ***               (AFTER %4d CYCLES)               ***\n" % len(cycles)
+        s += "                 " + "*" * 55 + "\n"
+        xyz = geometry(oo, dihedral)
+        e = energy(xyz)
+        s += orca_coordinates(xyz) + orca_energy(e)
+        s += "                                *** OPTIMIZATION RUN DONE ***\n\n\n"
+        s += "Storing optimized geometry in %s.%03d.xyz ... done\n" % (name, p + 1)
+        s += "Storing optimized geometry and energy in %s.xyzall ... done\n\n" % name
+        table.append((dihedral, e))
+    s += "                   **** RELAXED SURFACE SCAN DONE ***\n\n"
+    s += "                    SUMMARY OF THE CALCULATED SURFACE\n\n"
+    s += "----------------------------\nRELAXED SURFACE SCAN RESULTS\n----------------------------\n\n"
+    s += "Column   1: NONAME\n\n"
+    for what in ("the 'Actual Energy'", "the SCF energy"):
+        s += "The Calculated Surface using %s\n" % what
+        s += "".join("%13.8f %13.8f\n" % row for row in table) + "\n"
+    s += "\n                             ****ORCA TERMINATED NORMALLY****\n"
+    ORCA.write_text(s)
+    print(ORCA)
+
+
 if __name__ == "__main__":
-    main()
+    if sys.argv[1:] == ["orca"]:
+        write_orca()
+    else:
+        main()
+        write_orca()

@@ -6,7 +6,9 @@
 //! The fixture, tests/fixtures/logs/h2o2_scan.log, is written by
 //! scripts/make_scan_log_fixtures.py (PySCF) in the layout of cclib's regression files
 //! data/Gaussian/basicGaussian09/dvb_scan_relaxed.log and dvb_scan.log (Gaussian 09 D.01 and
-//! A.02), read line by line; nothing is copied from them.
+//! A.02), read line by line; nothing is copied from them. An ORCA relaxed surface scan of the
+//! same dihedral (tests/fixtures/logs/h2o2_scan_orca.out, the same script, in the layout of
+//! cclib's data/ORCA/basicORCA6.0/dvb_scan_relaxed.out) opens the same way.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -229,4 +231,182 @@ fn a_relaxed_scan_fchk_opens_its_points_with_their_energies() {
     let doc = formats::load_bytes(Path::new("bad.fchk"), bad.as_bytes()).unwrap();
     let energies: Vec<bool> = doc.structure.unwrap().structure.models.iter().map(|m| m.energy.is_some()).collect();
     assert_eq!(energies, [true, false, true, true, true]);
+}
+
+// ORCA's relaxed surface scan (`%geom Scan D 2 0 1 3 = 120, 360, 5 end end`): the fixture,
+// tests/fixtures/logs/h2o2_scan_orca.out, is written by scripts/make_scan_log_fixtures.py in the
+// layout of cclib's data/ORCA/basicORCA6.0/dvb_scan_relaxed.out (ORCA 6.0.1).
+
+fn orca_fixture() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/logs/h2o2_scan_orca.out")
+}
+
+/// The energy printed last before each "*** OPTIMIZATION RUN DONE ***", and the final table's
+/// rows (value, energy) under "The Calculated Surface using the 'Actual Energy'".
+fn orca_points(text: &str) -> (Vec<f64>, Vec<(f64, f64)>) {
+    let mut last = None;
+    let mut done = Vec::new();
+    for l in text.lines() {
+        if let Some(e) = l.strip_prefix("FINAL SINGLE POINT ENERGY") {
+            last = Some(e.trim().parse::<f64>().unwrap());
+        } else if l.contains("*** OPTIMIZATION RUN DONE ***") {
+            done.push(last.take().unwrap());
+        }
+    }
+    let table = text
+        .lines()
+        .skip_while(|l| !l.starts_with("The Calculated Surface using the 'Actual Energy'"))
+        .skip(1)
+        .take_while(|l| !l.trim().is_empty())
+        .map(|l| {
+            let v: Vec<f64> = l.split_whitespace().map(|t| t.parse().unwrap()).collect();
+            (v[0], v[1])
+        })
+        .collect();
+    (done, table)
+}
+
+#[test]
+fn an_orca_relaxed_scan_opens_its_points_with_the_coordinate_it_scanned() {
+    let text = std::fs::read_to_string(orca_fixture()).unwrap();
+    let doc = formats::load(&orca_fixture()).unwrap();
+    let models = &doc.structure.as_ref().expect("frames").structure.models;
+    assert_eq!(models.len(), 5, "one frame per point (two cycles and a final evaluation each)");
+    let (done, table) = orca_points(&text);
+    assert_eq!(done.len(), 5);
+    let energies: Vec<f64> = models.iter().map(|m| m.energy.unwrap()).collect();
+    assert_eq!(energies, done, "each point's energy is the one before its OPTIMIZATION RUN DONE");
+
+    let job = doc.job_scan.as_ref().expect("the scan's coordinate");
+    assert_eq!(job.coordinate, Coordinate::Dihedral([2, 0, 1, 3]), "D 2 0 1 3: ORCA numbers atoms from 0");
+    assert_eq!(job.coordinate.label(), "dihedral 3-1-2-4");
+    assert!(job.from.starts_with("line 15: D 2 0 1 3 = 120, 360, 5"), "{}", job.from);
+    // Measured in each frame's geometry, run on past 180°: the final table's values, and its
+    // energies to its 8 decimals.
+    assert_eq!(table.len(), 5);
+    for ((v, e), (tv, te)) in job.values.iter().zip(&energies).zip(&table) {
+        assert!((v - tv).abs() < 1e-3, "{:?} vs {table:?}", job.values);
+        assert!((e - te).abs() < 1e-8, "{e} vs {te}");
+    }
+}
+
+#[test]
+fn info_reports_the_orca_scan_and_each_frames_value() {
+    let path = orca_fixture();
+    let out = orbcloud(&["info", "--json", path.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let scan = &json["scan"];
+    assert_eq!(scan["coordinate"], "dihedral 3-1-2-4");
+    assert_eq!(scan["kind"], "dihedral");
+    assert_eq!(scan["atoms"], serde_json::json!([3, 1, 2, 4]), "reported from 1");
+    assert_eq!(scan["unit"], "°");
+    let values: Vec<f64> = scan["values"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+    assert_eq!(values.len(), json["structure"]["models"].as_array().unwrap().len());
+    for (v, e) in values.iter().zip([120.0, 180.0, 240.0, 300.0, 360.0]) {
+        assert!((v - e).abs() < 1e-3, "{values:?}");
+    }
+    assert!(scan["from"].as_str().unwrap().starts_with("line 15:"), "{scan}");
+}
+
+/// The ORCA fixture with `old` replaced by `new`, opened as `scan.out`.
+fn orca_with(old: &str, new: &str) -> orbcloud::model::Document {
+    let text = std::fs::read_to_string(orca_fixture()).unwrap();
+    assert!(text.contains(old), "{old}");
+    formats::load_bytes(Path::new("scan.out"), text.replacen(old, new, 1).as_bytes()).unwrap()
+}
+
+const ORCA_SCAN_LINE: &str = "|  4> D 2 0 1 3 = 120, 360, 5";
+
+#[test]
+fn an_unreadable_or_unsupported_orca_scan_block_leaves_the_coordinate_out_saying_where() {
+    for (new, at, expected) in [
+        ("|  4> D 2 0 1 = 120, 360, 5", 15, "4 atom numbers, then `=`"),
+        ("|  4> B 0 x = 1.3, 1.5, 5", 15, "2 atom numbers"),
+        ("|  4> D 2 0 1 3 = 120, 360", 15, "a number of points"),
+        ("|  4> D 2 0 1 3 = 120, 360, 1", 15, "a number of points"),
+        ("|  4> D 2 0 1 3 = [120 180", 15, "two or more values between `[` and `]`"),
+        ("|  4> D 2 0 1 3 = [120]", 15, "two or more values"),
+        ("|  4> C 2 = 1, 2, 3", 15, "only bonds, angles and dihedrals"),
+        ("|  4> D 2 0 1 9 = 120, 360, 5", 15, "atoms among the 4 of the molecule"),
+        ("|  4> D 2 0 1 3 = 120, 360, 5\n|  4> B 0 1 = 1.3, 1.5, 5", 16, "one scanned coordinate (line 15"),
+        ("|  4> D 2 0 1 3 = 120, 360, 5 *", 15, "`end` closing the `%geom Scan` block"),
+        ("|  4> D 2 -1 1 3 = 120, 360, 5", 15, "4 atom numbers"),
+    ] {
+        let doc = orca_with(ORCA_SCAN_LINE, new);
+        assert!(doc.job_scan.is_none(), "{new}");
+        assert_eq!(doc.structure.as_ref().unwrap().structure.models.len(), 5, "the frames open: {new}");
+        let p = doc.problems.iter().find(|p| p.contains("coordinate left out")).unwrap_or_else(|| panic!("{new}"));
+        assert!(p.contains(&format!("scan.out:{at}:")), "file and line: {p}");
+        assert!(p.contains(expected), "{new}: {p}");
+    }
+    // A scan whose input is not echoed: the frames open, the coordinate is missed, saying so.
+    let doc = orca_with("|  3> %geom Scan\n", "");
+    assert!(doc.job_scan.is_none());
+    assert!(doc.problems.iter().any(|p| p.contains("a `%geom Scan … end` block")), "{:?}", doc.problems);
+}
+
+#[test]
+fn the_orca_scan_block_may_list_its_values_or_stand_on_one_line() {
+    let values = |doc: &orbcloud::model::Document| doc.job_scan.as_ref().map(|j| (j.coordinate, j.values.len()));
+    let d = Some((Coordinate::Dihedral([2, 0, 1, 3]), 5));
+    let doc = orca_with(ORCA_SCAN_LINE, "|  4> d 2 0 1 3 = [120.0 180.0 240.0 300.0 360.0]  # listed");
+    assert_eq!(values(&doc), d, "{:?}", doc.problems);
+    let doc = orca_with(
+        "|  3> %geom Scan\n|  4> D 2 0 1 3 = 120, 360, 5\n|  5> end\n|  6> end\n",
+        "|  3> %geom scan D 2 0 1 3 = 120, 360, 5 end end\n",
+    );
+    assert_eq!(values(&doc), d, "{:?}", doc.problems);
+    let from = doc.job_scan.unwrap().from;
+    assert!(from.starts_with("line 14: %geom scan D 2 0 1 3 = 120, 360, 5 end end"), "{from}");
+    // Another `%geom` setting before the block, a bond scanned.
+    let doc = orca_with(
+        "|  3> %geom Scan\n|  4> D 2 0 1 3 = 120, 360, 5",
+        "|  3> %geom MaxIter 50 Scan\n|  4> B 0 1 = 1.3, 1.5, 5",
+    );
+    assert_eq!(values(&doc), Some((Coordinate::Distance([0, 1]), 5)), "{:?}", doc.problems);
+}
+
+#[test]
+fn an_orca_scan_cut_off_or_unconverged_says_so() {
+    let text = std::fs::read_to_string(orca_fixture()).unwrap();
+    // Cut off in step 4, before its first geometry: three points of five.
+    let cut = &text[..text.find("RELAXED SURFACE SCAN STEP   4").unwrap()];
+    let doc = formats::load_bytes(Path::new("cut.out"), cut.as_bytes()).unwrap();
+    let job = doc.job_scan.as_ref().expect("the coordinate");
+    assert_eq!(job.values.len(), 3);
+    assert!(job.from.ends_with("(3 of its 5 points)"), "{}", job.from);
+    // One point only: no series to measure.
+    let cut = &text[..text.find("RELAXED SURFACE SCAN STEP   2").unwrap()];
+    let doc = formats::load_bytes(Path::new("cut.out"), cut.as_bytes()).unwrap();
+    assert!(doc.job_scan.is_none());
+    assert!(doc.problems.iter().any(|p| p.contains("cut.out:15:") && p.contains("at least two")), "{:?}", doc.problems);
+    // A step whose optimisation gave up keeps its last geometry, and says so.
+    let step2 = text.find("RELAXED SURFACE SCAN STEP   2").unwrap();
+    let at = step2 + text[step2..].find("                 *** FINAL ENERGY EVALUATION").unwrap();
+    let gave_up = format!(
+        "{}The optimization did not converge but reached the maximum number of\noptimization cycles.\n{}",
+        &text[..at],
+        &text[at..]
+    );
+    let doc = formats::load_bytes(Path::new("gave_up.out"), gave_up.as_bytes()).unwrap();
+    assert_eq!(doc.job_scan.as_ref().unwrap().values.len(), 5);
+    assert!(doc.problems.iter().any(|p| p.contains("step 2 did not converge")), "{:?}", doc.problems);
+}
+
+#[test]
+fn an_orca_dihedral_scan_reads_from_the_value_it_asked_for() {
+    // The same geometries asked for a whole turn lower or higher: the measured values follow.
+    for (line, first) in [("|  4> D 2 0 1 3 = -240, 0, 5", -240.0), ("|  4> D 2 0 1 3 = [480 540 600 660 720]", 480.0)]
+    {
+        let doc = orca_with(ORCA_SCAN_LINE, line);
+        let values = &doc.job_scan.as_ref().unwrap().values;
+        for (k, v) in values.iter().enumerate() {
+            assert!((v - (first + 60.0 * k as f64)).abs() < 1e-3, "{line}: {values:?}");
+        }
+    }
+    // A bond is as measured whatever the input says.
+    let doc = orca_with("|  4> D 2 0 1 3 = 120, 360, 5", "|  4> B 0 1 = 9.0, 9.5, 5");
+    let values = &doc.job_scan.as_ref().unwrap().values;
+    assert!(values.iter().all(|v| (1.3..1.5).contains(v)), "{values:?}");
 }

@@ -100,8 +100,8 @@ impl ScanDialog {
 }
 
 impl ScanDialog {
-    /// The window for the frames of a scan job object `object` holds (a Gaussian relaxed scan's
-    /// log): its coordinate, the range its frames cover, the folder beside the file.
+    /// The window for the frames of a scan job object `object` holds (a Gaussian or ORCA relaxed
+    /// scan's log): its coordinate, the range its frames cover, the folder beside the file.
     pub fn for_job(object: usize, doc: &Document) -> Self {
         let Some(job) = &doc.job_scan else { return Self::default() };
         let (from, to) =

@@ -45,7 +45,7 @@ pub fn controls(ui: &mut egui::Ui, app: &mut OrbApp) -> Option<usize> {
     let title = if model.title.is_empty() { format!("MODEL {}", model.number) } else { model.title.clone() };
     ui.label(RichText::new(title).small().weak());
     let energies: Vec<Option<f64>> = view.structure.models.iter().map(|m| m.energy).collect();
-    // A scan job's frames (a Gaussian relaxed scan) lie along the coordinate it scanned: the
+    // A scan job's frames (a Gaussian or ORCA relaxed scan) lie along the coordinate it scanned: the
     // plot is against its values, and their orbitals can be computed to make a scan of them.
     let doc = &app.objects[app.active].doc;
     let job = doc.job_scan.as_ref().filter(|j| j.values.len() == count);

@@ -71,8 +71,8 @@ pub struct ComputeArgs {
 #[derive(Args)]
 pub struct ScanComputeArgs {
     /// The geometry to start from (any file orbcloud reads), or with --frames a multi-frame
-    /// XYZ file whose every frame is computed, or a scan job's log (a Gaussian relaxed scan),
-    /// its frames computed at the values of the coordinate it scanned.
+    /// XYZ file whose every frame is computed, or a scan job's log (a Gaussian or ORCA relaxed
+    /// scan), its frames computed at the values of the coordinate it scanned.
     file: PathBuf,
     #[command(flatten)]
     coordinate: CoordinateArgs,
@@ -195,7 +195,7 @@ fn scan_frames(args: &ScanComputeArgs, doc: &Document) -> Result<(Coordinate, Ve
         if args.relaxed {
             bail!("--relaxed holds a coordinate: give --distance, --angle or --dihedral, not --frames");
         }
-        // A scan job's frames (a Gaussian relaxed scan's log) keep the coordinate it scanned.
+        // A scan job's frames (a Gaussian or ORCA relaxed scan's log) keep the coordinate it scanned.
         if let Some(job) = compute::job_scan_frames(doc, &stem) {
             let (c, frames) = job.map_err(anyhow::Error::msg)?;
             return Ok((c, frames, 0));

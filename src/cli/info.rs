@@ -122,7 +122,7 @@ pub struct DocumentInfo {
     pub modes_geometry: Option<String>,
     /// Excited states the file lists, and what its excited state's density says.
     pub excited_states: Option<ExcitedInfo>,
-    /// The coordinate a scan job varied and its value at each frame (a Gaussian relaxed scan).
+    /// The coordinate a scan job varied and its value at each frame (a Gaussian or ORCA relaxed scan).
     pub scan: Option<JobScanInfo>,
     /// Parts of the file left out, each saying where and why.
     pub problems: Vec<String>,

@@ -306,26 +306,7 @@ impl Scan {
                 ),
             ));
         }
-        let molecules: Vec<Molecule> = frames
-            .iter()
-            .map(|(o, _)| Molecule {
-                atoms: o
-                    .z
-                    .iter()
-                    .zip(&o.positions)
-                    .map(|(&z, &position)| Atom { z, charge: z as f64, position, ghost: false })
-                    .collect(),
-                bonds: Vec::new(),
-            })
-            .collect();
-        let from = format!("line {}: {}", line + 1, log.lines[line].split_whitespace().collect::<Vec<_>>().join(" "));
-        let atoms = frames.first().map_or(0, |f| f.0.z.len());
-        let mut scan = JobScan::measured(coordinate, &molecules, from)
-            .ok_or_else(|| log.error_at(line, format!("atoms among the {atoms} of the molecule")))?;
-        if scan.values.len() < steps + 1 {
-            scan.from += &format!(" ({} of its {} points)", scan.values.len(), steps + 1);
-        }
-        Ok(Some(scan))
+        super::logs::job_scan(log, line, log.lines[line], coordinate, steps + 1, frames).map(Some)
     }
 
     /// The last orientation printed before line `line`.

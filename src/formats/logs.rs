@@ -12,7 +12,8 @@ use glam::DVec3;
 use super::text::{excerpt, parse_real};
 use super::wavefunction::OverlapFn;
 use super::{ParseError, gamess_log, gaussian_log, nwchem_log, orca_log, psi4_log, qchem_log};
-use crate::model::Document;
+use crate::model::scan::{Coordinate, JobScan};
+use crate::model::{Atom, Document, Molecule};
 
 /// Lines of the file's top in which the program's banner is looked for: a job scheduler may
 /// write a few lines first, and the banners sit within the first hundred lines.
@@ -206,6 +207,41 @@ pub(crate) fn trajectory(file: &str, title: &str, frames: &[(&Geometry, Option<f
         }
     }
     doc
+}
+
+/// A scan job's coordinate measured at each of its `frames` (one per point, the point's converged
+/// geometry), the coordinate named at 0-based line `line` of the job's echoed input (`text`, as
+/// the job wrote it): what the Gaussian and ORCA readers share. `points` is the number of points the job asked for; a log cut
+/// off before its last says how many it holds. An error when the coordinate names an atom
+/// beyond the molecule's.
+pub(crate) fn job_scan(
+    log: &LogLines,
+    line: usize,
+    text: &str,
+    coordinate: Coordinate,
+    points: usize,
+    frames: &[(&Geometry, Option<f64>)],
+) -> Result<JobScan, ParseError> {
+    let molecules: Vec<Molecule> = frames
+        .iter()
+        .map(|(g, _)| Molecule {
+            atoms: g
+                .z
+                .iter()
+                .zip(&g.positions)
+                .map(|(&z, &position)| Atom { z, charge: z as f64, position, ghost: false })
+                .collect(),
+            bonds: Vec::new(),
+        })
+        .collect();
+    let from = format!("line {}: {}", line + 1, text.split_whitespace().collect::<Vec<_>>().join(" "));
+    let atoms = frames.first().map_or(0, |f| f.0.z.len());
+    let mut scan = JobScan::measured(coordinate, &molecules, from)
+        .ok_or_else(|| log.error_at(line, format!("atoms among the {atoms} of the molecule")))?;
+    if scan.values.len() < points {
+        scan.from += &format!(" ({} of its {} points)", scan.values.len(), points);
+    }
+    Ok(scan)
 }
 
 /// Digits after the decimal point of a printed number ("-0.02805" → 5).

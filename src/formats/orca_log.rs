@@ -29,6 +29,18 @@
 //! one row per Cartesian coordinate x₀ y₀ z₀ x₁ …: ORCA's mass-weighted modes taken back to
 //! Cartesian displacements and normalised, as printed) and `IR SPECTRUM` (`Int` in km/mol), at the
 //! last coordinate table before them.
+//!
+//! A relaxed surface scan (`%geom Scan D 9 8 3 2 = 0, 360, 12 end end` with `Opt`; the layout of
+//! cclib's regression file data/ORCA/basicORCA6.0/dvb_scan_relaxed.out, ORCA 6.0.1) prints a
+//! banner `RELAXED SURFACE SCAN STEP n` per point, then that point's constrained optimisation
+//! (`GEOMETRY OPTIMIZATION CYCLE k`, each with its coordinates and energy), "THE OPTIMIZATION HAS
+//! CONVERGED", a "FINAL ENERGY EVALUATION AT THE STATIONARY POINT" (coordinates and energy once
+//! more) and "*** OPTIMIZATION RUN DONE ***"; at the end "The Calculated Surface using the 'Actual
+//! Energy'", one row per point. Such a log keeps one frame per point, the last geometry before
+//! the next banner, and the coordinate scanned from the echoed input block (atoms from 0, as
+//! ORCA numbers them; `first, last, points`, or the values listed in `[ ]`), measured in each
+//! point's geometry as the Gaussian reader does ([`super::logs::job_scan`]); a dihedral's values
+//! are turned by whole turns to start where the job asked (`= 200, …` reads 200°, not −160°).
 
 use std::collections::HashMap;
 
@@ -41,6 +53,7 @@ use super::wavefunction::{OverlapFn, orca_flipped};
 use super::{MAX_Z, ParseError};
 use crate::model::basis::{Basis, MAX_L, Shell, ShellKind};
 use crate::model::orbitals::{MolecularOrbital, Spin};
+use crate::model::scan::{Coordinate, JobScan};
 use crate::model::vibrations::{NormalMode, Vibrations};
 use crate::model::{Atom, Document};
 
@@ -72,11 +85,24 @@ fn read(log: &LogLines, overlap: Option<OverlapFn>) -> Result<Document, ParseErr
     let mut basis: Option<(usize, HashMap<String, Vec<PrintedShell>>)> = None;
     let mut orbitals: Option<MoSection> = None;
     let mut title = String::new();
+    // The echoed input (`| 10> D 9 8 3 2 = 0, 360, 12`): its lines and their text after `>`.
+    let mut echoed: Vec<(usize, &str)> = Vec::new();
+    // A relaxed surface scan's `RELAXED SURFACE SCAN STEP n` banners and the lines where an
+    // optimisation gave up ("The optimization did not converge").
+    let mut steps: Vec<usize> = Vec::new();
+    let mut unconverged: Vec<usize> = Vec::new();
     let mut i = 0;
     while i < log.lines.len() {
         let t = log.lines[i].trim();
         if title.is_empty() && t.starts_with("|  1>") {
             title = t.trim_start_matches("|  1>").trim().to_string();
+        }
+        if let Some(text) = echoed_input(t) {
+            echoed.push((i, text));
+        } else if t.contains("RELAXED SURFACE SCAN STEP") {
+            steps.push(i);
+        } else if t.starts_with("The optimization did not converge") {
+            unconverged.push(i);
         }
         if t == "CARTESIAN COORDINATES (A.U.)" {
             let (g, next) = coordinates(log, i)?;
@@ -99,7 +125,8 @@ fn read(log: &LogLines, overlap: Option<OverlapFn>) -> Result<Document, ParseErr
         }
         i += 1;
     }
-    let frames = frames(&geometries, &energies);
+    let all = frames(&geometries, &energies);
+    let frames = if steps.is_empty() { all } else { scan_points(&all, &steps) };
     let Some(last) = frames.last().map(|f| f.0) else {
         return Err(error(file, log.lines.len().max(1), "a `CARTESIAN COORDINATES (A.U.)` table", "none in the file"));
     };
@@ -126,7 +153,176 @@ fn read(log: &LogLines, overlap: Option<OverlapFn>) -> Result<Document, ParseErr
     };
     let mut doc = trajectory(file, &title, &frames);
     doc.problems.push(format!("{file}: no orbitals to draw: {why}"));
+    if !steps.is_empty() {
+        for (k, &s) in steps.iter().enumerate() {
+            let end = steps.get(k + 1).copied().unwrap_or(usize::MAX);
+            if let Some(&u) = unconverged.iter().find(|&&u| u > s && u < end) {
+                doc.problems.push(format!(
+                    "{file}:{}: the scan's step {} did not converge: its frame is the optimisation's last geometry",
+                    u + 1,
+                    k + 1
+                ));
+            }
+        }
+        // An unreadable `%geom Scan` block leaves the coordinate out, not the frames.
+        match relaxed_scan(log, &echoed, &steps, &frames) {
+            Ok(scan) => doc.job_scan = Some(scan),
+            Err(e) => doc.problems.push(format!("the scan's coordinate left out: {e}")),
+        }
+    }
     Ok(doc)
+}
+
+/// The text of an echoed input line (`| 10> D 9 8 3 2 = 0, 360, 12`) after its `>`.
+fn echoed_input(line: &str) -> Option<&str> {
+    let rest = line.strip_prefix('|')?.trim_start();
+    let digits = rest.find(|c: char| !c.is_ascii_digit())?;
+    if digits == 0 {
+        return None;
+    }
+    rest[digits..].strip_prefix('>')
+}
+
+/// The points of a relaxed surface scan: for each `RELAXED SURFACE SCAN STEP` banner, the last
+/// frame before the next (the constrained optimisation's converged geometry, evaluated once more
+/// after "THE OPTIMIZATION HAS CONVERGED" and before "*** OPTIMIZATION RUN DONE ***"). A step
+/// cut off before its first geometry has no point.
+fn scan_points<'a>(all: &[(&'a Geometry, Option<f64>)], steps: &[usize]) -> Vec<(&'a Geometry, Option<f64>)> {
+    let mut points = Vec::new();
+    for (k, &s) in steps.iter().enumerate() {
+        let end = steps.get(k + 1).copied().unwrap_or(usize::MAX);
+        if let Some(&f) = all.iter().rev().find(|f| f.0.line > s && f.0.line < end) {
+            points.push(f);
+        }
+    }
+    points
+}
+
+/// What a relaxed scan's coordinate is read from, in words.
+const SCAN: &str = "a scanned coordinate `B i j = start, end, points` (or `A i j k`, `D i j k l`; atoms from 0; or values `= [v1 v2 …]`)";
+
+/// The coordinate of a relaxed surface scan, read from the echoed `%geom Scan … end` block, and
+/// its value at each of `frames` (the scan's points).
+///
+/// ```text
+/// |  9> %geom Scan
+/// | 10> D 9 8 3 2 = 0, 360, 12          type, atoms (from 0), first, last value, points
+/// | 11> end                             or `B 0 1 = [1.0 1.1 1.3]`, the values listed
+/// | 12> end
+/// ```
+fn relaxed_scan(
+    log: &LogLines,
+    echoed: &[(usize, &str)],
+    steps: &[usize],
+    frames: &[(&Geometry, Option<f64>)],
+) -> Result<JobScan, ParseError> {
+    let Some((line, coordinate, points, first)) = scan_block(log, echoed)? else {
+        return Err(
+            log.error_at(steps[0], "a `%geom Scan … end` block in the echoed input naming the scanned coordinate")
+        );
+    };
+    if frames.len() < 2 {
+        return Err(log.error_at(
+            line,
+            format!("at least two of the scan's points optimised ({} `RELAXED SURFACE SCAN STEP`)", steps.len()),
+        ));
+    }
+    let text = echoed.iter().find(|e| e.0 == line).map_or("", |e| e.1);
+    Ok(super::logs::job_scan(log, line, text, coordinate, points, frames)?.starting_near(first))
+}
+
+/// The echoed input's `Scan` block inside `%geom`: its coordinate's line, the coordinate, the
+/// number of points and the first value asked for. `None` when the input scans nothing; an error for a block that cannot be
+/// read or that scans two coordinates (a grid of points, not a series along one coordinate).
+fn scan_block(log: &LogLines, echoed: &[(usize, &str)]) -> Result<Option<(usize, Coordinate, usize, f64)>, ParseError> {
+    // The input as tokens with their lines; `=`, `[` and `]` stand alone, commas separate.
+    let mut tokens: Vec<(usize, String)> = Vec::new();
+    for &(i, text) in echoed {
+        let text = text.split('#').next().unwrap_or("");
+        let spaced = text.replace(',', " ").replace('=', " = ").replace('[', " [ ").replace(']', " ] ");
+        tokens.extend(spaced.split_whitespace().map(|t| (i, t.to_ascii_lowercase())));
+    }
+    let mut in_geom = false;
+    let mut start = None;
+    for (k, (_, t)) in tokens.iter().enumerate() {
+        if t == "%geom" {
+            in_geom = true;
+        } else if t.starts_with(['%', '*', '!']) {
+            in_geom = false;
+        } else if in_geom && t == "scan" {
+            start = Some(k + 1);
+            break;
+        }
+    }
+    let Some(mut k) = start else { return Ok(None) };
+    let mut found: Option<(usize, Coordinate, usize, f64)> = None;
+    loop {
+        let Some((i, t)) = tokens.get(k) else {
+            let last = echoed.last().map_or(0, |e| e.0);
+            return Err(log.error_at(last, "`end` closing the `%geom Scan` block"));
+        };
+        let i = *i;
+        if t == "end" {
+            return Ok(found);
+        }
+        if t.starts_with(['%', '*', '!']) {
+            return Err(log.error_at(i, "`end` closing the `%geom Scan` block"));
+        }
+        let expected = match t.as_str() {
+            "b" => 2,
+            "a" => 3,
+            "d" => 4,
+            _ => return Err(log.error_at(i, format!("{SCAN}: only bonds, angles and dihedrals are scanned here"))),
+        };
+        if let Some((first, ..)) = found {
+            return Err(log.error_at(
+                i,
+                format!(
+                    "one scanned coordinate (line {} scans one already: a scan of two is a grid of points, not a series along one coordinate)",
+                    first + 1
+                ),
+            ));
+        }
+        k += 1;
+        let mut atoms: Vec<usize> = Vec::new();
+        while let Some(a) = tokens.get(k).and_then(|(_, t)| t.parse::<usize>().ok()) {
+            atoms.push(a);
+            k += 1;
+        }
+        if atoms.len() != expected || tokens.get(k).is_none_or(|(_, t)| t != "=") {
+            return Err(log.error_at(i, format!("{SCAN}: {expected} atom numbers, then `=`")));
+        }
+        k += 1;
+        let number = |k: usize| tokens.get(k).and_then(|(_, t)| parse_real(t)).filter(|v| v.is_finite());
+        let (points, first) = if tokens.get(k).is_some_and(|(_, t)| t == "[") {
+            k += 1;
+            let first = number(k).unwrap_or(0.0);
+            let mut n = 0;
+            while number(k).is_some() {
+                n += 1;
+                k += 1;
+            }
+            if tokens.get(k).is_none_or(|(_, t)| t != "]") || n < 2 {
+                return Err(log.error_at(i, format!("{SCAN}: two or more values between `[` and `]`")));
+            }
+            k += 1;
+            (n, first)
+        } else {
+            let count = tokens.get(k + 2).and_then(|(_, t)| t.parse::<usize>().ok()).filter(|&n| n >= 2);
+            let (Some(first), Some(_), Some(count)) = (number(k), number(k + 1), count) else {
+                return Err(log.error_at(i, format!("{SCAN}: a first value, a last value and a number of points")));
+            };
+            k += 3;
+            (count, first)
+        };
+        let coordinate = match atoms[..] {
+            [a, b] => Coordinate::Distance([a, b]),
+            [a, b, c] => Coordinate::Angle([a, b, c]),
+            [a, b, c, d] => Coordinate::Dihedral([a, b, c, d]),
+            _ => return Err(log.error_at(i, format!("{SCAN}: {expected} atom numbers, then `=`"))),
+        };
+        found = Some((i, coordinate, points, first));
+    }
 }
 
 #[derive(Debug, Clone)]

@@ -178,8 +178,9 @@ impl Coordinate {
     }
 }
 
-/// The coordinate a program's scan job varied (Gaussian's ModRedundant `S` line), read from the
-/// job rather than guessed from the geometries, with its value at each of the document's frames.
+/// The coordinate a program's scan job varied (Gaussian's ModRedundant `S` line, ORCA's `%geom
+/// Scan` block), read from the job rather than guessed from the geometries, with its value at
+/// each of the document's frames.
 #[derive(Debug, Clone, PartialEq)]
 pub struct JobScan {
     pub coordinate: Coordinate,
@@ -207,6 +208,19 @@ impl JobScan {
             values.push(v);
         }
         Some(Self { coordinate, values, from })
+    }
+
+    /// A dihedral's values turned by whole turns so that the first lies within half a turn of
+    /// `first`, the value the job asked for at its first point (a scan from 200° reads 200°,
+    /// not −160°); other coordinates are as measured.
+    pub fn starting_near(mut self, first: f64) -> Self {
+        if let (Coordinate::Dihedral(_), Some(&v)) = (self.coordinate, self.values.first()) {
+            let turns = ((first - v) / 360.0).round() * 360.0;
+            if turns.is_finite() {
+                self.values.iter_mut().for_each(|x| *x += turns);
+            }
+        }
+        self
     }
 }
 

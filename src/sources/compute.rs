@@ -340,7 +340,7 @@ pub fn frame_molecules(doc: &Document) -> Vec<Molecule> {
         .collect()
 }
 
-/// The frames of a scan job the document read ([`Document::job_scan`]: a Gaussian relaxed
+/// The frames of a scan job the document read ([`Document::job_scan`]: a Gaussian or ORCA relaxed
 /// scan) as frames to compute, each at the job's value of its coordinate and named after it:
 /// the geometries are the job's own, so each frame is a single point and nothing is moved or
 /// optimised again. `None` when the document holds no scan job; an error when two frames would
