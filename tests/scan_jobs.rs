@@ -56,19 +56,26 @@ fn a_relaxed_scan_opens_its_points_with_the_coordinate_it_scanned() {
     }
 }
 
-#[test]
-fn info_reports_the_scan_and_each_frames_value() {
-    let path = fixture();
+/// `info --json` of a scan job of H₂O₂'s dihedral 3-1-2-4 (atoms reported from 1): its `scan`
+/// object and one value per frame.
+fn info_json_scan(path: &Path) -> (serde_json::Value, Vec<f64>) {
     let out = orbcloud(&["info", "--json", path.to_str().unwrap()]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    let scan = &json["scan"];
+    let scan = json["scan"].clone();
     assert_eq!(scan["coordinate"], "dihedral 3-1-2-4");
     assert_eq!(scan["kind"], "dihedral");
     assert_eq!(scan["atoms"], serde_json::json!([3, 1, 2, 4]));
     assert_eq!(scan["unit"], "°");
     let values: Vec<f64> = scan["values"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
     assert_eq!(values.len(), json["structure"]["models"].as_array().unwrap().len());
+    (scan, values)
+}
+
+#[test]
+fn info_reports_the_scan_and_each_frames_value() {
+    let path = fixture();
+    let (_, values) = info_json_scan(&path);
     assert!((values[4] - 360.0).abs() < 1e-3, "{values:?}");
 
     let out = orbcloud(&["info", path.to_str().unwrap()]);
@@ -292,17 +299,7 @@ fn an_orca_relaxed_scan_opens_its_points_with_the_coordinate_it_scanned() {
 
 #[test]
 fn info_reports_the_orca_scan_and_each_frames_value() {
-    let path = orca_fixture();
-    let out = orbcloud(&["info", "--json", path.to_str().unwrap()]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    let scan = &json["scan"];
-    assert_eq!(scan["coordinate"], "dihedral 3-1-2-4");
-    assert_eq!(scan["kind"], "dihedral");
-    assert_eq!(scan["atoms"], serde_json::json!([3, 1, 2, 4]), "reported from 1");
-    assert_eq!(scan["unit"], "°");
-    let values: Vec<f64> = scan["values"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
-    assert_eq!(values.len(), json["structure"]["models"].as_array().unwrap().len());
+    let (scan, values) = info_json_scan(&orca_fixture());
     for (v, e) in values.iter().zip([120.0, 180.0, 240.0, 300.0, 360.0]) {
         assert!((v - e).abs() < 1e-3, "{values:?}");
     }
