@@ -54,7 +54,7 @@ h2
  1.3E-01 -1.4E-01 1.5E-01 -1.6E-01
 CUBE
 seed molden tests/fixtures/wavefunctions/h2o_cart_631gs.molden tests/fixtures/wavefunctions/h2o_cation_uhf_631gs.molden tests/fixtures/wavefunctions/h2_spdfgh.molden
-seed fchk tests/fixtures/wavefunctions/h2o_cart_631gs.fchk tests/fixtures/wavefunctions/h2o_cation_uhf_631gs.fchk
+seed fchk tests/fixtures/wavefunctions/h2o_cart_631gs.fchk tests/fixtures/wavefunctions/h2o_cation_uhf_631gs.fchk tests/fixtures/excited/formaldehyde_qchem_tda.fchk
 # wfn, wfx, MKL: the fixtures' layouts for H2 and OH (1–3 kB), written by PySCF when it is
 # there: AFL ran the 8–60 kB fixtures at 1 400 executions a second.
 python=${PYTHON:-python3}
