@@ -162,7 +162,23 @@ pub(super) fn read(root: Node, overlap: Option<OverlapFn>) -> Result<Document, P
     // The writer's reading first, then the other with and without the coefficients' folding.
     let readings = if psi4 { PSI4_FIRST } else { SPEC_FIRST };
     // The first reading whose orbitals are orthonormal; without an overlap to measure with,
-    // the writer's.
+    // the writer's. The chosen reading's overlap is kept for the check every reader's
+    // wavefunction gets ([`wavefunction_document`]), which would otherwise build it again.
+    let last: std::sync::Mutex<Option<(Basis, Vec<f64>)>> = Default::default();
+    let remembered = overlap.map(|overlap| {
+        move |basis: &Basis| {
+            let mut last = last.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+            match last.as_ref() {
+                Some((b, s)) if b == basis => s.clone(),
+                _ => {
+                    let s = overlap(basis);
+                    *last = Some((basis.clone(), s.clone()));
+                    s
+                }
+            }
+        }
+    });
+    let overlap: Option<OverlapFn> = remembered.as_ref().map(|f| f as OverlapFn);
     let mut chosen = (readings[0], f64::INFINITY);
     if let Some(overlap) = overlap {
         for reading in readings {

@@ -219,15 +219,36 @@ fn far_fields(fields: &[Option<&FarField>; LANES], anchor: DVec3, at: Points, v:
     _mm512_mask_add_pd(v, has, v, _mm512_div_pd(px, _mm512_sqrt_pd(r2)))
 }
 
-/// Each lane's index of the nearest table point ([`boys`]'s `nearest`), with arguments past the
-/// table held at its end: those lanes take the asymptotic form afterwards.
+/// Each lane's nearest table point ([`boys`]'s `nearest`), with arguments past the table held
+/// at its end (those lanes take the asymptotic form afterwards): where its row starts, and the
+/// argument's distance from it. The table is looked up once here, not per value read.
+#[derive(Clone, Copy)]
+struct TableRows {
+    /// Index of each lane's row's first value.
+    first: __m512i,
+    table: *const f64,
+    dt: __m512d,
+}
+
 #[target_feature(enable = "avx512f,avx512dq")]
-fn table_points(t: __m512d) -> (__m512i, __m512d) {
+fn table_points(t: __m512d) -> TableRows {
+    let table = boys::table();
     let held = _mm512_min_pd(t, splat(boys::T_TABLE));
     let index = _mm512_cvttpd_epu64(_mm512_add_pd(_mm512_mul_pd(held, splat(1.0 / boys::STEP)), splat(0.5)));
-    let index = _mm512_min_epu64(index, _mm512_set1_epi64(boys::table().len() as i64 - 1));
+    let index = _mm512_min_epu64(index, _mm512_set1_epi64(table.len() as i64 - 1));
     let dt = _mm512_sub_pd(t, _mm512_mul_pd(_mm512_cvtepu64_pd(index), splat(boys::STEP)));
-    (index, dt)
+    let first = _mm512_mullo_epi64(index, _mm512_set1_epi64(boys::ORDERS as i64));
+    TableRows { first, table: table.as_ptr().cast(), dt }
+}
+
+impl TableRows {
+    /// F_n(T_i) for each lane's table point i.
+    #[target_feature(enable = "avx512f,avx512dq")]
+    fn at(self, n: usize) -> __m512d {
+        let at = _mm512_add_epi64(self.first, _mm512_set1_epi64(n as i64));
+        // SAFETY: each row is one of the table's and n < ORDERS: inside the table.
+        unsafe { _mm512_i64gather_pd::<8>(at, self.table) }
+    }
 }
 
 /// −x, as the one-point path's negation (the sign bit flipped: 0 − x would make −0 of 0).
@@ -236,23 +257,14 @@ fn negate(x: __m512d) -> __m512d {
     _mm512_xor_pd(x, splat(-0.0))
 }
 
-/// F_{n}(T_i) for each lane's table point i.
-#[target_feature(enable = "avx512f,avx512dq")]
-fn table_at(index: __m512i, n: usize) -> __m512d {
-    let rows = _mm512_mullo_epi64(index, _mm512_set1_epi64(boys::ORDERS as i64));
-    let at = _mm512_add_epi64(rows, _mm512_set1_epi64(n as i64));
-    // SAFETY: index ≤ the table's last row and n < ORDERS: inside the table.
-    unsafe { _mm512_i64gather_pd::<8>(at, boys::table().as_ptr().cast()) }
-}
-
 /// [`boys::f0`] in each lane.
 #[target_feature(enable = "avx512f,avx512dq")]
 fn f0_lanes(t: __m512d) -> __m512d {
-    let (index, dt) = table_points(t);
-    let dt = negate(dt);
-    let mut sum = table_at(index, boys::TAYLOR - 1);
+    let rows = table_points(t);
+    let dt = negate(rows.dt);
+    let mut sum = rows.at(boys::TAYLOR - 1);
     for k in (0..boys::TAYLOR - 1).rev() {
-        sum = _mm512_add_pd(table_at(index, k), _mm512_div_pd(_mm512_mul_pd(sum, dt), splat((k + 1) as f64)));
+        sum = _mm512_add_pd(rows.at(k), _mm512_div_pd(_mm512_mul_pd(sum, dt), splat((k + 1) as f64)));
     }
     let far = _mm512_mul_pd(splat(0.5), _mm512_sqrt_pd(_mm512_div_pd(splat(std::f64::consts::PI), t)));
     _mm512_mask_blend_pd(_mm512_cmp_pd_mask::<_CMP_GE_OQ>(t, splat(boys::T_TABLE)), sum, far)
@@ -261,8 +273,8 @@ fn f0_lanes(t: __m512d) -> __m512d {
 /// [`boys::boys`] in each lane: `out[n]` = F_n(t) for n ≤ m.
 #[target_feature(enable = "avx512f,avx512dq")]
 fn boys_lanes(m: usize, t: __m512d, out: &mut [__m512d]) {
-    let (index, dt) = table_points(t);
-    let minus_dt = negate(dt);
+    let rows = table_points(t);
+    let minus_dt = negate(rows.dt);
     if m <= boys::DIRECT {
         let mut factors = [splat(1.0); boys::TAYLOR];
         for k in 1..boys::TAYLOR {
@@ -272,14 +284,14 @@ fn boys_lanes(m: usize, t: __m512d, out: &mut [__m512d]) {
             // `Iterator::sum`'s own start: the same additions as `boys`.
             let mut sum = splat(std::iter::empty::<f64>().sum::<f64>());
             for (k, &factor) in factors.iter().enumerate() {
-                sum = _mm512_add_pd(sum, _mm512_mul_pd(table_at(index, n + k), factor));
+                sum = _mm512_add_pd(sum, _mm512_mul_pd(rows.at(n + k), factor));
             }
             *o = sum;
         }
     } else {
         let (mut fm, mut factor) = (splat(0.0), splat(1.0));
         for k in 0..boys::TAYLOR {
-            fm = _mm512_add_pd(fm, _mm512_mul_pd(table_at(index, m + k), factor));
+            fm = _mm512_add_pd(fm, _mm512_mul_pd(rows.at(m + k), factor));
             factor = _mm512_mul_pd(factor, _mm512_div_pd(minus_dt, splat((k + 1) as f64)));
         }
         out[m] = fm;
