@@ -242,3 +242,18 @@ fn qchem_54s_real_checkpoints_agree_with_their_logs() {
         assert!(kept > printed_count, "{name}: the file's own amplitudes kept ({kept}, printed {printed_count})");
     }
 }
+
+#[test]
+fn real_qchem_and_gaussian_checkpoints_without_amplitudes_open_as_before() {
+    // The amplitude records are read only where a file has them: the corpus's real Q-Chem 5.2
+    // ground-state fchk lists no states and no problems, and Gaussian's real TD checkpoint keeps
+    // its states (from `ETran`) without transitions, which its log supplies.
+    let Some(dir) = common::refdata("qchem_fchk_states::real_checkpoints_without_amplitudes") else { return };
+    let qchem = load(&dir.join("water_hf_sto3g_qchem5.2.fchk"));
+    assert!(qchem.excited.is_none(), "{:?}", qchem.excited);
+    assert!(qchem.problems.is_empty(), "{:?}", qchem.problems);
+    let gaussian = load(&dir.join("logs/basicGaussian09_dvb_td.fchk"));
+    let states = gaussian.excited.expect("Gaussian's TD states");
+    assert_eq!(states.states.len(), 5);
+    assert!(states.states.iter().all(|s| s.transitions.is_empty() && !s.amplitudes_normalised_to_one));
+}
