@@ -143,39 +143,62 @@ fn shade(value: f32, grad: vec3<f32>, from_eye: vec3<f32>) -> vec4<f32> {
     return shade_with(u, u.signed_field, SHAPED, needs_gradient(), value, grad, from_eye);
 }
 
-// `shade` for the cloud `c` describes: `field` is its `signed_field`, `shaped` and `gradient`
-// say which transfer function it uses (constants where one pipeline draws one cloud, which
-// settle the branches on them when the pipeline is built; values where a walk takes several).
-// Kept in one piece: split into calls that each take `c`, a walk ran 1.5 times as long on a CPU
-// rasteriser (a copy of the struct per call and sample).
-fn shade_with(c: VolumeUniforms, field: u32, shaped: bool, gradient: bool, value: f32, grad: vec3<f32>, from_eye: vec3<f32>) -> vec4<f32> {
+// What the transfer function makes of a value, without the gradient: x its extinction per
+// reference step (negative: invisible), y where its colour lies from the negative colour (0) to
+// the positive (1). The three-pass and α-mix programs keep this per texel of a key volume
+// (volume_classify.wgsl), so y is set for invisible values too: a visible sample beside them
+// keeps its lobe's colour.
+fn classify(c: VolumeUniforms, field: u32, shaped: bool, value: f32) -> vec2<f32> {
     let scaled = transfer_value(c, field, value);
-    var extinction: f32;
-    var color: vec3<f32>;
     if (!shaped) {
-        // Below this magnitude a sample is invisible (computed on the CPU from k1, k2).
-        if (abs(scaled) < c.visible_min) {
-            return vec4<f32>(-1.0);
-        }
+        var extinction: f32;
+        var hue: f32;
         if (field == 1u) {
             // rho = psi^2, so rho^k2 = |psi|^(2 k2).
             extinction = c.k1 * pow(abs(scaled), 2.0 * c.k2);
-            color = select(c.negative_color.rgb, c.positive_color.rgb, value >= 0.0);
+            hue = select(0.0, 1.0, value >= 0.0);
         } else {
             extinction = c.k1 * pow(max(scaled, 0.0), c.k2);
-            color = mix(c.negative_color.rgb, c.positive_color.rgb, sqrt(min(scaled, 1.0)));
+            hue = sqrt(min(scaled, 1.0));
         }
-    } else {
-        let positive = value >= 0.0 || field != 1u;
-        let lobe = select(c.tf_negative, c.tf_positive, positive);
-        let shape = select(c.shape_negative, c.shape_positive, positive);
-        let sign = select(-1.0, 1.0, positive);
-        extinction = lobe.z * shape_factor(shape, scaled, sign * lobe.x, lobe.y, sign);
-        if (extinction < 1e-5) {
-            return vec4<f32>(-1.0);
-        }
-        color = select(c.negative_color.rgb, c.positive_color.rgb, positive);
+        // Below this magnitude a sample is invisible (computed on the CPU from k1, k2).
+        return vec2<f32>(select(extinction, -1.0, abs(scaled) < c.visible_min), hue);
     }
+    let positive = value >= 0.0 || field != 1u;
+    let lobe = select(c.tf_negative, c.tf_positive, positive);
+    let shape = select(c.shape_negative, c.shape_positive, positive);
+    let sign = select(-1.0, 1.0, positive);
+    let extinction = lobe.z * shape_factor(shape, scaled, sign * lobe.x, lobe.y, sign);
+    return vec2<f32>(select(extinction, -1.0, extinction < 1e-5), select(0.0, 1.0, positive));
+}
+
+// Reference steps the ray travels between two planes (`plane`: their unit normal and spacing),
+// the factor of a sample's extinction in its opacity.
+fn path_steps(plane: vec4<f32>, ref_step: f32, from_eye: vec3<f32>) -> f32 {
+    let ray = normalize(from_eye);
+    return plane.w / max(abs(dot(ray, plane.xyz)), 0.05) / ref_step;
+}
+
+// The opacity of extinction x (one reference step's, times the steps travelled): the
+// extinction of one step composes exactly over the path, alpha = 1 − e^−x (Naka et al.'s
+// alpha = k1 rho^k2 for one step of the power law).
+fn opacity(x: f32) -> f32 {
+    // 1 − e^−x loses its digits to cancellation for small x: use the series there.
+    return select(1.0 - exp2(-1.442695 * x), x * (1.0 - x * (0.5 - x / 6.0)), x < 0.03);
+}
+
+// `shade` for the cloud `c` describes: `field` is its `signed_field`, `shaped` and `gradient`
+// say which transfer function it uses (constants where one pipeline draws one cloud, which
+// settle the branches on them when the pipeline is built; values where a walk takes several).
+// Kept in one piece with its callees taking scalars: split into calls that each take `c`, a
+// walk ran 1.5 times as long on a CPU rasteriser (a copy of the struct per call and sample).
+fn shade_with(c: VolumeUniforms, field: u32, shaped: bool, gradient: bool, value: f32, grad: vec3<f32>, from_eye: vec3<f32>) -> vec4<f32> {
+    let classified = classify(c, field, shaped, value);
+    if (classified.x < 0.0) {
+        return vec4<f32>(-1.0);
+    }
+    var extinction = classified.x;
+    var color = mix(c.negative_color.rgb, c.positive_color.rgb, classified.y);
     if (gradient) {
         let g = min(length(grad) * c.inv_max_grad, 1.0);
         if (c.gradient_power > 0.0) {
@@ -193,13 +216,6 @@ fn shade_with(c: VolumeUniforms, field: u32, shaped: bool, gradient: bool, value
             color = color * (0.3 + 0.7 * diffuse) + vec3<f32>(0.35 * specular);
         }
     }
-    // The extinction of one reference step (Naka et al.'s alpha = k1 rho^k2 for the power law)
-    // composes exactly over the distance the ray travels between two slices:
-    // alpha = 1 - exp(-extinction * path / step).
-    let ray = normalize(from_eye);
-    let path = c.plane.w / max(abs(dot(ray, c.plane.xyz)), 0.05);
-    let x = extinction * path / c.ref_step;
-    // 1 − e^−x loses its digits to cancellation for small x: use the series there.
-    let alpha = select(1.0 - exp2(-1.442695 * x), x * (1.0 - x * (0.5 - x / 6.0)), x < 0.03);
+    let alpha = opacity(extinction * path_steps(c.plane, c.ref_step, from_eye));
     return vec4<f32>(color * alpha, alpha);
 }

@@ -1,8 +1,8 @@
 //! Naka et al.'s two ways of compositing a slice between two key volumes, on lavapipe, against an
 //! independent CPU compositor (tests/common/cloud.rs samples each key volume along the same
-//! rays): α-mix (their eq. 5: per slice α = (1−k)α_A + kα_B and the colours mixed) and the
-//! three-pass method (their eqs. 6–7: attenuate by α_A, or α_B past the middle, then add
-//! (1−k)·A and k·B).
+//! rays, classified per grid point as Naka et al.'s coloured key volumes are): α-mix (their
+//! eq. 5: per slice α = (1−k)α_A + kα_B and the colours mixed) and the three-pass method (their
+//! eqs. 6–7: attenuate by α_A, or α_B past the middle, then add (1−k)·A and k·B).
 
 mod common;
 
@@ -34,6 +34,7 @@ fn mirrored(a: &VolumeGrid) -> VolumeGrid {
 
 /// The CPU picture: each ray's samples of A and B composited back to front by `mode`.
 fn reference(
+    classified: bool,
     a: &VolumeGrid,
     b: &VolumeGrid,
     k: f64,
@@ -44,7 +45,10 @@ fn reference(
     let (ra, rb) = (CloudReference::new(a, cam, s), CloudReference::new(b, cam, s));
     image::RgbaImage::from_fn(SIZE[0], SIZE[1], |px, py| {
         let d = ra.ray(cam, SIZE, px, py);
-        let (sa, sb) = (ra.samples(d), rb.samples(d));
+        let (sa, sb) = match classified {
+            true => (ra.classified_samples(d), rb.classified_samples(d)),
+            false => (ra.samples(d), rb.samples(d)),
+        };
         assert_eq!(sa.len(), sb.len(), "one set of slices");
         let mut c = s.background.map(|c| c as f64);
         for (x, y) in sa.iter().zip(&sb) {
@@ -61,14 +65,23 @@ fn reference(
     })
 }
 
-#[test]
-fn alpha_mix_and_three_pass_match_their_cpu_compositors() {
-    let a = p_orbital(24, false);
+/// One GPU picture of a mode at k, with the CPU's from classified key volumes and from
+/// samples classified after interpolation.
+struct Pictures {
+    gpu: image::RgbaImage,
+    classified: image::RgbaImage,
+    sampled: image::RgbaImage,
+}
+
+/// `a` and its mirror image as key volumes, drawn by each mode at each k with the power law's
+/// k2 (k1 0.35), on the GPU and by the CPU compositors.
+fn draw(a: VolumeGrid, k2: f32, ks: &[f32], modes: &[Interpolation]) -> Vec<(f32, Interpolation, Pictures)> {
     let b = mirrored(&a);
     let doc = scene(Some(a.clone()));
     let mut s = RenderSettings { atoms: AtomStyle::Hidden, ..Default::default() };
     s.volume.slices = 40;
     s.volume.k1 = 0.35;
+    s.volume.k2 = k2;
     s.volume.auto_k1 = false;
     let mut cam = default_camera(&doc);
     cam.orbit(50f32.to_radians(), 25f32.to_radians());
@@ -87,9 +100,9 @@ fn alpha_mix_and_three_pass_match_their_cpu_compositors() {
     let max_grad = ta.max_grad.max(tb.max_grad);
     let target = OffscreenTarget::new(&ctx.device, SIZE);
     let mut renderer = Renderer::new(&ctx);
-    for k in [0.3f32, 0.8] {
-        let mut pictures = Vec::new();
-        for mode in [Interpolation::AlphaMix, Interpolation::ThreePass] {
+    let mut out = Vec::new();
+    for &k in ks {
+        for &mode in modes {
             let (mut x, mut y) = (ta.clone(), tb.clone());
             x.max_grad = max_grad;
             y.max_grad = max_grad;
@@ -97,27 +110,62 @@ fn alpha_mix_and_three_pass_match_their_cpu_compositors() {
             let mut encoder = ctx.device.create_command_encoder(&Default::default());
             renderer.render(&ctx, &mut encoder, &target.color_view, &FrameInput::single(&cam, &s, SIZE));
             ctx.queue.submit([encoder.finish()]);
-            let gpu = target.read_rgba(&ctx.device, &ctx.queue).unwrap();
-            let cpu = reference(&a, &b, k as f64, mode, &cam, &s);
-            let (mean, worst) = common::mean_max_difference(&gpu, &cpu);
+            let pictures = Pictures {
+                gpu: target.read_rgba(&ctx.device, &ctx.queue).unwrap(),
+                classified: reference(true, &a, &b, k as f64, mode, &cam, &s),
+                sampled: reference(false, &a, &b, k as f64, mode, &cam, &s),
+            };
+            out.push((k, mode, pictures));
+        }
+    }
+    out
+}
+
+#[test]
+fn alpha_mix_and_three_pass_match_their_cpu_compositors() {
+    let modes = [Interpolation::AlphaMix, Interpolation::ThreePass];
+    let drawn = draw(p_orbital(24, false), RenderSettings::default().volume.k2, &[0.3, 0.8], &modes);
+    for pair in drawn.chunks(2) {
+        for (k, mode, p) in pair {
+            let (mean, worst) = common::mean_max_difference(&p.gpu, &p.classified);
             eprintln!("k = {k}, {mode:?}: mean |gpu − cpu| {mean:.3}/255, worst {worst}/255");
             // As for one volume (tests/volume_reference.rs): the f16 scene buffer rounds each of
             // ~40 blends; a ray grazing a slice polygon's edge may see one slice more or less.
             assert!(mean < 1.0 && worst <= 32, "k = {k}, {mode:?}: mean {mean}, worst {worst}");
-            pictures.push((gpu, cpu));
         }
         // The two ways differ (their CPU pictures), and each GPU picture is nearer its own.
-        let (alpha_mix, three_pass) = (&pictures[0], &pictures[1]);
-        let apart = common::mean_max_difference(&alpha_mix.1, &three_pass.1).0;
+        let (k, alpha_mix, three_pass) = (pair[0].0, &pair[0].2, &pair[1].2);
+        let apart = common::mean_max_difference(&alpha_mix.classified, &three_pass.classified).0;
         eprintln!("k = {k}: three-pass against α-mix (CPU): mean {apart:.3}/255");
         assert!(apart > 0.3, "the approximation shows at k = {k}: {apart}");
         assert!(
-            common::mean_max_difference(&three_pass.0, &three_pass.1).0
-                < common::mean_max_difference(&three_pass.0, &alpha_mix.1).0
+            common::mean_max_difference(&three_pass.gpu, &three_pass.classified).0
+                < common::mean_max_difference(&three_pass.gpu, &alpha_mix.classified).0
         );
         assert!(
-            common::mean_max_difference(&alpha_mix.0, &alpha_mix.1).0
-                < common::mean_max_difference(&alpha_mix.0, &three_pass.1).0
+            common::mean_max_difference(&alpha_mix.gpu, &alpha_mix.classified).0
+                < common::mean_max_difference(&alpha_mix.gpu, &three_pass.classified).0
         );
+    }
+}
+
+/// On a coarse grid with a steep opacity law, classifying the key volumes' points and
+/// interpolating (what the GPU's α-mix and three-pass do) visibly differs from classifying
+/// interpolated samples; the GPU matches the former, for an orbital (its sign in the
+/// extinction) and a density (its colour beside it).
+#[test]
+fn mixed_key_volumes_are_classified_per_grid_point() {
+    let orbital = p_orbital(10, false);
+    let squared = orbital.values.iter().map(|v| v * v).collect();
+    let density = VolumeGrid::new("p density", orbital.dims, orbital.world_from_grid, squared);
+    for (grid, k2) in [(orbital, 2.5), (density, 1.5)] {
+        let name = format!("{:?}", grid.kind);
+        for (k, mode, p) in draw(grid, k2, &[0.3], &[Interpolation::AlphaMix, Interpolation::ThreePass]) {
+            let classified = common::mean_max_difference(&p.gpu, &p.classified);
+            let sampled = common::mean_max_difference(&p.gpu, &p.sampled);
+            eprintln!("{name}, k = {k}, {mode:?}: against classified points {classified:?}, samples {sampled:?}");
+            assert!(classified.0 < 0.5 && classified.1 <= 4, "{name}, {mode:?}: {classified:?}");
+            assert!(sampled.0 > 2.0 * classified.0 && sampled.1 > 16, "{name}, {mode:?}: {sampled:?}");
+        }
     }
 }

@@ -7,6 +7,7 @@
 pub mod arrows;
 pub mod atoms;
 pub mod basis_buffers;
+pub mod classify;
 pub mod context;
 pub mod density_hessian;
 pub mod frame;
@@ -44,6 +45,7 @@ pub const SHADERS: &[(&str, &str)] = &[
     ("volume_slices.wgsl", include_str!("../../shaders/volume_slices.wgsl")),
     ("volume_direct.wgsl", include_str!("../../shaders/volume_direct.wgsl")),
     ("volume_morph.wgsl", include_str!("../../shaders/volume_morph.wgsl")),
+    ("volume_classify.wgsl", include_str!("../../shaders/volume_classify.wgsl")),
     ("atoms_common.wgsl", include_str!("../../shaders/atoms_common.wgsl")),
     ("atoms.wgsl", include_str!("../../shaders/atoms.wgsl")),
     ("atoms_cull.wgsl", include_str!("../../shaders/atoms_cull.wgsl")),
@@ -85,6 +87,7 @@ pub const SHADER_MODULES: &[(&str, &[&str])] = &[
     ),
     ("volume_direct.wgsl", &["volume_common.wgsl", "gto_common.wgsl", "volume_direct.wgsl"]),
     ("volume_morph.wgsl", &["volume_common.wgsl", "volume_gradient.wgsl", "volume_slab.wgsl", "volume_morph.wgsl"]),
+    ("volume_classify.wgsl", &["volume_common.wgsl", "volume_classify.wgsl"]),
     ("gto_fill.wgsl", &["gto_common.wgsl", "gto_fill.wgsl"]),
     ("density_hessian.wgsl", &["gto_common.wgsl", "density_hessian.wgsl"]),
     ("atoms.wgsl", &["atoms_common.wgsl", "atoms.wgsl"]),

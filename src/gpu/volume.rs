@@ -8,6 +8,7 @@ use glam::{DMat4, DVec3, Mat4, Vec3, Vec4};
 use wgpu::util::DeviceExt;
 
 use super::basis_buffers::{GtoArrays, GtoBuffers, gto_layout};
+use super::classify::{ClassifiedVolumes, Classifier};
 use super::{DEPTH_FORMAT, GpuContext, GpuError, SCENE_FORMAT};
 use crate::model::GridSpec;
 use crate::model::bricks::{BRICK_CELLS, BrickRanges};
@@ -233,12 +234,22 @@ struct Variant {
     slab: u8,
     /// The cloud's `signed_field` for the slab programs (0 for the others, which read the uniform).
     field: u8,
+    /// α-mix and three-pass sample the key volumes' classified textures ([`Classifier`]).
+    classified: bool,
 }
 
 impl Variant {
     /// The plain slices of a 3D texture with the power law, one plane per fragment.
-    const PLAIN: Variant =
-        Variant { program: Program::Slices, gradient: false, shaped: false, clip: false, clouds: 0, slab: 1, field: 1 };
+    const PLAIN: Variant = Variant {
+        program: Program::Slices,
+        gradient: false,
+        shaped: false,
+        clip: false,
+        clouds: 0,
+        slab: 1,
+        field: 1,
+        classified: false,
+    };
 }
 
 /// How many planes one fragment of a texture's slices samples, where the eye lies before them
@@ -271,9 +282,12 @@ impl SliceShader {
 
 /// The second key volume of an interpolated frame, and how to mix.
 struct Morph {
-    /// Keeps B's texture alive while its bind group is in use.
-    _partner: VolumeTexture,
+    partner: VolumeTexture,
+    /// B, then A's and B's classified textures (where a frame has not classified them, their
+    /// plain textures stand in, unread).
     bind_group: wgpu::BindGroup,
+    /// The classified textures `bind_group` holds, if any.
+    bound: Option<[wgpu::TextureView; 2]>,
     k: f32,
     mode: Interpolation,
 }
@@ -295,6 +309,7 @@ struct VolumeShaders {
     morph_layout: wgpu::BindGroupLayout,
     gto_layout: wgpu::BindGroupLayout,
     sampler: wgpu::Sampler,
+    classifier: Classifier,
     pipelines: Mutex<HashMap<Variant, wgpu::RenderPipeline>>,
 }
 
@@ -323,6 +338,8 @@ pub struct VolumePass {
     /// This frame's pipelines, one per program, in the order each slice is drawn with them.
     frame_pipeline: Option<wgpu::RenderPipeline>,
     morph: Option<Morph>,
+    /// Key volumes classified for α-mix and three-pass, kept while the transfer function stays.
+    classified: ClassifiedVolumes,
     uniforms: wgpu::Buffer,
     vertices: wgpu::Buffer,
     vertex_count: u32,
@@ -368,6 +385,9 @@ fn constants(variant: Variant) -> Vec<(&'static str, f64)> {
         _ => None,
     };
     constants.extend(mix.map(|m| ("MIX", m)));
+    if mix.is_some() {
+        constants.push(("CLASSIFIED", flag(variant.classified)));
+    }
     constants
 }
 
@@ -479,7 +499,8 @@ impl VolumePass {
             label: Some("volume bind group layout"),
             entries: &[
                 super::uniform_entry(0, wgpu::ShaderStages::VERTEX_FRAGMENT),
-                volume_entry(1),
+                // The classification's vertex stage places layers by the volume's size.
+                wgpu::BindGroupLayoutEntry { visibility: wgpu::ShaderStages::VERTEX_FRAGMENT, ..volume_entry(1) },
                 wgpu::BindGroupLayoutEntry {
                     binding: 2,
                     visibility: wgpu::ShaderStages::FRAGMENT,
@@ -491,7 +512,7 @@ impl VolumePass {
         let gto_layout = gto_layout(device, wgpu::ShaderStages::FRAGMENT);
         let morph_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("key volume B layout"),
-            entries: &[volume_entry(0)],
+            entries: &[volume_entry(0), volume_entry(1), volume_entry(2)],
         });
         let depth_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("volume slices' scene depth"),
@@ -517,6 +538,7 @@ impl VolumePass {
             min_filter: wgpu::FilterMode::Linear,
             ..Default::default()
         });
+        let classifier = Classifier::new(device, &layout);
         let shared = VolumeShaders {
             slices,
             direct,
@@ -529,6 +551,7 @@ impl VolumePass {
             morph_layout,
             gto_layout,
             sampler,
+            classifier,
             pipelines: Mutex::new(HashMap::new()),
         };
         shared.pipeline(device, Variant::PLAIN);
@@ -546,6 +569,7 @@ impl VolumePass {
             variant: Variant::PLAIN,
             frame_pipeline: None,
             morph: None,
+            classified: ClassifiedVolumes::default(),
             uniforms: super::uniform_buffer(device, "volume uniforms", std::mem::size_of::<VolumeUniforms>()),
             vertices: Self::vertex_buffer(device, 1024),
             vertex_count: 0,
@@ -620,17 +644,20 @@ impl VolumePass {
         self.shown_bricks = None;
         self.morph = None;
         self.volume = volume;
-        self.bind_group = self.volume.as_ref().map(|v| {
-            ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("volume bind group"),
-                layout: &self.shared.layout,
-                entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: self.uniforms.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&v.view) },
-                    wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&self.shared.sampler) },
-                ],
-            })
-        });
+        self.bind_group = self.volume.as_ref().map(|v| self.volume_group(&ctx.device, &v.view));
+    }
+
+    /// Group 0 of the slices: this cloud's uniforms and the volume `view`.
+    fn volume_group(&self, device: &wgpu::Device, view: &wgpu::TextureView) -> wgpu::BindGroup {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("volume bind group"),
+            layout: &self.shared.layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: self.uniforms.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(view) },
+                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&self.shared.sampler) },
+            ],
+        })
     }
 
     /// Naka et al.'s interpolated frame: key volumes `a` and `b` (one grid, one scale: `a`'s box
@@ -638,7 +665,7 @@ impl VolumePass {
     pub fn set_morph(&mut self, ctx: &GpuContext, mut a: VolumeTexture, b: VolumeTexture, k: f32, mode: Interpolation) {
         // Dragging within one pair of key volumes changes only the weight: the bind groups stay.
         let same_pair = self.volume.as_ref().is_some_and(|v| v.texture == a.texture)
-            && self.morph.as_ref().is_some_and(|m| m._partner.texture == b.texture);
+            && self.morph.as_ref().is_some_and(|m| m.partner.texture == b.texture);
         if let Some(morph) = self.morph.as_mut().filter(|_| same_pair) {
             morph.k = k.clamp(0.0, 1.0);
             morph.mode = mode;
@@ -649,13 +676,60 @@ impl VolumePass {
             (Some(x), Some(y)) => x.union(y).map(Arc::new),
             _ => None,
         };
+        let bind_group = self.morph_group(&ctx.device, &b, [&a.view, &b.view]);
         self.set_texture(ctx, Some(a));
-        let bind_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        self.morph = Some(Morph { partner: b, bind_group, bound: None, k: k.clamp(0.0, 1.0), mode });
+    }
+
+    /// Group 1 of the key volume programs: B and the two classified textures.
+    fn morph_group(
+        &self,
+        device: &wgpu::Device,
+        b: &VolumeTexture,
+        classified: [&wgpu::TextureView; 2],
+    ) -> wgpu::BindGroup {
+        let view = wgpu::BindingResource::TextureView;
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("key volume B"),
             layout: &self.shared.morph_layout,
-            entries: &[wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&b.view) }],
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: view(&b.view) },
+                wgpu::BindGroupEntry { binding: 1, resource: view(classified[0]) },
+                wgpu::BindGroupEntry { binding: 2, resource: view(classified[1]) },
+            ],
+        })
+    }
+
+    /// Whether this frame's α-mix or three-pass samples classified key volumes: both classified
+    /// (now, or kept from an earlier frame) for the transfer function of `u`, which the uniform
+    /// buffer holds, and bound. Not where the transfer function needs the gradient (its
+    /// lighting follows the view) nor for the exact mix.
+    fn bind_classified(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, u: &VolumeUniforms) -> bool {
+        let (Some(a), Some(a_group), Some(morph)) = (&self.volume, &self.bind_group, &self.morph) else { return false };
+        let wanted = matches!(morph.mode, Interpolation::ThreePass | Interpolation::AlphaMix) && !self.variant.gradient;
+        let mut kept = std::mem::take(&mut self.classified);
+        let views = wanted.then(|| {
+            let b = &morph.partner;
+            let b_group = self.volume_group(device, &b.view);
+            let classifier = &self.shared.classifier;
+            [
+                classifier.classified(device, queue, &mut kept, a, (a_group, u)),
+                classifier.classified(device, queue, &mut kept, b, (&b_group, u)),
+            ]
         });
-        self.morph = Some(Morph { _partner: b, bind_group, k: k.clamp(0.0, 1.0), mode });
+        self.classified = kept;
+        let Some(morph) = &self.morph else { return false };
+        if morph.bound != views {
+            let partner = &morph.partner;
+            let group = match &views {
+                Some([x, y]) => self.morph_group(device, partner, [x, y]),
+                None => self.morph_group(device, partner, [&a.view, &partner.view]),
+            };
+            let morph = self.morph.as_mut().expect("checked above");
+            morph.bind_group = group;
+            morph.bound = views.clone();
+        }
+        views.is_some()
     }
 
     /// Whether the orbital is evaluated per sample from its basis functions (direct mode).
@@ -818,8 +892,8 @@ impl VolumePass {
             clouds: 0,
             slab,
             field: if program.slabs() { signed_field as u8 } else { 0 },
+            classified: false,
         };
-        self.frame_pipeline = Some(self.shared.pipeline(device, self.variant));
         let lobe = |l: &crate::scene::transfer::Lobe| [l.center, l.width, l.opacity, 0.0];
         let v = self.variant;
         let bits = [(t.shading, TF_SHADING), (v.gradient, TF_GRADIENT), (v.shaped, TF_SHAPED), (v.clip, TF_CLIP)]
@@ -860,6 +934,8 @@ impl VolumePass {
         };
         queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
         self.frame_uniforms = u;
+        self.variant.classified = self.bind_classified(device, queue, &u);
+        self.frame_pipeline = Some(self.shared.pipeline(device, self.variant));
     }
 
     /// Whether a walk can take this frame's cloud: one drawn from a 3D texture in one pass
@@ -953,6 +1029,7 @@ impl VolumePass {
             clouds: clouds.len() as u8,
             slab: 1,
             field: 0,
+            classified: false,
         };
         Some((shared.pipeline(&ctx.device, variant), bind_group))
     }
@@ -1069,7 +1146,7 @@ fn walked_box(grid_box: &GridBox, cells: Option<&Occupancy>) -> Mat4 {
 /// The bits of `VolumeUniforms::tf_bits` (volume_common.wgsl's TF_*).
 const TF_SHADING: u32 = 1;
 const TF_GRADIENT: u32 = 2;
-const TF_SHAPED: u32 = 4;
+pub(crate) const TF_SHAPED: u32 = 4;
 const TF_CLIP: u32 = 8;
 
 impl super::frame::Representation for VolumePass {

@@ -65,6 +65,8 @@ pub struct CloudReference<'a> {
     /// The clipping plane (unit n, d): points with n·p > d are cut away.
     clip: Option<glam::DVec4>,
     pub eye: DVec3,
+    /// Each grid point's signed extinction and colour, made by the first `classified_samples`.
+    classified: std::cell::OnceCell<(VolumeGrid, VolumeGrid)>,
 }
 
 impl<'a> CloudReference<'a> {
@@ -91,6 +93,7 @@ impl<'a> CloudReference<'a> {
             grid_from_world: grid.world_from_grid.inverse(),
             clip: plane,
             eye: eye.as_dvec3(),
+            classified: std::cell::OnceCell::new(),
         }
     }
 
@@ -129,20 +132,12 @@ impl<'a> CloudReference<'a> {
 
     /// The samples along the ray from the eye in direction `d`, back to front.
     pub fn samples(&self, d: DVec3) -> Vec<Sample> {
-        let mut hits: Vec<f64> = self.tris.iter().filter_map(|&t| ray_triangle(self.eye, d, t)).collect();
-        hits.sort_by(|a, b| b.total_cmp(a));
-        let step = self.grid.voxel_volume().cbrt();
         let (pos, neg) = (self.vs.positive_color.map(|c| c as f64), self.vs.negative_color.map(|c| c as f64));
         let signed = self.grid.kind == ValueKind::Signed;
-        hits.into_iter()
-            .filter_map(|t| {
-                let p = self.eye + d * t;
-                if self.clip.is_some_and(|c| c.truncate().dot(p) > c.w) {
-                    return None;
-                }
+        self.points(d)
+            .map(|(t, p)| {
                 let v = self.grid.sample(self.grid_from_world.transform_point3(p));
-                let path = self.spacing / d.dot(self.normal).abs().max(0.05);
-                let alpha = 1.0 - (-self.extinction(v) * path / step).exp();
+                let alpha = self.opacity(self.extinction(v), d);
                 let color = match (signed, v >= 0.0) {
                     (true, true) => pos,
                     (true, false) => neg,
@@ -152,8 +147,54 @@ impl<'a> CloudReference<'a> {
                         [0, 1, 2].map(|i| neg[i] + (pos[i] - neg[i]) * w)
                     }
                 };
-                Some(Sample { t, color, alpha })
+                Sample { t, color, alpha }
             })
             .collect()
+    }
+
+    /// The samples as α-mix and three-pass take them from classified key volumes: each grid
+    /// point's extinction (with its value's sign for an orbital) and colour first, those
+    /// interpolated at the sample (the signed extinction's sign picks an orbital's colour).
+    pub fn classified_samples(&self, d: DVec3) -> Vec<Sample> {
+        let signed = self.grid.kind == ValueKind::Signed;
+        let (extinction, hue) = self.classified.get_or_init(|| {
+            let classified = |f: &dyn Fn(f64) -> f64| {
+                let values = self.grid.values.iter().map(|&v| f(v as f64) as f32).collect();
+                VolumeGrid::new("classified", self.grid.dims, self.grid.world_from_grid, values)
+            };
+            let extinction = classified(&|v| if signed && v < 0.0 { -self.extinction(v) } else { self.extinction(v) });
+            (extinction, classified(&|v| self.density_t(v).min(1.0).sqrt()))
+        });
+        let (pos, neg) = (self.vs.positive_color.map(|c| c as f64), self.vs.negative_color.map(|c| c as f64));
+        self.points(d)
+            .map(|(t, p)| {
+                let g = self.grid_from_world.transform_point3(p);
+                let e = extinction.sample(g);
+                let w = match signed {
+                    true => f64::from(u8::from(e >= 0.0)),
+                    false => hue.sample(g),
+                };
+                let color = [0, 1, 2].map(|i| neg[i] + (pos[i] - neg[i]) * w);
+                Sample { t, color, alpha: self.opacity(e.abs(), d) }
+            })
+            .collect()
+    }
+
+    /// Where the ray from the eye in direction `d` meets the slices and is not clipped, back to
+    /// front: its distance and the point.
+    fn points(&self, d: DVec3) -> impl Iterator<Item = (f64, DVec3)> + '_ {
+        let mut hits: Vec<f64> = self.tris.iter().filter_map(|&t| ray_triangle(self.eye, d, t)).collect();
+        hits.sort_by(|a, b| b.total_cmp(a));
+        hits.into_iter()
+            .map(move |t| (t, self.eye + d * t))
+            .filter(|(_, p)| !self.clip.is_some_and(|c| c.truncate().dot(*p) > c.w))
+    }
+
+    /// The opacity of `extinction` (per reference step, the grid spacing) over the path between
+    /// two slices along `d`.
+    fn opacity(&self, extinction: f64, d: DVec3) -> f64 {
+        let step = self.grid.voxel_volume().cbrt();
+        let path = self.spacing / d.dot(self.normal).abs().max(0.05);
+        1.0 - (-extinction * path / step).exp()
     }
 }
