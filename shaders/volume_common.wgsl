@@ -190,8 +190,9 @@ fn opacity(x: f32) -> f32 {
 // `shade` for the cloud `c` describes: `field` is its `signed_field`, `shaped` and `gradient`
 // say which transfer function it uses (constants where one pipeline draws one cloud, which
 // settle the branches on them when the pipeline is built; values where a walk takes several).
-// Kept in one piece with its callees taking scalars: split into calls that each take `c`, a
-// walk ran 1.5 times as long on a CPU rasteriser (a copy of the struct per call and sample).
+// The rest is kept in one piece: split into several calls that each take `c`, a walk ran 1.5
+// times as long on a CPU rasteriser (a copy of the struct per call and sample); the one call
+// to `classify` costs nothing measurable (`bench render`, `bench scene`).
 fn shade_with(c: VolumeUniforms, field: u32, shaped: bool, gradient: bool, value: f32, grad: vec3<f32>, from_eye: vec3<f32>) -> vec4<f32> {
     let classified = classify(c, field, shaped, value);
     if (classified.x < 0.0) {
