@@ -234,7 +234,7 @@ pub fn extract(grid: &VolumeGrid, levels: &[Level]) -> Vec<Mesh> {
     let slabs = nx - 1;
     let threads = rayon::current_num_threads();
     let runs = if threads == 1 { 1 } else { (4 * threads).clamp(1, slabs) };
-    let mut parts: Vec<Vec<Mesh>> = (0..runs)
+    let parts: Vec<Vec<Mesh>> = (0..runs)
         .into_par_iter()
         .map(|r| {
             let mut run = Run::new(grid, &frame, levels);
@@ -244,53 +244,33 @@ pub fn extract(grid: &VolumeGrid, levels: &[Level]) -> Vec<Mesh> {
             run.finish()
         })
         .collect();
-    if let [part] = parts.as_mut_slice() {
-        let mut meshes = std::mem::take(part);
-        meshes.iter_mut().for_each(|m| m.normals.iter_mut().for_each(|n| *n = n.normalize_or_zero()));
-        return meshes;
+    // Each level's pieces, joined in parallel with the other levels' (one run: nothing to copy).
+    let mut pieces: Vec<Vec<Mesh>> = (0..levels.len()).map(|_| Vec::with_capacity(runs)).collect();
+    for part in parts {
+        for (level, mesh) in pieces.iter_mut().zip(part) {
+            level.push(mesh);
+        }
     }
-    (0..levels.len()).map(|l| merge(parts.iter().map(|p| &p[l]).collect())).collect()
+    pieces.into_par_iter().map(merge).collect()
 }
 
-/// The runs' pieces of one level's mesh joined in order, each copied in parallel into its place
-/// in the whole (no reallocation on the way), its normals made unit on the way.
-fn merge(pieces: Vec<&Mesh>) -> Mesh {
-    let mut mesh = Mesh {
-        positions: bytemuck::zeroed_vec(pieces.iter().map(|p| p.positions.len()).sum()),
-        normals: bytemuck::zeroed_vec(pieces.iter().map(|p| p.normals.len()).sum()),
-        indices: vec![0; pieces.iter().map(|p| p.indices.len()).sum()],
-        colors: Vec::new(),
-    };
-    let positions = split(&mut mesh.positions, pieces.iter().map(|p| p.positions.len()));
-    let normals = split(&mut mesh.normals, pieces.iter().map(|p| p.normals.len()));
-    let indices = split(&mut mesh.indices, pieces.iter().map(|p| p.indices.len()));
-    let bases = pieces.iter().scan(0u32, |base, p| {
-        let first = *base;
-        *base += p.positions.len() as u32;
-        Some(first)
-    });
-    let jobs: Vec<_> = pieces.iter().zip(bases).zip(positions.into_iter().zip(normals).zip(indices)).collect();
-    jobs.into_par_iter().for_each(|((piece, base), ((positions, normals), indices))| {
-        positions.copy_from_slice(&piece.positions);
-        for (n, g) in normals.iter_mut().zip(&piece.normals) {
-            *n = g.normalize_or_zero();
-        }
-        for (i, &p) in indices.iter_mut().zip(&piece.indices) {
-            *i = p + base;
-        }
-    });
+/// The runs' pieces of one level's mesh joined in order onto the first (no zeroed whole to copy
+/// into), its normals made unit on the way.
+fn merge(pieces: Vec<Mesh>) -> Mesh {
+    let mut pieces = pieces.into_iter();
+    let mut mesh = pieces.next().unwrap_or_default();
+    let rest: Vec<Mesh> = pieces.collect();
+    mesh.positions.reserve(rest.iter().map(|p| p.positions.len()).sum());
+    mesh.normals.reserve(rest.iter().map(|p| p.normals.len()).sum());
+    mesh.indices.reserve(rest.iter().map(|p| p.indices.len()).sum());
+    for piece in &rest {
+        let base = mesh.positions.len() as u32;
+        mesh.positions.extend_from_slice(&piece.positions);
+        mesh.normals.extend_from_slice(&piece.normals);
+        mesh.indices.extend(piece.indices.iter().map(|&i| i + base));
+    }
+    mesh.normals.iter_mut().for_each(|n| *n = n.normalize_or_zero());
     mesh
-}
-
-/// `all` cut into consecutive pieces of the given lengths.
-fn split<T>(mut all: &mut [T], lengths: impl Iterator<Item = usize>) -> Vec<&mut [T]> {
-    lengths
-        .map(|n| {
-            let (piece, rest) = std::mem::take(&mut all).split_at_mut(n);
-            all = rest;
-            piece
-        })
-        .collect()
 }
 
 /// One plane's flags: per grid point, bit L set when the point is inside level L; per row of
