@@ -10,7 +10,7 @@
 
 use std::sync::LazyLock;
 
-use glam::{DMat3, DVec3, Mat3, Vec3};
+use glam::{Affine3A, DMat3, DVec3, Mat3A, Vec3, Vec3A};
 use rayon::prelude::*;
 
 use super::VolumeGrid;
@@ -207,9 +207,8 @@ fn triangulate_case(case: usize) -> Vec<[u8; 3]> {
 /// steps·(i, j, k), and ∇_world = J⁻ᵀ ∇_index (J the steps as columns). Each vertex is placed
 /// from its own index coordinates, so a vertex that two runs both make is bit-identical.
 struct Frame {
-    origin: Vec3,
-    steps: [Vec3; 3],
-    inv_t: Mat3,
+    world_from_index: Affine3A,
+    inv_t: Mat3A,
 }
 
 /// At most this many levels are extracted in one pass (one bit each per grid point).
@@ -225,9 +224,8 @@ pub fn extract(grid: &VolumeGrid, levels: &[Level]) -> Vec<Mesh> {
     }
     let jac = DMat3::from_cols(grid.step(0), grid.step(1), grid.step(2));
     let frame = Frame {
-        origin: grid.origin().as_vec3(),
-        steps: [0, 1, 2].map(|a| grid.step(a).as_vec3()),
-        inv_t: jac.inverse().transpose().as_mat3(),
+        world_from_index: Affine3A::from_mat3_translation(jac.as_mat3(), grid.origin().as_vec3()),
+        inv_t: Mat3A::from(jac.inverse().transpose().as_mat3()),
     };
     // A few runs per thread balance the load (one run when there is one thread: nothing to
     // merge); within a run, consecutive slabs share a plane's flags and the vertices on it.
@@ -502,7 +500,7 @@ struct Run<'a> {
     frame: &'a Frame,
     levels: &'a [Level],
     /// Per level: normal = −sign · J⁻ᵀ ∇_index (outside is where the signed field falls).
-    normal_from_index: Vec<Mat3>,
+    normal_from_index: Vec<Mat3A>,
     meshes: Vec<Mesh>,
     /// Per level, the meshes' index count (their index vectors are written ahead, in whole
     /// cases, and cut to this length at the end).
@@ -668,7 +666,7 @@ impl<'a> Run<'a> {
         let interior = (0..3).all(|a| p[a] > 0 && q[a] + 1 < self.grid.dims[a]);
         let (g0, g1) = if interior {
             let central = |at: usize| {
-                Vec3::new(
+                Vec3A::new(
                     values[at + sx] - values[at - sx],
                     values[at + sy] - values[at - sy],
                     values[at + 1] - values[at - 1],
@@ -678,21 +676,20 @@ impl<'a> Run<'a> {
         } else {
             (self.border_gradient(p, [nx, ny, nz]), self.border_gradient(q, [nx, ny, nz]))
         };
-        let mut x = Vec3::new(p[0] as u32 as f32, p[1] as u32 as f32, p[2] as u32 as f32);
+        let mut x = Vec3A::new(p[0] as u32 as f32, p[1] as u32 as f32, p[2] as u32 as f32);
         x[AXIS] += t;
-        let f = self.frame;
         let mesh = &mut self.meshes[l];
-        mesh.positions.push(f.origin + f.steps[0] * x.x + f.steps[1] * x.y + f.steps[2] * x.z);
-        mesh.normals.push(self.normal_from_index[l] * g0.lerp(g1, t));
+        mesh.positions.push(self.frame.world_from_index.transform_point3a(x).into());
+        mesh.normals.push((self.normal_from_index[l] * g0.lerp(g1, t)).into());
         (mesh.positions.len() - 1) as u32
     }
 
     /// Twice the field's gradient at grid point `p` in index space (the central differences'
     /// scale), one-sided where `p` is on the border.
     #[cold]
-    fn border_gradient(&self, p: [usize; 3], dims: [usize; 3]) -> Vec3 {
+    fn border_gradient(&self, p: [usize; 3], dims: [usize; 3]) -> Vec3A {
         let g = self.grid;
-        let mut d = Vec3::ZERO;
+        let mut d = Vec3A::ZERO;
         for a in 0..3 {
             let (mut lo, mut hi) = (p, p);
             lo[a] = p[a].saturating_sub(1);
