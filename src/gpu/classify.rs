@@ -105,27 +105,15 @@ impl Classifier {
         });
         let module = super::shader_module(device, "volume_classify.wgsl");
         let pipeline = |format: wgpu::TextureFormat| {
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(&format!("key volume classification into {format:?}")),
-                layout: Some(&pipeline_layout),
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some("vs_classify"),
-                    compilation_options: Default::default(),
-                    buffers: &[],
-                },
-                primitive: Default::default(),
-                depth_stencil: None,
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some("fs_classify"),
-                    compilation_options: Default::default(),
-                    targets: &[Some(format.into())],
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
+            let label = format!("key volume classification into {format:?}");
+            super::bufferless_pipeline(
+                device,
+                &label,
+                &pipeline_layout,
+                &module,
+                ("vs_classify", "fs_classify"),
+                format,
+            )
         };
         Self { pipelines: [pipeline(format(1)), pipeline(format(0))] }
     }
@@ -150,29 +138,23 @@ impl Classifier {
         }
         let size = volume.texture.size();
         let format = format(u.signed_field);
-        let texture = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("classified key volume"),
+        let texture = device.create_texture(&super::texture_descriptor(
+            "classified key volume",
             size,
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D3,
+            wgpu::TextureDimension::D3,
             format,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-            view_formats: &[],
-        });
+            wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        ));
         let view = texture.create_view(&Default::default());
         let [w, h, layers] = [size.width, size.height, size.depth_or_array_layers];
         let atlas = Atlas::new(w, h, layers);
-        let tiles = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("classified layers"),
-            size: wgpu::Extent3d { width: atlas.columns * w, height: atlas.rows * h, depth_or_array_layers: 1 },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
+        let tiles = device.create_texture(&super::texture_descriptor(
+            "classified layers",
+            wgpu::Extent3d { width: atlas.columns * w, height: atlas.rows * h, depth_or_array_layers: 1 },
+            wgpu::TextureDimension::D2,
             format,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+        ));
         let tiles_view = tiles.create_view(&Default::default());
         let pipeline = &self.pipelines[usize::from(u.signed_field != 1)];
         let mut encoder =

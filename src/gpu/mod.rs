@@ -115,6 +115,59 @@ pub(crate) fn shader_module(device: &wgpu::Device, name: &str) -> wgpu::ShaderMo
     })
 }
 
+/// A render pipeline whose vertex stage `vs` makes its own triangles (no vertex buffers) and
+/// whose fragment stage `fs` writes one `format` target as is: no depth, no blending.
+pub(crate) fn bufferless_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    (vs, fs): (&str, &str),
+    format: wgpu::TextureFormat,
+) -> wgpu::RenderPipeline {
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(label),
+        layout: Some(layout),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some(vs),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        primitive: Default::default(),
+        depth_stencil: None,
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module,
+            entry_point: Some(fs),
+            compilation_options: Default::default(),
+            targets: &[Some(format.into())],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+/// A texture of one mip level and sample, used as `usage` says.
+pub(crate) fn texture_descriptor(
+    label: &str,
+    size: wgpu::Extent3d,
+    dimension: wgpu::TextureDimension,
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+) -> wgpu::TextureDescriptor<'_> {
+    wgpu::TextureDescriptor {
+        label: Some(label),
+        size,
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension,
+        format,
+        usage,
+        view_formats: &[],
+    }
+}
+
 /// A bind-group layout of one uniform buffer (binding 0, vertex and fragment stages) and a
 /// pipeline layout of just that group: what the opaque passes use.
 pub(crate) fn uniform_layouts(device: &wgpu::Device, label: &str) -> (wgpu::BindGroupLayout, wgpu::PipelineLayout) {

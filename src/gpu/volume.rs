@@ -119,16 +119,13 @@ impl VolumeTexture {
         };
         let texture = ctx.device.create_texture_with_data(
             &ctx.queue,
-            &wgpu::TextureDescriptor {
-                label: Some(&format!("volume {}", grid.label)),
-                size: wgpu::Extent3d { width: nz as u32, height: ny as u32, depth_or_array_layers: nx as u32 },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D3,
+            &super::texture_descriptor(
+                &format!("volume {}", grid.label),
+                wgpu::Extent3d { width: nz as u32, height: ny as u32, depth_or_array_layers: nx as u32 },
+                wgpu::TextureDimension::D3,
                 format,
-                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-                view_formats: &[],
-            },
+                wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            ),
             wgpu::util::TextureDataOrder::LayerMajor,
             &bytes,
         );
