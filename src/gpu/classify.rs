@@ -24,10 +24,10 @@ const KEPT: usize = 4;
 /// from a frame's uniforms (not the view, the mix ratio or the colours, which are applied per
 /// sample).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct TransferKey([u32; 16]);
+struct TransferKey([u32; 16]);
 
 impl TransferKey {
-    pub fn of(u: &VolumeUniforms) -> Self {
+    fn of(u: &VolumeUniforms) -> Self {
         let f = |x: f32| x.to_bits();
         let [p, n] = [u.tf_positive, u.tf_negative];
         Self([
@@ -118,16 +118,17 @@ impl Classifier {
         Self { pipelines: [pipeline(format(1)), pipeline(format(0))] }
     }
 
-    /// `volume` classified for the transfer function of `u`, whose uniform buffer `group` (the
-    /// slices' group 0 holding `volume`) binds, written before this call: from `kept`, or drawn
-    /// now and submitted ahead of the frame that samples it.
+    /// `volume` classified for the transfer function of `u` (written to the uniform buffer
+    /// before this call): from `kept`, or drawn now and submitted ahead of the frame that samples
+    /// it, reading the slices' group 0 that `group` makes (the uniforms and `volume`), which is
+    /// made only then.
     pub fn classified(
         &self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         kept: &mut ClassifiedVolumes,
         volume: &VolumeTexture,
-        (group, u): (&wgpu::BindGroup, &VolumeUniforms),
+        (group, u): (impl FnOnce() -> wgpu::BindGroup, &VolumeUniforms),
     ) -> wgpu::TextureView {
         let transfer = TransferKey::of(u);
         if let Some(i) = kept.0.iter().position(|c| c.source == volume.texture && c.transfer == transfer) {
@@ -157,6 +158,7 @@ impl Classifier {
         ));
         let tiles_view = tiles.create_view(&Default::default());
         let pipeline = &self.pipelines[usize::from(u.signed_field != 1)];
+        let group = group();
         let mut encoder =
             device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("classify key volume") });
         for first in (0..layers).step_by(atlas.per_pass() as usize) {
@@ -176,7 +178,7 @@ impl Classifier {
                     ..Default::default()
                 });
                 pass.set_pipeline(pipeline);
-                pass.set_bind_group(0, group, &[]);
+                pass.set_bind_group(0, &group, &[]);
                 pass.draw(0..6, first..last);
             }
             for layer in first..last {

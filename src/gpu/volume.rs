@@ -707,11 +707,10 @@ impl VolumePass {
         let mut kept = std::mem::take(&mut self.classified);
         let views = wanted.then(|| {
             let b = &morph.partner;
-            let b_group = self.volume_group(device, &b.view);
             let classifier = &self.shared.classifier;
             [
-                classifier.classified(device, queue, &mut kept, a, (a_group, u)),
-                classifier.classified(device, queue, &mut kept, b, (&b_group, u)),
+                classifier.classified(device, queue, &mut kept, a, (|| a_group.clone(), u)),
+                classifier.classified(device, queue, &mut kept, b, (|| self.volume_group(device, &b.view), u)),
             ]
         });
         self.classified = kept;

@@ -65,6 +65,8 @@ pub struct CloudReference<'a> {
     /// The clipping plane (unit n, d): points with n·p > d are cut away.
     clip: Option<glam::DVec4>,
     pub eye: DVec3,
+    /// The grid's mean spacing: the step the opacity law's extinction refers to.
+    step: f64,
     /// Each grid point's signed extinction and colour, made by the first `classified_samples`.
     classified: std::cell::OnceCell<(VolumeGrid, VolumeGrid)>,
 }
@@ -93,6 +95,7 @@ impl<'a> CloudReference<'a> {
             grid_from_world: grid.world_from_grid.inverse(),
             clip: plane,
             eye: eye.as_dvec3(),
+            step: grid.voxel_volume().cbrt(),
             classified: std::cell::OnceCell::new(),
         }
     }
@@ -193,8 +196,7 @@ impl<'a> CloudReference<'a> {
     /// The opacity of `extinction` (per reference step, the grid spacing) over the path between
     /// two slices along `d`.
     fn opacity(&self, extinction: f64, d: DVec3) -> f64 {
-        let step = self.grid.voxel_volume().cbrt();
         let path = self.spacing / d.dot(self.normal).abs().max(0.05);
-        1.0 - (-extinction * path / step).exp()
+        1.0 - (-extinction * path / self.step).exp()
     }
 }
